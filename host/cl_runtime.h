@@ -1,0 +1,42 @@
+// OpenCL platforms and devices: listing, choosing one by index or name, and the context and queue on it.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CL/opencl.hpp>
+
+namespace algray {
+
+struct DeviceError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct DeviceInfo {
+  int index = 0;  // position in enumerate_devices(), the number `--device` accepts
+  std::string platform_name, platform_version;
+  std::string name, vendor, version, driver_version;
+  std::string type;  // "GPU", "CPU", "accelerator", ...
+  unsigned compute_units = 0;
+  bool fp64 = false;
+  cl::Device device;
+};
+
+// Every device of every platform, in platform order. Empty when no ICD is installed.
+std::vector<DeviceInfo> enumerate_devices();
+
+// spec "": the first GPU, else the first device. Digits: that index. Otherwise a case-insensitive substring of
+// the device or platform name. Throws DeviceError naming the devices that exist.
+DeviceInfo select_device(const std::string& spec);
+
+std::string describe_devices(const std::vector<DeviceInfo>& devices);
+
+struct ClSession {
+  explicit ClSession(DeviceInfo chosen);
+  DeviceInfo info;
+  cl::Context context;
+  cl::CommandQueue queue;
+};
+
+}  // namespace algray

@@ -1,0 +1,352 @@
+// Recursive-descent parser that expands an equation into an exact Polynomial.
+#include "expression.h"
+
+#include <cfloat>
+#include <climits>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
+
+namespace algray {
+
+EquationError::EquationError(std::size_t pos, const std::string& message)
+    : std::runtime_error(message), position(pos) {}
+
+namespace {
+
+constexpr unsigned max_exponent = 1000;
+constexpr int max_power_degree = 1000;
+// Keeps hostile input such as 100000 nested parentheses from overflowing the stack.
+constexpr int max_nesting = 500;
+
+enum class Tok { Number, Ident, Plus, Minus, Star, Slash, Caret, LParen, RParen, End };
+
+struct Token {
+  Tok kind;
+  std::size_t pos;
+  std::string_view text;
+};
+
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+bool is_ident_start(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; }
+bool is_ident_char(char c) { return is_ident_start(c) || is_digit(c); }
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
+
+std::string describe_char(char c) {
+  const auto u = static_cast<unsigned char>(c);
+  if (u >= 0x21 && u < 0x7f) return std::string("'") + c + "'";
+  static const char hex[] = "0123456789abcdef";
+  return std::string("byte 0x") + hex[u >> 4] + hex[u & 15];
+}
+
+std::vector<Token> tokenize(std::string_view s) {
+  std::vector<Token> out;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const char c = s[i];
+    if (is_space(c)) {
+      ++i;
+      continue;
+    }
+    const std::size_t start = i;
+    if (is_digit(c) || (c == '.' && i + 1 < s.size() && is_digit(s[i + 1]))) {
+      while (i < s.size() && is_digit(s[i])) ++i;
+      if (i < s.size() && s[i] == '.') {
+        ++i;
+        while (i < s.size() && is_digit(s[i])) ++i;
+      }
+      if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+        std::size_t j = i + 1;
+        if (j < s.size() && (s[j] == '+' || s[j] == '-')) ++j;
+        if (j >= s.size() || !is_digit(s[j]))
+          throw EquationError(i, "malformed number: '" + std::string(s.substr(i, 1)) +
+                                     "' must be followed by the digits of an exponent");
+        i = j;
+        while (i < s.size() && is_digit(s[i])) ++i;
+      }
+      out.push_back({Tok::Number, start, s.substr(start, i - start)});
+      continue;
+    }
+    if (is_ident_start(c)) {
+      while (i < s.size() && is_ident_char(s[i])) ++i;
+      out.push_back({Tok::Ident, start, s.substr(start, i - start)});
+      continue;
+    }
+    Tok kind;
+    std::size_t len = 1;
+    switch (c) {
+      case '+': kind = Tok::Plus; break;
+      case '-': kind = Tok::Minus; break;
+      case '*':
+        if (i + 1 < s.size() && s[i + 1] == '*') {
+          kind = Tok::Caret;
+          len = 2;
+        } else {
+          kind = Tok::Star;
+        }
+        break;
+      case '/': kind = Tok::Slash; break;
+      case '^': kind = Tok::Caret; break;
+      case '(': kind = Tok::LParen; break;
+      case ')': kind = Tok::RParen; break;
+      default: throw EquationError(i, "unexpected character " + describe_char(c));
+    }
+    out.push_back({kind, start, s.substr(start, len)});
+    i += len;
+  }
+  out.push_back({Tok::End, s.size(), {}});
+  return out;
+}
+
+// Literals are read as the exact decimal the user wrote, so that e.g. "x^2-0.81" and "0.81-x^2"
+// cancel exactly; a double detour would not guarantee that across different spellings.
+mpq_class parse_number(const Token& tok) {
+  const std::string_view s = tok.text;
+  std::string digits;
+  std::size_t i = 0;
+  long long frac_digits = 0;
+  while (i < s.size() && is_digit(s[i])) digits += s[i++];
+  if (i < s.size() && s[i] == '.') {
+    ++i;
+    while (i < s.size() && is_digit(s[i])) {
+      digits += s[i++];
+      ++frac_digits;
+    }
+  }
+  long long exp10 = 0;
+  if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+    ++i;
+    bool negative = false;
+    if (s[i] == '+' || s[i] == '-') negative = s[i++] == '-';
+    for (; i < s.size(); ++i)
+      exp10 = std::min(exp10 * 10 + (s[i] - '0'), 1'000'000'000LL);  // saturate: huge is huge
+    if (negative) exp10 = -exp10;
+  }
+
+  const std::size_t first_nonzero = digits.find_first_not_of('0');
+  if (first_nonzero == std::string::npos) return mpq_class(0);
+  digits.erase(0, first_nonzero);
+
+  const std::string out_of_range = "number literal " + std::string(s) + " is outside the range of double";
+  // The value lies in [10^(order-1), 10^order); reject hopeless magnitudes before computing powers of 10.
+  const long long order = static_cast<long long>(digits.size()) + exp10 - frac_digits;
+  if (order > DBL_MAX_10_EXP + 1 || order < DBL_MIN_10_EXP - 20) throw EquationError(tok.pos, out_of_range);
+
+  mpz_class mantissa(digits, 10);
+  const long long shift = exp10 - frac_digits;
+  mpz_class ten_pow;
+  mpz_ui_pow_ui(ten_pow.get_mpz_t(), 10, static_cast<unsigned long>(shift >= 0 ? shift : -shift));
+  mpq_class value;
+  if (shift >= 0) {
+    value = mpq_class(mantissa * ten_pow);
+  } else {
+    value = mpq_class(mantissa, ten_pow);
+    value.canonicalize();
+  }
+  if (value > exact_rational(DBL_MAX) || nearest_double(value) == 0.0) throw EquationError(tok.pos, out_of_range);
+  return value;
+}
+
+mpq_class exact_rational_long(long double v) {
+  int e = 0;
+  const long double m = std::frexp(v, &e);  // v = m * 2^e, 0.5 <= |m| < 1
+  constexpr int digits = std::numeric_limits<long double>::digits;
+  static_assert(sizeof(unsigned long) * CHAR_BIT >= digits, "the significand must fit an unsigned long");
+  const auto significand = static_cast<unsigned long>(std::ldexp(m, digits));
+  mpq_class r{mpz_class(significand)};
+  const int shift = e - digits;
+  if (shift >= 0)
+    mpq_mul_2exp(r.get_mpq_t(), r.get_mpq_t(), static_cast<mp_bitcnt_t>(shift));
+  else
+    mpq_div_2exp(r.get_mpq_t(), r.get_mpq_t(), static_cast<mp_bitcnt_t>(-shift));
+  return r;
+}
+
+class Parser {
+ public:
+  Parser(std::string_view text, const std::map<std::string, double>& parameters)
+      : params_(parameters), tokens_(tokenize(text)) {}
+
+  Polynomial parse() {
+    if (peek().kind == Tok::End) throw EquationError(0, "empty equation");
+    Polynomial p = expr();
+    const Token& t = peek();
+    if (t.kind == Tok::RParen) throw EquationError(t.pos, "unmatched ')'");
+    if (t.kind != Tok::End) throw missing_operator_or(t, "unexpected " + quote(t) + " after the end of the expression");
+    return p;
+  }
+
+ private:
+  const std::map<std::string, double>& params_;
+  std::vector<Token> tokens_;
+  std::size_t next_ = 0;
+  int depth_ = 0;
+
+  struct DepthGuard {
+    int& depth;
+    DepthGuard(int& d, std::size_t pos) : depth(d) {
+      if (++depth > max_nesting) throw EquationError(pos, "expression is nested too deeply");
+    }
+    ~DepthGuard() { --depth; }
+    DepthGuard(const DepthGuard&) = delete;
+    DepthGuard& operator=(const DepthGuard&) = delete;
+  };
+
+  const Token& peek() const { return tokens_[next_]; }
+  const Token& take() { return tokens_[next_++]; }
+  bool accept(Tok k) {
+    if (peek().kind != k) return false;
+    ++next_;
+    return true;
+  }
+
+  static std::string quote(const Token& t) {
+    return t.kind == Tok::End ? std::string("end of equation") : "'" + std::string(t.text) + "'";
+  }
+
+  // Two operands in a row almost always mean a forgotten '*', so say that rather than something vague.
+  static EquationError missing_operator_or(const Token& t, const std::string& otherwise) {
+    if (t.kind == Tok::Number || t.kind == Tok::Ident || t.kind == Tok::LParen)
+      return EquationError(t.pos, "missing operator before " + quote(t) + " (use '*' to multiply)");
+    return EquationError(t.pos, otherwise);
+  }
+
+  void expect_close(const char* what) {
+    const Token& t = peek();
+    if (t.kind == Tok::RParen) {
+      ++next_;
+      return;
+    }
+    if (t.kind == Tok::End) throw EquationError(t.pos, std::string("missing ')' ") + what);
+    throw missing_operator_or(t, "expected ')' " + std::string(what) + " but found " + quote(t));
+  }
+
+  Polynomial expr() {
+    Polynomial lhs = term();
+    for (;;) {
+      if (accept(Tok::Plus))
+        lhs = lhs + term();
+      else if (accept(Tok::Minus))
+        lhs = lhs - term();
+      else
+        return lhs;
+    }
+  }
+
+  Polynomial term() {
+    Polynomial lhs = unary();
+    for (;;) {
+      if (accept(Tok::Star)) {
+        lhs = lhs * unary();
+      } else if (accept(Tok::Slash)) {
+        const std::size_t pos = peek().pos;
+        const std::optional<mpq_class> divisor = unary().constant_value();
+        if (!divisor) throw EquationError(pos, "division by a variable: only constants may divide");
+        if (sgn(*divisor) == 0) throw EquationError(pos, "division by zero");
+        lhs = lhs * Polynomial::constant(1 / *divisor);
+      } else {
+        return lhs;
+      }
+    }
+  }
+
+  // Every nesting construct (parentheses, sqrt, unary signs, exponents) passes through here.
+  Polynomial unary() {
+    const DepthGuard guard(depth_, peek().pos);
+    if (accept(Tok::Plus)) return unary();
+    if (accept(Tok::Minus)) return -unary();
+    return power();
+  }
+
+  Polynomial power() {
+    Polynomial base = primary();
+    if (!accept(Tok::Caret)) return base;
+    const std::size_t pos = peek().pos;
+    const unsigned e = exponent(unary(), pos);
+    if (static_cast<long long>(base.degree()) * e > max_power_degree)
+      throw EquationError(pos, "this power would have degree " +
+                                   std::to_string(static_cast<long long>(base.degree()) * e) + ", more than " +
+                                   std::to_string(max_power_degree));
+    return base.pow(e);
+  }
+
+  static unsigned exponent(const Polynomial& p, std::size_t pos) {
+    const std::optional<mpq_class> v = p.constant_value();
+    if (!v) throw EquationError(pos, "exponent is not constant: it may not contain x, y or z");
+    if (sgn(*v) < 0) throw EquationError(pos, "negative exponent: only non-negative integer powers are allowed");
+    if (v->get_den() != 1)
+      throw EquationError(pos, "fractional exponent: only non-negative integer powers are allowed");
+    if (v->get_num() > max_exponent) {
+      const std::string shown =
+          mpz_sizeinbase(v->get_num().get_mpz_t(), 10) <= 20 ? " " + v->get_num().get_str() : std::string();
+      throw EquationError(pos, "exponent" + shown + " is too large (at most " + std::to_string(max_exponent) + ")");
+    }
+    return static_cast<unsigned>(v->get_num().get_ui());
+  }
+
+  Polynomial primary() {
+    const Token& t = take();
+    switch (t.kind) {
+      case Tok::Number:
+        return Polynomial::constant(parse_number(t));
+      case Tok::Ident:
+        return identifier(t);
+      case Tok::LParen: {
+        Polynomial inner = expr();
+        expect_close("to close the '('");
+        return inner;
+      }
+      case Tok::End:
+        throw EquationError(t.pos, "unexpected end of equation: expected a number, a variable or '('");
+      case Tok::RParen:
+        throw EquationError(t.pos, "unexpected ')': expected a number, a variable or '('");
+      default:
+        throw EquationError(t.pos, "unexpected " + quote(t) + ": expected a number, a variable or '('");
+    }
+  }
+
+  Polynomial identifier(const Token& t) {
+    if (t.text == "x") return Polynomial::variable(0);
+    if (t.text == "y") return Polynomial::variable(1);
+    if (t.text == "z") return Polynomial::variable(2);
+    if (t.text == "sqrt") return square_root();
+    const auto it = params_.find(std::string(t.text));
+    if (it == params_.end())
+      throw EquationError(t.pos, "unknown identifier '" + std::string(t.text) +
+                                     "': parameters must be declared in the scene before use");
+    if (!std::isfinite(it->second))
+      throw EquationError(t.pos, "parameter '" + it->first + "' is not finite (nan or inf)");
+    return Polynomial::constant(exact_rational(it->second));
+  }
+
+  Polynomial square_root() {
+    if (!accept(Tok::LParen)) throw EquationError(peek().pos, "expected '(' after sqrt");
+    const std::size_t pos = peek().pos;
+    const std::optional<mpq_class> v = expr().constant_value();
+    expect_close("to close sqrt(");
+    if (!v) throw EquationError(pos, "sqrt of a non-constant expression: its argument may not contain x, y or z");
+    if (sgn(*v) < 0) throw EquationError(pos, "sqrt of a negative number");
+    const mpz_class& num = v->get_num();
+    const mpz_class& den = v->get_den();
+    if (mpz_perfect_square_p(num.get_mpz_t()) && mpz_perfect_square_p(den.get_mpz_t())) {
+      mpq_class root{mpz_class(sqrt(num)), mpz_class(sqrt(den))};
+      root.canonicalize();
+      return Polynomial::constant(root);
+    }
+    const long double r = std::sqrt(nearest_long_double(*v));
+    if (!std::isfinite(r)) throw EquationError(pos, "sqrt argument is too large");
+    return Polynomial::constant(exact_rational_long(r));
+  }
+};
+
+}  // namespace
+
+Polynomial parse_equation(std::string_view text, const std::map<std::string, double>& parameters) {
+  for (const char* reserved : {"x", "y", "z", "sqrt"})
+    if (parameters.count(reserved))
+      throw EquationError(0, std::string("a parameter may not be named '") + reserved + "': the name is reserved");
+  return Parser(text, parameters).parse();
+}
+
+}  // namespace algray

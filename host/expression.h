@@ -1,0 +1,35 @@
+// The equation parser: text such as "x^4+y^4+z^4-(x^2+y^2+z^2)" to an exact Polynomial.
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "polynomial.h"
+
+namespace algray {
+
+// what() is the bare message; the caller turns `position` into "file:line:col".
+struct EquationError : std::runtime_error {
+  EquationError(std::size_t position, const std::string& message);
+  std::size_t position;  // 0-based offset (in bytes) into the equation text
+};
+
+// Parses and expands an equation to an exact Polynomial. `parameters` are named constants from the
+// scene file; x, y, z are the variables and sqrt is the only function, so parameters may not use
+// those names. Number literals are read exactly as decimal rationals.
+//
+// Grammar (whitespace anywhere):
+//   expr    := term (('+' | '-') term)*
+//   term    := unary (('*' | '/') unary)*            divisors must be nonzero constants
+//   unary   := ('+' | '-') unary | power
+//   power   := primary (('^' | '**') unary)?          right-associative; the exponent must be a
+//                                                     constant non-negative integer <= 1000
+//   primary := number | x | y | z | parameter | sqrt '(' expr ')' | '(' expr ')'
+// Zero polynomials and degree limits are left to the caller, except that a single power may not
+// exceed degree 1000, so that a typo cannot make the expansion run for hours.
+Polynomial parse_equation(std::string_view text, const std::map<std::string, double>& parameters);
+
+}  // namespace algray

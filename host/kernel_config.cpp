@@ -1,0 +1,92 @@
+// Names of the solver choices and the mapping of a KernelConfig onto OpenCL build options.
+#include "kernel_config.h"
+
+#include <array>
+#include <cstdio>
+#include <utility>
+
+#include "algray_shared.h"
+
+namespace algray {
+namespace {
+
+template <typename E, std::size_t N>
+bool parse_enum(const std::array<std::pair<const char*, E>, N>& names, const std::string& name, E& out) {
+  for (const auto& [text, value] : names)
+    if (name == text) {
+      out = value;
+      return true;
+    }
+  return false;
+}
+
+template <typename E, std::size_t N>
+std::string enum_name(const std::array<std::pair<const char*, E>, N>& names, E value) {
+  for (const auto& [text, v] : names)
+    if (v == value) return text;
+  return "?";
+}
+
+template <typename E, std::size_t N>
+std::string enum_choices(const std::array<std::pair<const char*, E>, N>& names) {
+  std::string s;
+  for (const auto& [text, v] : names) s += (s.empty() ? "" : ", ") + std::string(text);
+  return s;
+}
+
+constexpr std::array<std::pair<const char*, Precision>, 2> kPrecisions{{{"float", Precision::Float},
+                                                                        {"double", Precision::Double}}};
+constexpr std::array<std::pair<const char*, Isolation>, 2> kIsolations{
+    {{"bernstein", Isolation::Bernstein}, {"descartes", Isolation::PowerDescartes}}};
+constexpr std::array<std::pair<const char*, Refinement>, 2> kRefinements{
+    {{"brent", Refinement::Brent}, {"bisection", Refinement::Bisection}}};
+constexpr std::array<std::pair<const char*, RayOrigin>, 2> kOrigins{{{"extent", RayOrigin::Extent},
+                                                                     {"eye", RayOrigin::Eye}}};
+
+std::string hex_double(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%a", v);
+  return buf;
+}
+
+}  // namespace
+
+std::string to_string(Precision p) { return enum_name(kPrecisions, p); }
+std::string to_string(Isolation i) { return enum_name(kIsolations, i); }
+std::string to_string(Refinement r) { return enum_name(kRefinements, r); }
+std::string to_string(RayOrigin o) { return enum_name(kOrigins, o); }
+bool parse_precision(const std::string& n, Precision& out) { return parse_enum(kPrecisions, n, out); }
+bool parse_isolation(const std::string& n, Isolation& out) { return parse_enum(kIsolations, n, out); }
+bool parse_refinement(const std::string& n, Refinement& out) { return parse_enum(kRefinements, n, out); }
+bool parse_ray_origin(const std::string& n, RayOrigin& out) { return parse_enum(kOrigins, n, out); }
+std::string precision_choices() { return enum_choices(kPrecisions); }
+std::string isolation_choices() { return enum_choices(kIsolations); }
+std::string refinement_choices() { return enum_choices(kRefinements); }
+std::string ray_origin_choices() { return enum_choices(kOrigins); }
+
+std::string KernelConfig::build_options() const {
+  const int isolation_id =
+      isolation == Isolation::Bernstein ? ALGRAY_ISOLATION_BERNSTEIN : ALGRAY_ISOLATION_POWER;
+  const int refinement_id =
+      refinement == Refinement::Brent ? ALGRAY_REFINEMENT_BRENT : ALGRAY_REFINEMENT_BISECTION;
+  const int origin_id = ray_origin == RayOrigin::Extent ? ALGRAY_ORIGIN_EXTENT : ALGRAY_ORIGIN_EYE;
+  // Hexadecimal literals carry the tolerance bit for bit; float builds get a float literal, as devices
+  // without fp64 need not accept double constants.
+  const std::string tolerance_literal = precision == Precision::Double
+                                            ? hex_double(tolerance)
+                                            : hex_double(static_cast<float>(tolerance)) + "f";
+  return "-cl-std=CL1.2 -D DEGREE=" + std::to_string(degree) +
+         " -D ALGRAY_DOUBLE=" + (precision == Precision::Double ? "1" : "0") +
+         " -D ISOLATION=" + std::to_string(isolation_id) + " -D REFINEMENT=" + std::to_string(refinement_id) +
+         " -D RAY_ORIGIN=" + std::to_string(origin_id) + " -D TOLERANCE=" + tolerance_literal +
+         " -D MAX_ITERATIONS=" + std::to_string(max_iterations);
+}
+
+std::string KernelConfig::key() const {
+  return entry + " degree=" + std::to_string(degree) + " precision=" + to_string(precision) +
+         " isolation=" + to_string(isolation) + " refinement=" + to_string(refinement) +
+         " origin=" + to_string(ray_origin) + " tolerance=" + hex_double(tolerance) +
+         " max_iterations=" + std::to_string(max_iterations);
+}
+
+}  // namespace algray

@@ -1,0 +1,46 @@
+// KernelConfig: every choice that changes a kernel's code, turned into build options and a cache key.
+#pragma once
+
+#include <string>
+
+namespace algray {
+
+inline constexpr int kMaxDegree = 32;
+
+enum class Precision { Float, Double };
+enum class Isolation { Bernstein, PowerDescartes };
+enum class Refinement { Brent, Bisection };
+enum class RayOrigin { Extent, Eye };
+
+std::string to_string(Precision p);
+std::string to_string(Isolation i);
+std::string to_string(Refinement r);
+std::string to_string(RayOrigin o);
+// Parsers return false on an unknown name; `choices` then lists the accepted ones.
+bool parse_precision(const std::string& name, Precision& out);
+bool parse_isolation(const std::string& name, Isolation& out);
+bool parse_refinement(const std::string& name, Refinement& out);
+bool parse_ray_origin(const std::string& name, RayOrigin& out);
+std::string precision_choices();
+std::string isolation_choices();
+std::string refinement_choices();
+std::string ray_origin_choices();
+
+struct KernelConfig {
+  std::string entry = "primary";  // kernel file (without .cl) and kernel function
+  int degree = 1;
+  Precision precision = Precision::Double;
+  Isolation isolation = Isolation::Bernstein;
+  Refinement refinement = Refinement::Brent;
+  RayOrigin ray_origin = RayOrigin::Extent;
+  double tolerance = 1e-9;  // the paper's eps: stop when the bracket is <= 4*eps*max(|t|,1)
+  int max_iterations = 100;
+
+  // "-D DEGREE=6 -D ALGRAY_DOUBLE=1 ..." with the tolerance as an exact hexadecimal literal.
+  std::string build_options() const;
+  // Everything above, readable; two configs build the same code iff their keys are equal.
+  std::string key() const;
+  std::string source_file() const { return entry + ".cl"; }
+};
+
+}  // namespace algray

@@ -1,0 +1,74 @@
+// The algray command line: `algray render` and `algray devices`.
+#include <iostream>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+
+#include "cl_runtime.h"
+#include "image_io.h"
+#include "render_job.h"
+
+int main(int argc, char** argv) {
+  using namespace algray;
+  install_output_cleanup_handlers();
+
+  CLI::App app{"algray: ray tracing of real algebraic surfaces P(x,y,z) = 0 on any OpenCL device"};
+  app.require_subcommand(1);
+
+  RenderRequest request;
+  std::string scene_path;
+  std::vector<std::string> sets;
+  int width = 0, height = 0;
+  std::string precision;
+  bool no_cache = false;
+  std::string stats_path;
+  CLI::App* render = app.add_subcommand("render", "render a scene (default: the built-in Barth sextic)");
+  render->add_option("scene", scene_path, "scene file (.toml)");
+  render->add_option("-o,--output", request.outputs, "output image; .exr or .png by extension; may be repeated")
+      ->default_str("algray.exr");
+  render->add_option("--width", width, "image width in pixels (overrides image.width)");
+  render->add_option("--height", height, "image height in pixels (overrides image.height)");
+  render->add_option("--device", request.device_spec, "device index or name substring (see `algray devices`)");
+  render->add_option("--precision", precision, "float or double (overrides render.precision)");
+  render->add_option("--set", sets, "override a scene key: name=value (a bare name is a parameter)");
+  render->add_option("--stats", stats_path, "write render statistics as JSON");
+  render->add_flag("--no-cache", no_cache, "compile kernels from source; neither read nor write the program cache");
+
+  CLI::App* devices = app.add_subcommand("devices", "list OpenCL platforms and devices");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitBadInput;
+  }
+
+  if (devices->parsed()) {
+    const auto list = enumerate_devices();
+    if (list.empty()) {
+      std::cerr << "algray: no OpenCL device found (on Debian: apt-get install pocl-opencl-icd)\n";
+      return kExitFailure;
+    }
+    std::cout << describe_devices(list);
+    return kExitOk;
+  }
+
+  if (!scene_path.empty()) request.scene_path = scene_path;
+  if (request.outputs.empty()) request.outputs.push_back("algray.exr");
+  for (const std::string& s : sets) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      std::cerr << "algray: --set " << s << ": expected name=value\n";
+      return kExitBadInput;
+    }
+    request.overrides.push_back({s.substr(0, eq), s.substr(eq + 1)});
+  }
+  // Flags are overrides like any --set, applied last so they win.
+  if (width) request.overrides.push_back({"image.width", std::to_string(width)});
+  if (height) request.overrides.push_back({"image.height", std::to_string(height)});
+  if (!precision.empty()) request.overrides.push_back({"render.precision", "\"" + precision + "\""});
+  request.use_cache = !no_cache;
+  if (!stats_path.empty()) request.stats_path = stats_path;
+  request.progress = ::isatty(STDERR_FILENO) != 0;
+  return run_render(request, std::cerr);
+}

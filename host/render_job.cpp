@@ -1,0 +1,166 @@
+// The render command: validates everything before any work, renders, then writes images and stats atomically.
+#include "render_job.h"
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cl_runtime.h"
+#include "program_cache.h"
+#include "renderer.h"
+#include "shade.h"
+
+namespace algray {
+namespace {
+
+std::string vec_text(const glm::dvec3& v) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "%.17g %.17g %.17g", v.x, v.y, v.z);
+  return buf;
+}
+
+// Metadata that lets anyone rebuild any pixel's ray from the file and the README's camera convention.
+void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, const DeviceInfo& device) {
+  const RayBasis& b = r.basis;
+  const CameraSpec& cam = scene.camera;
+  img.string_attributes = {
+      {"algray/scene", scene.source},
+      {"algray/name", scene.name},
+      {"algray/equation", scene.equation},
+      {"algray/polynomial", scene.polynomial.to_string()},
+      {"algray/isolation", to_string(r.config.isolation)},
+      {"algray/refinement", to_string(r.config.refinement)},
+      {"algray/rayOrigin", to_string(r.config.ray_origin)},
+      {"algray/precision", to_string(r.config.precision)},
+      {"algray/device", device.name + " (" + device.platform_name + ", " + device.driver_version + ")"},
+      {"algray/camera/projection", cam.projection == Projection::Perspective ? "perspective" : "orthographic"},
+      {"algray/camera/eye", vec_text(cam.eye)},
+      {"algray/camera/lookAt", vec_text(cam.look_at)},
+      {"algray/camera/up", vec_text(cam.up)},
+      {"algray/ray/o00", vec_text(b.o00)},
+      {"algray/ray/ou", vec_text(b.ou)},
+      {"algray/ray/ov", vec_text(b.ov)},
+      {"algray/ray/d00", vec_text(b.d00)},
+      {"algray/ray/du", vec_text(b.du)},
+      {"algray/ray/dv", vec_text(b.dv)},
+      {"algray/extent",
+       scene.extent.kind == ExtentKind::Sphere
+           ? "sphere centre " + vec_text(scene.extent.centre) + " radius " + std::to_string(scene.extent.radius)
+           : "box min " + vec_text(scene.extent.min) + " max " + vec_text(scene.extent.max)},
+  };
+  double kernel_ms = 0;
+  for (const PassStats& p : r.passes) kernel_ms += p.kernel_ms;
+  img.double_attributes = {
+      {"algray/degree", r.config.degree},
+      {"algray/tolerance", r.config.tolerance},
+      {"algray/maxIterations", r.config.max_iterations},
+      {"algray/kernelMs", kernel_ms},
+      {"algray/camera/fovY", cam.fov_y_degrees},
+      {"algray/camera/orthoHeight", cam.ortho_height},
+  };
+  img.world_to_camera = world_to_camera_matrix(b, cam.eye);
+  img.world_to_ndc = world_to_ndc_matrix(cam, b, scene.image.width, scene.image.height);
+}
+
+nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const RenderResult& r,
+                          const DeviceInfo& device, double total_ms) {
+  nlohmann::json j;
+  j["scene"] = scene.source;
+  j["name"] = scene.name;
+  j["outputs"] = req.outputs;
+  j["image"] = {{"width", scene.image.width}, {"height", scene.image.height}};
+  j["device"] = {{"name", device.name}, {"platform", device.platform_name}, {"type", device.type},
+                 {"fp64", device.fp64}, {"driver", device.driver_version}};
+  j["surface"] = {{"equation", scene.equation}, {"degree", r.config.degree}};
+  j["solver"] = {{"isolation", to_string(r.config.isolation)}, {"refinement", to_string(r.config.refinement)},
+                 {"ray_origin", to_string(r.config.ray_origin)}, {"precision", to_string(r.config.precision)},
+                 {"tolerance", r.config.tolerance}, {"max_iterations", r.config.max_iterations}};
+  j["cache"] = req.use_cache ? ProgramCache::default_directory().string() : "off";
+  for (const ProgramRecord& p : r.programs)
+    j["programs"].push_back({{"key", p.key}, {"options", p.options}, {"from_cache", p.origin != "built"},
+                             {"origin", p.origin}, {"build_ms", p.build_ms}});
+  std::uint64_t hits = 0, tangent = 0, budget = 0, steps = 0, iterations = 0;
+  for (const HitRecord& h : r.hits.records) {
+    hits += (h.flags & ALGRAY_HIT_FOUND) != 0;
+    tangent += (h.flags & ALGRAY_HIT_TANGENT) != 0;
+    budget += (h.flags & ALGRAY_HIT_BUDGET) != 0;
+    steps += h.work & 0xffffu;
+    iterations += h.work >> 16;
+  }
+  for (const PassStats& p : r.passes)
+    j["passes"].push_back({{"name", p.name}, {"rays", p.rays}, {"launches", p.launches},
+                           {"kernel_ms", p.kernel_ms}, {"wall_ms", p.wall_ms}});
+  j["pixels"] = {{"hits", hits}, {"tangent_hits", tangent}, {"depth_limited", budget},
+                 {"isolation_steps", steps}, {"refine_iterations", iterations}};
+  j["total_ms"] = total_ms;
+  return j;
+}
+
+void write_text_atomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw OutputError("cannot write " + path);
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw OutputError("cannot write " + path);
+  }
+}
+
+}  // namespace
+
+int run_render(const RenderRequest& req, std::ostream& err) {
+  const auto start = std::chrono::steady_clock::now();
+  // Everything the user gave is checked before any device work, so bad input costs nothing and writes nothing.
+  Scene scene;
+  try {
+    scene = req.scene_path ? load_scene_file(*req.scene_path, req.overrides) : default_scene(req.overrides);
+    for (const std::string& out : req.outputs) format_from_extension(out);
+  } catch (const SceneError& e) {
+    err << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const OutputError& e) {
+    err << "algray: " << e.what() << "\n";
+    return kExitBadInput;
+  }
+
+  try {
+    ClSession session(select_device(req.device_spec));
+    ProgramCache cache(req.use_cache);
+    Renderer renderer(session, cache);
+    const RenderResult result = renderer.render(scene, req.progress);
+    FrameImage image = shade_preview(scene, result);
+    add_metadata(image, scene, result, session.info);
+    for (const std::string& out : req.outputs) write_image(out, image);
+    if (req.stats_path) {
+      const double total_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      write_text_atomically(*req.stats_path, stats_json(scene, req, result, session.info, total_ms).dump(2) + "\n");
+    }
+  } catch (const DeviceError& e) {
+    err << "algray: " << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const BuildError& e) {
+    err << "algray: " << e.what() << "\n";
+    return kExitFailure;
+  } catch (const cl::Error& e) {
+    err << "algray: OpenCL error " << e.err() << " in " << e.what() << "\n";
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    err << "algray: " << e.what() << "\n";
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+}  // namespace algray

@@ -1,0 +1,441 @@
+// Reads scene TOML into a Scene, checking every key and value and naming file, line and column on error.
+#include "scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include "embedded_files.h"
+#include "expression.h"
+
+namespace algray {
+namespace {
+
+constexpr int kMaxImageSide = 32768;
+
+std::string format_what(const std::string& where, const std::string& message, const std::string& excerpt) {
+  std::string s = where + ": error: " + message;
+  if (!excerpt.empty()) s += "\n" + excerpt;
+  return s;
+}
+
+// Edit distance, to suggest the key the user probably meant.
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1] ? 1u : 0u)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// Knows where the text came from, so every error can point into it.
+class SceneReader {
+ public:
+  SceneReader(std::string source, const std::string& text) : source_(std::move(source)) {
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) lines_.push_back(line);
+  }
+
+  [[noreturn]] void fail(const toml::source_region& region, const std::string& message,
+                         std::size_t column_offset = 0) const {
+    const auto& path = region.path;
+    if (path && path->rfind("--set", 0) == 0) throw SceneError(*path, message);
+    if (region.begin.line == 0) throw SceneError(source_, message);
+    const std::size_t line = region.begin.line;
+    const std::size_t column = region.begin.column + column_offset;
+    std::string excerpt;
+    if (line <= lines_.size()) {
+      excerpt = "  " + lines_[line - 1] + "\n  " + std::string(column > 0 ? column - 1 : 0, ' ') + "^";
+    }
+    throw SceneError(source_ + ":" + std::to_string(line) + ":" + std::to_string(column), message, excerpt);
+  }
+
+  const std::string& line_text(std::size_t line) const {
+    static const std::string empty;
+    return line >= 1 && line <= lines_.size() ? lines_[line - 1] : empty;
+  }
+
+  double number(const toml::node& node, const std::string& what) const {
+    double v;
+    if (auto i = node.value_exact<std::int64_t>())
+      v = static_cast<double>(*i);
+    else if (auto f = node.value_exact<double>())
+      v = *f;
+    else
+      fail(node.source(), what + " must be a number");
+    if (!std::isfinite(v)) fail(node.source(), what + " must be finite, not " + std::string(std::isnan(v) ? "nan" : "inf"));
+    return v;
+  }
+
+  long long integer(const toml::node& node, const std::string& what, long long lo, long long hi) const {
+    auto i = node.value_exact<std::int64_t>();
+    if (!i) fail(node.source(), what + " must be an integer");
+    if (*i < lo || *i > hi)
+      fail(node.source(), what + " must be between " + std::to_string(lo) + " and " + std::to_string(hi));
+    return *i;
+  }
+
+  std::string string(const toml::node& node, const std::string& what) const {
+    auto s = node.value_exact<std::string>();
+    if (!s) fail(node.source(), what + " must be a string");
+    return *s;
+  }
+
+  glm::dvec3 vec3(const toml::node& node, const std::string& what) const {
+    const toml::array* a = node.as_array();
+    if (!a || a->size() != 3) fail(node.source(), what + " must be an array of 3 numbers");
+    return {number(*a->get(0), what + "[0]"), number(*a->get(1), what + "[1]"), number(*a->get(2), what + "[2]")};
+  }
+
+  glm::dvec4 colour(const toml::node& node, const std::string& what, bool allow_alpha) const {
+    const toml::array* a = node.as_array();
+    if (!a || a->size() < 3 || a->size() > (allow_alpha ? 4u : 3u))
+      fail(node.source(), what + " must be an array of 3" + std::string(allow_alpha ? " or 4" : "") +
+                              " numbers (linear RGB" + (allow_alpha ? "[A]" : "") + ")");
+    glm::dvec4 c{0, 0, 0, 1};
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      c[static_cast<int>(i)] = number(*a->get(i), what);
+      if (c[static_cast<int>(i)] < 0) fail(a->get(i)->source(), what + " components must not be negative");
+    }
+    if (c.a > 1) fail(a->get(3)->source(), what + " alpha must be at most 1");
+    return c;
+  }
+
+  // Rejects keys that are not in `allowed`, suggesting the nearest allowed one.
+  void check_keys(const toml::table& table, const std::string& table_name, const std::set<std::string>& allowed) const {
+    for (auto&& [key, node] : table) {
+      const std::string k(key.str());
+      if (allowed.count(k)) continue;
+      std::string hint;
+      std::size_t best = 3;
+      for (const std::string& a : allowed)
+        if (std::size_t d = edit_distance(k, a); d < best) {
+          best = d;
+          hint = a;
+        }
+      std::string message = "unknown key '" + (table_name.empty() ? k : table_name + "." + k) + "'";
+      if (!hint.empty()) message += " (did you mean '" + hint + "'?)";
+      std::string known;
+      for (const std::string& a : allowed) known += (known.empty() ? "" : ", ") + a;
+      message += "; allowed here: " + known;
+      fail(key.source().begin.line ? key.source() : node.source(), message);
+    }
+  }
+
+  const toml::table* subtable(const toml::table& root, const std::string& name) const {
+    const toml::node* n = root.get(name);
+    if (!n) return nullptr;
+    if (!n->is_table()) fail(n->source(), "'" + name + "' must be a table ([" + name + "])");
+    return n->as_table();
+  }
+
+  // Column of character `offset` of a string value, counting escapes as one character.
+  std::size_t string_column_offset(const toml::node& node, std::size_t offset) const {
+    const std::string& line = line_text(node.source().begin.line);
+    std::size_t col = node.source().begin.column;  // 1-based, at the opening quote
+    if (col == 0 || col > line.size()) return 0;
+    const char quote = line[col - 1];
+    if ((quote != '"' && quote != '\'') || line.compare(col - 1, 3, std::string(3, quote)) == 0) return 0;
+    std::size_t i = col, chars = 0;  // i: 0-based index of the first character inside the quotes
+    while (i < line.size() && chars < offset && line[i] != quote) {
+      if (quote == '"' && line[i] == '\\' && i + 1 < line.size()) {
+        const char e = line[i + 1];
+        i += e == 'u' ? 6 : e == 'U' ? 10 : 2;
+      } else {
+        ++i;
+      }
+      ++chars;
+    }
+    return i + 1 - col;
+  }
+
+ private:
+  std::string source_;
+  std::vector<std::string> lines_;
+};
+
+const std::set<std::string> kTopKeys{"surface", "parameters", "extent", "camera", "image", "colours", "render"};
+const std::set<std::string> kSurfaceKeys{"name", "equation", "terms"};
+const std::set<std::string> kExtentKeys{"type", "centre", "radius", "min", "max"};
+const std::set<std::string> kCameraKeys{"projection", "eye", "look_at", "up", "fov_y", "height"};
+const std::set<std::string> kImageKeys{"width", "height", "background"};
+const std::set<std::string> kColourKeys{"front", "back"};
+const std::set<std::string> kRenderKeys{"precision",      "tolerance", "isolation", "refinement", "ray_origin",
+                                        "max_iterations", "tile_size"};
+
+bool is_identifier(const std::string& s) {
+  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
+  return std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isalnum(c) || c == '_'; });
+}
+
+void apply_override(toml::table& root, const Override& o) {
+  const std::string label = "--set " + o.key + "=" + o.value;
+  if (o.key.empty()) throw SceneError(label, "expected --set key=value");
+  std::vector<std::string> path;
+  if (o.key.find('.') == std::string::npos) {
+    path = {"parameters", o.key};  // a bare name is a parameter
+  } else {
+    std::stringstream parts(o.key);
+    for (std::string p; std::getline(parts, p, '.');) {
+      if (p.empty()) throw SceneError(label, "empty component in key '" + o.key + "'");
+      path.push_back(p);
+    }
+  }
+  // The value is TOML when it parses as TOML (numbers, arrays, quoted strings), else a bare string.
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + o.value, label);
+  } catch (const toml::parse_error&) {
+    std::string quoted = "'";
+    for (char c : o.value) {
+      if (c == '\'' || c == '\n') throw SceneError(label, "value is neither valid TOML nor a plain string");
+      quoted += c;
+    }
+    parsed = toml::parse("v = " + quoted + "'", label);
+  }
+  toml::table* t = &root;
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    toml::node* n = t->get(path[i]);
+    if (!n) {
+      t->insert(path[i], toml::table{});
+      n = t->get(path[i]);
+    }
+    if (!n->is_table()) throw SceneError(label, "'" + path[i] + "' is not a table");
+    t = n->as_table();
+  }
+  t->insert_or_assign(path.back(), std::move(*parsed.get("v")));
+}
+
+Polynomial polynomial_from_terms(const SceneReader& r, const toml::node& terms_node) {
+  const toml::array* terms = terms_node.as_array();
+  if (!terms || terms->empty()) r.fail(terms_node.source(), "surface.terms must be a non-empty array of [i, j, k, a]");
+  Polynomial p;
+  for (const toml::node& t : *terms) {
+    const toml::array* a = t.as_array();
+    if (!a || a->size() != 4) r.fail(t.source(), "each term must be [i, j, k, a]: exponents of x, y, z and the coefficient");
+    const int i = static_cast<int>(r.integer(*a->get(0), "exponent i", 0, 1000));
+    const int j = static_cast<int>(r.integer(*a->get(1), "exponent j", 0, 1000));
+    const int k = static_cast<int>(r.integer(*a->get(2), "exponent k", 0, 1000));
+    p.add_term(i, j, k, exact_rational(r.number(*a->get(3), "coefficient")));
+  }
+  return p;
+}
+
+Scene interpret(const SceneReader& r, const toml::table& root, const std::string& source) {
+  Scene scene;
+  scene.source = source;
+  r.check_keys(root, "", kTopKeys);
+
+  // Parameters first: the equation refers to them.
+  if (const toml::table* params = r.subtable(root, "parameters")) {
+    for (auto&& [key, node] : *params) {
+      const std::string name(key.str());
+      if (!is_identifier(name) || name == "x" || name == "y" || name == "z" || name == "sqrt")
+        r.fail(key.source(), "parameter name '" + name + "' must be an identifier other than x, y, z and sqrt");
+      scene.parameters[name] = r.number(node, "parameter '" + name + "'");
+    }
+  }
+
+  const toml::table* surface = r.subtable(root, "surface");
+  if (!surface) r.fail(root.source(), "missing [surface] table with an equation or a list of terms");
+  r.check_keys(*surface, "surface", kSurfaceKeys);
+  const toml::node* equation = surface->get("equation");
+  const toml::node* terms = surface->get("terms");
+  if (equation && terms) r.fail(terms->source(), "give surface.equation or surface.terms, not both");
+  const toml::node& surface_anchor = equation ? *equation : terms ? *terms : static_cast<const toml::node&>(*surface);
+  if (equation) {
+    scene.equation = r.string(*equation, "surface.equation");
+    try {
+      scene.polynomial = parse_equation(scene.equation, scene.parameters);
+    } catch (const EquationError& e) {
+      r.fail(equation->source(),
+             std::string(e.what()) + " (at character " + std::to_string(e.position + 1) + " of the equation)",
+             r.string_column_offset(*equation, e.position));
+    }
+  } else if (terms) {
+    scene.polynomial = polynomial_from_terms(r, *terms);
+    scene.equation = scene.polynomial.to_string();
+  } else {
+    r.fail(surface->source(), "[surface] needs an equation or a list of terms");
+  }
+  const int degree = scene.polynomial.degree();
+  if (degree < 0) r.fail(surface_anchor.source(), "the polynomial is identically zero after expansion");
+  if (degree == 0) r.fail(surface_anchor.source(), "the polynomial is a nonzero constant: it has no points");
+  if (degree > kMaxDegree)
+    r.fail(surface_anchor.source(), "degree " + std::to_string(degree) + " exceeds the supported maximum " +
+                                        std::to_string(kMaxDegree));
+  if (const toml::node* n = surface->get("name")) scene.name = r.string(*n, "surface.name");
+
+  const toml::table* extent = r.subtable(root, "extent");
+  if (!extent) r.fail(root.source(), "missing [extent] table (a sphere with centre and radius, or a box with min and max)");
+  r.check_keys(*extent, "extent", kExtentKeys);
+  const std::string type = extent->get("type") ? r.string(*extent->get("type"), "extent.type") : "sphere";
+  if (type == "sphere") {
+    scene.extent.kind = ExtentKind::Sphere;
+    for (const char* k : {"min", "max"})
+      if (const toml::node* n = extent->get(k)) r.fail(n->source(), std::string("extent.") + k + " belongs to a box extent");
+    if (const toml::node* n = extent->get("centre")) scene.extent.centre = r.vec3(*n, "extent.centre");
+    const toml::node* radius = extent->get("radius");
+    if (!radius) r.fail(extent->source(), "a sphere extent needs a radius");
+    scene.extent.radius = r.number(*radius, "extent.radius");
+    if (scene.extent.radius <= 0) r.fail(radius->source(), "the extent is empty: radius must be positive");
+  } else if (type == "box") {
+    scene.extent.kind = ExtentKind::Box;
+    for (const char* k : {"centre", "radius"})
+      if (const toml::node* n = extent->get(k)) r.fail(n->source(), std::string("extent.") + k + " belongs to a sphere extent");
+    const toml::node* mn = extent->get("min");
+    const toml::node* mx = extent->get("max");
+    if (!mn || !mx) r.fail(extent->source(), "a box extent needs min and max");
+    scene.extent.min = r.vec3(*mn, "extent.min");
+    scene.extent.max = r.vec3(*mx, "extent.max");
+    for (int i = 0; i < 3; ++i)
+      if (!(scene.extent.min[i] < scene.extent.max[i]))
+        r.fail(mx->source(), std::string("the extent is empty: max.") + "xyz"[i] + " must exceed min." + "xyz"[i]);
+  } else {
+    r.fail(extent->get("type")->source(), "extent.type must be \"sphere\" or \"box\"");
+  }
+
+  const toml::table* camera = r.subtable(root, "camera");
+  if (!camera) r.fail(root.source(), "missing [camera] table (eye, look_at, up)");
+  r.check_keys(*camera, "camera", kCameraKeys);
+  CameraSpec& cam = scene.camera;
+  if (const toml::node* n = camera->get("projection")) {
+    const std::string p = r.string(*n, "camera.projection");
+    if (p == "perspective") cam.projection = Projection::Perspective;
+    else if (p == "orthographic") cam.projection = Projection::Orthographic;
+    else r.fail(n->source(), "camera.projection must be \"perspective\" or \"orthographic\"");
+  }
+  for (const char* k : {"eye", "look_at", "up"})
+    if (!camera->get(k)) r.fail(camera->source(), std::string("camera.") + k + " is required");
+  cam.eye = r.vec3(*camera->get("eye"), "camera.eye");
+  cam.look_at = r.vec3(*camera->get("look_at"), "camera.look_at");
+  cam.up = r.vec3(*camera->get("up"), "camera.up");
+  const glm::dvec3 view = cam.look_at - cam.eye;
+  if (glm::length(view) <= 1e-12 * std::max(1.0, glm::length(cam.eye)))
+    r.fail(camera->get("look_at")->source(), "degenerate camera: look_at coincides with eye");
+  if (glm::length(glm::cross(glm::normalize(view), cam.up)) <= 1e-9 * glm::length(cam.up) || glm::length(cam.up) == 0)
+    r.fail(camera->get("up")->source(), "degenerate camera: up is zero or parallel to the viewing direction");
+  if (const toml::node* n = camera->get("fov_y")) {
+    if (cam.projection != Projection::Perspective) r.fail(n->source(), "camera.fov_y applies to perspective cameras");
+    cam.fov_y_degrees = r.number(*n, "camera.fov_y");
+    if (!(cam.fov_y_degrees > 0 && cam.fov_y_degrees < 180))
+      r.fail(n->source(), "degenerate camera: fov_y must be between 0 and 180 degrees, exclusive");
+  }
+  if (const toml::node* n = camera->get("height")) {
+    if (cam.projection != Projection::Orthographic)
+      r.fail(n->source(), "camera.height applies to orthographic cameras");
+    cam.ortho_height = r.number(*n, "camera.height");
+    if (!(cam.ortho_height > 0)) r.fail(n->source(), "degenerate camera: height must be positive");
+  } else if (cam.projection == Projection::Orthographic) {
+    r.fail(camera->source(), "an orthographic camera needs camera.height (the view height in world units)");
+  }
+
+  if (const toml::table* image = r.subtable(root, "image")) {
+    r.check_keys(*image, "image", kImageKeys);
+    if (const toml::node* n = image->get("width"))
+      scene.image.width = static_cast<int>(r.integer(*n, "image.width", 1, kMaxImageSide));
+    if (const toml::node* n = image->get("height"))
+      scene.image.height = static_cast<int>(r.integer(*n, "image.height", 1, kMaxImageSide));
+    if (const toml::node* n = image->get("background")) scene.image.background = r.colour(*n, "image.background", true);
+  }
+
+  if (const toml::table* colours = r.subtable(root, "colours")) {
+    r.check_keys(*colours, "colours", kColourKeys);
+    if (const toml::node* n = colours->get("front")) scene.colours.front = glm::dvec3(r.colour(*n, "colours.front", false));
+    if (const toml::node* n = colours->get("back")) scene.colours.back = glm::dvec3(r.colour(*n, "colours.back", false));
+  }
+
+  if (const toml::table* render = r.subtable(root, "render")) {
+    r.check_keys(*render, "render", kRenderKeys);
+    RenderSettings& rs = scene.render;
+    if (const toml::node* n = render->get("precision")) {
+      const std::string p = r.string(*n, "render.precision");
+      Precision value;
+      if (p == "auto") rs.precision.reset();
+      else if (parse_precision(p, value)) rs.precision = value;
+      else r.fail(n->source(), "render.precision must be auto, " + precision_choices());
+    }
+    if (const toml::node* n = render->get("tolerance")) {
+      rs.tolerance = r.number(*n, "render.tolerance");
+      if (!(rs.tolerance > 0 && rs.tolerance <= 0.1)) r.fail(n->source(), "render.tolerance must be in (0, 0.1]");
+    }
+    if (const toml::node* n = render->get("isolation"))
+      if (!parse_isolation(r.string(*n, "render.isolation"), rs.isolation))
+        r.fail(n->source(), "render.isolation must be one of " + isolation_choices());
+    if (const toml::node* n = render->get("refinement"))
+      if (!parse_refinement(r.string(*n, "render.refinement"), rs.refinement))
+        r.fail(n->source(), "render.refinement must be one of " + refinement_choices());
+    if (const toml::node* n = render->get("ray_origin")) {
+      if (!parse_ray_origin(r.string(*n, "render.ray_origin"), rs.ray_origin))
+        r.fail(n->source(), "render.ray_origin must be one of " + ray_origin_choices());
+      if (rs.ray_origin == RayOrigin::Eye && rs.isolation != Isolation::PowerDescartes)
+        r.fail(n->source(), "render.ray_origin = \"eye\" needs render.isolation = \"descartes\" (the power basis)");
+    }
+    if (const toml::node* n = render->get("max_iterations"))
+      rs.max_iterations = static_cast<int>(r.integer(*n, "render.max_iterations", 1, 1000000));
+    if (const toml::node* n = render->get("tile_size"))
+      rs.tile_size = static_cast<int>(r.integer(*n, "render.tile_size", 8, 8192));
+  }
+  return scene;
+}
+
+}  // namespace
+
+SceneError::SceneError(std::string where_, std::string message_, std::string excerpt_)
+    : std::runtime_error(format_what(where_, message_, excerpt_)),
+      where(std::move(where_)),
+      message(std::move(message_)),
+      excerpt(std::move(excerpt_)) {}
+
+glm::dvec3 Extent::unit_centre() const { return kind == ExtentKind::Sphere ? centre : (min + max) * 0.5; }
+
+double Extent::unit_scale() const { return kind == ExtentKind::Sphere ? radius : glm::length(max - min) * 0.5; }
+
+glm::dvec3 Extent::unit_box_half() const {
+  return kind == ExtentKind::Box ? (max - min) * 0.5 / unit_scale() : glm::dvec3(1);
+}
+
+Scene load_scene_text(const std::string& text, const std::string& source_name, const std::vector<Override>& overrides) {
+  SceneReader reader(source_name, text);
+  toml::table root;
+  try {
+    root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    reader.fail(e.source(), std::string(e.description()));
+  }
+  for (const Override& o : overrides) apply_override(root, o);
+  Scene scene = interpret(reader, root, source_name);
+  if (scene.name.empty()) {
+    const auto slash = source_name.find_last_of('/');
+    std::string stem = source_name.substr(slash == std::string::npos ? 0 : slash + 1);
+    scene.name = stem.substr(0, stem.rfind('.'));
+  }
+  return scene;
+}
+
+Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path, "cannot read the scene file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return load_scene_text(text.str(), path, overrides);
+}
+
+Scene default_scene(const std::vector<Override>& overrides) {
+  for (const EmbeddedFile& f : embedded_scene_files())
+    if (std::string(f.name) == "barth_sextic.toml") return load_scene_text(f.text, "<built-in default scene>", overrides);
+  throw std::logic_error("the default scene was not embedded");
+}
+
+}  // namespace algray

@@ -1,0 +1,141 @@
+/* Root isolation by Descartes' rule on Bernstein coefficients over [t_in, t_out], with de Casteljau halving. */
+#ifndef ALGRAY_BERNSTEIN_H
+#define ALGRAY_BERNSTEIN_H
+
+#include "isolation.h"
+
+/* The restriction produced scaled coefficients c_k = C(n,k) b_k; Descartes' rule and de Casteljau want b_k. */
+void bernstein_from_scaled(REAL* c) {
+  REAL binom = 1;
+  for (int k = 0; k <= DEGREE; ++k) {
+    c[k] = c[k] / binom;
+    binom = binom * (REAL)(DEGREE - k) / (REAL)(k + 1);
+  }
+}
+
+/* Keeps the part of the curve on [0, x]. In place: after pass r, c[r] is the r-th left coefficient. */
+void casteljau_keep_left(REAL* c, REAL x) {
+  const REAL x1 = (REAL)1 - x;
+  for (int r = 1; r <= DEGREE; ++r)
+    for (int k = DEGREE; k >= r; --k) c[k] = x1 * c[k - 1] + x * c[k];
+}
+
+/* Keeps the part on [x, 1]. */
+void casteljau_keep_right(REAL* c, REAL x) {
+  const REAL x1 = (REAL)1 - x;
+  for (int r = 1; r <= DEGREE; ++r)
+    for (int k = 0; k <= DEGREE - r; ++k) c[k] = x1 * c[k] + x * c[k + 1];
+}
+
+/* Value at y by de Casteljau: the most stable evaluation, used off the hot path. */
+REAL bernstein_value(const REAL* c, REAL y) {
+  REAL w[NCOEF];
+  poly_copy(w, c, DEGREE);
+  const REAL y1 = (REAL)1 - y;
+  for (int r = 1; r <= DEGREE; ++r)
+    for (int k = 0; k <= DEGREE - r; ++k) w[k] = y1 * w[k] + y * w[k + 1];
+  return w[0];
+}
+
+/* Coefficients on the dyadic interval [idx/2^level, (idx+1)/2^level], recomputed from the whole interval's. */
+void bernstein_restrict(const REAL* root, int level, ulong idx, REAL* out) {
+  poly_copy(out, root, DEGREE);
+  const REAL width = ldexp((REAL)1, -level);
+  const REAL lo = (REAL)idx * width, hi = lo + width;
+  if (hi < (REAL)1) casteljau_keep_left(out, hi);
+  if (lo > (REAL)0) casteljau_keep_right(out, lo / hi);
+}
+
+/* Finds the leftmost subinterval of [0,1] that isolates the smallest root of the polynomial with Bernstein
+ * coefficients `root`. Depth-first, left half first; the path is the pair (level, idx), so no stack is kept.
+ * The right half of the latest split is cached, as the left half is usually rejected at once.
+ * On return `cur` holds the Bernstein coefficients on [iso.lo, iso.hi]. */
+Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise, REAL* cur) {
+  Isolation iso = isolation_none();
+  REAL sib[NCOEF];
+  int sib_level = -1;
+  ulong sib_idx = 0;
+  int level = 0;
+  ulong idx = 0;
+  const REAL len = t_out - t_in;
+  poly_copy(cur, root, DEGREE);
+
+  for (;;) {
+    ++iso.steps;
+    const REAL width = ldexp((REAL)1, -level);
+    iso.lo = (REAL)idx * width;
+    iso.hi = iso.lo + width;
+    iso.f_lo = cur[0];
+    iso.f_hi = cur[DEGREE];
+    if (cur[0] == 0) {
+      iso.status = ISOLATION_EXACT;
+      return iso;
+    }
+    const int v = sign_variations(cur);
+    if (v == 1 && cur[DEGREE] != 0) {
+      iso.status = ISOLATION_BRACKET;
+      return iso;
+    }
+    if (v >= 1) {
+      const int located = width * len <= stop_width(t_in + iso.lo * len);
+      if (!located && level < REAL_MAX_HALVINGS) {
+        poly_copy(sib, cur, DEGREE);
+        casteljau_keep_left(cur, (REAL)0.5);
+        casteljau_keep_right(sib, (REAL)0.5);
+        ++level;
+        idx *= 2;
+        sib_level = level;
+        sib_idx = idx + 1;
+        continue;
+      }
+      /* A cluster narrower than the tolerance: an odd number of roots, a root of even multiplicity,
+       * or a complex pair close to the axis. */
+      if (!located) iso.budget = 1;
+      if ((cur[0] < 0) != (cur[DEGREE] < 0)) {
+        iso.status = ISOLATION_BRACKET;
+        return iso;
+      }
+      if (fabs(bernstein_value(cur, (REAL)0.5)) <= noise) {
+        iso.status = ISOLATION_TANGENT;
+        return iso;
+      }
+    }
+    /* Next interval in depth-first order: climb while we are a right child, then step right. */
+    while (idx & 1) {
+      idx >>= 1;
+      --level;
+    }
+    if (level == 0) return iso_finish_none(iso);
+    ++idx;
+    if (sib_level == level && sib_idx == idx)
+      poly_copy(cur, sib, DEGREE);
+    else
+      bernstein_restrict(root, level, idx, cur);
+  }
+}
+
+/* Turns Bernstein coefficients into the form isolated_value() expects: c_k * C(n,k). */
+void prepare_isolated(REAL* c) {
+  REAL binom = 1;
+  for (int k = 0; k <= DEGREE; ++k) {
+    c[k] *= binom;
+    binom = binom * (REAL)(DEGREE - k) / (REAL)(k + 1);
+  }
+}
+
+/* Value at y in [0,1] of a prepared polynomial in O(n): Horner in y/(1-y), mirrored past 1/2 so the ratio
+ * stays at most 1. */
+REAL isolated_value(const REAL* c, REAL y) {
+  if (y <= (REAL)0.5) {
+    const REAL r = y / ((REAL)1 - y);
+    REAL h = c[DEGREE];
+    for (int k = DEGREE - 1; k >= 0; --k) h = h * r + c[k];
+    return h * pown((REAL)1 - y, DEGREE);
+  }
+  const REAL r = ((REAL)1 - y) / y;
+  REAL h = c[0];
+  for (int k = 1; k <= DEGREE; ++k) h = h * r + c[k];
+  return h * pown(y, DEGREE);
+}
+
+#endif /* ALGRAY_BERNSTEIN_H */

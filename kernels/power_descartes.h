@@ -1,0 +1,95 @@
+/* The paper's root isolation: power basis mapped to (0, inf), Descartes' rule of signs, left half first. */
+#ifndef ALGRAY_POWER_DESCARTES_H
+#define ALGRAY_POWER_DESCARTES_H
+
+#include "isolation.h"
+
+/* c(x) -> c(x + a), by repeated synthetic division. */
+void taylor_shift(REAL* c, REAL a) {
+  for (int i = 0; i < DEGREE; ++i)
+    for (int k = DEGREE - 1; k >= i; --k) c[k] += a * c[k + 1];
+}
+
+/* A1(y) = p(alpha + beta*y): the polynomial on one subinterval, mapped to [0,1]. */
+void power_on_interval(const REAL* p, REAL alpha, REAL beta, REAL* a1) {
+  poly_copy(a1, p, DEGREE);
+  if (alpha != 0) taylor_shift(a1, alpha);
+  REAL s = 1;
+  for (int k = 0; k <= DEGREE; ++k) {
+    a1[k] *= s;
+    s *= beta;
+  }
+}
+
+/* Sign variations of A2(x) = (x+1)^n A1(1/(x+1)), whose positive roots are those of A1 in (0, 1]...
+ * except a root at 1, which maps to x = 0 and is not counted. */
+int descartes_unit_interval(const REAL* a1) {
+  REAL a2[NCOEF];
+  for (int k = 0; k <= DEGREE; ++k) a2[k] = a1[DEGREE - k];
+  taylor_shift(a2, (REAL)1);
+  return sign_variations(a2);
+}
+
+REAL power_value(const REAL* c, REAL y) {
+  REAL h = c[DEGREE];
+  for (int k = DEGREE - 1; k >= 0; --k) h = h * y + c[k];
+  return h;
+}
+
+/* p is P*(s) in the power basis, the extent interval being s in [s0, s0 + len_s]. Subintervals are the dyadic
+ * (level, idx) pieces of that interval, visited depth first, left first. On return `a1` is A1 on [lo, hi]. */
+Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL noise, REAL* a1) {
+  Isolation iso = isolation_none();
+  int level = 0;
+  ulong idx = 0;
+  const REAL len = t_out - t_in;
+
+  for (;;) {
+    ++iso.steps;
+    const REAL width = ldexp((REAL)1, -level);
+    iso.lo = (REAL)idx * width;
+    iso.hi = iso.lo + width;
+    power_on_interval(p, s0 + iso.lo * len_s, width * len_s, a1);
+    iso.f_lo = a1[0];
+    iso.f_hi = power_value(a1, (REAL)1);
+    if (a1[0] == 0) {
+      iso.status = ISOLATION_EXACT;
+      return iso;
+    }
+    const int v = descartes_unit_interval(a1);
+    if (v == 1 && iso.f_hi != 0) {
+      iso.status = ISOLATION_BRACKET;
+      return iso;
+    }
+    /* v counts roots in (lo, hi); a root exactly at hi is found as the right neighbour's EXACT case. */
+    if (v >= 1) {
+      const int located = width * len <= stop_width(t_in + iso.lo * len);
+      if (!located && level < REAL_MAX_HALVINGS) {
+        ++level;
+        idx *= 2;
+        continue;
+      }
+      if (!located) iso.budget = 1;
+      if ((iso.f_lo < 0) != (iso.f_hi < 0)) {
+        iso.status = ISOLATION_BRACKET;
+        return iso;
+      }
+      if (fabs(power_value(a1, (REAL)0.5)) <= noise) {
+        iso.status = ISOLATION_TANGENT;
+        return iso;
+      }
+    }
+    while (idx & 1) {
+      idx >>= 1;
+      --level;
+    }
+    if (level == 0) return iso_finish_none(iso);
+    ++idx;
+  }
+}
+
+void prepare_isolated(REAL* c) { (void)c; }
+
+REAL isolated_value(const REAL* c, REAL y) { return power_value(c, y); }
+
+#endif /* ALGRAY_POWER_DESCARTES_H */

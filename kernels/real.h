@@ -1,0 +1,40 @@
+/* The working precision REAL of a kernel build (-D ALGRAY_DOUBLE=1 selects double) and its constants. */
+#ifndef ALGRAY_REAL_H
+#define ALGRAY_REAL_H
+
+#if ALGRAY_DOUBLE
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+typedef double REAL;
+typedef double2 REAL2;
+typedef double3 REAL3;
+typedef double4 REAL4;
+#define REAL_EPS DBL_EPSILON
+#define REAL_MAX DBL_MAX
+#define REAL_MAX_HALVINGS 52   /* dyadic subintervals of [0,1] stay exact down to this level */
+#else
+typedef float REAL;
+typedef float2 REAL2;
+typedef float3 REAL3;
+typedef float4 REAL4;
+#define REAL_EPS FLT_EPSILON
+#define REAL_MAX FLT_MAX
+#define REAL_MAX_HALVINGS 23
+#endif
+
+/* The kernel is specialised by degree; everything sized by it lives in private arrays. */
+#ifndef DEGREE
+#error "DEGREE must be defined (-D DEGREE=n, 1..32)"
+#endif
+#define NCOEF (DEGREE + 1)
+
+#ifndef TOLERANCE
+#define TOLERANCE 1e-9
+#endif
+#ifndef MAX_ITERATIONS
+#define MAX_ITERATIONS 100
+#endif
+
+/* The paper's stopping width: a root is located once its bracket is at most 4*eps*max(|t|, 1) wide in t. */
+REAL stop_width(REAL t) { return (REAL)4 * (REAL)TOLERANCE * fmax(fabs(t), (REAL)1); }
+
+#endif /* ALGRAY_REAL_H */

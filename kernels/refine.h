@@ -1,0 +1,79 @@
+/* Root refinement inside an isolating interval: the paper's Dekker-Brent, or plain bisection. */
+#ifndef ALGRAY_REFINE_H
+#define ALGRAY_REFINE_H
+
+#include "real.h"
+
+/* Needs isolated_value(c, y) from the isolation method: the polynomial at y in [0,1] of the isolating interval.
+ * f0 and f1 are its values at 0 and 1, of opposite signs. tol_y is the stopping width in y.
+ * Returns the root's y and counts the iterations (function evaluations) in *iterations. */
+#if REFINEMENT == ALGRAY_REFINEMENT_BRENT
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, uint* iterations) {
+  /* b: best estimate; c_: contrapoint, f(c_) of the other sign; a: the previous b. */
+  REAL a = 0, fa = f0, b = 1, fb = f1, cp = 0, fc = f0;
+  uint it = 0;
+  for (; it < MAX_ITERATIONS; ++it) {
+    if (fabs(fc) < fabs(fb)) {
+      a = b; fa = fb;
+      b = cp; fb = fc;
+      cp = a; fc = fa;
+    }
+    /* The paper's stopping rule: |P*(b)| at machine precision, or a bracket at most the stopping width. */
+    if (fabs(fb) <= REAL_EPS || fabs(cp - b) <= tol_y) break;
+    REAL cand = b;
+    int have = 0;
+    if (fa != fc && fb != fc && fa != fb) {
+      /* inverse quadratic interpolation through (a, fa), (b, fb), (c, fc) */
+      const REAL r = fb / fc, s = fb / fa, q = fa / fc;
+      const REAL num = s * (q * (q - r) * (cp - b) - ((REAL)1 - r) * (b - a));
+      const REAL den = (q - (REAL)1) * (r - (REAL)1) * (s - (REAL)1);
+      cand = b - num / den;
+      have = 1;
+    } else if (fa != fb) {
+      cand = b - fb * (b - a) / (fb - fa); /* secant */
+      have = 1;
+    }
+    /* The paper's acceptance rule: the step must stay well inside the bracket and shrink; also toward c. */
+    const REAL step = cand - b;
+    const int accept = have && isfinite(cand) && step * (cp - b) > 0 &&
+                       fabs(step) < (REAL)0.75 * fabs(cp - b) && fabs(step) < (REAL)0.5 * fabs(b - a);
+    REAL next = accept ? cand : b + (REAL)0.5 * (cp - b);
+    if (fabs(next - b) < (REAL)0.5 * tol_y) next = b + copysign((REAL)0.5 * tol_y, cp - b);
+    a = b; fa = fb;
+    b = next;
+    fb = isolated_value(c, b);
+    if ((fb > 0) == (fc > 0)) { /* the sign change is now between a and b */
+      cp = a; fc = fa;
+    }
+  }
+  *iterations = it;
+  return b;
+}
+#elif REFINEMENT == ALGRAY_REFINEMENT_BISECTION
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, uint* iterations) {
+  REAL lo = 0, hi = 1, flo = f0;
+  (void)f1;
+  uint it = 0;
+  for (; it < MAX_ITERATIONS && hi - lo > tol_y; ++it) {
+    const REAL mid = (REAL)0.5 * (lo + hi);
+    const REAL fm = isolated_value(c, mid);
+    if (fm == 0) {
+      lo = hi = mid;
+      ++it;
+      break;
+    }
+    if ((fm < 0) == (flo < 0)) {
+      lo = mid;
+      flo = fm;
+    } else {
+      hi = mid;
+    }
+  }
+  *iterations = it;
+  return (REAL)0.5 * (lo + hi);
+}
+#else
+#error "REFINEMENT must name a refinement method"
+#endif
+
+#endif /* ALGRAY_REFINE_H */

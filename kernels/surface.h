@@ -1,0 +1,131 @@
+/* One ray against one surface: clip, restrict, isolate the smallest root, refine it; then its normal and side. */
+#ifndef ALGRAY_SURFACE_H
+#define ALGRAY_SURFACE_H
+
+#include "algray_shared.h"
+#include "real.h"
+#include "ray.h"
+
+#ifndef RAY_ORIGIN
+#define RAY_ORIGIN ALGRAY_ORIGIN_EXTENT
+#endif
+#if RAY_ORIGIN == ALGRAY_ORIGIN_EYE && ISOLATION != ALGRAY_ISOLATION_POWER
+#error "RAY_ORIGIN=eye needs the power basis"
+#endif
+
+typedef struct {
+  REAL t;          /* ray parameter of the hit; +inf when none */
+  REAL3 u;         /* hit point in unit coordinates */
+  REAL3 d_unit;    /* ray direction in unit coordinates */
+  REAL f_before;   /* P at the left end of the isolating interval: its sign tells the side */
+  uint flags;      /* ALGRAY_HIT_* */
+  uint steps;      /* isolation intervals examined */
+  uint iterations; /* refinement iterations */
+} SurfaceHit;
+
+SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
+                         __global const uint* exps, __global const REAL* coefs, uint count, REAL noise) {
+  SurfaceHit h;
+  h.t = INFINITY;
+  h.flags = 0;
+  h.steps = 0;
+  h.iterations = 0;
+  h.f_before = 0;
+  /* Unit coordinates keep every point of the extent within |u| <= 1: the conditioning step that makes float usable. */
+  const REAL3 o = (ray.o - centre) * inv_scale;
+  const REAL3 d = ray.d * inv_scale;
+  h.d_unit = d;
+  h.u = o;
+  REAL t_in, t_out;
+  if (!clip_to_extent(o, d, extent_kind, box_half, &t_in, &t_out)) return h;
+  h.flags |= ALGRAY_HIT_IN_EXTENT;
+  const REAL len = t_out - t_in;
+
+  REAL root[NCOEF], iso_c[NCOEF];
+#if RAY_ORIGIN == ALGRAY_ORIGIN_EYE
+  /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
+  restrict_to_ray(exps, coefs, count, (REAL2)(o.x, d.x), (REAL2)(o.y, d.y), (REAL2)(o.z, d.z), root);
+  const Isolation iso = isolate_power(root, t_in, len, t_in, t_out, noise, iso_c);
+#else
+  /* Entry and exit points: the ray restricted to the interval as s in [0, 1]. */
+  const REAL3 pa = o + t_in * d, pb = o + t_out * d;
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+  restrict_to_ray(exps, coefs, count, (REAL2)(pa.x, pb.x), (REAL2)(pa.y, pb.y), (REAL2)(pa.z, pb.z), root);
+  bernstein_from_scaled(root);
+  const Isolation iso = isolate_bernstein(root, t_in, t_out, noise, iso_c);
+#else
+  const REAL3 e = pb - pa;
+  restrict_to_ray(exps, coefs, count, (REAL2)(pa.x, e.x), (REAL2)(pa.y, e.y), (REAL2)(pa.z, e.z), root);
+  const Isolation iso = isolate_power(root, (REAL)0, (REAL)1, t_in, t_out, noise, iso_c);
+#endif
+#endif
+  h.steps = iso.steps;
+  if (iso.budget) h.flags |= ALGRAY_HIT_BUDGET;
+  if (iso.status == ISOLATION_NONE) return h;
+
+  REAL y = 0;
+  if (iso.status == ISOLATION_TANGENT) {
+    y = (REAL)0.5;
+    h.flags |= ALGRAY_HIT_TANGENT;
+  } else if (iso.status == ISOLATION_BRACKET) {
+    const REAL width_t = (iso.hi - iso.lo) * len;
+    const REAL tol_y = stop_width(t_in + iso.lo * len) / width_t;
+    prepare_isolated(iso_c);
+    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, &h.iterations);
+  }
+  h.t = t_in + (iso.lo + y * (iso.hi - iso.lo)) * len;
+  h.u = o + h.t * d;
+  h.f_before = iso.f_lo;
+  h.flags |= ALGRAY_HIT_FOUND;
+  return h;
+}
+
+/* grad P at u, from the monomials, with a table of powers per axis. */
+REAL3 surface_gradient(REAL3 u, __global const uint* exps, __global const REAL* coefs, uint count) {
+  REAL px[NCOEF], py[NCOEF], pz[NCOEF];
+  px[0] = py[0] = pz[0] = 1;
+  for (int n = 1; n <= DEGREE; ++n) {
+    px[n] = px[n - 1] * u.x;
+    py[n] = py[n - 1] * u.y;
+    pz[n] = pz[n - 1] * u.z;
+  }
+  REAL3 g = (REAL3)(0, 0, 0);
+  for (uint m = 0; m < count; ++m) {
+    const uint e = exps[m];
+    const int i = (int)(e & 0xffu), j = (int)((e >> 8) & 0xffu), k = (int)((e >> 16) & 0xffu);
+    const REAL a = coefs[m];
+    if (i > 0) g.x += a * (REAL)i * px[i - 1] * py[j] * pz[k];
+    if (j > 0) g.y += a * (REAL)j * px[i] * py[j - 1] * pz[k];
+    if (k > 0) g.z += a * (REAL)k * px[i] * py[j] * pz[k - 1];
+  }
+  return g;
+}
+
+HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global const REAL* coefs, uint count) {
+  HitRecord r;
+  r.flags = h.flags;
+  r.work = min(h.steps, 0xffffu) | (min(h.iterations, 0xffffu) << 16);
+  r.t_hi = INFINITY;
+  r.t_lo = 0;
+  r.depth = INFINITY;
+  r.normal_x = r.normal_y = r.normal_z = 0;
+  if (!(h.flags & ALGRAY_HIT_FOUND)) return r;
+
+  r.t_hi = (float)h.t;
+  r.t_lo = (float)(h.t - (REAL)r.t_hi);
+  r.depth = (float)(h.t * length(ray.d));
+  /* Unit coordinates differ from world ones by a translation and a uniform scale: same normal direction. */
+  const REAL3 g = surface_gradient(h.u, exps, coefs, count);
+  const REAL glen = length(g);
+  REAL3 n = (glen > 0 && isfinite(glen)) ? g / glen : -normalize(ray.d);
+  if (dot(n, ray.d) > 0) n = -n;
+  r.normal_x = (float)n.x;
+  r.normal_y = (float)n.y;
+  r.normal_z = (float)n.z;
+  /* Front is the side where P > 0; at an exact root use the direction in which P grows instead. */
+  const int back = h.f_before != 0 ? h.f_before < 0 : dot(g, h.d_unit) > 0;
+  if (back) r.flags |= ALGRAY_HIT_BACK;
+  return r;
+}
+
+#endif /* ALGRAY_SURFACE_H */
