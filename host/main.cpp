@@ -64,8 +64,8 @@ int main(int argc, char** argv) {
     request.overrides.push_back({s.substr(0, eq), s.substr(eq + 1)});
   }
   // Flags are overrides like any --set, applied last so they win.
-  if (width) request.overrides.push_back({"image.width", std::to_string(width)});
-  if (height) request.overrides.push_back({"image.height", std::to_string(height)});
+  if (render->count("--width")) request.overrides.push_back({"image.width", std::to_string(width)});
+  if (render->count("--height")) request.overrides.push_back({"image.height", std::to_string(height)});
   if (!precision.empty()) request.overrides.push_back({"render.precision", "\"" + precision + "\""});
   request.use_cache = !no_cache;
   if (!stats_path.empty()) request.stats_path = stats_path;

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -117,6 +118,15 @@ void write_text_atomically(const std::string& path, const std::string& text) {
   }
 }
 
+// An output that cannot be written is bad input, found before any rendering.
+void check_writable(const std::string& path) {
+  const std::filesystem::path p(path);
+  const std::filesystem::path dir = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
+  if (!std::filesystem::is_directory(dir)) throw OutputError(path + ": directory '" + dir.string() + "' does not exist");
+  if (std::filesystem::is_directory(p)) throw OutputError(path + " is a directory");
+  if (::access(dir.c_str(), W_OK) != 0) throw OutputError(path + ": directory '" + dir.string() + "' is not writable");
+}
+
 }  // namespace
 
 int run_render(const RenderRequest& req, std::ostream& err) {
@@ -125,7 +135,11 @@ int run_render(const RenderRequest& req, std::ostream& err) {
   Scene scene;
   try {
     scene = req.scene_path ? load_scene_file(*req.scene_path, req.overrides) : default_scene(req.overrides);
-    for (const std::string& out : req.outputs) format_from_extension(out);
+    for (const std::string& out : req.outputs) {
+      format_from_extension(out);
+      check_writable(out);
+    }
+    if (req.stats_path) check_writable(*req.stats_path);
   } catch (const SceneError& e) {
     err << e.what() << "\n";
     return kExitBadInput;

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 
 namespace algray {
@@ -16,24 +17,64 @@ double ms_between(const cl::Event& e) {
   return static_cast<double>(end - start) * 1e-6;
 }
 
-// Kernel arguments whose type follows REAL.
-class RealArgs {
+// Sets kernel arguments in declaration order; REAL-typed ones follow the build's precision.
+class KernelArgs {
  public:
-  RealArgs(cl::Kernel& k, Precision p) : kernel_(k), double_(p == Precision::Double) {}
-  void vec(cl_uint index, const glm::dvec3& v, double w = 0) {
-    if (double_) kernel_.setArg(index, cl_double4{{v.x, v.y, v.z, w}});
-    else kernel_.setArg(index, cl_float4{{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z),
-                                          static_cast<float>(w)}});
+  KernelArgs(cl::Kernel& k, Precision p) : kernel_(k), double_(p == Precision::Double) {}
+  void real_vec(const glm::dvec3& v) {
+    if (double_)
+      kernel_.setArg(index_++, cl_double4{{v.x, v.y, v.z, 0}});
+    else
+      kernel_.setArg(index_++, cl_float4{{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0}});
   }
-  void scalar(cl_uint index, double v) {
-    if (double_) kernel_.setArg(index, v);
-    else kernel_.setArg(index, static_cast<float>(v));
+  void real(double v) {
+    if (double_)
+      kernel_.setArg(index_++, v);
+    else
+      kernel_.setArg(index_++, static_cast<float>(v));
   }
+  template <typename T>
+  void plain(const T& v) {
+    kernel_.setArg(index_++, v);
+  }
+  cl_uint next() const { return index_; }
+  void skip(cl_uint n) { index_ += n; }
 
  private:
   cl::Kernel& kernel_;
   bool double_;
+  cl_uint index_ = 0;
 };
+
+// Buffer of REAL values from doubles.
+cl::Buffer real_buffer(const cl::Context& ctx, const std::vector<double>& values, Precision precision) {
+  if (precision == Precision::Double)
+    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(double),
+                      const_cast<double*>(values.data()));
+  std::vector<float> f(values.begin(), values.end());
+  return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, f.size() * sizeof(float), f.data());
+}
+
+// C(n, k) for 0 <= k <= n <= degree, row-major with rows of degree + 1 entries, as the kernels expect.
+std::vector<double> binomial_table(int degree) {
+  const int n1 = degree + 1;
+  std::vector<double> t(static_cast<std::size_t>(n1 * n1), 0.0);
+  for (int n = 0; n <= degree; ++n) {
+    t[static_cast<std::size_t>(n * n1)] = 1;
+    for (int k = 1; k <= n; ++k)
+      t[static_cast<std::size_t>(n * n1 + k)] =
+          t[static_cast<std::size_t>((n - 1) * n1 + k - 1)] + (k < n ? t[static_cast<std::size_t>((n - 1) * n1 + k)] : 0);
+  }
+  return t;
+}
+
+cl::NDRange local_range() {
+  const char* l = std::getenv("ALGRAY_LOCAL");
+  if (!l) return cl::NullRange;
+  int a = 1, b = 1;
+  std::sscanf(l, "%dx%d", &a, &b);
+  return cl::NDRange(static_cast<std::size_t>(a), static_cast<std::size_t>(b));
+}
 
 }  // namespace
 
@@ -96,39 +137,34 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   const cl::Context& ctx = session_.context;
   cl::Buffer exps(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, surface.exponents.size() * sizeof(cl_uint),
                   const_cast<cl_uint*>(surface.exponents.data()));
-  cl::Buffer coefs;
-  if (precision == Precision::Double) {
-    coefs = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, surface.coefficients.size() * sizeof(double),
-                       const_cast<double*>(surface.coefficients.data()));
-  } else {
-    std::vector<float> f(surface.coefficients.begin(), surface.coefficients.end());
-    coefs = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, f.size() * sizeof(float), f.data());
-  }
+  const cl::Buffer coefs = real_buffer(ctx, surface.coefficients, precision);
+  const cl::Buffer binomials = real_buffer(ctx, binomial_table(surface.degree), precision);
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, pixels * sizeof(HitRecord));
 
   const double eps = precision == Precision::Double ? std::numeric_limits<double>::epsilon()
                                                     : std::numeric_limits<float>::epsilon();
   const RayBasis& b = result.basis;
-  RealArgs real(kernel, precision);
-  real.vec(0, b.o00);
-  real.vec(1, b.ou);
-  real.vec(2, b.ov);
-  real.vec(3, b.d00);
-  real.vec(4, b.du);
-  real.vec(5, b.dv);
-  real.vec(6, scene.extent.unit_centre());
-  real.scalar(7, 1 / scene.extent.unit_scale());
-  real.vec(8, scene.extent.unit_box_half());
-  kernel.setArg(9, static_cast<cl_int>(scene.extent.kind == ExtentKind::Sphere ? ALGRAY_EXTENT_SPHERE
-                                                                                  : ALGRAY_EXTENT_BOX));
-  kernel.setArg(10, exps);
-  kernel.setArg(11, coefs);
-  kernel.setArg(12, static_cast<cl_uint>(surface.coefficients.size()));
-  real.scalar(13, kTangentNoiseFactor * surface.degree * eps * surface.abs_sum);
-  kernel.setArg(14, static_cast<cl_uint>(width));
-  kernel.setArg(19, out);
-
+  KernelArgs args(kernel, precision);
+  args.real_vec(b.o00);
+  args.real_vec(b.ou);
+  args.real_vec(b.ov);
+  args.real_vec(b.d00);
+  args.real_vec(b.du);
+  args.real_vec(b.dv);
+  args.real_vec(scene.extent.unit_centre());
+  args.real(1 / scene.extent.unit_scale());
+  args.real_vec(scene.extent.unit_box_half());
+  args.plain(static_cast<cl_int>(scene.extent.kind == ExtentKind::Sphere ? ALGRAY_EXTENT_SPHERE : ALGRAY_EXTENT_BOX));
+  args.plain(exps);
+  args.plain(coefs);
+  args.plain(static_cast<cl_uint>(surface.coefficients.size()));
+  args.plain(binomials);
+  args.real(kTangentNoiseFactor * surface.degree * eps * surface.abs_sum);
+  args.plain(static_cast<cl_uint>(width));
+  const cl_uint tile_arg = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
+  args.skip(4);
+  args.plain(out);
   PassStats pass;
   pass.name = "primary";
   const int tile = scene.render.tile_size;
@@ -138,14 +174,14 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
     for (int tx = 0; tx < tiles_x; ++tx) {
       const int x0 = tx * tile, y0 = ty * tile;
       const int w = std::min(tile, width - x0), h = std::min(tile, height - y0);
-      kernel.setArg(15, static_cast<cl_uint>(x0));
-      kernel.setArg(16, static_cast<cl_uint>(y0));
-      kernel.setArg(17, static_cast<cl_uint>(w));
-      kernel.setArg(18, static_cast<cl_uint>(h));
+      kernel.setArg(tile_arg, static_cast<cl_uint>(x0));
+      kernel.setArg(tile_arg + 1, static_cast<cl_uint>(y0));
+      kernel.setArg(tile_arg + 2, static_cast<cl_uint>(w));
+      kernel.setArg(tile_arg + 3, static_cast<cl_uint>(h));
       cl::Event done;
       session_.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(static_cast<std::size_t>(w),
                                                                              static_cast<std::size_t>(h)),
-                                          cl::NullRange, nullptr, &done);
+                                          local_range(), nullptr, &done);
       // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
       done.wait();
       pass.kernel_ms += ms_between(done);

@@ -174,47 +174,45 @@ const std::set<std::string> kColourKeys{"front", "back"};
 const std::set<std::string> kRenderKeys{"precision",      "tolerance", "isolation", "refinement", "ray_origin",
                                         "max_iterations", "tile_size"};
 
+
 bool is_identifier(const std::string& s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
   return std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isalnum(c) || c == '_'; });
 }
 
+// Merges `from` into `into`; tables merge key by key, anything else replaces.
+void merge_tables(toml::table& into, toml::table&& from) {
+  for (auto&& [key, node] : from) {
+    toml::node* existing = into.get(key.str());
+    if (existing && existing->is_table() && node.is_table())
+      merge_tables(*existing->as_table(), std::move(*node.as_table()));
+    else
+      into.insert_or_assign(key.str(), std::move(node));
+  }
+}
+
 void apply_override(toml::table& root, const Override& o) {
   const std::string label = "--set " + o.key + "=" + o.value;
-  if (o.key.empty()) throw SceneError(label, "expected --set key=value");
-  std::vector<std::string> path;
-  if (o.key.find('.') == std::string::npos) {
-    path = {"parameters", o.key};  // a bare name is a parameter
-  } else {
-    std::stringstream parts(o.key);
-    for (std::string p; std::getline(parts, p, '.');) {
-      if (p.empty()) throw SceneError(label, "empty component in key '" + o.key + "'");
-      path.push_back(p);
-    }
+  // A bare name is a parameter; any other key is a dotted path into the scene.
+  const std::string key = o.key.find('.') == std::string::npos ? "parameters." + o.key : o.key;
+  for (std::size_t start = 0;;) {
+    const std::size_t dot = key.find('.', start);
+    const std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    if (!is_identifier(part)) throw SceneError(label, "'" + o.key + "' is not a dotted scene key such as camera.fov_y");
+    if (dot == std::string::npos) break;
+    start = dot + 1;
   }
-  // The value is TOML when it parses as TOML (numbers, arrays, quoted strings), else a bare string.
+  // Parsed as the TOML line `key = value`, every node it creates carries the override as its source, so errors
+  // name it. A value that is not TOML (render.precision=float) is taken as a string.
   toml::table parsed;
   try {
-    parsed = toml::parse("v = " + o.value, label);
+    parsed = toml::parse(key + " = " + o.value, label);
   } catch (const toml::parse_error&) {
-    std::string quoted = "'";
-    for (char c : o.value) {
-      if (c == '\'' || c == '\n') throw SceneError(label, "value is neither valid TOML nor a plain string");
-      quoted += c;
-    }
-    parsed = toml::parse("v = " + quoted + "'", label);
+    if (o.value.find_first_of("'\n") != std::string::npos)
+      throw SceneError(label, "value is neither valid TOML nor a plain string");
+    parsed = toml::parse(key + " = '" + o.value + "'", label);
   }
-  toml::table* t = &root;
-  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
-    toml::node* n = t->get(path[i]);
-    if (!n) {
-      t->insert(path[i], toml::table{});
-      n = t->get(path[i]);
-    }
-    if (!n->is_table()) throw SceneError(label, "'" + path[i] + "' is not a table");
-    t = n->as_table();
-  }
-  t->insert_or_assign(path.back(), std::move(*parsed.get("v")));
+  merge_tables(root, std::move(parsed));
 }
 
 Polynomial polynomial_from_terms(const SceneReader& r, const toml::node& terms_node) {

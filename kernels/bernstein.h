@@ -5,12 +5,9 @@
 #include "isolation.h"
 
 /* The restriction produced scaled coefficients c_k = C(n,k) b_k; Descartes' rule and de Casteljau want b_k. */
-void bernstein_from_scaled(REAL* c) {
-  REAL binom = 1;
-  for (int k = 0; k <= DEGREE; ++k) {
-    c[k] = c[k] / binom;
-    binom = binom * (REAL)(DEGREE - k) / (REAL)(k + 1);
-  }
+void bernstein_from_scaled(REAL* c, __constant const REAL* binomials) {
+  __constant const REAL* row = binomials + DEGREE * NCOEF;
+  for (int k = 0; k <= DEGREE; ++k) c[k] /= row[k];
 }
 
 /* Keeps the part of the curve on [0, x]. In place: after pass r, c[r] is the r-th left coefficient. */
@@ -30,7 +27,7 @@ void casteljau_keep_right(REAL* c, REAL x) {
 /* Value at y by de Casteljau: the most stable evaluation, used off the hot path. */
 REAL bernstein_value(const REAL* c, REAL y) {
   REAL w[NCOEF];
-  poly_copy(w, c, DEGREE);
+  poly_copy(w, c);
   const REAL y1 = (REAL)1 - y;
   for (int r = 1; r <= DEGREE; ++r)
     for (int k = 0; k <= DEGREE - r; ++k) w[k] = y1 * w[k] + y * w[k + 1];
@@ -39,7 +36,7 @@ REAL bernstein_value(const REAL* c, REAL y) {
 
 /* Coefficients on the dyadic interval [idx/2^level, (idx+1)/2^level], recomputed from the whole interval's. */
 void bernstein_restrict(const REAL* root, int level, ulong idx, REAL* out) {
-  poly_copy(out, root, DEGREE);
+  poly_copy(out, root);
   const REAL width = ldexp((REAL)1, -level);
   const REAL lo = (REAL)idx * width, hi = lo + width;
   if (hi < (REAL)1) casteljau_keep_left(out, hi);
@@ -58,7 +55,7 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise,
   int level = 0;
   ulong idx = 0;
   const REAL len = t_out - t_in;
-  poly_copy(cur, root, DEGREE);
+  poly_copy(cur, root);
 
   for (;;) {
     ++iso.steps;
@@ -79,7 +76,7 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise,
     if (v >= 1) {
       const int located = width * len <= stop_width(t_in + iso.lo * len);
       if (!located && level < REAL_MAX_HALVINGS) {
-        poly_copy(sib, cur, DEGREE);
+        poly_copy(sib, cur);
         casteljau_keep_left(cur, (REAL)0.5);
         casteljau_keep_right(sib, (REAL)0.5);
         ++level;
@@ -108,19 +105,23 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise,
     if (level == 0) return iso_finish_none(iso);
     ++idx;
     if (sib_level == level && sib_idx == idx)
-      poly_copy(cur, sib, DEGREE);
+      poly_copy(cur, sib);
     else
       bernstein_restrict(root, level, idx, cur);
   }
 }
 
 /* Turns Bernstein coefficients into the form isolated_value() expects: c_k * C(n,k). */
-void prepare_isolated(REAL* c) {
-  REAL binom = 1;
-  for (int k = 0; k <= DEGREE; ++k) {
-    c[k] *= binom;
-    binom = binom * (REAL)(DEGREE - k) / (REAL)(k + 1);
-  }
+void prepare_isolated(REAL* c, __constant const REAL* binomials) {
+  __constant const REAL* row = binomials + DEGREE * NCOEF;
+  for (int k = 0; k <= DEGREE; ++k) c[k] *= row[k];
+}
+
+/* x^DEGREE by repeated multiplication: pown() goes through exp and log on some devices. */
+REAL power_of(REAL x) {
+  REAL p = 1;
+  for (int k = 0; k < DEGREE; ++k) p *= x;
+  return p;
 }
 
 /* Value at y in [0,1] of a prepared polynomial in O(n): Horner in y/(1-y), mirrored past 1/2 so the ratio
@@ -130,12 +131,12 @@ REAL isolated_value(const REAL* c, REAL y) {
     const REAL r = y / ((REAL)1 - y);
     REAL h = c[DEGREE];
     for (int k = DEGREE - 1; k >= 0; --k) h = h * r + c[k];
-    return h * pown((REAL)1 - y, DEGREE);
+    return h * power_of(1 - y);
   }
   const REAL r = ((REAL)1 - y) / y;
   REAL h = c[0];
   for (int k = 1; k <= DEGREE; ++k) h = h * r + c[k];
-  return h * pown(y, DEGREE);
+  return h * power_of(y);
 }
 
 #endif /* ALGRAY_BERNSTEIN_H */

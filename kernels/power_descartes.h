@@ -12,7 +12,7 @@ void taylor_shift(REAL* c, REAL a) {
 
 /* A1(y) = p(alpha + beta*y): the polynomial on one subinterval, mapped to [0,1]. */
 void power_on_interval(const REAL* p, REAL alpha, REAL beta, REAL* a1) {
-  poly_copy(a1, p, DEGREE);
+  poly_copy(a1, p);
   if (alpha != 0) taylor_shift(a1, alpha);
   REAL s = 1;
   for (int k = 0; k <= DEGREE; ++k) {
@@ -88,7 +88,10 @@ Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
   }
 }
 
-void prepare_isolated(REAL* c) { (void)c; }
+void prepare_isolated(REAL* c, __constant const REAL* binomials) {
+  (void)c;
+  (void)binomials;
+}
 
 REAL isolated_value(const REAL* c, REAL y) { return power_value(c, y); }
 

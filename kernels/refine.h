@@ -25,7 +25,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, uint* iterations) 
     if (fa != fc && fb != fc && fa != fb) {
       /* inverse quadratic interpolation through (a, fa), (b, fb), (c, fc) */
       const REAL r = fb / fc, s = fb / fa, q = fa / fc;
-      const REAL num = s * (q * (q - r) * (cp - b) - ((REAL)1 - r) * (b - a));
+      const REAL num = s * (q * (q - r) * (cp - b) - (r - (REAL)1) * (b - a));
       const REAL den = (q - (REAL)1) * (r - (REAL)1) * (s - (REAL)1);
       cand = b - num / den;
       have = 1;

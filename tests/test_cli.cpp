@@ -1,0 +1,372 @@
+// End-to-end tests of the algray binary: exit codes, stderr messages, output files, stats and the program cache.
+#include <catch2/catch.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "image_io.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string quoted(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_text(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+  REQUIRE(out.good());
+}
+
+fs::path unique_temp_dir(const std::string& tag) {
+  static std::atomic<int> counter{0};
+  const std::string name = "algray-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" +
+                           std::to_string(std::random_device{}());
+  const fs::path dir = fs::temp_directory_path() / name;
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Compiled kernels are shared by all tests of this run but never by the user's own cache.
+const fs::path& shared_cache_dir() {
+  struct Owned {
+    fs::path dir = unique_temp_dir("cache");
+    ~Owned() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  };
+  static const Owned owned;
+  return owned.dir;
+}
+
+struct Result {
+  int exit_code;
+  std::string out, err;
+};
+
+// One test's sandbox: the binary runs in work/ (so anything it leaves behind shows up there), while scenes and
+// captured output live in in/.
+struct Sandbox {
+  fs::path root = unique_temp_dir("cli");
+  fs::path work = root / "work";
+  fs::path in = root / "in";
+  fs::path cache = shared_cache_dir();
+
+  Sandbox() {
+    fs::create_directories(work);
+    fs::create_directories(in);
+  }
+  ~Sandbox() {
+    std::error_code ec;
+    fs::remove_all(root, ec);
+  }
+
+  Result run(const std::string& args) const {
+    const fs::path out = in / "stdout.txt", err = in / "stderr.txt";
+    const std::string cmd = "cd " + quoted(work.string()) + " && ALGRAY_CACHE_DIR=" + quoted(cache.string()) + " " +
+                            quoted(ALGRAY_BINARY) + " " + args + " >" + quoted(out.string()) + " 2>" +
+                            quoted(err.string()) + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    REQUIRE(status != -1);
+    REQUIRE(WIFEXITED(status));
+    return {WEXITSTATUS(status), read_text(out), read_text(err)};
+  }
+
+  fs::path scene(const std::string& name, const std::string& text) const {
+    write_text(in / name, text);
+    return in / name;
+  }
+
+  std::vector<std::string> work_files() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(work)) names.push_back(e.path().filename().string());
+    return names;
+  }
+
+  nlohmann::json stats(const std::string& name = "s.json") const {
+    const std::string text = read_text(work / name);
+    REQUIRE_FALSE(text.empty());
+    return nlohmann::json::parse(text);
+  }
+};
+
+// Every device-dependent test goes through this, so a missing OpenCL driver fails loudly instead of skipping.
+void require_device() {
+  static const bool ok = [] {
+    Sandbox box;
+    return box.run("devices").exit_code == 0;
+  }();
+  if (!ok) FAIL("`algray devices` failed: no usable OpenCL device; install pocl-opencl-icd to run these tests");
+}
+
+const std::string kTiny = "--width 32 --height 24";
+
+std::string scene_file(const char* name) { return quoted(std::string(ALGRAY_SOURCE_DIR) + "/scenes/" + name); }
+
+// A valid scene, line by line, so a bad variant replaces one line and knows the line number it expects.
+const std::vector<std::string> kUnitSphere = {
+    "# unit sphere seen from +z",        // 1
+    "[surface]",                         // 2
+    "equation = \"x^2+y^2+z^2-1\"",      // 3
+    "[extent]",                          // 4
+    "radius = 2",                        // 5
+    "[camera]",                          // 6
+    "eye = [0, 0, 5]",                   // 7
+    "look_at = [0, 0, 0]",               // 8
+    "up = [0, 1, 0]",                    // 9
+    "fov_y = 45",                        // 10
+};
+
+std::string sphere_with(int line, const std::string& replacement) {
+  std::string text;
+  for (std::size_t i = 0; i < kUnitSphere.size(); ++i)
+    text += (static_cast<int>(i + 1) == line ? replacement : kUnitSphere[i]) + "\n";
+  return text;
+}
+
+int finite_depths(const algray::FrameImage& img) {
+  int n = 0;
+  for (float z : img.depth) n += std::isfinite(z);
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("devices lists at least one device with its compute units and fp64 support", "[cli]") {
+  Sandbox box;
+  const Result r = box.run("devices");
+  INFO(r.err);
+  if (r.exit_code != 0) FAIL("`algray devices` exited " << r.exit_code << ": no usable OpenCL device\n" << r.err);
+  CHECK_THAT(r.out, Catch::Contains("[0] "));
+  CHECK_THAT(r.out, Catch::Contains("compute units"));
+  CHECK_THAT(r.out, Catch::Contains("fp64"));
+}
+
+TEST_CASE("the default render writes EXR, PNG and stats", "[cli]") {
+  require_device();
+  Sandbox box;
+  const Result r = box.run("render -o out.exr -o out.png " + kTiny + " --stats s.json");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(fs::exists(box.work / "out.png"));
+  REQUIRE(fs::exists(box.work / "out.exr"));
+  // Success is silent when stderr is not a terminal.
+  CHECK(r.err.empty());
+
+  const algray::FrameImage img = algray::read_exr(box.work / "out.exr");
+  CHECK(img.width == 32);
+  CHECK(img.height == 24);
+  REQUIRE(img.depth.size() == 32u * 24u);
+  int misses = 0;
+  for (float z : img.depth) misses += std::isinf(z) && z > 0;
+  CHECK(finite_depths(img) > 0);
+  CHECK(misses > 0);
+  CHECK(finite_depths(img) + misses == 32 * 24);
+  std::map<std::string, std::string> attrs(img.string_attributes.begin(), img.string_attributes.end());
+  REQUIRE(attrs.count("algray/equation"));
+  CHECK_FALSE(attrs["algray/equation"].empty());
+
+  const nlohmann::json s = box.stats();
+  REQUIRE(s["programs"].is_array());
+  REQUIRE_FALSE(s["programs"].empty());
+  CHECK(s["programs"][0]["from_cache"].is_boolean());
+  REQUIRE_FALSE(s["passes"].empty());
+  CHECK(s["passes"][0]["rays"] == 768);
+  CHECK(s["passes"][0]["kernel_ms"].get<double>() > 0);
+  CHECK(s["image"]["width"] == 32);
+  CHECK(s["image"]["height"] == 24);
+  // The stats must agree with the image about how many pixels hit the surface.
+  CHECK(s["pixels"]["hits"].get<int>() == finite_depths(img));
+}
+
+TEST_CASE("a second render reuses the compiled program and --no-cache does not", "[cli]") {
+  require_device();
+  Sandbox box;
+  box.cache = box.root / "cache";
+  // A fresh cache cannot hold the program: a fresh Sandbox root guarantees the first run compiles.
+  const Result first = box.run("render -o a.exr " + kTiny + " --stats s1.json");
+  INFO(first.err);
+  REQUIRE(first.exit_code == 0);
+  const nlohmann::json s1 = box.stats("s1.json");
+  CHECK(s1["programs"][0]["origin"] == "built");
+  CHECK(s1["programs"][0]["from_cache"] == false);
+  CHECK(s1["cache"] == box.cache.string());
+  CHECK(fs::exists(box.cache));
+  CHECK_FALSE(fs::is_empty(box.cache));
+
+  const Result second = box.run("render -o b.exr " + kTiny + " --stats s2.json");
+  INFO(second.err);
+  REQUIRE(second.exit_code == 0);
+  const nlohmann::json s2 = box.stats("s2.json");
+  const std::string origin = s2["programs"][0]["origin"];
+  CHECK((origin == "disk" || origin == "memory"));
+  CHECK(s2["programs"][0]["from_cache"] == true);
+  CHECK(s2["programs"][0]["key"] == s1["programs"][0]["key"]);
+
+  const Result uncached = box.run("render -o c.exr " + kTiny + " --no-cache --stats s3.json");
+  INFO(uncached.err);
+  REQUIRE(uncached.exit_code == 0);
+  const nlohmann::json s3 = box.stats("s3.json");
+  CHECK(s3["programs"][0]["origin"] == "built");
+  CHECK(s3["programs"][0]["from_cache"] == false);
+  CHECK(s3["cache"] == "off");
+
+  // The cached program must render the same image as the freshly built one.
+  const algray::FrameImage a = algray::read_exr(box.work / "a.exr");
+  const algray::FrameImage b = algray::read_exr(box.work / "b.exr");
+  const algray::FrameImage c = algray::read_exr(box.work / "c.exr");
+  CHECK(a.depth == b.depth);
+  CHECK(a.depth == c.depth);
+}
+
+TEST_CASE("bad input exits 2 with a located message and writes nothing", "[cli][errors]") {
+  Sandbox box;
+  struct Case {
+    const char* what;
+    int line;
+    const char* replacement;
+    const char* location;  // ":line:column" in the scene file
+    const char* phrase;
+  };
+  const std::vector<Case> cases = {
+      {"unknown key", 10, "fovy = 45", ":10:1", "unknown key 'camera.fovy' (did you mean 'fov_y'?)"},
+      {"malformed equation", 3, "equation = \"x^2+*y\"", ":3:17", "unexpected"},
+      {"division by a variable", 3, "equation = \"x/y\"", ":3:15", "division by a variable"},
+      {"negative power", 3, "equation = \"x^-2\"", ":3:15", "negative exponent"},
+      {"nan", 5, "radius = nan", ":5:10", "must be finite, not nan"},
+      {"degree 33", 3, "equation = \"x^33\"", ":3:12", "degree 33 exceeds the supported maximum 32"},
+      {"zero polynomial", 3, "equation = \"x-x\"", ":3:12", "identically zero"},
+      {"empty extent", 5, "radius = 0", ":5:10", "the extent is empty"},
+      {"degenerate camera", 8, "look_at = [0, 0, 5]", ":8:11", "look_at coincides with eye"},
+  };
+  for (const Case& c : cases) {
+    SECTION(c.what) {
+      const fs::path scene = box.scene("bad.toml", sphere_with(c.line, c.replacement));
+      const Result r = box.run("render " + quoted(scene.string()) + " -o out.exr -o out.png --stats s.json " + kTiny);
+      INFO(r.err);
+      CHECK(r.exit_code == 2);
+      CHECK_THAT(r.err, Catch::StartsWith(scene.string() + c.location + ": error: "));
+      CHECK_THAT(r.err, Catch::Contains(c.phrase));
+      // The excerpt repeats the offending line under the message.
+      CHECK_THAT(r.err, Catch::Contains(c.replacement) && Catch::Contains("^"));
+      CHECK(box.work_files().empty());
+    }
+  }
+  SECTION("a good scene renders in this sandbox, so the cases above fail for their own reason") {
+    require_device();
+    const fs::path scene = box.scene("good.toml", sphere_with(0, ""));  // no line 0: the scene unchanged
+    const Result r = box.run("render " + quoted(scene.string()) + " -o out.exr " + kTiny);
+    INFO(r.err);
+    CHECK(r.exit_code == 0);
+    CHECK(fs::exists(box.work / "out.exr"));
+  }
+  SECTION("unsupported output extension") {
+    const Result r = box.run("render -o out.exr -o out.jpg " + kTiny);
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("unsupported output extension '.jpg'"));
+    CHECK(box.work_files().empty());
+  }
+  SECTION("nonexistent scene file") {
+    const std::string missing = (box.in / "no-such-scene.toml").string();
+    const Result r = box.run("render " + quoted(missing) + " -o out.exr " + kTiny);
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::StartsWith(missing + ": error: cannot read the scene file"));
+    CHECK(box.work_files().empty());
+  }
+  SECTION("bad --set value") {
+    const Result r = box.run("render -o out.exr --set render.tolerance=nan " + kTiny);
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::StartsWith("--set render.tolerance=nan: error: "));
+    CHECK(box.work_files().empty());
+  }
+}
+
+TEST_CASE("a bad scene leaves an existing output byte-identical", "[cli][errors]") {
+  Sandbox box;
+  const std::string previous = "an earlier render that must survive\n";
+  write_text(box.work / "out.exr", previous);
+  const fs::path scene = box.scene("bad.toml", sphere_with(3, "equation = \"x/y\""));
+  const Result r = box.run("render " + quoted(scene.string()) + " -o out.exr " + kTiny);
+  CHECK(r.exit_code == 2);
+  CHECK(read_text(box.work / "out.exr") == previous);
+  CHECK(box.work_files() == std::vector<std::string>{"out.exr"});
+}
+
+TEST_CASE("double precision renders on a device with fp64", "[cli]") {
+  require_device();
+  Sandbox box;
+  const Result r = box.run("render -o out.exr --precision double --stats s.json " + kTiny);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const nlohmann::json s = box.stats();
+  REQUIRE(s["device"]["fp64"] == true);
+  CHECK(s["solver"]["precision"] == "double");
+  const algray::FrameImage img = algray::read_exr(box.work / "out.exr");
+  CHECK(finite_depths(img) > 0);
+}
+
+TEST_CASE("--device picks by index or name substring and lists the devices when none matches", "[cli]") {
+  require_device();
+  Sandbox box;
+  SECTION("an index out of range") {
+    const Result r = box.run("render -o out.exr --device 99 " + kTiny);
+    CHECK(r.exit_code != 0);
+    CHECK_THAT(r.err, Catch::Contains("--device 99"));
+    CHECK_THAT(r.err, Catch::Contains("[0] ") && Catch::Contains("compute units"));
+    CHECK(box.work_files().empty());
+  }
+  SECTION("a substring of the PoCL device name") {
+    const Result r = box.run("render -o out.exr --device pthread --stats s.json " + kTiny);
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const std::string name = box.stats()["device"]["name"];
+    CHECK_THAT(name, Catch::Contains("pthread"));
+  }
+}
+
+TEST_CASE("--set on a bare name changes a parameter of the render", "[cli]") {
+  require_device();
+  Sandbox box;
+  const std::string torus = scene_file("torus.toml");
+  const Result thin = box.run("render " + torus + " -o thin.exr --set r=0.5 " + kTiny);
+  INFO(thin.err);
+  REQUIRE(thin.exit_code == 0);
+  const Result fat = box.run("render " + torus + " -o fat.exr --set r=0.9 " + kTiny);
+  INFO(fat.err);
+  REQUIRE(fat.exit_code == 0);
+  const int thin_hits = finite_depths(algray::read_exr(box.work / "thin.exr"));
+  const int fat_hits = finite_depths(algray::read_exr(box.work / "fat.exr"));
+  CHECK(thin_hits > 0);
+  CHECK(thin_hits < fat_hits);
+  std::map<std::string, std::string> attrs;
+  for (const auto& [k, v] : algray::read_exr(box.work / "thin.exr").string_attributes) attrs[k] = v;
+  // The exact polynomial must differ too, not only the pixels.
+  std::map<std::string, std::string> fat_attrs;
+  for (const auto& [k, v] : algray::read_exr(box.work / "fat.exr").string_attributes) fat_attrs[k] = v;
+  CHECK(attrs["algray/polynomial"] != fat_attrs["algray/polynomial"]);
+}

@@ -1,0 +1,252 @@
+// Tests of the TOML scene reader: the shipped scenes, parameters, overrides and every error's file:line:column.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "expression.h"
+#include "scene.h"
+
+using algray::Override;
+using algray::Scene;
+using algray::SceneError;
+
+namespace {
+
+// A valid scene, one entry per line, so an error test can swap one line and know the line number it expects.
+// Line 1 is a comment so that top-level keys can be put before the first table.
+const std::vector<std::string> kUnitSphere = {
+    "# unit sphere seen from +z",        // 1
+    "[surface]",                         // 2
+    "equation = \"x^2+y^2+z^2-1\"",      // 3
+    "[extent]",                          // 4
+    "radius = 2",                        // 5
+    "[camera]",                          // 6
+    "eye = [0, 0, 5]",                   // 7
+    "look_at = [0, 0, 0]",               // 8
+    "up = [0, 1, 0]",                    // 9
+    "fov_y = 45",                        // 10
+};
+
+// The unit sphere scene with some lines replaced (a replacement may span several lines) and lines appended.
+std::string sphere_with(const std::map<int, std::string>& replaced, const std::vector<std::string>& appended = {}) {
+  std::string text;
+  for (std::size_t i = 0; i < kUnitSphere.size(); ++i) {
+    const auto it = replaced.find(static_cast<int>(i + 1));
+    text += (it == replaced.end() ? kUnitSphere[i] : it->second) + "\n";
+  }
+  for (const std::string& line : appended) text += line + "\n";
+  return text;
+}
+
+// Loads `text` expecting a SceneError and returns it; fails the test if the scene loads.
+SceneError error_of(const std::string& text, const std::vector<Override>& overrides = {}) {
+  try {
+    algray::load_scene_text(text, "t.toml", overrides);
+  } catch (const SceneError& e) {
+    return e;
+  }
+  FAIL("the scene loaded, but an error was expected:\n" << text);
+  throw std::logic_error("unreachable");
+}
+
+void check_error(const std::string& text, const std::string& where, const std::string& phrase) {
+  const SceneError e = error_of(text);
+  INFO("scene:\n" << text << "error: " << e.what());
+  CHECK(e.where == where);
+  CHECK_THAT(e.message, Catch::Contains(phrase));
+}
+
+algray::Polynomial equation(const std::string& text, const std::map<std::string, double>& params = {}) {
+  return algray::parse_equation(text, params);
+}
+
+}  // namespace
+
+TEST_CASE("every shipped scene loads with a supported degree and a non-empty extent", "[scene]") {
+  const std::filesystem::path dir = std::filesystem::path(ALGRAY_SOURCE_DIR) / "scenes";
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".toml") continue;
+    ++count;
+    INFO(entry.path());
+    Scene s;
+    REQUIRE_NOTHROW(s = algray::load_scene_file(entry.path().string()));
+    CHECK(s.polynomial.degree() >= 1);
+    CHECK(s.polynomial.degree() <= 32);
+    CHECK_FALSE(s.name.empty());
+    if (s.extent.kind == algray::ExtentKind::Sphere) {
+      CHECK(s.extent.radius > 0);
+    } else {
+      for (int i = 0; i < 3; ++i) CHECK(s.extent.min[i] < s.extent.max[i]);
+    }
+  }
+  // A wrong path would make the loop vacuous.
+  CHECK(count >= 10);
+}
+
+TEST_CASE("the default scene is the Barth sextic", "[scene]") {
+  const Scene s = algray::default_scene();
+  CHECK(s.polynomial.degree() == 6);
+  CHECK(s.polynomial.terms().size() == 17);
+  CHECK(s.name == "Barth sextic");
+  CHECK(s.source == "<built-in default scene>");
+  // The embedded copy must be the file in scenes/, not a stale one.
+  const Scene file = algray::load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_sextic.toml");
+  CHECK(s.polynomial == file.polynomial);
+}
+
+TEST_CASE("a scene without surface.name is named after its file", "[scene]") {
+  const Scene s = algray::load_scene_text(sphere_with({}), "some/dir/ball.toml");
+  CHECK(s.name == "ball");
+}
+
+TEST_CASE("parameters are substituted into the equation as their double values", "[scene]") {
+  const std::string text = sphere_with({{3, "equation = \"x^2+y^2+z^2-a\""}}, {"[parameters]", "a = 2.7"});
+  const Scene s = algray::load_scene_text(text, "t.toml");
+  CHECK(s.parameters.at("a") == 2.7);
+  CHECK(s.polynomial == equation("x^2+y^2+z^2-a", {{"a", 2.7}}));
+  CHECK_FALSE(s.polynomial == equation("x^2+y^2+z^2-3"));
+
+  SECTION("a bare override key names a parameter") {
+    const Scene o = algray::load_scene_text(text, "t.toml", {{"a", "3"}});
+    CHECK(o.parameters.at("a") == 3.0);
+    CHECK(o.polynomial == equation("x^2+y^2+z^2-3"));
+  }
+  SECTION("a bare override may add a parameter the file lacks") {
+    const std::string uses_b = sphere_with({{3, "equation = \"x^2+y^2+z^2-b\""}});
+    CHECK(algray::load_scene_text(uses_b, "t.toml", {{"b", "0.25"}}).polynomial == equation("x^2+y^2+z^2-0.25"));
+  }
+}
+
+TEST_CASE("dotted overrides reach image, render and camera keys", "[scene]") {
+  const Scene base = algray::load_scene_text(sphere_with({}), "t.toml");
+  REQUIRE(base.image.width != 64);
+  REQUIRE_FALSE(base.render.precision.has_value());
+  REQUIRE(base.camera.fov_y_degrees == 45);
+
+  const Scene s = algray::load_scene_text(
+      sphere_with({}), "t.toml", {{"image.width", "64"}, {"render.precision", "float"}, {"camera.fov_y", "30"}});
+  CHECK(s.image.width == 64);
+  REQUIRE(s.render.precision.has_value());
+  CHECK(*s.render.precision == algray::Precision::Float);
+  CHECK(s.camera.fov_y_degrees == 30);
+
+  // Later overrides win, which is how --width beats an earlier --set image.width.
+  const Scene twice = algray::load_scene_text(sphere_with({}), "t.toml", {{"image.width", "64"}, {"image.width", "48"}});
+  CHECK(twice.image.width == 48);
+}
+
+TEST_CASE("the paper's term list gives the same polynomial as the equation", "[scene]") {
+  const Scene s = algray::load_scene_text(
+      sphere_with({{3, "terms = [[2,0,0,1.0],[0,2,0,1.0],[0,0,2,1.0],[0,0,0,-1.0]]"}}), "t.toml");
+  CHECK(s.polynomial == equation("x^2+y^2+z^2-1"));
+  CHECK_FALSE(s.equation.empty());
+}
+
+TEST_CASE("unknown keys are reported at the key, with a suggestion when one is close", "[scene][errors]") {
+  check_error(sphere_with({{1, "colour = 1"}}), "t.toml:1:1", "unknown key 'colour'");
+
+  const SceneError e = error_of(sphere_with({{10, "fovy = 45"}}));
+  CHECK(e.where == "t.toml:10:1");
+  CHECK_THAT(e.message, Catch::Contains("unknown key 'camera.fovy'"));
+  CHECK_THAT(e.message, Catch::Contains("did you mean 'fov_y'?"));
+  CHECK(e.excerpt == "  fovy = 45\n  ^");
+}
+
+TEST_CASE("equation errors point at the character inside the string", "[scene][errors]") {
+  // `equation = "` is 12 characters, so character n (0-based) of the equation is column 13 + n.
+  SECTION("malformed") {
+    const SceneError e = error_of(sphere_with({{3, "equation = \"x^2+*y\""}}));
+    CHECK(e.where == "t.toml:3:17");
+    CHECK_THAT(e.message, Catch::Contains("unexpected"));
+    CHECK_THAT(e.message, Catch::Contains("at character 5 of the equation"));
+    CHECK(e.excerpt == "  equation = \"x^2+*y\"\n" + std::string(2 + 16, ' ') + "^");
+    // what() carries the location and the excerpt, since that is all the CLI prints.
+    CHECK_THAT(std::string(e.what()), Catch::StartsWith("t.toml:3:17: error: "));
+    CHECK_THAT(std::string(e.what()), Catch::Contains(e.excerpt));
+  }
+  SECTION("division by a variable") {
+    check_error(sphere_with({{3, "equation = \"x/y\""}}), "t.toml:3:15", "division by a variable");
+  }
+  SECTION("negative power") {
+    check_error(sphere_with({{3, "equation = \"x^-2\""}}), "t.toml:3:15", "negative exponent");
+  }
+  SECTION("fractional power") {
+    check_error(sphere_with({{3, "equation = \"x^2.5\""}}), "t.toml:3:15", "fractional exponent");
+  }
+  SECTION("unknown identifier") {
+    check_error(sphere_with({{3, "equation = \"x^2+w\""}}), "t.toml:3:17", "unknown identifier 'w'");
+  }
+  SECTION("escapes count as one character") {
+    // \u0078 is 'x': six source characters for one equation character, so '*' at offset 2 is column 13+6+1.
+    check_error(sphere_with({{3, "equation = \"\\u0078+*y\""}}), "t.toml:3:20", "unexpected");
+  }
+}
+
+TEST_CASE("the polynomial must have degree 1 to 32", "[scene][errors]") {
+  // These are reported at the equation value, whose opening quote is column 12.
+  check_error(sphere_with({{3, "equation = \"x^33\""}}), "t.toml:3:12", "degree 33 exceeds the supported maximum 32");
+  check_error(sphere_with({{3, "equation = \"x-x\""}}), "t.toml:3:12", "identically zero");
+  check_error(sphere_with({{3, "equation = \"2\""}}), "t.toml:3:12", "nonzero constant");
+  CHECK_NOTHROW(algray::load_scene_text(sphere_with({{3, "equation = \"x^32+y-1\""}}), "t.toml"));
+}
+
+TEST_CASE("nan and inf are rejected where they are written", "[scene][errors]") {
+  check_error(sphere_with({{5, "radius = nan"}}), "t.toml:5:10", "must be finite, not nan");
+  check_error(sphere_with({{7, "eye = [inf, 0, 0]"}}), "t.toml:7:8", "must be finite, not inf");
+  check_error(sphere_with({}, {"[parameters]", "k = nan"}), "t.toml:12:5", "parameter 'k' must be finite");
+  check_error(sphere_with({}, {"[parameters]", "k = -inf"}), "t.toml:12:5", "parameter 'k' must be finite");
+}
+
+TEST_CASE("empty extents are rejected", "[scene][errors]") {
+  check_error(sphere_with({{5, "radius = 0"}}), "t.toml:5:10", "the extent is empty");
+  check_error(sphere_with({{5, "radius = -1"}}), "t.toml:5:10", "the extent is empty");
+  // The box replaces line 5 with three lines; the error points at max on line 7, `max = [` putting '[' at column 7.
+  check_error(sphere_with({{5, "type = \"box\"\nmin = [1, -1, -1]\nmax = [1, 1, 1]"}}), "t.toml:7:7",
+              "max.x must exceed min.x");
+  check_error(sphere_with({{5, "type = \"box\"\nmin = [-1, -1, -1]\nmax = [1, 1, -2]"}}), "t.toml:7:7",
+              "max.z must exceed min.z");
+  CHECK_NOTHROW(
+      algray::load_scene_text(sphere_with({{5, "type = \"box\"\nmin = [-1, -1, -1]\nmax = [1, 1, 1]"}}), "t.toml"));
+}
+
+TEST_CASE("degenerate cameras are rejected", "[scene][errors]") {
+  check_error(sphere_with({{8, "look_at = [0, 0, 5]"}}), "t.toml:8:11", "look_at coincides with eye");
+  check_error(sphere_with({{9, "up = [0, 0, 2]"}}), "t.toml:9:6", "parallel to the viewing direction");
+  check_error(sphere_with({{9, "up = [0, 0, 0]"}}), "t.toml:9:6", "degenerate camera");
+  check_error(sphere_with({{10, "fov_y = 0"}}), "t.toml:10:9", "fov_y must be between 0 and 180");
+  check_error(sphere_with({{10, "fov_y = 180"}}), "t.toml:10:9", "fov_y must be between 0 and 180");
+  check_error(sphere_with({{10, "projection = \"orthographic\"\nheight = 0"}}), "t.toml:11:10",
+              "height must be positive");
+  CHECK_NOTHROW(
+      algray::load_scene_text(sphere_with({{10, "projection = \"orthographic\"\nheight = 3"}}), "t.toml"));
+}
+
+TEST_CASE("equation and terms together are rejected at terms", "[scene][errors]") {
+  check_error(sphere_with({{3, "equation = \"x^2+y^2+z^2-1\"\nterms = [[1,0,0,1.0]]"}}), "t.toml:4:9",
+              "not both");
+}
+
+TEST_CASE("TOML syntax errors carry toml++'s location", "[scene][errors]") {
+  // The second '=' on `radius = = 2` is column 10.
+  const SceneError e = error_of(sphere_with({{5, "radius = = 2"}}));
+  CHECK(e.where == "t.toml:5:10");
+  CHECK_FALSE(e.message.empty());
+  CHECK_THAT(e.excerpt, Catch::Contains("radius = = 2") && Catch::Contains("^"));
+}
+
+TEST_CASE("errors from overrides name the --set argument", "[scene][errors]") {
+  const SceneError e = error_of(sphere_with({}), {{"render.tolerance", "nan"}});
+  CHECK_THAT(e.where, Catch::StartsWith("--set"));
+  CHECK_THAT(e.where, Catch::Contains("render.tolerance"));
+  CHECK_THAT(e.message, Catch::Contains("finite"));
+  CHECK(e.excerpt.empty());
+
+  const SceneError width = error_of(sphere_with({}), {{"image.width", "0"}});
+  CHECK_THAT(width.where, Catch::StartsWith("--set"));
+  CHECK_THAT(width.message, Catch::Contains("image.width must be between 1"));
+}
