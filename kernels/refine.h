@@ -5,10 +5,12 @@
 #include "real.h"
 
 /* Needs isolated_value(c, y) from the isolation method: the polynomial at y in [0,1] of the isolating interval.
- * f0 and f1 are its values at 0 and 1, of opposite signs. tol_y is the stopping width in y.
+ * f0 and f1 are its values at 0 and 1, of opposite signs. tol_y is the stopping width in y; scale is the size
+ * of the polynomial's coefficients on the isolating interval, which makes the paper's |P*(b)| <= eps_m test
+ * independent of how P happens to be scaled (a bare eps_m stops float solves early on flat polynomials).
  * Returns the root's y and counts the iterations (function evaluations) in *iterations. */
 #if REFINEMENT == ALGRAY_REFINEMENT_BRENT
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, uint* iterations) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations) {
   /* b: best estimate; c_: contrapoint, f(c_) of the other sign; a: the previous b. */
   REAL a = 0, fa = f0, b = 1, fb = f1, cp = 0, fc = f0;
   uint it = 0;
@@ -19,7 +21,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, uint* iterations) 
       cp = a; fc = fa;
     }
     /* The paper's stopping rule: |P*(b)| at machine precision, or a bracket at most the stopping width. */
-    if (fabs(fb) <= REAL_EPS || fabs(cp - b) <= tol_y) break;
+    if (fabs(fb) <= REAL_EPS * scale || fabs(cp - b) <= tol_y) break;
     REAL cand = b;
     int have = 0;
     if (fa != fc && fb != fc && fa != fb) {
@@ -50,9 +52,10 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, uint* iterations) 
   return b;
 }
 #elif REFINEMENT == ALGRAY_REFINEMENT_BISECTION
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, uint* iterations) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations) {
   REAL lo = 0, hi = 1, flo = f0;
   (void)f1;
+  (void)scale;
   uint it = 0;
   for (; it < MAX_ITERATIONS && hi - lo > tol_y; ++it) {
     const REAL mid = (REAL)0.5 * (lo + hi);

@@ -71,8 +71,10 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   } else if (iso.status == ISOLATION_BRACKET) {
     const REAL width_t = (iso.hi - iso.lo) * len;
     const REAL tol_y = stop_width(t_in + iso.lo * len) / width_t;
+    REAL scale = 0;
+    for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(iso_c[k]));
     prepare_isolated(iso_c, binomials);
-    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, &h.iterations);
+    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, &h.iterations);
   }
   h.t = t_in + (iso.lo + y * (iso.hi - iso.lo)) * len;
   h.u = o + h.t * d;

@@ -1,0 +1,69 @@
+// Every kernel specialisation (DEGREE 1..32, float and double) builds, runs and finds a known root.
+#include <cmath>
+#include <sstream>
+
+#include <catch2/catch.hpp>
+
+#include "program_cache.h"
+#include "renderer.h"
+#include "scene.h"
+#include "test_support.h"
+
+using namespace algray;
+
+namespace {
+
+// (z + x/10)^D = a: seen from above by an orthographic camera, the first root on the ray through (x, y) is
+// z = a^(1/D) - x/10, a surface that needs every monomial x^i z^(D-i) of the degree.
+Scene degree_scene(int degree, const char* precision) {
+  std::ostringstream toml;
+  toml << "[surface]\nequation = \"(z + x/10)^" << degree << " - a\"\n"
+       << "[parameters]\na = 0.3\n"
+       << "[extent]\nradius = 1.5\n"
+       << "[camera]\nprojection = \"orthographic\"\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nheight = 2\n"
+       << "[image]\nwidth = 5\nheight = 5\n"
+       << "[render]\nprecision = \"" << precision << "\"\ntolerance = 1e-12\n";
+  return load_scene_text(toml.str(), "degree" + std::to_string(degree) + ".toml");
+}
+
+}  // namespace
+
+TEST_CASE("every DEGREE from 1 to 32 builds and finds the smallest root, in float and double", "[kernels]") {
+  ClSession& session = testing::device_session();
+  ProgramCache no_cache(false);  // compile every specialisation from source
+  Renderer renderer(session, no_cache);
+  for (const char* precision : {"float", "double"}) {
+    if (std::string(precision) == "double" && !session.info.fp64) FAIL("the test device lacks fp64");
+    for (int degree = 1; degree <= 32; ++degree) {
+      INFO("DEGREE=" << degree << " precision=" << precision);
+      const Scene scene = degree_scene(degree, precision);
+      REQUIRE(scene.polynomial.degree() == degree);
+      RenderResult result;
+      REQUIRE_NOTHROW(result = renderer.render(scene, false));  // a BuildError prints the options and the log
+      REQUIRE(result.programs.size() == 1);
+      CHECK(result.programs[0].origin == "built");
+      // Orthographic rays start on the plane z = 3 and run along -z with unit length, so t = 3 - z.
+      const double root = std::pow(0.3, 1.0 / degree);
+      const double width = 2.0, pixel = width / 5;
+      for (int py = 0; py < 5; ++py) {
+        for (int px = 0; px < 5; ++px) {
+          const HitRecord& h = result.hits.at(px, py);
+          const double x = -width / 2 + (px + 0.5) * pixel;
+          const double y = width / 2 - (py + 0.5) * pixel;
+          const double z = root - x / 10;
+          INFO("pixel " << px << "," << py);
+          if (x * x + y * y + z * z >= 1.5 * 1.5) continue;  // outside the extent
+          REQUIRE((h.flags & ALGRAY_HIT_FOUND) != 0);
+          const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
+          // Float: the polynomial's coefficients carry about D * 2^-24 relative error, magnified by the flat
+          // D-th power near its root. Double: the 1e-12 stopping width plus rounding.
+          const double allowed = std::string(precision) == "float" ? 2e-4 * degree : 1e-9;
+          CHECK(std::fabs(t - (3 - z)) <= allowed);
+          // The normal of (z + x/10)^D = a points along (1/10, 0, 1), towards the camera.
+          CHECK(h.normal_z > 0.99f);
+          CHECK(std::fabs(h.normal_x - 0.1f / std::sqrt(1.01f)) < 1e-3f);
+        }
+      }
+    }
+  }
+}
