@@ -68,8 +68,30 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
   img.world_to_ndc = world_to_ndc_matrix(cam, b, scene.image.width, scene.image.height);
 }
 
+// Wall time of each step of the command, for --stats.
+class PhaseTimer {
+ public:
+  void mark(const std::string& phase) {
+    const auto now = std::chrono::steady_clock::now();
+    phases_.push_back({phase, std::chrono::duration<double, std::milli>(now - last_).count()});
+    last_ = now;
+  }
+  double total_ms() const {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
+  }
+  nlohmann::json json() const {
+    nlohmann::json j = nlohmann::json::object();
+    for (const auto& [name, ms] : phases_) j[name] = ms;
+    return j;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_ = start_;
+  std::vector<std::pair<std::string, double>> phases_;
+};
+
 nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const RenderResult& r,
-                          const DeviceInfo& device, double total_ms) {
+                          const DeviceInfo& device, const PhaseTimer& timer) {
   nlohmann::json j;
   j["scene"] = scene.source;
   j["name"] = scene.name;
@@ -98,7 +120,8 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
                            {"kernel_ms", p.kernel_ms}, {"wall_ms", p.wall_ms}});
   j["pixels"] = {{"hits", hits}, {"tangent_hits", tangent}, {"depth_limited", budget},
                  {"isolation_steps", steps}, {"refine_iterations", iterations}};
-  j["total_ms"] = total_ms;
+  j["phases_ms"] = timer.json();
+  j["total_ms"] = timer.total_ms();
   return j;
 }
 
@@ -130,7 +153,7 @@ void check_writable(const std::string& path) {
 }  // namespace
 
 int run_render(const RenderRequest& req, std::ostream& err) {
-  const auto start = std::chrono::steady_clock::now();
+  PhaseTimer timer;
   // Everything the user gave is checked before any device work, so bad input costs nothing and writes nothing.
   Scene scene;
   try {
@@ -149,18 +172,20 @@ int run_render(const RenderRequest& req, std::ostream& err) {
   }
 
   try {
+    timer.mark("scene");
     ClSession session(select_device(req.device_spec));
+    timer.mark("device");
     ProgramCache cache(req.use_cache);
     Renderer renderer(session, cache);
     const RenderResult result = renderer.render(scene, req.progress);
+    timer.mark("render");
     FrameImage image = shade_preview(scene, result);
     add_metadata(image, scene, result, session.info);
+    timer.mark("shade");
     for (const std::string& out : req.outputs) write_image(out, image);
-    if (req.stats_path) {
-      const double total_ms =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-      write_text_atomically(*req.stats_path, stats_json(scene, req, result, session.info, total_ms).dump(2) + "\n");
-    }
+    timer.mark("write");
+    if (req.stats_path)
+      write_text_atomically(*req.stats_path, stats_json(scene, req, result, session.info, timer).dump(2) + "\n");
   } catch (const DeviceError& e) {
     err << "algray: " << e.what() << "\n";
     return kExitBadInput;

@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <limits>
 
 namespace algray {
@@ -68,14 +67,6 @@ std::vector<double> binomial_table(int degree) {
   return t;
 }
 
-cl::NDRange local_range() {
-  const char* l = std::getenv("ALGRAY_LOCAL");
-  if (!l) return cl::NullRange;
-  int a = 1, b = 1;
-  std::sscanf(l, "%dx%d", &a, &b);
-  return cl::NDRange(static_cast<std::size_t>(a), static_cast<std::size_t>(b));
-}
-
 }  // namespace
 
 SurfaceData prepare_surface(const Scene& scene) {
@@ -89,7 +80,11 @@ SurfaceData prepare_surface(const Scene& scene) {
   data.degree = unit.degree();
   Polynomial scaled;
   for (const auto& [e, a] : unit.terms()) scaled.add_term(e[0], e[1], e[2], a / largest);
+  data.even_axes = 7;
   for (const Monomial& m : scaled.monomials()) {
+    if (m.i % 2) data.even_axes &= ~1u;
+    if (m.j % 2) data.even_axes &= ~2u;
+    if (m.k % 2) data.even_axes &= ~4u;
     data.exponents.push_back(static_cast<cl_uint>(m.i) | static_cast<cl_uint>(m.j) << 8 |
                              static_cast<cl_uint>(m.k) << 16);
     data.coefficients.push_back(m.coef);
@@ -97,6 +92,8 @@ SurfaceData prepare_surface(const Scene& scene) {
   }
   return data;
 }
+
+int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 256 : 1024; }
 
 Precision resolve_precision(const Scene& scene, const DeviceInfo& device) {
   if (!scene.render.precision) return device.fp64 ? Precision::Double : Precision::Float;
@@ -160,6 +157,7 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   args.plain(coefs);
   args.plain(static_cast<cl_uint>(surface.coefficients.size()));
   args.plain(binomials);
+  args.plain(surface.even_axes);
   args.real(kTangentNoiseFactor * surface.degree * eps * surface.abs_sum);
   args.plain(static_cast<cl_uint>(width));
   const cl_uint tile_arg = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
@@ -167,7 +165,7 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   args.plain(out);
   PassStats pass;
   pass.name = "primary";
-  const int tile = scene.render.tile_size;
+  const int tile = scene.render.tile_size > 0 ? scene.render.tile_size : default_tile_size(session_.info);
   const int tiles_x = (width + tile - 1) / tile, tiles_y = (height + tile - 1) / tile;
   const int tiles = tiles_x * tiles_y;
   for (int ty = 0; ty < tiles_y; ++ty) {
@@ -181,7 +179,7 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
       cl::Event done;
       session_.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(static_cast<std::size_t>(w),
                                                                              static_cast<std::size_t>(h)),
-                                          local_range(), nullptr, &done);
+                                          cl::NullRange, nullptr, &done);
       // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
       done.wait();
       pass.kernel_ms += ms_between(done);

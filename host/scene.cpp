@@ -383,7 +383,7 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
     if (const toml::node* n = render->get("max_iterations"))
       rs.max_iterations = static_cast<int>(r.integer(*n, "render.max_iterations", 1, 1000000));
     if (const toml::node* n = render->get("tile_size"))
-      rs.tile_size = static_cast<int>(r.integer(*n, "render.tile_size", 8, 8192));
+      rs.tile_size = static_cast<int>(r.integer(*n, "render.tile_size", 8, 16384));
   }
   return scene;
 }

@@ -53,7 +53,7 @@ struct RenderSettings {
   Refinement refinement = Refinement::Brent;
   RayOrigin ray_origin = RayOrigin::Extent;
   int max_iterations = 100;
-  int tile_size = 256;  // pixels per side of a dispatched tile
+  int tile_size = 0;  // pixels per side of a dispatched tile; 0 chooses by device type
 };
 
 struct Scene {

@@ -15,11 +15,12 @@
 
 /* One tile of the image per launch: global size (tile_w, tile_h), results at out[py * image_width + px].
  * The polynomial is given in unit coordinates u = (p - centre) * inv_scale, with max |coefficient| = 1.
- * binomials[n * (DEGREE + 1) + k] = C(n, k) for 0 <= k <= n <= DEGREE (zero elsewhere). */
+ * binomials[n * (DEGREE + 1) + k] = C(n, k) for 0 <= k <= n <= DEGREE (zero elsewhere).
+ * even_axes: bit 0, 1, 2 set when every exponent of x, y, z in the polynomial is even. */
 __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, REAL4 ray_du, REAL4 ray_dv,
                       REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
                       __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
-                      __constant const REAL* binomials, REAL noise,
+                      __constant const REAL* binomials, uint even_axes, REAL noise,
                       uint image_width, uint tile_x0, uint tile_y0, uint tile_w, uint tile_h,
                       __global HitRecord* out) {
   const uint gx = get_global_id(0), gy = get_global_id(1);
@@ -28,6 +29,6 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
 
   const Ray ray = camera_ray(px, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
   const SurfaceHit hit = trace_surface(ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                       mono_exps, mono_coefs, mono_count, binomials, noise);
+                                       mono_exps, mono_coefs, mono_count, binomials, even_axes, noise);
   out[(size_t)py * image_width + px] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
 }

@@ -27,15 +27,45 @@ void poly_mul_linear(REAL* c, REAL l0, REAL l1) {
   c[0] = l0 * c[0];
 }
 
-/* c times L^times for a linear factor L. */
-void poly_mul_linear_pow(REAL* c, REAL l0, REAL l1, int times) {
-  for (int r = 0; r < times; ++r) poly_mul_linear(c, l0, l1);
+/* c (degree < DEGREE - 1) times (q0 + q1 s + q2 s^2), or the same in the scaled Bernstein form. */
+void poly_mul_quadratic(REAL* c, REAL q0, REAL q1, REAL q2) {
+  for (int k = DEGREE; k > 1; --k) c[k] = q0 * c[k] + q1 * c[k - 1] + q2 * c[k - 2];
+  c[1] = q0 * c[1] + q1 * c[0];
+  c[0] = q0 * c[0];
+}
+
+/* One coordinate along the segment: the linear factor l0 + l1 s (or l0 (1-s) + l1 s) and its square. */
+typedef struct {
+  REAL l0, l1;
+  REAL q0, q1, q2;
+  int even; /* every exponent of this coordinate in P is even: Horner steps by the square */
+} AxisFactor;
+
+AxisFactor axis_factor(REAL l0, REAL l1, int even) {
+  AxisFactor f;
+  f.l0 = l0;
+  f.l1 = l1;
+  f.q0 = l0 * l0;
+  f.q1 = (REAL)2 * l0 * l1;
+  f.q2 = l1 * l1;
+  f.even = even;
+  return f;
+}
+
+/* c times L^times. With only even exponents every gap is even, and one quadratic pass replaces two linear
+ * ones: fewer flops and half the sweeps over c. */
+void poly_mul_axis(REAL* c, AxisFactor f, int times) {
+  if (f.even) {
+    for (int r = 0; r < times; r += 2) poly_mul_quadratic(c, f.q0, f.q1, f.q2);
+  } else {
+    for (int r = 0; r < times; ++r) poly_mul_linear(c, f.l0, f.l1);
+  }
 }
 
 /* c times one^times: degree elevation in the Bernstein form; nothing to do in the power basis. */
 void poly_mul_one(REAL* c, int times) {
 #if RESTRICT_BERNSTEIN
-  poly_mul_linear_pow(c, (REAL)1, (REAL)1, times);
+  for (int r = 0; r < times; ++r) poly_mul_linear(c, (REAL)1, (REAL)1);
 #else
   (void)c;
   (void)times;
@@ -69,12 +99,14 @@ void poly_set_constant(REAL* c, REAL a) {
 }
 
 /* Monomials arrive sorted by i, then j, then k, all descending, exponents packed as i | j<<8 | k<<16.
- * P = sum_i x^i sum_j y^j sum_k a_ijk z^k w^(D-i-j-k), evaluated as three nested Horner levels.
- * lx, ly, lz: the linear factors of the three coordinates. Result: out[0..DEGREE]. */
+ * P = sum_i x^i sum_j y^j sum_k a_ijk z^k w^(D-i-j-k), evaluated as three nested Horner levels, each
+ * accumulator homogeneous of one degree so that sums need no elevation.
+ * fx, fy, fz: the coordinates' factors along the segment. Result: out[0..DEGREE]. */
 void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint count,
-                     __constant const REAL* binomials, REAL2 lx, REAL2 ly, REAL2 lz, REAL* out) {
+                     __constant const REAL* binomials, AxisFactor fx, AxisFactor fy, AxisFactor fz, REAL* out) {
   REAL acc_z[NCOEF], acc_y[NCOEF];
-  int deg_x = -1, deg_y = -1, deg_z = -1; /* -1: level still empty */
+  int deg_z = -1;             /* degree of acc_z; -1 while the (i, j) group is empty */
+  int have_y = 0, have_x = 0; /* acc_y, out hold a partial sum */
   int cur_i = -1, cur_j = -1, cur_k = -1;
   int prev_i = -1, prev_j = -1;
 
@@ -90,36 +122,30 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
     }
     /* Close the z-level group (cur_i, cur_j) when (i, j) changes or the list ends. */
     if (deg_z >= 0 && (i != cur_i || j != cur_j)) {
-      poly_mul_linear_pow(acc_z, lz.x, lz.y, cur_k);
-      deg_z += cur_k;
-      const int full = DEGREE - cur_i - cur_j; /* B_ij is homogeneous of this degree */
-      poly_mul_one(acc_z, full - deg_z);
-      deg_z = full;
-      if (deg_y < 0) {
+      poly_mul_axis(acc_z, fz, cur_k);
+      poly_mul_one(acc_z, DEGREE - cur_i - cur_j - (deg_z + cur_k)); /* B_ij has degree D - i - j */
+      if (!have_y) {
         poly_copy(acc_y, acc_z);
-        deg_y = deg_z;
+        have_y = 1;
       } else {
-        poly_mul_linear_pow(acc_y, ly.x, ly.y, prev_j - cur_j);
-        deg_y += prev_j - cur_j;
+        poly_mul_axis(acc_y, fy, prev_j - cur_j);
         poly_add(acc_y, acc_z);
       }
       prev_j = cur_j;
       deg_z = -1;
     }
     /* Close the y-level group cur_i when i changes or the list ends. */
-    if (deg_y >= 0 && i != cur_i) {
-      poly_mul_linear_pow(acc_y, ly.x, ly.y, prev_j);
-      deg_y += prev_j;
-      if (deg_x < 0) {
+    if (have_y && i != cur_i) {
+      poly_mul_axis(acc_y, fy, prev_j);
+      if (!have_x) {
         poly_copy(out, acc_y);
-        deg_x = deg_y;
+        have_x = 1;
       } else {
-        poly_mul_linear_pow(out, lx.x, lx.y, prev_i - cur_i);
-        deg_x += prev_i - cur_i;
+        poly_mul_axis(out, fx, prev_i - cur_i);
         poly_add(out, acc_y);
       }
       prev_i = cur_i;
-      deg_y = -1;
+      have_y = 0;
     }
     if (m == count) break;
     /* Add a_ijk to the z-level Horner sum of group (i, j). */
@@ -127,7 +153,7 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
       poly_set_constant(acc_z, a);
       deg_z = 0;
     } else {
-      poly_mul_linear_pow(acc_z, lz.x, lz.y, cur_k - k);
+      poly_mul_axis(acc_z, fz, cur_k - k);
       deg_z += cur_k - k;
       poly_add_constant(acc_z, deg_z, a, binomials);
     }
@@ -135,11 +161,11 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
     cur_j = j;
     cur_k = k;
   }
-  if (deg_x < 0) { /* no monomials: the host never sends this, but stay defined */
+  if (!have_x) { /* no monomials: the host never sends this, but stay defined */
     poly_set_constant(out, 0);
     return;
   }
-  poly_mul_linear_pow(out, lx.x, lx.y, prev_i);
+  poly_mul_axis(out, fx, prev_i);
 }
 
 #endif /* ALGRAY_RESTRICT_H */

@@ -25,7 +25,7 @@ typedef struct {
 
 SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                          __global const uint* exps, __global const REAL* coefs, uint count,
-                         __constant const REAL* binomials, REAL noise) {
+                         __constant const REAL* binomials, uint even_axes, REAL noise) {
   SurfaceHit h;
   h.t = INFINITY;
   h.flags = 0;
@@ -45,18 +45,21 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   REAL root[NCOEF], iso_c[NCOEF];
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EYE
   /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
-  restrict_to_ray(exps, coefs, count, binomials, (REAL2)(o.x, d.x), (REAL2)(o.y, d.y), (REAL2)(o.z, d.z), root);
+  restrict_to_ray(exps, coefs, count, binomials, axis_factor(o.x, d.x, even_axes & 1),
+                  axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root);
   const Isolation iso = isolate_power(root, t_in, len, t_in, t_out, noise, iso_c);
 #else
   /* Entry and exit points: the ray restricted to the interval as s in [0, 1]. */
   const REAL3 pa = o + t_in * d, pb = o + t_out * d;
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  restrict_to_ray(exps, coefs, count, binomials, (REAL2)(pa.x, pb.x), (REAL2)(pa.y, pb.y), (REAL2)(pa.z, pb.z), root);
+  restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, pb.x, even_axes & 1),
+                  axis_factor(pa.y, pb.y, even_axes & 2), axis_factor(pa.z, pb.z, even_axes & 4), root);
   bernstein_from_scaled(root, binomials);
   const Isolation iso = isolate_bernstein(root, t_in, t_out, noise, iso_c);
 #else
   const REAL3 e = pb - pa;
-  restrict_to_ray(exps, coefs, count, binomials, (REAL2)(pa.x, e.x), (REAL2)(pa.y, e.y), (REAL2)(pa.z, e.z), root);
+  restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, e.x, even_axes & 1),
+                  axis_factor(pa.y, e.y, even_axes & 2), axis_factor(pa.z, e.z, even_axes & 4), root);
   const Isolation iso = isolate_power(root, (REAL)0, (REAL)1, t_in, t_out, noise, iso_c);
 #endif
 #endif

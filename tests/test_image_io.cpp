@@ -11,22 +11,25 @@
 #pragma GCC diagnostic pop
 #include <png.h>
 #include <signal.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csetjmp>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace fs = std::filesystem;
 using algray::FrameImage;
@@ -163,6 +166,63 @@ bool read_png(const fs::path& p, PngData& out) {
   png_destroy_read_struct(&png, &info, nullptr);
   std::fclose(fp);
   return true;
+}
+
+// The image tests/image_writer_tool.cpp writes: rgba then depth drawn from one mt19937(seed), as uniform noise.
+FrameImage noisy_image(int side, std::mt19937::result_type seed) {
+  FrameImage im;
+  im.width = im.height = side;
+  const std::size_t n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  im.rgba.resize(4 * n);
+  for (float& v : im.rgba) v = uniform(rng);
+  im.depth.resize(n);
+  for (float& v : im.depth) v = uniform(rng) * 100.0f;
+  return im;
+}
+
+// Runs image_writer_tool with these arguments in a child process and returns its pid (-1 if fork failed).
+// The child execs at once instead of writing itself: this process may already run OpenEXR's global thread
+// pool, whose threads would be missing in a forked child and deadlock its EXR write.
+pid_t spawn_writer(std::vector<std::string> args) {
+  args.insert(args.begin(), ALGRAY_IMAGE_WRITER_TOOL);
+  std::vector<char*> argv;  // built before fork: the child may only make async-signal-safe calls
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t child = ::fork();
+  if (child == 0) {
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  return child;
+}
+
+// Polls for the child's exit for at most `timeout`; returns its wait status, or nothing if it did not
+// exit in time (or cannot be waited for).
+std::optional<int> poll_child(pid_t child, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    int status = 0;
+    const pid_t r = ::waitpid(child, &status, WNOHANG);
+    if (r == child) return status;
+    if (r < 0 && errno != EINTR) return std::nullopt;
+    if (std::chrono::steady_clock::now() >= deadline) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
+// SIGKILLs a child that overran its time and reaps it, still without waiting forever.
+void kill_child(pid_t child) {
+  ::kill(child, SIGKILL);
+  (void)poll_child(child, std::chrono::seconds(5));
+}
+
+// Waits for the child, but never forever: a writer that hangs (e.g. deadlocked) is killed after 20 s.
+std::optional<int> wait_child(pid_t child) {
+  const std::optional<int> status = poll_child(child, std::chrono::seconds(20));
+  if (!status) kill_child(child);
+  return status;
 }
 
 }  // namespace
@@ -393,39 +453,19 @@ TEST_CASE("a failed write leaves the destination untouched and no temp file", "[
   }
   SECTION("the disk refuses data halfway through the write") {
     // A file-size limit makes the temp file's writes fail with EFBIG after a few kilobytes; done in a
-    // child so the limit does not leak into the test process.
+    // child process so the limit does not leak into the test process. The 256x256 image is noise, hence
+    // incompressible, so the PNG outgrows the limit too.
     const fs::path exr = dir / "out.exr";
     const fs::path png = dir / "out.png";
     write_bytes(exr, original);
     write_bytes(png, original);
-    FrameImage big = make_image(256, 256);
-    std::mt19937 rng(7);
-    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-    for (float& v : big.rgba) v = uniform(rng);  // incompressible, so the PNG outgrows the limit too
-    const pid_t child = ::fork();
+    const pid_t child = spawn_writer({"--fsize-limit=4096", "256", "7", exr.string(), png.string()});
     REQUIRE(child >= 0);
-    if (child == 0) {
-      ::signal(SIGXFSZ, SIG_IGN);
-      struct rlimit limit {};
-      limit.rlim_cur = limit.rlim_max = 4096;
-      ::setrlimit(RLIMIT_FSIZE, &limit);
-      int failures = 0;
-      try {
-        algray::write_exr(exr, big);
-      } catch (const OutputError&) {
-        ++failures;
-      }
-      try {
-        algray::write_png(png, big);
-      } catch (const OutputError&) {
-        ++failures;
-      }
-      ::_exit(failures);
-    }
-    int status = 0;
-    REQUIRE(::waitpid(child, &status, 0) == child);
-    REQUIRE(WIFEXITED(status));
-    CHECK(WEXITSTATUS(status) == 2);  // both writes reported failure
+    const std::optional<int> status = wait_child(child);
+    if (!status) FAIL("image_writer_tool did not exit within 20 s and was killed");
+    REQUIRE(WIFEXITED(*status));
+    INFO("exit status 127 means " ALGRAY_IMAGE_WRITER_TOOL " could not be executed");
+    CHECK(WEXITSTATUS(*status) == 2);  // both writes reported failure
     CHECK((read_bytes(exr) == original));
     CHECK((read_bytes(png) == original));
     CHECK(list_dir(dir.path()) == std::vector<std::string>{"out.exr", "out.png"});
@@ -439,40 +479,31 @@ TEST_CASE("a writer killed by SIGTERM leaves no temp file behind", "[image_io][s
   int side = 1024;
   bool interrupted = false;
   for (int attempt = 0; attempt < 3 && !interrupted; ++attempt, side *= 2) {
-    FrameImage im;
-    im.width = im.height = side;
-    const std::size_t n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
-    std::mt19937 rng(42);
-    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-    im.rgba.resize(4 * n);
-    for (float& v : im.rgba) v = uniform(rng);
-    im.depth.resize(n);
-    for (float& v : im.depth) v = uniform(rng) * 100.0f;
-
-    const pid_t child = ::fork();
+    constexpr std::mt19937::result_type seed = 42;
+    const pid_t child = spawn_writer({"--cleanup-handlers", std::to_string(side), std::to_string(seed), dest.string()});
     REQUIRE(child >= 0);
-    if (child == 0) {
-      algray::install_output_cleanup_handlers();
-      try {
-        algray::write_exr(dest, im);
-      } catch (...) {
-        ::_exit(3);
-      }
-      ::_exit(0);
-    }
     // Signal only once the temp file exists, so the kill lands inside the write rather than before it.
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     bool saw_temp = false, finished_first = false;
     int status = 0;
     while (!saw_temp && !finished_first && std::chrono::steady_clock::now() < deadline) {
       saw_temp = has_temp_file(dir.path());
-      finished_first = !saw_temp && ::waitpid(child, &status, WNOHANG) == child;
+      if (!saw_temp) {
+        const pid_t r = ::waitpid(child, &status, WNOHANG);
+        if (r < 0 && errno != EINTR) FAIL("waitpid failed on image_writer_tool: " << std::strerror(errno));
+        finished_first = r == child;
+      }
       if (!saw_temp && !finished_first) std::this_thread::sleep_for(std::chrono::microseconds(200));
     }
+    if (!saw_temp && !finished_first) {
+      kill_child(child);
+      FAIL("image_writer_tool neither created a temp file nor exited within 10 s and was killed");
+    }
     if (!finished_first) {
-      REQUIRE(saw_temp);
       ::kill(child, SIGTERM);
-      REQUIRE(::waitpid(child, &status, 0) == child);
+      const std::optional<int> waited = wait_child(child);
+      if (!waited) FAIL("image_writer_tool did not exit within 20 s of SIGTERM and was killed");
+      status = *waited;
       if (WIFSIGNALED(status)) {
         // Killed by the default action of the re-raised signal, after the handler cleaned up.
         CHECK(WTERMSIG(status) == SIGTERM);
@@ -482,12 +513,13 @@ TEST_CASE("a writer killed by SIGTERM leaves no temp file behind", "[image_io][s
       }
     }
     REQUIRE(WIFEXITED(status));
+    INFO("exit status 127 means " ALGRAY_IMAGE_WRITER_TOOL " could not be executed");
     REQUIRE(WEXITSTATUS(status) == 0);
     // The writer won the race: whatever exists must be the complete image.
     CHECK_FALSE(has_temp_file(dir.path()));
     const FrameImage back = algray::read_exr(dest);
     CHECK(back.width == side);
-    CHECK(back.depth == im.depth);
+    CHECK(back.depth == noisy_image(side, seed).depth);
     fs::remove(dest);
   }
   CHECK(interrupted);
