@@ -50,7 +50,7 @@ std::array<float, 16> world_to_ndc_matrix(const CameraSpec& camera, const RayBas
     const double half_tan = std::tan(glm::radians(camera.fov_y_degrees) / 2);
     proj[0] = 1 / (half_tan * aspect);
     proj[5] = 1 / half_tan;
-    proj[10] = 1;   // z passes through; w = -z
+    proj[10] = 1;  // z passes through; w = -z
     proj[11] = -1;
   } else {
     const double half_h = camera.ortho_height / 2;

@@ -2,7 +2,6 @@
 #pragma once
 
 #include <array>
-
 #include <glm/glm.hpp>
 
 namespace algray {

@@ -91,8 +91,8 @@ DeviceInfo select_device(const std::string& spec) {
   if (std::all_of(spec.begin(), spec.end(), [](unsigned char c) { return std::isdigit(c); })) {
     const unsigned long index = std::stoul(spec);
     if (index < devices.size()) return devices[index];
-    throw DeviceError("--device " + spec + ": there are only " + std::to_string(devices.size()) +
-                      " devices:\n" + describe_devices(devices));
+    throw DeviceError("--device " + spec + ": there are only " + std::to_string(devices.size()) + " devices:\n" +
+                      describe_devices(devices));
   }
   const std::string needle = lower(spec);
   for (const DeviceInfo& d : devices)

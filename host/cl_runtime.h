@@ -1,11 +1,10 @@
 // OpenCL platforms and devices: listing, choosing one by index or name, and the context and queue on it.
 #pragma once
 
+#include <CL/opencl.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <CL/opencl.hpp>
 
 namespace algray {
 

@@ -76,8 +76,12 @@ std::vector<Token> tokenize(std::string_view s) {
     Tok kind;
     std::size_t len = 1;
     switch (c) {
-      case '+': kind = Tok::Plus; break;
-      case '-': kind = Tok::Minus; break;
+      case '+':
+        kind = Tok::Plus;
+        break;
+      case '-':
+        kind = Tok::Minus;
+        break;
       case '*':
         if (i + 1 < s.size() && s[i + 1] == '*') {
           kind = Tok::Caret;
@@ -86,11 +90,20 @@ std::vector<Token> tokenize(std::string_view s) {
           kind = Tok::Star;
         }
         break;
-      case '/': kind = Tok::Slash; break;
-      case '^': kind = Tok::Caret; break;
-      case '(': kind = Tok::LParen; break;
-      case ')': kind = Tok::RParen; break;
-      default: throw EquationError(i, "unexpected character " + describe_char(c));
+      case '/':
+        kind = Tok::Slash;
+        break;
+      case '^':
+        kind = Tok::Caret;
+        break;
+      case '(':
+        kind = Tok::LParen;
+        break;
+      case ')':
+        kind = Tok::RParen;
+        break;
+      default:
+        throw EquationError(i, "unexpected character " + describe_char(c));
     }
     out.push_back({kind, start, s.substr(start, len)});
     i += len;
@@ -119,8 +132,7 @@ mpq_class parse_number(const Token& tok) {
     ++i;
     bool negative = false;
     if (s[i] == '+' || s[i] == '-') negative = s[i++] == '-';
-    for (; i < s.size(); ++i)
-      exp10 = std::min(exp10 * 10 + (s[i] - '0'), 1'000'000'000LL);  // saturate: huge is huge
+    for (; i < s.size(); ++i) exp10 = std::min(exp10 * 10 + (s[i] - '0'), 1'000'000'000LL);  // saturate: huge is huge
     if (negative) exp10 = -exp10;
   }
 

@@ -5,6 +5,8 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wconversion"
 #pragma GCC diagnostic ignored "-Wshadow"
+#include <ImathBox.h>
+#include <ImathMatrix.h>
 #include <ImfChannelList.h>
 #include <ImfDoubleAttribute.h>
 #include <ImfFrameBuffer.h>
@@ -12,10 +14,8 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfStandardAttributes.h>
-#include <ImfThreading.h>
 #include <ImfStringAttribute.h>
-#include <ImathBox.h>
-#include <ImathMatrix.h>
+#include <ImfThreading.h>
 #include <half.h>
 #pragma GCC diagnostic pop
 #include <fcntl.h>
@@ -36,9 +36,9 @@
 #include <limits>
 #include <memory>
 #include <mutex>
-#include <thread>
 #include <set>
 #include <system_error>
+#include <thread>
 
 namespace algray {
 namespace fs = std::filesystem;
@@ -76,7 +76,7 @@ std::string errno_text(int err) { return std::error_code(err, std::generic_categ
 // Owns one temporary file for its lifetime: registered for signal cleanup before the file can
 // exist, removed on destruction unless it was committed by renaming.
 class TempFile {
-public:
+ public:
   explicit TempFile(const fs::path& destination) {
     std::string stem = destination.filename().string();
     // Stay under NAME_MAX even for long destination names; uniqueness comes from pid and counter.
@@ -113,7 +113,7 @@ public:
     release_slot();
   }
 
-private:
+ private:
   void release_slot() {
     if (slot_ < 0) return;
     g_slots[slot_].state.store(kClaimed, std::memory_order_release);
@@ -180,8 +180,8 @@ std::size_t checked_pixel_count(const FrameImage& image) {
   // 16 floats per pixel is the widest buffer anyone sizes from this count.
   if (w > std::numeric_limits<std::size_t>::max() / 16 / h) throw OutputError("image too large");
   const std::size_t n = w * h;
-  if (image.rgba.size() != 4 * n) throw OutputError("rgba holds " + std::to_string(image.rgba.size()) +
-                                                    " floats, expected " + std::to_string(4 * n));
+  if (image.rgba.size() != 4 * n)
+    throw OutputError("rgba holds " + std::to_string(image.rgba.size()) + " floats, expected " + std::to_string(4 * n));
   return n;
 }
 
@@ -377,8 +377,10 @@ ImageFormat format_from_extension(const fs::path& p) {
 
 void write_image(const fs::path& path, const FrameImage& image) {
   switch (format_from_extension(path)) {
-    case ImageFormat::Exr: return write_exr(path, image);
-    case ImageFormat::Png: return write_png(path, image);
+    case ImageFormat::Exr:
+      return write_exr(path, image);
+    case ImageFormat::Png:
+      return write_png(path, image);
   }
 }
 
@@ -427,11 +429,16 @@ FrameImage read_exr(const fs::path& path) {
       if (it.channel().xSampling != 1 || it.channel().ySampling != 1) {
         throw OutputError("channel '" + name + "' is subsampled, which algray does not use");
       }
-      if (rgba_names.count(name)) has_rgba = true;
-      else if (name == "Z") has_depth = true;
-      else if (normal_names.count(name)) has_normal = true;
-      else if (it.channel().type == Imf::UINT) image.uint_channels.push_back({name, std::vector<std::uint32_t>(n)});
-      else image.float_channels.push_back({name, std::vector<float>(n)});
+      if (rgba_names.count(name))
+        has_rgba = true;
+      else if (name == "Z")
+        has_depth = true;
+      else if (normal_names.count(name))
+        has_normal = true;
+      else if (it.channel().type == Imf::UINT)
+        image.uint_channels.push_back({name, std::vector<std::uint32_t>(n)});
+      else
+        image.float_channels.push_back({name, std::vector<float>(n)});
     }
 
     // Slices are attached only after every vector has its final size, so no pointer is invalidated.

@@ -34,14 +34,14 @@ std::string enum_choices(const std::array<std::pair<const char*, E>, N>& names) 
   return s;
 }
 
-constexpr std::array<std::pair<const char*, Precision>, 2> kPrecisions{{{"float", Precision::Float},
-                                                                        {"double", Precision::Double}}};
+constexpr std::array<std::pair<const char*, Precision>, 2> kPrecisions{
+    {{"float", Precision::Float}, {"double", Precision::Double}}};
 constexpr std::array<std::pair<const char*, Isolation>, 2> kIsolations{
     {{"bernstein", Isolation::Bernstein}, {"descartes", Isolation::PowerDescartes}}};
 constexpr std::array<std::pair<const char*, Refinement>, 2> kRefinements{
     {{"brent", Refinement::Brent}, {"bisection", Refinement::Bisection}}};
-constexpr std::array<std::pair<const char*, RayOrigin>, 2> kOrigins{{{"extent", RayOrigin::Extent},
-                                                                     {"eye", RayOrigin::Eye}}};
+constexpr std::array<std::pair<const char*, RayOrigin>, 2> kOrigins{
+    {{"extent", RayOrigin::Extent}, {"eye", RayOrigin::Eye}}};
 
 std::string hex_double(double v) {
   char buf[64];
@@ -65,16 +65,13 @@ std::string refinement_choices() { return enum_choices(kRefinements); }
 std::string ray_origin_choices() { return enum_choices(kOrigins); }
 
 std::string KernelConfig::build_options() const {
-  const int isolation_id =
-      isolation == Isolation::Bernstein ? ALGRAY_ISOLATION_BERNSTEIN : ALGRAY_ISOLATION_POWER;
-  const int refinement_id =
-      refinement == Refinement::Brent ? ALGRAY_REFINEMENT_BRENT : ALGRAY_REFINEMENT_BISECTION;
+  const int isolation_id = isolation == Isolation::Bernstein ? ALGRAY_ISOLATION_BERNSTEIN : ALGRAY_ISOLATION_POWER;
+  const int refinement_id = refinement == Refinement::Brent ? ALGRAY_REFINEMENT_BRENT : ALGRAY_REFINEMENT_BISECTION;
   const int origin_id = ray_origin == RayOrigin::Extent ? ALGRAY_ORIGIN_EXTENT : ALGRAY_ORIGIN_EYE;
   // Hexadecimal literals carry the tolerance bit for bit; float builds get a float literal, as devices
   // without fp64 need not accept double constants.
-  const std::string tolerance_literal = precision == Precision::Double
-                                            ? hex_double(tolerance)
-                                            : hex_double(static_cast<float>(tolerance)) + "f";
+  const std::string tolerance_literal =
+      precision == Precision::Double ? hex_double(tolerance) : hex_double(static_cast<float>(tolerance)) + "f";
   return "-cl-std=CL1.2 -D DEGREE=" + std::to_string(degree) +
          " -D ALGRAY_DOUBLE=" + (precision == Precision::Double ? "1" : "0") +
          " -D ISOLATION=" + std::to_string(isolation_id) + " -D REFINEMENT=" + std::to_string(refinement_id) +

@@ -13,7 +13,8 @@ namespace {
 std::string read_kernel_file(const std::string& name) {
   if (const char* dir = std::getenv("ALGRAY_KERNEL_DIR"); dir && *dir) {
     std::ifstream in(std::string(dir) + "/" + name, std::ios::binary);
-    if (!in) throw std::runtime_error("ALGRAY_KERNEL_DIR is set but " + std::string(dir) + "/" + name + " cannot be read");
+    if (!in)
+      throw std::runtime_error("ALGRAY_KERNEL_DIR is set but " + std::string(dir) + "/" + name + " cannot be read");
     std::ostringstream text;
     text << in.rdbuf();
     return text.str();

@@ -1,8 +1,8 @@
 // The algray command line: `algray render` and `algray devices`.
-#include <iostream>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <iostream>
 
 #include "cl_runtime.h"
 #include "image_io.h"

@@ -27,8 +27,8 @@ T round_rational(const mpq_class& q) {
   const mpz_class& b = q.get_den();
 
   // e = floor(log2(a/b)): the bit lengths pin it down to one of two values.
-  long e = static_cast<long>(mpz_sizeinbase(a.get_mpz_t(), 2)) -
-           static_cast<long>(mpz_sizeinbase(b.get_mpz_t(), 2)) - 1;
+  long e =
+      static_cast<long>(mpz_sizeinbase(a.get_mpz_t(), 2)) - static_cast<long>(mpz_sizeinbase(b.get_mpz_t(), 2)) - 1;
   {
     mpz_class lhs = a, rhs = b;
     if (e + 1 >= 0)
@@ -90,10 +90,10 @@ std::string format_magnitude(const mpq_class& v) {
     mpz_class ten_pow;
     mpz_ui_pow_ui(ten_pow.get_mpz_t(), 10, places);
     const mpz_class scaled = num * ten_pow / den;
-    std::string s = scaled.get_str();
-    if (s.size() <= places) s.insert(0, places + 1 - s.size(), '0');
-    s.insert(s.size() - places, ".");
-    return s;
+    std::string digits = scaled.get_str();
+    if (digits.size() <= places) digits = std::string(places + 1 - digits.size(), '0') + digits;
+    const std::size_t point = digits.size() - places;
+    return digits.substr(0, point) + "." + digits.substr(point);
   }
   if (mpz_sizeinbase(num.get_mpz_t(), 10) <= 12 && mpz_sizeinbase(den.get_mpz_t(), 10) <= 12)
     return num.get_str() + "/" + den.get_str();
@@ -204,8 +204,7 @@ std::optional<mpq_class> Polynomial::constant_value() const {
   return terms_.begin()->second;
 }
 
-Polynomial Polynomial::translated_scaled(const std::array<mpq_class, 3>& centre,
-                                         const mpq_class& scale) const {
+Polynomial Polynomial::translated_scaled(const std::array<mpq_class, 3>& centre, const mpq_class& scale) const {
   const int d = degree();
   if (d < 0) return {};
   DenseCube cube(d);
@@ -306,7 +305,10 @@ std::string Polynomial::to_string() const {
       if (e == 0) continue;
       if (!vars.empty()) vars += "*";
       vars += names[a];
-      if (e > 1) vars += "^" + std::to_string(e);
+      if (e > 1) {
+        vars += '^';
+        vars += std::to_string(e);
+      }
     }
     const mpq_class magnitude = abs(t->second);
     if (vars.empty())

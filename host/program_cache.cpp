@@ -1,12 +1,13 @@
 // Program cache: in memory, then on disk (verified before use, rebuilt when stale or corrupt), then compiled.
 #include "program_cache.h"
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include "kernel_sources.h"
 
@@ -60,13 +61,11 @@ cl::Kernel ProgramCache::kernel(ClSession& session, const KernelConfig& config, 
   // Everything the binary depends on: a change to any of it must miss.
   const std::string identity = "source-hash=" + hex64(fnv1a(source)) + "\noptions=" + options +
                                "\ndevice=" + session.info.name + "\ndriver=" + session.info.driver_version +
-                               "\nplatform=" + session.info.platform_name + " " + session.info.platform_version +
-                               "\n";
+                               "\nplatform=" + session.info.platform_name + " " + session.info.platform_version + "\n";
   ProgramRecord rec{config.key(), options, "built", 0};
 
   cl::Program program;
-  const std::string memory_key = std::to_string(reinterpret_cast<std::uintptr_t>(session.context()))
-                                 + "\n" + identity;
+  const std::string memory_key = std::to_string(reinterpret_cast<std::uintptr_t>(session.context())) + "\n" + identity;
   if (auto it = memory_.find(memory_key); enabled_ && it != memory_.end()) {
     program = it->second;
     rec.origin = "memory";
@@ -86,8 +85,8 @@ cl::Kernel ProgramCache::kernel(ClSession& session, const KernelConfig& config, 
   return k;
 }
 
-cl::Program ProgramCache::build_from_source(ClSession& session, const std::string& source,
-                                            const std::string& options, const std::string& key) {
+cl::Program ProgramCache::build_from_source(ClSession& session, const std::string& source, const std::string& options,
+                                            const std::string& key) {
   cl::Program program(session.context, source);
   try {
     program.build({session.info.device}, options.c_str());

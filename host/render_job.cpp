@@ -1,15 +1,15 @@
 // The render command: validates everything before any work, renders, then writes images and stats atomically.
 #include "render_job.h"
 
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <sstream>
-#include <unistd.h>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "cl_runtime.h"
 #include "program_cache.h"
@@ -90,23 +90,32 @@ class PhaseTimer {
   std::vector<std::pair<std::string, double>> phases_;
 };
 
-nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const RenderResult& r,
-                          const DeviceInfo& device, const PhaseTimer& timer) {
+nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const RenderResult& r, const DeviceInfo& device,
+                          const PhaseTimer& timer) {
   nlohmann::json j;
   j["scene"] = scene.source;
   j["name"] = scene.name;
   j["outputs"] = req.outputs;
   j["image"] = {{"width", scene.image.width}, {"height", scene.image.height}};
-  j["device"] = {{"name", device.name}, {"platform", device.platform_name}, {"type", device.type},
-                 {"fp64", device.fp64}, {"driver", device.driver_version}};
+  j["device"] = {{"name", device.name},
+                 {"platform", device.platform_name},
+                 {"type", device.type},
+                 {"fp64", device.fp64},
+                 {"driver", device.driver_version}};
   j["surface"] = {{"equation", scene.equation}, {"degree", r.config.degree}};
-  j["solver"] = {{"isolation", to_string(r.config.isolation)}, {"refinement", to_string(r.config.refinement)},
-                 {"ray_origin", to_string(r.config.ray_origin)}, {"precision", to_string(r.config.precision)},
-                 {"tolerance", r.config.tolerance}, {"max_iterations", r.config.max_iterations}};
+  j["solver"] = {{"isolation", to_string(r.config.isolation)},
+                 {"refinement", to_string(r.config.refinement)},
+                 {"ray_origin", to_string(r.config.ray_origin)},
+                 {"precision", to_string(r.config.precision)},
+                 {"tolerance", r.config.tolerance},
+                 {"max_iterations", r.config.max_iterations}};
   j["cache"] = req.use_cache ? ProgramCache::default_directory().string() : "off";
   for (const ProgramRecord& p : r.programs)
-    j["programs"].push_back({{"key", p.key}, {"options", p.options}, {"from_cache", p.origin != "built"},
-                             {"origin", p.origin}, {"build_ms", p.build_ms}});
+    j["programs"].push_back({{"key", p.key},
+                             {"options", p.options},
+                             {"from_cache", p.origin != "built"},
+                             {"origin", p.origin},
+                             {"build_ms", p.build_ms}});
   std::uint64_t hits = 0, tangent = 0, budget = 0, steps = 0, iterations = 0;
   for (const HitRecord& h : r.hits.records) {
     hits += (h.flags & ALGRAY_HIT_FOUND) != 0;
@@ -116,10 +125,16 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
     iterations += h.work >> 16;
   }
   for (const PassStats& p : r.passes)
-    j["passes"].push_back({{"name", p.name}, {"rays", p.rays}, {"launches", p.launches},
-                           {"kernel_ms", p.kernel_ms}, {"wall_ms", p.wall_ms}});
-  j["pixels"] = {{"hits", hits}, {"tangent_hits", tangent}, {"depth_limited", budget},
-                 {"isolation_steps", steps}, {"refine_iterations", iterations}};
+    j["passes"].push_back({{"name", p.name},
+                           {"rays", p.rays},
+                           {"launches", p.launches},
+                           {"kernel_ms", p.kernel_ms},
+                           {"wall_ms", p.wall_ms}});
+  j["pixels"] = {{"hits", hits},
+                 {"tangent_hits", tangent},
+                 {"depth_limited", budget},
+                 {"isolation_steps", steps},
+                 {"refine_iterations", iterations}};
   j["phases_ms"] = timer.json();
   j["total_ms"] = timer.total_ms();
   return j;
@@ -145,7 +160,8 @@ void write_text_atomically(const std::string& path, const std::string& text) {
 void check_writable(const std::string& path) {
   const std::filesystem::path p(path);
   const std::filesystem::path dir = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
-  if (!std::filesystem::is_directory(dir)) throw OutputError(path + ": directory '" + dir.string() + "' does not exist");
+  if (!std::filesystem::is_directory(dir))
+    throw OutputError(path + ": directory '" + dir.string() + "' does not exist");
   if (std::filesystem::is_directory(p)) throw OutputError(path + " is a directory");
   if (::access(dir.c_str(), W_OK) != 0) throw OutputError(path + ": directory '" + dir.string() + "' is not writable");
 }

@@ -24,7 +24,8 @@ class KernelArgs {
     if (double_)
       kernel_.setArg(index_++, cl_double4{{v.x, v.y, v.z, 0}});
     else
-      kernel_.setArg(index_++, cl_float4{{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0}});
+      kernel_.setArg(index_++,
+                     cl_float4{{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0}});
   }
   void real(double v) {
     if (double_)
@@ -61,8 +62,8 @@ std::vector<double> binomial_table(int degree) {
   for (int n = 0; n <= degree; ++n) {
     t[static_cast<std::size_t>(n * n1)] = 1;
     for (int k = 1; k <= n; ++k)
-      t[static_cast<std::size_t>(n * n1 + k)] =
-          t[static_cast<std::size_t>((n - 1) * n1 + k - 1)] + (k < n ? t[static_cast<std::size_t>((n - 1) * n1 + k)] : 0);
+      t[static_cast<std::size_t>(n * n1 + k)] = t[static_cast<std::size_t>((n - 1) * n1 + k - 1)] +
+                                                (k < n ? t[static_cast<std::size_t>((n - 1) * n1 + k)] : 0);
   }
   return t;
 }
@@ -111,8 +112,8 @@ KernelConfig primary_config(const Scene& scene, Precision precision) {
   config.refinement = scene.render.refinement;
   config.ray_origin = scene.render.ray_origin;
   // Below a few units of roundoff the stopping rule can never trigger.
-  const double eps = precision == Precision::Double ? std::numeric_limits<double>::epsilon()
-                                                    : std::numeric_limits<float>::epsilon();
+  const double eps =
+      precision == Precision::Double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();
   config.tolerance = std::max(scene.render.tolerance, 2 * eps);
   config.max_iterations = scene.render.max_iterations;
   return config;
@@ -139,8 +140,8 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, pixels * sizeof(HitRecord));
 
-  const double eps = precision == Precision::Double ? std::numeric_limits<double>::epsilon()
-                                                    : std::numeric_limits<float>::epsilon();
+  const double eps =
+      precision == Precision::Double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();
   const RayBasis& b = result.basis;
   KernelArgs args(kernel, precision);
   args.real_vec(b.o00);
@@ -177,16 +178,16 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
       kernel.setArg(tile_arg + 2, static_cast<cl_uint>(w));
       kernel.setArg(tile_arg + 3, static_cast<cl_uint>(h));
       cl::Event done;
-      session_.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(static_cast<std::size_t>(w),
-                                                                             static_cast<std::size_t>(h)),
+      session_.queue.enqueueNDRangeKernel(kernel, cl::NullRange,
+                                          cl::NDRange(static_cast<std::size_t>(w), static_cast<std::size_t>(h)),
                                           cl::NullRange, nullptr, &done);
       // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
       done.wait();
       pass.kernel_ms += ms_between(done);
       ++pass.launches;
       if (show_progress) {
-        std::fprintf(stderr, "\rrendering %s: %3d%% (%d/%d tiles)", scene.name.c_str(),
-                     100 * pass.launches / tiles, pass.launches, tiles);
+        std::fprintf(stderr, "\rrendering %s: %3d%% (%d/%d tiles)", scene.name.c_str(), 100 * pass.launches / tiles,
+                     pass.launches, tiles);
         std::fflush(stderr);
       }
     }

@@ -18,7 +18,7 @@ struct SurfaceData {
   int degree = 0;
   std::vector<cl_uint> exponents;  // i | j << 8 | k << 16, sorted by i, j, k descending
   std::vector<double> coefficients;
-  double abs_sum = 0;  // sum of |coefficients|: bounds |P| anywhere in the extent
+  double abs_sum = 0;     // sum of |coefficients|: bounds |P| anywhere in the extent
   cl_uint even_axes = 0;  // bit a set when every exponent of axis a is even (the kernels then step by squares)
 };
 SurfaceData prepare_surface(const Scene& scene);

@@ -1,13 +1,13 @@
 // Reads scene TOML into a Scene, checking every key and value and naming file, line and column on error.
 #include "scene.h"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
-
-#include <toml++/toml.h>
 
 #include "embedded_files.h"
 #include "expression.h"
@@ -74,7 +74,8 @@ class SceneReader {
       v = *f;
     else
       fail(node.source(), what + " must be a number");
-    if (!std::isfinite(v)) fail(node.source(), what + " must be finite, not " + std::string(std::isnan(v) ? "nan" : "inf"));
+    if (!std::isfinite(v))
+      fail(node.source(), what + " must be finite, not " + std::string(std::isnan(v) ? "nan" : "inf"));
     return v;
   }
 
@@ -171,9 +172,8 @@ const std::set<std::string> kExtentKeys{"type", "centre", "radius", "min", "max"
 const std::set<std::string> kCameraKeys{"projection", "eye", "look_at", "up", "fov_y", "height"};
 const std::set<std::string> kImageKeys{"width", "height", "background"};
 const std::set<std::string> kColourKeys{"front", "back"};
-const std::set<std::string> kRenderKeys{"precision",      "tolerance", "isolation", "refinement", "ray_origin",
-                                        "max_iterations", "tile_size"};
-
+const std::set<std::string> kRenderKeys{"precision",  "tolerance",      "isolation", "refinement",
+                                        "ray_origin", "max_iterations", "tile_size"};
 
 bool is_identifier(const std::string& s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
@@ -221,7 +221,8 @@ Polynomial polynomial_from_terms(const SceneReader& r, const toml::node& terms_n
   Polynomial p;
   for (const toml::node& t : *terms) {
     const toml::array* a = t.as_array();
-    if (!a || a->size() != 4) r.fail(t.source(), "each term must be [i, j, k, a]: exponents of x, y, z and the coefficient");
+    if (!a || a->size() != 4)
+      r.fail(t.source(), "each term must be [i, j, k, a]: exponents of x, y, z and the coefficient");
     const int i = static_cast<int>(r.integer(*a->get(0), "exponent i", 0, 1000));
     const int j = static_cast<int>(r.integer(*a->get(1), "exponent j", 0, 1000));
     const int k = static_cast<int>(r.integer(*a->get(2), "exponent k", 0, 1000));
@@ -271,18 +272,20 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
   if (degree < 0) r.fail(surface_anchor.source(), "the polynomial is identically zero after expansion");
   if (degree == 0) r.fail(surface_anchor.source(), "the polynomial is a nonzero constant: it has no points");
   if (degree > kMaxDegree)
-    r.fail(surface_anchor.source(), "degree " + std::to_string(degree) + " exceeds the supported maximum " +
-                                        std::to_string(kMaxDegree));
+    r.fail(surface_anchor.source(),
+           "degree " + std::to_string(degree) + " exceeds the supported maximum " + std::to_string(kMaxDegree));
   if (const toml::node* n = surface->get("name")) scene.name = r.string(*n, "surface.name");
 
   const toml::table* extent = r.subtable(root, "extent");
-  if (!extent) r.fail(root.source(), "missing [extent] table (a sphere with centre and radius, or a box with min and max)");
+  if (!extent)
+    r.fail(root.source(), "missing [extent] table (a sphere with centre and radius, or a box with min and max)");
   r.check_keys(*extent, "extent", kExtentKeys);
   const std::string type = extent->get("type") ? r.string(*extent->get("type"), "extent.type") : "sphere";
   if (type == "sphere") {
     scene.extent.kind = ExtentKind::Sphere;
     for (const char* k : {"min", "max"})
-      if (const toml::node* n = extent->get(k)) r.fail(n->source(), std::string("extent.") + k + " belongs to a box extent");
+      if (const toml::node* n = extent->get(k))
+        r.fail(n->source(), std::string("extent.") + k + " belongs to a box extent");
     if (const toml::node* n = extent->get("centre")) scene.extent.centre = r.vec3(*n, "extent.centre");
     const toml::node* radius = extent->get("radius");
     if (!radius) r.fail(extent->source(), "a sphere extent needs a radius");
@@ -291,7 +294,8 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
   } else if (type == "box") {
     scene.extent.kind = ExtentKind::Box;
     for (const char* k : {"centre", "radius"})
-      if (const toml::node* n = extent->get(k)) r.fail(n->source(), std::string("extent.") + k + " belongs to a sphere extent");
+      if (const toml::node* n = extent->get(k))
+        r.fail(n->source(), std::string("extent.") + k + " belongs to a sphere extent");
     const toml::node* mn = extent->get("min");
     const toml::node* mx = extent->get("max");
     if (!mn || !mx) r.fail(extent->source(), "a box extent needs min and max");
@@ -310,9 +314,12 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
   CameraSpec& cam = scene.camera;
   if (const toml::node* n = camera->get("projection")) {
     const std::string p = r.string(*n, "camera.projection");
-    if (p == "perspective") cam.projection = Projection::Perspective;
-    else if (p == "orthographic") cam.projection = Projection::Orthographic;
-    else r.fail(n->source(), "camera.projection must be \"perspective\" or \"orthographic\"");
+    if (p == "perspective")
+      cam.projection = Projection::Perspective;
+    else if (p == "orthographic")
+      cam.projection = Projection::Orthographic;
+    else
+      r.fail(n->source(), "camera.projection must be \"perspective\" or \"orthographic\"");
   }
   for (const char* k : {"eye", "look_at", "up"})
     if (!camera->get(k)) r.fail(camera->source(), std::string("camera.") + k + " is required");
@@ -350,8 +357,10 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
 
   if (const toml::table* colours = r.subtable(root, "colours")) {
     r.check_keys(*colours, "colours", kColourKeys);
-    if (const toml::node* n = colours->get("front")) scene.colours.front = glm::dvec3(r.colour(*n, "colours.front", false));
-    if (const toml::node* n = colours->get("back")) scene.colours.back = glm::dvec3(r.colour(*n, "colours.back", false));
+    if (const toml::node* n = colours->get("front"))
+      scene.colours.front = glm::dvec3(r.colour(*n, "colours.front", false));
+    if (const toml::node* n = colours->get("back"))
+      scene.colours.back = glm::dvec3(r.colour(*n, "colours.back", false));
   }
 
   if (const toml::table* render = r.subtable(root, "render")) {
@@ -360,9 +369,12 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
     if (const toml::node* n = render->get("precision")) {
       const std::string p = r.string(*n, "render.precision");
       Precision value;
-      if (p == "auto") rs.precision.reset();
-      else if (parse_precision(p, value)) rs.precision = value;
-      else r.fail(n->source(), "render.precision must be auto, " + precision_choices());
+      if (p == "auto")
+        rs.precision.reset();
+      else if (parse_precision(p, value))
+        rs.precision = value;
+      else
+        r.fail(n->source(), "render.precision must be auto, " + precision_choices());
     }
     if (const toml::node* n = render->get("tolerance")) {
       rs.tolerance = r.number(*n, "render.tolerance");
@@ -432,7 +444,8 @@ Scene load_scene_file(const std::string& path, const std::vector<Override>& over
 
 Scene default_scene(const std::vector<Override>& overrides) {
   for (const EmbeddedFile& f : embedded_scene_files())
-    if (std::string(f.name) == "barth_sextic.toml") return load_scene_text(f.text, "<built-in default scene>", overrides);
+    if (std::string(f.name) == "barth_sextic.toml")
+      return load_scene_text(f.text, "<built-in default scene>", overrides);
   throw std::logic_error("the default scene was not embedded");
 }
 

@@ -1,13 +1,12 @@
 // Scene: the surface, extent, camera, image, colours and render settings read from a TOML file and overrides.
 #pragma once
 
+#include <glm/glm.hpp>
 #include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "camera.h"
 #include "kernel_config.h"

@@ -7,21 +7,40 @@
 /* The restriction produced scaled coefficients c_k = C(n,k) b_k; Descartes' rule and de Casteljau want b_k. */
 void bernstein_from_scaled(REAL* c, __constant const REAL* binomials) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
+  ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) c[k] /= row[k];
 }
 
 /* Keeps the part of the curve on [0, x]. In place: after pass r, c[r] is the r-th left coefficient. */
 void casteljau_keep_left(REAL* c, REAL x) {
   const REAL x1 = (REAL)1 - x;
+  ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r)
+    ALGRAY_UNROLL
     for (int k = DEGREE; k >= r; --k) c[k] = x1 * c[k - 1] + x * c[k];
 }
 
 /* Keeps the part on [x, 1]. */
 void casteljau_keep_right(REAL* c, REAL x) {
   const REAL x1 = (REAL)1 - x;
+  ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r)
+    ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE - r; ++k) c[k] = x1 * c[k] + x * c[k + 1];
+}
+
+/* Halves c at 1/2 in one de Casteljau triangle: c becomes the left half, right the right half. */
+void casteljau_halve(REAL* c, REAL* right) {
+  REAL t[NCOEF];
+  poly_copy(t, c);
+  right[DEGREE] = t[DEGREE];
+  ALGRAY_UNROLL
+  for (int r = 1; r <= DEGREE; ++r) {
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE - r; ++k) t[k] = (REAL)0.5 * (t[k] + t[k + 1]);
+    c[r] = t[0];
+    right[DEGREE - r] = t[DEGREE - r];
+  }
 }
 
 /* Value at y by de Casteljau: the most stable evaluation, used off the hot path. */
@@ -29,7 +48,9 @@ REAL bernstein_value(const REAL* c, REAL y) {
   REAL w[NCOEF];
   poly_copy(w, c);
   const REAL y1 = (REAL)1 - y;
+  ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r)
+    ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE - r; ++k) w[k] = y1 * w[k] + y * w[k + 1];
   return w[0];
 }
@@ -76,9 +97,7 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise,
     if (v >= 1) {
       const int located = width * len <= stop_width(t_in + iso.lo * len);
       if (!located && level < REAL_MAX_HALVINGS) {
-        poly_copy(sib, cur);
-        casteljau_keep_left(cur, (REAL)0.5);
-        casteljau_keep_right(sib, (REAL)0.5);
+        casteljau_halve(cur, sib);
         ++level;
         idx *= 2;
         sib_level = level;
@@ -114,12 +133,14 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise,
 /* Turns Bernstein coefficients into the form isolated_value() expects: c_k * C(n,k). */
 void prepare_isolated(REAL* c, __constant const REAL* binomials) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
+  ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) c[k] *= row[k];
 }
 
 /* x^DEGREE by repeated multiplication: pown() goes through exp and log on some devices. */
 REAL power_of(REAL x) {
   REAL p = 1;
+  ALGRAY_UNROLL
   for (int k = 0; k < DEGREE; ++k) p *= x;
   return p;
 }
@@ -130,11 +151,13 @@ REAL isolated_value(const REAL* c, REAL y) {
   if (y <= (REAL)0.5) {
     const REAL r = y / ((REAL)1 - y);
     REAL h = c[DEGREE];
+    ALGRAY_UNROLL
     for (int k = DEGREE - 1; k >= 0; --k) h = h * r + c[k];
     return h * power_of(1 - y);
   }
   const REAL r = ((REAL)1 - y) / y;
   REAL h = c[0];
+  ALGRAY_UNROLL
   for (int k = 1; k <= DEGREE; ++k) h = h * r + c[k];
   return h * power_of(y);
 }

@@ -40,6 +40,7 @@ Isolation iso_finish_none(Isolation iso) {
 int sign_variations(const REAL* c) {
   int v = 0;
   int prev = 0; /* sign of the last nonzero coefficient, 0 before the first */
+  ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) {
     const int s = (c[k] > 0) - (c[k] < 0);
     if (s == 0) continue;

@@ -6,7 +6,9 @@
 
 /* c(x) -> c(x + a), by repeated synthetic division. */
 void taylor_shift(REAL* c, REAL a) {
+  ALGRAY_UNROLL
   for (int i = 0; i < DEGREE; ++i)
+    ALGRAY_UNROLL
     for (int k = DEGREE - 1; k >= i; --k) c[k] += a * c[k + 1];
 }
 
@@ -15,6 +17,7 @@ void power_on_interval(const REAL* p, REAL alpha, REAL beta, REAL* a1) {
   poly_copy(a1, p);
   if (alpha != 0) taylor_shift(a1, alpha);
   REAL s = 1;
+  ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) {
     a1[k] *= s;
     s *= beta;
@@ -25,6 +28,7 @@ void power_on_interval(const REAL* p, REAL alpha, REAL beta, REAL* a1) {
  * except a root at 1, which maps to x = 0 and is not counted. */
 int descartes_unit_interval(const REAL* a1) {
   REAL a2[NCOEF];
+  ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) a2[k] = a1[DEGREE - k];
   taylor_shift(a2, (REAL)1);
   return sign_variations(a2);
@@ -32,6 +36,7 @@ int descartes_unit_interval(const REAL* a1) {
 
 REAL power_value(const REAL* c, REAL y) {
   REAL h = c[DEGREE];
+  ALGRAY_UNROLL
   for (int k = DEGREE - 1; k >= 0; --k) h = h * y + c[k];
   return h;
 }

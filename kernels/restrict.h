@@ -22,13 +22,15 @@
  * let the compiler unroll them and keep the arrays in registers, which beats skipping the zeros. */
 
 /* c (degree < DEGREE) times (l0 + l1 s), or times (l0 (1-s) + l1 s) in the scaled Bernstein form: same recurrence. */
-void poly_mul_linear(REAL* c, REAL l0, REAL l1) {
+ALGRAY_INLINE void poly_mul_linear(REAL* c, REAL l0, REAL l1) {
+  ALGRAY_UNROLL
   for (int k = DEGREE; k > 0; --k) c[k] = l0 * c[k] + l1 * c[k - 1];
   c[0] = l0 * c[0];
 }
 
 /* c (degree < DEGREE - 1) times (q0 + q1 s + q2 s^2), or the same in the scaled Bernstein form. */
-void poly_mul_quadratic(REAL* c, REAL q0, REAL q1, REAL q2) {
+ALGRAY_INLINE void poly_mul_quadratic(REAL* c, REAL q0, REAL q1, REAL q2) {
+  ALGRAY_UNROLL
   for (int k = DEGREE; k > 1; --k) c[k] = q0 * c[k] + q1 * c[k - 1] + q2 * c[k - 2];
   c[1] = q0 * c[1] + q1 * c[0];
   c[0] = q0 * c[0];
@@ -54,7 +56,7 @@ AxisFactor axis_factor(REAL l0, REAL l1, int even) {
 
 /* c times L^times. With only even exponents every gap is even, and one quadratic pass replaces two linear
  * ones: fewer flops and half the sweeps over c. */
-void poly_mul_axis(REAL* c, AxisFactor f, int times) {
+ALGRAY_INLINE void poly_mul_axis(REAL* c, AxisFactor f, int times) {
   if (f.even) {
     for (int r = 0; r < times; r += 2) poly_mul_quadratic(c, f.q0, f.q1, f.q2);
   } else {
@@ -63,7 +65,7 @@ void poly_mul_axis(REAL* c, AxisFactor f, int times) {
 }
 
 /* c times one^times: degree elevation in the Bernstein form; nothing to do in the power basis. */
-void poly_mul_one(REAL* c, int times) {
+ALGRAY_INLINE void poly_mul_one(REAL* c, int times) {
 #if RESTRICT_BERNSTEIN
   for (int r = 0; r < times; ++r) poly_mul_linear(c, (REAL)1, (REAL)1);
 #else
@@ -73,10 +75,11 @@ void poly_mul_one(REAL* c, int times) {
 }
 
 /* c (degree n) plus a * one^n. binomials[n * NCOEF + k] = C(n, k), zero for k > n. */
-void poly_add_constant(REAL* c, int n, REAL a, __constant const REAL* binomials) {
+ALGRAY_INLINE void poly_add_constant(REAL* c, int n, REAL a, __constant const REAL* binomials) {
 #if RESTRICT_BERNSTEIN
   /* one^n = sum C(n,k) (1-s)^(n-k) s^k in the scaled basis. */
   __constant const REAL* row = binomials + n * NCOEF;
+  ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) c[k] += a * row[k];
 #else
   (void)n;
@@ -85,15 +88,17 @@ void poly_add_constant(REAL* c, int n, REAL a, __constant const REAL* binomials)
 #endif
 }
 
-void poly_add(REAL* c, const REAL* other) {
+ALGRAY_INLINE void poly_add(REAL* c, const REAL* other) {
+  ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) c[k] += other[k];
 }
 
-void poly_copy(REAL* dst, const REAL* src) {
+ALGRAY_INLINE void poly_copy(REAL* dst, const REAL* src) {
+  ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) dst[k] = src[k];
 }
 
-void poly_set_constant(REAL* c, REAL a) {
+ALGRAY_INLINE void poly_set_constant(REAL* c, REAL a) {
   c[0] = a;
   for (int k = 1; k <= DEGREE; ++k) c[k] = 0;
 }

@@ -1,4 +1,5 @@
-// Helper for test_image_io: writes a noisy image in a fresh process, optionally under a file-size limit or cleanup handlers.
+// Helper for test_image_io: writes a noisy image in a fresh process, optionally under a file-size limit or cleanup
+// handlers.
 //
 // usage: image_writer_tool [--cleanup-handlers] [--fsize-limit=BYTES] SIDE SEED PATH...
 //
@@ -9,8 +10,6 @@
 //
 // The tests fork() and exec this instead of writing in a forked child, because the test process may
 // already run OpenEXR's global thread pool, whose threads do not exist in a forked child.
-#include "image_io.h"
-
 #include <signal.h>
 #include <sys/resource.h>
 
@@ -20,15 +19,20 @@
 #include <random>
 #include <string>
 
+#include "image_io.h"
+
 int main(int argc, char** argv) {
   bool cleanup_handlers = false;
   long long fsize_limit = -1;
   int arg = 1;
   for (; arg < argc && std::string(argv[arg]).rfind("--", 0) == 0; ++arg) {
     const std::string opt = argv[arg];
-    if (opt == "--cleanup-handlers") cleanup_handlers = true;
-    else if (opt.rfind("--fsize-limit=", 0) == 0) fsize_limit = std::atoll(opt.c_str() + 14);
-    else break;
+    if (opt == "--cleanup-handlers")
+      cleanup_handlers = true;
+    else if (opt.rfind("--fsize-limit=", 0) == 0)
+      fsize_limit = std::atoll(opt.c_str() + 14);
+    else
+      break;
   }
   if (argc - arg < 3) {
     std::fprintf(stderr, "usage: %s [--cleanup-handlers] [--fsize-limit=BYTES] SIDE SEED PATH...\n", argv[0]);
@@ -69,8 +73,10 @@ int main(int argc, char** argv) {
   try {
     for (int i = arg + 2; i < argc; ++i) {
       try {
-        if (algray::format_from_extension(argv[i]) == algray::ImageFormat::Exr) algray::write_exr(argv[i], im);
-        else algray::write_png(argv[i], im);
+        if (algray::format_from_extension(argv[i]) == algray::ImageFormat::Exr)
+          algray::write_exr(argv[i], im);
+        else
+          algray::write_png(argv[i], im);
       } catch (const algray::OutputError&) {
         ++failures;  // expected under --fsize-limit; the test checks the count, so stay quiet
       }

@@ -1,21 +1,19 @@
 // End-to-end tests of the algray binary: exit codes, stderr messages, output files, stats and the program cache.
-#include <catch2/catch.hpp>
-
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "image_io.h"
 
@@ -130,16 +128,16 @@ std::string scene_file(const char* name) { return quoted(std::string(ALGRAY_SOUR
 
 // A valid scene, line by line, so a bad variant replaces one line and knows the line number it expects.
 const std::vector<std::string> kUnitSphere = {
-    "# unit sphere seen from +z",        // 1
-    "[surface]",                         // 2
-    "equation = \"x^2+y^2+z^2-1\"",      // 3
-    "[extent]",                          // 4
-    "radius = 2",                        // 5
-    "[camera]",                          // 6
-    "eye = [0, 0, 5]",                   // 7
-    "look_at = [0, 0, 0]",               // 8
-    "up = [0, 1, 0]",                    // 9
-    "fov_y = 45",                        // 10
+    "# unit sphere seen from +z",    // 1
+    "[surface]",                     // 2
+    "equation = \"x^2+y^2+z^2-1\"",  // 3
+    "[extent]",                      // 4
+    "radius = 2",                    // 5
+    "[camera]",                      // 6
+    "eye = [0, 0, 5]",               // 7
+    "look_at = [0, 0, 0]",           // 8
+    "up = [0, 1, 0]",                // 9
+    "fov_y = 45",                    // 10
 };
 
 std::string sphere_with(int line, const std::string& replacement) {

@@ -1,6 +1,5 @@
 // Tests of the exact polynomial algebra and the equation parser against hand-expanded polynomials.
 #include <catch2/catch.hpp>
-
 #include <cfloat>
 #include <chrono>
 #include <cmath>
@@ -13,8 +12,8 @@
 #include "polynomial.h"
 
 using algray::EquationError;
-using algray::Polynomial;
 using algray::parse_equation;
+using algray::Polynomial;
 
 namespace {
 
@@ -37,7 +36,8 @@ Polynomial parse(const std::string& s, const std::map<std::string, double>& para
 }
 
 // Returns the position and message of the EquationError thrown by parsing `text`.
-std::pair<std::size_t, std::string> error_of(const std::string& text, const std::map<std::string, double>& params = {}) {
+std::pair<std::size_t, std::string> error_of(const std::string& text,
+                                             const std::map<std::string, double>& params = {}) {
   try {
     parse_equation(text, params);
   } catch (const EquationError& e) {
@@ -59,8 +59,7 @@ void check_error(const std::string& text, std::size_t position, const std::strin
 // Reference substitution by plain polynomial arithmetic, to check translated_scaled exactly.
 Polynomial substitute(const Polynomial& p, const std::array<mpq_class, 3>& c, const mpq_class& s) {
   std::array<Polynomial, 3> axis;
-  for (int a = 0; a < 3; ++a)
-    axis[a] = Polynomial::constant(c[a]) + Polynomial::constant(s) * Polynomial::variable(a);
+  for (int a = 0; a < 3; ++a) axis[a] = Polynomial::constant(c[a]) + Polynomial::constant(s) * Polynomial::variable(a);
   Polynomial r;
   for (const auto& [e, coef] : p.terms())
     r = r + Polynomial::constant(coef) * axis[0].pow(e[0]) * axis[1].pow(e[1]) * axis[2].pow(e[2]);

@@ -15,7 +15,6 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
-
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -38,7 +37,7 @@ using algray::OutputError;
 namespace {
 
 class TempDir {
-public:
+ public:
   TempDir() {
     static int counter = 0;
     std::random_device rd;
@@ -55,7 +54,7 @@ public:
   const fs::path& path() const { return path_; }
   fs::path operator/(const std::string& name) const { return path_ / name; }
 
-private:
+ private:
   fs::path path_;
 };
 
@@ -331,8 +330,8 @@ TEST_CASE("EXR without optional layers reads back without them", "[image_io][exr
 TEST_CASE("PNG stores sRGB-encoded 8-bit values and the sRGB chunk", "[image_io][png]") {
   TempDir dir;
   // linear -> expected sRGB byte, from the exact piecewise sRGB transfer function.
-  const std::vector<std::pair<float, int>> cases = {
-      {0.0f, 0}, {0.5f, 188}, {1.0f, 255}, {2.0f, 255}, {-1.0f, 0}, {0.18f, 118}, {0.002f, 7}, {0.0031308f, 10}};
+  const std::vector<std::pair<float, int>> cases = {{0.0f, 0},  {0.5f, 188},  {1.0f, 255}, {2.0f, 255},
+                                                    {-1.0f, 0}, {0.18f, 118}, {0.002f, 7}, {0.0031308f, 10}};
   FrameImage im;
   im.width = static_cast<int>(cases.size());
   im.height = 2;
@@ -340,8 +339,10 @@ TEST_CASE("PNG stores sRGB-encoded 8-bit values and the sRGB chunk", "[image_io]
     for (const auto& [linear, expected] : cases) {
       (void)expected;
       // The second row swaps channels so rows cannot be confused.
-      if (y == 0) im.rgba.insert(im.rgba.end(), {linear, 0.0f, 1.0f, 1.0f});
-      else im.rgba.insert(im.rgba.end(), {1.0f, linear, 0.0f, 1.0f});
+      if (y == 0)
+        im.rgba.insert(im.rgba.end(), {linear, 0.0f, 1.0f, 1.0f});
+      else
+        im.rgba.insert(im.rgba.end(), {1.0f, linear, 0.0f, 1.0f});
     }
 
   SECTION("opaque image is written as RGB") {
@@ -368,9 +369,9 @@ TEST_CASE("PNG stores sRGB-encoded 8-bit values and the sRGB chunk", "[image_io]
   }
 
   SECTION("translucent pixels make it RGBA with straight, linearly encoded alpha") {
-    im.rgba[3] = 0.5f;    // first pixel
-    im.rgba[7] = 0.0f;    // second pixel: colour must survive zero alpha (not premultiplied)
-    im.rgba[11] = 1.7f;   // clamps
+    im.rgba[3] = 0.5f;   // first pixel
+    im.rgba[7] = 0.0f;   // second pixel: colour must survive zero alpha (not premultiplied)
+    im.rgba[11] = 1.7f;  // clamps
     algray::write_png(dir / "rgba.png", im);
     PngData png;
     REQUIRE(read_png(dir / "rgba.png", png));

@@ -1,8 +1,7 @@
 // Every kernel specialisation (DEGREE 1..32, float and double) builds, runs and finds a known root.
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <sstream>
-
-#include <catch2/catch.hpp>
 
 #include "program_cache.h"
 #include "renderer.h"

@@ -1,6 +1,5 @@
 // Tests of the TOML scene reader: the shipped scenes, parameters, overrides and every error's file:line:column.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -19,16 +18,16 @@ namespace {
 // A valid scene, one entry per line, so an error test can swap one line and know the line number it expects.
 // Line 1 is a comment so that top-level keys can be put before the first table.
 const std::vector<std::string> kUnitSphere = {
-    "# unit sphere seen from +z",        // 1
-    "[surface]",                         // 2
-    "equation = \"x^2+y^2+z^2-1\"",      // 3
-    "[extent]",                          // 4
-    "radius = 2",                        // 5
-    "[camera]",                          // 6
-    "eye = [0, 0, 5]",                   // 7
-    "look_at = [0, 0, 0]",               // 8
-    "up = [0, 1, 0]",                    // 9
-    "fov_y = 45",                        // 10
+    "# unit sphere seen from +z",    // 1
+    "[surface]",                     // 2
+    "equation = \"x^2+y^2+z^2-1\"",  // 3
+    "[extent]",                      // 4
+    "radius = 2",                    // 5
+    "[camera]",                      // 6
+    "eye = [0, 0, 5]",               // 7
+    "look_at = [0, 0, 0]",           // 8
+    "up = [0, 1, 0]",                // 9
+    "fov_y = 45",                    // 10
 };
 
 // The unit sphere scene with some lines replaced (a replacement may span several lines) and lines appended.
@@ -136,7 +135,8 @@ TEST_CASE("dotted overrides reach image, render and camera keys", "[scene]") {
   CHECK(s.camera.fov_y_degrees == 30);
 
   // Later overrides win, which is how --width beats an earlier --set image.width.
-  const Scene twice = algray::load_scene_text(sphere_with({}), "t.toml", {{"image.width", "64"}, {"image.width", "48"}});
+  const Scene twice =
+      algray::load_scene_text(sphere_with({}), "t.toml", {{"image.width", "64"}, {"image.width", "48"}});
   CHECK(twice.image.width == 48);
 }
 
@@ -222,13 +222,11 @@ TEST_CASE("degenerate cameras are rejected", "[scene][errors]") {
   check_error(sphere_with({{10, "fov_y = 180"}}), "t.toml:10:9", "fov_y must be between 0 and 180");
   check_error(sphere_with({{10, "projection = \"orthographic\"\nheight = 0"}}), "t.toml:11:10",
               "height must be positive");
-  CHECK_NOTHROW(
-      algray::load_scene_text(sphere_with({{10, "projection = \"orthographic\"\nheight = 3"}}), "t.toml"));
+  CHECK_NOTHROW(algray::load_scene_text(sphere_with({{10, "projection = \"orthographic\"\nheight = 3"}}), "t.toml"));
 }
 
 TEST_CASE("equation and terms together are rejected at terms", "[scene][errors]") {
-  check_error(sphere_with({{3, "equation = \"x^2+y^2+z^2-1\"\nterms = [[1,0,0,1.0]]"}}), "t.toml:4:9",
-              "not both");
+  check_error(sphere_with({{3, "equation = \"x^2+y^2+z^2-1\"\nterms = [[1,0,0,1.0]]"}}), "t.toml:4:9", "not both");
 }
 
 TEST_CASE("TOML syntax errors carry toml++'s location", "[scene][errors]") {

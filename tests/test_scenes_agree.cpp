@@ -1,12 +1,11 @@
 // Every scene in scenes/, rendered small in float and double, agrees with an independent CPU check in long double.
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 #include <random>
 #include <vector>
-
-#include <catch2/catch.hpp>
 
 #include "program_cache.h"
 #include "renderer.h"
@@ -26,7 +25,7 @@ using Real = long double;
 //   significance: a sample's sign counts only where |P| > factor * degree * eps * ray_scale
 constexpr Real kResidualFactor = 16;
 constexpr Real kSignificanceFactor = 16;
-constexpr Real kEndMarginFactor = 256;   // scans stay this many eps * max(t, 1) inside [t_in, t_out]
+constexpr Real kEndMarginFactor = 256;  // scans stay this many eps * max(t, 1) inside [t_in, t_out]
 constexpr int kScanSamples = 2000;
 constexpr int kSampledHits = 80, kSampledMisses = 80;
 constexpr int kWidth = 80, kHeight = 60;
@@ -160,8 +159,10 @@ TEST_CASE("each scene agrees with an independent CPU check on a seeded sample of
       std::vector<int> hits, misses;
       for (int i = 0; i < kWidth * kHeight; ++i) {
         const HitRecord& h = result.hits.records[static_cast<std::size_t>(i)];
-        if (h.flags & ALGRAY_HIT_FOUND) hits.push_back(i);
-        else if (h.flags & ALGRAY_HIT_IN_EXTENT) misses.push_back(i);
+        if (h.flags & ALGRAY_HIT_FOUND)
+          hits.push_back(i);
+        else if (h.flags & ALGRAY_HIT_IN_EXTENT)
+          misses.push_back(i);
       }
       std::mt19937 rng(kSeed);
       std::shuffle(hits.begin(), hits.end(), rng);
@@ -177,13 +178,15 @@ TEST_CASE("each scene agrees with an independent CPU check on a seeded sample of
           const int px = index % kWidth, py = index / kWidth;
           const HitRecord& h = result.hits.records[static_cast<std::size_t>(index)];
           Vec o, d;
-          if (is_double) rebuild_ray<double>(result.basis, px, py, o, d);
-          else rebuild_ray<float>(result.basis, px, py, o, d);
+          if (is_double)
+            rebuild_ray<double>(result.basis, px, py, o, d);
+          else
+            rebuild_ray<float>(result.basis, px, py, o, d);
           Real t_in = 0, t_out = 0;
           const bool crosses = clip(scene.extent, o, d, t_in, t_out);
           INFO(file.filename().string() << " precision=" << precision << " seed=" << kSeed << " case "
-                                        << (set == &hits ? "hit" : "miss") << " #" << n << " pixel (" << px << ","
-                                        << py << ") t_in=" << double(t_in) << " t_out=" << double(t_out));
+                                        << (set == &hits ? "hit" : "miss") << " #" << n << " pixel (" << px << "," << py
+                                        << ") t_in=" << double(t_in) << " t_out=" << double(t_out));
           REQUIRE(crosses);
           const Real end_margin = kEndMarginFactor * eps * std::max<Real>(t_out, 1);
           const Scan samples = scan(poly, o, d, t_in + end_margin, t_out - end_margin);

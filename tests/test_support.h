@@ -1,10 +1,9 @@
 // Helpers shared by the tests that need an OpenCL device: the device is required, never optional.
 #pragma once
 
+#include <catch2/catch.hpp>
 #include <memory>
 #include <string>
-
-#include <catch2/catch.hpp>
 
 #include "cl_runtime.h"
 
@@ -17,8 +16,9 @@ inline ClSession& device_session() {
   if (!session) {
     const auto devices = enumerate_devices();
     if (devices.empty())
-      FAIL("No OpenCL device found. These tests need one: on Debian install pocl-opencl-icd "
-           "(scripts/install-deps.sh does) and check with `algray devices`.");
+      FAIL(
+          "No OpenCL device found. These tests need one: on Debian install pocl-opencl-icd "
+          "(scripts/install-deps.sh does) and check with `algray devices`.");
     session = std::make_unique<ClSession>(select_device(""));
   }
   return *session;
