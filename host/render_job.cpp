@@ -110,12 +110,17 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
                  {"tolerance", r.config.tolerance},
                  {"max_iterations", r.config.max_iterations}};
   j["cache"] = req.use_cache ? ProgramCache::default_directory().string() : "off";
-  for (const ProgramRecord& p : r.programs)
+  for (const ProgramRecord& p : r.programs) {
+    double kernel_ms = 0;
+    for (const PassStats& pass : r.passes)
+      if (pass.program_key == p.key) kernel_ms += pass.kernel_ms;
     j["programs"].push_back({{"key", p.key},
                              {"options", p.options},
                              {"from_cache", p.origin != "built"},
                              {"origin", p.origin},
-                             {"build_ms", p.build_ms}});
+                             {"build_ms", p.build_ms},
+                             {"kernel_ms", kernel_ms}});
+  }
   std::uint64_t hits = 0, tangent = 0, budget = 0, steps = 0, iterations = 0;
   for (const HitRecord& h : r.hits.records) {
     hits += (h.flags & ALGRAY_HIT_FOUND) != 0;

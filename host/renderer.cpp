@@ -166,6 +166,7 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   args.plain(out);
   PassStats pass;
   pass.name = "primary";
+  pass.program_key = record.key;
   const int tile = scene.render.tile_size > 0 ? scene.render.tile_size : default_tile_size(session_.info);
   const int tiles_x = (width + tile - 1) / tile, tiles_y = (height + tile - 1) / tile;
   const int tiles = tiles_x * tiles_y;

@@ -31,6 +31,7 @@ struct HitBuffer {
 
 struct PassStats {
   std::string name;
+  std::string program_key;  // ProgramRecord::key of the kernel the pass launched
   std::uint64_t rays = 0;
   int launches = 0;
   double kernel_ms = 0;  // device time summed over launches (profiling events)

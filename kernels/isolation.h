@@ -36,16 +36,16 @@ Isolation iso_finish_none(Isolation iso) {
   return iso;
 }
 
-/* Sign changes between consecutive nonzero coefficients, counted only up to 2: the callers need 0, 1 or more. */
+/* Sign changes between consecutive nonzero coefficients. Branch-free: a zero keeps the previous sign, and a
+ * change is a product of signs below zero (the first nonzero sign never counts, as prev starts at 0). */
 int sign_variations(const REAL* c) {
   int v = 0;
   int prev = 0; /* sign of the last nonzero coefficient, 0 before the first */
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) {
     const int s = (c[k] > 0) - (c[k] < 0);
-    if (s == 0) continue;
-    if (prev != 0 && s != prev && ++v >= 2) return v;
-    prev = s;
+    v += s * prev < 0;
+    prev = s != 0 ? s : prev;
   }
   return v;
 }

@@ -368,3 +368,30 @@ TEST_CASE("--set on a bare name changes a parameter of the render", "[cli]") {
   for (const auto& [k, v] : algray::read_exr(box.work / "fat.exr").string_attributes) fat_attrs[k] = v;
   CHECK(attrs["algray/polynomial"] != fat_attrs["algray/polynomial"]);
 }
+
+TEST_CASE("a kernel that fails to build exits 1 with the build log and the options, writing nothing", "[cli][errors]") {
+  require_device();
+  Sandbox box;
+  // A copy of the kernels with a syntax error, read through ALGRAY_KERNEL_DIR instead of the embedded ones.
+  const fs::path kernels = box.in / "kernels";
+  fs::create_directories(kernels);
+  for (const auto& e : fs::directory_iterator(fs::path(ALGRAY_SOURCE_DIR) / "kernels"))
+    if (e.path().extension() == ".cl" || e.path().extension() == ".h")
+      fs::copy_file(e.path(), kernels / e.path().filename());
+  write_text(kernels / "primary.cl", read_text(kernels / "primary.cl") + "\nthis is not OpenCL C;\n");
+  const std::string cmd = "ALGRAY_KERNEL_DIR=" + quoted(kernels.string()) + " ";
+  const fs::path err = box.in / "build_err.txt";
+  const int status = std::system(("cd " + quoted(box.work.string()) + " && " + cmd + quoted(ALGRAY_BINARY) +
+                                  " render --no-cache --width 8 --height 6 -o out.png 2>" + quoted(err.string()) +
+                                  " >/dev/null </dev/null")
+                                     .c_str());
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 1);
+  const std::string message = read_text(err);
+  INFO(message);
+  CHECK(message.find("OpenCL build failed") != std::string::npos);
+  CHECK(message.find("options: -cl-std=CL1.2 -D DEGREE=6") != std::string::npos);
+  CHECK(message.find("build log:") != std::string::npos);
+  CHECK(message.find("primary.cl") != std::string::npos);  // the log names the file and line of the error
+  CHECK_FALSE(fs::exists(box.work / "out.png"));
+}

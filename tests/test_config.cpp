@@ -1,0 +1,172 @@
+// Host pieces that need no device: kernel configuration keys, precision choice, tiles, cameras, unit coordinates.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <random>
+#include <set>
+
+#include "camera.h"
+#include "expression.h"
+#include "kernel_config.h"
+#include "kernel_sources.h"
+#include "renderer.h"
+#include "scene.h"
+
+using namespace algray;
+
+namespace {
+
+const char* kSphereScene = R"(
+[surface]
+equation = "(x-1)^2 + y^2 + z^2 - 0.25"
+[extent]
+type = "box"
+min = [0, -1, -1]
+max = [3, 1, 1]
+[camera]
+eye = [1, 0, 5]
+look_at = [1, 0, 0]
+up = [0, 1, 0]
+)";
+
+}  // namespace
+
+TEST_CASE("every choice that changes the kernel changes both the build options and the cache key", "[config]") {
+  KernelConfig base;
+  base.degree = 6;
+  std::vector<KernelConfig> variants(8, base);
+  variants[1].degree = 7;
+  variants[2].precision = Precision::Float;
+  variants[3].isolation = Isolation::PowerDescartes;
+  variants[4].refinement = Refinement::Bisection;
+  variants[5].ray_origin = RayOrigin::Eye;
+  variants[6].tolerance = 1e-8;
+  variants[7].max_iterations = 1000;
+  std::set<std::string> keys, options;
+  for (const KernelConfig& c : variants) {
+    keys.insert(c.key());
+    options.insert(c.build_options());
+  }
+  CHECK(keys.size() == variants.size());
+  CHECK(options.size() == variants.size());
+  // The tolerance travels bit for bit, as a hexadecimal literal.
+  KernelConfig odd = base;
+  odd.tolerance = 1.0 / 3.0;
+  CHECK(odd.build_options().find("-D TOLERANCE=0x1.5555555555555p-2") != std::string::npos);
+  odd.precision = Precision::Float;
+  CHECK(odd.build_options().find("-D TOLERANCE=0x1.555556p-2f") != std::string::npos);
+}
+
+TEST_CASE("solver names round-trip and unknown names are refused", "[config]") {
+  for (Isolation i : {Isolation::Bernstein, Isolation::PowerDescartes}) {
+    Isolation back{};
+    REQUIRE(parse_isolation(to_string(i), back));
+    CHECK(back == i);
+  }
+  for (Refinement r : {Refinement::Brent, Refinement::Bisection}) {
+    Refinement back{};
+    REQUIRE(parse_refinement(to_string(r), back));
+    CHECK(back == r);
+  }
+  Precision p{};
+  CHECK_FALSE(parse_precision("quad", p));
+  CHECK(precision_choices() == "float, double");
+}
+
+TEST_CASE("precision follows the device: double refused without fp64, auto falls back to float", "[config]") {
+  Scene scene = load_scene_text(kSphereScene, "t.toml");
+  DeviceInfo no_fp64;
+  no_fp64.name = "toy device";
+  no_fp64.fp64 = false;
+  DeviceInfo with_fp64 = no_fp64;
+  with_fp64.fp64 = true;
+  CHECK(resolve_precision(scene, no_fp64) == Precision::Float);
+  CHECK(resolve_precision(scene, with_fp64) == Precision::Double);
+  scene.render.precision = Precision::Double;
+  CHECK_THROWS_WITH(resolve_precision(scene, no_fp64), Catch::Contains("has no double precision"));
+  CHECK(resolve_precision(scene, with_fp64) == Precision::Double);
+}
+
+TEST_CASE("tolerances below the working precision are raised to it", "[config]") {
+  Scene scene = load_scene_text(kSphereScene, "t.toml", {{"render.tolerance", "1e-15"}});
+  CHECK(primary_config(scene, Precision::Double).tolerance == Approx(1e-15));
+  CHECK(primary_config(scene, Precision::Float).tolerance >= 1e-7);
+}
+
+TEST_CASE("GPUs get watchdog-sized tiles, CPUs few large ones", "[config]") {
+  DeviceInfo gpu, cpu;
+  gpu.type = "GPU";
+  cpu.type = "CPU";
+  CHECK(default_tile_size(gpu) <= 256);
+  CHECK(default_tile_size(cpu) >= 1024);
+}
+
+TEST_CASE("the surface in unit coordinates vanishes where the world surface does", "[config]") {
+  const Scene scene = load_scene_text(kSphereScene, "t.toml");
+  const SurfaceData data = prepare_surface(scene);
+  REQUIRE(data.degree == 2);
+  CHECK(data.even_axes == 6);  // y and z appear squared only; x - 1 brings in odd powers of x
+  double largest = 0, sum = 0;
+  for (double c : data.coefficients) {
+    largest = std::max(largest, std::fabs(c));
+    sum += std::fabs(c);
+  }
+  CHECK(largest == 1.0);
+  CHECK(data.abs_sum == Approx(sum));
+  // Points of the world sphere (centre (1,0,0), radius 0.5) map to zeros of the unit polynomial.
+  const glm::dvec3 c = scene.extent.unit_centre();
+  const double s = scene.extent.unit_scale();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> angle(0, 6.283185307179586);
+  for (int n = 0; n < 20; ++n) {
+    const double a = angle(rng), b = angle(rng);
+    const glm::dvec3 p{1 + 0.5 * std::cos(a) * std::cos(b), 0.5 * std::sin(a) * std::cos(b), 0.5 * std::sin(b)};
+    const glm::dvec3 u = (p - c) / s;
+    double value = 0;
+    for (std::size_t m = 0; m < data.coefficients.size(); ++m) {
+      const cl_uint e = data.exponents[m];
+      value += data.coefficients[m] * std::pow(u.x, e & 0xff) * std::pow(u.y, (e >> 8) & 0xff) *
+               std::pow(u.z, (e >> 16) & 0xff);
+    }
+    INFO("case " << n);
+    CHECK(std::fabs(value) < 1e-14);
+  }
+  // The box becomes a box inside the unit sphere.
+  const glm::dvec3 half = scene.extent.unit_box_half();
+  CHECK(glm::length(half) == Approx(1.0));
+}
+
+TEST_CASE("the ray basis follows the README's convention", "[config]") {
+  CameraSpec cam;
+  cam.eye = {0, 0, 5};
+  cam.look_at = {0, 0, 0};
+  cam.up = {0, 1, 0};
+  cam.fov_y_degrees = 90;
+  const RayBasis b = make_ray_basis(cam, 4, 2);
+  // The centre of the image looks straight at look_at; the top-left corner pixel up and to the left.
+  const glm::dvec3 centre = b.d00 + 2.0 * b.du + 1.0 * b.dv;
+  CHECK(centre.x == Approx(0).margin(1e-15));
+  CHECK(centre.y == Approx(0).margin(1e-15));
+  CHECK(centre.z == Approx(-1));
+  const glm::dvec3 corner = b.d00 + 0.5 * b.du + 0.5 * b.dv;
+  CHECK(corner.x < 0);
+  CHECK(corner.y > 0);
+  // With a 90 degree field of view the top edge of the image is at 45 degrees.
+  const glm::dvec3 top = b.d00 + 2.0 * b.du;
+  CHECK(top.y / -top.z == Approx(1.0));
+  cam.projection = Projection::Orthographic;
+  cam.ortho_height = 2;
+  const RayBasis o = make_ray_basis(cam, 4, 2);
+  CHECK(o.du == glm::dvec3(0));
+  CHECK(o.dv == glm::dvec3(0));
+  const glm::dvec3 first = o.o00 + 0.5 * o.ou + 0.5 * o.ov;
+  CHECK(first.x == Approx(-1.5));
+  CHECK(first.y == Approx(0.5));
+}
+
+TEST_CASE("kernel sources resolve their includes from the embedded files", "[config]") {
+  const std::string source = assemble_kernel_source("primary.cl");
+  CHECK(source.find("__kernel void primary(") != std::string::npos);
+  CHECK(source.find("typedef struct {") != std::string::npos);  // algray_shared.h's HitRecord came in
+  CHECK(source.find("#include \"") == std::string::npos);       // every include was resolved
+  CHECK_THROWS(assemble_kernel_source("no_such_kernel.cl"));
+}
