@@ -55,10 +55,11 @@ cl::Buffer real_buffer(const cl::Context& ctx, const std::vector<double>& values
   return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, f.size() * sizeof(float), f.data());
 }
 
-// C(n, k) for 0 <= k <= n <= degree, row-major with rows of degree + 1 entries, as the kernels expect.
+// C(n, k) for 0 <= k <= n <= degree, row-major with rows of degree + 1 entries, as the kernels expect; sixteen
+// zeros of padding let a kernel read any row as one 16-wide vector.
 std::vector<double> binomial_table(int degree) {
   const int n1 = degree + 1;
-  std::vector<double> t(static_cast<std::size_t>(n1 * n1), 0.0);
+  std::vector<double> t(static_cast<std::size_t>(n1 * n1 + 16), 0.0);
   for (int n = 0; n <= degree; ++n) {
     t[static_cast<std::size_t>(n * n1)] = 1;
     for (int k = 1; k <= n; ++k)

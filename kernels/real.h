@@ -8,6 +8,8 @@ typedef double REAL;
 typedef double2 REAL2;
 typedef double3 REAL3;
 typedef double4 REAL4;
+typedef double8 REAL8;
+typedef double16 REAL16;
 #define REAL_EPS DBL_EPSILON
 #define REAL_MAX DBL_MAX
 #define REAL_MAX_HALVINGS 52   /* dyadic subintervals of [0,1] stay exact down to this level */
@@ -16,6 +18,8 @@ typedef float REAL;
 typedef float2 REAL2;
 typedef float3 REAL3;
 typedef float4 REAL4;
+typedef float8 REAL8;
+typedef float16 REAL16;
 #define REAL_EPS FLT_EPSILON
 #define REAL_MAX FLT_MAX
 #define REAL_MAX_HALVINGS 23
