@@ -95,7 +95,7 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise,
       return iso;
     }
     if (v >= 1) {
-      const int located = width * len <= stop_width(t_in + iso.lo * len);
+      const int located = interval_located(width, iso.lo, t_in, len);
       if (!located && level < REAL_MAX_HALVINGS) {
         casteljau_halve(cur, sib);
         ++level;
@@ -104,25 +104,12 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise,
         sib_idx = idx + 1;
         continue;
       }
-      /* A cluster narrower than the tolerance: an odd number of roots, a root of even multiplicity,
-       * or a complex pair close to the axis. */
-      if (!located) iso.budget = 1;
-      if ((cur[0] < 0) != (cur[DEGREE] < 0)) {
-        iso.status = ISOLATION_BRACKET;
-        return iso;
-      }
-      if (fabs(bernstein_value(cur, (REAL)0.5)) <= noise) {
-        iso.status = ISOLATION_TANGENT;
-        return iso;
-      }
+      if (settle_cluster(&iso, located, bernstein_value(cur, (REAL)0.5), noise)) return iso;
     }
-    /* Next interval in depth-first order: climb while we are a right child, then step right. */
-    while (idx & 1) {
-      idx >>= 1;
-      --level;
+    if (!next_interval(&level, &idx)) {
+      iso.status = ISOLATION_NONE;
+      return iso;
     }
-    if (level == 0) return iso_finish_none(iso);
-    ++idx;
     if (sib_level == level && sib_idx == idx)
       poly_copy(cur, sib);
     else

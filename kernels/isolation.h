@@ -31,9 +31,36 @@ Isolation isolation_none(void) {
   return iso;
 }
 
-Isolation iso_finish_none(Isolation iso) {
-  iso.status = ISOLATION_NONE;
-  return iso;
+/* Whether an interval `width` (a fraction of [t_in, t_out], starting at fraction lo) is down to the stopping
+ * width: then it is located, however many roots Descartes' rule still allows in it. */
+int interval_located(REAL width, REAL lo, REAL t_in, REAL len) { return width * len <= stop_width(t_in + lo * len); }
+
+/* An interval still holding several roots, or a complex pair, once it is located or at the halving limit:
+ * a sign change between its ends is a root; no sign change but |P| in the middle within the rounding noise is
+ * a root of even multiplicity; anything else counts as no root. Returns 1 when it settled iso->status. */
+int settle_cluster(Isolation* iso, int located, REAL mid_value, REAL noise) {
+  if (!located) iso->budget = 1;
+  if ((iso->f_lo < 0) != (iso->f_hi < 0)) {
+    iso->status = ISOLATION_BRACKET;
+    return 1;
+  }
+  if (fabs(mid_value) <= noise) {
+    iso->status = ISOLATION_TANGENT;
+    return 1;
+  }
+  return 0;
+}
+
+/* The next dyadic interval (level, idx) in depth-first, left-first order: climb while a right child, then
+ * step right. Returns 0 when the whole interval has been searched. */
+int next_interval(int* level, ulong* idx) {
+  while (*idx & 1) {
+    *idx >>= 1;
+    --*level;
+  }
+  if (*level == 0) return 0;
+  ++*idx;
+  return 1;
 }
 
 /* Sign changes between consecutive nonzero coefficients. Branch-free: a zero keeps the previous sign, and a

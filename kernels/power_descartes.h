@@ -68,28 +68,18 @@ Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
     }
     /* v counts roots in (lo, hi); a root exactly at hi is found as the right neighbour's EXACT case. */
     if (v >= 1) {
-      const int located = width * len <= stop_width(t_in + iso.lo * len);
+      const int located = interval_located(width, iso.lo, t_in, len);
       if (!located && level < REAL_MAX_HALVINGS) {
         ++level;
         idx *= 2;
         continue;
       }
-      if (!located) iso.budget = 1;
-      if ((iso.f_lo < 0) != (iso.f_hi < 0)) {
-        iso.status = ISOLATION_BRACKET;
-        return iso;
-      }
-      if (fabs(power_value(a1, (REAL)0.5)) <= noise) {
-        iso.status = ISOLATION_TANGENT;
-        return iso;
-      }
+      if (settle_cluster(&iso, located, power_value(a1, (REAL)0.5), noise)) return iso;
     }
-    while (idx & 1) {
-      idx >>= 1;
-      --level;
+    if (!next_interval(&level, &idx)) {
+      iso.status = ISOLATION_NONE;
+      return iso;
     }
-    if (level == 0) return iso_finish_none(iso);
-    ++idx;
   }
 }
 

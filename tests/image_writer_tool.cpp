@@ -4,7 +4,7 @@
 // usage: image_writer_tool [--cleanup-handlers] [--fsize-limit=BYTES] SIDE SEED PATH...
 //
 // Builds a SIDE x SIDE image whose rgba and depth are uniform noise from std::mt19937(SEED) (the same
-// recipe as noisy_image() in test_image_io.cpp, which rebuilds it to check a finished file), then writes
+// recipe as noisy_image() in noisy_image.h, which test_image_io uses to check a finished file), then writes
 // it to each PATH with write_exr or write_png, chosen by extension. Exit status: the number of writes
 // that threw OutputError; 100 for bad usage, 101 for any other exception.
 //
@@ -20,6 +20,7 @@
 #include <string>
 
 #include "image_io.h"
+#include "noisy_image.h"
 
 int main(int argc, char** argv) {
   bool cleanup_handlers = false;
@@ -45,17 +46,7 @@ int main(int argc, char** argv) {
     return 100;
   }
 
-  // Noisy data is incompressible and compresses slowly: the write outgrows a small limit and stays in
-  // progress long enough to be interrupted.
-  algray::FrameImage im;
-  im.width = im.height = side;
-  const std::size_t n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-  im.rgba.resize(4 * n);
-  for (float& v : im.rgba) v = uniform(rng);
-  im.depth.resize(n);
-  for (float& v : im.depth) v = uniform(rng) * 100.0f;
+  const algray::FrameImage im = algray::testing::noisy_image(side, seed);
 
   if (cleanup_handlers) algray::install_output_cleanup_handlers();
   if (fsize_limit >= 0) {

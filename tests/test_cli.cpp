@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "image_io.h"
+#include "scene_fixtures.h"
 
 namespace fs = std::filesystem;
 
@@ -126,25 +127,8 @@ const std::string kTiny = "--width 32 --height 24";
 
 std::string scene_file(const char* name) { return quoted(std::string(ALGRAY_SOURCE_DIR) + "/scenes/" + name); }
 
-// A valid scene, line by line, so a bad variant replaces one line and knows the line number it expects.
-const std::vector<std::string> kUnitSphere = {
-    "# unit sphere seen from +z",    // 1
-    "[surface]",                     // 2
-    "equation = \"x^2+y^2+z^2-1\"",  // 3
-    "[extent]",                      // 4
-    "radius = 2",                    // 5
-    "[camera]",                      // 6
-    "eye = [0, 0, 5]",               // 7
-    "look_at = [0, 0, 0]",           // 8
-    "up = [0, 1, 0]",                // 9
-    "fov_y = 45",                    // 10
-};
-
 std::string sphere_with(int line, const std::string& replacement) {
-  std::string text;
-  for (std::size_t i = 0; i < kUnitSphere.size(); ++i)
-    text += (static_cast<int>(i + 1) == line ? replacement : kUnitSphere[i]) + "\n";
-  return text;
+  return algray::testing::sphere_with({{line, replacement}});
 }
 
 int finite_depths(const algray::FrameImage& img) {

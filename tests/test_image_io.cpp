@@ -1,5 +1,6 @@
 // Tests for EXR/PNG output: round trips, sRGB encoding, atomic replacement and cleanup after signals.
 #include "image_io.h"
+#include "noisy_image.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wconversion"
@@ -167,19 +168,7 @@ bool read_png(const fs::path& p, PngData& out) {
   return true;
 }
 
-// The image tests/image_writer_tool.cpp writes: rgba then depth drawn from one mt19937(seed), as uniform noise.
-FrameImage noisy_image(int side, std::mt19937::result_type seed) {
-  FrameImage im;
-  im.width = im.height = side;
-  const std::size_t n = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-  im.rgba.resize(4 * n);
-  for (float& v : im.rgba) v = uniform(rng);
-  im.depth.resize(n);
-  for (float& v : im.depth) v = uniform(rng) * 100.0f;
-  return im;
-}
+using algray::testing::noisy_image;
 
 // Runs image_writer_tool with these arguments in a child process and returns its pid (-1 if fork failed).
 // The child execs at once instead of writing itself: this process may already run OpenEXR's global thread

@@ -8,6 +8,7 @@
 
 #include "expression.h"
 #include "scene.h"
+#include "scene_fixtures.h"
 
 using algray::Override;
 using algray::Scene;
@@ -15,31 +16,7 @@ using algray::SceneError;
 
 namespace {
 
-// A valid scene, one entry per line, so an error test can swap one line and know the line number it expects.
-// Line 1 is a comment so that top-level keys can be put before the first table.
-const std::vector<std::string> kUnitSphere = {
-    "# unit sphere seen from +z",    // 1
-    "[surface]",                     // 2
-    "equation = \"x^2+y^2+z^2-1\"",  // 3
-    "[extent]",                      // 4
-    "radius = 2",                    // 5
-    "[camera]",                      // 6
-    "eye = [0, 0, 5]",               // 7
-    "look_at = [0, 0, 0]",           // 8
-    "up = [0, 1, 0]",                // 9
-    "fov_y = 45",                    // 10
-};
-
-// The unit sphere scene with some lines replaced (a replacement may span several lines) and lines appended.
-std::string sphere_with(const std::map<int, std::string>& replaced, const std::vector<std::string>& appended = {}) {
-  std::string text;
-  for (std::size_t i = 0; i < kUnitSphere.size(); ++i) {
-    const auto it = replaced.find(static_cast<int>(i + 1));
-    text += (it == replaced.end() ? kUnitSphere[i] : it->second) + "\n";
-  }
-  for (const std::string& line : appended) text += line + "\n";
-  return text;
-}
+using algray::testing::sphere_with;
 
 // Loads `text` expecting a SceneError and returns it; fails the test if the scene loads.
 SceneError error_of(const std::string& text, const std::vector<Override>& overrides = {}) {
