@@ -1,11 +1,12 @@
 // Resolves the kernels' quoted #include lines against the embedded files (or a directory, for kernel work).
 #include "kernel_sources.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
-#include <set>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 namespace algray {
 namespace {
@@ -24,8 +25,12 @@ std::string read_kernel_file(const std::string& name) {
   throw std::runtime_error("kernel file '" + name + "' is not embedded in this build");
 }
 
-void append_with_includes(const std::string& name, std::set<std::string>& done, std::string& out) {
-  if (!done.insert(name).second) return;
+// Every #include is expanded where it stands, even when the file came in before: an earlier copy may sit in a
+// branch of #if that the preprocessor drops, so only the headers' own include guards may skip it.
+void append_with_includes(const std::string& name, std::vector<std::string>& stack, std::string& out) {
+  if (std::find(stack.begin(), stack.end(), name) != stack.end())
+    throw std::runtime_error("kernel file '" + name + "' includes itself");
+  stack.push_back(name);
   std::istringstream lines(read_kernel_file(name));
   std::string line;
   int number = 0;
@@ -36,7 +41,7 @@ void append_with_includes(const std::string& name, std::set<std::string>& done, 
     if (first != std::string::npos && line.compare(first, 9, "#include ") == 0) {
       const auto open = line.find('"', first), close = line.rfind('"');
       if (open != std::string::npos && close > open) {
-        append_with_includes(line.substr(open + 1, close - open - 1), done, out);
+        append_with_includes(line.substr(open + 1, close - open - 1), stack, out);
         out += "#line " + std::to_string(number + 1) + " \"" + name + "\"\n";
         continue;
       }
@@ -44,14 +49,15 @@ void append_with_includes(const std::string& name, std::set<std::string>& done, 
     out += line;
     out += '\n';
   }
+  stack.pop_back();
 }
 
 }  // namespace
 
 std::string assemble_kernel_source(const std::string& main_file) {
-  std::set<std::string> done;
+  std::vector<std::string> stack;
   std::string out;
-  append_with_includes(main_file, done, out);
+  append_with_includes(main_file, stack, out);
   return out;
 }
 

@@ -169,4 +169,8 @@ TEST_CASE("kernel sources resolve their includes from the embedded files", "[con
   CHECK(source.find("typedef struct {") != std::string::npos);  // algray_shared.h's HitRecord came in
   CHECK(source.find("#include \"") == std::string::npos);       // every include was resolved
   CHECK_THROWS(assemble_kernel_source("no_such_kernel.cl"));
+  // A header included in one #if branch must come again in the next: the preprocessor drops the first copy.
+  const auto power_branch = source.find("#elif ISOLATION == ALGRAY_ISOLATION_POWER");
+  REQUIRE(power_branch != std::string::npos);
+  CHECK(source.find("int sign_variations(", power_branch) != std::string::npos);
 }
