@@ -1,0 +1,286 @@
+// The reference solver: exact isolation (Vincent-Collins-Akritas), exact bisection and classification.
+#include "solver_ref.h"
+
+#include <bit>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <utility>
+
+#include "restrict.h"
+#include "univariate.h"
+
+namespace algray::ref {
+
+using detail::ZPoly;
+
+const char* to_string(Classification kind) {
+  switch (kind) {
+    case Classification::Miss:
+      return "miss";
+    case Classification::SimpleRoot:
+      return "simple root";
+    case Classification::MultipleRootOddSignChange:
+      return "multiple root, odd (sign change)";
+    case Classification::EvenRootNoSignChange:
+      return "multiple root, even (no sign change)";
+    case Classification::IdenticallyZero:
+      return "identically zero";
+  }
+  return "?";
+}
+
+Polynomial from_monomials(const std::vector<Monomial>& monomials) {
+  Polynomial p;
+  for (const Monomial& m : monomials) p.add_term(m.i, m.j, m.k, exact_rational(m.coef));
+  return p;
+}
+
+std::vector<mpq_class> restrict_exact(const Polynomial& p, const ExactRay& ray) {
+  const detail::ScaledRestriction r = detail::restrict_integer(p, ray);
+  std::vector<mpq_class> out(r.poly.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = mpq_class(r.poly[i], r.divisor);
+    out[i].canonicalize();
+  }
+  return out;
+}
+
+namespace {
+
+// Round to nearest, ties to even. mpq_get_d truncates, so the answer is it or its neighbour away from zero.
+double nearest_double(const mpq_class& q) {
+  const double toward_zero = q.get_d();
+  if (!std::isfinite(toward_zero) || mpq_class(toward_zero) == q) return toward_zero;
+  const double away = std::nextafter(toward_zero, sgn(q) > 0 ? HUGE_VAL : -HUGE_VAL);
+  if (!std::isfinite(away)) return toward_zero;
+  const mpq_class gap_toward = abs(q - mpq_class(toward_zero));
+  const mpq_class gap_away = abs(mpq_class(away) - q);
+  if (gap_toward != gap_away) return gap_toward < gap_away ? toward_zero : away;
+  return (std::bit_cast<std::uint64_t>(toward_zero) & 1) == 0 ? toward_zero : away;
+}
+
+Classification classify(int multiplicity) {
+  if (multiplicity == 1) return Classification::SimpleRoot;
+  return multiplicity % 2 == 0 ? Classification::EvenRootNoSignChange : Classification::MultipleRootOddSignChange;
+}
+
+// A root known exactly: its multiplicity is the order of the first derivative that does not vanish there.
+Answer exact_root(const ZPoly& p, const mpq_class& t, const mpq_class& t_in, const mpq_class& t_out) {
+  Answer a;
+  ZPoly d = p;
+  while (detail::sign_at(d, t) == 0) {
+    ++a.multiplicity;
+    d = detail::derivative(d);
+  }
+  a.kind = classify(a.multiplicity);
+  a.lo = a.hi = t;
+  a.t_nearest = nearest_double(t);
+  a.root_at_t_in = t == t_in;
+  a.root_at_t_out = t == t_out;
+  return a;
+}
+
+Answer miss() {
+  Answer a;
+  a.t_nearest = std::numeric_limits<double>::infinity();
+  return a;
+}
+
+// The square-free part, which has the same distinct roots, and the factorisation that gives multiplicities.
+struct SquareFree {
+  ZPoly part;
+  std::vector<ZPoly> factors;  // factors[i] holds the roots of multiplicity i + 1; empty: all are simple
+};
+
+SquareFree square_free(const ZPoly& p) {
+  // The modular test settles almost every ray's polynomial without a single exact gcd.
+  if (detail::certainly_square_free(p)) return {p, {}};
+  std::vector<ZPoly> factors = detail::square_free_factors(p);
+  if (factors.size() == 1) return {p, {}};
+  ZPoly part{1};
+  for (const ZPoly& f : factors)
+    if (detail::degree(f) > 0) part = detail::multiply(part, f);
+  detail::make_primitive(part);
+  return {std::move(part), std::move(factors)};
+}
+
+// [t_in, t_out] = [A/M, (A+H)/M] with integers, M, H > 0, so a point s in [0, 1] is t = (A 2^D + H k) / (M 2^D)
+// when s = k / 2^D.
+struct Segment {
+  mpz_class A, H, M;
+
+  Segment(const mpq_class& t_in, const mpq_class& t_out) {
+    mpz_lcm(M.get_mpz_t(), t_in.get_den_mpz_t(), t_out.get_den_mpz_t());
+    A = t_in.get_num() * (M / t_in.get_den());
+    H = t_out.get_num() * (M / t_out.get_den()) - A;
+  }
+
+  mpq_class t_of(const mpz_class& k, unsigned long depth) const {
+    mpz_class num, den;
+    mpz_mul_2exp(num.get_mpz_t(), A.get_mpz_t(), depth);
+    mpz_addmul(num.get_mpz_t(), H.get_mpz_t(), k.get_mpz_t());
+    mpz_mul_2exp(den.get_mpz_t(), M.get_mpz_t(), depth);
+    mpq_class t(num, den);
+    t.canonicalize();
+    return t;
+  }
+
+  // The smallest D with (t_out - t_in) / 2^D <= width.
+  unsigned long depth_for(const mpq_class& width) const {
+    const mpz_class num = H * width.get_den();
+    const mpz_class den = M * width.get_num();
+    const long bits =
+        static_cast<long>(mpz_sizeinbase(num.get_mpz_t(), 2)) - static_cast<long>(mpz_sizeinbase(den.get_mpz_t(), 2));
+    auto d = static_cast<unsigned long>(std::max(0L, bits - 1));
+    mpz_class scaled;
+    for (;; ++d) {
+      mpz_mul_2exp(scaled.get_mpz_t(), den.get_mpz_t(), d);
+      if (scaled >= num) return d;
+    }
+  }
+};
+
+// The leftmost root of r in the open unit interval, in the interval's own coordinate s. `local` is r moved
+// to the isolating interval (num / 2^depth, (num + 1) / 2^depth), where it has exactly one root, simple.
+struct Isolated {
+  bool exact = false;  // the root is s = num / 2^depth itself
+  mpz_class num;
+  unsigned long depth = 0;
+  ZPoly local;
+};
+
+// r square-free, r(0) != 0. Depth first, left half first, so the first interval with one sign variation
+// holds the smallest root; a root exactly at a midpoint shows as a zero constant term and is caught between
+// the two halves.
+std::optional<Isolated> leftmost(const ZPoly& r, const mpz_class& num, unsigned long depth) {
+  const int v = detail::descartes_bound_unit(r, 2);
+  if (v == 0) return std::nullopt;
+  if (v == 1) return Isolated{false, num, depth, r};
+  ZPoly left = detail::left_half(r);
+  detail::remove_power_of_two(left);
+  if (auto found = leftmost(left, 2 * num, depth + 1)) return found;
+  ZPoly right = detail::taylor_shift_one(left);
+  if (sgn(right[0]) == 0) return Isolated{true, 2 * num + 1, depth + 1, {}};
+  detail::remove_power_of_two(right);
+  return leftmost(right, 2 * num + 1, depth + 1);
+}
+
+// Whether square-free r has a root in the open unit interval. An odd Descartes bound already proves one.
+bool any_root(const ZPoly& r) {
+  const int v = detail::descartes_bound_unit(r, INT_MAX);
+  if (v == 0) return false;
+  if (v % 2 == 1) return true;
+  ZPoly left = detail::left_half(r);
+  detail::remove_power_of_two(left);
+  if (any_root(left)) return true;
+  ZPoly right = detail::taylor_shift_one(left);
+  if (sgn(right[0]) == 0) return true;
+  detail::remove_power_of_two(right);
+  return any_root(right);
+}
+
+int multiplicity_in(const std::vector<ZPoly>& factors, const mpq_class& lo, const mpq_class& hi) {
+  // Every factor divides the square-free part, which is nonzero at lo and hi and has one simple root
+  // between them; so the factor holding that root is the one that changes sign.
+  for (std::size_t i = 0; i < factors.size(); ++i)
+    if (detail::degree(factors[i]) > 0 && detail::sign_at(factors[i], lo) * detail::sign_at(factors[i], hi) < 0)
+      return static_cast<int>(i) + 1;
+  throw std::logic_error("solver_ref: isolated root belongs to no square-free factor");
+}
+
+Answer solve(const ZPoly& p, const mpq_class& t_in, const mpq_class& t_out, const mpq_class& width) {
+  if (t_out < t_in) throw std::invalid_argument("smallest_root: t_in > t_out");
+  if (sgn(width) <= 0) throw std::invalid_argument("smallest_root: width must be positive");
+  if (p.empty()) {
+    Answer a;
+    a.kind = Classification::IdenticallyZero;
+    a.lo = a.hi = t_in;
+    a.t_nearest = nearest_double(t_in);
+    a.root_at_t_in = true;
+    a.root_at_t_out = t_in == t_out;
+    return a;
+  }
+  if (detail::degree(p) == 0) return miss();
+  if (detail::sign_at(p, t_in) == 0) return exact_root(p, t_in, t_in, t_out);
+  if (t_in == t_out) return miss();
+
+  const SquareFree sf = square_free(p);
+  const Segment seg(t_in, t_out);
+  ZPoly r = detail::to_unit_interval(sf.part, seg.A, seg.H, seg.M);
+  detail::make_primitive(r);
+  const std::optional<Isolated> found = leftmost(r, 0, 0);
+  if (!found) return detail::sign_at(sf.part, t_out) == 0 ? exact_root(p, t_out, t_in, t_out) : miss();
+  if (found->exact) return exact_root(p, seg.t_of(found->num, found->depth), t_in, t_out);
+
+  // Bisect at dyadic points of the isolating interval, in its local coordinate: [L, L + 1] / 2^j. The left
+  // end never vanishes (it is t_in or a midpoint already tested); the right end may be a root further on, and
+  // the multiplicity test needs both ends nonzero, so a zero there forces one more halving.
+  const ZPoly& local = found->local;
+  const int sign_lo = sgn(local.front());
+  mpz_class at_one = 0;  // the value at the right end is the sum of the coefficients
+  for (const mpz_class& c : local) at_one += c;
+  bool hi_is_root = sgn(at_one) == 0;
+  const unsigned long needed = seg.depth_for(width);
+  mpz_class L = 0;
+  unsigned long j = 0;
+  const auto global = [&](const mpz_class& k, unsigned long jj) {  // local k / 2^jj as s = num' / 2^depth'
+    mpz_class g;
+    mpz_mul_2exp(g.get_mpz_t(), found->num.get_mpz_t(), jj);
+    return std::pair<mpz_class, unsigned long>(g + k, found->depth + jj);
+  };
+  while (found->depth + j < needed || hi_is_root) {
+    const mpz_class mid = 2 * L + 1;
+    ++j;
+    const int s = detail::sign_at_dyadic(local, mid, j);
+    if (s == 0) {
+      const auto [k, d] = global(mid, j);
+      return exact_root(p, seg.t_of(k, d), t_in, t_out);
+    }
+    if (s == sign_lo) {
+      L = mid;
+    } else {
+      L = 2 * L;
+      hi_is_root = false;
+    }
+  }
+  const auto [k, d] = global(L, j);
+  Answer a;
+  a.lo = seg.t_of(k, d);
+  a.hi = seg.t_of(k + 1, d);
+  a.multiplicity = sf.factors.empty() ? 1 : multiplicity_in(sf.factors, a.lo, a.hi);
+  a.kind = classify(a.multiplicity);
+  a.t_nearest = nearest_double((a.lo + a.hi) / 2);
+  return a;
+}
+
+}  // namespace
+
+Answer smallest_root(const std::vector<mpq_class>& poly, const mpq_class& t_in, const mpq_class& t_out,
+                     const mpq_class& width) {
+  return solve(detail::primitive_from_rational(poly), t_in, t_out, width);
+}
+
+Answer smallest_root(const Polynomial& p, const ExactRay& ray, const mpq_class& t_in, const mpq_class& t_out,
+                     const mpq_class& width) {
+  ZPoly r = detail::restrict_integer(p, ray).poly;
+  detail::make_primitive(r);
+  return solve(r, t_in, t_out, width);
+}
+
+bool has_root_in_open(const std::vector<mpq_class>& poly, const mpq_class& a, const mpq_class& b) {
+  if (!(a < b)) return false;
+  const ZPoly p = detail::primitive_from_rational(poly);
+  if (p.empty()) return true;
+  if (detail::degree(p) == 0) return false;
+  const SquareFree sf = square_free(p);
+  const Segment seg(a, b);
+  ZPoly r = detail::to_unit_interval(sf.part, seg.A, seg.H, seg.M);
+  detail::make_primitive(r);
+  return any_root(r);
+}
+
+}  // namespace algray::ref
