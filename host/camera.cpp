@@ -29,6 +29,29 @@ RayBasis make_ray_basis(const CameraSpec& camera, int width, int height) {
   return b;
 }
 
+namespace {
+
+template <typename R>
+glm::dvec3 convention_sum(const glm::dvec3& v00, const glm::dvec3& vx, const glm::dvec3& vy, int px, int py) {
+  const R fx = static_cast<R>(px) + R(0.5), fy = static_cast<R>(py) + R(0.5);
+  glm::dvec3 out;
+  for (int i = 0; i < 3; ++i) {
+    const R x_part = fx * static_cast<R>(vx[i]);
+    const R y_part = fy * static_cast<R>(vy[i]);
+    const R partial = static_cast<R>(v00[i]) + x_part;
+    out[i] = static_cast<double>(static_cast<R>(partial + y_part));
+  }
+  return out;
+}
+
+}  // namespace
+
+PixelRay pixel_ray(const RayBasis& b, bool single_precision, int px, int py) {
+  if (single_precision)
+    return {convention_sum<float>(b.o00, b.ou, b.ov, px, py), convention_sum<float>(b.d00, b.du, b.dv, px, py)};
+  return {convention_sum<double>(b.o00, b.ou, b.ov, px, py), convention_sum<double>(b.d00, b.du, b.dv, px, py)};
+}
+
 std::array<float, 16> world_to_camera_matrix(const RayBasis& basis, const glm::dvec3& eye) {
   // Rows of the rotation are the camera axes (right, up, -forward) as columns for p * M.
   const glm::dvec3 axes[3] = {basis.right, basis.true_up, -basis.forward};

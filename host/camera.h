@@ -27,6 +27,13 @@ struct RayBasis {
 
 RayBasis make_ray_basis(const CameraSpec& camera, int width, int height);
 
+// The ray of pixel (px, py) exactly as a kernel of the given precision computes it: the basis rounded to that
+// precision, then each product and sum rounded in the README's order. The result is that ray's exact value.
+struct PixelRay {
+  glm::dvec3 origin, direction;
+};
+PixelRay pixel_ray(const RayBasis& basis, bool single_precision, int px, int py);
+
 // Row-major 4x4 matrices for the row-vector convention (p' = p * M) that OpenEXR's Imath uses.
 // Camera space: x right, y up, looking down -z. NDC: x, y in [-1, 1] across the image, y up; the
 // homogeneous w is -z for perspective cameras (1 for orthographic), and z is left as camera-space z.

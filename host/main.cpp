@@ -33,6 +33,9 @@ int main(int argc, char** argv) {
   render->add_option("--set", sets, "override a scene key: name=value (a bare name is a parameter)");
   render->add_option("--stats", stats_path, "write render statistics as JSON");
   render->add_flag("--no-cache", no_cache, "compile kernels from source; neither read nor write the program cache");
+  render->add_flag(
+      "--reference", request.reference,
+      "solve every pixel exactly on the CPU (solver_ref, all cores, slow); adds a reference.class channel");
 
   CLI::App* devices = app.add_subcommand("devices", "list OpenCL platforms and devices");
 

@@ -13,6 +13,7 @@
 
 #include "cl_runtime.h"
 #include "program_cache.h"
+#include "reference_render.h"
 #include "renderer.h"
 #include "shade.h"
 
@@ -194,19 +195,34 @@ int run_render(const RenderRequest& req, std::ostream& err) {
 
   try {
     timer.mark("scene");
-    ClSession session(select_device(req.device_spec));
-    timer.mark("device");
-    ProgramCache cache(req.use_cache);
-    Renderer renderer(session, cache);
-    const RenderResult result = renderer.render(scene, req.progress);
-    timer.mark("render");
-    FrameImage image = shade_preview(scene, result);
-    add_metadata(image, scene, result, session.info);
+    FrameImage image;
+    RenderResult result;
+    DeviceInfo device;
+    if (req.reference) {
+      // No device: exact arithmetic on the CPU, rays rebuilt in the precision the kernels would use.
+      device.name = "CPU reference (solver_ref, exact arithmetic)";
+      device.type = "CPU";
+      ReferenceResult ref = render_reference(scene, scene.render.precision.value_or(Precision::Double));
+      timer.mark("render");
+      result = std::move(ref.render);
+      image = shade_preview(scene, result);
+      image.uint_channels.push_back({"reference.class", std::move(ref.classes)});
+    } else {
+      ClSession session(select_device(req.device_spec));
+      device = session.info;
+      timer.mark("device");
+      ProgramCache cache(req.use_cache);
+      Renderer renderer(session, cache);
+      result = renderer.render(scene, req.progress);
+      timer.mark("render");
+      image = shade_preview(scene, result);
+    }
+    add_metadata(image, scene, result, device);
     timer.mark("shade");
     for (const std::string& out : req.outputs) write_image(out, image);
     timer.mark("write");
     if (req.stats_path)
-      write_text_atomically(*req.stats_path, stats_json(scene, req, result, session.info, timer).dump(2) + "\n");
+      write_text_atomically(*req.stats_path, stats_json(scene, req, result, device, timer).dump(2) + "\n");
   } catch (const DeviceError& e) {
     err << "algray: " << e.what() << "\n";
     return kExitBadInput;

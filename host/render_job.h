@@ -23,6 +23,7 @@ struct RenderRequest {
   bool use_cache = true;                  // --no-cache turns it off
   std::optional<std::string> stats_path;  // --stats FILE.json
   bool progress = false;                  // per-tile progress on stderr
+  bool reference = false;                 // --reference: solve on the CPU with solver_ref instead of a device
 };
 
 // Runs the request, printing errors (and nothing else on success, unless progress) to `err`.

@@ -1,0 +1,167 @@
+// Reference rendering: solver_ref on every pixel's exact ray, rows spread over threads, results as hit records.
+#include "reference_render.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+#include "algray_shared.h"
+#include "solver_ref.h"
+
+namespace algray {
+namespace {
+
+// [t_in, t_out] of the ray in the extent, in long double; the reference treats roots near the ends as ambiguous,
+// so this needs to be close to the kernels' clipping, not exact.
+bool clip(const Extent& e, const PixelRay& ray, long double& t_in, long double& t_out) {
+  using R = long double;
+  const R o[3] = {ray.origin.x, ray.origin.y, ray.origin.z}, d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+  if (e.kind == ExtentKind::Sphere) {
+    R a = 0, b = 0, c = -R(e.radius) * R(e.radius);
+    for (int i = 0; i < 3; ++i) {
+      const R oc = o[i] - R(e.centre[i]);
+      a += d[i] * d[i];
+      b += oc * d[i];
+      c += oc * oc;
+    }
+    const R disc = b * b - a * c;
+    if (!(disc > 0)) return false;
+    t_in = std::max<R>(0, (-b - std::sqrt(disc)) / a);
+    t_out = (-b + std::sqrt(disc)) / a;
+  } else {
+    t_in = 0;
+    t_out = std::numeric_limits<R>::max();
+    for (int i = 0; i < 3; ++i) {
+      const R t0 = (R(e.min[i]) - o[i]) / d[i], t1 = (R(e.max[i]) - o[i]) / d[i];
+      t_in = std::max(t_in, std::min(t0, t1));
+      t_out = std::min(t_out, std::max(t0, t1));
+    }
+  }
+  return t_out > t_in;
+}
+
+mpq_class evaluate(const std::vector<mpq_class>& poly, const mpq_class& t) {
+  mpq_class v = 0;
+  for (auto it = poly.rbegin(); it != poly.rend(); ++it) v = v * t + *it;
+  return v;
+}
+
+PixelClass classify(ref::Classification kind) {
+  switch (kind) {
+    case ref::Classification::Miss:
+      return PixelClass::Miss;
+    case ref::Classification::SimpleRoot:
+      return PixelClass::SimpleRoot;
+    case ref::Classification::MultipleRootOddSignChange:
+      return PixelClass::OddMultipleRoot;
+    case ref::Classification::EvenRootNoSignChange:
+      return PixelClass::EvenRoot;
+    case ref::Classification::IdenticallyZero:
+      return PixelClass::OnSurface;
+  }
+  return PixelClass::Miss;
+}
+
+}  // namespace
+
+ReferenceResult render_reference(const Scene& scene, Precision ray_precision, unsigned threads) {
+  const int width = scene.image.width, height = scene.image.height;
+  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  ReferenceResult out;
+  RenderResult& r = out.render;
+  r.config = primary_config(scene, ray_precision);
+  r.basis = make_ray_basis(scene.camera, width, height);
+  r.hits.width = width;
+  r.hits.height = height;
+  r.hits.records.assign(pixels, HitRecord{});
+  out.classes.assign(pixels, static_cast<std::uint32_t>(PixelClass::OutsideExtent));
+  out.t.assign(pixels, std::numeric_limits<double>::infinity());
+
+  const bool single = ray_precision == Precision::Float;
+  const long double eps = single ? std::numeric_limits<float>::epsilon() : std::numeric_limits<double>::epsilon();
+  const std::vector<Monomial> monomials = scene.polynomial.monomials();
+
+  auto solve_pixel = [&](int px, int py) {
+    const std::size_t i = static_cast<std::size_t>(py) * width + px;
+    HitRecord& h = r.hits.records[i];
+    h.t_hi = h.depth = std::numeric_limits<float>::infinity();
+    const PixelRay ray = pixel_ray(r.basis, single, px, py);
+    long double t_in = 0, t_out = 0;
+    if (!clip(scene.extent, ray, t_in, t_out)) return;
+    h.flags = ALGRAY_HIT_IN_EXTENT;
+    // Solve on the interval widened by the clipping margin, so a root the kernels' own clipping may just
+    // include or exclude shows up as ambiguous instead of as a certified answer.
+    const long double margin = kReferenceEndMargin * eps * std::max<long double>(t_out, 1);
+    const ref::ExactRay exact{{ray.origin.x, ray.origin.y, ray.origin.z},
+                              {ray.direction.x, ray.direction.y, ray.direction.z}};
+    const mpq_class lo = exact_rational(static_cast<double>(std::max<long double>(0, t_in - margin)));
+    const mpq_class hi = exact_rational(static_cast<double>(t_out + margin));
+    const mpq_class width_t = exact_rational(kReferenceWidth * static_cast<double>(std::max<long double>(t_out, 1)));
+    const std::vector<mpq_class> restricted = ref::restrict_exact(scene.polynomial, exact);
+    const ref::Answer a = ref::smallest_root(restricted, lo, hi, width_t);
+    PixelClass cls = classify(a.kind);
+    if (a.kind == ref::Classification::Miss) {
+      out.classes[i] = static_cast<std::uint32_t>(cls);
+      return;
+    }
+    const long double t = a.t_nearest;
+    if (t < t_in + margin || t > t_out - margin) cls = PixelClass::NearEnd;
+    out.classes[i] = static_cast<std::uint32_t>(cls);
+    out.t[i] = a.t_nearest;
+    h.flags |= ALGRAY_HIT_FOUND;
+    if (cls == PixelClass::EvenRoot) h.flags |= ALGRAY_HIT_TANGENT;
+    h.t_hi = static_cast<float>(a.t_nearest);
+    h.t_lo = static_cast<float>(a.t_nearest - static_cast<double>(h.t_hi));
+    h.depth = static_cast<float>(a.t_nearest * glm::length(ray.direction));
+    // Normal from the gradient of the exact polynomial, in long double; facing the viewer.
+    const long double p[3] = {ray.origin.x + t * ray.direction.x, ray.origin.y + t * ray.direction.y,
+                              ray.origin.z + t * ray.direction.z};
+    long double g[3] = {0, 0, 0};
+    for (const Monomial& m : monomials) {
+      const int e[3] = {m.i, m.j, m.k};
+      for (int axis = 0; axis < 3; ++axis) {
+        if (e[axis] == 0) continue;
+        long double term = m.coef * e[axis];
+        for (int other = 0; other < 3; ++other) term *= std::pow(p[other], e[other] - (other == axis));
+        g[axis] += term;
+      }
+    }
+    const long double len = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    glm::dvec3 n = len > 0 ? glm::dvec3(double(g[0] / len), double(g[1] / len), double(g[2] / len))
+                           : -glm::normalize(ray.direction);
+    if (glm::dot(n, ray.direction) > 0) n = -n;
+    h.normal_x = static_cast<float>(n.x);
+    h.normal_y = static_cast<float>(n.y);
+    h.normal_z = static_cast<float>(n.z);
+    // The side: P has one sign on [t_in, root), the sign at the start (or, for a root there, of P' there).
+    const mpq_class start = exact_rational(static_cast<double>(t_in));
+    int before = sgn(evaluate(restricted, start));
+    if (before == 0) {
+      std::vector<mpq_class> derivative;
+      for (std::size_t k = 1; k < restricted.size(); ++k) derivative.push_back(restricted[k] * static_cast<long>(k));
+      before = -sgn(evaluate(derivative, start));
+    }
+    if (before < 0) h.flags |= ALGRAY_HIT_BACK;
+  };
+
+  const unsigned workers = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
+  std::atomic<int> next_row{0};
+  auto work = [&] {
+    for (int py = next_row++; py < height; py = next_row++)
+      for (int px = 0; px < width; ++px) solve_pixel(px, py);
+  };
+  std::vector<std::thread> pool;
+  for (unsigned w = 1; w < workers; ++w) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+
+  PassStats pass;
+  pass.name = "reference";
+  pass.rays = pixels;
+  r.passes.push_back(pass);
+  return out;
+}
+
+}  // namespace algray

@@ -1,0 +1,38 @@
+// The CPU reference image: every pixel's ray solved by solver_ref in exact arithmetic, on all cores.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "renderer.h"
+#include "scene.h"
+
+namespace algray {
+
+// What the reference certifies for one pixel (EXR channel "reference.class").
+enum class PixelClass : std::uint32_t {
+  OutsideExtent = 0,    // the ray does not meet the extent
+  Miss = 1,             // certified: no root in [t_in, t_out]
+  SimpleRoot = 2,       // the smallest root is simple: P changes sign there
+  OddMultipleRoot = 3,  // odd multiplicity >= 3 (singular or inflectional), still a sign change
+  EvenRoot = 4,         // even multiplicity: touches without crossing (tangent ray, node, isolated point)
+  OnSurface = 5,        // P vanishes on the whole segment
+  NearEnd = 6,          // the smallest root lies within the clipping margin of t_in or t_out: ambiguous
+};
+
+struct ReferenceResult {
+  RenderResult render;                 // hit records as the kernels would write them (work = 0)
+  std::vector<std::uint32_t> classes;  // PixelClass per pixel
+  std::vector<double> t;               // the certified root's nearest double; +inf without one
+};
+
+// Relative width of the reference's root enclosures, and the margin (relative to max(t_out, 1), in units of
+// the ray precision's epsilon) within which a root at the clipping ends counts as ambiguous.
+inline constexpr double kReferenceWidth = 1e-13;
+inline constexpr double kReferenceEndMargin = 256;
+
+// Rays are rebuilt in `ray_precision` exactly as the kernels build them (README convention), and P is the
+// scene's exact polynomial. threads = 0 uses every core.
+ReferenceResult render_reference(const Scene& scene, Precision ray_precision, unsigned threads = 0);
+
+}  // namespace algray

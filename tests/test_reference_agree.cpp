@@ -1,0 +1,128 @@
+// Every scene at 160x120, in double and float, against the certified reference (issue 3's image thresholds).
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "program_cache.h"
+#include "reference_render.h"
+#include "renderer.h"
+#include "scene.h"
+#include "test_support.h"
+
+using namespace algray;
+
+namespace {
+
+constexpr int kWidth = 160, kHeight = 120;
+
+// Thresholds of issue 3, per precision: hit/miss disagreements among certified pixels, and the largest
+// relative depth error on certified simple hits.
+struct Thresholds {
+  double disagreement_share;
+  double depth_error;
+};
+constexpr Thresholds kDouble{0.0, 1e-7};
+constexpr Thresholds kFloat{1e-3, 1e-3};
+
+struct Comparison {
+  long certified = 0, disagreements = 0, simple_hits = 0, ambiguous = 0;
+  double worst_depth = 0;
+  int worst_x = -1, worst_y = -1, disagree_x = -1, disagree_y = -1;
+};
+
+Comparison compare(const RenderResult& kernel, const ReferenceResult& ref) {
+  Comparison c;
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * kWidth + x;
+      const auto cls = static_cast<PixelClass>(ref.classes[i]);
+      if (cls == PixelClass::OutsideExtent) continue;
+      if (cls != PixelClass::Miss && cls != PixelClass::SimpleRoot) {
+        ++c.ambiguous;  // never counted as agreement
+        continue;
+      }
+      ++c.certified;
+      const HitRecord& h = kernel.hits.records[i];
+      const bool kernel_hit = (h.flags & ALGRAY_HIT_FOUND) != 0;
+      if (kernel_hit != (cls == PixelClass::SimpleRoot)) {
+        if (c.disagreements++ == 0) c.disagree_x = x, c.disagree_y = y;
+        continue;
+      }
+      if (!kernel_hit) continue;
+      ++c.simple_hits;
+      const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
+      const double error = std::fabs(t - ref.t[i]) / std::fabs(ref.t[i]);
+      if (error > c.worst_depth) {
+        c.worst_depth = error;
+        c.worst_x = x;
+        c.worst_y = y;
+      }
+    }
+  }
+  return c;
+}
+
+// Float on the Barth decic and the Endrass octic does not reach its line yet: measured at 160x120, the decic
+// has 3 disagreements (0.04%) but a hit on the wrong sheet (depth error 0.19), the octic 28 disagreements (0.34%)
+// and a depth error of 0.24. Both expand to large cancelling monomials, whose rounding in float swamps P*(t);
+// building P*(t) in compensated arithmetic is the planned fix (issue 3). Until then they are checked in a test
+// that is expected to fail, so the day they pass it says so.
+const std::set<std::string> kFloatNotYet = {"barth_decic", "endrass_octic"};
+
+void check_scene(Renderer& renderer, const std::filesystem::path& file, const char* precision) {
+  const Scene scene = load_scene_file(file.string(), {{"image.width", std::to_string(kWidth)},
+                                                      {"image.height", std::to_string(kHeight)},
+                                                      {"render.precision", precision}});
+  const bool is_double = std::string(precision) == "double";
+  const RenderResult kernel = renderer.render(scene, false);
+  const ReferenceResult ref = render_reference(scene, is_double ? Precision::Double : Precision::Float);
+  const Comparison c = compare(kernel, ref);
+  std::printf("%-28s %-6s %9ld %9ld %12ld %9ld %12.3g\n", file.stem().string().c_str(), precision, c.certified,
+              c.ambiguous, c.disagreements, c.simple_hits, c.worst_depth);
+  const Thresholds limit = is_double ? kDouble : kFloat;
+  INFO(file.filename().string() << " " << precision << ": " << c.disagreements << " of " << c.certified
+                                << " certified pixels disagree on hit/miss (first at " << c.disagree_x << ","
+                                << c.disagree_y << "); worst relative depth error " << c.worst_depth << " at "
+                                << c.worst_x << "," << c.worst_y << "; " << c.ambiguous << " ambiguous");
+  CHECK(c.certified > kWidth * kHeight / 10);
+  CHECK(static_cast<double>(c.disagreements) <= limit.disagreement_share * static_cast<double>(c.certified));
+  CHECK(c.worst_depth <= limit.depth_error);
+}
+
+std::vector<std::filesystem::path> scene_files() {
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(ALGRAY_SOURCE_DIR "/scenes"))
+    if (entry.path().extension() == ".toml") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+}  // namespace
+
+TEST_CASE("every scene agrees with the certified reference within issue 3's thresholds", "[reference]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  const auto files = scene_files();
+  REQUIRE(files.size() >= 12);
+  std::printf("%-28s %-6s %9s %9s %12s %9s %12s\n", "scene", "prec", "certified", "ambiguous", "disagree", "hits",
+              "max depth err");
+  for (const auto& file : files) {
+    check_scene(renderer, file, "double");
+    if (!kFloatNotYet.count(file.stem().string())) check_scene(renderer, file, "float");
+  }
+}
+
+TEST_CASE("float on the cancelling degree-8 and degree-10 surfaces (known to miss the line)",
+          "[reference][!shouldfail]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  for (const auto& file : scene_files())
+    if (kFloatNotYet.count(file.stem().string())) check_scene(renderer, file, "float");
+}
