@@ -34,8 +34,8 @@ std::string enum_choices(const std::array<std::pair<const char*, E>, N>& names) 
   return s;
 }
 
-constexpr std::array<std::pair<const char*, Precision>, 2> kPrecisions{
-    {{"float", Precision::Float}, {"double", Precision::Double}}};
+constexpr std::array<std::pair<const char*, Precision>, 3> kPrecisions{
+    {{"float", Precision::Float}, {"double", Precision::Double}, {"mixed", Precision::Mixed}}};
 constexpr std::array<std::pair<const char*, Isolation>, 2> kIsolations{
     {{"bernstein", Isolation::Bernstein}, {"descartes", Isolation::PowerDescartes}}};
 constexpr std::array<std::pair<const char*, Refinement>, 2> kRefinements{
@@ -74,6 +74,7 @@ std::string KernelConfig::build_options() const {
       precision == Precision::Double ? hex_double(tolerance) : hex_double(static_cast<float>(tolerance)) + "f";
   return "-cl-std=CL1.2 -D DEGREE=" + std::to_string(degree) +
          " -D ALGRAY_DOUBLE=" + (precision == Precision::Double ? "1" : "0") +
+         " -D ALGRAY_COMPENSATED=" + (precision == Precision::Mixed ? "1" : "0") +
          " -D ISOLATION=" + std::to_string(isolation_id) + " -D REFINEMENT=" + std::to_string(refinement_id) +
          " -D RAY_ORIGIN=" + std::to_string(origin_id) + " -D TOLERANCE=" + tolerance_literal +
          " -D MAX_ITERATIONS=" + std::to_string(max_iterations);

@@ -7,7 +7,9 @@ namespace algray {
 
 inline constexpr int kMaxDegree = 32;
 
-enum class Precision { Float, Double };
+// Mixed: float, except that P*(t) is built in compensated float-float arithmetic (degrees up to 15).
+enum class Precision { Float, Double, Mixed };
+inline constexpr int kMaxMixedDegree = 15;
 enum class Isolation { Bernstein, PowerDescartes };
 enum class Refinement { Brent, Bisection };
 enum class RayOrigin { Extent, Eye };

@@ -79,7 +79,7 @@ ReferenceResult render_reference(const Scene& scene, Precision ray_precision, un
   out.classes.assign(pixels, static_cast<std::uint32_t>(PixelClass::OutsideExtent));
   out.t.assign(pixels, std::numeric_limits<double>::infinity());
 
-  const bool single = ray_precision == Precision::Float;
+  const bool single = ray_precision != Precision::Double;
   const long double eps = single ? std::numeric_limits<float>::epsilon() : std::numeric_limits<double>::epsilon();
   const std::vector<Monomial> monomials = scene.polynomial.monomials();
 

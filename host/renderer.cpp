@@ -136,7 +136,12 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   const cl::Context& ctx = session_.context;
   cl::Buffer exps(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, surface.exponents.size() * sizeof(cl_uint),
                   const_cast<cl_uint*>(surface.exponents.data()));
-  const cl::Buffer coefs = real_buffer(ctx, surface.coefficients, precision);
+  // Mixed precision takes each coefficient as a float pair hi + lo (hi's, then lo's): rounding expanded,
+  // cancelling coefficients to float alone would already change the surface.
+  std::vector<double> coefficient_data = surface.coefficients;
+  if (precision == Precision::Mixed)
+    for (double c : surface.coefficients) coefficient_data.push_back(c - static_cast<double>(static_cast<float>(c)));
+  const cl::Buffer coefs = real_buffer(ctx, coefficient_data, precision);
   const cl::Buffer binomials = real_buffer(ctx, binomial_table(surface.degree), precision);
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, pixels * sizeof(HitRecord));

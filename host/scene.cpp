@@ -375,6 +375,9 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
         rs.precision = value;
       else
         r.fail(n->source(), "render.precision must be auto, " + precision_choices());
+      if (rs.precision == Precision::Mixed && degree > kMaxMixedDegree)
+        r.fail(n->source(), "mixed precision supports degrees up to " + std::to_string(kMaxMixedDegree) +
+                                "; this surface has degree " + std::to_string(degree));
     }
     if (const toml::node* n = render->get("tolerance")) {
       rs.tolerance = r.number(*n, "render.tolerance");

@@ -2,6 +2,10 @@
 #ifndef ALGRAY_REAL_H
 #define ALGRAY_REAL_H
 
+#ifndef ALGRAY_COMPENSATED
+#define ALGRAY_COMPENSATED 0 /* 1: float, but P*(t) built in compensated (float-float) arithmetic */
+#endif
+
 #if ALGRAY_DOUBLE
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 typedef double REAL;

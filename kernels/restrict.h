@@ -107,7 +107,104 @@ ALGRAY_INLINE void poly_set_constant(REAL* c, REAL a) {
  * step is a few vector instructions (measured on PoCL: Barth sextic kernel 105 ms -> 77 ms). Lanes above the
  * degree may hold garbage, which only ever moves to higher lanes, never into the coefficients. The host pads
  * the binomial table so that any row can be loaded as one vector. */
-#if DEGREE <= 15
+#if ALGRAY_COMPENSATED
+/* Mixed precision: float everywhere but here. Expanded polynomials such as 64 L - Q^2 are sums of large terms
+ * that cancel; in plain float their rounding swamps P*(t). Each accumulator is an unevaluated sum hi + lo of
+ * two float vectors (error-free transformations with fma), so cancellation happens at ~48 bits; the result is
+ * rounded to float once, relative to its own size. Coefficients arrive as hi/lo pairs for the same reason. */
+#if DEGREE > 15
+#error "mixed precision supports degrees up to 15"
+#endif
+#define ACC_SLOTS 1
+#if DEGREE <= 7
+#define ACC_WIDTH 8
+typedef REAL8 AccV;
+#define ACC_SHIFT(c) ((AccV)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6))
+#define ACC_LOAD(p) vload8(0, p)
+#define ACC_STORE(v, p) vstore8(v, 0, p)
+#else
+#define ACC_WIDTH 16
+typedef REAL16 AccV;
+#define ACC_SHIFT(c)                                                                                        \
+  ((AccV)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6, (c).s7, (c).s8, (c).s9, (c).sa, (c).sb, \
+          (c).sc, (c).sd, (c).se))
+#define ACC_LOAD(p) vload16(0, p)
+#define ACC_STORE(v, p) vstore16(v, 0, p)
+#endif
+typedef struct {
+  AccV hi, lo;
+} Acc;
+
+/* hi + lo = a + b exactly (Knuth's two-sum), then renormalised with the low parts. */
+ALGRAY_INLINE Acc acc_sum(Acc x, Acc y) {
+  const AccV s = x.hi + y.hi;
+  const AccV bb = s - x.hi;
+  const AccV e = (x.hi - (s - bb)) + (y.hi - bb) + x.lo + y.lo;
+  Acc r;
+  r.hi = s + e;
+  r.lo = e - (r.hi - s);
+  return r;
+}
+/* x * f for a float vector f, the product's rounding error recovered by fma. */
+ALGRAY_INLINE Acc acc_scale(Acc x, AccV f) {
+  const AccV p = x.hi * f;
+  const AccV e = fma(x.hi, f, -p) + x.lo * f;
+  Acc r;
+  r.hi = p + e;
+  r.lo = e - (r.hi - p);
+  return r;
+}
+ALGRAY_INLINE Acc acc_shifted(Acc x) {
+  Acc r;
+  r.hi = ACC_SHIFT(x.hi);
+  r.lo = ACC_SHIFT(x.lo);
+  return r;
+}
+ALGRAY_INLINE void acc_mul_linear(Acc* c, REAL l0, REAL l1) {
+  *c = acc_sum(acc_scale(*c, (AccV)(l0)), acc_scale(acc_shifted(*c), (AccV)(l1)));
+}
+/* Linear steps only: the squared factors are rounded to float, which would bring back the error this avoids. */
+ALGRAY_INLINE void acc_mul_axis(Acc* c, AxisFactor f, int times) {
+  for (int r = 0; r < times; ++r) acc_mul_linear(c, f.l0, f.l1);
+}
+ALGRAY_INLINE void acc_mul_one(Acc* c, int times) {
+#if RESTRICT_BERNSTEIN
+  for (int r = 0; r < times; ++r) acc_mul_linear(c, (REAL)1, (REAL)1);
+#else
+  (void)c;
+  (void)times;
+#endif
+}
+ALGRAY_INLINE void acc_add_constant(Acc* c, int n, REAL a, REAL a_lo, __constant const REAL* binomials) {
+  Acc term;
+  term.hi = (AccV)(a);
+  term.lo = (AccV)(a_lo);
+#if RESTRICT_BERNSTEIN
+  term = acc_scale(term, ACC_LOAD(binomials + n * NCOEF)); /* binomials are exact in float up to degree 15 */
+#else
+  (void)n;
+  (void)binomials;
+  term.hi = (AccV)((REAL)0);
+  term.lo = (AccV)((REAL)0);
+  term.hi.s0 = a;
+  term.lo.s0 = a_lo;
+#endif
+  *c = acc_sum(*c, term);
+}
+ALGRAY_INLINE void acc_add(Acc* c, const Acc* other) { *c = acc_sum(*c, *other); }
+ALGRAY_INLINE void acc_copy(Acc* dst, const Acc* src) { *dst = *src; }
+ALGRAY_INLINE void acc_set_constant(Acc* c, REAL a, REAL a_lo) {
+  c->hi = (AccV)((REAL)0);
+  c->lo = (AccV)((REAL)0);
+  c->hi.s0 = a;
+  c->lo.s0 = a_lo;
+}
+ALGRAY_INLINE void acc_store(REAL* out, const Acc* c) {
+  REAL t[ACC_WIDTH];
+  ACC_STORE(c->hi + c->lo, t);
+  for (int k = 0; k <= DEGREE; ++k) out[k] = t[k];
+}
+#elif DEGREE <= 15
 #define ACC_SLOTS 1
 #if DEGREE <= 7
 #define ACC_WIDTH 8
@@ -144,7 +241,8 @@ ALGRAY_INLINE void acc_mul_one(Acc* c, int times) {
   (void)times;
 #endif
 }
-ALGRAY_INLINE void acc_add_constant(Acc* c, int n, REAL a, __constant const REAL* binomials) {
+ALGRAY_INLINE void acc_add_constant(Acc* c, int n, REAL a, REAL a_lo, __constant const REAL* binomials) {
+  (void)a_lo;
 #if RESTRICT_BERNSTEIN
   *c += a * ACC_LOAD(binomials + n * NCOEF);
 #else
@@ -155,7 +253,8 @@ ALGRAY_INLINE void acc_add_constant(Acc* c, int n, REAL a, __constant const REAL
 }
 ALGRAY_INLINE void acc_add(Acc* c, const Acc* other) { *c += *other; }
 ALGRAY_INLINE void acc_copy(Acc* dst, const Acc* src) { *dst = *src; }
-ALGRAY_INLINE void acc_set_constant(Acc* c, REAL a) {
+ALGRAY_INLINE void acc_set_constant(Acc* c, REAL a, REAL a_lo) {
+  (void)a_lo;
   *c = (Acc)((REAL)0);
   (*c).s0 = a;
 }
@@ -169,10 +268,10 @@ ALGRAY_INLINE void acc_store(REAL* out, const Acc* c) {
 typedef REAL Acc;
 #define acc_mul_axis poly_mul_axis
 #define acc_mul_one poly_mul_one
-#define acc_add_constant poly_add_constant
+#define acc_add_constant(c, n, a, a_lo, binomials) poly_add_constant(c, n, a, binomials)
 #define acc_add poly_add
 #define acc_copy poly_copy
-#define acc_set_constant poly_set_constant
+#define acc_set_constant(c, a, a_lo) poly_set_constant(c, a)
 #define acc_store poly_copy
 #endif
 
@@ -190,13 +289,16 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
 
   for (uint m = 0; m <= count; ++m) {
     int i = -1, j = -1, k = -1;
-    REAL a = 0;
+    REAL a = 0, a_lo = 0;
     if (m < count) {
       const uint e = exps[m];
       i = (int)(e & 0xffu);
       j = (int)((e >> 8) & 0xffu);
       k = (int)((e >> 16) & 0xffu);
       a = coefs[m];
+#if ALGRAY_COMPENSATED
+      a_lo = coefs[count + m]; /* the coefficient's low part: hi + lo carries ~48 bits */
+#endif
     }
     /* Close the z-level group (cur_i, cur_j) when (i, j) changes or the list ends. */
     if (deg_z >= 0 && (i != cur_i || j != cur_j)) {
@@ -228,18 +330,18 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
     if (m == count) break;
     /* Add a_ijk to the z-level Horner sum of group (i, j). */
     if (deg_z < 0) {
-      acc_set_constant(acc_z, a);
+      acc_set_constant(acc_z, a, a_lo);
       deg_z = 0;
     } else {
       acc_mul_axis(acc_z, fz, cur_k - k);
       deg_z += cur_k - k;
-      acc_add_constant(acc_z, deg_z, a, binomials);
+      acc_add_constant(acc_z, deg_z, a, a_lo, binomials);
     }
     cur_i = i;
     cur_j = j;
     cur_k = k;
   }
-  if (!have_x) acc_set_constant(acc_x, 0); /* no monomials: the host never sends this, but stay defined */
+  if (!have_x) acc_set_constant(acc_x, 0, 0); /* no monomials: the host never sends this, but stay defined */
   acc_mul_axis(acc_x, fx, prev_i);
   acc_store(out, acc_x);
 }

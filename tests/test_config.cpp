@@ -69,7 +69,14 @@ TEST_CASE("solver names round-trip and unknown names are refused", "[config]") {
   }
   Precision p{};
   CHECK_FALSE(parse_precision("quad", p));
-  CHECK(precision_choices() == "float, double");
+  CHECK(precision_choices() == "float, double, mixed");
+  // Mixed precision stops at degree 15, with the scene's position in the message.
+  CHECK_THROWS_WITH(
+      load_scene_text(kSphereScene, "t.toml", {{"surface.equation", "\"x^16 - 1\""}, {"render.precision", "mixed"}}),
+      Catch::Contains("mixed precision supports degrees up to 15"));
+  KernelConfig mixed;
+  mixed.precision = Precision::Mixed;
+  CHECK(mixed.build_options().find("-D ALGRAY_DOUBLE=0 -D ALGRAY_COMPENSATED=1") != std::string::npos);
 }
 
 TEST_CASE("precision follows the device: double refused without fp64, auto falls back to float", "[config]") {
