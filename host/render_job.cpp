@@ -122,10 +122,9 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
                              {"build_ms", p.build_ms},
                              {"kernel_ms", kernel_ms}});
   }
-  std::uint64_t hits = 0, tangent = 0, budget = 0, steps = 0, iterations = 0;
+  std::uint64_t hits = 0, budget = 0, steps = 0, iterations = 0;
   for (const HitRecord& h : r.hits.records) {
     hits += (h.flags & ALGRAY_HIT_FOUND) != 0;
-    tangent += (h.flags & ALGRAY_HIT_TANGENT) != 0;
     budget += (h.flags & ALGRAY_HIT_BUDGET) != 0;
     steps += h.work & 0xffffu;
     iterations += h.work >> 16;
@@ -136,11 +135,8 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
                            {"launches", p.launches},
                            {"kernel_ms", p.kernel_ms},
                            {"wall_ms", p.wall_ms}});
-  j["pixels"] = {{"hits", hits},
-                 {"tangent_hits", tangent},
-                 {"depth_limited", budget},
-                 {"isolation_steps", steps},
-                 {"refine_iterations", iterations}};
+  j["pixels"] = {
+      {"hits", hits}, {"depth_limited", budget}, {"isolation_steps", steps}, {"refine_iterations", iterations}};
   j["phases_ms"] = timer.json();
   j["total_ms"] = timer.total_ms();
   return j;

@@ -90,7 +90,6 @@ SurfaceData prepare_surface(const Scene& scene) {
     data.exponents.push_back(static_cast<cl_uint>(m.i) | static_cast<cl_uint>(m.j) << 8 |
                              static_cast<cl_uint>(m.k) << 16);
     data.coefficients.push_back(m.coef);
-    data.abs_sum += std::fabs(m.coef);
   }
   return data;
 }
@@ -146,8 +145,6 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, pixels * sizeof(HitRecord));
 
-  const double eps =
-      precision == Precision::Double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();
   const RayBasis& b = result.basis;
   KernelArgs args(kernel, precision);
   args.real_vec(b.o00);
@@ -165,7 +162,6 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   args.plain(static_cast<cl_uint>(surface.coefficients.size()));
   args.plain(binomials);
   args.plain(surface.even_axes);
-  args.real(kTangentNoiseFactor * surface.degree * eps * surface.abs_sum);
   args.plain(static_cast<cl_uint>(width));
   const cl_uint tile_arg = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
   args.skip(4);

@@ -18,7 +18,6 @@ struct SurfaceData {
   int degree = 0;
   std::vector<cl_uint> exponents;  // i | j << 8 | k << 16, sorted by i, j, k descending
   std::vector<double> coefficients;
-  double abs_sum = 0;     // sum of |coefficients|: bounds |P| anywhere in the extent
   cl_uint even_axes = 0;  // bit a set when every exponent of axis a is even (the kernels then step by squares)
 };
 SurfaceData prepare_surface(const Scene& scene);
@@ -55,10 +54,6 @@ KernelConfig primary_config(const Scene& scene, Precision precision);
 // CPUs (PoCL) lose ~2 ms per launch and idle cores at each launch's tail, so they get few, large launches:
 // measured on the Barth sextic at 1024x768, 256-pixel tiles 137 ms, one 1024-pixel tile 109 ms.
 int default_tile_size(const DeviceInfo& device);
-
-// Multiplies the tolerance noise floor: a root of even multiplicity counts as a hit when |P| at the bracket's
-// middle is within this many unit roundoffs times the degree times the coefficient sum.
-inline constexpr double kTangentNoiseFactor = 8;
 
 class Renderer {
  public:

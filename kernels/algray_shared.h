@@ -17,7 +17,7 @@ typedef cl_int algray_i32;
 /* HitRecord.flags */
 #define ALGRAY_HIT_FOUND 1u        /* a root of P*(t) was accepted in [t_in, t_out] */
 #define ALGRAY_HIT_BACK 2u         /* the ray arrived from the side where P < 0 (the back/inside colour) */
-#define ALGRAY_HIT_TANGENT 4u      /* accepted without a sign change: a root of even multiplicity within noise */
+#define ALGRAY_HIT_TANGENT 4u      /* reference images only: the smallest root has even multiplicity */
 #define ALGRAY_HIT_BUDGET 8u       /* isolation stopped at its depth limit with the question still open */
 #define ALGRAY_HIT_IN_EXTENT 16u   /* the ray met the extent at all */
 

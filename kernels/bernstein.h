@@ -43,18 +43,6 @@ void casteljau_halve(REAL* c, REAL* right) {
   }
 }
 
-/* Value at y by de Casteljau: the most stable evaluation, used off the hot path. */
-REAL bernstein_value(const REAL* c, REAL y) {
-  REAL w[NCOEF];
-  poly_copy(w, c);
-  const REAL y1 = (REAL)1 - y;
-  ALGRAY_UNROLL
-  for (int r = 1; r <= DEGREE; ++r)
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE - r; ++k) w[k] = y1 * w[k] + y * w[k + 1];
-  return w[0];
-}
-
 /* Coefficients on the dyadic interval [idx/2^level, (idx+1)/2^level], recomputed from the whole interval's. */
 void bernstein_restrict(const REAL* root, int level, ulong idx, REAL* out) {
   poly_copy(out, root);
@@ -68,7 +56,7 @@ void bernstein_restrict(const REAL* root, int level, ulong idx, REAL* out) {
  * coefficients `root`. Depth-first, left half first; the path is the pair (level, idx), so no stack is kept.
  * The right half of the latest split is cached, as the left half is usually rejected at once.
  * On return `cur` holds the Bernstein coefficients on [iso.lo, iso.hi]. */
-Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise, REAL* cur) {
+Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL* cur) {
   Isolation iso = isolation_none();
   REAL sib[NCOEF];
   int sib_level = -1;
@@ -76,6 +64,7 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise,
   int level = 0;
   ulong idx = 0;
   const REAL len = t_out - t_in;
+  const int start_sign = (root[0] > 0) - (root[0] < 0);
   poly_copy(cur, root);
 
   for (;;) {
@@ -89,6 +78,7 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise,
       iso.status = ISOLATION_EXACT;
       return iso;
     }
+    if (crossed_at_left_end(&iso, start_sign)) return iso;
     const int v = sign_variations(cur);
     if (v == 1 && cur[DEGREE] != 0) {
       iso.status = ISOLATION_BRACKET;
@@ -104,10 +94,13 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL noise,
         sib_idx = idx + 1;
         continue;
       }
-      if (settle_cluster(&iso, located, bernstein_value(cur, (REAL)0.5), noise)) return iso;
+      if (settle_cluster(&iso, located)) return iso;
     }
     if (!next_interval(&level, &idx)) {
-      iso.status = ISOLATION_NONE;
+      /* Intervals are half open; the far end is the one point left to look at. */
+      iso.status = root[DEGREE] == 0 ? ISOLATION_EXACT : ISOLATION_NONE;
+      iso.lo = iso.hi = 1;
+      iso.f_lo = iso.f_hi = 0;
       return iso;
     }
     if (sib_level == level && sib_idx == idx)

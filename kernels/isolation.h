@@ -8,7 +8,6 @@
 #define ISOLATION_NONE 0     /* certified: no root in [t_in, t_out] (up to the tolerance) */
 #define ISOLATION_BRACKET 1  /* one root (or an odd cluster) bracketed by a sign change on [lo, hi] */
 #define ISOLATION_EXACT 2    /* the polynomial is exactly zero at lo */
-#define ISOLATION_TANGENT 3  /* no sign change, but |P| within noise on a tolerance-wide interval */
 
 /* lo, hi are fractions of [t_in, t_out]; f_lo, f_hi the polynomial's values there in the method's scaling. */
 typedef struct {
@@ -35,20 +34,27 @@ Isolation isolation_none(void) {
  * width: then it is located, however many roots Descartes' rule still allows in it. */
 int interval_located(REAL width, REAL lo, REAL t_in, REAL len) { return width * len <= stop_width(t_in + lo * len); }
 
-/* An interval still holding several roots, or a complex pair, once it is located or at the halving limit:
- * a sign change between its ends is a root; no sign change but |P| in the middle within the rounding noise is
- * a root of even multiplicity; anything else counts as no root. Returns 1 when it settled iso->status. */
-int settle_cluster(Isolation* iso, int located, REAL mid_value, REAL noise) {
+/* An interval still holding several roots, or a complex pair, once it is located or at the halving limit: a
+ * sign change between its ends is a root; without one it counts as no root. So a root of even multiplicity is
+ * invisible, as on the true surface (an isolated point, a tangent ray), and a rounded double root that became
+ * a complex pair is never reported. Returns 1 when it settled iso->status. */
+int settle_cluster(Isolation* iso, int located) {
   if (!located) iso->budget = 1;
   if ((iso->f_lo < 0) != (iso->f_hi < 0)) {
     iso->status = ISOLATION_BRACKET;
     return 1;
   }
-  if (fabs(mid_value) <= noise) {
-    iso->status = ISOLATION_TANGENT;
-    return 1;
-  }
   return 0;
+}
+
+/* Every interval before this one was root-free or without a sign change, so P should still have the sign it had
+ * at t_in. If this interval starts with the other sign, P changed sign where two subdivisions meet, within
+ * their rounding noise: that point is the root. Returns 1 when it settled iso->status. */
+int crossed_at_left_end(Isolation* iso, int start_sign) {
+  const int s = (iso->f_lo > 0) - (iso->f_lo < 0);
+  if (s == 0 || s == start_sign) return 0;
+  iso->status = ISOLATION_EXACT;
+  return 1;
 }
 
 /* The next dyadic interval (level, idx) in depth-first, left-first order: climb while a right child, then

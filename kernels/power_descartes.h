@@ -43,11 +43,12 @@ REAL power_value(const REAL* c, REAL y) {
 
 /* p is P*(s) in the power basis, the extent interval being s in [s0, s0 + len_s]. Subintervals are the dyadic
  * (level, idx) pieces of that interval, visited depth first, left first. On return `a1` is A1 on [lo, hi]. */
-Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL noise, REAL* a1) {
+Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1) {
   Isolation iso = isolation_none();
   int level = 0;
   ulong idx = 0;
   const REAL len = t_out - t_in;
+  int start_sign = 0; /* of P at t_in, set at the first interval */
 
   for (;;) {
     ++iso.steps;
@@ -61,6 +62,8 @@ Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
       iso.status = ISOLATION_EXACT;
       return iso;
     }
+    if (iso.steps == 1) start_sign = (a1[0] > 0) - (a1[0] < 0);
+    if (crossed_at_left_end(&iso, start_sign)) return iso;
     const int v = descartes_unit_interval(a1);
     if (v == 1 && iso.f_hi != 0) {
       iso.status = ISOLATION_BRACKET;
@@ -74,7 +77,7 @@ Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
         idx *= 2;
         continue;
       }
-      if (settle_cluster(&iso, located, power_value(a1, (REAL)0.5), noise)) return iso;
+      if (settle_cluster(&iso, located)) return iso;
     }
     if (!next_interval(&level, &idx)) {
       iso.status = ISOLATION_NONE;

@@ -20,7 +20,7 @@
 __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, REAL4 ray_du, REAL4 ray_dv,
                       REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
                       __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
-                      __constant const REAL* binomials, uint even_axes, REAL noise,
+                      __constant const REAL* binomials, uint even_axes,
                       uint image_width, uint tile_x0, uint tile_y0, uint tile_w, uint tile_h,
                       __global HitRecord* out) {
   const uint gx = get_global_id(0), gy = get_global_id(1);
@@ -29,6 +29,6 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
 
   const Ray ray = camera_ray(px, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
   const SurfaceHit hit = trace_surface(ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                       mono_exps, mono_coefs, mono_count, binomials, even_axes, noise);
+                                       mono_exps, mono_coefs, mono_count, binomials, even_axes);
   out[(size_t)py * image_width + px] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
 }

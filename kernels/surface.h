@@ -23,9 +23,43 @@ typedef struct {
   uint iterations; /* refinement iterations */
 } SurfaceHit;
 
+/* The outcome of isolating and refining the smallest root of P*(t) on [t_in, t_out]. */
+typedef struct {
+  REAL t;          /* the root; meaningful with ALGRAY_HIT_FOUND */
+  REAL f_before;   /* P at the left end of the isolating interval */
+  uint flags;      /* ALGRAY_HIT_FOUND, ALGRAY_HIT_BUDGET */
+  uint steps;      /* isolation intervals examined */
+  uint iterations; /* refinement iterations */
+} SegmentRoot;
+
+/* Refines what the isolation found; iso_c holds the polynomial on the isolating interval. */
+SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out, __constant const REAL* binomials) {
+  SegmentRoot r;
+  r.t = INFINITY;
+  r.f_before = 0;
+  r.flags = iso.budget ? ALGRAY_HIT_BUDGET : 0u;
+  r.steps = iso.steps;
+  r.iterations = 0;
+  if (iso.status == ISOLATION_NONE) return r;
+  const REAL len = t_out - t_in;
+  REAL y = 0; /* ISOLATION_EXACT: the root is the interval's left end */
+  if (iso.status == ISOLATION_BRACKET) {
+    const REAL width_t = (iso.hi - iso.lo) * len;
+    const REAL tol_y = stop_width(t_in + iso.lo * len) / width_t;
+    REAL scale = 0;
+    for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(iso_c[k]));
+    prepare_isolated(iso_c, binomials);
+    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, &r.iterations);
+  }
+  r.t = t_in + (iso.lo + y * (iso.hi - iso.lo)) * len;
+  r.f_before = iso.f_lo;
+  r.flags |= ALGRAY_HIT_FOUND;
+  return r;
+}
+
 SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                          __global const uint* exps, __global const REAL* coefs, uint count,
-                         __constant const REAL* binomials, uint even_axes, REAL noise) {
+                         __constant const REAL* binomials, uint even_axes) {
   SurfaceHit h;
   h.t = INFINITY;
   h.flags = 0;
@@ -40,14 +74,13 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   REAL t_in, t_out;
   if (!clip_to_extent(o, d, extent_kind, box_half, &t_in, &t_out)) return h;
   h.flags |= ALGRAY_HIT_IN_EXTENT;
-  const REAL len = t_out - t_in;
 
   REAL root[NCOEF], iso_c[NCOEF];
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EYE
   /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(o.x, d.x, even_axes & 1),
                   axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root);
-  const Isolation iso = isolate_power(root, t_in, len, t_in, t_out, noise, iso_c);
+  const Isolation iso = isolate_power(root, t_in, t_out - t_in, t_in, t_out, iso_c);
 #else
   /* Entry and exit points: the ray restricted to the interval as s in [0, 1]. */
   const REAL3 pa = o + t_in * d, pb = o + t_out * d;
@@ -55,34 +88,22 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, pb.x, even_axes & 1),
                   axis_factor(pa.y, pb.y, even_axes & 2), axis_factor(pa.z, pb.z, even_axes & 4), root);
   bernstein_from_scaled(root, binomials);
-  const Isolation iso = isolate_bernstein(root, t_in, t_out, noise, iso_c);
+  const Isolation iso = isolate_bernstein(root, t_in, t_out, iso_c);
 #else
   const REAL3 e = pb - pa;
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, e.x, even_axes & 1),
                   axis_factor(pa.y, e.y, even_axes & 2), axis_factor(pa.z, e.z, even_axes & 4), root);
-  const Isolation iso = isolate_power(root, (REAL)0, (REAL)1, t_in, t_out, noise, iso_c);
+  const Isolation iso = isolate_power(root, (REAL)0, (REAL)1, t_in, t_out, iso_c);
 #endif
 #endif
-  h.steps = iso.steps;
-  if (iso.budget) h.flags |= ALGRAY_HIT_BUDGET;
-  if (iso.status == ISOLATION_NONE) return h;
-
-  REAL y = 0;
-  if (iso.status == ISOLATION_TANGENT) {
-    y = (REAL)0.5;
-    h.flags |= ALGRAY_HIT_TANGENT;
-  } else if (iso.status == ISOLATION_BRACKET) {
-    const REAL width_t = (iso.hi - iso.lo) * len;
-    const REAL tol_y = stop_width(t_in + iso.lo * len) / width_t;
-    REAL scale = 0;
-    for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(iso_c[k]));
-    prepare_isolated(iso_c, binomials);
-    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, &h.iterations);
-  }
-  h.t = t_in + (iso.lo + y * (iso.hi - iso.lo)) * len;
+  const SegmentRoot sr = refine_isolated(iso, iso_c, t_in, t_out, binomials);
+  h.steps = sr.steps;
+  h.iterations = sr.iterations;
+  h.flags |= sr.flags;
+  if (!(sr.flags & ALGRAY_HIT_FOUND)) return h;
+  h.t = sr.t;
+  h.f_before = sr.f_before;
   h.u = o + h.t * d;
-  h.f_before = iso.f_lo;
-  h.flags |= ALGRAY_HIT_FOUND;
   return h;
 }
 

@@ -1,0 +1,38 @@
+/* Test and benchmark kernel: the smallest root in [0, 1] of a batch of univariate polynomials, one per work-item,
+ * through the same isolation and refinement as the primary kernel (everything after the restriction). */
+#include "algray_shared.h"
+#include "real.h"
+#include "restrict.h"
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+#include "bernstein.h"
+#elif ISOLATION == ALGRAY_ISOLATION_POWER
+#include "power_descartes.h"
+#else
+#error "ISOLATION must name an isolation method"
+#endif
+#include "refine.h"
+#include "surface.h"
+
+/* polys: DEGREE + 1 coefficients per polynomial, in the basis the isolation works in (Bernstein on [0, 1], or
+ * the power basis in t). out: t (as t_hi + t_lo), flags and work, in HitRecord's fields. */
+__kernel void univariate(__global const REAL* polys, uint count, __constant const REAL* binomials,
+                         __global HitRecord* out) {
+  const uint i = get_global_id(0);
+  if (i >= count) return;
+  REAL root[NCOEF], iso_c[NCOEF];
+  for (int k = 0; k <= DEGREE; ++k) root[k] = polys[(size_t)i * NCOEF + k];
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+  const Isolation iso = isolate_bernstein(root, (REAL)0, (REAL)1, iso_c);
+#else
+  const Isolation iso = isolate_power(root, (REAL)0, (REAL)1, (REAL)0, (REAL)1, iso_c);
+#endif
+  const SegmentRoot sr = refine_isolated(iso, iso_c, (REAL)0, (REAL)1, binomials);
+  HitRecord r;
+  r.t_hi = (float)sr.t;
+  r.t_lo = (sr.flags & ALGRAY_HIT_FOUND) ? (float)(sr.t - (REAL)r.t_hi) : 0.0f;
+  r.depth = r.t_hi;
+  r.normal_x = r.normal_y = r.normal_z = 0;
+  r.flags = sr.flags;
+  r.work = min(sr.steps, 0xffffu) | (min(sr.iterations, 0xffffu) << 16);
+  out[i] = r;
+}

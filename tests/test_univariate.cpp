@@ -1,0 +1,236 @@
+// Seeded random univariate polynomials with known roots, per degree 1..16 and precision: the kernels' isolation
+// and refinement against the certified reference solver (issue 3).
+#include <gmpxx.h>
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "algray_shared.h"
+#include "program_cache.h"
+#include "solver_ref.h"
+#include "test_support.h"
+#include "tolerances.h"
+
+using namespace algray;
+using Poly = std::vector<mpq_class>;  // power basis in x, poly[i] multiplies x^i
+
+namespace {
+
+constexpr unsigned kSeed = 20261122;
+constexpr int kCases = 1000;
+constexpr int kMaxTestedDegree = 16;
+const char* const kKinds[] = {"separated",   "clustered",      "double root",
+                              "triple root", "root at an end", "root just outside"};
+
+Poly multiply(const Poly& a, const Poly& b) {
+  Poly c(a.size() + b.size() - 1, 0);
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (std::size_t j = 0; j < b.size(); ++j) c[i + j] += a[i] * b[j];
+  return c;
+}
+
+mpz_class binomial(unsigned long n, unsigned long k) {
+  mpz_class r;
+  mpz_bin_uiui(r.get_mpz_t(), n, k);
+  return r;
+}
+
+// A dyadic rational in [lo, hi), so the roots are exact.
+mpq_class dyadic(std::mt19937& rng, double lo, double hi) {
+  std::uniform_real_distribution<double> u(lo, hi);
+  return mpq_class(static_cast<long>(std::ldexp(u(rng), 20)), 1L << 20);
+}
+
+// A polynomial of exactly `degree` whose roots in [0, 1] follow `kind`; the rest of the degree is filled with
+// complex pairs near the interval and real roots outside it.
+Poly random_case(std::mt19937& rng, int degree, int kind) {
+  std::vector<mpq_class> roots;
+  switch (kind) {
+    case 0:  // well separated
+      for (int r = 0; r < std::min(degree, 3); ++r) roots.push_back(dyadic(rng, 0.05, 0.95));
+      break;
+    case 1: {  // a cluster: two roots 2^-10 .. 2^-20 apart
+      const mpq_class base = dyadic(rng, 0.1, 0.9);
+      roots.push_back(base);
+      if (degree >= 2) roots.push_back(base + mpq_class(1, 1L << std::uniform_int_distribution<int>(10, 20)(rng)));
+      break;
+    }
+    case 2:    // a double root
+    case 3: {  // a triple root
+      const mpq_class r = dyadic(rng, 0.1, 0.9);
+      for (int m = 0; m < std::min(degree, kind == 2 ? 2 : 3); ++m) roots.push_back(r);
+      break;
+    }
+    case 4:  // a root exactly at 0 or 1
+      roots.push_back(mpq_class(std::uniform_int_distribution<int>(0, 1)(rng)));
+      break;
+    default:  // a root just outside, by 2^-12
+      roots.push_back(std::uniform_int_distribution<int>(0, 1)(rng) ? mpq_class(-1, 1 << 12)
+                                                                    : mpq_class((1 << 12) + 1, 1 << 12));
+  }
+  Poly p{1};
+  for (const mpq_class& r : roots) p = multiply(p, {-r, 1});
+  int remaining = degree - static_cast<int>(roots.size());
+  while (remaining > 0) {
+    if (remaining >= 2 && std::uniform_int_distribution<int>(0, 1)(rng)) {
+      // (x - a)^2 + b^2: a complex pair, sometimes close to the real axis inside the interval
+      const mpq_class a = dyadic(rng, -0.2, 1.2), b = dyadic(rng, 0.01, 0.5);
+      p = multiply(p, {a * a + b * b, -2 * a, 1});
+      remaining -= 2;
+    } else {
+      const mpq_class r = std::uniform_int_distribution<int>(0, 1)(rng) ? dyadic(rng, -2, -0.1) : dyadic(rng, 1.1, 3);
+      p = multiply(p, {-r, 1});
+      remaining -= 1;
+    }
+  }
+  return p;
+}
+
+Poly to_bernstein(const Poly& a) {
+  const auto n = static_cast<unsigned long>(a.size() - 1);
+  Poly b(a.size(), 0);
+  for (unsigned long k = 0; k <= n; ++k)
+    for (unsigned long i = 0; i <= k; ++i) b[k] += mpq_class(binomial(k, i), binomial(n, i)) * a[i];
+  return b;
+}
+
+Poly from_bernstein(const Poly& b) {
+  const auto n = static_cast<unsigned long>(b.size() - 1);
+  Poly a(b.size(), 0);
+  for (unsigned long i = 0; i <= n; ++i)
+    for (unsigned long k = 0; k <= i; ++k)
+      a[i] += ((i - k) % 2 ? -1 : 1) * mpq_class(binomial(n, i) * binomial(i, k)) * b[k];
+  return a;
+}
+
+// |p(t)|, evaluated exactly and then rounded: the polynomials here are near-double roots, where a double
+// evaluation would be all rounding.
+double exact_magnitude(const Poly& p, double t) {
+  const mpq_class x = exact_rational(t);
+  mpq_class v = 0;
+  for (std::size_t i = p.size(); i-- > 0;) v = v * x + p[i];
+  return std::fabs(nearest_double(v));
+}
+
+// |p^(m)(t)| / m!, in double.
+double scaled_derivative(const Poly& p, int m, double t) {
+  double v = 0;
+  for (std::size_t i = p.size(); i-- > static_cast<std::size_t>(m);) {
+    double coefficient = p[i].get_d();
+    for (int j = 0; j < m; ++j) coefficient *= static_cast<double>(i - j) / (j + 1);
+    v = v * t + coefficient;
+  }
+  return std::fabs(v);
+}
+
+}  // namespace
+
+TEST_CASE("random polynomials: the kernels' smallest root matches the certified reference", "[univariate]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  for (Precision precision : {Precision::Double, Precision::Float}) {
+    const bool is_double = precision == Precision::Double;
+    const double eps = is_double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();
+    for (int degree = 1; degree <= kMaxTestedDegree; ++degree) {
+      KernelConfig config;
+      config.entry = "univariate";
+      config.degree = degree;
+      config.precision = precision;
+      config.tolerance = is_double ? 1e-12 : 2 * eps;
+      cl::Kernel kernel = cache.kernel(session, config);
+
+      // The cases, normalised to max |Bernstein coefficient| = 1 and rounded to the kernel's precision; the
+      // reference solves the rounded polynomial exactly, so both see the same polynomial.
+      std::mt19937 rng(kSeed + static_cast<unsigned>(degree));
+      std::vector<Poly> exact(kCases);
+      std::vector<double> device_values, abs_sums(kCases);
+      for (int c = 0; c < kCases; ++c) {
+        Poly b = to_bernstein(random_case(rng, degree, c % 6));
+        mpq_class largest = 0;
+        for (const mpq_class& v : b) largest = std::max<mpq_class>(largest, abs(v));
+        for (mpq_class& v : b) {
+          const mpq_class scaled = v / largest;
+          const double rounded = is_double ? nearest_double(scaled) : static_cast<float>(nearest_double(scaled));
+          v = exact_rational(rounded);
+          device_values.push_back(rounded);
+          abs_sums[static_cast<std::size_t>(c)] += std::fabs(rounded);
+        }
+        exact[static_cast<std::size_t>(c)] = from_bernstein(b);
+      }
+
+      const cl::Context& ctx = session.context;
+      std::vector<float> as_float(device_values.begin(), device_values.end());
+      cl::Buffer polys = is_double ? cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                                device_values.size() * sizeof(double), device_values.data())
+                                   : cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                                as_float.size() * sizeof(float), as_float.data());
+      std::vector<double> table((static_cast<std::size_t>(degree) + 1) * (degree + 1) + 16, 0.0);
+      for (int n = 0; n <= degree; ++n)
+        for (int k = 0; k <= n; ++k)
+          table[static_cast<std::size_t>(n * (degree + 1) + k)] = binomial(static_cast<unsigned long>(n), k).get_d();
+      std::vector<float> table_float(table.begin(), table.end());
+      cl::Buffer binomials = is_double ? cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                                    table.size() * sizeof(double), table.data())
+                                       : cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                                    table_float.size() * sizeof(float), table_float.data());
+      cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, kCases * sizeof(HitRecord));
+      kernel.setArg(0, polys);
+      kernel.setArg(1, static_cast<cl_uint>(kCases));
+      kernel.setArg(2, binomials);
+      kernel.setArg(3, out);
+      session.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(kCases));
+      std::vector<HitRecord> results(kCases);
+      session.queue.enqueueReadBuffer(out, CL_TRUE, 0, kCases * sizeof(HitRecord), results.data());
+
+      const mpq_class width(1, 1000000000000000L);
+      for (int c = 0; c < kCases; ++c) {
+        const Poly& p = exact[static_cast<std::size_t>(c)];
+        const HitRecord& h = results[static_cast<std::size_t>(c)];
+        const ref::Answer a = ref::smallest_root(p, 0, 1, width);
+        const bool hit = (h.flags & ALGRAY_HIT_FOUND) != 0;
+        const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
+        const double noise = degree * eps * abs_sums[static_cast<std::size_t>(c)];
+        INFO((is_double ? "double" : "float")
+             << " degree " << degree << " seed " << kSeed + degree << " case " << c << " (" << kKinds[c % 6]
+             << "): reference " << ref::to_string(a.kind) << " at " << a.t_nearest << " multiplicity " << a.multiplicity
+             << ", kernel " << (hit ? "hit at " : "miss") << (hit ? t : 0.0));
+        if (a.kind == ref::Classification::Miss) {
+          // Never a root where the reference certifies none, unless P is within the coefficients' rounding noise
+          // of zero there: a double root that rounding turned into a close complex pair is numerically a root.
+          if (hit) CHECK(exact_magnitude(p, t) <= testing::kNoiseFactor * noise);
+          continue;
+        }
+        if (a.kind == ref::Classification::SimpleRoot) {
+          // Never miss a certified simple root, unless the next root is so close that P between them stays
+          // within the rounding noise of the coefficients: then the pair is numerically one double root,
+          // which a kernel may see as a tangent hit or not at all.
+          const ref::Answer next = a.hi + width < 1 ? ref::smallest_root(p, a.hi + width, 1, width) : ref::Answer{};
+          const bool resolvable =
+              next.kind == ref::Classification::Miss ||
+              exact_magnitude(p, 0.5 * (a.t_nearest + next.t_nearest)) > testing::kNoiseFactor * noise;
+          if (resolvable) REQUIRE(hit);
+          if (!hit) continue;
+          const double slope = scaled_derivative(p, 1, a.t_nearest);
+          const double allowed =
+              testing::kStopWidthFactor * 4 * config.tolerance + testing::kNoiseFactor * noise / slope;
+          CHECK(std::fabs(t - a.t_nearest) <= allowed);
+          continue;
+        }
+        // A multiple root: with a sign change it must be found; without one it is invisible by design.
+        const bool crosses = a.kind == ref::Classification::MultipleRootOddSignChange;
+        if (crosses) REQUIRE(hit);
+        if (hit) {
+          const int m = a.multiplicity;
+          const double size = std::max(scaled_derivative(p, m, a.t_nearest), 1e-300);
+          const double allowed = testing::kStopWidthFactor * 4 * config.tolerance +
+                                 testing::kMultipleRootFactor * std::pow(testing::kNoiseFactor * noise / size, 1.0 / m);
+          CHECK(std::fabs(t - a.t_nearest) <= allowed);
+        }
+      }
+    }
+  }
+}
