@@ -54,26 +54,6 @@ AxisFactor axis_factor(REAL l0, REAL l1, int even) {
   return f;
 }
 
-/* c times L^times. With only even exponents every gap is even, and one quadratic pass replaces two linear
- * ones: fewer flops and half the sweeps over c. */
-ALGRAY_INLINE void poly_mul_axis(REAL* c, AxisFactor f, int times) {
-  if (f.even) {
-    for (int r = 0; r < times; r += 2) poly_mul_quadratic(c, f.q0, f.q1, f.q2);
-  } else {
-    for (int r = 0; r < times; ++r) poly_mul_linear(c, f.l0, f.l1);
-  }
-}
-
-/* c times one^times: degree elevation in the Bernstein form; nothing to do in the power basis. */
-ALGRAY_INLINE void poly_mul_one(REAL* c, int times) {
-#if RESTRICT_BERNSTEIN
-  for (int r = 0; r < times; ++r) poly_mul_linear(c, (REAL)1, (REAL)1);
-#else
-  (void)c;
-  (void)times;
-#endif
-}
-
 /* c (degree n) plus a * one^n. binomials[n * NCOEF + k] = C(n, k), zero for k > n. */
 ALGRAY_INLINE void poly_add_constant(REAL* c, int n, REAL a, __constant const REAL* binomials) {
 #if RESTRICT_BERNSTEIN
@@ -103,148 +83,113 @@ ALGRAY_INLINE void poly_set_constant(REAL* c, REAL a) {
   for (int k = 1; k <= DEGREE; ++k) c[k] = 0;
 }
 
-/* The Horner accumulators of the restriction. Up to degree 15 one vector holds a whole polynomial, so each
- * step is a few vector instructions (measured on PoCL: Barth sextic kernel 105 ms -> 77 ms). Lanes above the
- * degree may hold garbage, which only ever moves to higher lanes, never into the coefficients. The host pads
- * the binomial table so that any row can be loaded as one vector. */
+/* The Horner accumulators of the restriction, in one of three representations, each providing acc_mul_linear,
+ * acc_mul_quadratic (when ACC_SQUARES), acc_add_constant, acc_add, acc_copy, acc_set_constant and acc_store:
+ *  - up to degree 15, one vector holds a whole polynomial, so each step is a few vector instructions (measured
+ *    on PoCL: Barth sextic kernel 105 ms -> 77 ms). Lanes above the degree may hold garbage, which only ever
+ *    moves to higher lanes, never into the coefficients; the host pads the binomial table so that any row
+ *    loads as one vector;
+ *  - mixed precision: the same vectors as unevaluated float sums hi + lo;
+ *  - above degree 15, the unrolled arrays above. */
+#if DEGREE <= 15
+#if DEGREE <= 7
+#define ACC_WIDTH 8
+typedef REAL8 PolyVec;
+#define VEC_SHIFT(c) ((PolyVec)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6))
+#define VEC_LOAD(p) vload8(0, p)
+#define VEC_STORE(v, p) vstore8(v, 0, p)
+#else
+#define ACC_WIDTH 16
+typedef REAL16 PolyVec;
+#define VEC_SHIFT(c)                                                                                            \
+  ((PolyVec)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6, (c).s7, (c).s8, (c).s9, (c).sa, \
+             (c).sb, (c).sc, (c).sd, (c).se))
+#define VEC_LOAD(p) vload16(0, p)
+#define VEC_STORE(v, p) vstore16(v, 0, p)
+#endif
+#define ACC_SLOTS 1
+
+ALGRAY_INLINE PolyVec vec_constant(REAL a) {
+  PolyVec v = (PolyVec)((REAL)0);
+  v.s0 = a;
+  return v;
+}
+
+ALGRAY_INLINE void vec_store(REAL* out, PolyVec v) {
+  REAL t[ACC_WIDTH];
+  VEC_STORE(v, t);
+  for (int k = 0; k <= DEGREE; ++k) out[k] = t[k];
+}
+
 #if ALGRAY_COMPENSATED
 /* Mixed precision: float everywhere but here. Expanded polynomials such as 64 L - Q^2 are sums of large terms
  * that cancel; in plain float their rounding swamps P*(t). Each accumulator is an unevaluated sum hi + lo of
  * two float vectors (error-free transformations with fma), so cancellation happens at ~48 bits; the result is
- * rounded to float once, relative to its own size. Coefficients arrive as hi/lo pairs for the same reason. */
-#if DEGREE > 15
-#error "mixed precision supports degrees up to 15"
-#endif
-#define ACC_SLOTS 1
-#if DEGREE <= 7
-#define ACC_WIDTH 8
-typedef REAL8 AccV;
-#define ACC_SHIFT(c) ((AccV)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6))
-#define ACC_LOAD(p) vload8(0, p)
-#define ACC_STORE(v, p) vstore8(v, 0, p)
-#else
-#define ACC_WIDTH 16
-typedef REAL16 AccV;
-#define ACC_SHIFT(c)                                                                                        \
-  ((AccV)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6, (c).s7, (c).s8, (c).s9, (c).sa, (c).sb, \
-          (c).sc, (c).sd, (c).se))
-#define ACC_LOAD(p) vload16(0, p)
-#define ACC_STORE(v, p) vstore16(v, 0, p)
-#endif
+ * rounded to float once, relative to its own size. Coefficients arrive as hi/lo pairs for the same reason.
+ * Squared factors would be rounded to float, bringing back the error this avoids: linear steps only. */
+#define ACC_SQUARES 0
 typedef struct {
-  AccV hi, lo;
+  PolyVec hi, lo;
 } Acc;
 
-/* hi + lo = a + b exactly (Knuth's two-sum), then renormalised with the low parts. */
+/* hi + lo = x + y exactly (Knuth's two-sum), then renormalised with the low parts. */
 ALGRAY_INLINE Acc acc_sum(Acc x, Acc y) {
-  const AccV s = x.hi + y.hi;
-  const AccV bb = s - x.hi;
-  const AccV e = (x.hi - (s - bb)) + (y.hi - bb) + x.lo + y.lo;
+  const PolyVec s = x.hi + y.hi;
+  const PolyVec bb = s - x.hi;
+  const PolyVec e = (x.hi - (s - bb)) + (y.hi - bb) + x.lo + y.lo;
   Acc r;
   r.hi = s + e;
   r.lo = e - (r.hi - s);
   return r;
 }
 /* x * f for a float vector f, the product's rounding error recovered by fma. */
-ALGRAY_INLINE Acc acc_scale(Acc x, AccV f) {
-  const AccV p = x.hi * f;
-  const AccV e = fma(x.hi, f, -p) + x.lo * f;
+ALGRAY_INLINE Acc acc_scale(Acc x, PolyVec f) {
+  const PolyVec p = x.hi * f;
+  const PolyVec e = fma(x.hi, f, -p) + x.lo * f;
   Acc r;
   r.hi = p + e;
   r.lo = e - (r.hi - p);
   return r;
 }
-ALGRAY_INLINE Acc acc_shifted(Acc x) {
-  Acc r;
-  r.hi = ACC_SHIFT(x.hi);
-  r.lo = ACC_SHIFT(x.lo);
-  return r;
-}
 ALGRAY_INLINE void acc_mul_linear(Acc* c, REAL l0, REAL l1) {
-  *c = acc_sum(acc_scale(*c, (AccV)(l0)), acc_scale(acc_shifted(*c), (AccV)(l1)));
-}
-/* Linear steps only: the squared factors are rounded to float, which would bring back the error this avoids. */
-ALGRAY_INLINE void acc_mul_axis(Acc* c, AxisFactor f, int times) {
-  for (int r = 0; r < times; ++r) acc_mul_linear(c, f.l0, f.l1);
-}
-ALGRAY_INLINE void acc_mul_one(Acc* c, int times) {
-#if RESTRICT_BERNSTEIN
-  for (int r = 0; r < times; ++r) acc_mul_linear(c, (REAL)1, (REAL)1);
-#else
-  (void)c;
-  (void)times;
-#endif
+  Acc shifted;
+  shifted.hi = VEC_SHIFT(c->hi);
+  shifted.lo = VEC_SHIFT(c->lo);
+  *c = acc_sum(acc_scale(*c, (PolyVec)(l0)), acc_scale(shifted, (PolyVec)(l1)));
 }
 ALGRAY_INLINE void acc_add_constant(Acc* c, int n, REAL a, REAL a_lo, __constant const REAL* binomials) {
   Acc term;
-  term.hi = (AccV)(a);
-  term.lo = (AccV)(a_lo);
 #if RESTRICT_BERNSTEIN
-  term = acc_scale(term, ACC_LOAD(binomials + n * NCOEF)); /* binomials are exact in float up to degree 15 */
+  term.hi = (PolyVec)(a);
+  term.lo = (PolyVec)(a_lo);
+  term = acc_scale(term, VEC_LOAD(binomials + n * NCOEF)); /* binomials are exact in float up to degree 15 */
 #else
   (void)n;
   (void)binomials;
-  term.hi = (AccV)((REAL)0);
-  term.lo = (AccV)((REAL)0);
-  term.hi.s0 = a;
-  term.lo.s0 = a_lo;
+  term.hi = vec_constant(a);
+  term.lo = vec_constant(a_lo);
 #endif
   *c = acc_sum(*c, term);
 }
 ALGRAY_INLINE void acc_add(Acc* c, const Acc* other) { *c = acc_sum(*c, *other); }
 ALGRAY_INLINE void acc_copy(Acc* dst, const Acc* src) { *dst = *src; }
 ALGRAY_INLINE void acc_set_constant(Acc* c, REAL a, REAL a_lo) {
-  c->hi = (AccV)((REAL)0);
-  c->lo = (AccV)((REAL)0);
-  c->hi.s0 = a;
-  c->lo.s0 = a_lo;
+  c->hi = vec_constant(a);
+  c->lo = vec_constant(a_lo);
 }
-ALGRAY_INLINE void acc_store(REAL* out, const Acc* c) {
-  REAL t[ACC_WIDTH];
-  ACC_STORE(c->hi + c->lo, t);
-  for (int k = 0; k <= DEGREE; ++k) out[k] = t[k];
-}
-#elif DEGREE <= 15
-#define ACC_SLOTS 1
-#if DEGREE <= 7
-#define ACC_WIDTH 8
-typedef REAL8 Acc;
-#define ACC_SHIFT(c) ((Acc)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6))
-#define ACC_LOAD(p) vload8(0, p)
-#define ACC_STORE(v, p) vstore8(v, 0, p)
+ALGRAY_INLINE void acc_store(REAL* out, const Acc* c) { vec_store(out, c->hi + c->lo); }
 #else
-#define ACC_WIDTH 16
-typedef REAL16 Acc;
-#define ACC_SHIFT(c)                                                                                        \
-  ((Acc)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6, (c).s7, (c).s8, (c).s9, (c).sa, (c).sb, \
-         (c).sc, (c).sd, (c).se))
-#define ACC_LOAD(p) vload16(0, p)
-#define ACC_STORE(v, p) vstore16(v, 0, p)
-#endif
-ALGRAY_INLINE void acc_mul_linear(Acc* c, REAL l0, REAL l1) { *c = l0 * *c + l1 * ACC_SHIFT(*c); }
+#define ACC_SQUARES 1
+typedef PolyVec Acc;
+ALGRAY_INLINE void acc_mul_linear(Acc* c, REAL l0, REAL l1) { *c = l0 * *c + l1 * VEC_SHIFT(*c); }
 ALGRAY_INLINE void acc_mul_quadratic(Acc* c, REAL q0, REAL q1, REAL q2) {
-  const Acc s1 = ACC_SHIFT(*c);
-  *c = q0 * *c + q1 * s1 + q2 * ACC_SHIFT(s1);
-}
-ALGRAY_INLINE void acc_mul_axis(Acc* c, AxisFactor f, int times) {
-  if (f.even) {
-    for (int r = 0; r < times; r += 2) acc_mul_quadratic(c, f.q0, f.q1, f.q2);
-  } else {
-    for (int r = 0; r < times; ++r) acc_mul_linear(c, f.l0, f.l1);
-  }
-}
-ALGRAY_INLINE void acc_mul_one(Acc* c, int times) {
-#if RESTRICT_BERNSTEIN
-  for (int r = 0; r < times; ++r) acc_mul_linear(c, (REAL)1, (REAL)1);
-#else
-  (void)c;
-  (void)times;
-#endif
+  const Acc s1 = VEC_SHIFT(*c);
+  *c = q0 * *c + q1 * s1 + q2 * VEC_SHIFT(s1);
 }
 ALGRAY_INLINE void acc_add_constant(Acc* c, int n, REAL a, REAL a_lo, __constant const REAL* binomials) {
   (void)a_lo;
 #if RESTRICT_BERNSTEIN
-  *c += a * ACC_LOAD(binomials + n * NCOEF);
+  *c += a * VEC_LOAD(binomials + n * NCOEF);
 #else
   (void)n;
   (void)binomials;
@@ -255,25 +200,47 @@ ALGRAY_INLINE void acc_add(Acc* c, const Acc* other) { *c += *other; }
 ALGRAY_INLINE void acc_copy(Acc* dst, const Acc* src) { *dst = *src; }
 ALGRAY_INLINE void acc_set_constant(Acc* c, REAL a, REAL a_lo) {
   (void)a_lo;
-  *c = (Acc)((REAL)0);
-  (*c).s0 = a;
+  *c = vec_constant(a);
 }
-ALGRAY_INLINE void acc_store(REAL* out, const Acc* c) {
-  REAL t[ACC_WIDTH];
-  ACC_STORE(*c, t);
-  for (int k = 0; k <= DEGREE; ++k) out[k] = t[k];
-}
+ALGRAY_INLINE void acc_store(REAL* out, const Acc* c) { vec_store(out, *c); }
+#endif
 #else
+#if ALGRAY_COMPENSATED
+#error "mixed precision supports degrees up to 15"
+#endif
 #define ACC_SLOTS NCOEF
+#define ACC_SQUARES 1
 typedef REAL Acc;
-#define acc_mul_axis poly_mul_axis
-#define acc_mul_one poly_mul_one
-#define acc_add_constant(c, n, a, a_lo, binomials) poly_add_constant(c, n, a, binomials)
+#define acc_mul_linear poly_mul_linear
+#define acc_mul_quadratic poly_mul_quadratic
+#define acc_add_constant(c, n, a, a_lo, binomials) ((void)(a_lo), poly_add_constant(c, n, a, binomials))
 #define acc_add poly_add
 #define acc_copy poly_copy
-#define acc_set_constant(c, a, a_lo) poly_set_constant(c, a)
+#define acc_set_constant(c, a, a_lo) ((void)(a_lo), poly_set_constant(c, a))
 #define acc_store poly_copy
 #endif
+
+/* c times L^times. With only even exponents every gap is even, and one quadratic pass replaces two linear
+ * ones: fewer flops and half the sweeps over c. */
+ALGRAY_INLINE void acc_mul_axis(Acc* c, AxisFactor f, int times) {
+#if ACC_SQUARES
+  if (f.even) {
+    for (int r = 0; r < times; r += 2) acc_mul_quadratic(c, f.q0, f.q1, f.q2);
+    return;
+  }
+#endif
+  for (int r = 0; r < times; ++r) acc_mul_linear(c, f.l0, f.l1);
+}
+
+/* c times one^times: degree elevation in the Bernstein form; nothing to do in the power basis. */
+ALGRAY_INLINE void acc_mul_one(Acc* c, int times) {
+#if RESTRICT_BERNSTEIN
+  for (int r = 0; r < times; ++r) acc_mul_linear(c, (REAL)1, (REAL)1);
+#else
+  (void)c;
+  (void)times;
+#endif
+}
 
 /* Monomials arrive sorted by i, then j, then k, all descending, exponents packed as i | j<<8 | k<<16.
  * P = sum_i x^i sum_j y^j sum_k a_ijk z^k w^(D-i-j-k), evaluated as three nested Horner levels, each
