@@ -13,6 +13,7 @@
 #include "renderer.h"
 #include "scene.h"
 #include "test_support.h"
+#include "tolerances.h"
 
 using namespace algray;
 
@@ -20,14 +21,6 @@ namespace {
 
 constexpr int kWidth = 160, kHeight = 120;
 
-// Thresholds of issue 3, per precision: hit/miss disagreements among certified pixels, and the largest
-// relative depth error on certified simple hits.
-struct Thresholds {
-  double disagreement_share;
-  double depth_error;
-};
-constexpr Thresholds kDouble{0.0, 1e-7};
-constexpr Thresholds kFloat{1e-3, 1e-3};
 
 struct Comparison {
   long certified = 0, disagreements = 0, simple_hits = 0, ambiguous = 0;
@@ -87,7 +80,7 @@ void check_scene(Renderer& renderer, const std::filesystem::path& file, const ch
   const Comparison c = compare(kernel, ref);
   std::printf("%-28s %-6s %9ld %9ld %12ld %9ld %12.3g\n", file.stem().string().c_str(), precision, c.certified,
               c.ambiguous, c.disagreements, c.simple_hits, c.worst_depth);
-  const Thresholds limit = is_double ? kDouble : kFloat;
+  const testing::ImageThresholds limit = is_double ? testing::kDoubleImage : testing::kFloatImage;
   INFO(file.filename().string() << " " << precision << ": " << c.disagreements << " of " << c.certified
                                 << " certified pixels disagree on hit/miss (first at " << c.disagree_x << ","
                                 << c.disagree_y << "); worst relative depth error " << c.worst_depth << " at "
