@@ -13,9 +13,31 @@
 namespace algray {
 namespace {
 
-// [t_in, t_out] of the ray in the extent, in long double; the reference treats roots near the ends as ambiguous,
-// so this needs to be close to the kernels' clipping, not exact.
-bool clip(const Extent& e, const PixelRay& ray, long double& t_in, long double& t_out) {
+mpq_class evaluate(const std::vector<mpq_class>& poly, const mpq_class& t) {
+  mpq_class v = 0;
+  for (auto it = poly.rbegin(); it != poly.rend(); ++it) v = v * t + *it;
+  return v;
+}
+
+PixelClass classify(ref::Classification kind) {
+  switch (kind) {
+    case ref::Classification::Miss:
+      return PixelClass::Miss;
+    case ref::Classification::SimpleRoot:
+      return PixelClass::SimpleRoot;
+    case ref::Classification::MultipleRootOddSignChange:
+      return PixelClass::OddMultipleRoot;
+    case ref::Classification::EvenRootNoSignChange:
+      return PixelClass::EvenRoot;
+    case ref::Classification::IdenticallyZero:
+      return PixelClass::OnSurface;
+  }
+  return PixelClass::Miss;
+}
+
+}  // namespace
+
+bool extent_interval(const Extent& e, const PixelRay& ray, long double& t_in, long double& t_out) {
   using R = long double;
   const R o[3] = {ray.origin.x, ray.origin.y, ray.origin.z}, d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
   if (e.kind == ExtentKind::Sphere) {
@@ -42,30 +64,6 @@ bool clip(const Extent& e, const PixelRay& ray, long double& t_in, long double& 
   return t_out > t_in;
 }
 
-mpq_class evaluate(const std::vector<mpq_class>& poly, const mpq_class& t) {
-  mpq_class v = 0;
-  for (auto it = poly.rbegin(); it != poly.rend(); ++it) v = v * t + *it;
-  return v;
-}
-
-PixelClass classify(ref::Classification kind) {
-  switch (kind) {
-    case ref::Classification::Miss:
-      return PixelClass::Miss;
-    case ref::Classification::SimpleRoot:
-      return PixelClass::SimpleRoot;
-    case ref::Classification::MultipleRootOddSignChange:
-      return PixelClass::OddMultipleRoot;
-    case ref::Classification::EvenRootNoSignChange:
-      return PixelClass::EvenRoot;
-    case ref::Classification::IdenticallyZero:
-      return PixelClass::OnSurface;
-  }
-  return PixelClass::Miss;
-}
-
-}  // namespace
-
 ReferenceResult render_reference(const Scene& scene, Precision ray_precision, unsigned threads) {
   const int width = scene.image.width, height = scene.image.height;
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
@@ -89,7 +87,7 @@ ReferenceResult render_reference(const Scene& scene, Precision ray_precision, un
     h.t_hi = h.depth = std::numeric_limits<float>::infinity();
     const PixelRay ray = pixel_ray(r.basis, single, px, py);
     long double t_in = 0, t_out = 0;
-    if (!clip(scene.extent, ray, t_in, t_out)) return;
+    if (!extent_interval(scene.extent, ray, t_in, t_out)) return;
     h.flags = ALGRAY_HIT_IN_EXTENT;
     // Solve on the interval widened by the clipping margin, so a root the kernels' own clipping may just
     // include or exclude shows up as ambiguous instead of as a certified answer.

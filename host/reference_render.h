@@ -31,6 +31,10 @@ struct ReferenceResult {
 inline constexpr double kReferenceWidth = 1e-13;
 inline constexpr double kReferenceEndMargin = 256;
 
+// [t_in, t_out] of a ray in the extent, in long double: close to the kernels' clipping, which is what the
+// reference needs (roots near the ends are treated as ambiguous), not exact. False when the ray misses.
+bool extent_interval(const Extent& extent, const PixelRay& ray, long double& t_in, long double& t_out);
+
 // Rays are rebuilt in `ray_precision` exactly as the kernels build them (README convention), and P is the
 // scene's exact polynomial. threads = 0 uses every core.
 ReferenceResult render_reference(const Scene& scene, Precision ray_precision, unsigned threads = 0);

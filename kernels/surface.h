@@ -13,16 +13,6 @@
 #error "RAY_ORIGIN=eye needs the power basis"
 #endif
 
-typedef struct {
-  REAL t;          /* ray parameter of the hit; +inf when none */
-  REAL3 u;         /* hit point in unit coordinates */
-  REAL3 d_unit;    /* ray direction in unit coordinates */
-  REAL f_before;   /* P at the left end of the isolating interval: its sign tells the side */
-  uint flags;      /* ALGRAY_HIT_* */
-  uint steps;      /* isolation intervals examined */
-  uint iterations; /* refinement iterations */
-} SurfaceHit;
-
 /* The outcome of isolating and refining the smallest root of P*(t) on [t_in, t_out]. */
 typedef struct {
   REAL t;          /* the root; meaningful with ALGRAY_HIT_FOUND */
@@ -31,6 +21,13 @@ typedef struct {
   uint steps;      /* isolation intervals examined */
   uint iterations; /* refinement iterations */
 } SegmentRoot;
+
+typedef struct {
+  SegmentRoot root; /* root.t: the ray parameter of the hit; root.flags also carries ALGRAY_HIT_IN_EXTENT */
+  REAL3 u;          /* hit point in unit coordinates */
+  REAL3 d_unit;     /* ray direction in unit coordinates */
+} SurfaceHit;
+
 
 /* Refines what the isolation found; iso_c holds the polynomial on the isolating interval. */
 SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out, __constant const REAL* binomials) {
@@ -61,11 +58,11 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
                          __global const uint* exps, __global const REAL* coefs, uint count,
                          __constant const REAL* binomials, uint even_axes) {
   SurfaceHit h;
-  h.t = INFINITY;
-  h.flags = 0;
-  h.steps = 0;
-  h.iterations = 0;
-  h.f_before = 0;
+  h.root.t = INFINITY;
+  h.root.f_before = 0;
+  h.root.flags = 0;
+  h.root.steps = 0;
+  h.root.iterations = 0;
   /* Unit coordinates keep every point of the extent within |u| <= 1: the conditioning step that makes float usable. */
   const REAL3 o = (ray.o - centre) * inv_scale;
   const REAL3 d = ray.d * inv_scale;
@@ -73,7 +70,7 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   h.u = o;
   REAL t_in, t_out;
   if (!clip_to_extent(o, d, extent_kind, box_half, &t_in, &t_out)) return h;
-  h.flags |= ALGRAY_HIT_IN_EXTENT;
+  h.root.flags = ALGRAY_HIT_IN_EXTENT;
 
   REAL root[NCOEF], iso_c[NCOEF];
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EYE
@@ -96,14 +93,9 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   const Isolation iso = isolate_power(root, (REAL)0, (REAL)1, t_in, t_out, iso_c);
 #endif
 #endif
-  const SegmentRoot sr = refine_isolated(iso, iso_c, t_in, t_out, binomials);
-  h.steps = sr.steps;
-  h.iterations = sr.iterations;
-  h.flags |= sr.flags;
-  if (!(sr.flags & ALGRAY_HIT_FOUND)) return h;
-  h.t = sr.t;
-  h.f_before = sr.f_before;
-  h.u = o + h.t * d;
+  h.root = refine_isolated(iso, iso_c, t_in, t_out, binomials);
+  h.root.flags |= ALGRAY_HIT_IN_EXTENT;
+  if (h.root.flags & ALGRAY_HIT_FOUND) h.u = o + h.root.t * d;
   return h;
 }
 
@@ -130,17 +122,17 @@ REAL3 surface_gradient(REAL3 u, __global const uint* exps, __global const REAL* 
 
 HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global const REAL* coefs, uint count) {
   HitRecord r;
-  r.flags = h.flags;
-  r.work = min(h.steps, 0xffffu) | (min(h.iterations, 0xffffu) << 16);
+  r.flags = h.root.flags;
+  r.work = min(h.root.steps, 0xffffu) | (min(h.root.iterations, 0xffffu) << 16);
   r.t_hi = INFINITY;
   r.t_lo = 0;
   r.depth = INFINITY;
   r.normal_x = r.normal_y = r.normal_z = 0;
-  if (!(h.flags & ALGRAY_HIT_FOUND)) return r;
+  if (!(h.root.flags & ALGRAY_HIT_FOUND)) return r;
 
-  r.t_hi = (float)h.t;
-  r.t_lo = (float)(h.t - (REAL)r.t_hi);
-  r.depth = (float)(h.t * length(ray.d));
+  r.t_hi = (float)h.root.t;
+  r.t_lo = (float)(h.root.t - (REAL)r.t_hi);
+  r.depth = (float)(h.root.t * length(ray.d));
   /* Unit coordinates differ from world ones by a translation and a uniform scale: same normal direction. */
   const REAL3 g = surface_gradient(h.u, exps, coefs, count);
   const REAL glen = length(g);
@@ -150,7 +142,7 @@ HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global 
   r.normal_y = (float)n.y;
   r.normal_z = (float)n.z;
   /* Front is the side where P > 0; at an exact root use the direction in which P grows instead. */
-  const int back = h.f_before != 0 ? h.f_before < 0 : dot(g, h.d_unit) > 0;
+  const int back = h.root.f_before != 0 ? h.root.f_before < 0 : dot(g, h.d_unit) > 0;
   if (back) r.flags |= ALGRAY_HIT_BACK;
   return r;
 }

@@ -34,51 +34,46 @@ struct RaySolve {
   double t_in = 0, t_out = 0;
 };
 
-RaySolve solve(Renderer& renderer, const std::string& file, const glm::dvec3& from, const glm::dvec3& to,
+// The scene file's text without its perspective field of view, so the camera can become orthographic.
+std::string scene_without_fov(const std::string& file) {
+  std::ifstream in(std::string(ALGRAY_SOURCE_DIR) + "/scenes/" + file);
+  std::string line, text;
+  while (std::getline(in, line))
+    if (line.rfind("fov_y", 0) != 0) text += line + "\n";
+  return text;
+}
+
+// One renderer for the whole file, with an in-memory program cache: the rays below share a few programs.
+Renderer& renderer() {
+  static ProgramCache cache(true, std::filesystem::temp_directory_path() / "algray-test-hard-rays-cache");
+  static Renderer r(testing::device_session(), cache);
+  return r;
+}
+
+// The ray from `from` towards `to` as the only pixel of a 1x1 orthographic view, solved by the kernel and by
+// the reference over the same extent interval the reference images use.
+RaySolve solve(const std::string& file, const glm::dvec3& from, const glm::dvec3& to,
                const glm::dvec3& up = {0, 1, 0}) {
-  const std::vector<Override> overrides = {{"camera.projection", "\"orthographic\""},
-                                           {"camera.eye", vec(from)},
-                                           {"camera.look_at", vec(to)},
-                                           {"camera.up", vec(up)},
-                                           {"image.width", "1"},
-                                           {"image.height", "1"},
-                                           {"render.precision", "\"double\""}};
-  // fov_y belongs to perspective cameras: the scene is read without it and given an orthographic height.
-  std::vector<Override> all = overrides;
-  all.push_back({"camera.height", "1"});
-  Scene scene = load_scene_text(
-      [&] {
-        std::ifstream in(std::string(ALGRAY_SOURCE_DIR) + "/scenes/" + file);
-        std::string line, out;
-        while (std::getline(in, line))
-          if (line.rfind("fov_y", 0) != 0) out += line + "\n";
-        return out;
-      }(),
-      file, all);
+  const Scene scene = load_scene_text(scene_without_fov(file), file,
+                                      {{"camera.projection", "\"orthographic\""},
+                                       {"camera.height", "1"},
+                                       {"camera.eye", vec(from)},
+                                       {"camera.look_at", vec(to)},
+                                       {"camera.up", vec(up)},
+                                       {"image.width", "1"},
+                                       {"image.height", "1"},
+                                       {"render.precision", "\"double\""}});
   RaySolve r;
-  const RenderResult result = renderer.render(scene, false);
+  const RenderResult result = renderer().render(scene, false);
   r.kernel = result.hits.records[0];
   r.ray = pixel_ray(result.basis, false, 0, 0);
-  // The reference on the same ray. Clipping in double is enough: every ray here meets its root well inside.
+  long double t_in = 0, t_out = 0;
+  REQUIRE(extent_interval(scene.extent, r.ray, t_in, t_out));
+  r.t_in = static_cast<double>(t_in);
+  r.t_out = static_cast<double>(t_out);
   const glm::dvec3 o = r.ray.origin, d = r.ray.direction;
-  const ref::ExactRay exact{{o.x, o.y, o.z}, {d.x, d.y, d.z}};
-  if (scene.extent.kind == ExtentKind::Sphere) {
-    const glm::dvec3 c = scene.extent.centre;
-    const double a = glm::dot(d, d), b = glm::dot(o - c, d);
-    const double cc = glm::dot(o - c, o - c) - scene.extent.radius * scene.extent.radius;
-    r.t_in = std::max(0.0, (-b - std::sqrt(b * b - a * cc)) / a);
-    r.t_out = (-b + std::sqrt(b * b - a * cc)) / a;
-  } else {
-    r.t_in = 0;
-    r.t_out = std::numeric_limits<double>::max();
-    for (int i = 0; i < 3; ++i) {
-      const double t0 = (scene.extent.min[i] - o[i]) / d[i], t1 = (scene.extent.max[i] - o[i]) / d[i];
-      r.t_in = std::max(r.t_in, std::min(t0, t1));
-      r.t_out = std::min(r.t_out, std::max(t0, t1));
-    }
-  }
-  r.reference = ref::smallest_root(scene.polynomial, exact, exact_rational(r.t_in), exact_rational(r.t_out),
-                                   mpq_class(1, 1000000000000L));
+  r.reference = ref::smallest_root(scene.polynomial, ref::ExactRay{{o.x, o.y, o.z}, {d.x, d.y, d.z}},
+                                   exact_rational(r.t_in), exact_rational(r.t_out), mpq_class(1, 1000000000000L));
   return r;
 }
 
@@ -87,12 +82,9 @@ double kernel_t(const HitRecord& h) { return static_cast<double>(h.t_hi) + stati
 }  // namespace
 
 TEST_CASE("rays through nodes meet a double root", "[hard-rays]") {
-  ClSession& session = testing::device_session();
-  ProgramCache cache(true, std::filesystem::temp_directory_path() / "algray-test-hard-rays-cache");
-  Renderer renderer(session, cache);
   // Axis-aligned rays are exact, so these pass exactly through the nodes. The Cayley cubic along z through its
   // node (1, 1, -1): P = (z + 1)^2, a double root without a sign change.
-  const RaySolve cayley = solve(renderer, "cayley_cubic.toml", glm::dvec3(1, 1, 1), glm::dvec3(1, 1, -3));
+  const RaySolve cayley = solve("cayley_cubic.toml", glm::dvec3(1, 1, 1), glm::dvec3(1, 1, -3));
   INFO("Cayley: reference " << ref::to_string(cayley.reference.kind) << " at " << cayley.reference.t_nearest);
   CHECK(cayley.reference.kind == ref::Classification::EvenRootNoSignChange);
   CHECK(cayley.reference.multiplicity == 2);
@@ -100,7 +92,7 @@ TEST_CASE("rays through nodes meet a double root", "[hard-rays]") {
   if (cayley.kernel.flags & ALGRAY_HIT_FOUND) CHECK(kernel_t(cayley.kernel) == Approx(2).margin(1e-6));
   // The lemniscate's node at the origin along x: P = x^2 (x^2 - 2 a^2), negative on both sides of 0; the
   // kernel goes on to the far lobe at x = -a sqrt 2 unless rounding noise stops it at the node.
-  const RaySolve lemniscate = solve(renderer, "lemniscate.toml", glm::dvec3(1, 0, 0), glm::dvec3(-4, 0, 0));
+  const RaySolve lemniscate = solve("lemniscate.toml", glm::dvec3(1, 0, 0), glm::dvec3(-4, 0, 0));
   INFO("lemniscate: reference " << ref::to_string(lemniscate.reference.kind) << " at "
                                 << lemniscate.reference.t_nearest);
   CHECK(lemniscate.reference.kind == ref::Classification::EvenRootNoSignChange);
@@ -112,12 +104,9 @@ TEST_CASE("rays through nodes meet a double root", "[hard-rays]") {
 }
 
 TEST_CASE("a ray through the tooth's isolated point touches without crossing and stays invisible", "[hard-rays]") {
-  ClSession& session = testing::device_session();
-  ProgramCache cache(true, std::filesystem::temp_directory_path() / "algray-test-hard-rays-cache");
-  Renderer renderer(session, cache);
   // x^4+y^4+z^4-(x^2+y^2+z^2) is negative all around the origin: along the z axis P* = z^4 - z^2. From
   // z = 1/2 down (an axis-aligned ray, so it is exact) the origin is the first root, of even multiplicity.
-  const RaySolve s = solve(renderer, "tooth.toml", glm::dvec3(0, 0, 0.5), glm::dvec3(0, 0, -0.5));
+  const RaySolve s = solve("tooth.toml", glm::dvec3(0, 0, 0.5), glm::dvec3(0, 0, -0.5));
   INFO("reference " << ref::to_string(s.reference.kind) << " at " << s.reference.t_nearest);
   CHECK(s.reference.kind == ref::Classification::EvenRootNoSignChange);
   CHECK(s.reference.multiplicity == 2);
@@ -131,11 +120,8 @@ TEST_CASE("a ray through the tooth's isolated point touches without crossing and
 }
 
 TEST_CASE("a ray tangent to the torus along the top of its tube touches without crossing", "[hard-rays]") {
-  ClSession& session = testing::device_session();
-  ProgramCache cache(true, std::filesystem::temp_directory_path() / "algray-test-hard-rays-cache");
-  Renderer renderer(session, cache);
   // At z = r = 0.9 the torus equation is (x^2 + y^2 - a^2)^2: double roots at x = -2.5 and 2.5.
-  const RaySolve s = solve(renderer, "torus.toml", glm::dvec3(-3.4, 0, 0.9), glm::dvec3(3.4, 0, 0.9));
+  const RaySolve s = solve("torus.toml", glm::dvec3(-3.4, 0, 0.9), glm::dvec3(3.4, 0, 0.9));
   INFO("reference " << ref::to_string(s.reference.kind) << " at " << s.reference.t_nearest);
   CHECK(s.reference.kind == ref::Classification::EvenRootNoSignChange);
   CHECK(s.reference.multiplicity == 2);
@@ -147,12 +133,8 @@ TEST_CASE("a ray tangent to the torus along the top of its tube touches without 
 }
 
 TEST_CASE("the cusp catastrophe: a double root on the fold and a triple root at the cusp", "[hard-rays]") {
-  ClSession& session = testing::device_session();
-  ProgramCache cache(true, std::filesystem::temp_directory_path() / "algray-test-hard-rays-cache");
-  Renderer renderer(session, cache);
   // Through the fold point z0 = 1/2 (x0 = -3 z0^2, y0 = 2 z0^3) along z: P = (z - 1/2)^2 (z + 1).
-  const RaySolve fold =
-      solve(renderer, "cusp_catastrophe.toml", glm::dvec3(-0.75, 0.25, 2), glm::dvec3(-0.75, 0.25, -2));
+  const RaySolve fold = solve("cusp_catastrophe.toml", glm::dvec3(-0.75, 0.25, 2), glm::dvec3(-0.75, 0.25, -2));
   INFO("fold: reference " << ref::to_string(fold.reference.kind) << " at " << fold.reference.t_nearest);
   CHECK(fold.reference.kind == ref::Classification::EvenRootNoSignChange);
   CHECK(fold.ray.origin.z + fold.reference.t_nearest * fold.ray.direction.z == Approx(0.5).margin(1e-9));
@@ -162,7 +144,7 @@ TEST_CASE("the cusp catastrophe: a double root on the fold and a triple root at 
   INFO("kernel at z = " << z_hit);
   CHECK((std::fabs(z_hit - 0.5) < 1e-6 || std::fabs(z_hit + 1) < 1e-7));
   // Along z through the origin P = z^3: a triple root, which crosses and must be found.
-  const RaySolve cusp = solve(renderer, "cusp_catastrophe.toml", glm::dvec3(0, 0, 2), glm::dvec3(0, 0, -2));
+  const RaySolve cusp = solve("cusp_catastrophe.toml", glm::dvec3(0, 0, 2), glm::dvec3(0, 0, -2));
   INFO("cusp: reference " << ref::to_string(cusp.reference.kind) << " at " << cusp.reference.t_nearest);
   CHECK(cusp.reference.kind == ref::Classification::MultipleRootOddSignChange);
   CHECK(cusp.reference.multiplicity == 3);
@@ -171,9 +153,6 @@ TEST_CASE("the cusp catastrophe: a double root on the fold and a triple root at 
 }
 
 TEST_CASE("Fig. 8: where Newton from the left end catches the second root, the kernel keeps the first", "[hard-rays]") {
-  ClSession& session = testing::device_session();
-  ProgramCache cache(true, std::filesystem::temp_directory_path() / "algray-test-hard-rays-cache");
-  Renderer renderer(session, cache);
   // Rays from the camera sphere (radius 3R) whose P*(t) has the shape of the paper's Fig. 8(a): found by a
   // seeded scan of random rays, each confirmed below by running Newton's method.
   const std::vector<std::pair<glm::dvec3, glm::dvec3>> rays = {{{-1.316, 9.08, 5.106}, {-0.308, -1.21, -0.047}},
@@ -183,7 +162,7 @@ TEST_CASE("Fig. 8: where Newton from the left end catches the second root, the k
                                                                {{-8.717, 0.4, 5.84}, {0.954, 1.011, 0.233}}};
   int found = 0;
   for (const auto& [from, to] : rays) {
-    const RaySolve s = solve(renderer, "torus.toml", from, to, {0, 0, 1});
+    const RaySolve s = solve("torus.toml", from, to, {0, 0, 1});
     if (s.reference.kind != ref::Classification::SimpleRoot) continue;
     // Newton on the exact polynomial, in long double, from the left end of the interval.
     const glm::dvec3 o = s.ray.origin, d = s.ray.direction;
@@ -210,9 +189,6 @@ TEST_CASE("Fig. 8: where Newton from the left end catches the second root, the k
 }
 
 TEST_CASE("high-degree rays agree with the reference", "[hard-rays]") {
-  ClSession& session = testing::device_session();
-  ProgramCache cache(true, std::filesystem::temp_directory_path() / "algray-test-hard-rays-cache");
-  Renderer renderer(session, cache);
   struct Case {
     const char* file;
     glm::dvec3 from, to;
@@ -225,7 +201,7 @@ TEST_CASE("high-degree rays agree with the reference", "[hard-rays]") {
       {"endrass_octic.toml", {0.2, 3.9, 1.5}, {0.1, -1.0, 0.2}},
   };
   for (const Case& c : cases) {
-    const RaySolve s = solve(renderer, c.file, c.from, c.to);
+    const RaySolve s = solve(c.file, c.from, c.to);
     INFO(c.file << ": reference " << ref::to_string(s.reference.kind) << " at " << s.reference.t_nearest);
     REQUIRE((s.reference.kind == ref::Classification::SimpleRoot || s.reference.kind == ref::Classification::Miss));
     REQUIRE(((s.kernel.flags & ALGRAY_HIT_FOUND) != 0) == (s.reference.kind == ref::Classification::SimpleRoot));

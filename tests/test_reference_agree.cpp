@@ -21,7 +21,6 @@ namespace {
 
 constexpr int kWidth = 160, kHeight = 120;
 
-
 struct Comparison {
   long certified = 0, disagreements = 0, simple_hits = 0, ambiguous = 0;
   double worst_depth = 0;
@@ -90,13 +89,7 @@ void check_scene(Renderer& renderer, const std::filesystem::path& file, const ch
   CHECK(c.worst_depth <= limit.depth_error);
 }
 
-std::vector<std::filesystem::path> scene_files() {
-  std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(ALGRAY_SOURCE_DIR "/scenes"))
-    if (entry.path().extension() == ".toml") files.push_back(entry.path());
-  std::sort(files.begin(), files.end());
-  return files;
-}
+using testing::scene_files;
 
 }  // namespace
 

@@ -162,10 +162,7 @@ TEST_CASE("each scene agrees with an independent CPU check on a seeded sample of
   ClSession& session = testing::device_session();
   ProgramCache cache(false);
   Renderer renderer(session, cache);
-  std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(ALGRAY_SOURCE_DIR "/scenes"))
-    if (entry.path().extension() == ".toml") files.push_back(entry.path());
-  std::sort(files.begin(), files.end());
+  const std::vector<std::filesystem::path> files = testing::scene_files();
   REQUIRE(files.size() >= 12);
 
   for (const auto& file : files) {

@@ -1,9 +1,12 @@
 // Helpers shared by the tests that need an OpenCL device: the device is required, never optional.
 #pragma once
 
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cl_runtime.h"
 
@@ -22,6 +25,15 @@ inline ClSession& device_session() {
     session = std::make_unique<ClSession>(select_device(""));
   }
   return *session;
+}
+
+// Every scene file in scenes/, sorted by name.
+inline std::vector<std::filesystem::path> scene_files() {
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(ALGRAY_SOURCE_DIR "/scenes"))
+    if (entry.path().extension() == ".toml") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
 }
 
 }  // namespace algray::testing
