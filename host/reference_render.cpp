@@ -2,6 +2,7 @@
 #include "reference_render.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -33,6 +34,50 @@ PixelClass classify(ref::Classification kind) {
       return PixelClass::OnSurface;
   }
   return PixelClass::Miss;
+}
+
+// grad P at o + t d, in long double from the exact polynomial's monomials.
+std::array<long double, 3> gradient_at(const std::vector<Monomial>& monomials, const PixelRay& ray, long double t) {
+  const long double p[3] = {ray.origin.x + t * ray.direction.x, ray.origin.y + t * ray.direction.y,
+                            ray.origin.z + t * ray.direction.z};
+  std::array<long double, 3> g = {0, 0, 0};
+  for (const Monomial& m : monomials) {
+    const int e[3] = {m.i, m.j, m.k};
+    for (int axis = 0; axis < 3; ++axis) {
+      if (e[axis] == 0) continue;
+      long double term = m.coef * e[axis];
+      for (int other = 0; other < 3; ++other) term *= std::pow(p[other], e[other] - (other == axis));
+      g[axis] += term;
+    }
+  }
+  return g;
+}
+
+// Whether moving each ray component by kReferenceRayRoundings * eps of its size could change the number of roots
+// P* has on [lo, limit]: that needs some critical point of P* there where |P*| is within the first-order change
+// of P. Critical points are the roots of P*', found exactly; P* is flat at them, so a loose enclosure will do.
+bool flips_under_ray_rounding(const std::vector<mpq_class>& restricted, const std::vector<Monomial>& monomials,
+                              const PixelRay& ray, const mpq_class& lo, const mpq_class& limit, long double eps) {
+  std::vector<mpq_class> derivative;
+  for (std::size_t k = 1; k < restricted.size(); ++k) derivative.push_back(restricted[k] * static_cast<long>(k));
+  while (!derivative.empty() && derivative.back() == 0) derivative.pop_back();
+  if (derivative.size() < 2) return false;  // P* linear or constant: no critical point
+  const mpq_class width = abs(limit) / 1000000000 + mpq_class(1, 1000000000);
+  const double o[3] = {ray.origin.x, ray.origin.y, ray.origin.z},
+               d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+  mpq_class from = lo;
+  while (from <= limit) {
+    const ref::Answer c = ref::smallest_root(derivative, from, limit, width);
+    if (c.kind == ref::Classification::Miss || c.kind == ref::Classification::IdenticallyZero) return false;
+    const long double t = c.t_nearest;
+    const long double value = std::fabs(evaluate(restricted, exact_rational(c.t_nearest)).get_d());
+    const std::array<long double, 3> g = gradient_at(monomials, ray, t);
+    long double change = 0;
+    for (int axis = 0; axis < 3; ++axis) change += std::fabs(g[axis]) * (std::fabs(o[axis]) + std::fabs(t * d[axis]));
+    if (value <= kReferenceRayRoundings * eps * change) return true;
+    from = c.hi + width;
+  }
+  return false;
 }
 
 }  // namespace
@@ -101,11 +146,18 @@ ReferenceResult render_reference(const Scene& scene, Precision ray_precision, un
     const ref::Answer a = ref::smallest_root(restricted, lo, hi, width_t);
     PixelClass cls = classify(a.kind);
     if (a.kind == ref::Classification::Miss) {
+      if (flips_under_ray_rounding(restricted, monomials, ray, lo, hi, eps)) cls = PixelClass::RayRounding;
       out.classes[i] = static_cast<std::uint32_t>(cls);
       return;
     }
     const long double t = a.t_nearest;
     if (t < t_in + margin || t > t_out - margin) cls = PixelClass::NearEnd;
+    if (cls == PixelClass::SimpleRoot) {
+      // P* keeps its shape up to the second root: beyond it, nothing a small move does changes the answer.
+      const ref::Answer second = ref::smallest_root(restricted, a.hi + width_t, hi, width_t);
+      const mpq_class limit = second.kind == ref::Classification::Miss ? hi : second.hi;
+      if (flips_under_ray_rounding(restricted, monomials, ray, lo, limit, eps)) cls = PixelClass::RayRounding;
+    }
     out.classes[i] = static_cast<std::uint32_t>(cls);
     out.t[i] = a.t_nearest;
     h.flags |= ALGRAY_HIT_FOUND;
@@ -113,19 +165,8 @@ ReferenceResult render_reference(const Scene& scene, Precision ray_precision, un
     h.t_hi = static_cast<float>(a.t_nearest);
     h.t_lo = static_cast<float>(a.t_nearest - static_cast<double>(h.t_hi));
     h.depth = static_cast<float>(a.t_nearest * glm::length(ray.direction));
-    // Normal from the gradient of the exact polynomial, in long double; facing the viewer.
-    const long double p[3] = {ray.origin.x + t * ray.direction.x, ray.origin.y + t * ray.direction.y,
-                              ray.origin.z + t * ray.direction.z};
-    long double g[3] = {0, 0, 0};
-    for (const Monomial& m : monomials) {
-      const int e[3] = {m.i, m.j, m.k};
-      for (int axis = 0; axis < 3; ++axis) {
-        if (e[axis] == 0) continue;
-        long double term = m.coef * e[axis];
-        for (int other = 0; other < 3; ++other) term *= std::pow(p[other], e[other] - (other == axis));
-        g[axis] += term;
-      }
-    }
+    // Normal from the gradient of the exact polynomial, facing the viewer.
+    const std::array<long double, 3> g = gradient_at(monomials, ray, t);
     const long double len = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
     glm::dvec3 n = len > 0 ? glm::dvec3(double(g[0] / len), double(g[1] / len), double(g[2] / len))
                            : -glm::normalize(ray.direction);

@@ -18,6 +18,7 @@ enum class PixelClass : std::uint32_t {
   EvenRoot = 4,         // even multiplicity: touches without crossing (tangent ray, node, isolated point)
   OnSurface = 5,        // P vanishes on the whole segment
   NearEnd = 6,          // the smallest root lies within the clipping margin of t_in or t_out: ambiguous
+  RayRounding = 7,      // a miss or simple root whose answer a few ulps' change of the ray can flip: ambiguous
 };
 
 struct ReferenceResult {
@@ -30,6 +31,13 @@ struct ReferenceResult {
 // the ray precision's epsilon) within which a root at the clipping ends counts as ambiguous.
 inline constexpr double kReferenceWidth = 1e-13;
 inline constexpr double kReferenceEndMargin = 256;
+
+// A kernel never sees the exact ray: it moves the ray into unit coordinates and builds the segment's end points,
+// each a rounding of the ray's components. A miss or a simple root counts as certified only if P* keeps its
+// shape under that: at every critical point of P* before the second root, |P*| must exceed the first-order
+// change of P under a move of each ray component by kReferenceRayRoundings units of the ray precision's
+// roundoff. Otherwise (a near-touch of another sheet, two nearly equal roots) the pixel is RayRounding.
+inline constexpr double kReferenceRayRoundings = 8;
 
 // [t_in, t_out] of a ray in the extent, in long double: close to the kernels' clipping, which is what the
 // reference needs (roots near the ends are treated as ambiguous), not exact. False when the ray misses.

@@ -4,68 +4,146 @@
 
 #include "isolation.h"
 
+/* Mixed precision isolates in float-float: every Bernstein coefficient is an unevaluated sum hi + lo, and the
+ * *_lo arrays below hold the low parts (other builds never touch them). Rounding the coefficients to float
+ * before isolating was not enough: on the Endrass octic, rays that pass a node come within 1e-9 of the
+ * coefficients' size of zero, so float noise faked sign changes there and hid thin pairs of roots (measured:
+ * one hit on the wrong sheet, depth error 0.17). Sign variations read the hi parts, which carry the sign. */
+#if ALGRAY_COMPENSATED
+/* hi + lo = x1 a + x b, for float-float a, b and weights x1, x given as float-float too (lo 0 when exact). */
+ALGRAY_INLINE void ff_combine(REAL a, REAL a_lo, REAL x1, REAL x1_lo, REAL b, REAL b_lo, REAL x, REAL x_lo, REAL* hi,
+                              REAL* lo) {
+  const REAL p = x1 * a, q = x * b;
+  const REAL s = p + q, bb = s - p;
+  const REAL e =
+      (p - (s - bb)) + (q - bb) + fma(x1, a, -p) + fma(x, b, -q) + x1 * a_lo + x * b_lo + x1_lo * a + x_lo * b;
+  *hi = s + e;
+  *lo = e - (*hi - s);
+}
+#endif
+
 /* The restriction produced scaled coefficients c_k = C(n,k) b_k; Descartes' rule and de Casteljau want b_k. */
-void bernstein_from_scaled(REAL* c, __constant const REAL* binomials) {
+void bernstein_from_scaled(REAL* c, REAL* c_lo, __constant const REAL* binomials) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) c[k] /= row[k];
+  for (int k = 0; k <= DEGREE; ++k) {
+#if ALGRAY_COMPENSATED
+    const REAL q = c[k] / row[k];
+    c_lo[k] = (fma(-q, row[k], c[k]) + c_lo[k]) / row[k]; /* the division's remainder is exact */
+    c[k] = q;
+#else
+    (void)c_lo;
+    c[k] /= row[k];
+#endif
+  }
 }
 
-/* Keeps the part of the curve on [0, x]. In place: after pass r, c[r] is the r-th left coefficient. */
-void casteljau_keep_left(REAL* c, REAL x) {
-  const REAL x1 = (REAL)1 - x;
-  ALGRAY_UNROLL
-  for (int r = 1; r <= DEGREE; ++r)
-    ALGRAY_UNROLL
-    for (int k = DEGREE; k >= r; --k) c[k] = x1 * c[k - 1] + x * c[k];
+/* c = x1 a + x b: one step of de Casteljau's recurrence, in the build's arithmetic. */
+ALGRAY_INLINE void casteljau_step(REAL* c, REAL* c_lo, int k, int a, int b, REAL x1, REAL x1_lo, REAL x, REAL x_lo) {
+#if ALGRAY_COMPENSATED
+  ff_combine(c[a], c_lo[a], x1, x1_lo, c[b], c_lo[b], x, x_lo, &c[k], &c_lo[k]);
+#else
+  (void)c_lo;
+  (void)x1_lo;
+  (void)x_lo;
+  c[k] = x1 * c[a] + x * c[b];
+#endif
 }
 
-/* Keeps the part on [x, 1]. */
-void casteljau_keep_right(REAL* c, REAL x) {
+ALGRAY_INLINE void coefs_copy(REAL* dst, REAL* dst_lo, const REAL* src, const REAL* src_lo) {
+  poly_copy(dst, src);
+#if ALGRAY_COMPENSATED
+  poly_copy(dst_lo, src_lo);
+#else
+  (void)dst_lo;
+  (void)src_lo;
+#endif
+}
+
+/* Keeps the part of the curve on [0, x], x dyadic (so 1 - x is exact). In place: after pass r, c[r] is the
+ * r-th left coefficient. */
+void casteljau_keep_left(REAL* c, REAL* c_lo, REAL x) {
   const REAL x1 = (REAL)1 - x;
   ALGRAY_UNROLL
-  for (int r = 1; r <= DEGREE; ++r)
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE - r; ++k) c[k] = x1 * c[k] + x * c[k + 1];
+  for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
+  for (int k = DEGREE; k >= r; --k) casteljau_step(c, c_lo, k, k - 1, k, x1, 0, x, 0);
+}
+
+/* Keeps the part on [x + x_lo, 1], for x >= 1/2 (so 1 - x is exact). */
+void casteljau_keep_right(REAL* c, REAL* c_lo, REAL x, REAL x_lo) {
+  const REAL x1 = (REAL)1 - x;
+  ALGRAY_UNROLL
+  for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE - r; ++k) casteljau_step(c, c_lo, k, k, k + 1, x1, -x_lo, x, x_lo);
 }
 
 /* Halves c at 1/2 in one de Casteljau triangle: c becomes the left half, right the right half. */
-void casteljau_halve(REAL* c, REAL* right) {
-  REAL t[NCOEF];
-  poly_copy(t, c);
+void casteljau_halve(REAL* c, REAL* c_lo, REAL* right, REAL* right_lo) {
+  REAL t[NCOEF], t_lo[NCOEF];
+  coefs_copy(t, t_lo, c, c_lo);
   right[DEGREE] = t[DEGREE];
+#if ALGRAY_COMPENSATED
+  right_lo[DEGREE] = t_lo[DEGREE];
+#endif
   ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r) {
     ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE - r; ++k) t[k] = (REAL)0.5 * (t[k] + t[k + 1]);
+    for (int k = 0; k <= DEGREE - r; ++k) casteljau_step(t, t_lo, k, k, k + 1, (REAL)0.5, 0, (REAL)0.5, 0);
     c[r] = t[0];
     right[DEGREE - r] = t[DEGREE - r];
+#if ALGRAY_COMPENSATED
+    c_lo[r] = t_lo[0];
+    right_lo[DEGREE - r] = t_lo[DEGREE - r];
+#else
+    (void)right_lo;
+#endif
   }
 }
 
 /* Coefficients on the dyadic interval [idx/2^level, (idx+1)/2^level], recomputed from the whole interval's. */
-void bernstein_restrict(const REAL* root, int level, ulong idx, REAL* out) {
-  poly_copy(out, root);
+void bernstein_restrict(const REAL* root, const REAL* root_lo, int level, ulong idx, REAL* out, REAL* out_lo) {
+  coefs_copy(out, out_lo, root, root_lo);
   const REAL width = ldexp((REAL)1, -level);
   const REAL lo = (REAL)idx * width, hi = lo + width;
-  if (hi < (REAL)1) casteljau_keep_left(out, hi);
-  if (lo > (REAL)0) casteljau_keep_right(out, lo / hi);
+  if (hi < (REAL)1) casteljau_keep_left(out, out_lo, hi);
+  if (lo > (REAL)0) {
+    /* lo / hi = idx / (idx + 1) >= 1/2, and its rounding error recovered exactly by fma */
+    const REAL x = lo / hi;
+    casteljau_keep_right(out, out_lo, x, fma(-x, hi, lo) / hi);
+  }
+}
+
+/* Whether float refinement can find the root bracketed by cur's end values. Always in plain builds. In mixed
+ * precision the rounded coefficients are only good to eps of their largest, so an end value below that noise
+ * could stop the refinement at the wrong end (measured: an Endrass octic hit 0.19 from its root); the
+ * interval is halved further instead, in float-float, until its ends stand clear of the noise. */
+int refinable_in_float(const REAL* c) {
+#if ALGRAY_COMPENSATED
+  REAL scale = 0;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(c[k]));
+  return fmin(fabs(c[0]), fabs(c[DEGREE])) > (REAL)(4 * DEGREE) * REAL_EPS * scale;
+#else
+  (void)c;
+  return 1;
+#endif
 }
 
 /* Finds the leftmost subinterval of [0,1] that isolates the smallest root of the polynomial with Bernstein
- * coefficients `root`. Depth-first, left half first; the path is the pair (level, idx), so no stack is kept.
- * The right half of the latest split is cached, as the left half is usually rejected at once.
- * On return `cur` holds the Bernstein coefficients on [iso.lo, iso.hi]. */
-Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL* cur) {
+ * coefficients `root` (+ `root_lo` in mixed precision). Depth-first, left half first; the path is the pair
+ * (level, idx), so no stack is kept. The right half of the latest split is cached, as the left half is usually
+ * rejected at once. On return `cur` holds the Bernstein coefficients on [iso.lo, iso.hi] (rounded to float in
+ * mixed precision, where they are accurate relative to their own size). */
+Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out, REAL* cur) {
   Isolation iso = isolation_none();
-  REAL sib[NCOEF];
+  REAL cur_lo[NCOEF], sib[NCOEF], sib_lo[NCOEF];
   int sib_level = -1;
   ulong sib_idx = 0;
   int level = 0;
   ulong idx = 0;
   const REAL len = t_out - t_in;
   const int start_sign = (root[0] > 0) - (root[0] < 0);
-  poly_copy(cur, root);
+  coefs_copy(cur, cur_lo, root, root_lo);
 
   for (;;) {
     ++iso.steps;
@@ -80,14 +158,14 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL* cur) 
     }
     if (crossed_at_left_end(&iso, start_sign)) return iso;
     const int v = sign_variations(cur);
-    if (v == 1 && cur[DEGREE] != 0) {
+    if (v == 1 && cur[DEGREE] != 0 && refinable_in_float(cur)) {
       iso.status = ISOLATION_BRACKET;
       return iso;
     }
     if (v >= 1) {
       const int located = interval_located(width, iso.lo, t_in, len);
       if (!located && level < REAL_MAX_HALVINGS) {
-        casteljau_halve(cur, sib);
+        casteljau_halve(cur, cur_lo, sib, sib_lo);
         ++level;
         idx *= 2;
         sib_level = level;
@@ -104,9 +182,9 @@ Isolation isolate_bernstein(const REAL* root, REAL t_in, REAL t_out, REAL* cur) 
       return iso;
     }
     if (sib_level == level && sib_idx == idx)
-      poly_copy(cur, sib);
+      coefs_copy(cur, cur_lo, sib, sib_lo);
     else
-      bernstein_restrict(root, level, idx, cur);
+      bernstein_restrict(root, root_lo, level, idx, cur, cur_lo);
   }
 }
 

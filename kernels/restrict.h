@@ -101,9 +101,9 @@ typedef REAL8 PolyVec;
 #else
 #define ACC_WIDTH 16
 typedef REAL16 PolyVec;
-#define VEC_SHIFT(c)                                                                                            \
-  ((PolyVec)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6, (c).s7, (c).s8, (c).s9, (c).sa, \
-             (c).sb, (c).sc, (c).sd, (c).se))
+#define VEC_SHIFT(c)                                                                                                  \
+  ((PolyVec)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6, (c).s7, (c).s8, (c).s9, (c).sa, (c).sb, \
+             (c).sc, (c).sd, (c).se))
 #define VEC_LOAD(p) vload16(0, p)
 #define VEC_STORE(v, p) vstore16(v, 0, p)
 #endif
@@ -181,7 +181,12 @@ ALGRAY_INLINE void acc_set_constant(Acc* c, REAL a, REAL a_lo) {
   c->hi = vec_constant(a);
   c->lo = vec_constant(a_lo);
 }
-ALGRAY_INLINE void acc_store(REAL* out, const Acc* c) { vec_store(out, c->hi + c->lo); }
+/* out = hi + lo rounded to float; out_lo what the rounding lost, so out + out_lo keeps ~48 bits. */
+ALGRAY_INLINE void acc_store(REAL* out, REAL* out_lo, const Acc* c) {
+  const PolyVec rounded = c->hi + c->lo;
+  vec_store(out, rounded);
+  vec_store(out_lo, (c->hi - rounded) + c->lo);
+}
 #else
 #define ACC_SQUARES 1
 typedef PolyVec Acc;
@@ -206,7 +211,10 @@ ALGRAY_INLINE void acc_set_constant(Acc* c, REAL a, REAL a_lo) {
   (void)a_lo;
   *c = vec_constant(a);
 }
-ALGRAY_INLINE void acc_store(REAL* out, const Acc* c) { vec_store(out, *c); }
+ALGRAY_INLINE void acc_store(REAL* out, REAL* out_lo, const Acc* c) {
+  (void)out_lo;
+  vec_store(out, *c);
+}
 #endif
 #else
 #if ALGRAY_COMPENSATED
@@ -221,7 +229,7 @@ typedef REAL Acc;
 #define acc_add poly_add
 #define acc_copy poly_copy
 #define acc_set_constant(c, a, a_lo) ((void)(a_lo), poly_set_constant(c, a))
-#define acc_store poly_copy
+#define acc_store(out, out_lo, c) ((void)(out_lo), poly_copy(out, c))
 #endif
 
 /* c times L^times. With only even exponents every gap is even, and one quadratic pass replaces two linear
@@ -249,9 +257,11 @@ ALGRAY_INLINE void acc_mul_one(Acc* c, int times) {
 /* Monomials arrive sorted by i, then j, then k, all descending, exponents packed as i | j<<8 | k<<16.
  * P = sum_i x^i sum_j y^j sum_k a_ijk z^k w^(D-i-j-k), evaluated as three nested Horner levels, each
  * accumulator homogeneous of one degree so that sums need no elevation.
- * fx, fy, fz: the coordinates' factors along the segment. Result: out[0..DEGREE]. */
+ * fx, fy, fz: the coordinates' factors along the segment. Result: out[0..DEGREE]; mixed precision also writes
+ * out_lo, the low parts of the compensated result (other builds leave it alone). */
 void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint count,
-                     __constant const REAL* binomials, AxisFactor fx, AxisFactor fy, AxisFactor fz, REAL* out) {
+                     __constant const REAL* binomials, AxisFactor fx, AxisFactor fy, AxisFactor fz, REAL* out,
+                     REAL* out_lo) {
   Acc acc_z[ACC_SLOTS], acc_y[ACC_SLOTS], acc_x[ACC_SLOTS];
   int deg_z = -1;             /* degree of acc_z; -1 while the (i, j) group is empty */
   int have_y = 0, have_x = 0; /* acc_y, out hold a partial sum */
@@ -314,7 +324,7 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
   }
   if (!have_x) acc_set_constant(acc_x, 0, 0); /* no monomials: the host never sends this, but stay defined */
   acc_mul_axis(acc_x, fx, prev_i);
-  acc_store(out, acc_x);
+  acc_store(out, out_lo, acc_x);
 }
 
 #endif /* ALGRAY_RESTRICT_H */

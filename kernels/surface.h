@@ -3,8 +3,8 @@
 #define ALGRAY_SURFACE_H
 
 #include "algray_shared.h"
-#include "real.h"
 #include "ray.h"
+#include "real.h"
 
 #ifndef RAY_ORIGIN
 #define RAY_ORIGIN ALGRAY_ORIGIN_EXTENT
@@ -27,7 +27,6 @@ typedef struct {
   REAL3 u;          /* hit point in unit coordinates */
   REAL3 d_unit;     /* ray direction in unit coordinates */
 } SurfaceHit;
-
 
 /* Refines what the isolation found; iso_c holds the polynomial on the isolating interval. */
 SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out, __constant const REAL* binomials) {
@@ -72,24 +71,24 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   if (!clip_to_extent(o, d, extent_kind, box_half, &t_in, &t_out)) return h;
   h.root.flags = ALGRAY_HIT_IN_EXTENT;
 
-  REAL root[NCOEF], iso_c[NCOEF];
+  REAL root[NCOEF], root_lo[NCOEF], iso_c[NCOEF];
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EYE
   /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(o.x, d.x, even_axes & 1),
-                  axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root);
+                  axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root, root_lo);
   const Isolation iso = isolate_power(root, t_in, t_out - t_in, t_in, t_out, iso_c);
 #else
   /* Entry and exit points: the ray restricted to the interval as s in [0, 1]. */
   const REAL3 pa = o + t_in * d, pb = o + t_out * d;
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, pb.x, even_axes & 1),
-                  axis_factor(pa.y, pb.y, even_axes & 2), axis_factor(pa.z, pb.z, even_axes & 4), root);
-  bernstein_from_scaled(root, binomials);
-  const Isolation iso = isolate_bernstein(root, t_in, t_out, iso_c);
+                  axis_factor(pa.y, pb.y, even_axes & 2), axis_factor(pa.z, pb.z, even_axes & 4), root, root_lo);
+  bernstein_from_scaled(root, root_lo, binomials);
+  const Isolation iso = isolate_bernstein(root, root_lo, t_in, t_out, iso_c);
 #else
   const REAL3 e = pb - pa;
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, e.x, even_axes & 1),
-                  axis_factor(pa.y, e.y, even_axes & 2), axis_factor(pa.z, e.z, even_axes & 4), root);
+                  axis_factor(pa.y, e.y, even_axes & 2), axis_factor(pa.z, e.z, even_axes & 4), root, root_lo);
   const Isolation iso = isolate_power(root, (REAL)0, (REAL)1, t_in, t_out, iso_c);
 #endif
 #endif

@@ -19,10 +19,13 @@ __kernel void univariate(__global const REAL* polys, uint count, __constant cons
                          __global HitRecord* out) {
   const uint i = get_global_id(0);
   if (i >= count) return;
-  REAL root[NCOEF], iso_c[NCOEF];
-  for (int k = 0; k <= DEGREE; ++k) root[k] = polys[(size_t)i * NCOEF + k];
+  REAL root[NCOEF], root_lo[NCOEF], iso_c[NCOEF];
+  for (int k = 0; k <= DEGREE; ++k) {
+    root[k] = polys[(size_t)i * NCOEF + k];
+    root_lo[k] = 0; /* the test polynomials are exact in the build's precision */
+  }
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  const Isolation iso = isolate_bernstein(root, (REAL)0, (REAL)1, iso_c);
+  const Isolation iso = isolate_bernstein(root, root_lo, (REAL)0, (REAL)1, iso_c);
 #else
   const Isolation iso = isolate_power(root, (REAL)0, (REAL)1, (REAL)0, (REAL)1, iso_c);
 #endif
