@@ -103,6 +103,35 @@ TEST_CASE("rays through nodes meet a double root", "[hard-rays]") {
   CHECK((std::fabs(x_hit) < 1e-6 || std::fabs(x_hit + 2.7 * std::sqrt(2.0)) < 1e-8));
 }
 
+TEST_CASE("rays through a node of the Barth sextic and of the Kummer quartic", "[hard-rays]") {
+  // Most of their nodes are irrational points, which the scenes' rounded constants move off any exact ray. These
+  // two stay exact. Barth: (1, 0, 0) is a node for every value of phi (both terms vanish to second order), and
+  // along the x axis P = -(1 + 2 phi)(x^2 - 1)^2, so the ray from x = 3 touches at x = 1 and x = -1 without
+  // crossing. Kummer: on x = 0, z = 1 the planes p and q both vanish exactly, so along y P = (y^2 - 5/4)^2: a
+  // double root at the node (0, sqrt(5)/2, 1), irrational but exactly double.
+  const RaySolve barth = solve("barth_sextic.toml", glm::dvec3(3, 0, 0), glm::dvec3(-3, 0, 0));
+  INFO("Barth: reference " << ref::to_string(barth.reference.kind) << " at " << barth.reference.t_nearest);
+  CHECK(barth.reference.kind == ref::Classification::EvenRootNoSignChange);
+  CHECK(barth.reference.multiplicity == 2);
+  CHECK(barth.reference.t_nearest == Approx(2).margin(1e-12));
+  // Invisible on the true surface; rounding noise may stop the kernel at one of the two touching points.
+  if (barth.kernel.flags & ALGRAY_HIT_FOUND) {
+    const double x_hit = 3 - kernel_t(barth.kernel);
+    INFO("kernel at x = " << x_hit);
+    CHECK((std::fabs(x_hit - 1) < 1e-6 || std::fabs(x_hit + 1) < 1e-6));
+  }
+  const RaySolve kummer = solve("kummer.toml", glm::dvec3(0, 2.5, 1), glm::dvec3(0, -2.5, 1), {0, 0, 1});
+  INFO("Kummer: reference " << ref::to_string(kummer.reference.kind) << " at " << kummer.reference.t_nearest);
+  CHECK(kummer.reference.kind == ref::Classification::EvenRootNoSignChange);
+  CHECK(kummer.reference.multiplicity == 2);
+  CHECK(kummer.reference.t_nearest == Approx(2.5 - std::sqrt(1.25)).margin(1e-12));
+  if (kummer.kernel.flags & ALGRAY_HIT_FOUND) {
+    const double y_hit = 2.5 - kernel_t(kummer.kernel);
+    INFO("kernel at y = " << y_hit);
+    CHECK(std::fabs(std::fabs(y_hit) - std::sqrt(1.25)) < 1e-6);
+  }
+}
+
 TEST_CASE("a ray through the tooth's isolated point touches without crossing and stays invisible", "[hard-rays]") {
   // x^4+y^4+z^4-(x^2+y^2+z^2) is negative all around the origin: along the z axis P* = z^4 - z^2. From
   // z = 1/2 down (an axis-aligned ray, so it is exact) the origin is the first root, of even multiplicity.
