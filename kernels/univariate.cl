@@ -14,7 +14,8 @@
 #include "surface.h"
 
 /* polys: DEGREE + 1 coefficients per polynomial, in the basis the isolation works in (Bernstein on [0, 1], or
- * the power basis in t). out: t (as t_hi + t_lo), flags and work, in HitRecord's fields. */
+ * the power basis in t); mixed precision then has the low parts of all of them, in the same order. out: t (as t_hi +
+ * t_lo), flags and work, in HitRecord's fields. */
 __kernel void univariate(__global const REAL* polys, uint count, __constant const REAL* binomials,
                          __global HitRecord* out) {
   const uint i = get_global_id(0);
@@ -22,7 +23,11 @@ __kernel void univariate(__global const REAL* polys, uint count, __constant cons
   REAL root[NCOEF], root_lo[NCOEF], iso_c[NCOEF];
   for (int k = 0; k <= DEGREE; ++k) {
     root[k] = polys[(size_t)i * NCOEF + k];
-    root_lo[k] = 0; /* the test polynomials are exact in the build's precision */
+#if ALGRAY_COMPENSATED
+    root_lo[k] = polys[(size_t)count * NCOEF + (size_t)i * NCOEF + k]; /* the low parts follow all high parts */
+#else
+    root_lo[k] = 0;
+#endif
   }
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   const Isolation iso = isolate_bernstein(root, root_lo, (REAL)0, (REAL)1, iso_c);

@@ -132,22 +132,29 @@ double scaled_derivative(const Poly& p, int m, double t) {
 TEST_CASE("random polynomials: the kernels' smallest root matches the certified reference", "[univariate]") {
   ClSession& session = testing::device_session();
   ProgramCache cache(false);
-  for (Precision precision : {Precision::Double, Precision::Float}) {
-    const bool is_double = precision == Precision::Double;
-    const double eps = is_double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();
-    for (int degree = 1; degree <= kMaxTestedDegree; ++degree) {
+  for (Precision precision : {Precision::Double, Precision::Float, Precision::Mixed}) {
+    const bool is_double = precision == Precision::Double, is_mixed = precision == Precision::Mixed;
+    const char* const name = is_double ? "double" : is_mixed ? "mixed" : "float";
+    const double float_eps = std::numeric_limits<float>::epsilon();
+    // Mixed precision takes its coefficients as float pairs and isolates in float-float, whose roundoff is about
+    // 2^-46 after a few operations: hit or miss is held to that. Its refinement runs in float, so the root's
+    // position is held to float's.
+    const double eps = is_double ? std::numeric_limits<double>::epsilon() : is_mixed ? std::ldexp(1.0, -46) : float_eps;
+    const double refine_eps = is_mixed ? float_eps : eps;
+    const int max_degree = is_mixed ? std::min(kMaxTestedDegree, kMaxMixedDegree) : kMaxTestedDegree;
+    for (int degree = 1; degree <= max_degree; ++degree) {
       KernelConfig config;
       config.entry = "univariate";
       config.degree = degree;
       config.precision = precision;
-      config.tolerance = is_double ? 1e-12 : 2 * eps;
+      config.tolerance = is_double ? 1e-12 : 2 * float_eps;
       cl::Kernel kernel = cache.kernel(session, config);
 
       // The cases, normalised to max |Bernstein coefficient| = 1 and rounded to the kernel's precision; the
       // reference solves the rounded polynomial exactly, so both see the same polynomial.
       std::mt19937 rng(kSeed + static_cast<unsigned>(degree));
       std::vector<Poly> exact(kCases);
-      std::vector<double> device_values, abs_sums(kCases);
+      std::vector<double> device_values, low_parts, abs_sums(kCases);
       for (int c = 0; c < kCases; ++c) {
         Poly b = to_bernstein(random_case(rng, degree, c % 6));
         mpq_class largest = 0;
@@ -155,12 +162,16 @@ TEST_CASE("random polynomials: the kernels' smallest root matches the certified 
         for (mpq_class& v : b) {
           const mpq_class scaled = v / largest;
           const double rounded = is_double ? nearest_double(scaled) : static_cast<float>(nearest_double(scaled));
-          v = exact_rational(rounded);
+          const double low = is_mixed ? static_cast<float>(nearest_double(scaled - exact_rational(rounded))) : 0.0;
+          v = exact_rational(rounded) + exact_rational(low);
           device_values.push_back(rounded);
+          low_parts.push_back(low);
           abs_sums[static_cast<std::size_t>(c)] += std::fabs(rounded);
         }
         exact[static_cast<std::size_t>(c)] = from_bernstein(b);
       }
+      // Mixed precision's low parts follow all the high parts, as the primary kernel's coefficients do.
+      if (is_mixed) device_values.insert(device_values.end(), low_parts.begin(), low_parts.end());
 
       const cl::Context& ctx = session.context;
       std::vector<float> as_float(device_values.begin(), device_values.end());
@@ -194,10 +205,10 @@ TEST_CASE("random polynomials: the kernels' smallest root matches the certified 
         const bool hit = (h.flags & ALGRAY_HIT_FOUND) != 0;
         const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
         const double noise = degree * eps * abs_sums[static_cast<std::size_t>(c)];
-        INFO((is_double ? "double" : "float")
-             << " degree " << degree << " seed " << kSeed + degree << " case " << c << " (" << kKinds[c % 6]
-             << "): reference " << ref::to_string(a.kind) << " at " << a.t_nearest << " multiplicity " << a.multiplicity
-             << ", kernel " << (hit ? "hit at " : "miss") << (hit ? t : 0.0));
+        const double refine_noise = degree * refine_eps * abs_sums[static_cast<std::size_t>(c)];
+        INFO(name << " degree " << degree << " seed " << kSeed + degree << " case " << c << " (" << kKinds[c % 6]
+                  << "): reference " << ref::to_string(a.kind) << " at " << a.t_nearest << " multiplicity "
+                  << a.multiplicity << ", kernel " << (hit ? "hit at " : "miss") << (hit ? t : 0.0));
         if (a.kind == ref::Classification::Miss) {
           // Never a root where the reference certifies none, unless P is within the coefficients' rounding noise
           // of zero there: a double root that rounding turned into a close complex pair is numerically a root.
@@ -216,7 +227,7 @@ TEST_CASE("random polynomials: the kernels' smallest root matches the certified 
           if (!hit) continue;
           const double slope = scaled_derivative(p, 1, a.t_nearest);
           const double allowed =
-              testing::kStopWidthFactor * 4 * config.tolerance + testing::kNoiseFactor * noise / slope;
+              testing::kStopWidthFactor * 4 * config.tolerance + testing::kNoiseFactor * refine_noise / slope;
           CHECK(std::fabs(t - a.t_nearest) <= allowed);
           continue;
         }
@@ -226,8 +237,9 @@ TEST_CASE("random polynomials: the kernels' smallest root matches the certified 
         if (hit) {
           const int m = a.multiplicity;
           const double size = std::max(scaled_derivative(p, m, a.t_nearest), 1e-300);
-          const double allowed = testing::kStopWidthFactor * 4 * config.tolerance +
-                                 testing::kMultipleRootFactor * std::pow(testing::kNoiseFactor * noise / size, 1.0 / m);
+          const double allowed =
+              testing::kStopWidthFactor * 4 * config.tolerance +
+              testing::kMultipleRootFactor * std::pow(testing::kNoiseFactor * refine_noise / size, 1.0 / m);
           CHECK(std::fabs(t - a.t_nearest) <= allowed);
         }
       }
