@@ -36,10 +36,35 @@ std::string enum_choices(const std::array<std::pair<const char*, E>, N>& names) 
 
 constexpr std::array<std::pair<const char*, Precision>, 3> kPrecisions{
     {{"float", Precision::Float}, {"double", Precision::Double}, {"mixed", Precision::Mixed}}};
-constexpr std::array<std::pair<const char*, Isolation>, 2> kIsolations{
-    {{"bernstein", Isolation::Bernstein}, {"descartes", Isolation::PowerDescartes}}};
-constexpr std::array<std::pair<const char*, Refinement>, 2> kRefinements{
-    {{"brent", Refinement::Brent}, {"bisection", Refinement::Bisection}}};
+// Each choice: its name in scenes and on the command line, and its id in the kernels (algray_shared.h).
+constexpr std::array<std::pair<const char*, Isolation>, 4> kIsolations{
+    {{"bernstein", Isolation::Bernstein},
+     {"descartes", Isolation::PowerDescartes},
+     {"sturm", Isolation::Sturm},
+     {"derivative-chain", Isolation::DerivativeChain}}};
+constexpr std::array<std::pair<Isolation, int>, 4> kIsolationIds{
+    {{Isolation::Bernstein, ALGRAY_ISOLATION_BERNSTEIN},
+     {Isolation::PowerDescartes, ALGRAY_ISOLATION_POWER},
+     {Isolation::Sturm, ALGRAY_ISOLATION_STURM},
+     {Isolation::DerivativeChain, ALGRAY_ISOLATION_DERIVATIVE_CHAIN}}};
+constexpr std::array<std::pair<const char*, Refinement>, 5> kRefinements{{{"brent", Refinement::Brent},
+                                                                          {"bisection", Refinement::Bisection},
+                                                                          {"regula-falsi", Refinement::RegulaFalsi},
+                                                                          {"illinois", Refinement::Illinois},
+                                                                          {"newton", Refinement::Newton}}};
+constexpr std::array<std::pair<Refinement, int>, 5> kRefinementIds{
+    {{Refinement::Brent, ALGRAY_REFINEMENT_BRENT},
+     {Refinement::Bisection, ALGRAY_REFINEMENT_BISECTION},
+     {Refinement::RegulaFalsi, ALGRAY_REFINEMENT_REGULA_FALSI},
+     {Refinement::Illinois, ALGRAY_REFINEMENT_ILLINOIS},
+     {Refinement::Newton, ALGRAY_REFINEMENT_NEWTON}}};
+
+template <typename Enum, std::size_t N>
+int kernel_id(const std::array<std::pair<Enum, int>, N>& table, Enum value) {
+  for (const auto& [e, id] : table)
+    if (e == value) return id;
+  return 0;
+}
 constexpr std::array<std::pair<const char*, RayOrigin>, 2> kOrigins{
     {{"extent", RayOrigin::Extent}, {"eye", RayOrigin::Eye}}};
 
@@ -64,9 +89,11 @@ std::string isolation_choices() { return enum_choices(kIsolations); }
 std::string refinement_choices() { return enum_choices(kRefinements); }
 std::string ray_origin_choices() { return enum_choices(kOrigins); }
 
+int default_max_iterations(Refinement r) { return r == Refinement::RegulaFalsi ? 1000 : 100; }
+
 std::string KernelConfig::build_options() const {
-  const int isolation_id = isolation == Isolation::Bernstein ? ALGRAY_ISOLATION_BERNSTEIN : ALGRAY_ISOLATION_POWER;
-  const int refinement_id = refinement == Refinement::Brent ? ALGRAY_REFINEMENT_BRENT : ALGRAY_REFINEMENT_BISECTION;
+  const int isolation_id = kernel_id(kIsolationIds, isolation);
+  const int refinement_id = kernel_id(kRefinementIds, refinement);
   const int origin_id = ray_origin == RayOrigin::Extent ? ALGRAY_ORIGIN_EXTENT : ALGRAY_ORIGIN_EYE;
   // Hexadecimal literals carry the tolerance bit for bit; float builds get a float literal, as devices
   // without fp64 need not accept double constants.

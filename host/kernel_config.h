@@ -10,8 +10,8 @@ inline constexpr int kMaxDegree = 32;
 // Mixed: float, except that P*(t) is built in compensated float-float arithmetic (degrees up to 15).
 enum class Precision { Float, Double, Mixed };
 inline constexpr int kMaxMixedDegree = 15;
-enum class Isolation { Bernstein, PowerDescartes };
-enum class Refinement { Brent, Bisection };
+enum class Isolation { Bernstein, PowerDescartes, Sturm, DerivativeChain };
+enum class Refinement { Brent, Bisection, RegulaFalsi, Illinois, Newton };
 enum class RayOrigin { Extent, Eye };
 
 std::string to_string(Precision p);
@@ -28,6 +28,10 @@ std::string isolation_choices();
 std::string refinement_choices();
 std::string ray_origin_choices();
 
+// The refinement's iteration cap unless a scene sets one: 1000 for plain regula falsi, as in the paper (its
+// one-sided convergence needs them), 100 for the others.
+int default_max_iterations(Refinement r);
+
 struct KernelConfig {
   std::string entry = "primary";  // kernel file (without .cl) and kernel function
   int degree = 1;
@@ -35,8 +39,8 @@ struct KernelConfig {
   Isolation isolation = Isolation::Bernstein;
   Refinement refinement = Refinement::Brent;
   RayOrigin ray_origin = RayOrigin::Extent;
-  double tolerance = 1e-9;  // the paper's eps: stop when the bracket is <= 4*eps*max(|t|,1)
-  int max_iterations = 100;
+  double tolerance = 1e-9;   // the paper's eps: stop when the bracket is <= 4*eps*max(|t|,1)
+  int max_iterations = 100;  // see default_max_iterations
 
   // "-D DEGREE=6 -D ALGRAY_DOUBLE=1 ..." with the tolerance as an exact hexadecimal literal.
   std::string build_options() const;

@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   std::string scene_path;
   std::vector<std::string> sets;
   int width = 0, height = 0;
-  std::string precision;
+  std::string precision, isolation, refinement, tolerance, max_iterations;
   bool no_cache = false;
   std::string stats_path;
   CLI::App* render = app.add_subcommand("render", "render a scene (default: the built-in Barth sextic)");
@@ -29,7 +29,15 @@ int main(int argc, char** argv) {
   render->add_option("--width", width, "image width in pixels (overrides image.width)");
   render->add_option("--height", height, "image height in pixels (overrides image.height)");
   render->add_option("--device", request.device_spec, "device index or name substring (see `algray devices`)");
-  render->add_option("--precision", precision, "float or double (overrides render.precision)");
+  render->add_option("--precision", precision, "float, double or mixed (overrides render.precision)");
+  render->add_option("--isolation", isolation,
+                     "root isolation: bernstein, descartes, sturm or derivative-chain (overrides render.isolation)");
+  render->add_option(
+      "--refine", refinement,
+      "root refinement: brent, bisection, regula-falsi, illinois or newton (overrides render.refinement)");
+  render->add_option("--tolerance", tolerance, "the stopping tolerance eps (overrides render.tolerance)");
+  render->add_option("--max-iterations", max_iterations,
+                     "the refinement's iteration cap (overrides render.max_iterations)");
   render->add_option("--set", sets, "override a scene key: name=value (a bare name is a parameter)");
   render->add_option("--stats", stats_path, "write render statistics as JSON");
   render->add_flag("--no-cache", no_cache, "compile kernels from source; neither read nor write the program cache");
@@ -70,6 +78,11 @@ int main(int argc, char** argv) {
   if (render->count("--width")) request.overrides.push_back({"image.width", std::to_string(width)});
   if (render->count("--height")) request.overrides.push_back({"image.height", std::to_string(height)});
   if (!precision.empty()) request.overrides.push_back({"render.precision", "\"" + precision + "\""});
+  if (!isolation.empty()) request.overrides.push_back({"render.isolation", "\"" + isolation + "\""});
+  if (!refinement.empty()) request.overrides.push_back({"render.refinement", "\"" + refinement + "\""});
+  // Numbers pass through as written, so that the scene's own checks report them.
+  if (!tolerance.empty()) request.overrides.push_back({"render.tolerance", tolerance});
+  if (!max_iterations.empty()) request.overrides.push_back({"render.max_iterations", max_iterations});
   request.use_cache = !no_cache;
   if (!stats_path.empty()) request.stats_path = stats_path;
   request.progress = ::isatty(STDERR_FILENO) != 0;

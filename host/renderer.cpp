@@ -115,7 +115,8 @@ KernelConfig primary_config(const Scene& scene, Precision precision) {
   const double eps =
       precision == Precision::Double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();
   config.tolerance = std::max(scene.render.tolerance, 2 * eps);
-  config.max_iterations = scene.render.max_iterations;
+  config.max_iterations =
+      scene.render.max_iterations > 0 ? scene.render.max_iterations : default_max_iterations(scene.render.refinement);
   return config;
 }
 

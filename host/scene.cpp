@@ -392,8 +392,9 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
     if (const toml::node* n = render->get("ray_origin")) {
       if (!parse_ray_origin(r.string(*n, "render.ray_origin"), rs.ray_origin))
         r.fail(n->source(), "render.ray_origin must be one of " + ray_origin_choices());
-      if (rs.ray_origin == RayOrigin::Eye && rs.isolation != Isolation::PowerDescartes)
-        r.fail(n->source(), "render.ray_origin = \"eye\" needs render.isolation = \"descartes\" (the power basis)");
+      if (rs.ray_origin == RayOrigin::Eye && rs.isolation == Isolation::Bernstein)
+        r.fail(n->source(),
+               "render.ray_origin = \"eye\" needs a power-basis isolation (descartes, sturm or derivative-chain)");
     }
     if (const toml::node* n = render->get("max_iterations"))
       rs.max_iterations = static_cast<int>(r.integer(*n, "render.max_iterations", 1, 1000000));

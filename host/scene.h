@@ -51,7 +51,7 @@ struct RenderSettings {
   Isolation isolation = Isolation::Bernstein;
   Refinement refinement = Refinement::Brent;
   RayOrigin ray_origin = RayOrigin::Extent;
-  int max_iterations = 100;
+  int max_iterations = 0;  // 0: the refinement's default (default_max_iterations)
   int tile_size = 0;  // pixels per side of a dispatched tile; 0 chooses by device type
 };
 

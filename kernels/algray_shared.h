@@ -28,8 +28,13 @@ typedef cl_int algray_i32;
 /* Compile-time solver choices, passed as -D ISOLATION=... -D REFINEMENT=... */
 #define ALGRAY_ISOLATION_BERNSTEIN 1   /* Descartes' rule on Bernstein coefficients over [t_in, t_out], de Casteljau halving */
 #define ALGRAY_ISOLATION_POWER 2       /* the paper: power basis mapped to (0, inf), Descartes' rule, left half first */
+#define ALGRAY_ISOLATION_STURM 3       /* Sturm sequence of P* in the power basis, bisection by root counts */
+#define ALGRAY_ISOLATION_DERIVATIVE_CHAIN 4 /* roots of P*', P*'', ... cut [0, 1] into monotone pieces */
 #define ALGRAY_REFINEMENT_BRENT 1      /* Dekker-Brent with the paper's acceptance and stopping rules */
 #define ALGRAY_REFINEMENT_BISECTION 2  /* plain bisection of the bracket */
+#define ALGRAY_REFINEMENT_REGULA_FALSI 3 /* the paper's plain regula falsi (false position) */
+#define ALGRAY_REFINEMENT_ILLINOIS 4   /* regula falsi with the Illinois modification */
+#define ALGRAY_REFINEMENT_NEWTON 5     /* Newton's method, safeguarded by the bracket */
 #define ALGRAY_ORIGIN_EXTENT 1         /* P*(t) built around the middle of [t_in, t_out] (well conditioned) */
 #define ALGRAY_ORIGIN_EYE 2            /* P*(t) built around the ray origin, as the paper does */
 

@@ -220,4 +220,29 @@ REAL isolated_value(const REAL* c, REAL y) {
   return h * power_of(y);
 }
 
+/* Value and slope at y in [0,1] of a prepared polynomial, for Newton's method. With r = y/(1-y) and
+ * H(r) = sum c_k r^k, P = (1-y)^n H and P' = (1-y)^(n-2) (H' - n (1-y) H); mirrored past 1/2 like the value. */
+REAL isolated_value_slope(const REAL* c, REAL y, REAL* slope) {
+#if DEGREE == 1
+  *slope = c[1] - c[0];
+  return c[0] * ((REAL)1 - y) + c[1] * y;
+#else
+  const int mirrored = y > (REAL)0.5;
+  const REAL u = mirrored ? y : (REAL)1 - y; /* the factor raised to the power n */
+  const REAL r = mirrored ? ((REAL)1 - y) / y : y / ((REAL)1 - y);
+  REAL h = 0, d = 0;
+  ALGRAY_UNROLL
+  for (int k = DEGREE; k >= 0; --k) {
+    d = d * r + h;
+    h = h * r + c[mirrored ? DEGREE - k : k];
+  }
+  REAL un2 = 1; /* u^(n-2) */
+  ALGRAY_UNROLL
+  for (int k = 0; k < DEGREE - 2; ++k) un2 *= u;
+  /* dr/dy = 1/(1-y)^2 unmirrored, -1/y^2 mirrored */
+  *slope = mirrored ? un2 * ((REAL)DEGREE * u * h - d) : un2 * (d - (REAL)DEGREE * u * h);
+  return h * un2 * u * u;
+#endif
+}
+
 #endif /* ALGRAY_BERNSTEIN_H */

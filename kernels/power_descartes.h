@@ -2,27 +2,7 @@
 #ifndef ALGRAY_POWER_DESCARTES_H
 #define ALGRAY_POWER_DESCARTES_H
 
-#include "isolation.h"
-
-/* c(x) -> c(x + a), by repeated synthetic division. */
-void taylor_shift(REAL* c, REAL a) {
-  ALGRAY_UNROLL
-  for (int i = 0; i < DEGREE; ++i)
-    ALGRAY_UNROLL
-    for (int k = DEGREE - 1; k >= i; --k) c[k] += a * c[k + 1];
-}
-
-/* A1(y) = p(alpha + beta*y): the polynomial on one subinterval, mapped to [0,1]. */
-void power_on_interval(const REAL* p, REAL alpha, REAL beta, REAL* a1) {
-  poly_copy(a1, p);
-  if (alpha != 0) taylor_shift(a1, alpha);
-  REAL s = 1;
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) {
-    a1[k] *= s;
-    s *= beta;
-  }
-}
+#include "power_basis.h"
 
 /* Sign variations of A2(x) = (x+1)^n A1(1/(x+1)), whose positive roots are those of A1 in (0, 1]...
  * except a root at 1, which maps to x = 0 and is not counted. */
@@ -32,13 +12,6 @@ int descartes_unit_interval(const REAL* a1) {
   for (int k = 0; k <= DEGREE; ++k) a2[k] = a1[DEGREE - k];
   taylor_shift(a2, (REAL)1);
   return sign_variations(a2);
-}
-
-REAL power_value(const REAL* c, REAL y) {
-  REAL h = c[DEGREE];
-  ALGRAY_UNROLL
-  for (int k = DEGREE - 1; k >= 0; --k) h = h * y + c[k];
-  return h;
 }
 
 /* p is P*(s) in the power basis, the extent interval being s in [s0, s0 + len_s]. Subintervals are the dyadic
@@ -80,17 +53,15 @@ Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
       if (settle_cluster(&iso, located)) return iso;
     }
     if (!next_interval(&level, &idx)) {
-      iso.status = ISOLATION_NONE;
+      /* The last interval visited is the rightmost one: a root exactly at its far end is the one point left. */
+      iso.status = iso.f_hi == 0 ? ISOLATION_EXACT : ISOLATION_NONE;
+      iso.lo = iso.hi = 1;
+      iso.f_lo = iso.f_hi = 0;
       return iso;
     }
   }
 }
 
-void prepare_isolated(REAL* c, __constant const REAL* binomials) {
-  (void)c;
-  (void)binomials;
-}
-
-REAL isolated_value(const REAL* c, REAL y) { return power_value(c, y); }
+#define isolate_power_basis isolate_power
 
 #endif /* ALGRAY_POWER_DESCARTES_H */

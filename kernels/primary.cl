@@ -1,16 +1,9 @@
 /* The primary-ray kernel: one work-item per pixel, from camera ray to hit distance, normal, side and work. */
 #include "algray_shared.h"
-#include "real.h"
+#include "isolate.h"
 #include "ray.h"
+#include "real.h"
 #include "restrict.h"
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-#include "bernstein.h"
-#elif ISOLATION == ALGRAY_ISOLATION_POWER
-#include "power_descartes.h"
-#else
-#error "ISOLATION must name an isolation method"
-#endif
-#include "refine.h"
 #include "surface.h"
 
 /* One tile of the image per launch: global size (tile_w, tile_h), results at out[py * image_width + px].
@@ -20,9 +13,8 @@
 __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, REAL4 ray_du, REAL4 ray_dv,
                       REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
                       __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
-                      __constant const REAL* binomials, uint even_axes,
-                      uint image_width, uint tile_x0, uint tile_y0, uint tile_w, uint tile_h,
-                      __global HitRecord* out) {
+                      __constant const REAL* binomials, uint even_axes, uint image_width, uint tile_x0, uint tile_y0,
+                      uint tile_w, uint tile_h, __global HitRecord* out) {
   const uint gx = get_global_id(0), gy = get_global_id(1);
   if (gx >= tile_w || gy >= tile_h) return;
   const uint px = tile_x0 + gx, py = tile_y0 + gy;

@@ -1,4 +1,4 @@
-/* Root refinement inside an isolating interval: the paper's Dekker-Brent, or plain bisection. */
+/* Root refinement inside an isolating interval: Dekker-Brent, bisection, regula falsi (plain or Illinois), Newton. */
 #ifndef ALGRAY_REFINE_H
 #define ALGRAY_REFINE_H
 
@@ -16,9 +16,12 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
   uint it = 0;
   for (; it < MAX_ITERATIONS; ++it) {
     if (fabs(fc) < fabs(fb)) {
-      a = b; fa = fb;
-      b = cp; fb = fc;
-      cp = a; fc = fa;
+      a = b;
+      fa = fb;
+      b = cp;
+      fb = fc;
+      cp = a;
+      fc = fa;
     }
     /* The paper's stopping rule: |P*(b)| at machine precision, or a bracket at most the stopping width. */
     if (fabs(fb) <= REAL_EPS * scale || fabs(cp - b) <= tol_y) break;
@@ -37,15 +40,17 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
     }
     /* The paper's acceptance rule: the step must stay well inside the bracket and shrink; also toward c. */
     const REAL step = cand - b;
-    const int accept = have && isfinite(cand) && step * (cp - b) > 0 &&
-                       fabs(step) < (REAL)0.75 * fabs(cp - b) && fabs(step) < (REAL)0.5 * fabs(b - a);
+    const int accept = have && isfinite(cand) && step * (cp - b) > 0 && fabs(step) < (REAL)0.75 * fabs(cp - b) &&
+                       fabs(step) < (REAL)0.5 * fabs(b - a);
     REAL next = accept ? cand : b + (REAL)0.5 * (cp - b);
     if (fabs(next - b) < (REAL)0.5 * tol_y) next = b + copysign((REAL)0.5 * tol_y, cp - b);
-    a = b; fa = fb;
+    a = b;
+    fa = fb;
     b = next;
     fb = isolated_value(c, b);
     if ((fb > 0) == (fc > 0)) { /* the sign change is now between a and b */
-      cp = a; fc = fa;
+      cp = a;
+      fc = fa;
     }
   }
   *iterations = it;
@@ -74,6 +79,70 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
   }
   *iterations = it;
   return (REAL)0.5 * (lo + hi);
+}
+#elif REFINEMENT == ALGRAY_REFINEMENT_REGULA_FALSI || REFINEMENT == ALGRAY_REFINEMENT_ILLINOIS
+/* False position: the secant through the bracket's ends. Plain, as in the paper, one end can stay fixed for
+ * good, so the bracket never shrinks below the stopping width and only |P*| <= eps_m or the iteration cap
+ * stops it (the paper's Barth decic defects). The Illinois variant halves the value kept at an end that has
+ * survived twice in a row, which breaks that one-sidedness. */
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations) {
+  REAL a = 0, fa = f0, b = 1, fb = f1, x = fabs(f0) < fabs(f1) ? (REAL)0 : (REAL)1;
+  int kept = 0; /* +1: a survived the last step(s), -1: b did */
+  uint it = 0;
+  for (; it < MAX_ITERATIONS && b - a > tol_y; ++it) {
+    x = a - fa * (b - a) / (fb - fa);
+    if (!(x > a && x < b)) x = (REAL)0.5 * (a + b); /* rounding pushed it out: stay inside */
+    const REAL fx = isolated_value(c, x);
+    if (fabs(fx) <= REAL_EPS * scale) {
+      ++it;
+      break;
+    }
+    if ((fx < 0) == (fa < 0)) {
+      a = x;
+      fa = fx;
+#if REFINEMENT == ALGRAY_REFINEMENT_ILLINOIS
+      if (kept < 0) fb *= (REAL)0.5;
+#endif
+      kept = kept < 0 ? kept - 1 : -1;
+    } else {
+      b = x;
+      fb = fx;
+#if REFINEMENT == ALGRAY_REFINEMENT_ILLINOIS
+      if (kept > 0) fa *= (REAL)0.5;
+#endif
+      kept = kept > 0 ? kept + 1 : 1;
+    }
+  }
+  (void)kept;
+  *iterations = it;
+  return x;
+}
+#elif REFINEMENT == ALGRAY_REFINEMENT_NEWTON
+/* Newton's method inside the bracket: a step that would leave it, or that fails to halve |P*|, is replaced by
+ * bisection, so it converges like bisection at worst and quadratically near a simple root. Needs
+ * isolated_value_slope(c, y, &slope) from the isolation method. */
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations) {
+  REAL a = 0, b = 1, fa = f0;
+  REAL x = fabs(f0) < fabs(f1) ? (REAL)0 : (REAL)1, slope;
+  REAL fx = isolated_value_slope(c, x, &slope);
+  REAL previous = INFINITY;
+  uint it = 0;
+  for (; it < MAX_ITERATIONS && b - a > tol_y; ++it) {
+    if (fabs(fx) <= REAL_EPS * scale) break;
+    REAL next = x - fx / slope;
+    if (!(next > a && next < b) || !(fabs(fx) <= (REAL)0.5 * previous)) next = (REAL)0.5 * (a + b);
+    previous = fabs(fx);
+    x = next;
+    fx = isolated_value_slope(c, x, &slope);
+    if ((fx < 0) == (fa < 0)) {
+      a = x;
+      fa = fx;
+    } else {
+      b = x;
+    }
+  }
+  *iterations = it;
+  return x;
 }
 #else
 #error "REFINEMENT must name a refinement method"

@@ -9,8 +9,8 @@
 #ifndef RAY_ORIGIN
 #define RAY_ORIGIN ALGRAY_ORIGIN_EXTENT
 #endif
-#if RAY_ORIGIN == ALGRAY_ORIGIN_EYE && ISOLATION != ALGRAY_ISOLATION_POWER
-#error "RAY_ORIGIN=eye needs the power basis"
+#if RAY_ORIGIN == ALGRAY_ORIGIN_EYE && ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+#error "RAY_ORIGIN=eye needs a power-basis isolation method"
 #endif
 
 /* The outcome of isolating and refining the smallest root of P*(t) on [t_in, t_out]. */
@@ -76,7 +76,7 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(o.x, d.x, even_axes & 1),
                   axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root, root_lo);
-  const Isolation iso = isolate_power(root, t_in, t_out - t_in, t_in, t_out, iso_c);
+  const Isolation iso = isolate_power_basis(root, t_in, t_out - t_in, t_in, t_out, iso_c);
 #else
   /* Entry and exit points: the ray restricted to the interval as s in [0, 1]. */
   const REAL3 pa = o + t_in * d, pb = o + t_out * d;
@@ -89,7 +89,7 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   const REAL3 e = pb - pa;
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, e.x, even_axes & 1),
                   axis_factor(pa.y, e.y, even_axes & 2), axis_factor(pa.z, e.z, even_axes & 4), root, root_lo);
-  const Isolation iso = isolate_power(root, (REAL)0, (REAL)1, t_in, t_out, iso_c);
+  const Isolation iso = isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c);
 #endif
 #endif
   h.root = refine_isolated(iso, iso_c, t_in, t_out, binomials);

@@ -1,16 +1,9 @@
 /* Test and benchmark kernel: the smallest root in [0, 1] of a batch of univariate polynomials, one per work-item,
  * through the same isolation and refinement as the primary kernel (everything after the restriction). */
 #include "algray_shared.h"
+#include "isolate.h"
 #include "real.h"
 #include "restrict.h"
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-#include "bernstein.h"
-#elif ISOLATION == ALGRAY_ISOLATION_POWER
-#include "power_descartes.h"
-#else
-#error "ISOLATION must name an isolation method"
-#endif
-#include "refine.h"
 #include "surface.h"
 
 /* polys: DEGREE + 1 coefficients per polynomial, in the basis the isolation works in (Bernstein on [0, 1], or
@@ -32,7 +25,7 @@ __kernel void univariate(__global const REAL* polys, uint count, __constant cons
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   const Isolation iso = isolate_bernstein(root, root_lo, (REAL)0, (REAL)1, iso_c);
 #else
-  const Isolation iso = isolate_power(root, (REAL)0, (REAL)1, (REAL)0, (REAL)1, iso_c);
+  const Isolation iso = isolate_power_basis(root, (REAL)0, (REAL)1, (REAL)0, (REAL)1, iso_c);
 #endif
   const SegmentRoot sr = refine_isolated(iso, iso_c, (REAL)0, (REAL)1, binomials);
   HitRecord r;

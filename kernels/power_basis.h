@@ -1,0 +1,56 @@
+/* The power basis on an isolating interval: shifting and scaling P*(s) onto it, and its value for refinement. */
+#ifndef ALGRAY_POWER_BASIS_H
+#define ALGRAY_POWER_BASIS_H
+
+#include "isolation.h"
+
+/* c(x) -> c(x + a), by repeated synthetic division. */
+void taylor_shift(REAL* c, REAL a) {
+  ALGRAY_UNROLL
+  for (int i = 0; i < DEGREE; ++i) ALGRAY_UNROLL
+  for (int k = DEGREE - 1; k >= i; --k) c[k] += a * c[k + 1];
+}
+
+/* A1(y) = p(alpha + beta*y): the polynomial on one subinterval, mapped to [0,1]. */
+void power_on_interval(const REAL* p, REAL alpha, REAL beta, REAL* a1) {
+  poly_copy(a1, p);
+  if (alpha != 0) taylor_shift(a1, alpha);
+  REAL s = 1;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) {
+    a1[k] *= s;
+    s *= beta;
+  }
+}
+
+REAL power_value(const REAL* c, REAL y) {
+  REAL h = c[DEGREE];
+  ALGRAY_UNROLL
+  for (int k = DEGREE - 1; k >= 0; --k) h = h * y + c[k];
+  return h;
+}
+
+/* Value and slope at y of a polynomial in the power basis, by Horner's scheme with its derivative. */
+REAL power_value_slope(const REAL* c, REAL y, REAL* slope) {
+  REAL h = c[DEGREE], d = 0;
+  ALGRAY_UNROLL
+  for (int k = DEGREE - 1; k >= 0; --k) {
+    d = d * y + h;
+    h = h * y + c[k];
+  }
+  *slope = d;
+  return h;
+}
+
+/* The interface refine.h expects from every isolation method (see bernstein.h): on the isolating interval the
+ * polynomial is A1(y), y in [0, 1], in the power basis, ready as it is. */
+void prepare_isolated(REAL* c, __constant const REAL* binomials) {
+  (void)c;
+  (void)binomials;
+}
+
+REAL isolated_value(const REAL* c, REAL y) { return power_value(c, y); }
+
+REAL isolated_value_slope(const REAL* c, REAL y, REAL* slope) { return power_value_slope(c, y, slope); }
+
+#endif /* ALGRAY_POWER_BASIS_H */
