@@ -203,4 +203,45 @@ ReferenceResult render_reference(const Scene& scene, Precision ray_precision, un
   return out;
 }
 
+ReferenceComparison compare_with_reference(const HitBuffer& kernel, const ReferenceResult& reference) {
+  ReferenceComparison c;
+  std::vector<double> errors;
+  const int width = kernel.width, height = kernel.height;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * width + x;
+      const auto cls = static_cast<PixelClass>(reference.classes[i]);
+      if (cls == PixelClass::OutsideExtent) continue;
+      if (cls != PixelClass::Miss && cls != PixelClass::SimpleRoot) {
+        ++c.ambiguous;
+        c.ray_rounding += cls == PixelClass::RayRounding;
+        continue;
+      }
+      ++c.certified;
+      const HitRecord& h = kernel.records[i];
+      const bool kernel_hit = (h.flags & ALGRAY_HIT_FOUND) != 0;
+      if (kernel_hit != (cls == PixelClass::SimpleRoot)) {
+        if (c.disagreements++ == 0) c.disagree_x = x, c.disagree_y = y;
+        continue;
+      }
+      if (!kernel_hit) continue;
+      const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
+      const double error = std::fabs(t - reference.t[i]) / std::fabs(reference.t[i]);
+      errors.push_back(error);
+      if (error > c.worst_depth || c.worst_x < 0) {
+        c.worst_depth = error;
+        c.worst_x = x;
+        c.worst_y = y;
+      }
+    }
+  }
+  c.simple_hits = static_cast<long>(errors.size());
+  if (!errors.empty()) {
+    auto middle = errors.begin() + static_cast<std::ptrdiff_t>(errors.size() / 2);
+    std::nth_element(errors.begin(), middle, errors.end());
+    c.median_depth = *middle;
+  }
+  return c;
+}
+
 }  // namespace algray

@@ -47,4 +47,16 @@ bool extent_interval(const Extent& extent, const PixelRay& ray, long double& t_i
 // scene's exact polynomial. threads = 0 uses every core.
 ReferenceResult render_reference(const Scene& scene, Precision ray_precision, unsigned threads = 0);
 
+// How a kernel's hits compare with the reference, over the pixels the reference certifies (a miss or a simple
+// root); every other pixel inside the extent is ambiguous and never counts as agreement.
+struct ReferenceComparison {
+  long certified = 0, ambiguous = 0;
+  long ray_rounding = 0;                     // of the ambiguous ones, PixelClass::RayRounding
+  long disagreements = 0;                    // certified pixels where kernel and reference differ on hit or miss
+  long simple_hits = 0;                      // certified simple roots that the kernel hit too
+  double median_depth = 0, worst_depth = 0;  // relative error of the kernel's t on those
+  int worst_x = -1, worst_y = -1, disagree_x = -1, disagree_y = -1;  // first disagreement, worst depth
+};
+ReferenceComparison compare_with_reference(const HitBuffer& kernel, const ReferenceResult& reference);
+
 }  // namespace algray

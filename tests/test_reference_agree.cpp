@@ -21,45 +21,6 @@ namespace {
 
 constexpr int kWidth = 160, kHeight = 120;
 
-struct Comparison {
-  long certified = 0, disagreements = 0, simple_hits = 0, ambiguous = 0, ray_rounding = 0;
-  double worst_depth = 0;
-  int worst_x = -1, worst_y = -1, disagree_x = -1, disagree_y = -1;
-};
-
-Comparison compare(const RenderResult& kernel, const ReferenceResult& ref) {
-  Comparison c;
-  for (int y = 0; y < kHeight; ++y) {
-    for (int x = 0; x < kWidth; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * kWidth + x;
-      const auto cls = static_cast<PixelClass>(ref.classes[i]);
-      if (cls == PixelClass::OutsideExtent) continue;
-      if (cls != PixelClass::Miss && cls != PixelClass::SimpleRoot) {
-        ++c.ambiguous;  // never counted as agreement
-        c.ray_rounding += cls == PixelClass::RayRounding;
-        continue;
-      }
-      ++c.certified;
-      const HitRecord& h = kernel.hits.records[i];
-      const bool kernel_hit = (h.flags & ALGRAY_HIT_FOUND) != 0;
-      if (kernel_hit != (cls == PixelClass::SimpleRoot)) {
-        if (c.disagreements++ == 0) c.disagree_x = x, c.disagree_y = y;
-        continue;
-      }
-      if (!kernel_hit) continue;
-      ++c.simple_hits;
-      const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
-      const double error = std::fabs(t - ref.t[i]) / std::fabs(ref.t[i]);
-      if (error > c.worst_depth) {
-        c.worst_depth = error;
-        c.worst_x = x;
-        c.worst_y = y;
-      }
-    }
-  }
-  return c;
-}
-
 // Plain float on the Barth decic and the Endrass octic does not reach its line: measured at 160x120, the decic
 // has 3 disagreements (0.04%) but a hit on the wrong sheet (depth error 0.19), the octic 27 disagreements (0.33%)
 // and a depth error of 0.24. Both expand to large cancelling monomials, whose rounding in float swamps P*(t).
@@ -75,7 +36,7 @@ void check_scene(Renderer& renderer, const std::filesystem::path& file, const ch
   const bool is_float = !is_double;  // float and mixed both trace float rays
   const RenderResult kernel = renderer.render(scene, false);
   const ReferenceResult ref = render_reference(scene, is_float ? Precision::Float : Precision::Double);
-  const Comparison c = compare(kernel, ref);
+  const ReferenceComparison c = compare_with_reference(kernel.hits, ref);
   std::printf("%-28s %-6s %9ld %9ld %9ld %12ld %9ld %12.3g\n", file.stem().string().c_str(), precision, c.certified,
               c.ambiguous, c.ray_rounding, c.disagreements, c.simple_hits, c.worst_depth);
   const testing::ImageThresholds limit = is_double ? testing::kDoubleImage : testing::kFloatImage;
