@@ -312,6 +312,33 @@ TEST_CASE("double precision renders on a device with fp64", "[cli]") {
   CHECK(finite_depths(img) > 0);
 }
 
+TEST_CASE("the solver flags reach the kernel and its program key, and a bad choice is refused", "[cli]") {
+  require_device();
+  Sandbox box;
+  const Result r =
+      box.run("render -o out.exr --isolation descartes --refine illinois --tolerance 1e-6 --stats s.json " + kTiny);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const nlohmann::json s = box.stats();
+  CHECK(s["solver"]["isolation"] == "descartes");
+  CHECK(s["solver"]["refinement"] == "illinois");
+  CHECK(s["solver"]["tolerance"] == 1e-6);
+  CHECK(s["solver"]["max_iterations"] == 100);
+  const std::string key = s["programs"][0]["key"];
+  CHECK_THAT(key, Catch::Contains("isolation=descartes") && Catch::Contains("refinement=illinois"));
+  // Plain regula falsi gets the paper's 1000-iteration cap unless told otherwise.
+  REQUIRE(box.run("render -o out.exr --refine regula-falsi --stats s.json " + kTiny).exit_code == 0);
+  CHECK(box.stats()["solver"]["max_iterations"] == 1000);
+  REQUIRE(box.run("render -o out.exr --refine regula-falsi --max-iterations 50 --stats s.json " + kTiny).exit_code ==
+          0);
+  CHECK(box.stats()["solver"]["max_iterations"] == 50);
+
+  const Result bad = box.run("render -o other.exr --refine secant " + kTiny);
+  CHECK(bad.exit_code == 2);
+  CHECK_THAT(bad.err, Catch::Contains("render.refinement must be one of") && Catch::Contains("newton"));
+  CHECK(!fs::exists(box.work / "other.exr"));
+}
+
 TEST_CASE("--device picks by index or name substring and lists the devices when none matches", "[cli]") {
   require_device();
   Sandbox box;
