@@ -288,7 +288,7 @@ TEST_CASE("random polynomials: the kernels' smallest root matches the certified 
 }
 
 TEST_CASE("random polynomials: every isolation method", "[univariate][isolation]") {
-  for (Isolation isolation : {Isolation::PowerDescartes}) {
+  for (Isolation isolation : {Isolation::PowerDescartes, Isolation::DerivativeChain}) {
     SECTION(to_string(isolation)) {
       check_solver(solver(Precision::Double, isolation), kMaxTestedDegree);
       check_solver(solver(Precision::Float, isolation), kMaxTestedDegree);
