@@ -217,6 +217,22 @@ def section_accuracy(data):
                 cells.append("none")
         out.append(f"| {surface} | " + " | ".join(cells) + " |")
     out.append("")
+    out.append("What tightening the tolerance costs, per surface and precision, for the default method "
+               "(bernstein/brent): kernel ms and max depth error at the loosest and the tightest tolerance.")
+    out.append("")
+    out.append("| surface | precision | loosest tol: ms, max error | tightest tol: ms, max error | time ratio |")
+    out.append("|---|---|---|---|---|")
+    for surface in dict.fromkeys(r["surface"] for r in rows):
+        for precision in ("float", "mixed", "double"):
+            mine = sorted((r for r in rows if r["surface"] == surface and r["precision"] == precision
+                           and method(r) == "bernstein/brent"), key=lambda r: -r["tolerance"])
+            if len(mine) < 2:
+                continue
+            lo, hi = mine[0], mine[-1]
+            out.append(f"| {surface} | {precision} | {lo['tolerance']:g}: {lo['kernel_ms']:.1f}, "
+                       f"{accuracy_error(lo):.1g} | {hi['tolerance']:g}: {hi['kernel_ms']:.1f}, "
+                       f"{accuracy_error(hi):.1g} | {hi['kernel_ms'] / lo['kernel_ms']:.2f} |")
+    out.append("")
     out.append("Every run, as (kernel ms, wrong hit/miss, max depth error), by method and tolerance:")
     out.append("")
     tolerances = sorted({r["tolerance"] for r in rows}, reverse=True)
