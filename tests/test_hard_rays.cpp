@@ -79,6 +79,13 @@ RaySolve solve(const std::string& file, const glm::dvec3& from, const glm::dvec3
 
 double kernel_t(const HitRecord& h) { return static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo); }
 
+// The reference's answer for a ray that touches the surface: a double root, without a sign change, at t.
+void check_double_root(const RaySolve& s, double t) {
+  CHECK(s.reference.kind == ref::Classification::EvenRootNoSignChange);
+  CHECK(s.reference.multiplicity == 2);
+  CHECK(s.reference.t_nearest == Approx(t).margin(1e-12));
+}
+
 }  // namespace
 
 TEST_CASE("rays through nodes meet a double root", "[hard-rays]") {
@@ -86,9 +93,7 @@ TEST_CASE("rays through nodes meet a double root", "[hard-rays]") {
   // node (1, 1, -1): P = (z + 1)^2, a double root without a sign change.
   const RaySolve cayley = solve("cayley_cubic.toml", glm::dvec3(1, 1, 1), glm::dvec3(1, 1, -3));
   INFO("Cayley: reference " << ref::to_string(cayley.reference.kind) << " at " << cayley.reference.t_nearest);
-  CHECK(cayley.reference.kind == ref::Classification::EvenRootNoSignChange);
-  CHECK(cayley.reference.multiplicity == 2);
-  CHECK(cayley.reference.t_nearest == Approx(2).margin(1e-12));
+  check_double_root(cayley, 2);
   if (cayley.kernel.flags & ALGRAY_HIT_FOUND) CHECK(kernel_t(cayley.kernel) == Approx(2).margin(1e-6));
   // The lemniscate's node at the origin along x: P = x^2 (x^2 - 2 a^2), negative on both sides of 0; the
   // kernel goes on to the far lobe at x = -a sqrt 2 unless rounding noise stops it at the node.
@@ -111,9 +116,7 @@ TEST_CASE("rays through a node of the Barth sextic and of the Kummer quartic", "
   // double root at the node (0, sqrt(5)/2, 1), irrational but exactly double.
   const RaySolve barth = solve("barth_sextic.toml", glm::dvec3(3, 0, 0), glm::dvec3(-3, 0, 0));
   INFO("Barth: reference " << ref::to_string(barth.reference.kind) << " at " << barth.reference.t_nearest);
-  CHECK(barth.reference.kind == ref::Classification::EvenRootNoSignChange);
-  CHECK(barth.reference.multiplicity == 2);
-  CHECK(barth.reference.t_nearest == Approx(2).margin(1e-12));
+  check_double_root(barth, 2);
   // Invisible on the true surface; rounding noise may stop the kernel at one of the two touching points.
   if (barth.kernel.flags & ALGRAY_HIT_FOUND) {
     const double x_hit = 3 - kernel_t(barth.kernel);
@@ -122,9 +125,7 @@ TEST_CASE("rays through a node of the Barth sextic and of the Kummer quartic", "
   }
   const RaySolve kummer = solve("kummer.toml", glm::dvec3(0, 2.5, 1), glm::dvec3(0, -2.5, 1), {0, 0, 1});
   INFO("Kummer: reference " << ref::to_string(kummer.reference.kind) << " at " << kummer.reference.t_nearest);
-  CHECK(kummer.reference.kind == ref::Classification::EvenRootNoSignChange);
-  CHECK(kummer.reference.multiplicity == 2);
-  CHECK(kummer.reference.t_nearest == Approx(2.5 - std::sqrt(1.25)).margin(1e-12));
+  check_double_root(kummer, 2.5 - std::sqrt(1.25));
   if (kummer.kernel.flags & ALGRAY_HIT_FOUND) {
     const double y_hit = 2.5 - kernel_t(kummer.kernel);
     INFO("kernel at y = " << y_hit);
@@ -137,9 +138,7 @@ TEST_CASE("a ray through the tooth's isolated point touches without crossing and
   // z = 1/2 down (an axis-aligned ray, so it is exact) the origin is the first root, of even multiplicity.
   const RaySolve s = solve("tooth.toml", glm::dvec3(0, 0, 0.5), glm::dvec3(0, 0, -0.5));
   INFO("reference " << ref::to_string(s.reference.kind) << " at " << s.reference.t_nearest);
-  CHECK(s.reference.kind == ref::Classification::EvenRootNoSignChange);
-  CHECK(s.reference.multiplicity == 2);
-  CHECK(s.reference.t_nearest == Approx(0.5).margin(1e-12));
+  check_double_root(s, 0.5);
   // The kernel's rounded polynomial may dip across zero there by rounding noise; otherwise it passes through
   // to the far side of the tooth at z = -1.
   REQUIRE((s.kernel.flags & ALGRAY_HIT_FOUND) != 0);
