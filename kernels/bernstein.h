@@ -220,6 +220,17 @@ REAL isolated_value(const REAL* c, REAL y) {
   return h * power_of(y);
 }
 
+/* The size of the terms isolated_value(c, y) sums, sum |c_k| r^k times the same power: its rounding error is
+ * a small multiple of REAL_EPS times this, so a value below REAL_EPS times it has no reliable sign. */
+REAL isolated_magnitude(const REAL* c, REAL y) {
+  const int mirrored = y > (REAL)0.5;
+  const REAL r = mirrored ? ((REAL)1 - y) / y : y / ((REAL)1 - y);
+  REAL h = 0;
+  ALGRAY_UNROLL
+  for (int k = DEGREE; k >= 0; --k) h = h * r + fabs(c[mirrored ? DEGREE - k : k]);
+  return h * power_of(mirrored ? y : (REAL)1 - y);
+}
+
 /* Value and slope at y in [0,1] of a prepared polynomial, for Newton's method. With r = y/(1-y) and
  * H(r) = sum c_k r^k, P = (1-y)^n H and P' = (1-y)^(n-2) (H' - n (1-y) H); mirrored past 1/2 like the value. */
 REAL isolated_value_slope(const REAL* c, REAL y, REAL* slope) {

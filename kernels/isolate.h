@@ -6,7 +6,7 @@
 
 /* Bernstein isolation works on P*(s) in the Bernstein basis of the segment; the others in its power basis, and
  * name their entry point isolate_power_basis(p, s0, len_s, t_in, t_out, a1) (see power_descartes.h). Each
- * provides prepare_isolated, isolated_value and isolated_value_slope for refine.h. */
+ * provides prepare_isolated, isolated_value, isolated_value_slope and isolated_magnitude for refine.h. */
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
 #include "bernstein.h"
 #elif ISOLATION == ALGRAY_ISOLATION_POWER

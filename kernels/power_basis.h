@@ -53,4 +53,12 @@ REAL isolated_value(const REAL* c, REAL y) { return power_value(c, y); }
 
 REAL isolated_value_slope(const REAL* c, REAL y, REAL* slope) { return power_value_slope(c, y, slope); }
 
+/* sum |c_k| y^k: Horner's rounding error at y is a small multiple of REAL_EPS times this. */
+REAL isolated_magnitude(const REAL* c, REAL y) {
+  REAL h = fabs(c[DEGREE]);
+  ALGRAY_UNROLL
+  for (int k = DEGREE - 1; k >= 0; --k) h = h * y + fabs(c[k]);
+  return h;
+}
+
 #endif /* ALGRAY_POWER_BASIS_H */

@@ -6,9 +6,20 @@
 
 /* Needs isolated_value(c, y) from the isolation method: the polynomial at y in [0,1] of the isolating interval.
  * f0 and f1 are its values at 0 and 1, of opposite signs. tol_y is the stopping width in y; scale is the size
- * of the polynomial's coefficients on the isolating interval, which makes the paper's |P*(b)| <= eps_m test
- * independent of how P happens to be scaled (a bare eps_m stops float solves early on flat polynomials).
- * Returns the root's y and counts the iterations (function evaluations) in *iterations. */
+ * of the polynomial's coefficients on the isolating interval. Returns the root's y and counts the iterations
+ * (function evaluations) in *iterations. */
+
+/* The paper's value stop, |P*(y)| <= eps_m, made independent of how P is scaled: the value is within the
+ * rounding error of evaluating it at y, so its sign carries no more information. The error is measured at y
+ * (isolated_magnitude), not by the largest coefficient: on a wide power-basis bracket the coefficients are
+ * orders of magnitude larger than the terms near the root, and a coefficient-sized threshold stopped early
+ * there: 726 of 4096 pixels more than 1e-6 deep on (z + x/10)^21 = a (derivative chain, double). It is at most
+ * (DEGREE + 1) * scale, which skips computing it far from the root. */
+int value_within_rounding(const REAL* c, REAL y, REAL fy, REAL scale) {
+  if (fabs(fy) > REAL_EPS * (REAL)(DEGREE + 1) * scale) return 0;
+  return fabs(fy) <= REAL_EPS * isolated_magnitude(c, y);
+}
+
 #if REFINEMENT == ALGRAY_REFINEMENT_BRENT
 REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations) {
   /* b: best estimate; c_: contrapoint, f(c_) of the other sign; a: the previous b. */
@@ -24,7 +35,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
       fc = fa;
     }
     /* The paper's stopping rule: |P*(b)| at machine precision, or a bracket at most the stopping width. */
-    if (fabs(fb) <= REAL_EPS * scale || fabs(cp - b) <= tol_y) break;
+    if (fabs(cp - b) <= tol_y || value_within_rounding(c, b, fb, scale)) break;
     REAL cand = b;
     int have = 0;
     if (fa != fc && fb != fc && fa != fb) {
@@ -93,7 +104,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
     x = a - fa * (b - a) / (fb - fa);
     if (!(x > a && x < b)) x = (REAL)0.5 * (a + b); /* rounding pushed it out: stay inside */
     const REAL fx = isolated_value(c, x);
-    if (fabs(fx) <= REAL_EPS * scale) {
+    if (value_within_rounding(c, x, fx, scale)) {
       ++it;
       break;
     }
@@ -128,7 +139,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
   REAL previous = INFINITY;
   uint it = 0;
   for (; it < MAX_ITERATIONS && b - a > tol_y; ++it) {
-    if (fabs(fx) <= REAL_EPS * scale) break;
+    if (value_within_rounding(c, x, fx, scale)) break;
     REAL next = x - fx / slope;
     if (!(next > a && next < b) || !(fabs(fx) <= (REAL)0.5 * previous)) next = (REAL)0.5 * (a + b);
     previous = fabs(fx);

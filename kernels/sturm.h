@@ -171,13 +171,6 @@ void sturm_bracket(Isolation* iso, REAL* a1) {
   }
 }
 
-/* The refinement stops once |P| is within eps of the largest coefficient of A1 on the bracket (refine.h), and
- * on a wide bracket those are large: on (z + x/10)^D = a, brackets as wide as the segment, which a count of one
- * root allows, left depth errors above 1e-9 from degree 13 in double and of 2e-3 from degree 9 in float. So a
- * bracket is at most 2^-STURM_BRACKET_LEVEL of the segment; with 16ths, double held to degree 28 and float to
- * degree 16 there. */
-#define STURM_BRACKET_LEVEL 4
-
 /* p is P*(s) in the power basis, the extent interval being s in [s0, s0 + len_s]. The sequence is built once,
  * on A1 over the whole interval; then the dyadic (level, idx) pieces of [0, 1] are visited depth first, left
  * first, each needing the sequence at its right end only: its left end is its parent's, or the right end of
@@ -222,7 +215,7 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
      * that close to the end may be on either side of it, and may be a second one (measured: a pair 2^-20
      * apart, the larger one 2.5e-11 below a dyadic point, bracketed together, refined to the larger). */
     const int clear = fabs(f_lo) > noise_lo && fabs(f_hi) > noise_hi;
-    if (roots == 1 && crosses && clear && level >= STURM_BRACKET_LEVEL) {
+    if (roots == 1 && crosses && clear) {
       sturm_bracket(&iso, a1);
       return iso;
     }
