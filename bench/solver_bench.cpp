@@ -346,7 +346,7 @@ json bench_decic(ClSession& session, bool quick, const fs::path& scenes, const f
         defect[i] = bad;
         defects += bad;
       }
-      const FrameImage shaded = shade_preview(scene, t.result);
+      const FrameImage shaded = shade_frame(scene, t.result);
       for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x) {
           const std::size_t from = static_cast<std::size_t>(y) * width + x;

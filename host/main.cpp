@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets;
   int width = 0, height = 0;
   std::string precision, isolation, refinement, tolerance, max_iterations;
-  bool no_cache = false;
+  bool no_cache = false, preview = false;
   std::string stats_path;
   CLI::App* render = app.add_subcommand("render", "render a scene (default: the built-in Barth sextic)");
   render->add_option("scene", scene_path, "scene file (.toml)");
@@ -40,6 +40,8 @@ int main(int argc, char** argv) {
                      "the refinement's iteration cap (overrides render.max_iterations)");
   render->add_option("--set", sets, "override a scene key: name=value (a bare name is a parameter)");
   render->add_option("--stats", stats_path, "write render statistics as JSON");
+  render->add_flag("--preview", preview,
+                   "the paper's preview mode: primary rays only (no shadows); sets render.preview");
   render->add_flag("--no-cache", no_cache, "compile kernels from source; neither read nor write the program cache");
   render->add_flag(
       "--reference", request.reference,
@@ -83,6 +85,7 @@ int main(int argc, char** argv) {
   // Numbers pass through as written, so that the scene's own checks report them.
   if (!tolerance.empty()) request.overrides.push_back({"render.tolerance", tolerance});
   if (!max_iterations.empty()) request.overrides.push_back({"render.max_iterations", max_iterations});
+  if (preview) request.overrides.push_back({"render.preview", "true"});
   request.use_cache = !no_cache;
   if (!stats_path.empty()) request.stats_path = stats_path;
   request.progress = ::isatty(STDERR_FILENO) != 0;

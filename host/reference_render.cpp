@@ -116,6 +116,9 @@ ReferenceResult render_reference(const Scene& scene, Precision ray_precision, un
   RenderResult& r = out.render;
   r.config = primary_config(scene, ray_precision);
   r.basis = make_ray_basis(scene.camera, width, height);
+  // Primary rays only, one per pixel: the reference neither supersamples nor traces shadows.
+  r.plan.width = width;
+  r.plan.height = height;
   r.hits.width = width;
   r.hits.height = height;
   r.hits.records.assign(pixels, HitRecord{});

@@ -64,6 +64,8 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
       {"algray/kernelMs", kernel_ms},
       {"algray/camera/fovY", cam.fov_y_degrees},
       {"algray/camera/orthoHeight", cam.ortho_height},
+      // The ray basis above is per antialiasing sample: pixel (px, py) averages samples x samples rays.
+      {"algray/antialiasSamples", r.plan.samples},
   };
   img.world_to_camera = world_to_camera_matrix(b, cam.eye);
   img.world_to_ndc = world_to_ndc_matrix(cam, b, scene.image.width, scene.image.height);
@@ -129,12 +131,19 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
     steps += h.work & 0xffffu;
     iterations += h.work >> 16;
   }
-  for (const PassStats& p : r.passes)
+  j["plan"] = r.plan.json();
+  for (const PassStats& p : r.passes) {
+    std::string origin;
+    for (const ProgramRecord& program : r.programs)
+      if (program.key == p.program_key) origin = program.origin;
     j["passes"].push_back({{"name", p.name},
+                           {"kernel", p.program_key},
+                           {"kernel_origin", origin},
                            {"rays", p.rays},
                            {"launches", p.launches},
                            {"kernel_ms", p.kernel_ms},
                            {"wall_ms", p.wall_ms}});
+  }
   j["pixels"] = {
       {"hits", hits}, {"depth_limited", budget}, {"isolation_steps", steps}, {"refine_iterations", iterations}};
   j["phases_ms"] = timer.json();
@@ -201,7 +210,7 @@ int run_render(const RenderRequest& req, std::ostream& err) {
       ReferenceResult ref = render_reference(scene, scene.render.precision.value_or(Precision::Double));
       timer.mark("render");
       result = std::move(ref.render);
-      image = shade_preview(scene, result);
+      image = shade_frame(scene, result);
       image.uint_channels.push_back({"reference.class", std::move(ref.classes)});
     } else {
       ClSession session(select_device(req.device_spec));
@@ -211,7 +220,7 @@ int run_render(const RenderRequest& req, std::ostream& err) {
       Renderer renderer(session, cache);
       result = renderer.render(scene, req.progress);
       timer.mark("render");
-      image = shade_preview(scene, result);
+      image = shade_frame(scene, result);
     }
     add_metadata(image, scene, result, device);
     timer.mark("shade");

@@ -8,19 +8,12 @@
 #include "algray_shared.h"
 #include "camera.h"
 #include "cl_runtime.h"
+#include "device_surface.h"
 #include "program_cache.h"
+#include "render_plan.h"
 #include "scene.h"
 
 namespace algray {
-
-// The polynomial as the kernels see it: in unit coordinates of the extent, scaled to max |coefficient| = 1.
-struct SurfaceData {
-  int degree = 0;
-  std::vector<cl_uint> exponents;  // i | j << 8 | k << 16, sorted by i, j, k descending
-  std::vector<double> coefficients;
-  cl_uint even_axes = 0;  // bit a set when every exponent of axis a is even (the kernels then step by squares)
-};
-SurfaceData prepare_surface(const Scene& scene);
 
 struct HitBuffer {
   int width = 0, height = 0;
@@ -37,18 +30,30 @@ struct PassStats {
   double wall_ms = 0;
 };
 
+// What the shadow pass found for one light: for each surface point, bit s set when sample point s is hidden.
+struct LightOcclusion {
+  int light = 0;                       // index into Scene::lights
+  std::vector<std::uint64_t> masks;    // indexed like RenderResult::shading_points
+};
+
 struct RenderResult {
-  HitBuffer hits;
+  RenderPlan plan;
+  HitBuffer hits;       // one record per traced ray: plan.trace_width() x plan.trace_height()
   KernelConfig config;  // of the primary pass, with precision and tolerance as used
-  RayBasis basis;
+  RayBasis basis;       // of the traced rays (per antialiasing sample, not per pixel)
   std::vector<ProgramRecord> programs;
   std::vector<PassStats> passes;
+  // The shadow pass's surface points: the hit index (into hits.records) of each, and each light's answer.
+  std::vector<std::uint32_t> shading_points;
+  std::vector<LightOcclusion> occlusion;
 };
 
 // Precision a scene renders in on a device: as asked, or double where fp64 exists. Throws DeviceError when
 // double is asked of a device without fp64.
 Precision resolve_precision(const Scene& scene, const DeviceInfo& device);
-KernelConfig primary_config(const Scene& scene, Precision precision);
+
+// The world-space point a hit record stands for on the ray that produced it.
+glm::dvec3 hit_point(const PixelRay& ray, const HitRecord& hit);
 
 // Tile side for a device when the scene leaves it open. GPUs get launches short enough for display watchdogs;
 // CPUs (PoCL) lose ~2 ms per launch and idle cores at each launch's tail, so they get few, large launches:
@@ -58,10 +63,13 @@ int default_tile_size(const DeviceInfo& device);
 class Renderer {
  public:
   Renderer(ClSession& session, ProgramCache& cache) : session_(session), cache_(cache) {}
-  // show_progress: print per-tile progress to stderr (for terminals).
+  // Runs every pass of the scene's plan. show_progress: print per-tile progress to stderr (for terminals).
   RenderResult render(const Scene& scene, bool show_progress);
 
  private:
+  void run_primary(const Scene& scene, const DeviceSurface& surface, bool show_progress, RenderResult& result);
+  void run_shadow(const Scene& scene, const DeviceSurface& surface, RenderResult& result);
+
   ClSession& session_;
   ProgramCache& cache_;
 };

@@ -87,6 +87,23 @@ class SceneReader {
     return *i;
   }
 
+  bool boolean(const toml::node& node, const std::string& what) const {
+    auto b = node.value_exact<bool>();
+    if (!b) fail(node.source(), what + " must be true or false");
+    return *b;
+  }
+
+  // A number in [lo, hi].
+  double number_in(const toml::node& node, const std::string& what, double lo, double hi) const {
+    const double v = number(node, what);
+    if (v < lo || v > hi) {
+      std::ostringstream range;
+      range << what << " must be between " << lo << " and " << hi;
+      fail(node.source(), range.str());
+    }
+    return v;
+  }
+
   std::string string(const toml::node& node, const std::string& what) const {
     auto s = node.value_exact<std::string>();
     if (!s) fail(node.source(), what + " must be a string");
@@ -166,14 +183,20 @@ class SceneReader {
   std::vector<std::string> lines_;
 };
 
-const std::set<std::string> kTopKeys{"surface", "parameters", "extent", "camera", "image", "colours", "render"};
+const std::set<std::string> kTopKeys{"surface", "parameters", "extent",    "camera", "image",
+                                     "material", "light",      "antialias", "render"};
 const std::set<std::string> kSurfaceKeys{"name", "equation", "terms"};
 const std::set<std::string> kExtentKeys{"type", "centre", "radius", "min", "max"};
 const std::set<std::string> kCameraKeys{"projection", "eye", "look_at", "up", "fov_y", "height"};
 const std::set<std::string> kImageKeys{"width", "height", "background"};
-const std::set<std::string> kColourKeys{"front", "back"};
-const std::set<std::string> kRenderKeys{"precision",  "tolerance",      "isolation", "refinement",
-                                        "ray_origin", "max_iterations", "tile_size"};
+const std::set<std::string> kMaterialKeys{"front", "back"};
+const std::set<std::string> kMaterialSideKeys{"colour",   "ambient",      "diffuse",     "specular",
+                                              "exponent", "reflectivity", "transparency"};
+const std::set<std::string> kLightKeys{"type",   "position", "edge_u",    "edge_v",    "normal",
+                                       "radius", "samples",  "colour",    "intensity", "shadows"};
+const std::set<std::string> kAntialiasKeys{"samples"};
+const std::set<std::string> kRenderKeys{"precision",      "tolerance", "isolation", "refinement", "ray_origin",
+                                        "max_iterations", "tile_size", "preview"};
 
 bool is_identifier(const std::string& s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
@@ -229,6 +252,78 @@ Polynomial polynomial_from_terms(const SceneReader& r, const toml::node& terms_n
     p.add_term(i, j, k, exact_rational(r.number(*a->get(3), "coefficient")));
   }
   return p;
+}
+
+void read_material(const SceneReader& r, const toml::table& t, const std::string& name, Material& m) {
+  r.check_keys(t, name, kMaterialSideKeys);
+  if (const toml::node* n = t.get("colour")) m.colour = glm::dvec3(r.colour(*n, name + ".colour", false));
+  if (const toml::node* n = t.get("ambient")) m.ambient = r.number_in(*n, name + ".ambient", 0, 1);
+  if (const toml::node* n = t.get("diffuse")) m.diffuse = r.number_in(*n, name + ".diffuse", 0, 1);
+  if (const toml::node* n = t.get("specular")) m.specular = r.number_in(*n, name + ".specular", 0, 1);
+  if (const toml::node* n = t.get("exponent")) m.exponent = r.number_in(*n, name + ".exponent", 1, 10000);
+  // Secondary rays are not traced yet: a scene that asks for them is refused rather than drawn without them.
+  for (const char* key : {"reflectivity", "transparency"})
+    if (const toml::node* n = t.get(key)) {
+      const double v = r.number_in(*n, name + "." + key, 0, 1);
+      if (v > 0)
+        r.fail(n->source(), name + "." + key + ": " +
+                                (std::string(key) == "reflectivity" ? "reflections" : "transparency") +
+                                " are not implemented yet (only 0 is accepted)");
+      (std::string(key) == "reflectivity" ? m.reflectivity : m.transparency) = v;
+    }
+}
+
+Light read_light(const SceneReader& r, const toml::table& t) {
+  r.check_keys(t, "light", kLightKeys);
+  Light light;
+  const std::string type = t.get("type") ? r.string(*t.get("type"), "light.type") : "point";
+  if (type == "point")
+    light.kind = LightKind::Point;
+  else if (type == "rectangle")
+    light.kind = LightKind::Rectangle;
+  else if (type == "disc")
+    light.kind = LightKind::Disc;
+  else
+    r.fail(t.get("type")->source(), "light.type must be \"point\", \"rectangle\" or \"disc\"");
+  const toml::node* position = t.get("position");
+  if (!position) r.fail(t.source(), "a light needs a position (the centre of an area light)");
+  light.position = r.vec3(*position, "light.position");
+  // Keys that belong to another kind of light are mistakes, not things to ignore.
+  const std::set<std::string> own = light.kind == LightKind::Rectangle ? std::set<std::string>{"edge_u", "edge_v", "samples"}
+                                    : light.kind == LightKind::Disc   ? std::set<std::string>{"normal", "radius", "samples"}
+                                                                      : std::set<std::string>{};
+  for (const char* key : {"edge_u", "edge_v", "normal", "radius", "samples"})
+    if (const toml::node* n = t.get(key); n && !own.count(key))
+      r.fail(n->source(), std::string("light.") + key + " does not apply to a " + type + " light");
+  if (light.kind == LightKind::Rectangle) {
+    if (!t.get("edge_u") || !t.get("edge_v")) r.fail(t.source(), "a rectangle light needs edge_u and edge_v");
+    light.edge_u = r.vec3(*t.get("edge_u"), "light.edge_u");
+    light.edge_v = r.vec3(*t.get("edge_v"), "light.edge_v");
+    if (glm::length(glm::cross(light.edge_u, light.edge_v)) <= 0)
+      r.fail(t.get("edge_v")->source(), "the rectangle is degenerate: edge_u and edge_v must span an area");
+  }
+  if (light.kind == LightKind::Disc) {
+    if (!t.get("radius")) r.fail(t.source(), "a disc light needs a radius");
+    light.radius = r.number(*t.get("radius"), "light.radius");
+    if (!(light.radius > 0)) r.fail(t.get("radius")->source(), "light.radius must be positive");
+    if (const toml::node* n = t.get("normal")) {
+      light.normal = r.vec3(*n, "light.normal");
+      if (glm::length(light.normal) <= 0) r.fail(n->source(), "light.normal must not be zero");
+      light.normal = glm::normalize(light.normal);
+    }
+  }
+  if (light.kind != LightKind::Point) {
+    light.samples = 5;  // the paper's 25 points per area light
+    if (const toml::node* n = t.get("samples"))
+      light.samples = static_cast<int>(r.integer(*n, "light.samples", 1, kMaxLightSamplesPerSide));
+  }
+  if (const toml::node* n = t.get("colour")) light.colour = glm::dvec3(r.colour(*n, "light.colour", false));
+  if (const toml::node* n = t.get("intensity")) {
+    light.intensity = r.number(*n, "light.intensity");
+    if (light.intensity < 0) r.fail(n->source(), "light.intensity must not be negative");
+  }
+  if (const toml::node* n = t.get("shadows")) light.shadows = r.boolean(*n, "light.shadows");
+  return light;
 }
 
 Scene interpret(const SceneReader& r, const toml::table& root, const std::string& source) {
@@ -355,12 +450,25 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
     if (const toml::node* n = image->get("background")) scene.image.background = r.colour(*n, "image.background", true);
   }
 
-  if (const toml::table* colours = r.subtable(root, "colours")) {
-    r.check_keys(*colours, "colours", kColourKeys);
-    if (const toml::node* n = colours->get("front"))
-      scene.colours.front = glm::dvec3(r.colour(*n, "colours.front", false));
-    if (const toml::node* n = colours->get("back"))
-      scene.colours.back = glm::dvec3(r.colour(*n, "colours.back", false));
+  if (const toml::table* material = r.subtable(root, "material")) {
+    r.check_keys(*material, "material", kMaterialKeys);
+    for (const char* side : {"front", "back"})
+      if (const toml::table* t = r.subtable(*material, side))
+        read_material(r, *t, std::string("material.") + side,
+                      std::string(side) == "front" ? scene.materials.front : scene.materials.back);
+  }
+
+  if (const toml::node* lights = root.get("light")) {
+    const toml::array* list = lights->as_array();
+    if (!list || !list->is_array_of_tables())
+      r.fail(lights->source(), "lights are written as [[light]] tables, one per light");
+    for (const toml::node& node : *list) scene.lights.push_back(read_light(r, *node.as_table()));
+  }
+
+  if (const toml::table* aa = r.subtable(root, "antialias")) {
+    r.check_keys(*aa, "antialias", kAntialiasKeys);
+    if (const toml::node* n = aa->get("samples"))
+      scene.antialias.samples = static_cast<int>(r.integer(*n, "antialias.samples", 1, 16));
   }
 
   if (const toml::table* render = r.subtable(root, "render")) {
@@ -400,6 +508,7 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
       rs.max_iterations = static_cast<int>(r.integer(*n, "render.max_iterations", 1, 1000000));
     if (const toml::node* n = render->get("tile_size"))
       rs.tile_size = static_cast<int>(r.integer(*n, "render.tile_size", 8, 16384));
+    if (const toml::node* n = render->get("preview")) rs.preview = r.boolean(*n, "render.preview");
   }
   return scene;
 }
@@ -418,6 +527,36 @@ double Extent::unit_scale() const { return kind == ExtentKind::Sphere ? radius :
 
 glm::dvec3 Extent::unit_box_half() const {
   return kind == ExtentKind::Box ? (max - min) * 0.5 / unit_scale() : glm::dvec3(1);
+}
+
+std::vector<glm::dvec3> Light::sample_points() const {
+  if (kind == LightKind::Point) return {position};
+  std::vector<glm::dvec3> points;
+  const int n = samples;
+  // An orthonormal frame of the disc's plane.
+  const glm::dvec3 a = std::fabs(normal.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+  const glm::dvec3 e1 = glm::normalize(glm::cross(normal, a)), e2 = glm::cross(normal, e1);
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const double u = (i + 0.5) / n * 2 - 1, v = (j + 0.5) / n * 2 - 1;  // cell centres in [-1, 1]^2
+      if (kind == LightKind::Rectangle) {
+        points.push_back(position + 0.5 * u * edge_u + 0.5 * v * edge_v);
+        continue;
+      }
+      // Shirley and Chiu's concentric map: squares around the centre go to rings of equal area.
+      const double pi = 3.14159265358979323846;
+      double r = 0, phi = 0;
+      if (std::fabs(u) > std::fabs(v)) {
+        r = u;
+        phi = pi / 4 * (v / u);
+      } else if (v != 0) {
+        r = v;
+        phi = pi / 2 - pi / 4 * (u / v);
+      }
+      points.push_back(position + radius * r * (std::cos(phi) * e1 + std::sin(phi) * e2));
+    }
+  }
+  return points;
 }
 
 Scene load_scene_text(const std::string& text, const std::string& source_name, const std::vector<Override>& overrides) {

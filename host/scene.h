@@ -40,9 +40,51 @@ struct ImageSpec {
   glm::dvec4 background{1, 1, 1, 1};  // linear RGBA
 };
 
-struct Colours {
-  glm::dvec3 front{0.95, 0.65, 0.15};  // where the ray arrives from P > 0 (outside)
-  glm::dvec3 back{0.25, 0.45, 0.9};    // where it arrives from P < 0 (inside)
+// How a side of the surface reflects light (Phong), plus what it passes on to secondary rays.
+struct Material {
+  glm::dvec3 colour{0.95, 0.65, 0.15};
+  double ambient = 0.15;    // share of the colour lit by the ambient light, shadow or not
+  double diffuse = 0.75;    // Lambertian share per light
+  double specular = 0.35;   // highlight strength per light, in the light's colour
+  double exponent = 40;     // Phong exponent: larger is a smaller, sharper highlight
+  double reflectivity = 0;  // share of a mirror ray's colour (needs the reflection pass)
+  double transparency = 0;  // share of the colour seen through the surface (needs the transmission pass)
+};
+
+// Front: where the ray arrives from P > 0 (outside); back: from P < 0 (inside).
+struct Materials {
+  Material front;
+  Material back = [] {
+    Material m;
+    m.colour = {0.25, 0.45, 0.9};
+    return m;
+  }();
+};
+
+enum class LightKind { Point, Rectangle, Disc };
+
+// A light; area lights are sampled as samples x samples points spread uniformly over their area.
+struct Light {
+  LightKind kind = LightKind::Point;
+  glm::dvec3 position{0};          // the point, or the area's centre
+  glm::dvec3 edge_u{0}, edge_v{0};  // rectangle: its two edges (full length), centred on position
+  glm::dvec3 normal{0, 0, 1};       // disc: its plane's normal
+  double radius = 0;                // disc
+  int samples = 1;                  // n: n x n points for an area light; 1 for a point light
+  glm::dvec3 colour{1};
+  double intensity = 1;
+  bool shadows = true;
+
+  // The light's sample points: cell centres of an n x n grid over the rectangle, or the same grid mapped to
+  // the disc by an area-preserving (concentric) map.
+  std::vector<glm::dvec3> sample_points() const;
+};
+
+// The most points one area light may have: a shadow pass keeps one visibility bit per point in 64 bits.
+inline constexpr int kMaxLightSamplesPerSide = 8;
+
+struct Antialias {
+  int samples = 1;  // n x n supersampling; 1 is off
 };
 
 struct RenderSettings {
@@ -53,6 +95,7 @@ struct RenderSettings {
   RayOrigin ray_origin = RayOrigin::Extent;
   int max_iterations = 0;  // 0: the refinement's default (default_max_iterations)
   int tile_size = 0;  // pixels per side of a dispatched tile; 0 chooses by device type
+  bool preview = false;  // primary rays only: lights shade, but cast no shadows (the paper's preview mode)
 };
 
 struct Scene {
@@ -64,7 +107,9 @@ struct Scene {
   Extent extent;
   CameraSpec camera;
   ImageSpec image;
-  Colours colours;
+  Materials materials;
+  std::vector<Light> lights;  // none: a headlight at the eye shades the surface, without shadows
+  Antialias antialias;
   RenderSettings render;
 };
 

@@ -53,6 +53,35 @@ SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out, _
   return r;
 }
 
+/* Isolates the smallest root of P*(t) on [t_in, t_out] for the ray o + t*d in unit coordinates; iso_c gets
+ * the polynomial on the isolating interval. The primary and shadow kernels share this: one refines what it
+ * returns, the other only asks whether there is anything to refine. */
+Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
+                             __global const REAL* coefs, uint count, __constant const REAL* binomials,
+                             uint even_axes, REAL* iso_c) {
+  REAL root[NCOEF], root_lo[NCOEF];
+#if RAY_ORIGIN == ALGRAY_ORIGIN_EYE
+  /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
+  restrict_to_ray(exps, coefs, count, binomials, axis_factor(o.x, d.x, even_axes & 1),
+                  axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root, root_lo);
+  return isolate_power_basis(root, t_in, t_out - t_in, t_in, t_out, iso_c);
+#else
+  /* Entry and exit points: the ray restricted to the interval as s in [0, 1]. */
+  const REAL3 pa = o + t_in * d, pb = o + t_out * d;
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+  restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, pb.x, even_axes & 1),
+                  axis_factor(pa.y, pb.y, even_axes & 2), axis_factor(pa.z, pb.z, even_axes & 4), root, root_lo);
+  bernstein_from_scaled(root, root_lo, binomials);
+  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c);
+#else
+  const REAL3 e = pb - pa;
+  restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, e.x, even_axes & 1),
+                  axis_factor(pa.y, e.y, even_axes & 2), axis_factor(pa.z, e.z, even_axes & 4), root, root_lo);
+  return isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c);
+#endif
+#endif
+}
+
 SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                          __global const uint* exps, __global const REAL* coefs, uint count,
                          __constant const REAL* binomials, uint even_axes) {
@@ -71,27 +100,8 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   if (!clip_to_extent(o, d, extent_kind, box_half, &t_in, &t_out)) return h;
   h.root.flags = ALGRAY_HIT_IN_EXTENT;
 
-  REAL root[NCOEF], root_lo[NCOEF], iso_c[NCOEF];
-#if RAY_ORIGIN == ALGRAY_ORIGIN_EYE
-  /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
-  restrict_to_ray(exps, coefs, count, binomials, axis_factor(o.x, d.x, even_axes & 1),
-                  axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root, root_lo);
-  const Isolation iso = isolate_power_basis(root, t_in, t_out - t_in, t_in, t_out, iso_c);
-#else
-  /* Entry and exit points: the ray restricted to the interval as s in [0, 1]. */
-  const REAL3 pa = o + t_in * d, pb = o + t_out * d;
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, pb.x, even_axes & 1),
-                  axis_factor(pa.y, pb.y, even_axes & 2), axis_factor(pa.z, pb.z, even_axes & 4), root, root_lo);
-  bernstein_from_scaled(root, root_lo, binomials);
-  const Isolation iso = isolate_bernstein(root, root_lo, t_in, t_out, iso_c);
-#else
-  const REAL3 e = pb - pa;
-  restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, e.x, even_axes & 1),
-                  axis_factor(pa.y, e.y, even_axes & 2), axis_factor(pa.z, e.z, even_axes & 4), root, root_lo);
-  const Isolation iso = isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c);
-#endif
-#endif
+  REAL iso_c[NCOEF];
+  const Isolation iso = isolate_on_segment(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, iso_c);
   h.root = refine_isolated(iso, iso_c, t_in, t_out, binomials);
   h.root.flags |= ALGRAY_HIT_IN_EXTENT;
   if (h.root.flags & ALGRAY_HIT_FOUND) h.u = o + h.root.t * d;

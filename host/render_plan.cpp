@@ -1,0 +1,97 @@
+// Derives the render plan from a scene: passes, their kernels and their buffers.
+#include "render_plan.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "algray_shared.h"
+
+namespace algray {
+
+KernelConfig primary_config(const Scene& scene, Precision precision) {
+  KernelConfig config;
+  config.entry = "primary";
+  config.degree = scene.polynomial.degree();
+  config.precision = precision;
+  config.isolation = scene.render.isolation;
+  config.refinement = scene.render.refinement;
+  config.ray_origin = scene.render.ray_origin;
+  // Below a few units of roundoff the stopping rule can never trigger.
+  const double eps =
+      precision == Precision::Double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();
+  config.tolerance = std::max(scene.render.tolerance, 2 * eps);
+  config.max_iterations =
+      scene.render.max_iterations > 0 ? scene.render.max_iterations : default_max_iterations(scene.render.refinement);
+  return config;
+}
+
+double shadow_offset_unit(Precision precision) { return precision == Precision::Double ? 1e-6 : 1e-3; }
+
+const PlannedPass* RenderPlan::find(const std::string& name) const {
+  for (const PlannedPass& p : passes)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+RenderPlan make_render_plan(const Scene& scene, Precision precision) {
+  RenderPlan plan;
+  plan.width = scene.image.width;
+  plan.height = scene.image.height;
+  plan.samples = scene.antialias.samples;
+  const std::size_t rays = static_cast<std::size_t>(plan.trace_width()) * plan.trace_height();
+  const std::size_t real_size = precision == Precision::Double ? sizeof(double) : sizeof(float);
+
+  const KernelConfig primary = primary_config(scene, precision);
+  plan.passes.push_back({"primary", plan.samples > 1 ? "camera rays, " + std::to_string(plan.samples) + "x" +
+                                                           std::to_string(plan.samples) + " per pixel"
+                                                     : "camera rays, one per pixel",
+                         primary});
+  plan.buffers.push_back({"primary hits", rays * sizeof(HitRecord)});
+
+  for (std::size_t i = 0; i < scene.lights.size(); ++i)
+    if (scene.lights[i].shadows) plan.shadow_lights.push_back(static_cast<int>(i));
+  if (scene.render.preview) {
+    plan.shadow_lights.clear();
+    plan.skipped.push_back("shadow: preview mode traces primary rays only");
+  } else if (scene.lights.empty()) {
+    plan.skipped.push_back("shadow: no lights (a headlight shades the surface)");
+  } else if (plan.shadow_lights.empty()) {
+    plan.skipped.push_back("shadow: no light casts shadows");
+  }
+  if (!plan.shadow_lights.empty()) {
+    // The shadow kernel isolates roots and never refines them: the refinement is not part of its code.
+    KernelConfig shadow = primary;
+    shadow.entry = "shadow";
+    shadow.refinement = Refinement::Brent;
+    shadow.max_iterations = default_max_iterations(Refinement::Brent);
+    std::size_t points = 0;
+    for (int i : plan.shadow_lights) points += scene.lights[static_cast<std::size_t>(i)].sample_points().size();
+    plan.passes.push_back({"shadow",
+                           std::to_string(plan.shadow_lights.size()) + " shadow-casting light(s), " +
+                               std::to_string(points) + " sample point(s) per lit surface point",
+                           shadow});
+    // Sized for every ray hitting; the pass allocates for the hits there are.
+    plan.buffers.push_back({"shading points (at most)", rays * 4 * real_size});
+    plan.buffers.push_back({"shading normals (at most)", rays * 4 * sizeof(float)});
+    plan.buffers.push_back({"light sample points", points * 4 * real_size});
+    plan.buffers.push_back({"occlusion masks (at most)", rays * plan.shadow_lights.size() * sizeof(cl_ulong)});
+  }
+  plan.skipped.push_back("reflection: not implemented (materials must have reflectivity 0)");
+  plan.skipped.push_back("transmission: not implemented (materials must have transparency 0)");
+  return plan;
+}
+
+nlohmann::json RenderPlan::json() const {
+  nlohmann::json j;
+  j["image"] = {{"width", width}, {"height", height}};
+  j["antialias_samples"] = samples;
+  j["traced"] = {{"width", trace_width()}, {"height", trace_height()}};
+  for (const PlannedPass& p : passes)
+    j["passes"].push_back({{"name", p.name}, {"purpose", p.purpose}, {"kernel", p.kernel.key()}});
+  for (const PlannedBuffer& b : buffers) j["buffers"].push_back({{"name", b.name}, {"bytes", b.bytes}});
+  j["shadow_lights"] = shadow_lights;
+  j["skipped"] = skipped;
+  return j;
+}
+
+}  // namespace algray

@@ -1,0 +1,53 @@
+// The render plan: which passes a scene needs, the kernel each builds and the buffers each allocates.
+#pragma once
+
+#include <cstddef>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "kernel_config.h"
+#include "scene.h"
+
+namespace algray {
+
+// One pass: the rays it traces and the kernel it launches. Nothing outside the plan is built or launched.
+struct PlannedPass {
+  std::string name;     // "primary", "shadow"
+  std::string purpose;  // why the scene needs it, for --stats
+  KernelConfig kernel;
+};
+
+struct PlannedBuffer {
+  std::string name;
+  std::size_t bytes = 0;
+};
+
+struct RenderPlan {
+  int width = 0, height = 0;  // the output image
+  int samples = 1;            // antialiasing: samples x samples rays per pixel
+  int trace_width() const { return width * samples; }
+  int trace_height() const { return height * samples; }
+  std::vector<PlannedPass> passes;
+  std::vector<PlannedBuffer> buffers;
+  std::vector<int> shadow_lights;  // indices into Scene::lights whose shadows the shadow pass traces
+  // Everything left out, and why ("shadow: no light casts shadows"), so --stats explains the plan.
+  std::vector<std::string> skipped;
+
+  const PlannedPass* find(const std::string& name) const;
+  nlohmann::json json() const;
+};
+
+// The passes and buffers `scene` calls for in `precision`. The primary pass is always there; the shadow pass
+// only when a light casts shadows and the scene is not a preview.
+RenderPlan make_render_plan(const Scene& scene, Precision precision);
+
+// The kernel of the primary pass for `scene`.
+KernelConfig primary_config(const Scene& scene, Precision precision);
+
+// How far a shadow ray's origin is moved off the surface, along the normal to the light's side, in units of
+// the extent's radius (unit coordinates): well above the hit point's error in the precision, well below what
+// shows in an image. Measured by test_shadows' re-intersection test.
+double shadow_offset_unit(Precision precision);
+
+}  // namespace algray
