@@ -27,7 +27,9 @@ SEXTIC_KERNEL_TARGET_MS = 100
 def run(binary, scene, precision, env, width, height, workdir):
     stats = workdir / "stats.json"
     cmd = [str(binary), "render", str(scene), "-o", str(workdir / "out.exr"), "--width", str(width),
-           "--height", str(height), "--stats", str(stats)]
+           "--height", str(height), "--stats", str(stats),
+           # the paper's preview: primary rays only, one per pixel (the scenes' own 2x2 antialiasing is off)
+           "--preview", "--set", "antialias.samples=1"]
     if precision:
         cmd += ["--precision", precision]
     start = time.perf_counter()

@@ -218,8 +218,11 @@ json bench_accuracy(ClSession& session, bool quick, const fs::path& scenes, cons
   json rows = json::array();
   for (const std::string& name : surfaces) {
     const std::string file = (scenes / (name + ".toml")).string();
+    // Primary rays only, one per pixel: the pixels are compared one for one with the reference.
     const std::vector<Override> size = {{"image.width", std::to_string(width)},
-                                        {"image.height", std::to_string(height)}};
+                                        {"image.height", std::to_string(height)},
+                                        {"antialias.samples", "1"},
+                                        {"render.preview", "true"}};
     const Scene base = load_scene_file(file, size);
     const ReferenceResult float_rays = render_reference(base, Precision::Float);
     const ReferenceResult double_rays = render_reference(base, Precision::Double);
@@ -266,7 +269,7 @@ constexpr Setup kSetups[] = {{"paper", Isolation::PowerDescartes, "eye"}, {"ours
 constexpr Refinement kFig2Refinements[] = {Refinement::Bisection, Refinement::RegulaFalsi, Refinement::Brent};
 
 json bench_fig2(ClSession& session, bool quick, const fs::path& scenes, const fs::path& cache_dir) {
-  // Fig. 2: 1024x768 with antialiasing. Plain 2x2 supersampling traces the rays of a 2048x1536 image.
+  // Fig. 2: 1024x768 with antialiasing (2x2 supersampling, the rays of a 2048x1536 image), preview mode.
   const int supersampling = 2, width = 1024, height = 768, runs = quick ? 3 : 5;
   const std::vector<std::pair<std::string, double>> paper_seconds_brent = {
       {"barth_sextic", 457}, {"cusp_catastrophe", 114}, {"torus", 255},
@@ -279,8 +282,10 @@ json bench_fig2(ClSession& session, bool quick, const fs::path& scenes, const fs
       for (Refinement r : kFig2Refinements) {
         std::vector<Override> o = solver_overrides({setup.isolation, r}, Precision::Double, 1e-6);
         o.push_back({"render.ray_origin", quoted(setup.ray_origin)});
-        o.push_back({"image.width", std::to_string(width * supersampling)});
-        o.push_back({"image.height", std::to_string(height * supersampling)});
+        o.push_back({"image.width", std::to_string(width)});
+        o.push_back({"image.height", std::to_string(height)});
+        o.push_back({"antialias.samples", std::to_string(supersampling)});
+        o.push_back({"render.preview", "true"});
         const Scene scene = load_scene_file((scenes / (name + ".toml")).string(), o);
         const auto start = std::chrono::steady_clock::now();
         const Timed t = timed_render(renderer, scene, runs);
@@ -309,7 +314,10 @@ json bench_decic(ClSession& session, bool quick, const fs::path& scenes, const f
   const int width = quick ? 320 : 1024, height = quick ? 240 : 768;
   const double tolerance = 1e-6;  // the paper's accuracy, with its 1000-iteration cap for every method
   const std::string file = (scenes / "barth_decic.toml").string();
-  const std::vector<Override> size = {{"image.width", std::to_string(width)}, {"image.height", std::to_string(height)}};
+  const std::vector<Override> size = {{"image.width", std::to_string(width)},
+                                      {"image.height", std::to_string(height)},
+                                      {"antialias.samples", "1"},
+                                      {"render.preview", "true"}};
   const Scene base = load_scene_file(file, size);
   const ReferenceResult reference = render_reference(base, Precision::Double);
   ProgramCache cache(true, cache_dir);

@@ -53,33 +53,6 @@ std::array<long double, 3> gradient_at(const std::vector<Monomial>& monomials, c
   return g;
 }
 
-// Whether moving each ray component by kReferenceRayRoundings * eps of its size could change the number of roots
-// P* has on [lo, limit]: that needs some critical point of P* there where |P*| is within the first-order change
-// of P. Critical points are the roots of P*', found exactly; P* is flat at them, so a loose enclosure will do.
-bool flips_under_ray_rounding(const std::vector<mpq_class>& restricted, const std::vector<Monomial>& monomials,
-                              const PixelRay& ray, const mpq_class& lo, const mpq_class& limit, long double eps) {
-  std::vector<mpq_class> derivative;
-  for (std::size_t k = 1; k < restricted.size(); ++k) derivative.push_back(restricted[k] * static_cast<long>(k));
-  while (!derivative.empty() && derivative.back() == 0) derivative.pop_back();
-  if (derivative.size() < 2) return false;  // P* linear or constant: no critical point
-  const mpq_class width = abs(limit) / 1000000000 + mpq_class(1, 1000000000);
-  const double o[3] = {ray.origin.x, ray.origin.y, ray.origin.z},
-               d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
-  mpq_class from = lo;
-  while (from <= limit) {
-    const ref::Answer c = ref::smallest_root(derivative, from, limit, width);
-    if (c.kind == ref::Classification::Miss || c.kind == ref::Classification::IdenticallyZero) return false;
-    const long double t = c.t_nearest;
-    const long double value = std::fabs(evaluate(restricted, exact_rational(c.t_nearest)).get_d());
-    const std::array<long double, 3> g = gradient_at(monomials, ray, t);
-    long double change = 0;
-    for (int axis = 0; axis < 3; ++axis) change += std::fabs(g[axis]) * (std::fabs(o[axis]) + std::fabs(t * d[axis]));
-    if (value <= kReferenceRayRoundings * eps * change) return true;
-    from = c.hi + width;
-  }
-  return false;
-}
-
 }  // namespace
 
 bool extent_interval(const Extent& e, const PixelRay& ray, long double& t_in, long double& t_out) {
@@ -107,6 +80,31 @@ bool extent_interval(const Extent& e, const PixelRay& ray, long double& t_in, lo
     }
   }
   return t_out > t_in;
+}
+
+// Critical points are the roots of P*', found exactly; P* is flat at them, so a loose enclosure will do.
+bool flips_under_ray_rounding(const std::vector<mpq_class>& restricted, const std::vector<Monomial>& monomials,
+                              const PixelRay& ray, const mpq_class& lo, const mpq_class& limit, long double eps) {
+  std::vector<mpq_class> derivative;
+  for (std::size_t k = 1; k < restricted.size(); ++k) derivative.push_back(restricted[k] * static_cast<long>(k));
+  while (!derivative.empty() && derivative.back() == 0) derivative.pop_back();
+  if (derivative.size() < 2) return false;  // P* linear or constant: no critical point
+  const mpq_class width = abs(limit) / 1000000000 + mpq_class(1, 1000000000);
+  const double o[3] = {ray.origin.x, ray.origin.y, ray.origin.z},
+               d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+  mpq_class from = lo;
+  while (from <= limit) {
+    const ref::Answer c = ref::smallest_root(derivative, from, limit, width);
+    if (c.kind == ref::Classification::Miss || c.kind == ref::Classification::IdenticallyZero) return false;
+    const long double t = c.t_nearest;
+    const long double value = std::fabs(evaluate(restricted, exact_rational(c.t_nearest)).get_d());
+    const std::array<long double, 3> g = gradient_at(monomials, ray, t);
+    long double change = 0;
+    for (int axis = 0; axis < 3; ++axis) change += std::fabs(g[axis]) * (std::fabs(o[axis]) + std::fabs(t * d[axis]));
+    if (value <= kReferenceRayRoundings * eps * change) return true;
+    from = c.hi + width;
+  }
+  return false;
 }
 
 ReferenceResult render_reference(const Scene& scene, Precision ray_precision, unsigned threads) {

@@ -43,6 +43,12 @@ inline constexpr double kReferenceRayRoundings = 8;
 // reference needs (roots near the ends are treated as ambiguous), not exact. False when the ray misses.
 bool extent_interval(const Extent& extent, const PixelRay& ray, long double& t_in, long double& t_out);
 
+// Whether moving each component of `ray` by kReferenceRayRoundings * eps of its size could change the number of
+// roots P* (`restricted`, the exact restriction of the polynomial with `monomials` to `ray`) has on [lo, limit]:
+// that needs a critical point of P* there where |P*| is within the first-order change of P.
+bool flips_under_ray_rounding(const std::vector<mpq_class>& restricted, const std::vector<Monomial>& monomials,
+                              const PixelRay& ray, const mpq_class& lo, const mpq_class& limit, long double eps);
+
 // Rays are rebuilt in `ray_precision` exactly as the kernels build them (README convention), and P is the
 // scene's exact polynomial. threads = 0 uses every core.
 ReferenceResult render_reference(const Scene& scene, Precision ray_precision, unsigned threads = 0);

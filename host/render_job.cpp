@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -144,8 +145,22 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
                            {"kernel_ms", p.kernel_ms},
                            {"wall_ms", p.wall_ms}});
   }
-  j["pixels"] = {
-      {"hits", hits}, {"depth_limited", budget}, {"isolation_steps", steps}, {"refine_iterations", iterations}};
+  j["primary_rays"] = {{"count", r.hits.records.size()},
+                       {"hits", hits},
+                       {"depth_limited", budget},
+                       {"isolation_steps", steps},
+                       {"refine_iterations", iterations}};
+  // A pixel shows the surface when any of its antialiasing samples hit it.
+  const int samples = std::max(r.plan.samples, 1);
+  std::uint64_t covered = 0;
+  for (int y = 0; y < r.hits.height; y += samples)
+    for (int x = 0; x < r.hits.width; x += samples) {
+      bool any = false;
+      for (int sy = 0; sy < samples; ++sy)
+        for (int sx = 0; sx < samples; ++sx) any |= (r.hits.at(x + sx, y + sy).flags & ALGRAY_HIT_FOUND) != 0;
+      covered += any;
+    }
+  j["pixels"] = {{"count", (r.hits.width / samples) * (r.hits.height / samples)}, {"hits", covered}};
   j["phases_ms"] = timer.json();
   j["total_ms"] = timer.total_ms();
   return j;

@@ -31,12 +31,13 @@ __kernel void shadow(__global const REAL4* points, __global const float4* normal
   for (uint s = 0; s < light_count; ++s) {
     const ulong bit = (ulong)1 << s;
     if (mask & bit) continue;
-    const REAL3 to_light = light_points[s].xyz - o;
-    /* A light behind the tangent plane is hidden by the surface itself, whatever the roots say. */
-    if (dot(to_light, n) <= 0) {
+    /* A light behind the tangent plane is hidden by the surface itself, whatever the roots say. The plane is
+     * the surface point's, as in the shading, not the offset origin's. */
+    if (dot(light_points[s].xyz - p, n) <= 0) {
       mask |= bit;
       continue;
     }
+    const REAL3 to_light = light_points[s].xyz - o;
     /* The segment from the origin (t = 0) to the light sample (t = 1), inside the extent. */
     const REAL3 d_unit = to_light * extent_inv_scale;
     REAL t_in, t_out;

@@ -62,6 +62,8 @@ RaySolve solve(const std::string& file, const glm::dvec3& from, const glm::dvec3
                                        {"camera.up", vec(up)},
                                        {"image.width", "1"},
                                        {"image.height", "1"},
+                                       {"antialias.samples", "1"},
+                                       {"render.preview", "true"},
                                        {"render.precision", "\"double\""}});
   RaySolve r;
   const RenderResult result = renderer().render(scene, false);

@@ -31,7 +31,9 @@ const std::set<std::string> kFloatNotYet = {"barth_decic", "endrass_octic"};
 void check_scene(Renderer& renderer, const std::filesystem::path& file, const char* precision) {
   const Scene scene = load_scene_file(file.string(), {{"image.width", std::to_string(kWidth)},
                                                       {"image.height", std::to_string(kHeight)},
-                                                      {"render.precision", precision}});
+                                                      {"render.precision", precision},
+                                                      {"antialias.samples", "1"},
+                                                      {"render.preview", "true"}});
   const bool is_double = std::string(precision) == "double";
   const bool is_float = !is_double;  // float and mixed both trace float rays
   const RenderResult kernel = renderer.render(scene, false);

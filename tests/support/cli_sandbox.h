@@ -1,0 +1,123 @@
+// The algray binary run in a throwaway directory with a test-only program cache, and its stats read back.
+#pragma once
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <catch2/catch.hpp>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace algray::testing {
+
+namespace fs = std::filesystem;
+
+inline std::string quoted(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+inline std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+inline void write_text(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary | std::ios::trunc);
+  out << text;
+  REQUIRE(out.good());
+}
+
+inline fs::path unique_temp_dir(const std::string& tag) {
+  static std::atomic<int> counter{0};
+  const std::string name = "algray-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" +
+                           std::to_string(std::random_device{}());
+  const fs::path dir = fs::temp_directory_path() / name;
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Compiled kernels are shared by all tests of this run but never by the user's own cache.
+inline const fs::path& shared_cache_dir() {
+  struct Owned {
+    fs::path dir = unique_temp_dir("cache");
+    ~Owned() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  };
+  static const Owned owned;
+  return owned.dir;
+}
+
+struct Result {
+  int exit_code;
+  std::string out, err;
+};
+
+// One test's sandbox: the binary runs in work/ (so anything it leaves behind shows up there), while scenes and
+// captured output live in in/.
+struct Sandbox {
+  fs::path root = unique_temp_dir("cli");
+  fs::path work = root / "work";
+  fs::path in = root / "in";
+  fs::path cache = shared_cache_dir();
+
+  Sandbox() {
+    fs::create_directories(work);
+    fs::create_directories(in);
+  }
+  ~Sandbox() {
+    std::error_code ec;
+    fs::remove_all(root, ec);
+  }
+
+  Result run(const std::string& args) const {
+    const fs::path out = in / "stdout.txt", err = in / "stderr.txt";
+    const std::string cmd = "cd " + quoted(work.string()) + " && ALGRAY_CACHE_DIR=" + quoted(cache.string()) + " " +
+                            quoted(ALGRAY_BINARY) + " " + args + " >" + quoted(out.string()) + " 2>" +
+                            quoted(err.string()) + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    REQUIRE(status != -1);
+    REQUIRE(WIFEXITED(status));
+    return {WEXITSTATUS(status), read_text(out), read_text(err)};
+  }
+
+  fs::path scene(const std::string& name, const std::string& text) const {
+    write_text(in / name, text);
+    return in / name;
+  }
+
+  std::vector<std::string> work_files() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(work)) names.push_back(e.path().filename().string());
+    return names;
+  }
+
+  nlohmann::json stats(const std::string& name = "s.json") const {
+    const std::string text = read_text(work / name);
+    REQUIRE_FALSE(text.empty());
+    return nlohmann::json::parse(text);
+  }
+};
+
+// Every device-dependent test goes through this, so a missing OpenCL driver fails loudly instead of skipping.
+inline void require_device() {
+  static const bool ok = [] {
+    Sandbox box;
+    return box.run("devices").exit_code == 0;
+  }();
+  if (!ok) FAIL("`algray devices` failed: no usable OpenCL device; install pocl-opencl-icd to run these tests");
+}
+
+}  // namespace algray::testing

@@ -1,0 +1,125 @@
+// The render plan, seen through --stats: each effect's pass, kernel and rays exist only when the scene asks.
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "cli_sandbox.h"
+#include "scene_fixtures.h"
+
+using namespace algray::testing;
+
+namespace {
+
+// A rectangle light above and to the right of the unit sphere's camera, with `extra` lines added to it.
+std::vector<std::string> light_lines(const std::string& extra = "") {
+  std::vector<std::string> lines = {"[[light]]",        "type = \"rectangle\"", "position = [3, 4, 5]",
+                                    "edge_u = [1, 0, 0]", "edge_v = [0, 1, 0]", "samples = 3"};
+  if (!extra.empty()) lines.push_back(extra);
+  return lines;
+}
+
+std::vector<std::string> names_of(const nlohmann::json& list) {
+  std::vector<std::string> names;
+  for (const auto& item : list) names.push_back(item.at("name").get<std::string>());
+  return names;
+}
+
+struct PlanCase {
+  const char* what;
+  std::vector<std::string> scene_tail;
+  const char* flags;
+  bool shadows;
+};
+
+}  // namespace
+
+TEST_CASE("only the passes a scene calls for are built, launched and counted", "[plan]") {
+  require_device();
+  const std::vector<PlanCase> cases = {
+      {"no lights: a headlight, no shadows", {}, "", false},
+      {"a light that casts no shadows", light_lines("shadows = false"), "", false},
+      {"a shadow-casting light in preview mode", light_lines(), "--preview", false},
+      {"a shadow-casting light", light_lines(), "", true},
+      {"two lights, one casting shadows", [] {
+         std::vector<std::string> l = light_lines("shadows = false");
+         for (const std::string& line : light_lines()) l.push_back(line);
+         return l;
+       }(),
+       "", true},
+  };
+  for (const PlanCase& c : cases) {
+    INFO(c.what);
+    Sandbox box;
+    const auto scene = box.scene("s.toml", sphere_with({}, c.scene_tail));
+    const Result r = box.run("render " + quoted(scene.string()) + " -o out.exr --width 40 --height 30 --stats s.json " +
+                             c.flags);
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const nlohmann::json s = box.stats();
+    const std::vector<std::string> passes = names_of(s.at("passes"));
+    // What ran is what the plan says, in its order.
+    CHECK(passes == names_of(s.at("plan").at("passes")));
+    const std::vector<std::string> expected =
+        c.shadows ? std::vector<std::string>{"primary", "shadow"} : std::vector<std::string>{"primary"};
+    CHECK(passes == expected);
+    bool shadow_program = false;
+    for (const auto& p : s.at("programs")) shadow_program |= p.at("key").get<std::string>().rfind("shadow ", 0) == 0;
+    CHECK(shadow_program == c.shadows);
+    std::uint64_t shadow_rays = 0;
+    for (const auto& p : s.at("passes"))
+      if (p.at("name") == "shadow") shadow_rays = p.at("rays").get<std::uint64_t>();
+    if (c.shadows)
+      CHECK(shadow_rays > 0);
+    else
+      CHECK(shadow_rays == 0);
+    // No buffer of a pass that does not run.
+    for (const auto& b : s.at("plan").at("buffers")) {
+      const std::string name = b.at("name");
+      if (!c.shadows) CHECK(name == "primary hits");
+    }
+    CHECK(s.at("plan").at("skipped").size() >= (c.shadows ? 2u : 3u));
+  }
+}
+
+TEST_CASE("antialiasing traces samples x samples camera rays per pixel, and no more", "[plan]") {
+  require_device();
+  for (int samples : {1, 3}) {
+    INFO("antialias.samples = " << samples);
+    Sandbox box;
+    const auto scene =
+        box.scene("s.toml", sphere_with({}, {"[antialias]", "samples = " + std::to_string(samples)}));
+    const Result r = box.run("render " + quoted(scene.string()) + " -o out.exr --width 40 --height 30 --stats s.json");
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const nlohmann::json s = box.stats();
+    REQUIRE(s.at("passes").size() == 1);
+    CHECK(s.at("passes")[0].at("rays").get<long>() == 40L * 30 * samples * samples);
+    CHECK(s.at("plan").at("traced").at("width").get<int>() == 40 * samples);
+  }
+}
+
+TEST_CASE("reflection and transmission are never traced; a material that needs them is refused", "[plan]") {
+  require_device();
+  Sandbox box;
+  // A scene with ordinary materials: neither pass appears.
+  const auto plain = box.scene("plain.toml", sphere_with({}, {"[material.front]", "reflectivity = 0"}));
+  const Result ok = box.run("render " + quoted(plain.string()) + " -o out.exr --width 16 --height 12 --stats s.json");
+  REQUIRE(ok.exit_code == 0);
+  for (const std::string& name : names_of(box.stats().at("passes"))) {
+    CHECK(name != "reflection");
+    CHECK(name != "transmission");
+  }
+  // Until those passes exist, a material that needs one is bad input, named by line and column, not an image
+  // silently drawn without the effect.
+  for (const char* key : {"reflectivity", "transparency"}) {
+    INFO(key);
+    const auto bad = box.scene("bad.toml", sphere_with({}, {"[material.back]", std::string(key) + " = 0.5"}));
+    const Result r = box.run("render " + quoted(bad.string()) + " -o bad.exr --width 16 --height 12");
+    CHECK(r.exit_code == 2);
+    CHECK(r.err.find("bad.toml:12:") != std::string::npos);
+    CHECK(r.err.find("not implemented") != std::string::npos);
+    CHECK_FALSE(fs::exists(box.work / "bad.exr"));
+  }
+}

@@ -1,0 +1,200 @@
+// The shadow kernel against the certified reference: no self-shadowing, and the same answer wherever the
+// reference can certify whether the shadow ray meets the surface.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "program_cache.h"
+#include "reference_render.h"
+#include "render_plan.h"
+#include "renderer.h"
+#include "scene.h"
+#include "shadow_tracer.h"
+#include "solver_ref.h"
+#include "test_support.h"
+
+using namespace algray;
+
+namespace {
+
+constexpr unsigned kSeed = 20261129;
+const char* const kScenes[] = {"barth_sextic.toml", "torus.toml", "tanglecube.toml", "cusp_catastrophe.toml",
+                               "kummer.toml"};
+
+// A surface point seen by a camera ray: the shadow pass's input.
+struct SurfacePoint {
+  glm::dvec3 point;
+  glm::vec3 normal;
+};
+
+// Every hit of a small primary render of `scene`.
+std::vector<SurfacePoint> surface_points(Renderer& renderer, const Scene& scene) {
+  const RenderResult r = renderer.render(scene, false);
+  const bool single = r.config.precision != Precision::Double;
+  std::vector<SurfacePoint> points;
+  for (int y = 0; y < r.hits.height; ++y)
+    for (int x = 0; x < r.hits.width; ++x) {
+      const HitRecord& h = r.hits.at(x, y);
+      if (h.flags & ALGRAY_HIT_FOUND)
+        points.push_back({hit_point(pixel_ray(r.basis, single, x, y), h), {h.normal_x, h.normal_y, h.normal_z}});
+    }
+  return points;
+}
+
+enum class Verdict { Visible, Hidden, Ambiguous, OriginOnSurface };
+
+// What the reference certifies for the shadow ray the kernel builds from `sp` towards `light`: the origin moved
+// by the offset along the normal, in the kernel's precision, then the segment to the light inside the extent.
+Verdict reference_verdict(const Scene& scene, Precision precision, const SurfacePoint& sp, const glm::dvec3& light,
+                          PixelRay& ray) {
+  const double offset = shadow_offset_unit(precision) * scene.extent.unit_scale();
+  const bool single = precision != Precision::Double;
+  if (single) {
+    const glm::vec3 p(sp.point), q(light);
+    const glm::vec3 o = p + static_cast<float>(offset) * sp.normal;
+    ray = {glm::dvec3(o), glm::dvec3(q - o)};
+  } else {
+    const glm::dvec3 o = sp.point + offset * glm::dvec3(sp.normal);
+    ray = {o, light - o};
+  }
+  const long double eps = single ? 0x1p-23L : 0x1p-52L;
+  long double t_in = 0, t_out = 0;
+  if (!extent_interval(scene.extent, ray, t_in, t_out)) return Verdict::Visible;
+  t_in = std::max<long double>(t_in, 0);
+  t_out = std::min<long double>(t_out, 1);
+  if (!(t_out > t_in)) return Verdict::Visible;
+  const long double margin = kReferenceEndMargin * eps;
+  const ref::ExactRay exact{{ray.origin.x, ray.origin.y, ray.origin.z},
+                            {ray.direction.x, ray.direction.y, ray.direction.z}};
+  const std::vector<mpq_class> restricted = ref::restrict_exact(scene.polynomial, exact);
+  // Solved from a little before the origin: a root that close to it means the origin is still on the surface.
+  const mpq_class lo = exact_rational(static_cast<double>(t_in - margin));
+  const mpq_class hi = exact_rational(static_cast<double>(t_out + margin));
+  const mpq_class width = exact_rational(1e-13);
+  const ref::Answer a = ref::smallest_root(restricted, lo, hi, width);
+  if (a.kind == ref::Classification::Miss)
+    return flips_under_ray_rounding(restricted, scene.polynomial.monomials(), ray, lo, hi, eps) ? Verdict::Ambiguous
+                                                                                                 : Verdict::Visible;
+  const long double t = a.t_nearest;
+  if (std::fabs(t) <= margin) return Verdict::OriginOnSurface;
+  if (t < t_in + margin || t > t_out - margin) return Verdict::Ambiguous;
+  const bool crosses = a.kind == ref::Classification::SimpleRoot ||
+                       a.kind == ref::Classification::MultipleRootOddSignChange;
+  return crosses ? Verdict::Hidden : Verdict::Ambiguous;
+}
+
+const char* name(Verdict v) {
+  switch (v) {
+    case Verdict::Visible:
+      return "visible";
+    case Verdict::Hidden:
+      return "hidden";
+    case Verdict::Ambiguous:
+      return "ambiguous";
+    case Verdict::OriginOnSurface:
+      return "origin on the surface";
+  }
+  return "?";
+}
+
+// A light point for a shadow ray from `sp`: `elevation` radians above the tangent plane, on the normal's side,
+// at `distance`.
+glm::dvec3 light_at(std::mt19937& rng, const SurfacePoint& sp, double elevation, double distance) {
+  const glm::dvec3 n = glm::normalize(glm::dvec3(sp.normal));
+  const glm::dvec3 a = std::fabs(n.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+  const glm::dvec3 e1 = glm::normalize(glm::cross(n, a)), e2 = glm::cross(n, e1);
+  const double phi = std::uniform_real_distribution<double>(0, 6.283185307179586)(rng);
+  const glm::dvec3 tangent = std::cos(phi) * e1 + std::sin(phi) * e2;
+  return sp.point + distance * (std::cos(elevation) * tangent + std::sin(elevation) * n);
+}
+
+struct Tally {
+  int certified = 0, ambiguous = 0, failures = 0;
+};
+
+// Traces each (surface point, light point) pair with the shadow kernel and checks it against the reference.
+// `make_light` picks the light point of ray `index`.
+template <typename MakeLight>
+Tally check_shadow_rays(Precision precision, int rays_per_scene, MakeLight make_light) {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  Tally tally;
+  for (const char* file : kScenes) {
+    const Scene scene = load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/" + file,
+                                        {{"image.width", "48"},
+                                         {"image.height", "36"},
+                                         {"antialias.samples", "1"},
+                                         {"render.precision", "\"" + to_string(precision) + "\""}});
+    const std::vector<SurfacePoint> points = surface_points(renderer, scene);
+    REQUIRE(points.size() > 100);
+    const RenderPlan plan = make_render_plan(scene, precision);
+    KernelConfig config = primary_config(scene, precision);
+    config.entry = "shadow";
+    config.refinement = Refinement::Brent;
+    config.max_iterations = default_max_iterations(Refinement::Brent);
+    const DeviceSurface surface(session.context, scene, precision);
+    ShadowTracer tracer(session, cache, config, surface, shadow_offset_unit(precision) * scene.extent.unit_scale());
+    std::mt19937 rng(kSeed);
+    for (int index = 0; index < rays_per_scene; ++index) {
+      const SurfacePoint& sp = points[std::uniform_int_distribution<std::size_t>(0, points.size() - 1)(rng)];
+      const glm::dvec3 light = make_light(rng, scene, sp);
+      PixelRay ray;
+      const Verdict verdict = reference_verdict(scene, precision, sp, light, ray);
+      const bool hidden = tracer.trace({sp.point}, {sp.normal}, {light}).masks[0] & 1u;
+      INFO(file << " " << to_string(precision) << " seed " << kSeed << " ray " << index << ": from "
+                << sp.point.x << "," << sp.point.y << "," << sp.point.z << " to " << light.x << "," << light.y
+                << "," << light.z << "; reference " << name(verdict) << ", kernel "
+                << (hidden ? "hidden" : "visible"));
+      CHECK(verdict != Verdict::OriginOnSurface);  // the offset must take the origin clearly off the surface
+      if (verdict == Verdict::Ambiguous || verdict == Verdict::OriginOnSurface) {
+        ++tally.ambiguous;
+        continue;
+      }
+      ++tally.certified;
+      const bool agree = hidden == (verdict == Verdict::Hidden);
+      tally.failures += !agree;
+      CHECK(agree);
+    }
+  }
+  return tally;
+}
+
+}  // namespace
+
+TEST_CASE("shadow rays never hit the surface they leave, at any angle, in double and float", "[shadows]") {
+  // 1000 rays per precision (200 per surface): a fifth of them grazing, 0.5 to 5 degrees above the tangent
+  // plane, the rest up to the normal; lights 1% to 2.5 extent radii away, so that short rays are tried too.
+  for (Precision precision : {Precision::Double, Precision::Float}) {
+    const Tally t = check_shadow_rays(precision, 200, [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
+      const bool grazing = std::uniform_int_distribution<int>(0, 4)(rng) == 0;
+      const double degrees = grazing ? std::uniform_real_distribution<double>(0.5, 5)(rng)
+                                     : std::uniform_real_distribution<double>(5, 90)(rng);
+      const double distance = std::uniform_real_distribution<double>(0.01, 2.5)(rng) * scene.extent.unit_scale();
+      return light_at(rng, sp, degrees * 3.141592653589793 / 180, distance);
+    });
+    INFO(to_string(precision) << ": " << t.certified << " certified, " << t.ambiguous << " ambiguous");
+    CHECK(t.failures == 0);
+    CHECK(t.certified >= 900);  // the reference certifies almost all of them, so the check means something
+  }
+}
+
+TEST_CASE("shadow answers agree with the reference towards the lights of a scene", "[shadows]") {
+  // Light points where a scene puts its lights: on a sphere of 3 extent radii around the extent, on the side
+  // of the surface point's normal (behind the tangent plane the kernel answers "hidden" without tracing).
+  for (Precision precision : {Precision::Double, Precision::Float}) {
+    const Tally t = check_shadow_rays(precision, 200, [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
+      std::normal_distribution<double> g;
+      for (;;) {
+        const glm::dvec3 dir = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
+        const glm::dvec3 light = scene.extent.unit_centre() + 3 * scene.extent.unit_scale() * dir;
+        if (glm::dot(light - sp.point, glm::dvec3(sp.normal)) > 0) return light;
+      }
+    });
+    INFO(to_string(precision) << ": " << t.certified << " certified, " << t.ambiguous << " ambiguous");
+    CHECK(t.failures == 0);
+    CHECK(t.certified >= 900);
+  }
+}
