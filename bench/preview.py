@@ -7,17 +7,13 @@ end-to-end ms is the wall time of the whole `algray render` process, EXR written
 """
 import argparse
 import datetime
-import json
-import os
-import platform
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+from bench_common import ROOT, fresh_caches, machine, replace_section, run_render
+
 # The paper's surfaces, with the targets of issue 2 (end to end, warm cache).
 PAPER = {"barth_sextic", "cusp_catastrophe", "torus", "tooth", "lemniscate", "barth_decic", "tanglecube"}
 E2E_TARGET_MS = 500
@@ -25,30 +21,11 @@ SEXTIC_KERNEL_TARGET_MS = 100
 
 
 def run(binary, scene, precision, env, width, height, workdir):
-    stats = workdir / "stats.json"
-    cmd = [str(binary), "render", str(scene), "-o", str(workdir / "out.exr"), "--width", str(width),
-           "--height", str(height), "--stats", str(stats),
-           # the paper's preview: primary rays only, one per pixel (the scenes' own 2x2 antialiasing is off)
-           "--preview", "--set", "antialias.samples=1"]
+    # the paper's preview: primary rays only, one per pixel (the scenes' own 2x2 antialiasing is off)
+    args = ["--width", str(width), "--height", str(height), "--preview", "--set", "antialias.samples=1"]
     if precision:
-        cmd += ["--precision", precision]
-    start = time.perf_counter()
-    subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    wall = (time.perf_counter() - start) * 1000
-    s = json.loads(stats.read_text())
-    return wall, s
-
-
-def machine():
-    cpu = "unknown CPU"
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
+        args += ["--precision", precision]
+    return run_render(binary, scene, args, env, workdir)
 
 
 def main():
@@ -71,8 +48,7 @@ def main():
         for scene in scenes:
             row = {"scene": scene.stem}
             for precision in ("double", "float"):
-                caches = Path(tempfile.mkdtemp(dir=tmp))
-                env = dict(os.environ, ALGRAY_CACHE_DIR=str(caches / "algray"), POCL_CACHE_DIR=str(caches / "pocl"))
+                env = fresh_caches(tempfile.mkdtemp(dir=tmp))
                 cold_wall, cold = run(args.binary, scene, precision, env, args.width, args.height, work)
                 warm = [run(args.binary, scene, precision, env, args.width, args.height, work)
                         for _ in range(args.runs)]
@@ -122,17 +98,8 @@ def main():
                      f"{f['kernel'] / d['kernel']:.2f} | {target} |")
     section = "\n".join(lines) + "\n"
 
-    out = Path(args.output)
-    text = out.read_text() if out.exists() else "# Benchmark results\n\nFigures from `bench/`, newest run of each benchmark.\n\n"
-    marker = "## Preview mode, 1024x768 (issue 2)"
-    if marker in text:
-        start = text.index(marker)
-        end = text.find("\n## ", start + len(marker))
-        text = text[:start] + section + (text[end + 1:] if end != -1 else "")
-    else:
-        text = text.rstrip("\n") + "\n\n" + section
-    out.write_text(text)
-    print(f"wrote {out}", file=sys.stderr)
+    replace_section(args.output, "## Preview mode, 1024x768 (issue 2)", section)
+    print(f"wrote {args.output}", file=sys.stderr)
 
 
 if __name__ == "__main__":

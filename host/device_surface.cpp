@@ -54,6 +54,13 @@ cl::Buffer real_buffer(const cl::Context& ctx, const std::vector<double>& values
   return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, f.size() * sizeof(float), f.data());
 }
 
+cl::Buffer real4_buffer(const cl::Context& ctx, const std::vector<glm::dvec3>& values, Precision precision) {
+  std::vector<double> flat;
+  flat.reserve(4 * values.size());
+  for (const glm::dvec3& v : values) flat.insert(flat.end(), {v.x, v.y, v.z, 0});
+  return real_buffer(ctx, flat, precision);
+}
+
 SurfaceData prepare_surface(const Scene& scene) {
   const glm::dvec3 c = scene.extent.unit_centre();
   const std::array<mpq_class, 3> centre{exact_rational(c.x), exact_rational(c.y), exact_rational(c.z)};

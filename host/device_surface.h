@@ -42,6 +42,8 @@ class KernelArgs {
 
 // Buffer of REAL values (double, or float for float and mixed precision) from doubles.
 cl::Buffer real_buffer(const cl::Context& ctx, const std::vector<double>& values, Precision precision);
+// Buffer of REAL4 values (x, y, z, 0) from points or directions.
+cl::Buffer real4_buffer(const cl::Context& ctx, const std::vector<glm::dvec3>& values, Precision precision);
 
 // The surface's buffers in one precision, shared by every pass's kernel.
 class DeviceSurface {

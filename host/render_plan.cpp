@@ -76,8 +76,34 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
     plan.buffers.push_back({"light sample points", points * 4 * real_size});
     plan.buffers.push_back({"occlusion masks (at most)", rays * plan.shadow_lights.size() * sizeof(cl_ulong)});
   }
-  plan.skipped.push_back("reflection: not implemented (materials must have reflectivity 0)");
-  plan.skipped.push_back("transmission: not implemented (materials must have transparency 0)");
+  // Secondary rays: one pass per effect a material asks for, sharing the one "trace" kernel.
+  KernelConfig trace = primary;
+  trace.entry = "trace";
+  const Materials& m = scene.materials;
+  const struct {
+    const char* name;
+    bool wanted;
+    const char* why;
+  } effects[] = {
+      {"reflection", m.front.reflectivity > 0 || m.back.reflectivity > 0, "mirror rays of reflective sides"},
+      {"transmission", m.front.transparency > 0 || m.back.transparency > 0,
+       "rays continued through transparent sides to the next root"},
+  };
+  for (const auto& effect : effects) {
+    const std::string name = effect.name;
+    if (!effect.wanted)
+      plan.skipped.push_back(name + ": no material asks for it");
+    else if (scene.render.preview)
+      plan.skipped.push_back(name + ": preview mode traces primary rays only");
+    else if (scene.render.max_depth == 0)
+      plan.skipped.push_back(name + ": render.max_depth is 0");
+    else {
+      plan.passes.push_back(
+          {name, std::string(effect.why) + ", up to depth " + std::to_string(scene.render.max_depth), trace});
+      plan.buffers.push_back({name + " rays per bounce (at most)", rays * 8 * real_size});
+      plan.buffers.push_back({name + " hits per bounce (at most)", rays * sizeof(HitRecord)});
+    }
+  }
   return plan;
 }
 

@@ -1,4 +1,4 @@
-// Runs a render plan: the primary pass in tiles, then the shadow pass, with timing per pass.
+// Runs a render plan: camera rays in tiles, shadow rays for every hit, then bounce by bounce the secondary rays.
 #include "renderer.h"
 
 #include <algorithm>
@@ -6,7 +6,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 
+#include "ray_tracer.h"
 #include "shadow_tracer.h"
 
 namespace algray {
@@ -25,21 +27,81 @@ glm::dvec3 hit_point(const PixelRay& ray, const HitRecord& hit) {
   return ray.origin + t * ray.direction;
 }
 
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Shadow rays from every hit of one batch; ray(i) rebuilds the ray of hit i exactly as the kernel traced it.
+template <typename RayOf>
+ShadowData trace_shadows(const Scene& scene, const RenderPlan& plan, ShadowTracer& tracer,
+                         const std::vector<HitRecord>& hits, RayOf ray, PassStats& stats) {
+  const auto start = std::chrono::steady_clock::now();
+  ShadowData data;
+  std::vector<glm::dvec3> points;
+  std::vector<glm::vec3> normals;
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    const HitRecord& h = hits[i];
+    if (!(h.flags & ALGRAY_HIT_FOUND)) continue;
+    data.points.push_back(static_cast<std::uint32_t>(i));
+    points.push_back(hit_point(ray(i), h));
+    normals.emplace_back(h.normal_x, h.normal_y, h.normal_z);
+  }
+  for (int light : plan.shadow_lights) {
+    ShadowAnswer answer = tracer.trace(points, normals, scene.lights[static_cast<std::size_t>(light)].sample_points());
+    stats.kernel_ms += answer.kernel_ms;
+    stats.rays += answer.rays_traced;
+    ++stats.launches;
+    data.occlusion.push_back({light, std::move(answer.masks)});
+  }
+  stats.wall_ms += ms_since(start);
+  return data;
+}
+
+}  // namespace
+
 RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   RenderResult result;
   const Precision precision = resolve_precision(scene, session_.info);
   result.plan = make_render_plan(scene, precision);
   result.config = primary_config(scene, precision);
-
   const DeviceSurface surface(session_.context, scene, precision);
 
-  run_primary(scene, surface, show_progress, result);
-  if (result.plan.find("shadow")) run_shadow(scene, surface, result);
+  // Statistics per planned pass, filled as the passes run (the shadow and secondary passes run once per bounce).
+  std::vector<PassStats> stats(result.plan.passes.size());
+  auto stats_of = [&](const std::string& name) -> PassStats* {
+    for (std::size_t i = 0; i < stats.size(); ++i)
+      if (result.plan.passes[i].name == name) return &stats[i];
+    return nullptr;
+  };
+  run_primary(scene, surface, show_progress, result, *stats_of("primary"));
+
+  std::unique_ptr<ShadowTracer> shadows;
+  PassStats* shadow_stats = stats_of("shadow");
+  if (shadow_stats) {
+    shadows = std::make_unique<ShadowTracer>(session_, cache_, result.plan.find("shadow")->kernel, surface,
+                                             shadow_offset_unit(precision) * scene.extent.unit_scale());
+    result.programs.push_back(shadows->program());
+    shadow_stats->program_key = shadows->program().key;
+    const bool single = precision != Precision::Double;
+    const int width = result.hits.width;
+    result.shadows = trace_shadows(scene, result.plan, *shadows, result.hits.records, [&](std::size_t i) {
+      return pixel_ray(result.basis, single, static_cast<int>(i % width), static_cast<int>(i / width));
+    }, *shadow_stats);
+  }
+  if (stats_of("reflection") || stats_of("transmission"))
+    run_secondary(scene, surface, result, stats, shadows.get(), shadow_stats);
+
+  for (std::size_t i = 0; i < stats.size(); ++i) {
+    stats[i].name = result.plan.passes[i].name;
+    result.passes.push_back(stats[i]);
+  }
   return result;
 }
 
 void Renderer::run_primary(const Scene& scene, const DeviceSurface& surface, bool show_progress,
-                           RenderResult& result) {
+                           RenderResult& result, PassStats& pass) {
   const auto wall_start = std::chrono::steady_clock::now();
   const int width = result.plan.trace_width(), height = result.plan.trace_height();
   result.basis = make_ray_basis(scene.camera, width, height);
@@ -63,8 +125,6 @@ void Renderer::run_primary(const Scene& scene, const DeviceSurface& surface, boo
   const cl_uint tile_arg = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
   args.skip(4);
   args.plain(out);
-  PassStats pass;
-  pass.name = "primary";
   pass.program_key = record.key;
   const int tile = scene.render.tile_size > 0 ? scene.render.tile_size : default_tile_size(session_.info);
   const int tiles_x = (width + tile - 1) / tile, tiles_y = (height + tile - 1) / tile;
@@ -99,45 +159,84 @@ void Renderer::run_primary(const Scene& scene, const DeviceSurface& surface, boo
   result.hits.height = height;
   result.hits.records.resize(pixels);
   session_.queue.enqueueReadBuffer(out, CL_TRUE, 0, pixels * sizeof(HitRecord), result.hits.records.data());
-  pass.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall_start).count() -
-                 record.build_ms;
-  result.passes.push_back(pass);
+  pass.wall_ms = ms_since(wall_start) - record.build_ms;
 }
 
-void Renderer::run_shadow(const Scene& scene, const DeviceSurface& surface, RenderResult& result) {
-  const auto wall_start = std::chrono::steady_clock::now();
-  const PlannedPass& planned = *result.plan.find("shadow");
-  ShadowTracer tracer(session_, cache_, planned.kernel, surface,
-                      shadow_offset_unit(surface.precision()) * scene.extent.unit_scale());
-  result.programs.push_back(tracer.program());
+// A ray waiting to be continued: the traced camera ray it adds to, its weight, the ray and its hit.
+struct Renderer::Bounce {
+  std::uint32_t sample;
+  double weight;
+  PixelRay ray;
+  HitRecord hit;
+};
 
-  // The surface points: every hit, at the exact point of the ray the kernel traced.
-  const bool single = surface.precision() != Precision::Double;
-  std::vector<glm::dvec3> points;
-  std::vector<glm::vec3> normals;
-  const HitBuffer& hits = result.hits;
-  for (int y = 0; y < hits.height; ++y) {
-    for (int x = 0; x < hits.width; ++x) {
-      const HitRecord& h = hits.at(x, y);
-      if (!(h.flags & ALGRAY_HIT_FOUND)) continue;
-      result.shading_points.push_back(static_cast<std::uint32_t>(y * hits.width + x));
-      points.push_back(hit_point(pixel_ray(result.basis, single, x, y), h));
-      normals.emplace_back(h.normal_x, h.normal_y, h.normal_z);
+void Renderer::run_secondary(const Scene& scene, const DeviceSurface& surface, RenderResult& result,
+                             std::vector<PassStats>& stats, ShadowTracer* shadows, PassStats* shadow_stats) {
+  const Precision precision = surface.precision();
+  const bool single = precision != Precision::Double;
+  const double offset = shadow_offset_unit(precision) * scene.extent.unit_scale();
+  // Below this a bounce cannot change a pixel's 8-bit colour.
+  constexpr double kNegligibleWeight = 1.0 / 512;
+  RayTracer tracer(session_, cache_, result.plan.find(result.plan.find("reflection") ? "reflection" : "transmission")->kernel,
+                   surface);
+  result.programs.push_back(tracer.program());
+  PassStats* pass_stats[2] = {nullptr, nullptr};
+  const char* names[2] = {"reflection", "transmission"};
+  for (int k = 0; k < 2; ++k)
+    for (std::size_t i = 0; i < stats.size(); ++i)
+      if (result.plan.passes[i].name == names[k]) {
+        pass_stats[k] = &stats[i];
+        stats[i].program_key = tracer.program().key;
+      }
+
+  // The camera rays' hits start the first bounce.
+  std::vector<Bounce> current;
+  const int width = result.hits.width;
+  for (std::size_t i = 0; i < result.hits.records.size(); ++i) {
+    const HitRecord& h = result.hits.records[i];
+    if (h.flags & ALGRAY_HIT_FOUND)
+      current.push_back({static_cast<std::uint32_t>(i), 1.0,
+                         pixel_ray(result.basis, single, static_cast<int>(i % width), static_cast<int>(i / width)), h});
+  }
+  for (int depth = 1; depth <= scene.render.max_depth && !current.empty(); ++depth) {
+    std::vector<Bounce> next;
+    for (int k = 0; k < 2; ++k) {
+      if (!pass_stats[k]) continue;
+      const auto start = std::chrono::steady_clock::now();
+      SecondaryBatch batch;
+      batch.pass = names[k];
+      batch.depth = depth;
+      for (const Bounce& b : current) {
+        const Material& m = (b.hit.flags & ALGRAY_HIT_BACK) ? scene.materials.back : scene.materials.front;
+        const double share = k == 0 ? m.reflectivity : m.transparency;
+        if (b.weight * share < kNegligibleWeight) continue;
+        const glm::dvec3 p = hit_point(b.ray, b.hit);
+        const glm::dvec3 n(b.hit.normal_x, b.hit.normal_y, b.hit.normal_z);  // faces the incoming ray
+        const glm::dvec3 d = b.ray.direction;
+        // Off the surface on the side the new ray leaves into, as shadow rays are, so it cannot find its own hit.
+        const PixelRay ray = k == 0 ? PixelRay{p + offset * n, d - 2 * glm::dot(d, n) * n}
+                                    : PixelRay{p - offset * n, d};
+        batch.sample.push_back(b.sample);
+        batch.weight.push_back(b.weight * share);
+        batch.rays.push_back(ray);
+      }
+      if (batch.rays.empty()) continue;
+      TracedBatch traced = tracer.trace(batch.rays);
+      batch.hits = std::move(traced.hits);
+      pass_stats[k]->kernel_ms += traced.kernel_ms;
+      pass_stats[k]->rays += batch.rays.size();
+      ++pass_stats[k]->launches;
+      pass_stats[k]->wall_ms += ms_since(start);
+      if (shadows)
+        batch.shadows = trace_shadows(scene, result.plan, *shadows, batch.hits,
+                                      [&](std::size_t i) { return batch.rays[i]; }, *shadow_stats);
+      for (std::size_t i = 0; i < batch.rays.size(); ++i)
+        if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
+          next.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i]});
+      result.secondary.push_back(std::move(batch));
     }
+    current = std::move(next);
   }
-  PassStats pass;
-  pass.name = "shadow";
-  pass.program_key = tracer.program().key;
-  for (int light_index : result.plan.shadow_lights) {
-    ShadowAnswer answer = tracer.trace(points, normals, scene.lights[static_cast<std::size_t>(light_index)].sample_points());
-    pass.kernel_ms += answer.kernel_ms;
-    pass.rays += answer.rays_traced;
-    ++pass.launches;
-    result.occlusion.push_back({light_index, std::move(answer.masks)});
-  }
-  pass.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall_start).count() -
-                 tracer.program().build_ms;
-  result.passes.push_back(pass);
 }
 
 }  // namespace algray

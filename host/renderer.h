@@ -32,8 +32,25 @@ struct PassStats {
 
 // What the shadow pass found for one light: for each surface point, bit s set when sample point s is hidden.
 struct LightOcclusion {
-  int light = 0;                       // index into Scene::lights
-  std::vector<std::uint64_t> masks;    // indexed like RenderResult::shading_points
+  int light = 0;                     // index into Scene::lights
+  std::vector<std::uint64_t> masks;  // indexed like ShadowData::points
+};
+
+// The shadow pass's answers for one batch of hits.
+struct ShadowData {
+  std::vector<std::uint32_t> points;     // the index in its batch of each hit the pass traced from
+  std::vector<LightOcclusion> occlusion;  // one per shadow-casting light
+};
+
+// One bounce's reflection or transmission rays: where each adds to the image and what it found.
+struct SecondaryBatch {
+  std::string pass;                  // "reflection" or "transmission"
+  int depth = 1;                     // 1: spawned by the camera rays' hits
+  std::vector<std::uint32_t> sample;  // the traced camera ray (index into RenderResult::hits) it contributes to
+  std::vector<double> weight;         // its share of that ray's colour
+  std::vector<PixelRay> rays;
+  std::vector<HitRecord> hits;
+  ShadowData shadows;
 };
 
 struct RenderResult {
@@ -43,9 +60,8 @@ struct RenderResult {
   RayBasis basis;       // of the traced rays (per antialiasing sample, not per pixel)
   std::vector<ProgramRecord> programs;
   std::vector<PassStats> passes;
-  // The shadow pass's surface points: the hit index (into hits.records) of each, and each light's answer.
-  std::vector<std::uint32_t> shading_points;
-  std::vector<LightOcclusion> occlusion;
+  ShadowData shadows;                    // of the camera rays' hits
+  std::vector<SecondaryBatch> secondary;  // in the order traced: by depth, reflection before transmission
 };
 
 // Precision a scene renders in on a device: as asked, or double where fp64 exists. Throws DeviceError when
@@ -67,8 +83,11 @@ class Renderer {
   RenderResult render(const Scene& scene, bool show_progress);
 
  private:
-  void run_primary(const Scene& scene, const DeviceSurface& surface, bool show_progress, RenderResult& result);
-  void run_shadow(const Scene& scene, const DeviceSurface& surface, RenderResult& result);
+  void run_primary(const Scene& scene, const DeviceSurface& surface, bool show_progress, RenderResult& result,
+                   PassStats& stats);
+  struct Bounce;
+  void run_secondary(const Scene& scene, const DeviceSurface& surface, RenderResult& result,
+                     std::vector<PassStats>& stats, class ShadowTracer* shadows, PassStats* shadow_stats);
 
   ClSession& session_;
   ProgramCache& cache_;

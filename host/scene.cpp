@@ -196,7 +196,7 @@ const std::set<std::string> kLightKeys{"type",   "position", "edge_u",    "edge_
                                        "radius", "samples",  "colour",    "intensity", "shadows"};
 const std::set<std::string> kAntialiasKeys{"samples"};
 const std::set<std::string> kRenderKeys{"precision",      "tolerance", "isolation", "refinement", "ray_origin",
-                                        "max_iterations", "tile_size", "preview"};
+                                        "max_iterations", "tile_size", "preview",    "max_depth"};
 
 bool is_identifier(const std::string& s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
@@ -261,16 +261,8 @@ void read_material(const SceneReader& r, const toml::table& t, const std::string
   if (const toml::node* n = t.get("diffuse")) m.diffuse = r.number_in(*n, name + ".diffuse", 0, 1);
   if (const toml::node* n = t.get("specular")) m.specular = r.number_in(*n, name + ".specular", 0, 1);
   if (const toml::node* n = t.get("exponent")) m.exponent = r.number_in(*n, name + ".exponent", 1, 10000);
-  // Secondary rays are not traced yet: a scene that asks for them is refused rather than drawn without them.
-  for (const char* key : {"reflectivity", "transparency"})
-    if (const toml::node* n = t.get(key)) {
-      const double v = r.number_in(*n, name + "." + key, 0, 1);
-      if (v > 0)
-        r.fail(n->source(), name + "." + key + ": " +
-                                (std::string(key) == "reflectivity" ? "reflections" : "transparency") +
-                                " are not implemented yet (only 0 is accepted)");
-      (std::string(key) == "reflectivity" ? m.reflectivity : m.transparency) = v;
-    }
+  if (const toml::node* n = t.get("reflectivity")) m.reflectivity = r.number_in(*n, name + ".reflectivity", 0, 1);
+  if (const toml::node* n = t.get("transparency")) m.transparency = r.number_in(*n, name + ".transparency", 0, 1);
 }
 
 Light read_light(const SceneReader& r, const toml::table& t) {
@@ -509,6 +501,8 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
     if (const toml::node* n = render->get("tile_size"))
       rs.tile_size = static_cast<int>(r.integer(*n, "render.tile_size", 8, 16384));
     if (const toml::node* n = render->get("preview")) rs.preview = r.boolean(*n, "render.preview");
+    if (const toml::node* n = render->get("max_depth"))
+      rs.max_depth = static_cast<int>(r.integer(*n, "render.max_depth", 0, 64));
   }
   return scene;
 }

@@ -47,8 +47,11 @@ struct Material {
   double diffuse = 0.75;    // Lambertian share per light
   double specular = 0.35;   // highlight strength per light, in the light's colour
   double exponent = 40;     // Phong exponent: larger is a smaller, sharper highlight
-  double reflectivity = 0;  // share of a mirror ray's colour (needs the reflection pass)
-  double transparency = 0;  // share of the colour seen through the surface (needs the transmission pass)
+  // Share of the mirror ray's colour added to the surface's own (a reflection pass traces the mirror rays).
+  double reflectivity = 0;
+  // Share of the colour seen through the surface, the ray continuing to the next root as in surf and SURFER;
+  // the surface's own colour keeps 1 - transparency (a transmission pass traces the continued rays).
+  double transparency = 0;
 };
 
 // Front: where the ray arrives from P > 0 (outside); back: from P < 0 (inside).
@@ -96,6 +99,8 @@ struct RenderSettings {
   int max_iterations = 0;  // 0: the refinement's default (default_max_iterations)
   int tile_size = 0;  // pixels per side of a dispatched tile; 0 chooses by device type
   bool preview = false;  // primary rays only: lights shade, but cast no shadows (the paper's preview mode)
+  // Secondary bounces after the camera ray: reflection and transmission rays stop after this many.
+  int max_depth = 5;
 };
 
 struct Scene {

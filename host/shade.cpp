@@ -1,4 +1,5 @@
-// Shading of every traced ray (Phong with area-light shadows, or a headlight) and the antialiasing resolve.
+// Shading of every traced ray (Phong with area-light shadows, or a headlight), the colour its reflection and
+// transmission rays bring back, and the antialiasing resolve.
 #include "shade.h"
 
 #include <algorithm>
@@ -13,22 +14,49 @@ namespace {
 struct LightSamples {
   const Light* light;
   std::vector<glm::dvec3> points;
-  const LightOcclusion* occlusion;  // null when the light casts no shadows or the plan traced none
 };
 
-// Colour of one traced ray that hit the surface.
+// A batch's shadow answers, looked up by the index of a hit in its batch.
+class ShadowLookup {
+ public:
+  ShadowLookup(const ShadowData& data, std::size_t batch_size, const std::vector<Light>& lights)
+      : data_(data), by_light_(lights.size(), nullptr) {
+    if (data.points.empty()) return;
+    point_of_hit_.assign(batch_size, UINT32_MAX);
+    for (std::size_t k = 0; k < data.points.size(); ++k) point_of_hit_[data.points[k]] = static_cast<std::uint32_t>(k);
+    for (const LightOcclusion& o : data.occlusion) by_light_[static_cast<std::size_t>(o.light)] = &o;
+  }
+  // Bit s set when the shadow pass found light point s of light `light` hidden from hit `hit`.
+  std::uint64_t hidden(std::size_t light, std::size_t hit) const {
+    const LightOcclusion* o = by_light_[light];
+    if (!o || point_of_hit_.empty() || point_of_hit_[hit] == UINT32_MAX) return 0;
+    return o->masks[point_of_hit_[hit]];
+  }
+
+ private:
+  const ShadowData& data_;
+  std::vector<const LightOcclusion*> by_light_;
+  std::vector<std::uint32_t> point_of_hit_;
+};
+
+// Colour of one traced ray that hit the surface: the side's own colour (times 1 - transparency, the rest
+// coming from the transmission pass), lit by every light's points that the shadow pass left visible.
 glm::dvec3 shade_hit(const Scene& scene, const std::vector<LightSamples>& lights, const HitRecord& h,
-                     const glm::dvec3& point, const glm::dvec3& to_eye, std::uint32_t shading_point) {
+                     const glm::dvec3& point, const glm::dvec3& to_eye, const ShadowLookup& shadows,
+                     std::size_t hit_index) {
   const Material& m = (h.flags & ALGRAY_HIT_BACK) ? scene.materials.back : scene.materials.front;
   const glm::dvec3 n(h.normal_x, h.normal_y, h.normal_z);
+  const double own = 1 - m.transparency;
   if (lights.empty()) {
     const double facing = std::fabs(glm::dot(n, to_eye));
-    return m.colour * (kPreviewAmbient + (1 - kPreviewAmbient) * facing);
+    return own * m.colour * (kPreviewAmbient + (1 - kPreviewAmbient) * facing);
   }
+  // Highlights below 1/4096 of full strength are skipped: they cannot show, and pow() dominates shading.
+  const double highlight_cutoff = std::pow(1.0 / 4096, 1 / m.exponent);
   glm::dvec3 c = m.ambient * m.colour;
-  for (const LightSamples& ls : lights) {
-    const std::uint64_t hidden =
-        ls.occlusion && shading_point != UINT32_MAX ? ls.occlusion->masks[shading_point] : std::uint64_t{0};
+  for (std::size_t li = 0; li < lights.size(); ++li) {
+    const LightSamples& ls = lights[li];
+    const std::uint64_t hidden = shadows.hidden(li, hit_index);
     double diffuse = 0, specular = 0;
     for (std::size_t s = 0; s < ls.points.size(); ++s) {
       if (hidden >> s & 1u) continue;
@@ -36,13 +64,13 @@ glm::dvec3 shade_hit(const Scene& scene, const std::vector<LightSamples>& lights
       const double n_dot_l = glm::dot(n, l);
       if (n_dot_l <= 0) continue;  // behind the tangent plane: the surface hides it from itself
       diffuse += n_dot_l;
-      const glm::dvec3 mirrored = 2 * n_dot_l * n - l;
-      specular += std::pow(std::max(0.0, glm::dot(mirrored, to_eye)), m.exponent);
+      const double r_dot_v = glm::dot(2 * n_dot_l * n - l, to_eye);
+      if (r_dot_v > highlight_cutoff) specular += std::pow(r_dot_v, m.exponent);
     }
     const double share = 1.0 / static_cast<double>(ls.points.size());
     c += ls.light->intensity * ls.light->colour * (m.diffuse * diffuse * share * m.colour + m.specular * specular * share);
   }
-  return c;
+  return own * c;
 }
 
 }  // namespace
@@ -67,20 +95,24 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
   FrameImage::UintChannel flags{"solver.flags", std::vector<std::uint32_t>(n)};
 
   std::vector<LightSamples> lights;
-  for (std::size_t i = 0; i < scene.lights.size(); ++i) {
-    LightSamples ls{&scene.lights[i], scene.lights[i].sample_points(), nullptr};
-    for (const LightOcclusion& o : result.occlusion)
-      if (o.light == static_cast<int>(i)) ls.occlusion = &o;
-    lights.push_back(std::move(ls));
-  }
-  // Hit index -> shading point of the shadow pass.
-  std::vector<std::uint32_t> shading_point;
-  if (!result.shading_points.empty()) {
-    shading_point.assign(hits.records.size(), UINT32_MAX);
-    for (std::size_t k = 0; k < result.shading_points.size(); ++k)
-      shading_point[result.shading_points[k]] = static_cast<std::uint32_t>(k);
-  }
+  for (const Light& light : scene.lights) lights.push_back({&light, light.sample_points()});
+  const ShadowLookup primary_shadows(result.shadows, hits.records.size(), scene.lights);
   const bool single = result.config.precision != Precision::Double;
+
+  // What reflection and transmission rays add to each traced camera ray: their weight times what they met.
+  std::vector<glm::dvec3> secondary(result.secondary.empty() ? 0 : hits.records.size(), glm::dvec3(0));
+  for (const SecondaryBatch& batch : result.secondary) {
+    const ShadowLookup batch_shadows(batch.shadows, batch.hits.size(), scene.lights);
+    for (std::size_t i = 0; i < batch.hits.size(); ++i) {
+      const HitRecord& h = batch.hits[i];
+      const glm::dvec3 seen =
+          (h.flags & ALGRAY_HIT_FOUND)
+              ? shade_hit(scene, lights, h, hit_point(batch.rays[i], h), -glm::normalize(batch.rays[i].direction),
+                          batch_shadows, i)
+              : glm::dvec3(scene.image.background);
+      secondary[batch.sample[i]] += batch.weight[i] * seen;
+    }
+  }
   const double weight = 1.0 / (samples * samples);
 
   // Rows are independent; shading a 1024x768 frame on one core costs as much as a fifth of the kernel.
@@ -103,8 +135,9 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
             }
             const PixelRay ray = pixel_ray(result.basis, single, tx, ty);
             const glm::dvec3 to_eye = -glm::normalize(ray.direction);
-            const std::uint32_t sp = shading_point.empty() ? UINT32_MAX : shading_point[k];
-            sum += glm::dvec4(shade_hit(scene, lights, h, hit_point(ray, h), to_eye, sp), 1);
+            glm::dvec3 colour = shade_hit(scene, lights, h, hit_point(ray, h), to_eye, primary_shadows, k);
+            if (!secondary.empty()) colour += secondary[k];
+            sum += glm::dvec4(colour, 1);
             if (h.depth < img.depth[i]) {
               img.depth[i] = h.depth;
               img.normal[3 * i] = h.normal_x;

@@ -21,21 +21,15 @@ ShadowAnswer ShadowTracer::trace(const std::vector<glm::dvec3>& points, const st
   answer.masks.assign(count, 0);
   if (count == 0) return answer;
 
-  std::vector<double> point_data, light_data;
   std::vector<float> normal_data;
-  point_data.reserve(4 * count);
   normal_data.reserve(4 * count);
-  for (std::size_t i = 0; i < count; ++i) {
-    point_data.insert(point_data.end(), {points[i].x, points[i].y, points[i].z, 0});
-    normal_data.insert(normal_data.end(), {normals[i].x, normals[i].y, normals[i].z, 0});
-  }
-  for (const glm::dvec3& q : light_points) light_data.insert(light_data.end(), {q.x, q.y, q.z, 0});
+  for (const glm::vec3& n : normals) normal_data.insert(normal_data.end(), {n.x, n.y, n.z, 0});
   const cl::Context& ctx = session_.context;
   const Precision precision = surface_.precision();
-  const cl::Buffer point_buffer = real_buffer(ctx, point_data, precision);
+  const cl::Buffer point_buffer = real4_buffer(ctx, points, precision);
   const cl::Buffer normal_buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, normal_data.size() * sizeof(float),
                                  normal_data.data());
-  const cl::Buffer light_buffer = real_buffer(ctx, light_data, precision);
+  const cl::Buffer light_buffer = real4_buffer(ctx, light_points, precision);
   cl::Buffer masks(ctx, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, count * sizeof(cl_ulong), answer.masks.data());
   cl_uint traced = 0;
   cl::Buffer traced_buffer(ctx, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, sizeof(cl_uint), &traced);

@@ -1,0 +1,32 @@
+// The secondary-ray kernel on a batch of given rays: reflection and transmission rays against the surface.
+#pragma once
+
+#include <vector>
+
+#include "algray_shared.h"
+#include "camera.h"
+#include "device_surface.h"
+#include "program_cache.h"
+
+namespace algray {
+
+struct TracedBatch {
+  std::vector<HitRecord> hits;  // one per ray, as the primary kernel writes them
+  double kernel_ms = 0;
+};
+
+// Built once per render, then asked once per batch of rays.
+class RayTracer {
+ public:
+  RayTracer(ClSession& session, ProgramCache& cache, const KernelConfig& config, const DeviceSurface& surface);
+  const ProgramRecord& program() const { return record_; }
+  TracedBatch trace(const std::vector<PixelRay>& rays);
+
+ private:
+  ClSession& session_;
+  const DeviceSurface& surface_;
+  ProgramRecord record_;
+  cl::Kernel kernel_;
+};
+
+}  // namespace algray
