@@ -37,7 +37,12 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
   RenderPlan plan;
   plan.width = scene.image.width;
   plan.height = scene.image.height;
-  plan.samples = scene.antialias.samples;
+  const bool adaptive = scene.antialias.adaptive && scene.antialias.samples > 1;
+  plan.samples = adaptive ? 1 : scene.antialias.samples;
+  if (adaptive) {
+    plan.refine_samples = scene.antialias.samples;
+    plan.refine_threshold = scene.antialias.threshold;
+  }
   const std::size_t rays = static_cast<std::size_t>(plan.trace_width()) * plan.trace_height();
   const std::size_t real_size = precision == Precision::Double ? sizeof(double) : sizeof(float);
 
@@ -104,6 +109,15 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
       plan.buffers.push_back({name + " hits per bounce (at most)", rays * sizeof(HitRecord)});
     }
   }
+  if (adaptive) {
+    const std::string n = std::to_string(plan.refine_samples);
+    plan.passes.push_back({"antialias", n + "x" + n + " camera rays in pixels whose colour differs from a neighbour's",
+                           trace});
+    plan.buffers.push_back({"antialias rays (at most)", rays * plan.refine_samples * plan.refine_samples * 8 * real_size});
+  } else {
+    plan.skipped.push_back("antialias: " + std::string(scene.antialias.samples > 1 ? "uniform supersampling"
+                                                                                     : "off (one ray per pixel)"));
+  }
   return plan;
 }
 
@@ -111,6 +125,7 @@ nlohmann::json RenderPlan::json() const {
   nlohmann::json j;
   j["image"] = {{"width", width}, {"height", height}};
   j["antialias_samples"] = samples;
+  j["adaptive_antialias_samples"] = refine_samples;
   j["traced"] = {{"width", trace_width()}, {"height", trace_height()}};
   for (const PlannedPass& p : passes)
     j["passes"].push_back({{"name", p.name}, {"purpose", p.purpose}, {"kernel", p.kernel.key()}});

@@ -25,7 +25,9 @@ struct PlannedBuffer {
 
 struct RenderPlan {
   int width = 0, height = 0;  // the output image
-  int samples = 1;            // antialiasing: samples x samples rays per pixel
+  int samples = 1;            // antialiasing: samples x samples camera rays per pixel, traced as one grid
+  int refine_samples = 0;     // adaptive antialiasing: n x n rays later, in pixels that differ (0: off)
+  double refine_threshold = 0;
   int trace_width() const { return width * samples; }
   int trace_height() const { return height * samples; }
   std::vector<PlannedPass> passes;

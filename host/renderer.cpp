@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "ray_tracer.h"
+#include "shade.h"
 #include "shadow_tracer.h"
 
 namespace algray {
@@ -61,41 +62,73 @@ ShadowData trace_shadows(const Scene& scene, const RenderPlan& plan, ShadowTrace
 
 }  // namespace
 
+// A ray waiting to be continued: the traced camera ray it adds to, its weight, the ray and its hit.
+struct Renderer::Bounce {
+  std::uint32_t sample;
+  double weight;
+  PixelRay ray;
+  HitRecord hit;
+};
+
+// What the passes after the primary one share while a render runs: the kernels built so far and the stats.
+struct Renderer::Passes {
+  const Scene& scene;
+  const DeviceSurface& surface;
+  RenderResult& result;
+  std::vector<PassStats> stats;  // one per planned pass, in plan order
+  std::unique_ptr<ShadowTracer> shadows;
+  std::unique_ptr<RayTracer> rays;
+
+  PassStats* stats_of(const std::string& name) {
+    for (std::size_t i = 0; i < stats.size(); ++i)
+      if (result.plan.passes[i].name == name) return &stats[i];
+    return nullptr;
+  }
+};
+
 RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   RenderResult result;
   const Precision precision = resolve_precision(scene, session_.info);
   result.plan = make_render_plan(scene, precision);
   result.config = primary_config(scene, precision);
   const DeviceSurface surface(session_.context, scene, precision);
+  Passes passes{scene, surface, result, std::vector<PassStats>(result.plan.passes.size()), nullptr, nullptr};
+  run_primary(scene, surface, show_progress, result, *passes.stats_of("primary"));
 
-  // Statistics per planned pass, filled as the passes run (the shadow and secondary passes run once per bounce).
-  std::vector<PassStats> stats(result.plan.passes.size());
-  auto stats_of = [&](const std::string& name) -> PassStats* {
-    for (std::size_t i = 0; i < stats.size(); ++i)
-      if (result.plan.passes[i].name == name) return &stats[i];
-    return nullptr;
-  };
-  run_primary(scene, surface, show_progress, result, *stats_of("primary"));
-
-  std::unique_ptr<ShadowTracer> shadows;
-  PassStats* shadow_stats = stats_of("shadow");
-  if (shadow_stats) {
-    shadows = std::make_unique<ShadowTracer>(session_, cache_, result.plan.find("shadow")->kernel, surface,
-                                             shadow_offset_unit(precision) * scene.extent.unit_scale());
-    result.programs.push_back(shadows->program());
-    shadow_stats->program_key = shadows->program().key;
-    const bool single = precision != Precision::Double;
-    const int width = result.hits.width;
-    result.shadows = trace_shadows(scene, result.plan, *shadows, result.hits.records, [&](std::size_t i) {
-      return pixel_ray(result.basis, single, static_cast<int>(i % width), static_cast<int>(i / width));
-    }, *shadow_stats);
+  if (PassStats* stats = passes.stats_of("shadow")) {
+    passes.shadows = std::make_unique<ShadowTracer>(session_, cache_, result.plan.find("shadow")->kernel, surface,
+                                                    shadow_offset_unit(precision) * scene.extent.unit_scale());
+    result.programs.push_back(passes.shadows->program());
+    stats->program_key = passes.shadows->program().key;
   }
-  if (stats_of("reflection") || stats_of("transmission"))
-    run_secondary(scene, surface, result, stats, shadows.get(), shadow_stats);
+  // Every secondary pass launches the same trace kernel.
+  for (const char* name : {"reflection", "transmission", "antialias"})
+    if (PassStats* stats = passes.stats_of(name)) {
+      if (!passes.rays) {
+        passes.rays = std::make_unique<RayTracer>(session_, cache_, result.plan.find(name)->kernel, surface);
+        result.programs.push_back(passes.rays->program());
+      }
+      stats->program_key = passes.rays->program().key;
+    }
 
-  for (std::size_t i = 0; i < stats.size(); ++i) {
-    stats[i].name = result.plan.passes[i].name;
-    result.passes.push_back(stats[i]);
+  const bool single = precision != Precision::Double;
+  const int width = result.hits.width;
+  auto camera_ray = [&](std::size_t i) {
+    return pixel_ray(result.basis, single, static_cast<int>(i % width), static_cast<int>(i / width));
+  };
+  if (passes.shadows)
+    result.shadows = trace_shadows(scene, result.plan, *passes.shadows, result.hits.records, camera_ray,
+                                   *passes.stats_of("shadow"));
+  std::vector<Bounce> first;
+  for (std::size_t i = 0; i < result.hits.records.size(); ++i)
+    if (result.hits.records[i].flags & ALGRAY_HIT_FOUND)
+      first.push_back({static_cast<std::uint32_t>(i), 1.0, camera_ray(i), result.hits.records[i]});
+  run_bounces(passes, std::move(first), false);
+  if (result.plan.refine_samples > 1) run_antialias(passes);
+
+  for (std::size_t i = 0; i < passes.stats.size(); ++i) {
+    passes.stats[i].name = result.plan.passes[i].name;
+    result.passes.push_back(passes.stats[i]);
   }
   return result;
 }
@@ -162,50 +195,36 @@ void Renderer::run_primary(const Scene& scene, const DeviceSurface& surface, boo
   pass.wall_ms = ms_since(wall_start) - record.build_ms;
 }
 
-// A ray waiting to be continued: the traced camera ray it adds to, its weight, the ray and its hit.
-struct Renderer::Bounce {
-  std::uint32_t sample;
-  double weight;
-  PixelRay ray;
-  HitRecord hit;
-};
+// Traces one batch of secondary rays, then the shadow rays of its hits.
+void Renderer::trace_batch(Passes& passes, SecondaryBatch& batch) {
+  const auto start = std::chrono::steady_clock::now();
+  PassStats& stats = *passes.stats_of(batch.pass);
+  TracedBatch traced = passes.rays->trace(batch.rays);
+  batch.hits = std::move(traced.hits);
+  stats.kernel_ms += traced.kernel_ms;
+  stats.rays += batch.rays.size();
+  ++stats.launches;
+  stats.wall_ms += ms_since(start);
+  if (passes.shadows)
+    batch.shadows = trace_shadows(passes.scene, passes.result.plan, *passes.shadows, batch.hits,
+                                  [&](std::size_t i) { return batch.rays[i]; }, *passes.stats_of("shadow"));
+}
 
-void Renderer::run_secondary(const Scene& scene, const DeviceSurface& surface, RenderResult& result,
-                             std::vector<PassStats>& stats, ShadowTracer* shadows, PassStats* shadow_stats) {
-  const Precision precision = surface.precision();
-  const bool single = precision != Precision::Double;
-  const double offset = shadow_offset_unit(precision) * scene.extent.unit_scale();
+void Renderer::run_bounces(Passes& passes, std::vector<Bounce> current, bool refinement) {
+  const Scene& scene = passes.scene;
+  const double offset = shadow_offset_unit(passes.surface.precision()) * scene.extent.unit_scale();
   // Below this a bounce cannot change a pixel's 8-bit colour.
   constexpr double kNegligibleWeight = 1.0 / 512;
-  RayTracer tracer(session_, cache_, result.plan.find(result.plan.find("reflection") ? "reflection" : "transmission")->kernel,
-                   surface);
-  result.programs.push_back(tracer.program());
-  PassStats* pass_stats[2] = {nullptr, nullptr};
-  const char* names[2] = {"reflection", "transmission"};
-  for (int k = 0; k < 2; ++k)
-    for (std::size_t i = 0; i < stats.size(); ++i)
-      if (result.plan.passes[i].name == names[k]) {
-        pass_stats[k] = &stats[i];
-        stats[i].program_key = tracer.program().key;
-      }
-
-  // The camera rays' hits start the first bounce.
-  std::vector<Bounce> current;
-  const int width = result.hits.width;
-  for (std::size_t i = 0; i < result.hits.records.size(); ++i) {
-    const HitRecord& h = result.hits.records[i];
-    if (h.flags & ALGRAY_HIT_FOUND)
-      current.push_back({static_cast<std::uint32_t>(i), 1.0,
-                         pixel_ray(result.basis, single, static_cast<int>(i % width), static_cast<int>(i / width)), h});
-  }
+  const char* const names[2] = {"reflection", "transmission"};
+  const bool wanted[2] = {passes.stats_of(names[0]) != nullptr, passes.stats_of(names[1]) != nullptr};
   for (int depth = 1; depth <= scene.render.max_depth && !current.empty(); ++depth) {
     std::vector<Bounce> next;
     for (int k = 0; k < 2; ++k) {
-      if (!pass_stats[k]) continue;
-      const auto start = std::chrono::steady_clock::now();
+      if (!wanted[k]) continue;
       SecondaryBatch batch;
       batch.pass = names[k];
       batch.depth = depth;
+      batch.refinement = refinement;
       for (const Bounce& b : current) {
         const Material& m = (b.hit.flags & ALGRAY_HIT_BACK) ? scene.materials.back : scene.materials.front;
         const double share = k == 0 ? m.reflectivity : m.transparency;
@@ -221,22 +240,57 @@ void Renderer::run_secondary(const Scene& scene, const DeviceSurface& surface, R
         batch.rays.push_back(ray);
       }
       if (batch.rays.empty()) continue;
-      TracedBatch traced = tracer.trace(batch.rays);
-      batch.hits = std::move(traced.hits);
-      pass_stats[k]->kernel_ms += traced.kernel_ms;
-      pass_stats[k]->rays += batch.rays.size();
-      ++pass_stats[k]->launches;
-      pass_stats[k]->wall_ms += ms_since(start);
-      if (shadows)
-        batch.shadows = trace_shadows(scene, result.plan, *shadows, batch.hits,
-                                      [&](std::size_t i) { return batch.rays[i]; }, *shadow_stats);
+      trace_batch(passes, batch);
       for (std::size_t i = 0; i < batch.rays.size(); ++i)
         if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
           next.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i]});
-      result.secondary.push_back(std::move(batch));
+      passes.result.secondary.push_back(std::move(batch));
     }
     current = std::move(next);
   }
+}
+
+void Renderer::run_antialias(Passes& passes) {
+  RenderResult& result = passes.result;
+  const RenderPlan& plan = result.plan;
+  // The image as it stands, one ray per pixel: where a pixel differs from a neighbour, it gets n x n rays.
+  const FrameImage coarse = shade_frame(passes.scene, result);
+  const int w = coarse.width, h = coarse.height, n = plan.refine_samples;
+  auto differs = [&](int x0, int y0, int x1, int y1) {
+    if (x1 < 0 || y1 < 0 || x1 >= w || y1 >= h) return false;
+    const std::size_t a = 4 * (static_cast<std::size_t>(y0) * w + x0), b = 4 * (static_cast<std::size_t>(y1) * w + x1);
+    for (int c = 0; c < 4; ++c)
+      if (std::fabs(coarse.rgba[a + c] - coarse.rgba[b + c]) > plan.refine_threshold) return true;
+    return false;
+  };
+  result.refined.assign(static_cast<std::size_t>(w) * h, 0);
+  const bool single = passes.surface.precision() != Precision::Double;
+  // The rays of the n-times finer grid, so that a refined pixel gets exactly the rays uniform n x n would trace.
+  const RayBasis fine = make_ray_basis(passes.scene.camera, w * n, h * n);
+  SecondaryBatch batch;
+  batch.pass = "antialias";
+  batch.depth = 0;
+  batch.refinement = true;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (!(differs(x, y, x - 1, y) || differs(x, y, x + 1, y) || differs(x, y, x, y - 1) || differs(x, y, x, y + 1)))
+        continue;
+      const std::uint32_t pixel = static_cast<std::uint32_t>(y * w + x);
+      result.refined[pixel] = 1;
+      for (int sy = 0; sy < n; ++sy)
+        for (int sx = 0; sx < n; ++sx) {
+          batch.sample.push_back(pixel);
+          batch.weight.push_back(1.0 / (n * n));
+          batch.rays.push_back(pixel_ray(fine, single, x * n + sx, y * n + sy));
+        }
+    }
+  if (batch.rays.empty()) return;
+  trace_batch(passes, batch);
+  std::vector<Bounce> first;
+  for (std::size_t i = 0; i < batch.rays.size(); ++i)
+    if (batch.hits[i].flags & ALGRAY_HIT_FOUND) first.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i]});
+  result.secondary.push_back(std::move(batch));
+  run_bounces(passes, std::move(first), true);
 }
 
 }  // namespace algray

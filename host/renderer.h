@@ -44,8 +44,9 @@ struct ShadowData {
 
 // One bounce's reflection or transmission rays: where each adds to the image and what it found.
 struct SecondaryBatch {
-  std::string pass;                  // "reflection" or "transmission"
-  int depth = 1;                     // 1: spawned by the camera rays' hits
+  std::string pass;                   // "reflection", "transmission", or "antialias" (camera rays)
+  int depth = 1;                      // 1: spawned by the camera rays' hits; 0 for antialias batches
+  bool refinement = false;            // part of adaptive antialiasing: replaces its pixel's first colour
   std::vector<std::uint32_t> sample;  // the traced camera ray (index into RenderResult::hits) it contributes to
   std::vector<double> weight;         // its share of that ray's colour
   std::vector<PixelRay> rays;
@@ -62,6 +63,8 @@ struct RenderResult {
   std::vector<PassStats> passes;
   ShadowData shadows;                    // of the camera rays' hits
   std::vector<SecondaryBatch> secondary;  // in the order traced: by depth, reflection before transmission
+  // Adaptive antialiasing: 1 for the pixels (of hits) whose colour is the antialias batch's rays, not their own.
+  std::vector<std::uint8_t> refined;
 };
 
 // Precision a scene renders in on a device: as asked, or double where fp64 exists. Throws DeviceError when
@@ -85,9 +88,13 @@ class Renderer {
  private:
   void run_primary(const Scene& scene, const DeviceSurface& surface, bool show_progress, RenderResult& result,
                    PassStats& stats);
+  struct Passes;
   struct Bounce;
-  void run_secondary(const Scene& scene, const DeviceSurface& surface, RenderResult& result,
-                     std::vector<PassStats>& stats, class ShadowTracer* shadows, PassStats* shadow_stats);
+  void trace_batch(Passes& passes, SecondaryBatch& batch);
+  // Reflection and transmission rays, bounce by bounce, from the hits in `current`.
+  void run_bounces(Passes& passes, std::vector<Bounce> current, bool refinement);
+  // Adaptive antialiasing: n x n more camera rays in the pixels that differ from a neighbour.
+  void run_antialias(Passes& passes);
 
   ClSession& session_;
   ProgramCache& cache_;

@@ -194,7 +194,7 @@ const std::set<std::string> kMaterialSideKeys{"colour",   "ambient",      "diffu
                                               "exponent", "reflectivity", "transparency"};
 const std::set<std::string> kLightKeys{"type",   "position", "edge_u",    "edge_v",    "normal",
                                        "radius", "samples",  "colour",    "intensity", "shadows"};
-const std::set<std::string> kAntialiasKeys{"samples"};
+const std::set<std::string> kAntialiasKeys{"samples", "adaptive", "threshold"};
 const std::set<std::string> kRenderKeys{"precision",      "tolerance", "isolation", "refinement", "ray_origin",
                                         "max_iterations", "tile_size", "preview",    "max_depth"};
 
@@ -461,6 +461,9 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
     r.check_keys(*aa, "antialias", kAntialiasKeys);
     if (const toml::node* n = aa->get("samples"))
       scene.antialias.samples = static_cast<int>(r.integer(*n, "antialias.samples", 1, 16));
+    if (const toml::node* n = aa->get("adaptive")) scene.antialias.adaptive = r.boolean(*n, "antialias.adaptive");
+    if (const toml::node* n = aa->get("threshold"))
+      scene.antialias.threshold = r.number_in(*n, "antialias.threshold", 0, 1);
   }
 
   if (const toml::table* render = r.subtable(root, "render")) {

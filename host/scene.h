@@ -88,6 +88,10 @@ inline constexpr int kMaxLightSamplesPerSide = 8;
 
 struct Antialias {
   int samples = 1;  // n x n supersampling; 1 is off
+  // Adaptive: one ray per pixel first, then n x n only in pixels whose colour differs from a neighbour's by
+  // more than `threshold` in some channel (the antialiasing refinement pass).
+  bool adaptive = false;
+  double threshold = 0.1;
 };
 
 struct RenderSettings {

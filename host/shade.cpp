@@ -100,7 +100,10 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
   const bool single = result.config.precision != Precision::Double;
 
   // What reflection and transmission rays add to each traced camera ray: their weight times what they met.
+  // Adaptive antialiasing's camera rays are such contributions too, with weights 1/n^2; they also carry alpha.
   std::vector<glm::dvec3> secondary(result.secondary.empty() ? 0 : hits.records.size(), glm::dvec3(0));
+  std::vector<glm::dvec3> refined_colour(result.refined.empty() ? 0 : hits.records.size(), glm::dvec3(0));
+  std::vector<double> refined_alpha(refined_colour.size(), 0.0);
   for (const SecondaryBatch& batch : result.secondary) {
     const ShadowLookup batch_shadows(batch.shadows, batch.hits.size(), scene.lights);
     for (std::size_t i = 0; i < batch.hits.size(); ++i) {
@@ -110,7 +113,9 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
               ? shade_hit(scene, lights, h, hit_point(batch.rays[i], h), -glm::normalize(batch.rays[i].direction),
                           batch_shadows, i)
               : glm::dvec3(scene.image.background);
-      secondary[batch.sample[i]] += batch.weight[i] * seen;
+      (batch.refinement ? refined_colour : secondary)[batch.sample[i]] += batch.weight[i] * seen;
+      if (batch.pass == "antialias")
+        refined_alpha[batch.sample[i]] += batch.weight[i] * ((h.flags & ALGRAY_HIT_FOUND) ? 1.0 : scene.image.background.a);
     }
   }
   const double weight = 1.0 / (samples * samples);
@@ -129,6 +134,17 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
             steps.values[i] += h.work & 0xffffu;
             iterations.values[i] += h.work >> 16;
             flags.values[i] |= h.flags;
+            if (!result.refined.empty() && result.refined[k]) {
+              // Its colour is what the antialias batch's n x n rays (and their bounces) saw.
+              sum += glm::dvec4(refined_colour[k], refined_alpha[k]);
+              if (h.flags & ALGRAY_HIT_FOUND) {
+                img.depth[i] = h.depth;
+                img.normal[3 * i] = h.normal_x;
+                img.normal[3 * i + 1] = h.normal_y;
+                img.normal[3 * i + 2] = h.normal_z;
+              }
+              continue;
+            }
             if (!(h.flags & ALGRAY_HIT_FOUND)) {
               sum += scene.image.background;
               continue;

@@ -1,11 +1,14 @@
 // The render plan, seen through --stats: each effect's pass, kernel and rays exist only when the scene asks.
+#include <algorithm>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "cli_sandbox.h"
+#include "image_io.h"
 #include "scene_fixtures.h"
 
 using namespace algray::testing;
@@ -143,4 +146,43 @@ TEST_CASE("reflection and transmission passes run only for materials that ask, a
     for (const auto& p : s.at("programs")) trace_program |= p.at("key").get<std::string>().rfind("trace ", 0) == 0;
     CHECK(trace_program == !c.passes.empty());
   }
+}
+
+TEST_CASE("adaptive antialiasing traces n x n rays only where neighbours differ, and looks like uniform", "[plan]") {
+  require_device();
+  Sandbox box;
+  const std::string scene = quoted(std::string(ALGRAY_SOURCE_DIR) + "/scenes/tanglecube.toml");
+  const std::string common = " --width 96 --height 72 --set antialias.samples=3 --set render.precision=double";
+  const Result uniform = box.run("render " + scene + " -o uniform.exr --stats u.json" + common);
+  const Result adaptive =
+      box.run("render " + scene + " -o adaptive.exr --stats a.json --set antialias.adaptive=true" + common);
+  INFO(uniform.err << adaptive.err);
+  REQUIRE(uniform.exit_code == 0);
+  REQUIRE(adaptive.exit_code == 0);
+  const nlohmann::json u = box.stats("u.json"), a = box.stats("a.json");
+  CHECK(names_of(u.at("passes")) == std::vector<std::string>{"primary", "shadow"});
+  CHECK(names_of(a.at("passes")) == std::vector<std::string>{"primary", "shadow", "antialias"});
+  // One camera ray per pixel first; then 9 per refined pixel, some but not all of them.
+  CHECK(a.at("passes")[0].at("rays").get<long>() == 96 * 72);
+  const long refined_rays = a.at("passes")[2].at("rays").get<long>();
+  CHECK(refined_rays % 9 == 0);
+  CHECK(refined_rays > 0);
+  CHECK(refined_rays / 9 < 96 * 72 / 2);
+  CHECK(a.at("passes")[1].at("rays").get<long>() < u.at("passes")[1].at("rays").get<long>());
+
+  const algray::FrameImage ui = algray::read_exr(box.work / "uniform.exr");
+  const algray::FrameImage ai = algray::read_exr(box.work / "adaptive.exr");
+  REQUIRE(ui.rgba.size() == ai.rgba.size());
+  double total = 0;
+  int far = 0;
+  for (std::size_t p = 0; p < ui.rgba.size() / 4; ++p) {
+    double worst = 0;
+    for (int c = 0; c < 4; ++c) worst = std::max(worst, std::fabs(double(ui.rgba[4 * p + c]) - ai.rgba[4 * p + c]));
+    total += worst;
+    far += worst > 0.1;  // the default threshold
+  }
+  const double mean = total / static_cast<double>(ui.rgba.size() / 4);
+  INFO("mean difference " << mean << ", " << far << " pixels off by more than the threshold");
+  CHECK(mean < 0.005);
+  CHECK(far <= 96 * 72 / 200);  // a feature thinner than a pixel can fall between the first rays
 }
