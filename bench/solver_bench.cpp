@@ -227,7 +227,7 @@ json bench_accuracy(ClSession& session, bool quick, const fs::path& scenes, cons
     const ReferenceResult float_rays = render_reference(base, Precision::Float);
     const ReferenceResult double_rays = render_reference(base, Precision::Double);
     for (Precision precision : {Precision::Float, Precision::Mixed, Precision::Double}) {
-      if (precision == Precision::Mixed && base.polynomial.degree() > kMaxMixedDegree) continue;
+      if (precision == Precision::Mixed && base.surface().polynomial.degree() > kMaxMixedDegree) continue;
       for (const Method& m : one_at_a_time()) {
         for (double tolerance : tolerances) {
           const Scene scene = load_scene_file(file, joined(size, solver_overrides(m, precision, tolerance)));

@@ -61,11 +61,12 @@ cl::Buffer real4_buffer(const cl::Context& ctx, const std::vector<glm::dvec3>& v
   return real_buffer(ctx, flat, precision);
 }
 
-SurfaceData prepare_surface(const Scene& scene) {
+SurfaceData prepare_surface(const Scene& scene, std::size_t surface) {
   const glm::dvec3 c = scene.extent.unit_centre();
   const std::array<mpq_class, 3> centre{exact_rational(c.x), exact_rational(c.y), exact_rational(c.z)};
   // Exact translation and scaling: rounding happens once, to the final coefficients.
-  Polynomial unit = scene.polynomial.translated_scaled(centre, exact_rational(scene.extent.unit_scale()));
+  Polynomial unit =
+      scene.surfaces.at(surface).polynomial.translated_scaled(centre, exact_rational(scene.extent.unit_scale()));
   mpq_class largest = 0;
   for (const auto& [e, a] : unit.terms()) largest = std::max<mpq_class>(largest, abs(a));
   SurfaceData data;
@@ -84,8 +85,8 @@ SurfaceData prepare_surface(const Scene& scene) {
   return data;
 }
 
-DeviceSurface::DeviceSurface(const cl::Context& ctx, const Scene& scene, Precision precision)
-    : precision_(precision), extent_(scene.extent), data_(prepare_surface(scene)) {
+DeviceSurface::DeviceSurface(const cl::Context& ctx, const Scene& scene, Precision precision, std::size_t surface)
+    : precision_(precision), extent_(scene.extent), data_(prepare_surface(scene, surface)) {
   exps_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data_.exponents.size() * sizeof(cl_uint),
                      data_.exponents.data());
   // Mixed precision takes each coefficient as a float pair hi + lo (hi's, then lo's): rounding expanded,

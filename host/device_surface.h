@@ -16,7 +16,7 @@ struct SurfaceData {
   std::vector<double> coefficients;
   cl_uint even_axes = 0;  // bit a set when every exponent of axis a is even (the kernels then step by squares)
 };
-SurfaceData prepare_surface(const Scene& scene);
+SurfaceData prepare_surface(const Scene& scene, std::size_t surface = 0);
 
 // Device time of a finished command, in milliseconds (the queue has profiling on).
 double ms_between(const cl::Event& e);
@@ -45,10 +45,10 @@ cl::Buffer real_buffer(const cl::Context& ctx, const std::vector<double>& values
 // Buffer of REAL4 values (x, y, z, 0) from points or directions.
 cl::Buffer real4_buffer(const cl::Context& ctx, const std::vector<glm::dvec3>& values, Precision precision);
 
-// The surface's buffers in one precision, shared by every pass's kernel.
+// One surface's buffers in one precision, shared by every pass's kernel.
 class DeviceSurface {
  public:
-  DeviceSurface(const cl::Context& ctx, const Scene& scene, Precision precision);
+  DeviceSurface(const cl::Context& ctx, const Scene& scene, Precision precision, std::size_t surface = 0);
   Precision precision() const { return precision_; }
   const SurfaceData& data() const { return data_; }
   // Extent and surface arguments, in the order primary.cl and shadow.cl declare them.

@@ -125,7 +125,7 @@ ReferenceResult render_reference(const Scene& scene, Precision ray_precision, un
 
   const bool single = ray_precision != Precision::Double;
   const long double eps = single ? std::numeric_limits<float>::epsilon() : std::numeric_limits<double>::epsilon();
-  const std::vector<Monomial> monomials = scene.polynomial.monomials();
+  const std::vector<Monomial> monomials = scene.surface().polynomial.monomials();
 
   auto solve_pixel = [&](int px, int py) {
     const std::size_t i = static_cast<std::size_t>(py) * width + px;
@@ -143,7 +143,7 @@ ReferenceResult render_reference(const Scene& scene, Precision ray_precision, un
     const mpq_class lo = exact_rational(static_cast<double>(std::max<long double>(0, t_in - margin)));
     const mpq_class hi = exact_rational(static_cast<double>(t_out + margin));
     const mpq_class width_t = exact_rational(kReferenceWidth * static_cast<double>(std::max<long double>(t_out, 1)));
-    const std::vector<mpq_class> restricted = ref::restrict_exact(scene.polynomial, exact);
+    const std::vector<mpq_class> restricted = ref::restrict_exact(scene.surface().polynomial, exact);
     const ref::Answer a = ref::smallest_root(restricted, lo, hi, width_t);
     PixelClass cls = classify(a.kind);
     if (a.kind == ref::Classification::Miss) {

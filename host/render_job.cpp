@@ -34,8 +34,8 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
   img.string_attributes = {
       {"algray/scene", scene.source},
       {"algray/name", scene.name},
-      {"algray/equation", scene.equation},
-      {"algray/polynomial", scene.polynomial.to_string()},
+      {"algray/equation", scene.surface().equation},
+      {"algray/polynomial", scene.surface().polynomial.to_string()},
       {"algray/isolation", to_string(r.config.isolation)},
       {"algray/refinement", to_string(r.config.refinement)},
       {"algray/rayOrigin", to_string(r.config.ray_origin)},
@@ -106,7 +106,9 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
                  {"type", device.type},
                  {"fp64", device.fp64},
                  {"driver", device.driver_version}};
-  j["surface"] = {{"equation", scene.equation}, {"degree", r.config.degree}};
+  j["surface"] = {{"equation", scene.surface().equation}, {"degree", r.config.degree}};
+  for (const SceneSurface& s : scene.surfaces)
+    j["surfaces"].push_back({{"name", s.name}, {"equation", s.equation}, {"degree", s.polynomial.degree()}});
   j["solver"] = {{"isolation", to_string(r.config.isolation)},
                  {"refinement", to_string(r.config.refinement)},
                  {"ray_origin", to_string(r.config.ray_origin)},
@@ -117,7 +119,7 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
   for (const ProgramRecord& p : r.programs) {
     double kernel_ms = 0;
     for (const PassStats& pass : r.passes)
-      if (pass.program_key == p.key) kernel_ms += pass.kernel_ms;
+      if (pass.program_keys.size() == 1 && pass.program_keys.front() == p.key) kernel_ms += pass.kernel_ms;
     j["programs"].push_back({{"key", p.key},
                              {"options", p.options},
                              {"from_cache", p.origin != "built"},
@@ -134,12 +136,15 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
   }
   j["plan"] = r.plan.json();
   for (const PassStats& p : r.passes) {
-    std::string origin;
-    for (const ProgramRecord& program : r.programs)
-      if (program.key == p.program_key) origin = program.origin;
+    nlohmann::json kernels = nlohmann::json::array();
+    for (const std::string& key : p.program_keys) {
+      std::string origin;
+      for (const ProgramRecord& program : r.programs)
+        if (program.key == key) origin = program.origin;
+      kernels.push_back({{"key", key}, {"origin", origin}});
+    }
     j["passes"].push_back({{"name", p.name},
-                           {"kernel", p.program_key},
-                           {"kernel_origin", origin},
+                           {"kernels", kernels},
                            {"rays", p.rays},
                            {"launches", p.launches},
                            {"kernel_ms", p.kernel_ms},
@@ -200,6 +205,9 @@ int run_render(const RenderRequest& req, std::ostream& err) {
   Scene scene;
   try {
     scene = req.scene_path ? load_scene_file(*req.scene_path, req.overrides) : default_scene(req.overrides);
+    if (req.reference && scene.surfaces.size() > 1)
+      throw SceneError(scene.source, "--reference solves one surface; this scene has " +
+                                         std::to_string(scene.surfaces.size()));
     for (const std::string& out : req.outputs) {
       format_from_extension(out);
       check_writable(out);

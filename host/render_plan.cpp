@@ -8,10 +8,10 @@
 
 namespace algray {
 
-KernelConfig primary_config(const Scene& scene, Precision precision) {
+KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t surface) {
   KernelConfig config;
   config.entry = "primary";
-  config.degree = scene.polynomial.degree();
+  config.degree = scene.surfaces.at(surface).polynomial.degree();
   config.precision = precision;
   config.isolation = scene.render.isolation;
   config.refinement = scene.render.refinement;
@@ -46,7 +46,14 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
   const std::size_t rays = static_cast<std::size_t>(plan.trace_width()) * plan.trace_height();
   const std::size_t real_size = precision == Precision::Double ? sizeof(double) : sizeof(float);
 
-  const KernelConfig primary = primary_config(scene, precision);
+  // Every pass has one kernel per surface: each surface's degree specialises its own.
+  std::vector<KernelConfig> primary;
+  for (std::size_t i = 0; i < scene.surfaces.size(); ++i) primary.push_back(primary_config(scene, precision, i));
+  auto with_entry = [&](const std::string& entry) {
+    std::vector<KernelConfig> configs = primary;
+    for (KernelConfig& c : configs) c.entry = entry;
+    return configs;
+  };
   plan.passes.push_back({"primary", plan.samples > 1 ? "camera rays, " + std::to_string(plan.samples) + "x" +
                                                            std::to_string(plan.samples) + " per pixel"
                                                      : "camera rays, one per pixel",
@@ -65,10 +72,11 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
   }
   if (!plan.shadow_lights.empty()) {
     // The shadow kernel isolates roots and never refines them: the refinement is not part of its code.
-    KernelConfig shadow = primary;
-    shadow.entry = "shadow";
-    shadow.refinement = Refinement::Brent;
-    shadow.max_iterations = default_max_iterations(Refinement::Brent);
+    std::vector<KernelConfig> shadow = with_entry("shadow");
+    for (KernelConfig& c : shadow) {
+      c.refinement = Refinement::Brent;
+      c.max_iterations = default_max_iterations(Refinement::Brent);
+    }
     std::size_t points = 0;
     for (int i : plan.shadow_lights) points += scene.lights[static_cast<std::size_t>(i)].sample_points().size();
     plan.passes.push_back({"shadow",
@@ -82,17 +90,19 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
     plan.buffers.push_back({"occlusion masks (at most)", rays * plan.shadow_lights.size() * sizeof(cl_ulong)});
   }
   // Secondary rays: one pass per effect a material asks for, sharing the one "trace" kernel.
-  KernelConfig trace = primary;
-  trace.entry = "trace";
-  const Materials& m = scene.materials;
+  const std::vector<KernelConfig> trace = with_entry("trace");
+  bool reflective = false, transparent = false;
+  for (const SceneSurface& s : scene.surfaces) {
+    reflective |= s.materials.front.reflectivity > 0 || s.materials.back.reflectivity > 0;
+    transparent |= s.materials.front.transparency > 0 || s.materials.back.transparency > 0;
+  }
   const struct {
     const char* name;
     bool wanted;
     const char* why;
   } effects[] = {
-      {"reflection", m.front.reflectivity > 0 || m.back.reflectivity > 0, "mirror rays of reflective sides"},
-      {"transmission", m.front.transparency > 0 || m.back.transparency > 0,
-       "rays continued through transparent sides to the next root"},
+      {"reflection", reflective, "mirror rays of reflective sides"},
+      {"transmission", transparent, "rays continued through transparent sides to the next root"},
   };
   for (const auto& effect : effects) {
     const std::string name = effect.name;
@@ -127,8 +137,11 @@ nlohmann::json RenderPlan::json() const {
   j["antialias_samples"] = samples;
   j["adaptive_antialias_samples"] = refine_samples;
   j["traced"] = {{"width", trace_width()}, {"height", trace_height()}};
-  for (const PlannedPass& p : passes)
-    j["passes"].push_back({{"name", p.name}, {"purpose", p.purpose}, {"kernel", p.kernel.key()}});
+  for (const PlannedPass& p : passes) {
+    nlohmann::json kernels = nlohmann::json::array();
+    for (const KernelConfig& k : p.kernels) kernels.push_back(k.key());
+    j["passes"].push_back({{"name", p.name}, {"purpose", p.purpose}, {"kernels", kernels}});
+  }
   for (const PlannedBuffer& b : buffers) j["buffers"].push_back({{"name", b.name}, {"bytes", b.bytes}});
   j["shadow_lights"] = shadow_lights;
   j["skipped"] = skipped;

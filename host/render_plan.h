@@ -13,9 +13,9 @@ namespace algray {
 
 // One pass: the rays it traces and the kernel it launches. Nothing outside the plan is built or launched.
 struct PlannedPass {
-  std::string name;     // "primary", "shadow"
+  std::string name;     // "primary", "shadow", "reflection", "transmission", "antialias"
   std::string purpose;  // why the scene needs it, for --stats
-  KernelConfig kernel;
+  std::vector<KernelConfig> kernels;  // one per surface of the scene, in scene order
 };
 
 struct PlannedBuffer {
@@ -44,8 +44,8 @@ struct RenderPlan {
 // only when a light casts shadows and the scene is not a preview.
 RenderPlan make_render_plan(const Scene& scene, Precision precision);
 
-// The kernel of the primary pass for `scene`.
-KernelConfig primary_config(const Scene& scene, Precision precision);
+// The kernel of the primary pass for one surface of `scene`.
+KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t surface = 0);
 
 // How far a shadow ray's origin is moved off the surface, along the normal to the light's side, in units of
 // the extent's radius (unit coordinates): well above the hit point's error in the precision, well below what

@@ -36,7 +36,8 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 
 // Shadow rays from every hit of one batch; ray(i) rebuilds the ray of hit i exactly as the kernel traced it.
 template <typename RayOf>
-ShadowData trace_shadows(const Scene& scene, const RenderPlan& plan, ShadowTracer& tracer,
+ShadowData trace_shadows(const Scene& scene, const RenderPlan& plan,
+                         const std::vector<std::unique_ptr<ShadowTracer>>& tracers,
                          const std::vector<HitRecord>& hits, RayOf ray, PassStats& stats) {
   const auto start = std::chrono::steady_clock::now();
   ShadowData data;
@@ -50,14 +51,37 @@ ShadowData trace_shadows(const Scene& scene, const RenderPlan& plan, ShadowTrace
     normals.emplace_back(h.normal_x, h.normal_y, h.normal_z);
   }
   for (int light : plan.shadow_lights) {
-    ShadowAnswer answer = tracer.trace(points, normals, scene.lights[static_cast<std::size_t>(light)].sample_points());
-    stats.kernel_ms += answer.kernel_ms;
-    stats.rays += answer.rays_traced;
-    ++stats.launches;
-    data.occlusion.push_back({light, std::move(answer.masks)});
+    // Each surface's kernel in turn; a light point one surface hides is not traced against the next.
+    std::vector<std::uint64_t> hidden;
+    for (const auto& tracer : tracers) {
+      ShadowAnswer answer =
+          tracer->trace(points, normals, scene.lights[static_cast<std::size_t>(light)].sample_points(), hidden);
+      stats.kernel_ms += answer.kernel_ms;
+      stats.rays += answer.rays_traced;
+      ++stats.launches;
+      hidden = std::move(answer.masks);
+    }
+    data.occlusion.push_back({light, std::move(hidden)});
   }
   stats.wall_ms += ms_since(start);
   return data;
+}
+
+// Keeps, per ray, the nearer of the hits found so far (surface `best`) and `other`'s hits (surface `index`).
+void keep_nearest(std::vector<HitRecord>& best, std::vector<std::uint8_t>& best_surface,
+                  const std::vector<HitRecord>& other, std::uint8_t index) {
+  if (best_surface.empty()) best_surface.assign(best.size(), 0);
+  for (std::size_t i = 0; i < best.size(); ++i) {
+    const HitRecord& o = other[i];
+    if (!(o.flags & ALGRAY_HIT_FOUND)) continue;
+    const HitRecord& b = best[i];
+    const double tb = static_cast<double>(b.t_hi) + static_cast<double>(b.t_lo);
+    const double to = static_cast<double>(o.t_hi) + static_cast<double>(o.t_lo);
+    if (!(b.flags & ALGRAY_HIT_FOUND) || to < tb) {
+      best[i] = o;
+      best_surface[i] = index;
+    }
+  }
 }
 
 }  // namespace
@@ -68,16 +92,18 @@ struct Renderer::Bounce {
   double weight;
   PixelRay ray;
   HitRecord hit;
+  std::uint8_t surface;  // which of the scene's surfaces it hit
 };
 
 // What the passes after the primary one share while a render runs: the kernels built so far and the stats.
 struct Renderer::Passes {
   const Scene& scene;
-  const DeviceSurface& surface;
+  Precision precision;
+  std::vector<std::unique_ptr<DeviceSurface>> surfaces;  // one per scene surface
   RenderResult& result;
   std::vector<PassStats> stats;  // one per planned pass, in plan order
-  std::unique_ptr<ShadowTracer> shadows;
-  std::unique_ptr<RayTracer> rays;
+  std::vector<std::unique_ptr<ShadowTracer>> shadows;  // one per surface, when the plan has a shadow pass
+  std::vector<std::unique_ptr<RayTracer>> rays;        // one per surface, when it has a secondary pass
 
   PassStats* stats_of(const std::string& name) {
     for (std::size_t i = 0; i < stats.size(); ++i)
@@ -91,24 +117,30 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   const Precision precision = resolve_precision(scene, session_.info);
   result.plan = make_render_plan(scene, precision);
   result.config = primary_config(scene, precision);
-  const DeviceSurface surface(session_.context, scene, precision);
-  Passes passes{scene, surface, result, std::vector<PassStats>(result.plan.passes.size()), nullptr, nullptr};
-  run_primary(scene, surface, show_progress, result, *passes.stats_of("primary"));
+  Passes passes{scene, precision, {}, result, std::vector<PassStats>(result.plan.passes.size()), {}, {}};
+  for (std::size_t i = 0; i < scene.surfaces.size(); ++i)
+    passes.surfaces.push_back(std::make_unique<DeviceSurface>(session_.context, scene, precision, i));
+  run_primary(passes, show_progress);
 
   if (PassStats* stats = passes.stats_of("shadow")) {
-    passes.shadows = std::make_unique<ShadowTracer>(session_, cache_, result.plan.find("shadow")->kernel, surface,
-                                                    shadow_offset_unit(precision) * scene.extent.unit_scale());
-    result.programs.push_back(passes.shadows->program());
-    stats->program_key = passes.shadows->program().key;
+    const double offset = shadow_offset_unit(precision) * scene.extent.unit_scale();
+    for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+      passes.shadows.push_back(std::make_unique<ShadowTracer>(session_, cache_, result.plan.find("shadow")->kernels[i],
+                                                              *passes.surfaces[i], offset));
+      result.programs.push_back(passes.shadows.back()->program());
+      stats->program_keys.push_back(passes.shadows.back()->program().key);
+    }
   }
-  // Every secondary pass launches the same trace kernel.
+  // Every secondary pass launches the same trace kernels.
   for (const char* name : {"reflection", "transmission", "antialias"})
     if (PassStats* stats = passes.stats_of(name)) {
-      if (!passes.rays) {
-        passes.rays = std::make_unique<RayTracer>(session_, cache_, result.plan.find(name)->kernel, surface);
-        result.programs.push_back(passes.rays->program());
-      }
-      stats->program_key = passes.rays->program().key;
+      if (passes.rays.empty())
+        for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+          passes.rays.push_back(std::make_unique<RayTracer>(session_, cache_, result.plan.find(name)->kernels[i],
+                                                            *passes.surfaces[i]));
+          result.programs.push_back(passes.rays.back()->program());
+        }
+      for (const auto& tracer : passes.rays) stats->program_keys.push_back(tracer->program().key);
     }
 
   const bool single = precision != Precision::Double;
@@ -116,13 +148,14 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   auto camera_ray = [&](std::size_t i) {
     return pixel_ray(result.basis, single, static_cast<int>(i % width), static_cast<int>(i / width));
   };
-  if (passes.shadows)
-    result.shadows = trace_shadows(scene, result.plan, *passes.shadows, result.hits.records, camera_ray,
+  if (!passes.shadows.empty())
+    result.shadows = trace_shadows(scene, result.plan, passes.shadows, result.hits.records, camera_ray,
                                    *passes.stats_of("shadow"));
   std::vector<Bounce> first;
   for (std::size_t i = 0; i < result.hits.records.size(); ++i)
     if (result.hits.records[i].flags & ALGRAY_HIT_FOUND)
-      first.push_back({static_cast<std::uint32_t>(i), 1.0, camera_ray(i), result.hits.records[i]});
+      first.push_back({static_cast<std::uint32_t>(i), 1.0, camera_ray(i), result.hits.records[i],
+                       static_cast<std::uint8_t>(result.hits.surface_of(i))});
   run_bounces(passes, std::move(first), false);
   if (result.plan.refine_samples > 1) run_antialias(passes);
 
@@ -133,86 +166,98 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   return result;
 }
 
-void Renderer::run_primary(const Scene& scene, const DeviceSurface& surface, bool show_progress,
-                           RenderResult& result, PassStats& pass) {
-  const auto wall_start = std::chrono::steady_clock::now();
+void Renderer::run_primary(Passes& passes, bool show_progress) {
+  const Scene& scene = passes.scene;
+  RenderResult& result = passes.result;
+  PassStats& pass = *passes.stats_of("primary");
   const int width = result.plan.trace_width(), height = result.plan.trace_height();
   result.basis = make_ray_basis(scene.camera, width, height);
-  ProgramRecord record;
-  cl::Kernel kernel = cache_.kernel(session_, result.config, &record);
-  result.programs.push_back(record);
-
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
-  cl::Buffer out(session_.context, CL_MEM_WRITE_ONLY, pixels * sizeof(HitRecord));
-  const RayBasis& b = result.basis;
-  KernelArgs args(kernel, surface.precision());
-  args.real_vec(b.o00);
-  args.real_vec(b.ou);
-  args.real_vec(b.ov);
-  args.real_vec(b.d00);
-  args.real_vec(b.du);
-  args.real_vec(b.dv);
-  surface.set_extent_args(args);
-  surface.set_surface_args(args);
-  args.plain(static_cast<cl_uint>(width));
-  const cl_uint tile_arg = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
-  args.skip(4);
-  args.plain(out);
-  pass.program_key = record.key;
-  const int tile = scene.render.tile_size > 0 ? scene.render.tile_size : default_tile_size(session_.info);
-  const int tiles_x = (width + tile - 1) / tile, tiles_y = (height + tile - 1) / tile;
-  const int tiles = tiles_x * tiles_y;
-  for (int ty = 0; ty < tiles_y; ++ty) {
-    for (int tx = 0; tx < tiles_x; ++tx) {
-      const int x0 = tx * tile, y0 = ty * tile;
-      const int w = std::min(tile, width - x0), h = std::min(tile, height - y0);
-      kernel.setArg(tile_arg, static_cast<cl_uint>(x0));
-      kernel.setArg(tile_arg + 1, static_cast<cl_uint>(y0));
-      kernel.setArg(tile_arg + 2, static_cast<cl_uint>(w));
-      kernel.setArg(tile_arg + 3, static_cast<cl_uint>(h));
-      cl::Event done;
-      session_.queue.enqueueNDRangeKernel(kernel, cl::NullRange,
-                                          cl::NDRange(static_cast<std::size_t>(w), static_cast<std::size_t>(h)),
-                                          cl::NullRange, nullptr, &done);
-      // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
-      done.wait();
-      pass.kernel_ms += ms_between(done);
-      ++pass.launches;
-      if (show_progress) {
-        std::fprintf(stderr, "\rrendering %s: %3d%% (%d/%d tiles)", scene.name.c_str(), 100 * pass.launches / tiles,
-                     pass.launches, tiles);
-        std::fflush(stderr);
-      }
-    }
-  }
-  if (show_progress) std::fprintf(stderr, "\n");
-  pass.rays = pixels;
-
   result.hits.width = width;
   result.hits.height = height;
-  result.hits.records.resize(pixels);
-  session_.queue.enqueueReadBuffer(out, CL_TRUE, 0, pixels * sizeof(HitRecord), result.hits.records.data());
-  pass.wall_ms = ms_since(wall_start) - record.build_ms;
+  const int tile = scene.render.tile_size > 0 ? scene.render.tile_size : default_tile_size(session_.info);
+  const int tiles_x = (width + tile - 1) / tile, tiles_y = (height + tile - 1) / tile;
+  const int tiles = tiles_x * tiles_y * static_cast<int>(scene.surfaces.size());
+  for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
+    const auto wall_start = std::chrono::steady_clock::now();
+    const DeviceSurface& surface = *passes.surfaces[s];
+    ProgramRecord record;
+    cl::Kernel kernel = cache_.kernel(session_, result.plan.find("primary")->kernels[s], &record);
+    result.programs.push_back(record);
+    pass.program_keys.push_back(record.key);
+    cl::Buffer out(session_.context, CL_MEM_WRITE_ONLY, pixels * sizeof(HitRecord));
+    const RayBasis& b = result.basis;
+    KernelArgs args(kernel, surface.precision());
+    args.real_vec(b.o00);
+    args.real_vec(b.ou);
+    args.real_vec(b.ov);
+    args.real_vec(b.d00);
+    args.real_vec(b.du);
+    args.real_vec(b.dv);
+    surface.set_extent_args(args);
+    surface.set_surface_args(args);
+    args.plain(static_cast<cl_uint>(width));
+    const cl_uint tile_arg = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
+    args.skip(4);
+    args.plain(out);
+    for (int ty = 0; ty < tiles_y; ++ty) {
+      for (int tx = 0; tx < tiles_x; ++tx) {
+        const int x0 = tx * tile, y0 = ty * tile;
+        const int w = std::min(tile, width - x0), h = std::min(tile, height - y0);
+        kernel.setArg(tile_arg, static_cast<cl_uint>(x0));
+        kernel.setArg(tile_arg + 1, static_cast<cl_uint>(y0));
+        kernel.setArg(tile_arg + 2, static_cast<cl_uint>(w));
+        kernel.setArg(tile_arg + 3, static_cast<cl_uint>(h));
+        cl::Event done;
+        session_.queue.enqueueNDRangeKernel(kernel, cl::NullRange,
+                                            cl::NDRange(static_cast<std::size_t>(w), static_cast<std::size_t>(h)),
+                                            cl::NullRange, nullptr, &done);
+        // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
+        done.wait();
+        pass.kernel_ms += ms_between(done);
+        ++pass.launches;
+        if (show_progress) {
+          std::fprintf(stderr, "\rrendering %s: %3d%% (%d/%d tiles)", scene.name.c_str(),
+                       100 * pass.launches / tiles, pass.launches, tiles);
+          std::fflush(stderr);
+        }
+      }
+    }
+    pass.rays += pixels;
+    std::vector<HitRecord> hits(pixels);
+    session_.queue.enqueueReadBuffer(out, CL_TRUE, 0, pixels * sizeof(HitRecord), hits.data());
+    if (s == 0)
+      result.hits.records = std::move(hits);
+    else
+      keep_nearest(result.hits.records, result.hits.surface, hits, static_cast<std::uint8_t>(s));
+    pass.wall_ms += ms_since(wall_start) - record.build_ms;
+  }
+  if (show_progress) std::fprintf(stderr, "\n");
 }
 
 // Traces one batch of secondary rays, then the shadow rays of its hits.
 void Renderer::trace_batch(Passes& passes, SecondaryBatch& batch) {
   const auto start = std::chrono::steady_clock::now();
   PassStats& stats = *passes.stats_of(batch.pass);
-  TracedBatch traced = passes.rays->trace(batch.rays);
-  batch.hits = std::move(traced.hits);
-  stats.kernel_ms += traced.kernel_ms;
-  stats.rays += batch.rays.size();
-  ++stats.launches;
+  for (std::size_t s = 0; s < passes.rays.size(); ++s) {
+    TracedBatch traced = passes.rays[s]->trace(batch.rays);
+    if (s == 0)
+      batch.hits = std::move(traced.hits);
+    else
+      keep_nearest(batch.hits, batch.hit_surface, traced.hits, static_cast<std::uint8_t>(s));
+    stats.kernel_ms += traced.kernel_ms;
+    stats.rays += batch.rays.size();
+    ++stats.launches;
+  }
   stats.wall_ms += ms_since(start);
-  if (passes.shadows)
-    batch.shadows = trace_shadows(passes.scene, passes.result.plan, *passes.shadows, batch.hits,
+  if (!passes.shadows.empty())
+    batch.shadows = trace_shadows(passes.scene, passes.result.plan, passes.shadows, batch.hits,
                                   [&](std::size_t i) { return batch.rays[i]; }, *passes.stats_of("shadow"));
 }
 
 void Renderer::run_bounces(Passes& passes, std::vector<Bounce> current, bool refinement) {
   const Scene& scene = passes.scene;
-  const double offset = shadow_offset_unit(passes.surface.precision()) * scene.extent.unit_scale();
+  const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
   // Below this a bounce cannot change a pixel's 8-bit colour.
   constexpr double kNegligibleWeight = 1.0 / 512;
   const char* const names[2] = {"reflection", "transmission"};
@@ -226,7 +271,8 @@ void Renderer::run_bounces(Passes& passes, std::vector<Bounce> current, bool ref
       batch.depth = depth;
       batch.refinement = refinement;
       for (const Bounce& b : current) {
-        const Material& m = (b.hit.flags & ALGRAY_HIT_BACK) ? scene.materials.back : scene.materials.front;
+        const Materials& sides = scene.surfaces[b.surface].materials;
+        const Material& m = (b.hit.flags & ALGRAY_HIT_BACK) ? sides.back : sides.front;
         const double share = k == 0 ? m.reflectivity : m.transparency;
         if (b.weight * share < kNegligibleWeight) continue;
         const glm::dvec3 p = hit_point(b.ray, b.hit);
@@ -243,7 +289,8 @@ void Renderer::run_bounces(Passes& passes, std::vector<Bounce> current, bool ref
       trace_batch(passes, batch);
       for (std::size_t i = 0; i < batch.rays.size(); ++i)
         if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
-          next.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i]});
+          next.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i],
+                          batch.hit_surface.empty() ? std::uint8_t{0} : batch.hit_surface[i]});
       passes.result.secondary.push_back(std::move(batch));
     }
     current = std::move(next);
@@ -264,7 +311,7 @@ void Renderer::run_antialias(Passes& passes) {
     return false;
   };
   result.refined.assign(static_cast<std::size_t>(w) * h, 0);
-  const bool single = passes.surface.precision() != Precision::Double;
+  const bool single = passes.precision != Precision::Double;
   // The rays of the n-times finer grid, so that a refined pixel gets exactly the rays uniform n x n would trace.
   const RayBasis fine = make_ray_basis(passes.scene.camera, w * n, h * n);
   SecondaryBatch batch;
@@ -288,7 +335,9 @@ void Renderer::run_antialias(Passes& passes) {
   trace_batch(passes, batch);
   std::vector<Bounce> first;
   for (std::size_t i = 0; i < batch.rays.size(); ++i)
-    if (batch.hits[i].flags & ALGRAY_HIT_FOUND) first.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i]});
+    if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
+      first.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i],
+                       batch.hit_surface.empty() ? std::uint8_t{0} : batch.hit_surface[i]});
   result.secondary.push_back(std::move(batch));
   run_bounces(passes, std::move(first), true);
 }

@@ -18,12 +18,14 @@ namespace algray {
 struct HitBuffer {
   int width = 0, height = 0;
   std::vector<HitRecord> records;  // row-major, top row first
+  std::vector<std::uint8_t> surface;  // which scene surface each record hit; empty when the scene has one
   const HitRecord& at(int x, int y) const { return records[static_cast<std::size_t>(y) * width + x]; }
+  int surface_of(std::size_t i) const { return surface.empty() ? 0 : surface[i]; }
 };
 
 struct PassStats {
   std::string name;
-  std::string program_key;  // ProgramRecord::key of the kernel the pass launched
+  std::vector<std::string> program_keys;  // ProgramRecord::key of the kernels the pass launched, per surface
   std::uint64_t rays = 0;
   int launches = 0;
   double kernel_ms = 0;  // device time summed over launches (profiling events)
@@ -51,13 +53,14 @@ struct SecondaryBatch {
   std::vector<double> weight;         // its share of that ray's colour
   std::vector<PixelRay> rays;
   std::vector<HitRecord> hits;
+  std::vector<std::uint8_t> hit_surface;  // as HitBuffer::surface
   ShadowData shadows;
 };
 
 struct RenderResult {
   RenderPlan plan;
   HitBuffer hits;       // one record per traced ray: plan.trace_width() x plan.trace_height()
-  KernelConfig config;  // of the primary pass, with precision and tolerance as used
+  KernelConfig config;  // of the first surface's primary pass, with precision and tolerance as used
   RayBasis basis;       // of the traced rays (per antialiasing sample, not per pixel)
   std::vector<ProgramRecord> programs;
   std::vector<PassStats> passes;
@@ -86,10 +89,9 @@ class Renderer {
   RenderResult render(const Scene& scene, bool show_progress);
 
  private:
-  void run_primary(const Scene& scene, const DeviceSurface& surface, bool show_progress, RenderResult& result,
-                   PassStats& stats);
   struct Passes;
   struct Bounce;
+  void run_primary(Passes& passes, bool show_progress);
   void trace_batch(Passes& passes, SecondaryBatch& batch);
   // Reflection and transmission rays, bounce by bounce, from the hits in `current`.
   void run_bounces(Passes& passes, std::vector<Bounce> current, bool refinement);

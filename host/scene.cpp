@@ -185,7 +185,7 @@ class SceneReader {
 
 const std::set<std::string> kTopKeys{"surface", "parameters", "extent",    "camera", "image",
                                      "material", "light",      "antialias", "render"};
-const std::set<std::string> kSurfaceKeys{"name", "equation", "terms"};
+const std::set<std::string> kSurfaceKeys{"name", "equation", "terms", "material"};
 const std::set<std::string> kExtentKeys{"type", "centre", "radius", "min", "max"};
 const std::set<std::string> kCameraKeys{"projection", "eye", "look_at", "up", "fov_y", "height"};
 const std::set<std::string> kImageKeys{"width", "height", "background"};
@@ -265,6 +265,46 @@ void read_material(const SceneReader& r, const toml::table& t, const std::string
   if (const toml::node* n = t.get("transparency")) m.transparency = r.number_in(*n, name + ".transparency", 0, 1);
 }
 
+void read_materials(const SceneReader& r, const toml::table& t, const std::string& name, Materials& m) {
+  r.check_keys(t, name, kMaterialKeys);
+  for (const char* side : {"front", "back"})
+    if (const toml::table* st = r.subtable(t, side))
+      read_material(r, *st, name + "." + side, std::string(side) == "front" ? m.front : m.back);
+}
+
+SceneSurface read_surface(const SceneReader& r, const toml::table& surface,
+                          const std::map<std::string, double>& parameters) {
+  SceneSurface out;
+  r.check_keys(surface, "surface", kSurfaceKeys);
+  const toml::node* equation = surface.get("equation");
+  const toml::node* terms = surface.get("terms");
+  if (equation && terms) r.fail(terms->source(), "give surface.equation or surface.terms, not both");
+  const toml::node& anchor = equation ? *equation : terms ? *terms : static_cast<const toml::node&>(surface);
+  if (equation) {
+    out.equation = r.string(*equation, "surface.equation");
+    try {
+      out.polynomial = parse_equation(out.equation, parameters);
+    } catch (const EquationError& e) {
+      r.fail(equation->source(),
+             std::string(e.what()) + " (at character " + std::to_string(e.position + 1) + " of the equation)",
+             r.string_column_offset(*equation, e.position));
+    }
+  } else if (terms) {
+    out.polynomial = polynomial_from_terms(r, *terms);
+    out.equation = out.polynomial.to_string();
+  } else {
+    r.fail(surface.source(), "[surface] needs an equation or a list of terms");
+  }
+  const int degree = out.polynomial.degree();
+  if (degree < 0) r.fail(anchor.source(), "the polynomial is identically zero after expansion");
+  if (degree == 0) r.fail(anchor.source(), "the polynomial is a nonzero constant: it has no points");
+  if (degree > kMaxDegree)
+    r.fail(anchor.source(),
+           "degree " + std::to_string(degree) + " exceeds the supported maximum " + std::to_string(kMaxDegree));
+  if (const toml::node* n = surface.get("name")) out.name = r.string(*n, "surface.name");
+  return out;
+}
+
 Light read_light(const SceneReader& r, const toml::table& t) {
   r.check_keys(t, "light", kLightKeys);
   Light light;
@@ -333,35 +373,23 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
     }
   }
 
-  const toml::table* surface = r.subtable(root, "surface");
-  if (!surface) r.fail(root.source(), "missing [surface] table with an equation or a list of terms");
-  r.check_keys(*surface, "surface", kSurfaceKeys);
-  const toml::node* equation = surface->get("equation");
-  const toml::node* terms = surface->get("terms");
-  if (equation && terms) r.fail(terms->source(), "give surface.equation or surface.terms, not both");
-  const toml::node& surface_anchor = equation ? *equation : terms ? *terms : static_cast<const toml::node&>(*surface);
-  if (equation) {
-    scene.equation = r.string(*equation, "surface.equation");
-    try {
-      scene.polynomial = parse_equation(scene.equation, scene.parameters);
-    } catch (const EquationError& e) {
-      r.fail(equation->source(),
-             std::string(e.what()) + " (at character " + std::to_string(e.position + 1) + " of the equation)",
-             r.string_column_offset(*equation, e.position));
-    }
-  } else if (terms) {
-    scene.polynomial = polynomial_from_terms(r, *terms);
-    scene.equation = scene.polynomial.to_string();
+  // One [surface] table, or several [[surface]] tables: the nearest hit among them wins.
+  const toml::node* surface_node = root.get("surface");
+  if (!surface_node) r.fail(root.source(), "missing [surface] table with an equation or a list of terms");
+  std::vector<const toml::table*> surface_tables;
+  if (const toml::table* t = surface_node->as_table()) {
+    surface_tables.push_back(t);
+  } else if (const toml::array* list = surface_node->as_array(); list && list->is_array_of_tables() && !list->empty()) {
+    if (list->size() > kMaxSurfaces)
+      r.fail(surface_node->source(), "at most " + std::to_string(kMaxSurfaces) + " surfaces per scene");
+    for (const toml::node& n : *list) surface_tables.push_back(n.as_table());
   } else {
-    r.fail(surface->source(), "[surface] needs an equation or a list of terms");
+    r.fail(surface_node->source(), "'surface' must be a [surface] table or [[surface]] tables");
   }
-  const int degree = scene.polynomial.degree();
-  if (degree < 0) r.fail(surface_anchor.source(), "the polynomial is identically zero after expansion");
-  if (degree == 0) r.fail(surface_anchor.source(), "the polynomial is a nonzero constant: it has no points");
-  if (degree > kMaxDegree)
-    r.fail(surface_anchor.source(),
-           "degree " + std::to_string(degree) + " exceeds the supported maximum " + std::to_string(kMaxDegree));
-  if (const toml::node* n = surface->get("name")) scene.name = r.string(*n, "surface.name");
+  for (const toml::table* t : surface_tables) scene.surfaces.push_back(read_surface(r, *t, scene.parameters));
+  if (!scene.surfaces.front().name.empty()) scene.name = scene.surfaces.front().name;
+  int degree = 0;
+  for (const SceneSurface& s : scene.surfaces) degree = std::max(degree, s.polynomial.degree());
 
   const toml::table* extent = r.subtable(root, "extent");
   if (!extent)
@@ -442,12 +470,14 @@ Scene interpret(const SceneReader& r, const toml::table& root, const std::string
     if (const toml::node* n = image->get("background")) scene.image.background = r.colour(*n, "image.background", true);
   }
 
-  if (const toml::table* material = r.subtable(root, "material")) {
-    r.check_keys(*material, "material", kMaterialKeys);
-    for (const char* side : {"front", "back"})
-      if (const toml::table* t = r.subtable(*material, side))
-        read_material(r, *t, std::string("material.") + side,
-                      std::string(side) == "front" ? scene.materials.front : scene.materials.back);
+  // [material] sets every surface's sides; a surface's own [surface.material] then changes its keys.
+  Materials defaults;
+  if (const toml::table* material = r.subtable(root, "material")) read_materials(r, *material, "material", defaults);
+  for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+    Materials own = defaults;
+    if (const toml::table* material = r.subtable(*surface_tables[i], "material"))
+      read_materials(r, *material, "surface.material", own);
+    scene.surfaces[i].materials = own;
   }
 
   if (const toml::node* lights = root.get("light")) {

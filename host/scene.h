@@ -107,19 +107,31 @@ struct RenderSettings {
   int max_depth = 5;
 };
 
-struct Scene {
-  std::string source;    // the scene file's path, or "<built-in default scene>"
-  std::string name;      // surface.name, else the file stem
+// One surface of a scene: its polynomial and how its two sides look.
+struct SceneSurface {
+  std::string name;
   std::string equation;  // as written, or generated from the term list
-  std::map<std::string, double> parameters;
   Polynomial polynomial;
+  Materials materials;
+};
+
+// Surfaces one scene may hold; each is traced by its own kernel specialisation.
+inline constexpr std::size_t kMaxSurfaces = 8;
+
+struct Scene {
+  std::string source;  // the scene file's path, or "<built-in default scene>"
+  std::string name;    // the first surface's name, else the file stem
+  std::map<std::string, double> parameters;
+  std::vector<SceneSurface> surfaces;  // at least one; where several meet a ray, the nearest hit wins
   Extent extent;
   CameraSpec camera;
   ImageSpec image;
-  Materials materials;
   std::vector<Light> lights;  // none: a headlight at the eye shades the surface, without shadows
   Antialias antialias;
   RenderSettings render;
+
+  // The first surface: the one single-surface tools (the reference solver, the solver benchmarks) work on.
+  const SceneSurface& surface() const { return surfaces.front(); }
 };
 
 // "key=value" from --set (or a flag such as --width): key is a dotted scene key; a key without a dot names a

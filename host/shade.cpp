@@ -41,10 +41,11 @@ class ShadowLookup {
 
 // Colour of one traced ray that hit the surface: the side's own colour (times 1 - transparency, the rest
 // coming from the transmission pass), lit by every light's points that the shadow pass left visible.
-glm::dvec3 shade_hit(const Scene& scene, const std::vector<LightSamples>& lights, const HitRecord& h,
+glm::dvec3 shade_hit(const Scene& scene, const std::vector<LightSamples>& lights, const HitRecord& h, int surface,
                      const glm::dvec3& point, const glm::dvec3& to_eye, const ShadowLookup& shadows,
                      std::size_t hit_index) {
-  const Material& m = (h.flags & ALGRAY_HIT_BACK) ? scene.materials.back : scene.materials.front;
+  const Materials& sides = scene.surfaces[static_cast<std::size_t>(surface)].materials;
+  const Material& m = (h.flags & ALGRAY_HIT_BACK) ? sides.back : sides.front;
   const glm::dvec3 n(h.normal_x, h.normal_y, h.normal_z);
   const double own = 1 - m.transparency;
   if (lights.empty()) {
@@ -110,8 +111,8 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
       const HitRecord& h = batch.hits[i];
       const glm::dvec3 seen =
           (h.flags & ALGRAY_HIT_FOUND)
-              ? shade_hit(scene, lights, h, hit_point(batch.rays[i], h), -glm::normalize(batch.rays[i].direction),
-                          batch_shadows, i)
+              ? shade_hit(scene, lights, h, batch.hit_surface.empty() ? 0 : batch.hit_surface[i],
+                          hit_point(batch.rays[i], h), -glm::normalize(batch.rays[i].direction), batch_shadows, i)
               : glm::dvec3(scene.image.background);
       (batch.refinement ? refined_colour : secondary)[batch.sample[i]] += batch.weight[i] * seen;
       if (batch.pass == "antialias")
@@ -151,7 +152,8 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
             }
             const PixelRay ray = pixel_ray(result.basis, single, tx, ty);
             const glm::dvec3 to_eye = -glm::normalize(ray.direction);
-            glm::dvec3 colour = shade_hit(scene, lights, h, hit_point(ray, h), to_eye, primary_shadows, k);
+            glm::dvec3 colour =
+                shade_hit(scene, lights, h, hits.surface_of(k), hit_point(ray, h), to_eye, primary_shadows, k);
             if (!secondary.empty()) colour += secondary[k];
             sum += glm::dvec4(colour, 1);
             if (h.depth < img.depth[i]) {

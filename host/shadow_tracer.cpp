@@ -12,13 +12,16 @@ ShadowTracer::ShadowTracer(ClSession& session, ProgramCache& cache, const Kernel
 }
 
 ShadowAnswer ShadowTracer::trace(const std::vector<glm::dvec3>& points, const std::vector<glm::vec3>& normals,
-                                 const std::vector<glm::dvec3>& light_points) {
+                                 const std::vector<glm::dvec3>& light_points,
+                                 const std::vector<std::uint64_t>& already_hidden) {
   if (light_points.empty() || light_points.size() > 64)
     throw std::invalid_argument("a shadow query takes 1 to 64 light points");
   if (normals.size() != points.size()) throw std::invalid_argument("one normal per surface point");
   ShadowAnswer answer;
   const std::size_t count = points.size();
-  answer.masks.assign(count, 0);
+  if (!already_hidden.empty() && already_hidden.size() != count)
+    throw std::invalid_argument("one already-hidden mask per surface point");
+  answer.masks = already_hidden.empty() ? std::vector<std::uint64_t>(count, 0) : already_hidden;
   if (count == 0) return answer;
 
   std::vector<float> normal_data;

@@ -24,9 +24,10 @@ class ShadowTracer {
                double offset);
   const ProgramRecord& program() const { return record_; }
   // points and normals: world-space surface points and unit normals on the side the light is looked for from.
-  // At most 64 light points.
+  // At most 64 light points. already_hidden (empty, or one mask per point): light points another surface
+  // hides, which are not traced again and stay set in the answer.
   ShadowAnswer trace(const std::vector<glm::dvec3>& points, const std::vector<glm::vec3>& normals,
-                     const std::vector<glm::dvec3>& light_points);
+                     const std::vector<glm::dvec3>& light_points, const std::vector<std::uint64_t>& already_hidden = {});
 
  private:
   ClSession& session_;

@@ -74,7 +74,7 @@ RaySolve solve(const std::string& file, const glm::dvec3& from, const glm::dvec3
   r.t_in = static_cast<double>(t_in);
   r.t_out = static_cast<double>(t_out);
   const glm::dvec3 o = r.ray.origin, d = r.ray.direction;
-  r.reference = ref::smallest_root(scene.polynomial, ref::ExactRay{{o.x, o.y, o.z}, {d.x, d.y, d.z}},
+  r.reference = ref::smallest_root(scene.surface().polynomial, ref::ExactRay{{o.x, o.y, o.z}, {d.x, d.y, d.z}},
                                    exact_rational(r.t_in), exact_rational(r.t_out), mpq_class(1, 1000000000000L));
   return r;
 }
@@ -197,7 +197,7 @@ TEST_CASE("Fig. 8: where Newton from the left end catches the second root, the k
     // Newton on the exact polynomial, in long double, from the left end of the interval.
     const glm::dvec3 o = s.ray.origin, d = s.ray.direction;
     const std::vector<mpq_class> p =
-        ref::restrict_exact(load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/torus.toml").polynomial,
+        ref::restrict_exact(load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/torus.toml").surface().polynomial,
                             ref::ExactRay{{o.x, o.y, o.z}, {d.x, d.y, d.z}});
     long double t = s.t_in;
     for (int it = 0; it < 100; ++it) {

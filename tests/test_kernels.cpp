@@ -77,7 +77,7 @@ TEST_CASE("every DEGREE from 1 to 32 builds and finds the smallest root, in floa
     for (int degree = 1; degree <= max_degree; ++degree) {
       INFO("DEGREE=" << degree << " precision=" << precision);
       const Scene scene = degree_scene(degree, precision);
-      REQUIRE(scene.polynomial.degree() == degree);
+      REQUIRE(scene.surface().polynomial.degree() == degree);
       RenderResult result;
       REQUIRE_NOTHROW(result = renderer.render(scene, false));  // a BuildError prints the options and the log
       REQUIRE(result.programs.size() == 1);

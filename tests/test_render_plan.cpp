@@ -139,7 +139,7 @@ TEST_CASE("reflection and transmission passes run only for materials that ask, a
       secondary.insert(name);
       // The unit sphere fills the middle of the view: every bounce pass has camera hits to start from.
       CHECK(p.at("rays").get<std::uint64_t>() > 0);
-      CHECK(p.at("kernel").get<std::string>().rfind("trace ", 0) == 0);
+      for (const auto& k : p.at("kernels")) CHECK(k.at("key").get<std::string>().rfind("trace ", 0) == 0);
     }
     CHECK(secondary == c.passes);
     bool trace_program = false;

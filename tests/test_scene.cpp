@@ -51,8 +51,8 @@ TEST_CASE("every shipped scene loads with a supported degree and a non-empty ext
     INFO(entry.path());
     Scene s;
     REQUIRE_NOTHROW(s = algray::load_scene_file(entry.path().string()));
-    CHECK(s.polynomial.degree() >= 1);
-    CHECK(s.polynomial.degree() <= 32);
+    CHECK(s.surface().polynomial.degree() >= 1);
+    CHECK(s.surface().polynomial.degree() <= 32);
     CHECK_FALSE(s.name.empty());
     if (s.extent.kind == algray::ExtentKind::Sphere) {
       CHECK(s.extent.radius > 0);
@@ -66,13 +66,13 @@ TEST_CASE("every shipped scene loads with a supported degree and a non-empty ext
 
 TEST_CASE("the default scene is the Barth sextic", "[scene]") {
   const Scene s = algray::default_scene();
-  CHECK(s.polynomial.degree() == 6);
-  CHECK(s.polynomial.terms().size() == 17);
+  CHECK(s.surface().polynomial.degree() == 6);
+  CHECK(s.surface().polynomial.terms().size() == 17);
   CHECK(s.name == "Barth sextic");
   CHECK(s.source == "<built-in default scene>");
   // The embedded copy must be the file in scenes/, not a stale one.
   const Scene file = algray::load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_sextic.toml");
-  CHECK(s.polynomial == file.polynomial);
+  CHECK(s.surface().polynomial == file.surface().polynomial);
 }
 
 TEST_CASE("a scene without surface.name is named after its file", "[scene]") {
@@ -84,17 +84,17 @@ TEST_CASE("parameters are substituted into the equation as their double values",
   const std::string text = sphere_with({{3, "equation = \"x^2+y^2+z^2-a\""}}, {"[parameters]", "a = 2.7"});
   const Scene s = algray::load_scene_text(text, "t.toml");
   CHECK(s.parameters.at("a") == 2.7);
-  CHECK(s.polynomial == equation("x^2+y^2+z^2-a", {{"a", 2.7}}));
-  CHECK_FALSE(s.polynomial == equation("x^2+y^2+z^2-3"));
+  CHECK(s.surface().polynomial == equation("x^2+y^2+z^2-a", {{"a", 2.7}}));
+  CHECK_FALSE(s.surface().polynomial == equation("x^2+y^2+z^2-3"));
 
   SECTION("a bare override key names a parameter") {
     const Scene o = algray::load_scene_text(text, "t.toml", {{"a", "3"}});
     CHECK(o.parameters.at("a") == 3.0);
-    CHECK(o.polynomial == equation("x^2+y^2+z^2-3"));
+    CHECK(o.surface().polynomial == equation("x^2+y^2+z^2-3"));
   }
   SECTION("a bare override may add a parameter the file lacks") {
     const std::string uses_b = sphere_with({{3, "equation = \"x^2+y^2+z^2-b\""}});
-    CHECK(algray::load_scene_text(uses_b, "t.toml", {{"b", "0.25"}}).polynomial == equation("x^2+y^2+z^2-0.25"));
+    CHECK(algray::load_scene_text(uses_b, "t.toml", {{"b", "0.25"}}).surface().polynomial == equation("x^2+y^2+z^2-0.25"));
   }
 }
 
@@ -120,8 +120,8 @@ TEST_CASE("dotted overrides reach image, render and camera keys", "[scene]") {
 TEST_CASE("the paper's term list gives the same polynomial as the equation", "[scene]") {
   const Scene s = algray::load_scene_text(
       sphere_with({{3, "terms = [[2,0,0,1.0],[0,2,0,1.0],[0,0,2,1.0],[0,0,0,-1.0]]"}}), "t.toml");
-  CHECK(s.polynomial == equation("x^2+y^2+z^2-1"));
-  CHECK_FALSE(s.equation.empty());
+  CHECK(s.surface().polynomial == equation("x^2+y^2+z^2-1"));
+  CHECK_FALSE(s.surface().equation.empty());
 }
 
 TEST_CASE("unknown keys are reported at the key, with a suggestion when one is close", "[scene][errors]") {
@@ -224,4 +224,61 @@ TEST_CASE("errors from overrides name the --set argument", "[scene][errors]") {
   const SceneError width = error_of(sphere_with({}), {{"image.width", "0"}});
   CHECK_THAT(width.where, Catch::StartsWith("--set"));
   CHECK_THAT(width.message, Catch::Contains("image.width must be between 1"));
+}
+
+TEST_CASE("several [[surface]] tables: each with its polynomial and materials over the scene's", "[scene]") {
+  const std::string camera = "[extent]\nradius = 2\n[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n";
+  const Scene s = algray::load_scene_text(
+      "[[surface]]\nname = \"a\"\nequation = \"x^2+y^2+z^2-1\"\n"
+      "[[surface]]\nequation = \"x^4+y^4+z^4-1\"\n[surface.material.front]\nreflectivity = 0.5\n"
+      "[material.front]\ncolour = [0, 1, 0]\n" + camera,
+      "t.toml");
+  REQUIRE(s.surfaces.size() == 2);
+  CHECK(s.name == "a");
+  CHECK(s.surfaces[1].polynomial.degree() == 4);
+  // The scene's [material] reaches both; the second surface's own table adds to it.
+  CHECK(s.surfaces[0].materials.front.colour == glm::dvec3(0, 1, 0));
+  CHECK(s.surfaces[1].materials.front.colour == glm::dvec3(0, 1, 0));
+  CHECK(s.surfaces[0].materials.front.reflectivity == 0);
+  CHECK(s.surfaces[1].materials.front.reflectivity == 0.5);
+
+  std::string nine;
+  for (int i = 0; i < 9; ++i) nine += "[[surface]]\nequation = \"x - " + std::to_string(i) + "\"\n";
+  const SceneError e = error_of(nine + camera);
+  CHECK(e.where == "t.toml:1:1");
+  CHECK_THAT(e.message, Catch::Contains("at most 8 surfaces"));
+  check_error("[[surface]]\nequation = \"x\"\n[[surface]]\nequation = \"3\"\n" + camera, "t.toml:4:12",
+              "nonzero constant");
+}
+
+TEST_CASE("lights: kinds, keys that belong to another kind, and area samples spread uniformly", "[scene]") {
+  const std::string base = sphere_with({});
+  check_error(base + "[[light]]\ntype = \"point\"\nposition = [1, 2, 3]\nradius = 2\n", "t.toml:14:10",
+              "does not apply to a point light");
+  check_error(base + "[[light]]\ntype = \"rectangle\"\nposition = [1, 2, 3]\nedge_u = [1, 0, 0]\nedge_v = [2, 0, 0]\n",
+              "t.toml:15:10", "degenerate");
+  check_error(base + "[[light]]\ntype = \"disc\"\nposition = [0, 0, 0]\nradius = 1\nsamples = 9\n", "t.toml:15:11",
+              "between 1 and 8");
+  // A disc's n x n points lie on the disc, in its plane, and cover it by area: mean r^2 is R^2 / 2.
+  const Scene s = algray::load_scene_text(
+      base + "[[light]]\ntype = \"disc\"\nposition = [1, 2, 3]\nnormal = [0, 0, 2]\nradius = 2\nsamples = 8\n", "t.toml");
+  REQUIRE(s.lights.size() == 1);
+  const std::vector<glm::dvec3> points = s.lights[0].sample_points();
+  REQUIRE(points.size() == 64);
+  double mean_r2 = 0;
+  for (const glm::dvec3& p : points) {
+    const glm::dvec3 d = p - glm::dvec3(1, 2, 3);
+    CHECK(std::fabs(d.z) < 1e-12);
+    CHECK(glm::length(d) <= 2 + 1e-12);
+    mean_r2 += glm::dot(d, d) / 64;
+  }
+  CHECK(mean_r2 == Approx(2.0).epsilon(0.05));
+  // A rectangle's points are the centres of an n x n grid of cells.
+  const Scene r = algray::load_scene_text(
+      base + "[[light]]\ntype = \"rectangle\"\nposition = [0, 0, 0]\nedge_u = [2, 0, 0]\nedge_v = [0, 4, 0]\nsamples = 2\n",
+      "t.toml");
+  const std::vector<glm::dvec3> corners = r.lights[0].sample_points();
+  REQUIRE(corners.size() == 4);
+  CHECK(corners[0] == glm::dvec3(-0.5, -1, 0));
+  CHECK(corners[3] == glm::dvec3(0.5, 1, 0));
 }

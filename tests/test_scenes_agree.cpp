@@ -187,9 +187,9 @@ TEST_CASE("each scene agrees with an independent CPU check on a seeded sample of
       const RenderResult result = renderer.render(scene, false);
       const bool is_double = result.config.precision == Precision::Double;
       const Real eps = is_double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();
-      const Real degree = scene.polynomial.degree();
+      const Real degree = scene.surface().polynomial.degree();
       const Real tol = std::max<Real>(result.config.tolerance, eps);
-      const std::vector<Monomial> poly = scene.polynomial.monomials();
+      const std::vector<Monomial> poly = scene.surface().polynomial.monomials();
 
       // A seeded sample of hit pixels and of pixels whose ray crosses the extent without a hit.
       std::vector<int> hits, misses;

@@ -68,14 +68,14 @@ Verdict reference_verdict(const Scene& scene, Precision precision, const Surface
   const long double margin = kReferenceEndMargin * eps;
   const ref::ExactRay exact{{ray.origin.x, ray.origin.y, ray.origin.z},
                             {ray.direction.x, ray.direction.y, ray.direction.z}};
-  const std::vector<mpq_class> restricted = ref::restrict_exact(scene.polynomial, exact);
+  const std::vector<mpq_class> restricted = ref::restrict_exact(scene.surface().polynomial, exact);
   // Solved from a little before the origin: a root that close to it means the origin is still on the surface.
   const mpq_class lo = exact_rational(static_cast<double>(t_in - margin));
   const mpq_class hi = exact_rational(static_cast<double>(t_out + margin));
   const mpq_class width = exact_rational(1e-13);
   const ref::Answer a = ref::smallest_root(restricted, lo, hi, width);
   if (a.kind == ref::Classification::Miss)
-    return flips_under_ray_rounding(restricted, scene.polynomial.monomials(), ray, lo, hi, eps) ? Verdict::Ambiguous
+    return flips_under_ray_rounding(restricted, scene.surface().polynomial.monomials(), ray, lo, hi, eps) ? Verdict::Ambiguous
                                                                                                  : Verdict::Visible;
   const long double t = a.t_nearest;
   if (std::fabs(t) <= margin) return Verdict::OriginOnSurface;
