@@ -119,7 +119,8 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
   for (const ProgramRecord& p : r.programs) {
     double kernel_ms = 0;
     for (const PassStats& pass : r.passes)
-      if (pass.program_keys.size() == 1 && pass.program_keys.front() == p.key) kernel_ms += pass.kernel_ms;
+      for (std::size_t k = 0; k < pass.program_keys.size(); ++k)
+        if (pass.program_keys[k] == p.key) kernel_ms += pass.program_ms[k];
     j["programs"].push_back({{"key", p.key},
                              {"options", p.options},
                              {"from_cache", p.origin != "built"},

@@ -51,14 +51,18 @@ ShadowData trace_shadows(const Scene& scene, const RenderPlan& plan,
     normals.emplace_back(h.normal_x, h.normal_y, h.normal_z);
   }
   for (int light : plan.shadow_lights) {
-    // Each surface's kernel in turn; a light point one surface hides is not traced against the next.
+    // Each surface's kernel in turn; a light point one surface hides is not traced against the next. A ray
+    // counts once, from the first surface's kernel, which traces every light point in front of the surface.
     std::vector<std::uint64_t> hidden;
-    for (const auto& tracer : tracers) {
+    for (std::size_t s = 0; s < tracers.size(); ++s) {
       ShadowAnswer answer =
-          tracer->trace(points, normals, scene.lights[static_cast<std::size_t>(light)].sample_points(), hidden);
-      stats.kernel_ms += answer.kernel_ms;
-      stats.rays += answer.rays_traced;
-      ++stats.launches;
+          tracers[s]->trace(points, normals, scene.lights[static_cast<std::size_t>(light)].sample_points(), hidden);
+      if (!points.empty()) {
+        stats.kernel_ms += answer.kernel_ms;
+        stats.program_ms[s] += answer.kernel_ms;
+        ++stats.launches;
+      }
+      if (s == 0) stats.rays += answer.rays_traced;
       hidden = std::move(answer.masks);
     }
     data.occlusion.push_back({light, std::move(hidden)});
@@ -68,19 +72,25 @@ ShadowData trace_shadows(const Scene& scene, const RenderPlan& plan,
 }
 
 // Keeps, per ray, the nearer of the hits found so far (surface `best`) and `other`'s hits (surface `index`).
+// The solver work of both is added up, and a depth-limited isolation on either is kept, so the statistics
+// and the solver channels count every surface's kernel.
 void keep_nearest(std::vector<HitRecord>& best, std::vector<std::uint8_t>& best_surface,
                   const std::vector<HitRecord>& other, std::uint8_t index) {
   if (best_surface.empty()) best_surface.assign(best.size(), 0);
   for (std::size_t i = 0; i < best.size(); ++i) {
     const HitRecord& o = other[i];
-    if (!(o.flags & ALGRAY_HIT_FOUND)) continue;
-    const HitRecord& b = best[i];
+    HitRecord& b = best[i];
+    const std::uint32_t steps = std::min(0xffffu, (b.work & 0xffffu) + (o.work & 0xffffu));
+    const std::uint32_t iterations = std::min(0xffffu, (b.work >> 16) + (o.work >> 16));
+    const std::uint32_t shared_flags = (b.flags | o.flags) & (ALGRAY_HIT_BUDGET | ALGRAY_HIT_IN_EXTENT);
     const double tb = static_cast<double>(b.t_hi) + static_cast<double>(b.t_lo);
     const double to = static_cast<double>(o.t_hi) + static_cast<double>(o.t_lo);
-    if (!(b.flags & ALGRAY_HIT_FOUND) || to < tb) {
-      best[i] = o;
+    if ((o.flags & ALGRAY_HIT_FOUND) && (!(b.flags & ALGRAY_HIT_FOUND) || to < tb)) {
+      b = o;
       best_surface[i] = index;
     }
+    b.work = steps | iterations << 16;
+    b.flags |= shared_flags;
   }
 }
 
@@ -129,6 +139,7 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
                                                               *passes.surfaces[i], offset));
       result.programs.push_back(passes.shadows.back()->program());
       stats->program_keys.push_back(passes.shadows.back()->program().key);
+      stats->program_ms.push_back(0);
     }
   }
   // Every secondary pass launches the same trace kernels.
@@ -140,7 +151,10 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
                                                             *passes.surfaces[i]));
           result.programs.push_back(passes.rays.back()->program());
         }
-      for (const auto& tracer : passes.rays) stats->program_keys.push_back(tracer->program().key);
+      for (const auto& tracer : passes.rays) {
+        stats->program_keys.push_back(tracer->program().key);
+        stats->program_ms.push_back(0);
+      }
     }
 
   const bool single = precision != Precision::Double;
@@ -185,6 +199,7 @@ void Renderer::run_primary(Passes& passes, bool show_progress) {
     cl::Kernel kernel = cache_.kernel(session_, result.plan.find("primary")->kernels[s], &record);
     result.programs.push_back(record);
     pass.program_keys.push_back(record.key);
+    pass.program_ms.push_back(0);
     cl::Buffer out(session_.context, CL_MEM_WRITE_ONLY, pixels * sizeof(HitRecord));
     const RayBasis& b = result.basis;
     KernelArgs args(kernel, surface.precision());
@@ -215,6 +230,7 @@ void Renderer::run_primary(Passes& passes, bool show_progress) {
         // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
         done.wait();
         pass.kernel_ms += ms_between(done);
+        pass.program_ms[s] += ms_between(done);
         ++pass.launches;
         if (show_progress) {
           std::fprintf(stderr, "\rrendering %s: %3d%% (%d/%d tiles)", scene.name.c_str(),
@@ -223,7 +239,7 @@ void Renderer::run_primary(Passes& passes, bool show_progress) {
         }
       }
     }
-    pass.rays += pixels;
+    if (s == 0) pass.rays += pixels;  // each camera ray once, however many surfaces it is tested against
     std::vector<HitRecord> hits(pixels);
     session_.queue.enqueueReadBuffer(out, CL_TRUE, 0, pixels * sizeof(HitRecord), hits.data());
     if (s == 0)
@@ -246,7 +262,8 @@ void Renderer::trace_batch(Passes& passes, SecondaryBatch& batch) {
     else
       keep_nearest(batch.hits, batch.hit_surface, traced.hits, static_cast<std::uint8_t>(s));
     stats.kernel_ms += traced.kernel_ms;
-    stats.rays += batch.rays.size();
+    stats.program_ms[s] += traced.kernel_ms;
+    if (s == 0) stats.rays += batch.rays.size();
     ++stats.launches;
   }
   stats.wall_ms += ms_since(start);
@@ -260,6 +277,8 @@ void Renderer::run_bounces(Passes& passes, std::vector<Bounce> current, bool ref
   const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
   // Below this a bounce cannot change a pixel's 8-bit colour.
   constexpr double kNegligibleWeight = 1.0 / 512;
+  const double pixel_share =
+      refinement ? static_cast<double>(passes.result.plan.refine_samples) * passes.result.plan.refine_samples : 1.0;
   const char* const names[2] = {"reflection", "transmission"};
   const bool wanted[2] = {passes.stats_of(names[0]) != nullptr, passes.stats_of(names[1]) != nullptr};
   for (int depth = 1; depth <= scene.render.max_depth && !current.empty(); ++depth) {
@@ -274,7 +293,8 @@ void Renderer::run_bounces(Passes& passes, std::vector<Bounce> current, bool ref
         const Materials& sides = scene.surfaces[b.surface].materials;
         const Material& m = (b.hit.flags & ALGRAY_HIT_BACK) ? sides.back : sides.front;
         const double share = k == 0 ? m.reflectivity : m.transparency;
-        if (b.weight * share < kNegligibleWeight) continue;
+        // A refined pixel's rays carry 1/n^2 each: the cut-off is on the share of the pixel they stand for.
+        if (b.weight * share * pixel_share < kNegligibleWeight) continue;
         const glm::dvec3 p = hit_point(b.ray, b.hit);
         const glm::dvec3 n(b.hit.normal_x, b.hit.normal_y, b.hit.normal_z);  // faces the incoming ray
         const glm::dvec3 d = b.ray.direction;

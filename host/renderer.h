@@ -26,7 +26,8 @@ struct HitBuffer {
 struct PassStats {
   std::string name;
   std::vector<std::string> program_keys;  // ProgramRecord::key of the kernels the pass launched, per surface
-  std::uint64_t rays = 0;
+  std::vector<double> program_ms;         // device time of each of those kernels
+  std::uint64_t rays = 0;                 // rays traced, each once however many surfaces it was tested against
   int launches = 0;
   double kernel_ms = 0;  // device time summed over launches (profiling events)
   double wall_ms = 0;

@@ -225,6 +225,19 @@ void apply_override(toml::table& root, const Override& o) {
     if (dot == std::string::npos) break;
     start = dot + 1;
   }
+  // Tables in arrays ([[surface]], [[light]]) have no name a dotted key could reach: refuse rather than
+  // replace the whole array with one table.
+  const toml::node* at = &root;
+  for (std::size_t start = 0; at && at->is_table();) {
+    const std::size_t dot = key.find('.', start);
+    const std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
+    at = at->as_table()->get(part);
+    if (at && at->is_array_of_tables())
+      throw SceneError(label, "'" + part + "' is a list of [[" + part +
+                                  "]] tables, which --set cannot reach into; change the scene file instead");
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
   // Parsed as the TOML line `key = value`, every node it creates carries the override as its source, so errors
   // name it. A value that is not TOML (render.precision=float) is taken as a string.
   toml::table parsed;

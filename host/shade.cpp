@@ -43,11 +43,12 @@ class ShadowLookup {
 // coming from the transmission pass), lit by every light's points that the shadow pass left visible.
 glm::dvec3 shade_hit(const Scene& scene, const std::vector<LightSamples>& lights, const HitRecord& h, int surface,
                      const glm::dvec3& point, const glm::dvec3& to_eye, const ShadowLookup& shadows,
-                     std::size_t hit_index) {
+                     std::size_t hit_index, bool transmits) {
   const Materials& sides = scene.surfaces[static_cast<std::size_t>(surface)].materials;
   const Material& m = (h.flags & ALGRAY_HIT_BACK) ? sides.back : sides.front;
   const glm::dvec3 n(h.normal_x, h.normal_y, h.normal_z);
-  const double own = 1 - m.transparency;
+  // Without a transmission pass (preview, max_depth = 0) nothing is seen through: the side shows opaque.
+  const double own = transmits ? 1 - m.transparency : 1.0;
   if (lights.empty()) {
     const double facing = std::fabs(glm::dot(n, to_eye));
     return own * m.colour * (kPreviewAmbient + (1 - kPreviewAmbient) * facing);
@@ -99,6 +100,7 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
   for (const Light& light : scene.lights) lights.push_back({&light, light.sample_points()});
   const ShadowLookup primary_shadows(result.shadows, hits.records.size(), scene.lights);
   const bool single = result.config.precision != Precision::Double;
+  const bool transmits = result.plan.find("transmission") != nullptr;
 
   // What reflection and transmission rays add to each traced camera ray: their weight times what they met.
   // Adaptive antialiasing's camera rays are such contributions too, with weights 1/n^2; they also carry alpha.
@@ -112,7 +114,8 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
       const glm::dvec3 seen =
           (h.flags & ALGRAY_HIT_FOUND)
               ? shade_hit(scene, lights, h, batch.hit_surface.empty() ? 0 : batch.hit_surface[i],
-                          hit_point(batch.rays[i], h), -glm::normalize(batch.rays[i].direction), batch_shadows, i)
+                          hit_point(batch.rays[i], h), -glm::normalize(batch.rays[i].direction), batch_shadows, i,
+                          transmits)
               : glm::dvec3(scene.image.background);
       (batch.refinement ? refined_colour : secondary)[batch.sample[i]] += batch.weight[i] * seen;
       if (batch.pass == "antialias")
@@ -153,7 +156,7 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
             const PixelRay ray = pixel_ray(result.basis, single, tx, ty);
             const glm::dvec3 to_eye = -glm::normalize(ray.direction);
             glm::dvec3 colour =
-                shade_hit(scene, lights, h, hits.surface_of(k), hit_point(ray, h), to_eye, primary_shadows, k);
+                shade_hit(scene, lights, h, hits.surface_of(k), hit_point(ray, h), to_eye, primary_shadows, k, transmits);
             if (!secondary.empty()) colour += secondary[k];
             sum += glm::dvec4(colour, 1);
             if (h.depth < img.depth[i]) {

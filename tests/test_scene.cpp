@@ -282,3 +282,19 @@ TEST_CASE("lights: kinds, keys that belong to another kind, and area samples spr
   CHECK(corners[0] == glm::dvec3(-0.5, -1, 0));
   CHECK(corners[3] == glm::dvec3(0.5, 1, 0));
 }
+
+TEST_CASE("--set cannot reach into [[surface]] or [[light]] lists, and says so", "[scene][errors]") {
+  const std::string text = sphere_with({}, {"[[light]]", "position = [1, 2, 3]"});
+  for (const char* key : {"light.intensity", "light.position"}) {
+    INFO(key);
+    const SceneError e = error_of(text, {{key, "2"}});
+    CHECK(e.where == std::string("--set ") + key + "=2");
+    CHECK_THAT(e.message, Catch::Contains("[[light]]"));
+  }
+  const std::string two = "[[surface]]\nequation = \"x\"\n[[surface]]\nequation = \"y\"\n" +
+                          std::string("[extent]\nradius = 2\n[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n");
+  CHECK_THAT(error_of(two, {{"surface.equation", "\"z\""}}).message, Catch::Contains("[[surface]]"));
+  // A single [surface] table is still reachable.
+  CHECK(algray::load_scene_text(text, "t.toml", {{"surface.equation", "\"x^2+y^2+z^2-4\""}}).surface().polynomial ==
+        equation("x^2+y^2+z^2-4"));
+}

@@ -7,6 +7,7 @@
 #include "program_cache.h"
 #include "renderer.h"
 #include "scene.h"
+#include "shade.h"
 #include "test_support.h"
 
 using namespace algray;
@@ -105,4 +106,22 @@ TEST_CASE("reflection rays leave by the mirror direction and find the other sphe
     for (const HitRecord& h : b.hits) hits += (h.flags & ALGRAY_HIT_FOUND) != 0;
   CHECK(checked > 1000);
   CHECK(hits > 50);  // the spheres see each other in their inner flanks
+}
+
+TEST_CASE("a transparent side without a transmission pass shows opaque, not darkened", "[secondary]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  for (const char* how : {"preview = true", "max_depth = 0"}) {
+    INFO(how);
+    const Scene clear = sphere_scene("x^2+y^2+z^2-1", {"[material.front]", "transparency = 1", "[render]", how});
+    Scene opaque = clear;
+    opaque.surfaces[0].materials.front.transparency = 0;
+    const RenderResult r = renderer.render(clear, false);
+    CHECK(r.plan.find("transmission") == nullptr);
+    const FrameImage a = shade_frame(clear, r), b = shade_frame(opaque, renderer.render(opaque, false));
+    const std::size_t centre = 4 * (static_cast<std::size_t>(a.height / 2) * a.width + a.width / 2);
+    CHECK(a.rgba[centre] > 0.1f);
+    CHECK(a.rgba[centre] == b.rgba[centre]);
+  }
 }

@@ -52,6 +52,15 @@ TEST_CASE("a scene's surfaces each get their own kernel, and the nearest hit win
   CHECK(both.passes[0].program_keys[0].find("degree=2 ") != std::string::npos);
   CHECK(both.passes[0].program_keys[1].find("degree=4 ") != std::string::npos);
 
+  // Each camera ray counts once in the statistics, and the solver work of both kernels is kept.
+  CHECK(both.passes[0].rays == both.hits.records.size());
+  std::uint64_t work_both = 0, work_apart = 0;
+  for (std::size_t i = 0; i < both.hits.records.size(); ++i) {
+    work_both += both.hits.records[i].work & 0xffffu;
+    work_apart += (ball.hits.records[i].work & 0xffffu) + (ring.hits.records[i].work & 0xffffu);
+  }
+  CHECK(work_both == work_apart);
+
   std::set<int> seen;
   for (std::size_t i = 0; i < both.hits.records.size(); ++i) {
     const HitRecord& h = both.hits.records[i];
