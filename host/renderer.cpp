@@ -34,7 +34,8 @@ double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Shadow rays from every hit of one batch; ray(i) rebuilds the ray of hit i exactly as the kernel traced it.
+// Shadow rays from every hit of one batch; ray(i) is the ray of hit i (camera rays rebuilt exactly as the
+// kernel traced them; secondary rays in double, which a float kernel traced rounded).
 template <typename RayOf>
 ShadowData trace_shadows(const Scene& scene, const RenderPlan& plan,
                          const std::vector<std::unique_ptr<ShadowTracer>>& tracers,

@@ -20,7 +20,7 @@ struct LightSamples {
 class ShadowLookup {
  public:
   ShadowLookup(const ShadowData& data, std::size_t batch_size, const std::vector<Light>& lights)
-      : data_(data), by_light_(lights.size(), nullptr) {
+      : by_light_(lights.size(), nullptr) {
     if (data.points.empty()) return;
     point_of_hit_.assign(batch_size, UINT32_MAX);
     for (std::size_t k = 0; k < data.points.size(); ++k) point_of_hit_[data.points[k]] = static_cast<std::uint32_t>(k);
@@ -34,7 +34,6 @@ class ShadowLookup {
   }
 
  private:
-  const ShadowData& data_;
   std::vector<const LightOcclusion*> by_light_;
   std::vector<std::uint32_t> point_of_hit_;
 };

@@ -29,6 +29,17 @@ std::vector<std::string> names_of(const nlohmann::json& list) {
   return names;
 }
 
+// Renders the unit sphere with `tail` appended at 40x30 and returns its --stats.
+nlohmann::json stats_of_unit_sphere(const std::vector<std::string>& tail, const std::string& flags) {
+  Sandbox box;
+  const auto scene = box.scene("s.toml", sphere_with({}, tail));
+  const Result r =
+      box.run("render " + quoted(scene.string()) + " -o out.exr --width 40 --height 30 --stats s.json " + flags);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  return box.stats();
+}
+
 struct PlanCase {
   const char* what;
   std::vector<std::string> scene_tail;
@@ -54,13 +65,7 @@ TEST_CASE("only the passes a scene calls for are built, launched and counted", "
   };
   for (const PlanCase& c : cases) {
     INFO(c.what);
-    Sandbox box;
-    const auto scene = box.scene("s.toml", sphere_with({}, c.scene_tail));
-    const Result r = box.run("render " + quoted(scene.string()) + " -o out.exr --width 40 --height 30 --stats s.json " +
-                             c.flags);
-    INFO(r.err);
-    REQUIRE(r.exit_code == 0);
-    const nlohmann::json s = box.stats();
+    const nlohmann::json s = stats_of_unit_sphere(c.scene_tail, c.flags);
     const std::vector<std::string> passes = names_of(s.at("passes"));
     // What ran is what the plan says, in its order.
     CHECK(passes == names_of(s.at("plan").at("passes")));
@@ -124,13 +129,7 @@ TEST_CASE("reflection and transmission passes run only for materials that ask, a
   };
   for (const EffectCase& c : cases) {
     INFO(c.what);
-    Sandbox box;
-    const auto scene = box.scene("s.toml", sphere_with({}, c.tail));
-    const Result r = box.run("render " + quoted(scene.string()) + " -o out.exr --width 40 --height 30 --stats s.json " +
-                             c.flags);
-    INFO(r.err);
-    REQUIRE(r.exit_code == 0);
-    const nlohmann::json s = box.stats();
+    const nlohmann::json s = stats_of_unit_sphere(c.tail, c.flags);
     CHECK(names_of(s.at("passes")) == names_of(s.at("plan").at("passes")));
     std::set<std::string> secondary;
     for (const auto& p : s.at("passes")) {
