@@ -20,6 +20,8 @@ typedef cl_int algray_i32;
 #define ALGRAY_HIT_TANGENT 4u      /* reference images only: the smallest root has even multiplicity */
 #define ALGRAY_HIT_BUDGET 8u       /* isolation stopped at its depth limit with the question still open */
 #define ALGRAY_HIT_IN_EXTENT 16u   /* the ray met the extent at all */
+#define ALGRAY_HIT_EXACT 32u       /* the root is where P* came out exactly 0, or changed sign between two intervals */
+#define ALGRAY_HIT_CLUSTER 64u     /* the root is a sign change across an interval that still held several roots */
 
 /* Extent kinds (kernel argument extent_kind). */
 #define ALGRAY_EXTENT_SPHERE 0
@@ -49,5 +51,42 @@ typedef struct {
   algray_u32 flags;     /* ALGRAY_HIT_* bits */
   algray_u32 work;      /* isolation steps in the low 16 bits, refinement iterations in the high 16 bits */
 } HitRecord;
+
+/* The probe: kernels/probe.cl records what the solver did on one ray as a list of events, each with four REAL
+ * values in a separate buffer (values[4 i .. 4 i + 3] belong to event i). */
+#define ALGRAY_EVENT_SEGMENT 1      /* values: t_in, t_out of the ray in the extent */
+#define ALGRAY_EVENT_COEFFICIENT 2  /* count: k; decision: ALGRAY_BASIS_*; values: c_k and its low part (mixed) */
+#define ALGRAY_EVENT_STEP 3         /* an isolation step. count: sign variations (Sturm: distinct roots), -1 if not
+                                       counted; decision: ALGRAY_STEP_*; level: halving level; values: the
+                                       interval's ends lo, hi as fractions of [t_in, t_out], and P there */
+#define ALGRAY_EVENT_CHAIN_ITERATE 4 /* derivative chain: one Newton/bisection step on the derivative of order
+                                       `level`; values: x, its value there, then the bracket lo, hi (fractions) */
+#define ALGRAY_EVENT_ISOLATED 5     /* the isolation's result. decision: 0 none, 1 bracket, 2 exact; count: 1 at
+                                       the halving limit; values: lo, hi, P(lo), P(hi) */
+#define ALGRAY_EVENT_ITERATE 6      /* a refinement iterate. count: its number; values: y, P(y), and the bracket
+                                       (y in [0, 1] across the isolating interval) */
+
+#define ALGRAY_BASIS_BERNSTEIN 1     /* Bernstein basis of s in [0, 1] over [t_in, t_out] */
+#define ALGRAY_BASIS_POWER_SEGMENT 2 /* power basis of s in [0, 1] over [t_in, t_out] */
+#define ALGRAY_BASIS_POWER_EYE 3     /* power basis of t itself, around the ray origin (the paper's RAY_ORIGIN=eye) */
+
+/* ALGRAY_EVENT_STEP decisions */
+#define ALGRAY_STEP_EXACT_ZERO 1   /* P is exactly 0 at the interval's left end: the root is there */
+#define ALGRAY_STEP_CROSSED 2      /* P changed sign at the left end, between two intervals: the root is there */
+#define ALGRAY_STEP_ISOLATED 3     /* exactly one root: the isolating interval */
+#define ALGRAY_STEP_SPLIT 4        /* possibly several roots: halve */
+#define ALGRAY_STEP_NO_ROOT 5      /* no root: go on to the next interval */
+#define ALGRAY_STEP_CLUSTER_ROOT 6 /* down to the stopping width (or the halving limit) and P changes sign: root */
+#define ALGRAY_STEP_CLUSTER_SKIP 7 /* down to the stopping width without a sign change: an even cluster, skipped */
+#define ALGRAY_STEP_END_ZERO 8     /* nothing before the far end, where P is 0 */
+#define ALGRAY_STEP_END_NONE 9     /* nothing in the whole segment */
+#define ALGRAY_STEP_PIECE 10       /* derivative chain: a monotone piece of P without a sign change */
+
+typedef struct {
+  algray_u32 kind;     /* ALGRAY_EVENT_* */
+  algray_i32 count;    /* see the event kinds */
+  algray_u32 decision; /* ALGRAY_STEP_* or ALGRAY_BASIS_* */
+  algray_u32 level;
+} ProbeEvent;
 
 #endif /* ALGRAY_SHARED_H */

@@ -134,7 +134,7 @@ int refinable_in_float(const REAL* c) {
  * (level, idx), so no stack is kept. The right half of the latest split is cached, as the left half is usually
  * rejected at once. On return `cur` holds the Bernstein coefficients on [iso.lo, iso.hi] (rounded to float in
  * mixed precision, where they are accurate relative to their own size). */
-Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out, REAL* cur) {
+Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out, REAL* cur PROBE_PARAM) {
   Isolation iso = isolation_none();
   REAL cur_lo[NCOEF], sib[NCOEF], sib_lo[NCOEF];
   int sib_level = -1;
@@ -153,18 +153,24 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
     iso.f_lo = cur[0];
     iso.f_hi = cur[DEGREE];
     if (cur[0] == 0) {
+      PROBE_STEP(iso, -1, ALGRAY_STEP_EXACT_ZERO, level);
       iso.status = ISOLATION_EXACT;
       return iso;
     }
-    if (crossed_at_left_end(&iso, start_sign)) return iso;
+    if (crossed_at_left_end(&iso, start_sign)) {
+      PROBE_STEP(iso, -1, ALGRAY_STEP_CROSSED, level);
+      return iso;
+    }
     const int v = sign_variations(cur);
     if (v == 1 && cur[DEGREE] != 0 && refinable_in_float(cur)) {
+      PROBE_STEP(iso, v, ALGRAY_STEP_ISOLATED, level);
       iso.status = ISOLATION_BRACKET;
       return iso;
     }
     if (v >= 1) {
       const int located = interval_located(width, iso.lo, t_in, len);
       if (!located && level < REAL_MAX_HALVINGS) {
+        PROBE_STEP(iso, v, ALGRAY_STEP_SPLIT, level);
         casteljau_halve(cur, cur_lo, sib, sib_lo);
         ++level;
         idx *= 2;
@@ -172,13 +178,21 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
         sib_idx = idx + 1;
         continue;
       }
-      if (settle_cluster(&iso, located)) return iso;
+      if (settle_cluster(&iso, located)) {
+        PROBE_STEP(iso, v, ALGRAY_STEP_CLUSTER_ROOT, level);
+        return iso;
+      }
+      PROBE_STEP(iso, v, ALGRAY_STEP_CLUSTER_SKIP, level);
+    } else {
+      PROBE_STEP(iso, v, ALGRAY_STEP_NO_ROOT, level);
     }
     if (!next_interval(&level, &idx)) {
       /* Intervals are half open; the far end is the one point left to look at. */
       iso.status = root[DEGREE] == 0 ? ISOLATION_EXACT : ISOLATION_NONE;
       iso.lo = iso.hi = 1;
       iso.f_lo = iso.f_hi = 0;
+      PROBE(ALGRAY_EVENT_STEP, -1, iso.status == ISOLATION_EXACT ? ALGRAY_STEP_END_ZERO : ALGRAY_STEP_END_NONE, 0u,
+            (REAL)1, (REAL)1, root[DEGREE], root[DEGREE]);
       return iso;
     }
     if (sib_level == level && sib_idx == idx)

@@ -70,7 +70,7 @@ REAL chain_value_at_one(const REAL* a) {
  * stopping width tol lets pass as located (no sign change, as in settle_cluster). Below A', such a missed pair
  * leaves a wiggle of order d^3 in the level above that: a near triple root of A, found within ~2d either way.
  * The last Newton step usually lands far closer than tol anyway. */
-REAL chain_root(const REAL* c, int m, REAL lo, REAL hi, REAL f_lo, REAL f_hi, REAL tol, Isolation* iso) {
+REAL chain_root(const REAL* c, int m, REAL lo, REAL hi, REAL f_lo, REAL f_hi, REAL tol, Isolation* iso PROBE_PARAM) {
   const int rising = f_lo < 0;
   REAL x = lo - f_lo * ((hi - lo) / (f_hi - f_lo));
   if (!(x > lo && x < hi)) x = (REAL)0.5 * (lo + hi);
@@ -80,6 +80,7 @@ REAL chain_root(const REAL* c, int m, REAL lo, REAL hi, REAL f_lo, REAL f_hi, RE
     ++iso->steps;
     REAL slope;
     const REAL f = chain_value_slope(c, m, x, &slope);
+    PROBE(ALGRAY_EVENT_CHAIN_ITERATE, it, 0u, (uint)(DEGREE - m), x, f, lo, hi);
     if (f == 0) return x;
     if ((f < 0) == rising)
       lo = x;
@@ -153,7 +154,7 @@ typedef struct {
  * on a boundary is a root only if A has the other sign after it (a double root only touches, and is invisible
  * as in settle_cluster), or if it is the far end, where nothing follows to tell. A NaN is neither a sign nor a
  * zero, so a degenerate polynomial finds nothing. Returns 1 when it settled iso->status. */
-int chain_visit(ChainWalk* w, Isolation* iso, const REAL* a, REAL x) {
+int chain_visit(ChainWalk* w, Isolation* iso, const REAL* a, REAL x PROBE_PARAM) {
   ++iso->steps;
   const REAL f = x == (REAL)1 ? chain_value_at_one(a) : power_value(a, x);
   const int s = (f > 0) - (f < 0);
@@ -163,6 +164,7 @@ int chain_visit(ChainWalk* w, Isolation* iso, const REAL* a, REAL x) {
     iso->hi = x;
     iso->f_lo = w->f;
     iso->f_hi = f;
+    PROBE_STEP(*iso, -1, ALGRAY_STEP_ISOLATED, 0);
     return 1;
   }
   REAL root = -1;
@@ -178,8 +180,10 @@ int chain_visit(ChainWalk* w, Isolation* iso, const REAL* a, REAL x) {
     iso->status = ISOLATION_EXACT;
     iso->lo = iso->hi = root;
     iso->f_lo = iso->f_hi = 0;
+    PROBE_STEP(*iso, -1, ALGRAY_STEP_EXACT_ZERO, 0);
     return 1;
   }
+  PROBE(ALGRAY_EVENT_STEP, -1, ALGRAY_STEP_PIECE, 0u, w->x, x, w->f, f);
   w->x = x;
   w->f = f;
   return 0;
@@ -191,7 +195,8 @@ int chain_visit(ChainWalk* w, Isolation* iso, const REAL* a, REAL x) {
  * multiplicity, as in the other methods: the ray starts on the surface. iso.steps counts polynomial
  * evaluations: piece ends at every level, inner solver iterations, the closed-form bottom as one. On return
  * `a1` is A1 on [lo, hi] when the status is a bracket. */
-Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1) {
+Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out,
+                                   REAL* a1 PROBE_PARAM) {
   Isolation iso = isolation_none();
   REAL a[NCOEF];
   power_on_interval(p, s0, len_s, a);
@@ -199,6 +204,7 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
   if (a[0] == 0) {
     iso.status = ISOLATION_EXACT;
     iso.lo = iso.hi = 0;
+    PROBE_STEP(iso, -1, ALGRAY_STEP_EXACT_ZERO, 0);
     return iso;
   }
   ChainWalk walk;
@@ -252,7 +258,7 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
       const REAL u = last_f[m];
       REAL root = -1;
       if ((u < 0 && v > 0) || (u > 0 && v < 0))
-        root = chain_root(c, m, last_x[m], y, u, v, tol, &iso);
+        root = chain_root(c, m, last_x[m], y, u, v, tol, &iso PROBE_ARG);
       else if (v == 0 && y < (REAL)1)
         root = y; /* a root on a boundary: one too many is harmless, a monotone piece split in two */
       last_x[m] = y;
@@ -267,7 +273,7 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
     }
     /* y is the next root of level m, or the end 1: the next piece boundary of the level above */
     if (m == DEGREE - 1) {
-      if (chain_visit(&walk, &iso, a, y) || y == (REAL)1) break;
+      if (chain_visit(&walk, &iso, a, y PROBE_ARG) || y == (REAL)1) break;
       have = 0;
     } else {
       ++m;
@@ -277,7 +283,7 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
 #else
   (void)t_in;
   (void)t_out;
-  chain_visit(&walk, &iso, a, (REAL)1);
+  chain_visit(&walk, &iso, a, (REAL)1 PROBE_ARG);
 #endif
   /* The bracket's own polynomial, from A as its end values were, so that refinement sees the same signs. */
   if (iso.status == ISOLATION_BRACKET) power_on_interval(a, iso.lo, iso.hi - iso.lo, a1);

@@ -2,6 +2,7 @@
 #ifndef ALGRAY_ISOLATION_H
 #define ALGRAY_ISOLATION_H
 
+#include "probe_log.h"
 #include "real.h"
 #include "restrict.h"
 
@@ -13,6 +14,7 @@
 typedef struct {
   int status;
   int budget;  /* 1 when some interval hit the halving limit before reaching the tolerance */
+  int cluster; /* 1 when the bracket is an interval that still held several roots (settle_cluster) */
   uint steps;  /* intervals examined */
   REAL lo, hi;
   REAL f_lo, f_hi;
@@ -22,6 +24,7 @@ Isolation isolation_none(void) {
   Isolation iso;
   iso.status = ISOLATION_NONE;
   iso.budget = 0;
+  iso.cluster = 0;
   iso.steps = 0;
   iso.lo = 0;
   iso.hi = 1;
@@ -42,6 +45,7 @@ int settle_cluster(Isolation* iso, int located) {
   if (!located) iso->budget = 1;
   if ((iso->f_lo < 0) != (iso->f_hi < 0)) {
     iso->status = ISOLATION_BRACKET;
+    iso->cluster = 1;
     return 1;
   }
   return 0;

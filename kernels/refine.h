@@ -2,6 +2,7 @@
 #ifndef ALGRAY_REFINE_H
 #define ALGRAY_REFINE_H
 
+#include "probe_log.h"
 #include "real.h"
 
 /* Needs isolated_value(c, y) from the isolation method: the polynomial at y in [0,1] of the isolating interval.
@@ -21,7 +22,7 @@ int value_within_rounding(const REAL* c, REAL y, REAL fy, REAL scale) {
 }
 
 #if REFINEMENT == ALGRAY_REFINEMENT_BRENT
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations PROBE_PARAM) {
   /* b: best estimate; c_: contrapoint, f(c_) of the other sign; a: the previous b. */
   REAL a = 0, fa = f0, b = 1, fb = f1, cp = 0, fc = f0;
   uint it = 0;
@@ -63,12 +64,13 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
       cp = a;
       fc = fa;
     }
+    PROBE_ITERATE(it, b, fb, fmin(b, cp), fmax(b, cp));
   }
   *iterations = it;
   return b;
 }
 #elif REFINEMENT == ALGRAY_REFINEMENT_BISECTION
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations PROBE_PARAM) {
   REAL lo = 0, hi = 1, flo = f0;
   (void)f1;
   (void)scale;
@@ -77,6 +79,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
     const REAL mid = (REAL)0.5 * (lo + hi);
     const REAL fm = isolated_value(c, mid);
     if (fm == 0) {
+      PROBE_ITERATE(it, mid, fm, mid, mid);
       lo = hi = mid;
       ++it;
       break;
@@ -87,6 +90,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
     } else {
       hi = mid;
     }
+    PROBE_ITERATE(it, mid, fm, lo, hi);
   }
   *iterations = it;
   return (REAL)0.5 * (lo + hi);
@@ -96,7 +100,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
  * good, so the bracket never shrinks below the stopping width and only |P*| <= eps_m or the iteration cap
  * stops it (the paper's Barth decic defects). The Illinois variant halves the value kept at an end that has
  * survived twice in a row, which breaks that one-sidedness. */
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations PROBE_PARAM) {
   REAL a = 0, fa = f0, b = 1, fb = f1, x = fabs(f0) < fabs(f1) ? (REAL)0 : (REAL)1;
   int kept = 0; /* +1: a survived the last step(s), -1: b did */
   uint it = 0;
@@ -105,6 +109,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
     if (!(x > a && x < b)) x = (REAL)0.5 * (a + b); /* rounding pushed it out: stay inside */
     const REAL fx = isolated_value(c, x);
     if (value_within_rounding(c, x, fx, scale)) {
+      PROBE_ITERATE(it, x, fx, a, b);
       ++it;
       break;
     }
@@ -123,6 +128,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
 #endif
       kept = kept > 0 ? kept + 1 : 1;
     }
+    PROBE_ITERATE(it, x, fx, a, b);
   }
   (void)kept;
   *iterations = it;
@@ -132,7 +138,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
 /* Newton's method inside the bracket: a step that would leave it, or that fails to halve |P*|, is replaced by
  * bisection, so it converges like bisection at worst and quadratically near a simple root. Needs
  * isolated_value_slope(c, y, &slope) from the isolation method. */
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations PROBE_PARAM) {
   REAL a = 0, b = 1, fa = f0;
   REAL x = fabs(f0) < fabs(f1) ? (REAL)0 : (REAL)1, slope;
   REAL fx = isolated_value_slope(c, x, &slope);
@@ -151,6 +157,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
     } else {
       b = x;
     }
+    PROBE_ITERATE(it, x, fx, a, b);
   }
   *iterations = it;
   return x;

@@ -175,7 +175,7 @@ void sturm_bracket(Isolation* iso, REAL* a1) {
  * on A1 over the whole interval; then the dyadic (level, idx) pieces of [0, 1] are visited depth first, left
  * first, each needing the sequence at its right end only: its left end is its parent's, or the right end of
  * the interval examined before it. On return `a1` is A1 on [lo, hi]. */
-Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1) {
+Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1 PROBE_PARAM) {
   Isolation iso = isolation_none();
   const REAL len = t_out - t_in;
   power_on_interval(p, s0, len_s, a1);
@@ -183,6 +183,7 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
     iso.steps = 1;
     iso.status = ISOLATION_EXACT;
     iso.f_hi = power_value(a1, (REAL)1);
+    PROBE_STEP(iso, -1, ALGRAY_STEP_EXACT_ZERO, 0);
     return iso;
   }
   REAL seq[STURM_STORE];
@@ -203,10 +204,14 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
     iso.f_lo = f_lo;
     iso.f_hi = f_hi;
     if (f_lo == 0) {
+      PROBE_STEP(iso, -1, ALGRAY_STEP_EXACT_ZERO, level);
       iso.status = ISOLATION_EXACT;
       return iso;
     }
-    if (crossed_at_left_end(&iso, start_sign)) return iso;
+    if (crossed_at_left_end(&iso, start_sign)) {
+      PROBE_STEP(iso, -1, ALGRAY_STEP_CROSSED, level);
+      return iso;
+    }
     /* Distinct roots in (lo, hi): the count is of (lo, hi], and a root exactly at hi belongs to the next
      * interval, which finds it as an exact zero at its left end. */
     const int roots = v_lo - v_hi - (f_hi == 0);
@@ -216,6 +221,7 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
      * apart, the larger one 2.5e-11 below a dyadic point, bracketed together, refined to the larger). */
     const int clear = fabs(f_lo) > noise_lo && fabs(f_hi) > noise_hi;
     if (roots == 1 && crosses && clear) {
+      PROBE_STEP(iso, roots, ALGRAY_STEP_ISOLATED, level);
       sturm_bracket(&iso, a1);
       return iso;
     }
@@ -227,20 +233,27 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
     if (roots != 0 || crosses || f_hi == 0) {
       const int located = interval_located(width, iso.lo, t_in, len);
       if (!located && level < REAL_MAX_HALVINGS) {
+        PROBE_STEP(iso, roots, ALGRAY_STEP_SPLIT, level);
         ++level;
         idx *= 2;
         continue;
       }
       if (settle_cluster(&iso, located)) {
+        PROBE_STEP(iso, roots, ALGRAY_STEP_CLUSTER_ROOT, level);
         sturm_bracket(&iso, a1);
         return iso;
       }
+      PROBE_STEP(iso, roots, ALGRAY_STEP_CLUSTER_SKIP, level);
+    } else {
+      PROBE_STEP(iso, roots, ALGRAY_STEP_NO_ROOT, level);
     }
     if (!next_interval(&level, &idx)) {
       /* Intervals are half open; the far end is the one point left to look at. A root within rounding of it
        * may have come out just outside, where the counts, reading the same value, agree: it is numerically
        * at 1. */
       iso.status = fabs(f_hi) <= noise_hi ? ISOLATION_EXACT : ISOLATION_NONE;
+      PROBE(ALGRAY_EVENT_STEP, -1, iso.status == ISOLATION_EXACT ? ALGRAY_STEP_END_ZERO : ALGRAY_STEP_END_NONE, 0u,
+            (REAL)1, (REAL)1, f_hi, f_hi);
       iso.lo = iso.hi = 1;
       iso.f_lo = iso.f_hi = 0;
       return iso;

@@ -28,15 +28,29 @@ typedef struct {
   REAL3 d_unit;     /* ray direction in unit coordinates */
 } SurfaceHit;
 
+/* The probe records the coefficients the isolation starts from, in its basis; a render build has no such call. */
+#if ALGRAY_PROBE
+void probe_coefficients(const REAL* c, const REAL* c_lo, uint basis PROBE_PARAM) {
+  for (int k = 0; k <= DEGREE; ++k)
+    PROBE(ALGRAY_EVENT_COEFFICIENT, k, basis, 0u, c[k], ALGRAY_COMPENSATED ? c_lo[k] : (REAL)0, (REAL)0, (REAL)0);
+}
+#else
+#define probe_coefficients(c, c_lo, basis) ((void)0)
+#endif
+
 /* Refines what the isolation found; iso_c holds the polynomial on the isolating interval. */
-SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out, __constant const REAL* binomials) {
+SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
+                            __constant const REAL* binomials PROBE_PARAM) {
   SegmentRoot r;
   r.t = INFINITY;
   r.f_before = 0;
   r.flags = iso.budget ? ALGRAY_HIT_BUDGET : 0u;
   r.steps = iso.steps;
   r.iterations = 0;
+  PROBE(ALGRAY_EVENT_ISOLATED, iso.budget, (uint)iso.status, 0u, iso.lo, iso.hi, iso.f_lo, iso.f_hi);
   if (iso.status == ISOLATION_NONE) return r;
+  if (iso.status == ISOLATION_EXACT) r.flags |= ALGRAY_HIT_EXACT;
+  if (iso.cluster) r.flags |= ALGRAY_HIT_CLUSTER;
   const REAL len = t_out - t_in;
   REAL y = 0; /* ISOLATION_EXACT: the root is the interval's left end */
   if (iso.status == ISOLATION_BRACKET) {
@@ -45,7 +59,7 @@ SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out, _
     REAL scale = 0;
     for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(iso_c[k]));
     prepare_isolated(iso_c, binomials);
-    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, &r.iterations);
+    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, &r.iterations PROBE_ARG);
   }
   r.t = t_in + (iso.lo + y * (iso.hi - iso.lo)) * len;
   r.f_before = iso.f_lo;
@@ -58,13 +72,14 @@ SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out, _
  * returns, the other only asks whether there is anything to refine. */
 Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
                              __global const REAL* coefs, uint count, __constant const REAL* binomials,
-                             uint even_axes, REAL* iso_c) {
+                             uint even_axes, REAL* iso_c PROBE_PARAM) {
   REAL root[NCOEF], root_lo[NCOEF];
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EYE
   /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(o.x, d.x, even_axes & 1),
                   axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root, root_lo);
-  return isolate_power_basis(root, t_in, t_out - t_in, t_in, t_out, iso_c);
+  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_EYE PROBE_ARG);
+  return isolate_power_basis(root, t_in, t_out - t_in, t_in, t_out, iso_c PROBE_ARG);
 #else
   /* Entry and exit points: the ray restricted to the interval as s in [0, 1]. */
   const REAL3 pa = o + t_in * d, pb = o + t_out * d;
@@ -72,19 +87,21 @@ Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global c
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, pb.x, even_axes & 1),
                   axis_factor(pa.y, pb.y, even_axes & 2), axis_factor(pa.z, pb.z, even_axes & 4), root, root_lo);
   bernstein_from_scaled(root, root_lo, binomials);
-  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c);
+  probe_coefficients(root, root_lo, ALGRAY_BASIS_BERNSTEIN PROBE_ARG);
+  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
 #else
   const REAL3 e = pb - pa;
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, e.x, even_axes & 1),
                   axis_factor(pa.y, e.y, even_axes & 2), axis_factor(pa.z, e.z, even_axes & 4), root, root_lo);
-  return isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c);
+  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_SEGMENT PROBE_ARG);
+  return isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c PROBE_ARG);
 #endif
 #endif
 }
 
 SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                          __global const uint* exps, __global const REAL* coefs, uint count,
-                         __constant const REAL* binomials, uint even_axes) {
+                         __constant const REAL* binomials, uint even_axes PROBE_PARAM) {
   SurfaceHit h;
   h.root.t = INFINITY;
   h.root.f_before = 0;
@@ -98,11 +115,13 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   h.u = o;
   REAL t_in, t_out;
   if (!clip_to_extent(o, d, extent_kind, box_half, &t_in, &t_out)) return h;
+  PROBE(ALGRAY_EVENT_SEGMENT, 0, 0u, 0u, t_in, t_out, (REAL)0, (REAL)0);
   h.root.flags = ALGRAY_HIT_IN_EXTENT;
 
   REAL iso_c[NCOEF];
-  const Isolation iso = isolate_on_segment(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, iso_c);
-  h.root = refine_isolated(iso, iso_c, t_in, t_out, binomials);
+  const Isolation iso =
+      isolate_on_segment(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, iso_c PROBE_ARG);
+  h.root = refine_isolated(iso, iso_c, t_in, t_out, binomials PROBE_ARG);
   h.root.flags |= ALGRAY_HIT_IN_EXTENT;
   if (h.root.flags & ALGRAY_HIT_FOUND) h.u = o + h.root.t * d;
   return h;
