@@ -1,4 +1,4 @@
-// EXR and PNG output through temp-file-and-rename, signal-time cleanup of temp files, and EXR read-back.
+// EXR, PNG and text output through temp-file-and-rename, signal-time cleanup of temp files, and EXR read-back.
 #include "image_io.h"
 
 // OpenEXR/Imath headers trip -Wconversion/-Wshadow when not reached through -isystem.
@@ -331,6 +331,16 @@ bool encode_png_stream(std::FILE* fp, png_uint_32 width, png_uint_32 height, int
   return true;
 }
 
+// Opens `file` for writing, lets `write` fill it and closes it, treating a failed flush or close as a failed
+// write: buffered data can still fail to reach the file there (e.g. disk full).
+void write_with_stdio(const fs::path& file, const std::function<void(std::FILE*)>& write) {
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> fp(std::fopen(file.c_str(), "wb"), &std::fclose);
+  if (!fp) throw OutputError("cannot create temporary file: " + errno_text(errno));
+  write(fp.get());
+  if (std::fflush(fp.get()) != 0) throw OutputError("write failed: " + errno_text(errno));
+  if (std::fclose(fp.release()) != 0) throw OutputError("close failed: " + errno_text(errno));
+}
+
 void encode_png(const fs::path& file, const FrameImage& image) {
   const std::size_t n = checked_pixel_count(image);
   bool opaque = true;
@@ -346,16 +356,20 @@ void encode_png(const fs::path& file, const FrameImage& image) {
   std::vector<png_bytep> rows(static_cast<std::size_t>(image.height));
   for (std::size_t y = 0; y < rows.size(); ++y) rows[y] = bytes.data() + y * width * channels;
 
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> fp(std::fopen(file.c_str(), "wb"), &std::fclose);
-  if (!fp) throw OutputError("cannot create temporary file: " + errno_text(errno));
-  PngErrorState error;
-  if (!encode_png_stream(fp.get(), static_cast<png_uint_32>(image.width), static_cast<png_uint_32>(image.height),
-                         opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA, rows.data(), &error)) {
-    throw OutputError(std::string("libpng: ") + error.message);
-  }
-  // Buffered data can still fail to reach the file here (e.g. disk full), so both results count.
-  if (std::fflush(fp.get()) != 0) throw OutputError("write failed: " + errno_text(errno));
-  if (std::fclose(fp.release()) != 0) throw OutputError("close failed: " + errno_text(errno));
+  write_with_stdio(file, [&](std::FILE* fp) {
+    PngErrorState error;
+    if (!encode_png_stream(fp, static_cast<png_uint_32>(image.width), static_cast<png_uint_32>(image.height),
+                           opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA, rows.data(), &error)) {
+      throw OutputError(std::string("libpng: ") + error.message);
+    }
+  });
+}
+
+void encode_text(const fs::path& file, const std::string& text) {
+  write_with_stdio(file, [&](std::FILE* fp) {
+    if (std::fwrite(text.data(), 1, text.size(), fp) != text.size())
+      throw OutputError("write failed: " + errno_text(errno));
+  });
 }
 
 std::string lowercase_extension(const fs::path& p) {
@@ -390,6 +404,10 @@ void write_exr(const fs::path& path, const FrameImage& image) {
 
 void write_png(const fs::path& path, const FrameImage& image) {
   write_atomically(path, [&](const fs::path& temp) { encode_png(temp, image); });
+}
+
+void write_text_file(const fs::path& path, const std::string& text) {
+  write_atomically(path, [&](const fs::path& temp) { encode_text(temp, text); });
 }
 
 void install_output_cleanup_handlers() {

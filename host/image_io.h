@@ -1,4 +1,4 @@
-// Rendered-frame container and its EXR/PNG writers, which replace the output file atomically.
+// Rendered-frame container and its EXR/PNG (and plain text) writers, which replace the output file atomically.
 #pragma once
 
 #include <array>
@@ -61,6 +61,8 @@ void write_image(const std::filesystem::path& path, const FrameImage& image);  /
 void write_exr(const std::filesystem::path& path, const FrameImage& image);
 // PNG: 8-bit sRGB-encoded RGB, or RGBA when some alpha does not round to 255; tagged with sRGB/gAMA/cHRM.
 void write_png(const std::filesystem::path& path, const FrameImage& image);
+// Text (SVG, JSON, ...) byte for byte, through the same temporary file and rename as the images.
+void write_text_file(const std::filesystem::path& path, const std::string& text);
 
 // Installs (once) SIGINT/SIGTERM/SIGHUP handlers that unlink any temporary file being written, then
 // re-raise the signal with its default action, so interrupted runs leave nothing behind. A signal that
