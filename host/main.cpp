@@ -1,4 +1,4 @@
-// The algray command line: `algray render` and `algray devices`.
+// The algray command line: `algray render`, `algray probe` and `algray devices`.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -6,46 +6,127 @@
 
 #include "cl_runtime.h"
 #include "image_io.h"
+#include "probe_report.h"
 #include "render_job.h"
 
+namespace {
+
+using namespace algray;
+
+// The options every scene-taking command shares: the scene, its overrides and the device.
+struct SceneOptions {
+  std::string scene_path;
+  std::vector<std::string> sets;
+  int width = 0, height = 0;
+  std::string precision, isolation, refinement, tolerance, max_iterations;
+  std::string device_spec;
+  bool no_cache = false, preview = false;
+};
+
+void add_scene_options(CLI::App* cmd, SceneOptions& o) {
+  cmd->add_option("scene", o.scene_path, "scene file (.toml); default: the built-in Barth sextic");
+  cmd->add_option("--width", o.width, "image width in pixels (overrides image.width)");
+  cmd->add_option("--height", o.height, "image height in pixels (overrides image.height)");
+  cmd->add_option("--device", o.device_spec, "device index or name substring (see `algray devices`)");
+  cmd->add_option("--precision", o.precision, "float, double or mixed (overrides render.precision)");
+  cmd->add_option("--isolation", o.isolation,
+                  "root isolation: bernstein, descartes, sturm or derivative-chain (overrides render.isolation)");
+  cmd->add_option("--refine", o.refinement,
+                  "root refinement: brent, bisection, regula-falsi, illinois or newton (overrides render.refinement)");
+  cmd->add_option("--tolerance", o.tolerance, "the stopping tolerance eps (overrides render.tolerance)");
+  cmd->add_option("--max-iterations", o.max_iterations,
+                  "the refinement's iteration cap (overrides render.max_iterations)");
+  cmd->add_option("--set", o.sets, "override a scene key: name=value (a bare name is a parameter)");
+  cmd->add_flag("--preview", o.preview,
+                "the paper's preview mode: primary rays only (no shadows); sets render.preview");
+  cmd->add_flag("--no-cache", o.no_cache, "compile kernels from source; neither read nor write the program cache");
+}
+
+// --set first, then the flags, which are overrides like any --set applied last so that they win. Returns false
+// (after saying why) on a malformed --set.
+bool collect_overrides(const CLI::App* cmd, const SceneOptions& o, std::vector<Override>& out) {
+  for (const std::string& s : o.sets) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      std::cerr << "algray: --set " << s << ": expected name=value\n";
+      return false;
+    }
+    out.push_back({s.substr(0, eq), s.substr(eq + 1)});
+  }
+  if (cmd->count("--width")) out.push_back({"image.width", std::to_string(o.width)});
+  if (cmd->count("--height")) out.push_back({"image.height", std::to_string(o.height)});
+  if (!o.precision.empty()) out.push_back({"render.precision", "\"" + o.precision + "\""});
+  if (!o.isolation.empty()) out.push_back({"render.isolation", "\"" + o.isolation + "\""});
+  if (!o.refinement.empty()) out.push_back({"render.refinement", "\"" + o.refinement + "\""});
+  // Numbers pass through as written, so that the scene's own checks report them.
+  if (!o.tolerance.empty()) out.push_back({"render.tolerance", o.tolerance});
+  if (!o.max_iterations.empty()) out.push_back({"render.max_iterations", o.max_iterations});
+  if (o.preview) out.push_back({"render.preview", "true"});
+  return true;
+}
+
+// "a,b,c" into exactly n numbers.
+bool parse_numbers(const std::string& text, std::size_t n, std::vector<double>& out) {
+  out.clear();
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = text.find(',', start);
+    const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    try {
+      std::size_t used = 0;
+      out.push_back(std::stod(part, &used));
+      if (used != part.size()) return false;
+    } catch (const std::exception&) {
+      return false;
+    }
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out.size() == n;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  using namespace algray;
   install_output_cleanup_handlers();
 
   CLI::App app{"algray: ray tracing of real algebraic surfaces P(x,y,z) = 0 on any OpenCL device"};
   app.require_subcommand(1);
 
   RenderRequest request;
-  std::string scene_path;
-  std::vector<std::string> sets;
-  int width = 0, height = 0;
-  std::string precision, isolation, refinement, tolerance, max_iterations;
-  bool no_cache = false, preview = false;
+  SceneOptions render_opts;
   std::string stats_path;
   CLI::App* render = app.add_subcommand("render", "render a scene (default: the built-in Barth sextic)");
-  render->add_option("scene", scene_path, "scene file (.toml)");
+  add_scene_options(render, render_opts);
   render->add_option("-o,--output", request.outputs, "output image; .exr or .png by extension; may be repeated")
       ->default_str("algray.exr");
-  render->add_option("--width", width, "image width in pixels (overrides image.width)");
-  render->add_option("--height", height, "image height in pixels (overrides image.height)");
-  render->add_option("--device", request.device_spec, "device index or name substring (see `algray devices`)");
-  render->add_option("--precision", precision, "float, double or mixed (overrides render.precision)");
-  render->add_option("--isolation", isolation,
-                     "root isolation: bernstein, descartes, sturm or derivative-chain (overrides render.isolation)");
-  render->add_option(
-      "--refine", refinement,
-      "root refinement: brent, bisection, regula-falsi, illinois or newton (overrides render.refinement)");
-  render->add_option("--tolerance", tolerance, "the stopping tolerance eps (overrides render.tolerance)");
-  render->add_option("--max-iterations", max_iterations,
-                     "the refinement's iteration cap (overrides render.max_iterations)");
-  render->add_option("--set", sets, "override a scene key: name=value (a bare name is a parameter)");
   render->add_option("--stats", stats_path, "write render statistics as JSON");
-  render->add_flag("--preview", preview,
-                   "the paper's preview mode: primary rays only (no shadows); sets render.preview");
-  render->add_flag("--no-cache", no_cache, "compile kernels from source; neither read nor write the program cache");
   render->add_flag(
       "--reference", request.reference,
       "solve every pixel exactly on the CPU (solver_ref, all cores, slow); adds a reference.class channel");
+
+  std::string aov_text;
+  render->add_option("--aov", aov_text,
+                     "solver channels for EXR outputs, comma-separated: iterations, isolation, classification, flags");
+  render->add_option("--heatmap", request.heatmap_path,
+                     "write a heat map of solver work per pixel (isolation steps + refinement iterations), .png");
+
+  ProbeRequest probe_request;
+  SceneOptions probe_opts;
+  std::string pixel_text, ray_text;
+  CLI::App* probe = app.add_subcommand(
+      "probe", "trace one ray through the render's own solver code and show every step beside solver_ref's answer");
+  add_scene_options(probe, probe_opts);
+  auto* pixel_opt = probe->add_option("--pixel", pixel_text,
+                                      "X,Y: the pixel's centre ray, as a render without antialiasing traces it");
+  auto* ray_opt = probe->add_option("--ray", ray_text, "ox,oy,oz,dx,dy,dz: a ray o + t d in world coordinates");
+  pixel_opt->excludes(ray_opt);
+  probe->add_flag("--all-solvers", probe_request.all_solvers,
+                  "every isolation x refinement side by side, the scene's own first");
+  probe->add_option("--plot", probe_request.plot_path,
+                    "draw P*(t) on [t_in, t_out] with the isolating interval, the root and solver_ref's roots "
+                    "(.svg or .png)");
+  probe->add_flag("--json", probe_request.json, "print the report as JSON (for scripts) instead of text");
 
   CLI::App* devices = app.add_subcommand("devices", "list OpenCL platforms and devices");
 
@@ -66,27 +147,47 @@ int main(int argc, char** argv) {
     return kExitOk;
   }
 
-  if (!scene_path.empty()) request.scene_path = scene_path;
-  if (request.outputs.empty()) request.outputs.push_back("algray.exr");
-  for (const std::string& s : sets) {
-    const auto eq = s.find('=');
-    if (eq == std::string::npos || eq == 0) {
-      std::cerr << "algray: --set " << s << ": expected name=value\n";
+  if (probe->parsed()) {
+    ProbeRequest& req = probe_request;
+    if (!probe_opts.scene_path.empty()) req.scene_path = probe_opts.scene_path;
+    if (!collect_overrides(probe, probe_opts, req.overrides)) return kExitBadInput;
+    req.device_spec = probe_opts.device_spec;
+    req.use_cache = !probe_opts.no_cache;
+    std::vector<double> v;
+    if (!pixel_text.empty()) {
+      if (!parse_numbers(pixel_text, 2, v) || v[0] != static_cast<int>(v[0]) || v[1] != static_cast<int>(v[1])) {
+        std::cerr << "algray: --pixel " << pixel_text << ": expected two integers X,Y\n";
+        return kExitBadInput;
+      }
+      req.target.px = static_cast<int>(v[0]);
+      req.target.py = static_cast<int>(v[1]);
+    } else if (!ray_text.empty()) {
+      if (!parse_numbers(ray_text, 6, v)) {
+        std::cerr << "algray: --ray " << ray_text << ": expected six numbers ox,oy,oz,dx,dy,dz\n";
+        return kExitBadInput;
+      }
+      req.target.given_ray = true;
+      req.target.origin = {v[0], v[1], v[2]};
+      req.target.direction = {v[3], v[4], v[5]};
+    } else {
+      std::cerr << "algray: probe needs --pixel X,Y or --ray ox,oy,oz,dx,dy,dz\n";
       return kExitBadInput;
     }
-    request.overrides.push_back({s.substr(0, eq), s.substr(eq + 1)});
+    return run_probe(req, std::cout, std::cerr);
   }
-  // Flags are overrides like any --set, applied last so they win.
-  if (render->count("--width")) request.overrides.push_back({"image.width", std::to_string(width)});
-  if (render->count("--height")) request.overrides.push_back({"image.height", std::to_string(height)});
-  if (!precision.empty()) request.overrides.push_back({"render.precision", "\"" + precision + "\""});
-  if (!isolation.empty()) request.overrides.push_back({"render.isolation", "\"" + isolation + "\""});
-  if (!refinement.empty()) request.overrides.push_back({"render.refinement", "\"" + refinement + "\""});
-  // Numbers pass through as written, so that the scene's own checks report them.
-  if (!tolerance.empty()) request.overrides.push_back({"render.tolerance", tolerance});
-  if (!max_iterations.empty()) request.overrides.push_back({"render.max_iterations", max_iterations});
-  if (preview) request.overrides.push_back({"render.preview", "true"});
-  request.use_cache = !no_cache;
+
+  if (!render_opts.scene_path.empty()) request.scene_path = render_opts.scene_path;
+  if (request.outputs.empty()) request.outputs.push_back("algray.exr");
+  if (!collect_overrides(render, render_opts, request.overrides)) return kExitBadInput;
+  request.device_spec = render_opts.device_spec;
+  if (!aov_text.empty()) {
+    std::string error;
+    if (!parse_aov_list(aov_text, request.aovs, error)) {
+      std::cerr << "algray: --aov " << aov_text << ": " << error << "\n";
+      return kExitBadInput;
+    }
+  }
+  request.use_cache = !render_opts.no_cache;
   if (!stats_path.empty()) request.stats_path = stats_path;
   request.progress = ::isatty(STDERR_FILENO) != 0;
   return run_render(request, std::cerr);

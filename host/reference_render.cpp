@@ -55,6 +55,28 @@ std::array<long double, 3> gradient_at(const std::vector<Monomial>& monomials, c
 
 }  // namespace
 
+const char* pixel_class_name(PixelClass c) {
+  switch (c) {
+    case PixelClass::OutsideExtent:
+      return "outside extent";
+    case PixelClass::Miss:
+      return "miss";
+    case PixelClass::SimpleRoot:
+      return "simple root";
+    case PixelClass::OddMultipleRoot:
+      return "odd multiple root";
+    case PixelClass::EvenRoot:
+      return "even root";
+    case PixelClass::OnSurface:
+      return "on surface";
+    case PixelClass::NearEnd:
+      return "root near a clipping end";
+    case PixelClass::RayRounding:
+      return "ray rounding could change the answer";
+  }
+  return "?";
+}
+
 bool extent_interval(const Extent& e, const PixelRay& ray, long double& t_in, long double& t_out) {
   using R = long double;
   const R o[3] = {ray.origin.x, ray.origin.y, ray.origin.z}, d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
@@ -107,6 +129,38 @@ bool flips_under_ray_rounding(const std::vector<mpq_class>& restricted, const st
   return false;
 }
 
+RayCertificate certify_ray(const Polynomial& polynomial, const std::vector<Monomial>& monomials, const Extent& extent,
+                           const PixelRay& ray, Precision ray_precision) {
+  RayCertificate c;
+  if (!extent_interval(extent, ray, c.t_in, c.t_out)) return c;
+  const long double eps = ray_precision != Precision::Double ? std::numeric_limits<float>::epsilon()
+                                                             : std::numeric_limits<double>::epsilon();
+  // Solve on the interval widened by the clipping margin, so a root the kernels' own clipping may just
+  // include or exclude shows up as ambiguous instead of as a certified answer.
+  const long double margin = kReferenceEndMargin * eps * std::max<long double>(c.t_out, 1);
+  const ref::ExactRay exact{{ray.origin.x, ray.origin.y, ray.origin.z},
+                            {ray.direction.x, ray.direction.y, ray.direction.z}};
+  c.lo = exact_rational(static_cast<double>(std::max<long double>(0, c.t_in - margin)));
+  c.hi = exact_rational(static_cast<double>(c.t_out + margin));
+  c.width = exact_rational(kReferenceWidth * static_cast<double>(std::max<long double>(c.t_out, 1)));
+  c.restricted = ref::restrict_exact(polynomial, exact);
+  c.answer = ref::smallest_root(c.restricted, c.lo, c.hi, c.width);
+  c.cls = classify(c.answer.kind);
+  if (c.answer.kind == ref::Classification::Miss) {
+    if (flips_under_ray_rounding(c.restricted, monomials, ray, c.lo, c.hi, eps)) c.cls = PixelClass::RayRounding;
+    return c;
+  }
+  const long double t = c.answer.t_nearest;
+  if (t < c.t_in + margin || t > c.t_out - margin) c.cls = PixelClass::NearEnd;
+  if (c.cls == PixelClass::SimpleRoot) {
+    // P* keeps its shape up to the second root: beyond it, nothing a small move does changes the answer.
+    const ref::Answer second = ref::smallest_root(c.restricted, c.answer.hi + c.width, c.hi, c.width);
+    const mpq_class limit = second.kind == ref::Classification::Miss ? c.hi : second.hi;
+    if (flips_under_ray_rounding(c.restricted, monomials, ray, c.lo, limit, eps)) c.cls = PixelClass::RayRounding;
+  }
+  return c;
+}
+
 ReferenceResult render_reference(const Scene& scene, Precision ray_precision, unsigned threads) {
   const int width = scene.image.width, height = scene.image.height;
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
@@ -124,7 +178,6 @@ ReferenceResult render_reference(const Scene& scene, Precision ray_precision, un
   out.t.assign(pixels, std::numeric_limits<double>::infinity());
 
   const bool single = ray_precision != Precision::Double;
-  const long double eps = single ? std::numeric_limits<float>::epsilon() : std::numeric_limits<double>::epsilon();
   const std::vector<Monomial> monomials = scene.surface().polynomial.monomials();
 
   auto solve_pixel = [&](int px, int py) {
@@ -132,37 +185,16 @@ ReferenceResult render_reference(const Scene& scene, Precision ray_precision, un
     HitRecord& h = r.hits.records[i];
     h.t_hi = h.depth = std::numeric_limits<float>::infinity();
     const PixelRay ray = pixel_ray(r.basis, single, px, py);
-    long double t_in = 0, t_out = 0;
-    if (!extent_interval(scene.extent, ray, t_in, t_out)) return;
+    const RayCertificate c = certify_ray(scene.surface().polynomial, monomials, scene.extent, ray, ray_precision);
+    out.classes[i] = static_cast<std::uint32_t>(c.cls);
+    if (c.cls == PixelClass::OutsideExtent) return;
     h.flags = ALGRAY_HIT_IN_EXTENT;
-    // Solve on the interval widened by the clipping margin, so a root the kernels' own clipping may just
-    // include or exclude shows up as ambiguous instead of as a certified answer.
-    const long double margin = kReferenceEndMargin * eps * std::max<long double>(t_out, 1);
-    const ref::ExactRay exact{{ray.origin.x, ray.origin.y, ray.origin.z},
-                              {ray.direction.x, ray.direction.y, ray.direction.z}};
-    const mpq_class lo = exact_rational(static_cast<double>(std::max<long double>(0, t_in - margin)));
-    const mpq_class hi = exact_rational(static_cast<double>(t_out + margin));
-    const mpq_class width_t = exact_rational(kReferenceWidth * static_cast<double>(std::max<long double>(t_out, 1)));
-    const std::vector<mpq_class> restricted = ref::restrict_exact(scene.surface().polynomial, exact);
-    const ref::Answer a = ref::smallest_root(restricted, lo, hi, width_t);
-    PixelClass cls = classify(a.kind);
-    if (a.kind == ref::Classification::Miss) {
-      if (flips_under_ray_rounding(restricted, monomials, ray, lo, hi, eps)) cls = PixelClass::RayRounding;
-      out.classes[i] = static_cast<std::uint32_t>(cls);
-      return;
-    }
+    if (c.answer.kind == ref::Classification::Miss) return;
+    const ref::Answer& a = c.answer;
     const long double t = a.t_nearest;
-    if (t < t_in + margin || t > t_out - margin) cls = PixelClass::NearEnd;
-    if (cls == PixelClass::SimpleRoot) {
-      // P* keeps its shape up to the second root: beyond it, nothing a small move does changes the answer.
-      const ref::Answer second = ref::smallest_root(restricted, a.hi + width_t, hi, width_t);
-      const mpq_class limit = second.kind == ref::Classification::Miss ? hi : second.hi;
-      if (flips_under_ray_rounding(restricted, monomials, ray, lo, limit, eps)) cls = PixelClass::RayRounding;
-    }
-    out.classes[i] = static_cast<std::uint32_t>(cls);
     out.t[i] = a.t_nearest;
     h.flags |= ALGRAY_HIT_FOUND;
-    if (cls == PixelClass::EvenRoot) h.flags |= ALGRAY_HIT_TANGENT;
+    if (c.cls == PixelClass::EvenRoot) h.flags |= ALGRAY_HIT_TANGENT;
     h.t_hi = static_cast<float>(a.t_nearest);
     h.t_lo = static_cast<float>(a.t_nearest - static_cast<double>(h.t_hi));
     h.depth = static_cast<float>(a.t_nearest * glm::length(ray.direction));
@@ -176,11 +208,12 @@ ReferenceResult render_reference(const Scene& scene, Precision ray_precision, un
     h.normal_y = static_cast<float>(n.y);
     h.normal_z = static_cast<float>(n.z);
     // The side: P has one sign on [t_in, root), the sign at the start (or, for a root there, of P' there).
-    const mpq_class start = exact_rational(static_cast<double>(t_in));
-    int before = sgn(evaluate(restricted, start));
+    const mpq_class start = exact_rational(static_cast<double>(c.t_in));
+    int before = sgn(evaluate(c.restricted, start));
     if (before == 0) {
       std::vector<mpq_class> derivative;
-      for (std::size_t k = 1; k < restricted.size(); ++k) derivative.push_back(restricted[k] * static_cast<long>(k));
+      for (std::size_t k = 1; k < c.restricted.size(); ++k)
+        derivative.push_back(c.restricted[k] * static_cast<long>(k));
       before = -sgn(evaluate(derivative, start));
     }
     if (before < 0) h.flags |= ALGRAY_HIT_BACK;

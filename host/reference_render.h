@@ -6,6 +6,7 @@
 
 #include "renderer.h"
 #include "scene.h"
+#include "solver_ref.h"
 
 namespace algray {
 
@@ -20,6 +21,9 @@ enum class PixelClass : std::uint32_t {
   NearEnd = 6,          // the smallest root lies within the clipping margin of t_in or t_out: ambiguous
   RayRounding = 7,      // a miss or simple root whose answer a few ulps' change of the ray can flip: ambiguous
 };
+
+// "outside extent", "miss", "simple root", ...: the classes' names as reports print them.
+const char* pixel_class_name(PixelClass c);
 
 struct ReferenceResult {
   RenderResult render;                 // hit records as the kernels would write them (work = 0)
@@ -48,6 +52,18 @@ bool extent_interval(const Extent& extent, const PixelRay& ray, long double& t_i
 // that needs a critical point of P* there where |P*| is within the first-order change of P.
 bool flips_under_ray_rounding(const std::vector<mpq_class>& restricted, const std::vector<Monomial>& monomials,
                               const PixelRay& ray, const mpq_class& lo, const mpq_class& limit, long double eps);
+
+// What solver_ref certifies for one ray against one polynomial, as the reference image does for each pixel.
+struct RayCertificate {
+  PixelClass cls = PixelClass::OutsideExtent;
+  long double t_in = 0, t_out = 0;    // extent_interval(); both 0 outside the extent
+  mpq_class lo, hi, width;            // the interval solved on (t_in, t_out widened by the end margin), enclosure width
+  std::vector<mpq_class> restricted;  // P*(t) exactly, power basis of t
+  ref::Answer answer;                 // the smallest root on [lo, hi]
+};
+// `ray` is taken at its exact value; `ray_precision` sets the margins of what counts as ambiguous.
+RayCertificate certify_ray(const Polynomial& polynomial, const std::vector<Monomial>& monomials, const Extent& extent,
+                           const PixelRay& ray, Precision ray_precision);
 
 // Rays are rebuilt in `ray_precision` exactly as the kernels build them (README convention), and P is the
 // scene's exact polynomial. threads = 0 uses every core.

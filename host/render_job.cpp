@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "cl_runtime.h"
+#include "diagnostic_images.h"
 #include "program_cache.h"
 #include "reference_render.h"
 #include "renderer.h"
@@ -172,24 +173,10 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
   return j;
 }
 
-void write_text_atomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw OutputError("cannot write " + path);
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw OutputError("cannot write " + path);
-  }
-}
+}  // namespace
 
 // An output that cannot be written is bad input, found before any rendering.
-void check_writable(const std::string& path) {
+void check_output_writable(const std::string& path) {
   const std::filesystem::path p(path);
   const std::filesystem::path dir = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
   if (!std::filesystem::is_directory(dir))
@@ -198,8 +185,6 @@ void check_writable(const std::string& path) {
   if (::access(dir.c_str(), W_OK) != 0) throw OutputError(path + ": directory '" + dir.string() + "' is not writable");
 }
 
-}  // namespace
-
 int run_render(const RenderRequest& req, std::ostream& err) {
   PhaseTimer timer;
   // Everything the user gave is checked before any device work, so bad input costs nothing and writes nothing.
@@ -207,13 +192,17 @@ int run_render(const RenderRequest& req, std::ostream& err) {
   try {
     scene = req.scene_path ? load_scene_file(*req.scene_path, req.overrides) : default_scene(req.overrides);
     if (req.reference && scene.surfaces.size() > 1)
-      throw SceneError(scene.source, "--reference solves one surface; this scene has " +
-                                         std::to_string(scene.surfaces.size()));
+      throw SceneError(scene.source,
+                       "--reference solves one surface; this scene has " + std::to_string(scene.surfaces.size()));
     for (const std::string& out : req.outputs) {
       format_from_extension(out);
-      check_writable(out);
+      check_output_writable(out);
     }
-    if (req.stats_path) check_writable(*req.stats_path);
+    if (req.stats_path) check_output_writable(*req.stats_path);
+    if (req.heatmap_path) {
+      format_from_extension(*req.heatmap_path);
+      check_output_writable(*req.heatmap_path);
+    }
   } catch (const SceneError& e) {
     err << e.what() << "\n";
     return kExitBadInput;
@@ -247,11 +236,21 @@ int run_render(const RenderRequest& req, std::ostream& err) {
       image = shade_frame(scene, result);
     }
     add_metadata(image, scene, result, device);
+    if (!req.aovs.empty() || req.heatmap_path) {
+      const SolverWork work = solver_work(result);
+      add_solver_aovs(image, work, req.aovs);
+      if (req.heatmap_path) {
+        const std::string per =
+            work.samples > 1 ? " (sum over " + std::to_string(work.samples * work.samples) + " samples)" : "";
+        write_image(*req.heatmap_path, work_heatmap(work.width, work.height, work.total(), work.in_extent,
+                                                    "isolation steps + refinement iterations per pixel" + per));
+      }
+    }
     timer.mark("shade");
     for (const std::string& out : req.outputs) write_image(out, image);
     timer.mark("write");
     if (req.stats_path)
-      write_text_atomically(*req.stats_path, stats_json(scene, req, result, device, timer).dump(2) + "\n");
+      write_text_file(*req.stats_path, stats_json(scene, req, result, device, timer).dump(2) + "\n");
   } catch (const DeviceError& e) {
     err << "algray: " << e.what() << "\n";
     return kExitBadInput;

@@ -69,7 +69,8 @@ glm::dvec3 shade_hit(const Scene& scene, const std::vector<LightSamples>& lights
       if (r_dot_v > highlight_cutoff) specular += std::pow(r_dot_v, m.exponent);
     }
     const double share = 1.0 / static_cast<double>(ls.points.size());
-    c += ls.light->intensity * ls.light->colour * (m.diffuse * diffuse * share * m.colour + m.specular * specular * share);
+    c += ls.light->intensity * ls.light->colour *
+         (m.diffuse * diffuse * share * m.colour + m.specular * specular * share);
   }
   return own * c;
 }
@@ -91,9 +92,6 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
   img.rgba.assign(4 * n, 0.0f);
   img.depth.assign(n, std::numeric_limits<float>::infinity());
   img.normal.assign(3 * n, 0.0f);
-  FrameImage::UintChannel steps{"solver.isolationSteps", std::vector<std::uint32_t>(n)};
-  FrameImage::UintChannel iterations{"solver.refineIterations", std::vector<std::uint32_t>(n)};
-  FrameImage::UintChannel flags{"solver.flags", std::vector<std::uint32_t>(n)};
 
   std::vector<LightSamples> lights;
   for (const Light& light : scene.lights) lights.push_back({&light, light.sample_points()});
@@ -110,15 +108,15 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
     const ShadowLookup batch_shadows(batch.shadows, batch.hits.size(), scene.lights);
     for (std::size_t i = 0; i < batch.hits.size(); ++i) {
       const HitRecord& h = batch.hits[i];
-      const glm::dvec3 seen =
-          (h.flags & ALGRAY_HIT_FOUND)
-              ? shade_hit(scene, lights, h, batch.hit_surface.empty() ? 0 : batch.hit_surface[i],
-                          hit_point(batch.rays[i], h), -glm::normalize(batch.rays[i].direction), batch_shadows, i,
-                          transmits)
-              : glm::dvec3(scene.image.background);
+      const glm::dvec3 seen = (h.flags & ALGRAY_HIT_FOUND)
+                                  ? shade_hit(scene, lights, h, batch.hit_surface.empty() ? 0 : batch.hit_surface[i],
+                                              hit_point(batch.rays[i], h), -glm::normalize(batch.rays[i].direction),
+                                              batch_shadows, i, transmits)
+                                  : glm::dvec3(scene.image.background);
       (batch.refinement ? refined_colour : secondary)[batch.sample[i]] += batch.weight[i] * seen;
       if (batch.pass == "antialias")
-        refined_alpha[batch.sample[i]] += batch.weight[i] * ((h.flags & ALGRAY_HIT_FOUND) ? 1.0 : scene.image.background.a);
+        refined_alpha[batch.sample[i]] +=
+            batch.weight[i] * ((h.flags & ALGRAY_HIT_FOUND) ? 1.0 : scene.image.background.a);
     }
   }
   const double weight = 1.0 / (samples * samples);
@@ -134,9 +132,6 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
             const int tx = x * samples + sx, ty = y * samples + sy;
             const std::size_t k = static_cast<std::size_t>(ty) * hits.width + tx;
             const HitRecord& h = hits.records[k];
-            steps.values[i] += h.work & 0xffffu;
-            iterations.values[i] += h.work >> 16;
-            flags.values[i] |= h.flags;
             if (!result.refined.empty() && result.refined[k]) {
               // Its colour is what the antialias batch's n x n rays (and their bounces) saw.
               sum += glm::dvec4(refined_colour[k], refined_alpha[k]);
@@ -154,8 +149,8 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
             }
             const PixelRay ray = pixel_ray(result.basis, single, tx, ty);
             const glm::dvec3 to_eye = -glm::normalize(ray.direction);
-            glm::dvec3 colour =
-                shade_hit(scene, lights, h, hits.surface_of(k), hit_point(ray, h), to_eye, primary_shadows, k, transmits);
+            glm::dvec3 colour = shade_hit(scene, lights, h, hits.surface_of(k), hit_point(ray, h), to_eye,
+                                          primary_shadows, k, transmits);
             if (!secondary.empty()) colour += secondary[k];
             sum += glm::dvec4(colour, 1);
             if (h.depth < img.depth[i]) {
@@ -176,7 +171,6 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
     workers.emplace_back(shade_rows, img.height * t / threads, img.height * (t + 1) / threads);
   shade_rows(0, img.height / threads);
   for (std::thread& w : workers) w.join();
-  img.uint_channels = {std::move(steps), std::move(iterations), std::move(flags)};
   return img;
 }
 

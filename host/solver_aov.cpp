@@ -1,0 +1,96 @@
+// Solver diagnostics per pixel from the primary pass's hit records.
+#include "solver_aov.h"
+
+#include <algorithm>
+#include <sstream>
+
+namespace algray {
+
+bool parse_aov_list(const std::string& text, std::vector<SolverAov>& out, std::string& error) {
+  std::istringstream in(text);
+  std::string word;
+  while (std::getline(in, word, ',')) {
+    SolverAov aov;
+    if (word == "iterations")
+      aov = SolverAov::Iterations;
+    else if (word == "isolation")
+      aov = SolverAov::Isolation;
+    else if (word == "classification")
+      aov = SolverAov::Classification;
+    else if (word == "flags")
+      aov = SolverAov::Flags;
+    else {
+      error =
+          "unknown AOV '" + word + "': expected a comma-separated list of iterations, isolation, classification, flags";
+      return false;
+    }
+    if (std::find(out.begin(), out.end(), aov) == out.end()) out.push_back(aov);
+  }
+  if (out.empty()) {
+    error = "empty AOV list: expected iterations, isolation, classification or flags";
+    return false;
+  }
+  return true;
+}
+
+SolverClass solver_class(const HitRecord& hit) {
+  if (!(hit.flags & ALGRAY_HIT_IN_EXTENT)) return SolverClass::OutsideExtent;
+  if (hit.flags & ALGRAY_HIT_BUDGET) return SolverClass::HalvingLimit;
+  if (!(hit.flags & ALGRAY_HIT_FOUND)) return SolverClass::NoRoot;
+  if (hit.flags & ALGRAY_HIT_CLUSTER) return SolverClass::Cluster;
+  if (hit.flags & ALGRAY_HIT_EXACT) return SolverClass::ExactZero;
+  return SolverClass::Isolated;
+}
+
+std::vector<std::uint32_t> SolverWork::total() const {
+  std::vector<std::uint32_t> sum(isolation_steps.size());
+  for (std::size_t i = 0; i < sum.size(); ++i) sum[i] = isolation_steps[i] + refine_iterations[i];
+  return sum;
+}
+
+SolverWork solver_work(const RenderResult& result) {
+  const HitBuffer& hits = result.hits;
+  SolverWork w;
+  w.samples = std::max(result.plan.samples, 1);
+  w.width = hits.width / w.samples;
+  w.height = hits.height / w.samples;
+  const std::size_t n = static_cast<std::size_t>(w.width) * w.height;
+  w.isolation_steps.assign(n, 0);
+  w.refine_iterations.assign(n, 0);
+  w.flags.assign(n, 0);
+  w.classification.assign(n, 0);
+  w.in_extent.assign(n, 0);
+  for (int ty = 0; ty < hits.height; ++ty) {
+    for (int tx = 0; tx < hits.width; ++tx) {
+      const HitRecord& h = hits.at(tx, ty);
+      const std::size_t i = static_cast<std::size_t>(ty / w.samples) * w.width + tx / w.samples;
+      w.isolation_steps[i] += h.work & 0xffffu;
+      w.refine_iterations[i] += h.work >> 16;
+      w.flags[i] |= h.flags;
+      w.classification[i] = std::max(w.classification[i], static_cast<std::uint32_t>(solver_class(h)));
+      w.in_extent[i] |= (h.flags & ALGRAY_HIT_IN_EXTENT) != 0;
+    }
+  }
+  return w;
+}
+
+void add_solver_aovs(FrameImage& image, const SolverWork& work, const std::vector<SolverAov>& aovs) {
+  for (SolverAov aov : aovs) {
+    switch (aov) {
+      case SolverAov::Iterations:
+        image.uint_channels.push_back({"solver.refineIterations", work.refine_iterations});
+        break;
+      case SolverAov::Isolation:
+        image.uint_channels.push_back({"solver.isolationSteps", work.isolation_steps});
+        break;
+      case SolverAov::Classification:
+        image.uint_channels.push_back({"solver.class", work.classification});
+        break;
+      case SolverAov::Flags:
+        image.uint_channels.push_back({"solver.flags", work.flags});
+        break;
+    }
+  }
+}
+
+}  // namespace algray

@@ -1,0 +1,288 @@
+// The probe: the Fig. 8 torus ray, the plot and JSON from the command, and the traced path against the render.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "cli_sandbox.h"
+#include "image_io.h"
+#include "probe_report.h"
+#include "render_plan.h"
+#include "renderer.h"
+#include "test_support.h"
+
+using namespace algray;
+using algray::testing::device_session;
+
+namespace {
+
+ProgramCache& probe_cache() {
+  static ProgramCache cache(true, algray::testing::shared_cache_dir());
+  return cache;
+}
+
+Scene torus_scene(std::vector<Override> extra = {}) {
+  std::vector<Override> overrides = {{"antialias.samples", "1"}, {"render.preview", "true"}};
+  overrides.insert(overrides.end(), extra.begin(), extra.end());
+  return load_scene_file(ALGRAY_SOURCE_DIR "/scenes/torus.toml", overrides);
+}
+
+// A TOML string value.
+std::string toml_string(const std::string& s) {
+  std::string q = "\"";
+  q += s;
+  return q += '"';
+}
+
+KernelConfig solver(const Scene& scene, Precision precision, Isolation isolation, Refinement refinement) {
+  KernelConfig c = primary_config(scene, precision);
+  c.isolation = isolation;
+  c.refinement = refinement;
+  c.max_iterations = default_max_iterations(refinement);
+  return c;
+}
+
+// The paper's Fig. 8: a ray that grazes the near side of the tube (two close roots, x1 < x2) and then crosses
+// the far side (x3 < x4). P* has a shallow hump between x1 and x2; Newton started left of it can jump to x2.
+// Torus a = 2.5, r = 0.9 around the z axis; the ray runs along x at height z = 0.85, from x = -5.
+constexpr double kHeight = 0.85;
+double fig8_root(int i) {
+  const double half = std::sqrt(0.9 * 0.9 - kHeight * kHeight);  // half the chord through the tube
+  const double xs[4] = {-2.5 - half, -2.5 + half, 2.5 - half, 2.5 + half};
+  return xs[i] + 5.0;
+}
+
+}  // namespace
+
+TEST_CASE("the probe names the smallest root of the Fig. 8 torus ray and the isolation that found it", "[probe]") {
+  ClSession& session = device_session();
+  const Scene scene = torus_scene();
+  ProbeTarget target;
+  target.given_ray = true;
+  target.origin = {-5, 0, kHeight};
+  target.direction = {1, 0, 0};
+  const double x1 = fig8_root(0), x2 = fig8_root(1);
+
+  const ProbeReference ref = probe_reference(scene, 0, {target.origin, target.direction}, Precision::Double);
+  REQUIRE(ref.roots.size() == 4);
+  for (int i = 0; i < 4; ++i) {
+    INFO("root " << i);
+    CHECK(ref.roots[i].t == Approx(fig8_root(i)).epsilon(1e-12));
+    CHECK(ref.roots[i].multiplicity == 1);
+  }
+  CHECK(ref.certificate.cls == PixelClass::SimpleRoot);
+
+  struct Case {
+    Isolation isolation;
+    Refinement refinement;
+  };
+  // Newton is the method the paper saw jump to x2; the bracket must keep it on x1.
+  const Case cases[] = {{Isolation::Bernstein, Refinement::Brent},
+                        {Isolation::Bernstein, Refinement::Newton},
+                        {Isolation::PowerDescartes, Refinement::Brent},
+                        {Isolation::Sturm, Refinement::Newton}};
+  for (const Case& c : cases) {
+    const KernelConfig config = solver(scene, Precision::Double, c.isolation, c.refinement);
+    INFO(to_string(c.isolation) << " + " << to_string(c.refinement));
+    const SolverTrace tr = trace_probe(session, probe_cache(), scene, 0, config, target);
+    REQUIRE(tr.in_extent);
+    const double t_in = 5 - std::sqrt(3.5 * 3.5 - kHeight * kHeight);
+    CHECK(tr.t_in == Approx(t_in).epsilon(1e-12));
+    CHECK(tr.t_out == Approx(10 - t_in).epsilon(1e-12));
+    REQUIRE(tr.coefficients.size() == 5);
+    CHECK(tr.basis == (c.isolation == Isolation::Bernstein ? ALGRAY_BASIS_BERNSTEIN : ALGRAY_BASIS_POWER_SEGMENT));
+
+    // The root: x1, within the tolerance, and solver_ref's smallest.
+    REQUIRE(tr.found());
+    CHECK(std::fabs(tr.t - x1) <= 4e-9 * x1);
+    CHECK(std::fabs(tr.t - ref.certificate.answer.t_nearest) <= 4e-9 * x1);
+
+    // The isolation: it starts on the whole segment, which holds all four roots, and must split it; it ends
+    // on one interval around x1 that leaves x2 out. Every step in between splits or drops an interval.
+    REQUIRE(tr.steps.size() >= 2);
+    const ProbeStep& first = tr.steps.front();
+    CHECK(first.decision == ALGRAY_STEP_SPLIT);
+    CHECK(first.lo == 0);
+    CHECK(first.hi == 1);
+    if (c.isolation == Isolation::Sturm)
+      CHECK(first.count == 4);  // Sturm counts distinct real roots exactly
+    else
+      CHECK(first.count >= 4);  // Descartes' rule bounds them from above
+    const ProbeStep& last = tr.steps.back();
+    CHECK(last.decision == ALGRAY_STEP_ISOLATED);
+    CHECK(last.count == 1);
+    CHECK(tr.t_at(last.lo) < x1);
+    CHECK(x1 < tr.t_at(last.hi));
+    CHECK(tr.t_at(last.hi) < x2);
+    for (std::size_t i = 1; i + 1 < tr.steps.size(); ++i) {
+      INFO("step " << i);
+      CHECK((tr.steps[i].decision == ALGRAY_STEP_SPLIT || tr.steps[i].decision == ALGRAY_STEP_NO_ROOT));
+    }
+    CHECK(tr.steps.size() == tr.isolation_steps());
+    CHECK(tr.isolation_status == 1);
+    CHECK(tr.iso_lo == last.lo);
+    CHECK(tr.iso_hi == last.hi);
+
+    // The refinement: one event per counted iteration, every iterate inside the isolating interval, the
+    // last one the root.
+    REQUIRE(!tr.iterates.empty());
+    CHECK(tr.iterates.size() == tr.refine_iterations());
+    for (const ProbeIterate& it : tr.iterates) {
+      INFO("iterate " << it.number);
+      CHECK(it.y >= 0);
+      CHECK(it.y <= 1);
+      CHECK(it.lo <= it.hi);
+    }
+    CHECK(std::fabs(tr.iterates.back().t - tr.t) <= 8e-9 * x1);
+    CHECK(tr.events_offered == tr.events_recorded);
+  }
+}
+
+TEST_CASE("a probed pixel gets the render's hit record bit for bit", "[probe]") {
+  ClSession& session = device_session();
+  struct Case {
+    Precision precision;
+    Isolation isolation;
+    Refinement refinement;
+  };
+  const Case cases[] = {{Precision::Double, Isolation::Bernstein, Refinement::Brent},
+                        {Precision::Float, Isolation::Bernstein, Refinement::Brent},
+                        {Precision::Mixed, Isolation::Bernstein, Refinement::Illinois},
+                        {Precision::Double, Isolation::PowerDescartes, Refinement::RegulaFalsi},
+                        {Precision::Double, Isolation::Sturm, Refinement::Newton},
+                        {Precision::Double, Isolation::DerivativeChain, Refinement::Bisection}};
+  for (const Case& c : cases) {
+    const Scene scene = torus_scene({{"image.width", "48"},
+                                     {"image.height", "36"},
+                                     {"render.precision", toml_string(to_string(c.precision))},
+                                     {"render.isolation", toml_string(to_string(c.isolation))},
+                                     {"render.refinement", toml_string(to_string(c.refinement))}});
+    INFO(to_string(c.precision) << " " << to_string(c.isolation) << " + " << to_string(c.refinement));
+    Renderer renderer(session, probe_cache());
+    const RenderResult render = renderer.render(scene, false);
+    REQUIRE(render.hits.width == 48);
+    const KernelConfig config = primary_config(scene, c.precision);
+    int hits = 0, misses_in_extent = 0, compared = 0;
+    // Every third pixel: a few hundred rays, hits and misses, grazing ones at the silhouette included.
+    for (int py = 0; py < 36; ++py) {
+      for (int px = (py % 3); px < 48; px += 3) {
+        ProbeTarget target;
+        target.px = px;
+        target.py = py;
+        const SolverTrace tr = trace_probe(session, probe_cache(), scene, 0, config, target);
+        const HitRecord& rendered = render.hits.at(px, py);
+        INFO("pixel (" << px << ", " << py << ")");
+        REQUIRE(std::memcmp(&tr.hit, &rendered, sizeof(HitRecord)) == 0);
+        ++compared;
+        hits += tr.found();
+        misses_in_extent += tr.in_extent && !tr.found();
+      }
+    }
+    CHECK(compared == 576);
+    CHECK(hits > 50);
+    CHECK(misses_in_extent > 10);
+  }
+}
+
+TEST_CASE("probe --plot writes a valid SVG and PNG, and --json the same story", "[probe][cli]") {
+  using namespace algray::testing;
+  Sandbox box;
+  const std::string scene = quoted(ALGRAY_SOURCE_DIR "/scenes/torus.toml");
+  const std::string ray = " --ray -5,0,0.85,1,0,0";
+
+  const Result svg = box.run("probe " + scene + ray + " --plot fig8.svg");
+  INFO(svg.err);
+  REQUIRE(svg.exit_code == 0);
+  CHECK(svg.out.find("one root: isolated") != std::string::npos);
+  CHECK(svg.out.find("solver_ref: simple root") != std::string::npos);
+  const std::string text = read_text(box.work / "fig8.svg");
+  CHECK(text.rfind("<?xml", 0) == 0);
+  CHECK(text.find("<svg") != std::string::npos);
+  CHECK(text.find("</svg>") != std::string::npos);
+  CHECK(text.find("solver_ref") != std::string::npos);
+
+  const Result png = box.run("probe " + scene + ray + " --all-solvers --plot fig8.png");
+  INFO(png.err);
+  REQUIRE(png.exit_code == 0);
+  CHECK(png.out.find("side by side") != std::string::npos);
+  const std::string bytes = read_text(box.work / "fig8.png");
+  REQUIRE(bytes.size() > 1000);
+  CHECK(bytes.compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) == 0);
+
+  const Result json = box.run("probe " + scene + ray + " --json");
+  REQUIRE(json.exit_code == 0);
+  const nlohmann::json j = nlohmann::json::parse(json.out);
+  const nlohmann::json& s = j["surfaces"][0];
+  REQUIRE(s["solvers"].size() == 1);
+  CHECK(s["reference"]["roots"].size() == 4);
+  CHECK(s["solvers"][0]["t"].get<double>() == Approx(fig8_root(0)).epsilon(1e-8));
+  CHECK(s["solvers"][0]["steps"].back()["decision_code"] == ALGRAY_STEP_ISOLATED);
+
+  // Bad input: no ray, a pixel outside the image, a plot format it cannot write. Nothing is written.
+  CHECK(box.run("probe " + scene).exit_code == 2);
+  const Result outside = box.run("probe " + scene + " --pixel 5000,1");
+  CHECK(outside.exit_code == 2);
+  CHECK(outside.err.find("outside") != std::string::npos);
+  CHECK(box.run("probe " + scene + ray + " --plot fig8.gif").exit_code == 2);
+  CHECK(!fs::exists(box.work / "fig8.gif"));
+}
+
+TEST_CASE("render --aov adds the solver channels asked for and --heatmap draws the work", "[probe][cli]") {
+  using namespace algray::testing;
+  Sandbox box;
+  const std::string scene =
+      quoted(ALGRAY_SOURCE_DIR "/scenes/torus.toml") + " --width 64 --height 48 --preview --set antialias.samples=1";
+  const Result r =
+      box.run("render " + scene + " -o out.exr --aov classification,isolation,iterations --heatmap work.png");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const FrameImage img = read_exr(box.work / "out.exr");
+  // read_exr returns extra channels sorted by name.
+  REQUIRE(img.uint_channels.size() == 3);
+  CHECK(img.uint_channels[0].name == "solver.class");
+  CHECK(img.uint_channels[1].name == "solver.isolationSteps");
+  CHECK(img.uint_channels[2].name == "solver.refineIterations");
+  const auto& cls = img.uint_channels[0].values;
+  const auto& steps = img.uint_channels[1].values;
+  const auto& iterations = img.uint_channels[2].values;
+  int counts[6] = {0, 0, 0, 0, 0, 0};
+  for (std::size_t i = 0; i < cls.size(); ++i) {
+    INFO("pixel " << i);
+    REQUIRE(cls[i] <= 5);
+    ++counts[cls[i]];
+    const bool hit = std::isfinite(img.depth[i]);
+    if (cls[i] != 5) CHECK(hit == (cls[i] >= 2));  // at the depth limit it may be either
+    if (cls[i] == 0) CHECK(steps[i] == 0);         // nothing solved outside the extent
+    if (cls[i] == 2) CHECK(iterations[i] > 0);
+    if (cls[i] >= 1) CHECK(steps[i] > 0);
+  }
+  CHECK(counts[0] > 0);
+  CHECK(counts[1] > 0);
+  CHECK(counts[2] > 100);
+
+  // The channel agrees with the probe of the same pixel.
+  const int px = 32, py = 24;
+  const Result probe = box.run("probe " + scene + " --pixel 32,24 --json");
+  REQUIRE(probe.exit_code == 0);
+  const nlohmann::json s = nlohmann::json::parse(probe.out)["surfaces"][0]["solvers"][0];
+  CHECK(s["isolation_steps"].get<std::uint32_t>() == steps[py * 64 + px]);
+  CHECK(s["refine_iterations"].get<std::uint32_t>() == iterations[py * 64 + px]);
+
+  // The heat map: a PNG at least as large as the image (it adds a colour bar and caption).
+  const std::string png = read_text(box.work / "work.png");
+  REQUIRE(png.size() > 24);
+  const auto be32 = [&](std::size_t at) {
+    return (std::uint32_t(std::uint8_t(png[at])) << 24) | (std::uint32_t(std::uint8_t(png[at + 1])) << 16) |
+           (std::uint32_t(std::uint8_t(png[at + 2])) << 8) | std::uint32_t(std::uint8_t(png[at + 3]));
+  };
+  CHECK(be32(16) >= 64);
+  CHECK(be32(20) >= 48);
+
+  // Without --aov there are no solver channels; an unknown name is bad input.
+  REQUIRE(box.run("render " + scene + " -o plain.exr").exit_code == 0);
+  CHECK(read_exr(box.work / "plain.exr").uint_channels.empty());
+  const Result bad = box.run("render " + scene + " -o bad.exr --aov iterations,colour");
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.err.find("colour") != std::string::npos);
+  CHECK(!fs::exists(box.work / "bad.exr"));
+}
