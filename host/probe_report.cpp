@@ -147,6 +147,8 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
     const double error = std::fabs(tr.t - cert.answer.t_nearest);
     out << "vs solver_ref: |t - t_ref| = " << num(error, 3) << " (relative "
         << num(error / std::fabs(cert.answer.t_nearest), 3) << ")\n";
+  } else if (!tr.found() && cert.answer.kind == ref::Classification::Miss) {
+    out << "vs solver_ref: agrees, no root\n";
   } else if (tr.found() != (cert.answer.kind != ref::Classification::Miss)) {
     out << "vs solver_ref: DISAGREES (" << (tr.found() ? "kernel hit, reference miss" : "kernel miss, reference root")
         << ")\n";
@@ -245,7 +247,9 @@ nlohmann::json reference_json(const ProbeReference& ref) {
   return j;
 }
 
-// P*(t) from solver_ref's exact restriction, sampled densely and at the marked points.
+// P*(t) from solver_ref's exact restriction, sampled evenly and at the isolating intervals' ends. Not at the
+// roots: a sample there is 0 to rounding, and the plot's log floor would follow it down to 1e-12 of the
+// largest value, spending most of the height on decades that only the roots' neighbourhoods reach.
 ProbePlot make_plot(const Scene& scene, const ProbeTarget& target, const SurfaceProbe& probe) {
   const SolverTrace& first = probe.traces.front();
   ProbePlot plot;
@@ -271,7 +275,6 @@ ProbePlot make_plot(const Scene& scene, const ProbeTarget& target, const Surface
   }
   for (const ProbeReference::Root& r : probe.reference.roots) {
     plot.markers.push_back({PlotMarker::Kind::ReferenceRoot, r.t, "solver_ref " + r.kind + " " + num(r.t, 10)});
-    ts.push_back(r.t);
   }
   std::sort(ts.begin(), ts.end());
   ts.erase(std::unique(ts.begin(), ts.end()), ts.end());
