@@ -183,7 +183,7 @@ class SceneReader {
   std::vector<std::string> lines_;
 };
 
-const std::set<std::string> kTopKeys{"surface", "parameters", "extent",    "camera", "image",
+const std::set<std::string> kTopKeys{"surface",  "parameters", "extent",    "camera", "image",
                                      "material", "light",      "antialias", "render"};
 const std::set<std::string> kSurfaceKeys{"name", "equation", "terms", "material"};
 const std::set<std::string> kExtentKeys{"type", "centre", "radius", "min", "max"};
@@ -192,11 +192,11 @@ const std::set<std::string> kImageKeys{"width", "height", "background"};
 const std::set<std::string> kMaterialKeys{"front", "back"};
 const std::set<std::string> kMaterialSideKeys{"colour",   "ambient",      "diffuse",     "specular",
                                               "exponent", "reflectivity", "transparency"};
-const std::set<std::string> kLightKeys{"type",   "position", "edge_u",    "edge_v",    "normal",
-                                       "radius", "samples",  "colour",    "intensity", "shadows"};
+const std::set<std::string> kLightKeys{"type",   "position", "edge_u", "edge_v",    "normal",
+                                       "radius", "samples",  "colour", "intensity", "shadows"};
 const std::set<std::string> kAntialiasKeys{"samples", "adaptive", "threshold"};
 const std::set<std::string> kRenderKeys{"precision",      "tolerance", "isolation", "refinement", "ray_origin",
-                                        "max_iterations", "tile_size", "preview",    "max_depth"};
+                                        "max_iterations", "tile_size", "preview",   "max_depth"};
 
 bool is_identifier(const std::string& s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
@@ -214,41 +214,74 @@ void merge_tables(toml::table& into, toml::table&& from) {
   }
 }
 
+bool is_index(const std::string& s) {
+  return !s.empty() && s.size() <= 6 &&
+         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
+}
+
 void apply_override(toml::table& root, const Override& o) {
   const std::string label = "--set " + o.key + "=" + o.value;
   // A bare name is a parameter; any other key is a dotted path into the scene.
   const std::string key = o.key.find('.') == std::string::npos ? "parameters." + o.key : o.key;
+  std::vector<std::string> parts;
   for (std::size_t start = 0;;) {
     const std::size_t dot = key.find('.', start);
-    const std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
-    if (!is_identifier(part)) throw SceneError(label, "'" + o.key + "' is not a dotted scene key such as camera.fov_y");
+    parts.push_back(key.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
     if (dot == std::string::npos) break;
     start = dot + 1;
   }
-  // Tables in arrays ([[surface]], [[light]]) have no name a dotted key could reach: refuse rather than
-  // replace the whole array with one table.
-  const toml::node* at = &root;
-  for (std::size_t start = 0; at && at->is_table();) {
-    const std::size_t dot = key.find('.', start);
-    const std::string part = key.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
-    at = at->as_table()->get(part);
-    if (at && at->is_array_of_tables())
-      throw SceneError(label, "'" + part + "' is a list of [[" + part +
-                                  "]] tables, which --set cannot reach into; change the scene file instead");
-    if (dot == std::string::npos) break;
-    start = dot + 1;
+  const auto check_identifier = [&](const std::string& part) {
+    if (!is_identifier(part))
+      throw SceneError(label, "'" + o.key + "' is not a dotted scene key such as camera.fov_y or light.0.intensity");
+  };
+  // Walk down the existing tables. A list of tables ([[surface]], [[light]]) is reached by index, as in
+  // light.0.intensity, and the override applies inside that one table: merging at the list would replace the
+  // whole list with a single table.
+  toml::table* target = &root;
+  std::size_t i = 0;
+  while (i + 1 < parts.size()) {
+    check_identifier(parts[i]);
+    toml::node* at = target->get(parts[i]);
+    if (at && at->is_table()) {
+      target = at->as_table();
+      ++i;
+      continue;
+    }
+    if (!at || !at->is_array_of_tables()) break;
+    const std::string& list_name = parts[i];
+    const toml::array& list = *at->as_array();
+    if (!is_index(parts[i + 1]))
+      throw SceneError(label, "'" + list_name + "' is a list of [[" + list_name +
+                                  "]] tables: name one by its index from 0, as in " + list_name + ".0." + parts[i + 1]);
+    const std::size_t index = std::stoul(parts[i + 1]);
+    if (index >= list.size())
+      throw SceneError(label, "the scene has " + std::to_string(list.size()) + " [[" + list_name + "]] table" +
+                                  (list.size() == 1 ? "" : "s") + ", indexed from 0: there is no " + list_name + "." +
+                                  parts[i + 1]);
+    if (i + 2 == parts.size())
+      throw SceneError(label, "'" + o.key + "' names a whole [[" + list_name + "]] table; set one of its keys");
+    target = at->as_array()->get(index)->as_table();
+    i += 2;
+  }
+  if (i + 1 == parts.size() && target->get(parts[i]) && target->get(parts[i])->is_array_of_tables())
+    throw SceneError(label, "'" + parts[i] + "' is a list of [[" + parts[i] +
+                                "]] tables: name one by its index from 0, as in " + parts[i] + ".0.KEY");
+  std::string rest;
+  for (std::size_t k = i; k < parts.size(); ++k) {
+    check_identifier(parts[k]);
+    rest += (k > i ? "." : "") + parts[k];
   }
   // Parsed as the TOML line `key = value`, every node it creates carries the override as its source, so errors
   // name it. A value that is not TOML (render.precision=float) is taken as a string.
   toml::table parsed;
   try {
-    parsed = toml::parse(key + " = " + o.value, label);
+    parsed = toml::parse(rest + " = " + o.value, label);
   } catch (const toml::parse_error&) {
     if (o.value.find_first_of("'\n") != std::string::npos)
       throw SceneError(label, "value is neither valid TOML nor a plain string");
-    parsed = toml::parse(key + " = '" + o.value + "'", label);
+    parsed = toml::parse(rest + " = '" + o.value + "'", label);
   }
-  merge_tables(root, std::move(parsed));
+  merge_tables(*target, std::move(parsed));
 }
 
 Polynomial polynomial_from_terms(const SceneReader& r, const toml::node& terms_node) {
@@ -334,9 +367,10 @@ Light read_light(const SceneReader& r, const toml::table& t) {
   if (!position) r.fail(t.source(), "a light needs a position (the centre of an area light)");
   light.position = r.vec3(*position, "light.position");
   // Keys that belong to another kind of light are mistakes, not things to ignore.
-  const std::set<std::string> own = light.kind == LightKind::Rectangle ? std::set<std::string>{"edge_u", "edge_v", "samples"}
-                                    : light.kind == LightKind::Disc   ? std::set<std::string>{"normal", "radius", "samples"}
-                                                                      : std::set<std::string>{};
+  const std::set<std::string> own =
+      light.kind == LightKind::Rectangle ? std::set<std::string>{"edge_u", "edge_v", "samples"}
+      : light.kind == LightKind::Disc    ? std::set<std::string>{"normal", "radius", "samples"}
+                                         : std::set<std::string>{};
   for (const char* key : {"edge_u", "edge_v", "normal", "radius", "samples"})
     if (const toml::node* n = t.get(key); n && !own.count(key))
       r.fail(n->source(), std::string("light.") + key + " does not apply to a " + type + " light");

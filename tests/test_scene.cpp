@@ -94,7 +94,8 @@ TEST_CASE("parameters are substituted into the equation as their double values",
   }
   SECTION("a bare override may add a parameter the file lacks") {
     const std::string uses_b = sphere_with({{3, "equation = \"x^2+y^2+z^2-b\""}});
-    CHECK(algray::load_scene_text(uses_b, "t.toml", {{"b", "0.25"}}).surface().polynomial == equation("x^2+y^2+z^2-0.25"));
+    CHECK(algray::load_scene_text(uses_b, "t.toml", {{"b", "0.25"}}).surface().polynomial ==
+          equation("x^2+y^2+z^2-0.25"));
   }
 }
 
@@ -231,7 +232,8 @@ TEST_CASE("several [[surface]] tables: each with its polynomial and materials ov
   const Scene s = algray::load_scene_text(
       "[[surface]]\nname = \"a\"\nequation = \"x^2+y^2+z^2-1\"\n"
       "[[surface]]\nequation = \"x^4+y^4+z^4-1\"\n[surface.material.front]\nreflectivity = 0.5\n"
-      "[material.front]\ncolour = [0, 1, 0]\n" + camera,
+      "[material.front]\ncolour = [0, 1, 0]\n" +
+          camera,
       "t.toml");
   REQUIRE(s.surfaces.size() == 2);
   CHECK(s.name == "a");
@@ -261,7 +263,8 @@ TEST_CASE("lights: kinds, keys that belong to another kind, and area samples spr
               "between 1 and 8");
   // A disc's n x n points lie on the disc, in its plane, and cover it by area: mean r^2 is R^2 / 2.
   const Scene s = algray::load_scene_text(
-      base + "[[light]]\ntype = \"disc\"\nposition = [1, 2, 3]\nnormal = [0, 0, 2]\nradius = 2\nsamples = 8\n", "t.toml");
+      base + "[[light]]\ntype = \"disc\"\nposition = [1, 2, 3]\nnormal = [0, 0, 2]\nradius = 2\nsamples = 8\n",
+      "t.toml");
   REQUIRE(s.lights.size() == 1);
   const std::vector<glm::dvec3> points = s.lights[0].sample_points();
   REQUIRE(points.size() == 64);
@@ -274,27 +277,50 @@ TEST_CASE("lights: kinds, keys that belong to another kind, and area samples spr
   }
   CHECK(mean_r2 == Approx(2.0).epsilon(0.05));
   // A rectangle's points are the centres of an n x n grid of cells.
-  const Scene r = algray::load_scene_text(
-      base + "[[light]]\ntype = \"rectangle\"\nposition = [0, 0, 0]\nedge_u = [2, 0, 0]\nedge_v = [0, 4, 0]\nsamples = 2\n",
-      "t.toml");
+  const Scene r = algray::load_scene_text(base +
+                                              "[[light]]\ntype = \"rectangle\"\nposition = [0, 0, 0]\nedge_u = [2, 0, "
+                                              "0]\nedge_v = [0, 4, 0]\nsamples = 2\n",
+                                          "t.toml");
   const std::vector<glm::dvec3> corners = r.lights[0].sample_points();
   REQUIRE(corners.size() == 4);
   CHECK(corners[0] == glm::dvec3(-0.5, -1, 0));
   CHECK(corners[3] == glm::dvec3(0.5, 1, 0));
 }
 
-TEST_CASE("--set cannot reach into [[surface]] or [[light]] lists, and says so", "[scene][errors]") {
-  const std::string text = sphere_with({}, {"[[light]]", "position = [1, 2, 3]"});
+TEST_CASE("--set reaches into [[surface]] and [[light]] lists by index, and says how when not indexed",
+          "[scene][errors]") {
+  const std::string text = sphere_with({}, {"[[light]]", "position = [1, 2, 3]", "[[light]]", "position = [4, 5, 6]"});
+  // Unindexed: refused, naming the list and showing the indexed form.
   for (const char* key : {"light.intensity", "light.position"}) {
     INFO(key);
     const SceneError e = error_of(text, {{key, "2"}});
     CHECK(e.where == std::string("--set ") + key + "=2");
     CHECK_THAT(e.message, Catch::Contains("[[light]]"));
+    CHECK_THAT(e.message, Catch::Contains("light.0."));
   }
-  const std::string two = "[[surface]]\nequation = \"x\"\n[[surface]]\nequation = \"y\"\n" +
-                          std::string("[extent]\nradius = 2\n[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n");
+  // Indexed: only that table changes.
+  const Scene lit =
+      algray::load_scene_text(text, "t.toml", {{"light.1.intensity", "0.25"}, {"light.0.position", "[7, 8, 9]"}});
+  REQUIRE(lit.lights.size() == 2);
+  CHECK(lit.lights[0].position == glm::dvec3(7, 8, 9));
+  CHECK(lit.lights[0].intensity == 1);
+  CHECK(lit.lights[1].position == glm::dvec3(4, 5, 6));
+  CHECK(lit.lights[1].intensity == 0.25);
+  // Out of range, or the whole table: errors that say what exists.
+  CHECK_THAT(error_of(text, {{"light.2.intensity", "1"}}).message, Catch::Contains("2 [[light]] tables"));
+  CHECK_THAT(error_of(text, {{"light.0", "1"}}).message, Catch::Contains("whole [[light]] table"));
+  // Errors in an indexed value still name the --set argument.
+  const SceneError bad = error_of(text, {{"light.1.intensity", "[1, 2]"}});
+  CHECK(bad.where == "--set light.1.intensity=[1, 2]");
+
+  const std::string two =
+      "[[surface]]\nequation = \"x\"\n[[surface]]\nequation = \"y\"\n" +
+      std::string("[extent]\nradius = 2\n[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n");
   CHECK_THAT(error_of(two, {{"surface.equation", "\"z\""}}).message, Catch::Contains("[[surface]]"));
-  // A single [surface] table is still reachable.
+  const Scene second = algray::load_scene_text(two, "two.toml", {{"surface.1.equation", "\"z\""}});
+  CHECK(second.surfaces[0].polynomial == equation("x"));
+  CHECK(second.surfaces[1].polynomial == equation("z"));
+  // A single [surface] table is still reachable without an index.
   CHECK(algray::load_scene_text(text, "t.toml", {{"surface.equation", "\"x^2+y^2+z^2-4\""}}).surface().polynomial ==
         equation("x^2+y^2+z^2-4"));
 }
