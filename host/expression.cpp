@@ -15,6 +15,12 @@ EquationError::EquationError(std::size_t pos, const std::string& message)
 
 namespace {
 
+bool is_constant_function(std::string_view name) {
+  for (const char* f : {"sin", "cos", "tan", "asin", "acos", "atan", "exp", "log", "abs", "sign", "floor", "ceil"})
+    if (name == f) return true;
+  return false;
+}
+
 constexpr unsigned max_exponent = 1000;
 constexpr int max_power_degree = 1000;
 // Keeps hostile input such as 100000 nested parentheses from overflowing the stack.
@@ -161,8 +167,9 @@ mpq_class parse_number(const Token& tok) {
 }
 
 mpq_class exact_rational_long(long double v) {
+  if (v < 0) return -exact_rational_long(-v);  // the significand below is taken unsigned
   int e = 0;
-  const long double m = std::frexp(v, &e);  // v = m * 2^e, 0.5 <= |m| < 1
+  const long double m = std::frexp(v, &e);  // v = m * 2^e, 0.5 <= m < 1
   constexpr int digits = std::numeric_limits<long double>::digits;
   static_assert(sizeof(unsigned long) * CHAR_BIT >= digits, "the significand must fit an unsigned long");
   const auto significand = static_cast<unsigned long>(std::ldexp(m, digits));
@@ -323,6 +330,7 @@ class Parser {
     if (t.text == "y") return Polynomial::variable(1);
     if (t.text == "z") return Polynomial::variable(2);
     if (t.text == "sqrt") return square_root();
+    if (is_constant_function(t.text)) return constant_function(std::string(t.text));
     const auto it = params_.find(std::string(t.text));
     if (it == params_.end())
       throw EquationError(t.pos, "unknown identifier '" + std::string(t.text) +
@@ -330,6 +338,45 @@ class Parser {
     if (!std::isfinite(it->second))
       throw EquationError(t.pos, "parameter '" + it->first + "' is not finite (nan or inf)");
     return Polynomial::constant(exact_rational(it->second));
+  }
+
+  // Functions of constants only, as jsurf allows them: evaluated in long double, then taken exactly.
+  Polynomial constant_function(const std::string& name) {
+    if (!accept(Tok::LParen)) throw EquationError(peek().pos, "expected '(' after " + name);
+    const std::size_t pos = peek().pos;
+    const std::optional<mpq_class> v = expr().constant_value();
+    expect_close(("to close " + name + "(").c_str());
+    if (!v) throw EquationError(pos, name + " of a non-constant expression: its argument may not contain x, y or z");
+    if (name == "abs") return Polynomial::constant(abs(*v));
+    if (name == "sign") return Polynomial::constant(mpq_class(sgn(*v)));
+    if (name == "floor") return Polynomial::constant(mpq_class(floor_of(*v)));
+    if (name == "ceil") return Polynomial::constant(mpq_class(-floor_of(-*v)));
+    const long double a = nearest_long_double(*v);
+    long double r = 0;
+    if (name == "sin")
+      r = std::sin(a);
+    else if (name == "cos")
+      r = std::cos(a);
+    else if (name == "tan")
+      r = std::tan(a);
+    else if (name == "asin")
+      r = std::asin(a);
+    else if (name == "acos")
+      r = std::acos(a);
+    else if (name == "atan")
+      r = std::atan(a);
+    else if (name == "exp")
+      r = std::exp(a);
+    else if (name == "log")
+      r = std::log(a);
+    if (!std::isfinite(r)) throw EquationError(pos, name + " is not finite (or not defined) at this argument");
+    return Polynomial::constant(exact_rational_long(r));
+  }
+
+  static mpz_class floor_of(const mpq_class& q) {
+    mpz_class f;
+    mpz_fdiv_q(f.get_mpz_t(), q.get_num_mpz_t(), q.get_den_mpz_t());
+    return f;
   }
 
   Polynomial square_root() {
@@ -355,7 +402,8 @@ class Parser {
 }  // namespace
 
 Polynomial parse_equation(std::string_view text, const std::map<std::string, double>& parameters) {
-  for (const char* reserved : {"x", "y", "z", "sqrt"})
+  for (const char* reserved : {"x", "y", "z", "sqrt", "sin", "cos", "tan", "asin", "acos", "atan", "exp", "log", "abs",
+                               "sign", "floor", "ceil"})
     if (parameters.count(reserved))
       throw EquationError(0, std::string("a parameter may not be named '") + reserved + "': the name is reserved");
   return Parser(text, parameters).parse();

@@ -18,8 +18,9 @@ struct EquationError : std::runtime_error {
 };
 
 // Parses and expands an equation to an exact Polynomial. `parameters` are named constants from the
-// scene file; x, y, z are the variables and sqrt is the only function, so parameters may not use
-// those names. Number literals are read exactly as decimal rationals.
+// scene file; x, y, z are the variables. Functions apply to constants only (as in jsurf): sqrt (exact
+// for squares of rationals), sin, cos, tan, asin, acos, atan, exp, log (natural), abs, sign, floor, ceil;
+// parameters may not use those names. Number literals are read exactly as decimal rationals.
 //
 // Grammar (whitespace anywhere):
 //   expr    := term (('+' | '-') term)*
@@ -27,7 +28,7 @@ struct EquationError : std::runtime_error {
 //   unary   := ('+' | '-') unary | power
 //   power   := primary (('^' | '**') unary)?          right-associative; the exponent must be a
 //                                                     constant non-negative integer <= 1000
-//   primary := number | x | y | z | parameter | sqrt '(' expr ')' | '(' expr ')'
+//   primary := number | x | y | z | parameter | function '(' expr ')' | '(' expr ')'
 // Zero polynomials and degree limits are left to the caller, except that a single power may not
 // exceed degree 1000, so that a typo cannot make the expansion run for hours.
 Polynomial parse_equation(std::string_view text, const std::map<std::string, double>& parameters);

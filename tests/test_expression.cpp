@@ -234,6 +234,27 @@ TEST_CASE("sqrt", "[expression]") {
   CHECK(parse("x^sqrt(4)") == poly({{2, 0, 0, 1}}));
 }
 
+TEST_CASE("functions of constants, as jsurf files use them", "[expression]") {
+  const auto value = [](const char* text) { return algray::nearest_double(*parse(text).constant_value()); };
+  // Negative results included: cos(4 pi / 5) once came out as 0.5, its significand taken unsigned.
+  CHECK(value("cos(4*3.14159265358979/5)") == Approx(std::cos(4 * 3.14159265358979 / 5)).epsilon(1e-15));
+  CHECK(value("sin(-1)") == Approx(std::sin(-1.0)).epsilon(1e-15));
+  CHECK(value("tan(0.5)") == Approx(std::tan(0.5)).epsilon(1e-15));
+  CHECK(value("asin(-0.5)") == Approx(std::asin(-0.5)).epsilon(1e-15));
+  CHECK(value("acos(-1)") == Approx(3.141592653589793).epsilon(1e-15));
+  CHECK(value("atan(2)") == Approx(std::atan(2.0)).epsilon(1e-15));
+  CHECK(value("exp(-2)") == Approx(std::exp(-2.0)).epsilon(1e-15));
+  CHECK(value("log(0.25)") == Approx(std::log(0.25)).epsilon(1e-15));
+  CHECK(*parse("abs(-3/2)").constant_value() == q("3/2"));
+  CHECK(*parse("sign(-7)").constant_value() == -1);
+  CHECK(*parse("floor(-5/2)").constant_value() == -3);
+  CHECK(*parse("ceil(-5/2)").constant_value() == -2);
+  CHECK(parse("cos(0)*x - sin(0)*y") == poly({{1, 0, 0, 1}}));
+  check_error("cos(x)", 4, "cos of a non-constant");
+  check_error("log(0)", 4, "not finite");
+  check_error("asin(2)", 5, "not finite");
+}
+
 TEST_CASE("exact cancellation", "[expression]") {
   const Polynomial z = parse("(x+1)^2-x^2-2*x-1");
   CHECK(z.is_zero());
