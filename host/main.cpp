@@ -127,6 +127,7 @@ int main(int argc, char** argv) {
                     "draw P*(t) on [t_in, t_out] with the isolating interval, the root and solver_ref's roots "
                     "(.svg or .png)");
   probe->add_flag("--json", probe_request.json, "print the report as JSON (for scripts) instead of text");
+  probe->add_option("--stats", probe_request.stats_path, "write the report as JSON to this file too");
 
   CLI::App* devices = app.add_subcommand("devices", "list OpenCL platforms and devices");
 

@@ -368,7 +368,8 @@ nlohmann::json probe_json(const Scene& scene, const ProbeTarget& target, const s
 int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
   Scene scene;
   try {
-    scene = req.scene_path ? load_scene_file(*req.scene_path, req.overrides) : default_scene(req.overrides);
+    scene = load_scene(req.scene_path, req.overrides);
+    print_warnings(scene, err);
     if (!req.target.given_ray && (req.target.px < 0 || req.target.py < 0 || req.target.px >= scene.image.width ||
                                   req.target.py >= scene.image.height))
       throw SceneError("--pixel", "pixel (" + std::to_string(req.target.px) + ", " + std::to_string(req.target.py) +
@@ -382,30 +383,29 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
       if (ext != ".svg" && ext != ".png") throw OutputError(*req.plot_path + ": a plot is .svg or .png");
       check_output_writable(*req.plot_path);
     }
-  } catch (const SceneError& e) {
-    err << e.what() << "\n";
-    return kExitBadInput;
-  } catch (const OutputError& e) {
-    err << "algray: " << e.what() << "\n";
-    return kExitBadInput;
+    if (req.stats_path) check_output_writable(*req.stats_path);
+  } catch (const std::exception& e) {
+    return report_error(e, err);
   }
   try {
-    ClSession session(select_device(req.device_spec));
-    ProgramCache cache(req.use_cache);
+    RenderContext context(req.device_spec, req.use_cache);
+    ClSession& session = context.session();
     const Precision precision = resolve_precision(scene, session.info);
     std::vector<SurfaceProbe> probes;
     for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
       SurfaceProbe p;
       p.surface = s;
       for (const KernelConfig& c : solver_configs(scene, precision, s, req.all_solvers))
-        p.traces.push_back(trace_probe(session, cache, scene, s, c, req.target));
+        p.traces.push_back(trace_probe(session, context.cache(), scene, s, c, req.target));
       p.reference = probe_reference(scene, s, p.traces.front().ray, precision);
       probes.push_back(std::move(p));
     }
-    if (req.json)
-      out << probe_json(scene, req.target, probes).dump(2) << "\n";
-    else
-      print_probe(out, scene, req.target, probes);
+    if (req.json || req.stats_path) {
+      const nlohmann::json j = probe_json(scene, req.target, probes);
+      if (req.json) out << j.dump(2) << "\n";
+      if (req.stats_path) write_text_file(*req.stats_path, j.dump(2) + "\n");
+    }
+    if (!req.json) print_probe(out, scene, req.target, probes);
     if (req.plot_path) {
       // The surface whose root the render shows (the nearest), else the first the ray meets at all.
       const SurfaceProbe* hit = nullptr;
@@ -419,18 +419,8 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
       }
       write_probe_plot(*req.plot_path, make_plot(scene, req.target, *hit));
     }
-  } catch (const DeviceError& e) {
-    err << "algray: " << e.what() << "\n";
-    return kExitBadInput;
-  } catch (const BuildError& e) {
-    err << "algray: " << e.what() << "\n";
-    return kExitFailure;
-  } catch (const cl::Error& e) {
-    err << "algray: OpenCL error " << e.err() << " in " << e.what() << "\n";
-    return kExitFailure;
   } catch (const std::exception& e) {
-    err << "algray: " << e.what() << "\n";
-    return kExitFailure;
+    return report_error(e, err);
   }
   return kExitOk;
 }

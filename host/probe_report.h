@@ -21,6 +21,7 @@ struct ProbeRequest {
   bool all_solvers = false;              // every isolation x refinement, side by side
   std::optional<std::string> plot_path;  // .svg or .png
   bool json = false;                     // JSON on stdout instead of text
+  std::optional<std::string> stats_path; // the JSON report written to a file as well
   bool use_cache = true;
 };
 

@@ -8,12 +8,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "cl_runtime.h"
 #include "diagnostic_images.h"
+#include "jsurf.h"
 #include "program_cache.h"
 #include "reference_render.h"
 #include "renderer.h"
@@ -185,84 +187,124 @@ void check_output_writable(const std::string& path) {
   if (::access(dir.c_str(), W_OK) != 0) throw OutputError(path + ": directory '" + dir.string() + "' is not writable");
 }
 
-int run_render(const RenderRequest& req, std::ostream& err) {
+RenderContext::RenderContext(std::string device_spec, bool use_cache)
+    : device_spec_(std::move(device_spec)), use_cache_(use_cache) {}
+
+RenderContext::~RenderContext() = default;
+
+ClSession& RenderContext::session() {
+  if (!session_) session_ = std::make_unique<ClSession>(select_device(device_spec_));
+  return *session_;
+}
+
+ProgramCache& RenderContext::cache() {
+  if (!cache_) cache_ = std::make_unique<ProgramCache>(use_cache_);
+  return *cache_;
+}
+
+Scene load_scene(const std::optional<std::string>& path, const std::vector<Override>& overrides) {
+  if (!path) return default_scene(overrides);
+  if (*path == "-") {
+    // Standard input can be read once: a second "-" in the same process is an error, not an empty scene.
+    static bool consumed = false;
+    if (consumed) throw SceneError("<stdin>", "standard input was already read");
+    consumed = true;
+    std::ostringstream text;
+    text << std::cin.rdbuf();
+    if (looks_like_jsurf(text.str())) return load_jsurf_text(text.str(), "<stdin>", overrides);
+    return load_scene_text(text.str(), "<stdin>", overrides);
+  }
+  return load_scene_file(*path, overrides);
+}
+
+void print_warnings(const Scene& scene, std::ostream& err) {
+  for (const std::string& w : scene.warnings) err << "algray: warning: " << w << "\n";
+}
+
+void check_outputs(const Scene& scene, const RenderRequest& req) {
+  if (req.reference && scene.surfaces.size() > 1)
+    throw SceneError(scene.source,
+                     "--reference solves one surface; this scene has " + std::to_string(scene.surfaces.size()));
+  for (const std::string& out : req.outputs) {
+    format_from_extension(out);
+    check_output_writable(out);
+  }
+  if (req.stats_path) check_output_writable(*req.stats_path);
+  if (req.heatmap_path) {
+    format_from_extension(*req.heatmap_path);
+    check_output_writable(*req.heatmap_path);
+  }
+}
+
+nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, RenderContext& context) {
   PhaseTimer timer;
+  FrameImage image;
+  RenderResult result;
+  DeviceInfo device;
+  if (req.reference) {
+    // No device: exact arithmetic on the CPU, rays rebuilt in the precision the kernels would use.
+    device.name = "CPU reference (solver_ref, exact arithmetic)";
+    device.type = "CPU";
+    ReferenceResult ref = render_reference(scene, scene.render.precision.value_or(Precision::Double));
+    timer.mark("render");
+    result = std::move(ref.render);
+    image = shade_frame(scene, result);
+    image.uint_channels.push_back({"reference.class", std::move(ref.classes)});
+  } else {
+    ClSession& session = context.session();
+    device = session.info;
+    timer.mark("device");
+    Renderer renderer(session, context.cache());
+    result = renderer.render(scene, req.progress);
+    timer.mark("render");
+    image = shade_frame(scene, result);
+  }
+  add_metadata(image, scene, result, device);
+  if (!req.aovs.empty() || req.heatmap_path) {
+    const SolverWork work = solver_work(result);
+    add_solver_aovs(image, work, req.aovs);
+    if (req.heatmap_path) {
+      const std::string per =
+          work.samples > 1 ? " (sum over " + std::to_string(work.samples * work.samples) + " samples)" : "";
+      write_image(*req.heatmap_path, work_heatmap(work.width, work.height, work.total(), work.in_extent,
+                                                  "isolation steps + refinement iterations per pixel" + per));
+    }
+  }
+  timer.mark("shade");
+  for (const std::string& out : req.outputs) write_image(out, image);
+  timer.mark("write");
+  nlohmann::json stats = stats_json(scene, req, result, device, timer);
+  if (req.stats_path) write_text_file(*req.stats_path, stats.dump(2) + "\n");
+  return stats;
+}
+
+int report_error(const std::exception& e, std::ostream& err) {
+  if (dynamic_cast<const SceneError*>(&e)) {
+    err << e.what() << "\n";
+    return kExitBadInput;
+  }
+  err << "algray: ";
+  if (const auto* cl_error = dynamic_cast<const cl::Error*>(&e)) err << "OpenCL error " << cl_error->err() << " in ";
+  err << e.what() << "\n";
+  const bool bad_input = dynamic_cast<const OutputError*>(&e) || dynamic_cast<const DeviceError*>(&e);
+  return bad_input ? kExitBadInput : kExitFailure;
+}
+
+int run_render(const RenderRequest& req, std::ostream& err) {
   // Everything the user gave is checked before any device work, so bad input costs nothing and writes nothing.
   Scene scene;
   try {
-    scene = req.scene_path ? load_scene_file(*req.scene_path, req.overrides) : default_scene(req.overrides);
-    if (req.reference && scene.surfaces.size() > 1)
-      throw SceneError(scene.source,
-                       "--reference solves one surface; this scene has " + std::to_string(scene.surfaces.size()));
-    for (const std::string& out : req.outputs) {
-      format_from_extension(out);
-      check_output_writable(out);
-    }
-    if (req.stats_path) check_output_writable(*req.stats_path);
-    if (req.heatmap_path) {
-      format_from_extension(*req.heatmap_path);
-      check_output_writable(*req.heatmap_path);
-    }
-  } catch (const SceneError& e) {
-    err << e.what() << "\n";
-    return kExitBadInput;
-  } catch (const OutputError& e) {
-    err << "algray: " << e.what() << "\n";
-    return kExitBadInput;
-  }
-
-  try {
-    timer.mark("scene");
-    FrameImage image;
-    RenderResult result;
-    DeviceInfo device;
-    if (req.reference) {
-      // No device: exact arithmetic on the CPU, rays rebuilt in the precision the kernels would use.
-      device.name = "CPU reference (solver_ref, exact arithmetic)";
-      device.type = "CPU";
-      ReferenceResult ref = render_reference(scene, scene.render.precision.value_or(Precision::Double));
-      timer.mark("render");
-      result = std::move(ref.render);
-      image = shade_frame(scene, result);
-      image.uint_channels.push_back({"reference.class", std::move(ref.classes)});
-    } else {
-      ClSession session(select_device(req.device_spec));
-      device = session.info;
-      timer.mark("device");
-      ProgramCache cache(req.use_cache);
-      Renderer renderer(session, cache);
-      result = renderer.render(scene, req.progress);
-      timer.mark("render");
-      image = shade_frame(scene, result);
-    }
-    add_metadata(image, scene, result, device);
-    if (!req.aovs.empty() || req.heatmap_path) {
-      const SolverWork work = solver_work(result);
-      add_solver_aovs(image, work, req.aovs);
-      if (req.heatmap_path) {
-        const std::string per =
-            work.samples > 1 ? " (sum over " + std::to_string(work.samples * work.samples) + " samples)" : "";
-        write_image(*req.heatmap_path, work_heatmap(work.width, work.height, work.total(), work.in_extent,
-                                                    "isolation steps + refinement iterations per pixel" + per));
-      }
-    }
-    timer.mark("shade");
-    for (const std::string& out : req.outputs) write_image(out, image);
-    timer.mark("write");
-    if (req.stats_path)
-      write_text_file(*req.stats_path, stats_json(scene, req, result, device, timer).dump(2) + "\n");
-  } catch (const DeviceError& e) {
-    err << "algray: " << e.what() << "\n";
-    return kExitBadInput;
-  } catch (const BuildError& e) {
-    err << "algray: " << e.what() << "\n";
-    return kExitFailure;
-  } catch (const cl::Error& e) {
-    err << "algray: OpenCL error " << e.err() << " in " << e.what() << "\n";
-    return kExitFailure;
+    scene = load_scene(req.scene_path, req.overrides);
+    print_warnings(scene, err);
+    check_outputs(scene, req);
   } catch (const std::exception& e) {
-    err << "algray: " << e.what() << "\n";
-    return kExitFailure;
+    return report_error(e, err);
+  }
+  try {
+    RenderContext context(req.device_spec, req.use_cache);
+    render_scene(scene, req, context);
+  } catch (const std::exception& e) {
+    return report_error(e, err);
   }
   return kExitOk;
 }

@@ -1,11 +1,15 @@
 // One `algray render` invocation end to end: scene, device, kernels, shading, image files and stats.
 #pragma once
 
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
 
+#include "cl_runtime.h"
+#include "program_cache.h"
 #include "scene.h"
 #include "solver_aov.h"
 
@@ -32,6 +36,41 @@ struct RenderRequest {
 // Throws OutputError when `path` cannot be written (missing or unwritable directory, or a directory itself): bad
 // input, found before any work.
 void check_output_writable(const std::string& path);
+
+// The device session and program cache, opened on first use and then shared by every render of the process:
+// a batch compiles each kernel once and opens the device once.
+class RenderContext {
+ public:
+  RenderContext(std::string device_spec, bool use_cache);
+  ~RenderContext();
+  ClSession& session();  // throws DeviceError when the device cannot be opened
+  ProgramCache& cache();
+
+ private:
+  std::string device_spec_;
+  bool use_cache_;
+  std::unique_ptr<ClSession> session_;
+  std::unique_ptr<ProgramCache> cache_;
+};
+
+// The scene a command names: a scene file, "-" for standard input (once per process), or, when unset, the
+// built-in default. Throws SceneError.
+Scene load_scene(const std::optional<std::string>& path, const std::vector<Override>& overrides);
+
+// The scene's warnings, one "algray: warning: ..." line each.
+void print_warnings(const Scene& scene, std::ostream& err);
+
+// Bad input in the request's outputs (unknown format, missing or unwritable directory), found before any work:
+// throws OutputError or SceneError.
+void check_outputs(const Scene& scene, const RenderRequest& request);
+
+// Renders `scene` on the context's device and writes the request's images, heat map and stats file; returns
+// the stats. Throws on failure; outputs already written stay complete (each is replaced atomically).
+nlohmann::json render_scene(const Scene& scene, const RenderRequest& request, RenderContext& context);
+
+// Prints a failure as the CLI does and returns its exit code: bad input (scene, output path, device) is 2,
+// anything else 1.
+int report_error(const std::exception& e, std::ostream& err);
 
 // Runs the request, printing errors (and nothing else on success, unless progress) to `err`.
 int run_render(const RenderRequest& request, std::ostream& err);

@@ -4,13 +4,16 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
 
 #include "embedded_files.h"
 #include "expression.h"
+#include "jsurf.h"
 
 namespace algray {
 namespace {
@@ -651,11 +654,23 @@ Scene load_scene_text(const std::string& text, const std::string& source_name, c
   return scene;
 }
 
+Scene load_jsurf_text(const std::string& text, const std::string& source_name, const std::vector<Override>& overrides) {
+  std::vector<std::string> warnings;
+  const std::string toml = jsurf_to_toml(text, source_name, warnings);
+  Scene scene = load_scene_text(toml, source_name + " (translated to TOML)", overrides);
+  scene.source = source_name;
+  scene.warnings = std::move(warnings);
+  return scene;
+}
+
 Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path, "cannot read the scene file");
   std::ostringstream text;
   text << in.rdbuf();
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".jsurf") return load_jsurf_text(text.str(), path, overrides);
   return load_scene_text(text.str(), path, overrides);
 }
 

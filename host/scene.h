@@ -43,10 +43,10 @@ struct ImageSpec {
 // How a side of the surface reflects light (Phong), plus what it passes on to secondary rays.
 struct Material {
   glm::dvec3 colour{0.95, 0.65, 0.15};
-  double ambient = 0.15;    // share of the colour lit by the ambient light, shadow or not
-  double diffuse = 0.75;    // Lambertian share per light
-  double specular = 0.35;   // highlight strength per light, in the light's colour
-  double exponent = 40;     // Phong exponent: larger is a smaller, sharper highlight
+  double ambient = 0.15;   // share of the colour lit by the ambient light, shadow or not
+  double diffuse = 0.75;   // Lambertian share per light
+  double specular = 0.35;  // highlight strength per light, in the light's colour
+  double exponent = 40;    // Phong exponent: larger is a smaller, sharper highlight
   // Share of the mirror ray's colour added to the surface's own (a reflection pass traces the mirror rays).
   double reflectivity = 0;
   // Share of the colour seen through the surface, the ray continuing to the next root as in surf and SURFER;
@@ -69,7 +69,7 @@ enum class LightKind { Point, Rectangle, Disc };
 // A light; area lights are sampled as samples x samples points spread uniformly over their area.
 struct Light {
   LightKind kind = LightKind::Point;
-  glm::dvec3 position{0};          // the point, or the area's centre
+  glm::dvec3 position{0};           // the point, or the area's centre
   glm::dvec3 edge_u{0}, edge_v{0};  // rectangle: its two edges (full length), centred on position
   glm::dvec3 normal{0, 0, 1};       // disc: its plane's normal
   double radius = 0;                // disc
@@ -101,8 +101,8 @@ struct RenderSettings {
   Refinement refinement = Refinement::Brent;
   RayOrigin ray_origin = RayOrigin::Extent;
   int max_iterations = 0;  // 0: the refinement's default (default_max_iterations)
-  int tile_size = 0;  // pixels per side of a dispatched tile; 0 chooses by device type
-  bool preview = false;  // primary rays only: lights shade, but cast no shadows (the paper's preview mode)
+  int tile_size = 0;       // pixels per side of a dispatched tile; 0 chooses by device type
+  bool preview = false;    // primary rays only: lights shade, but cast no shadows (the paper's preview mode)
   // Secondary bounces after the camera ray: reflection and transmission rays stop after this many.
   int max_depth = 5;
 };
@@ -129,6 +129,9 @@ struct Scene {
   std::vector<Light> lights;  // none: a headlight at the eye shades the surface, without shadows
   Antialias antialias;
   RenderSettings render;
+  // What the scene's reader could not render as written (a .jsurf feature algray draws differently, an unknown
+  // key it ignored); commands print them as warnings.
+  std::vector<std::string> warnings;
 
   // The first surface: the one single-surface tools (the reference solver, the solver benchmarks) work on.
   const SceneSurface& surface() const { return surfaces.front(); }
@@ -141,8 +144,11 @@ struct Override {
   std::string value;
 };
 
+// A .toml scene, or a SURFER/jsurf .jsurf file (by extension, any case), translated with jsurf's framing.
 Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides = {});
 Scene load_scene_text(const std::string& text, const std::string& source_name,
+                      const std::vector<Override>& overrides = {});
+Scene load_jsurf_text(const std::string& text, const std::string& source_name,
                       const std::vector<Override>& overrides = {});
 Scene default_scene(const std::vector<Override>& overrides = {});
 

@@ -82,11 +82,12 @@ struct Sandbox {
     fs::remove_all(root, ec);
   }
 
-  Result run(const std::string& args) const {
+  // Standard input is `stdin_path`, /dev/null unless a test pipes a scene in.
+  Result run(const std::string& args, const fs::path& stdin_path = "/dev/null") const {
     const fs::path out = in / "stdout.txt", err = in / "stderr.txt";
     const std::string cmd = "cd " + quoted(work.string()) + " && ALGRAY_CACHE_DIR=" + quoted(cache.string()) + " " +
                             quoted(ALGRAY_BINARY) + " " + args + " >" + quoted(out.string()) + " 2>" +
-                            quoted(err.string()) + " </dev/null";
+                            quoted(err.string()) + " <" + quoted(stdin_path.string());
     const int status = std::system(cmd.c_str());
     REQUIRE(status != -1);
     REQUIRE(WIFEXITED(status));
