@@ -1,9 +1,10 @@
-// The algray command line: `algray render`, `algray probe` and `algray devices`.
+// The algray command line: `algray render`, `algray probe`, `algray batch` and `algray devices`.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "batch.h"
 #include "cl_runtime.h"
 #include "image_io.h"
 #include "probe_report.h"
@@ -23,8 +24,11 @@ struct SceneOptions {
   bool no_cache = false, preview = false;
 };
 
-void add_scene_options(CLI::App* cmd, SceneOptions& o) {
-  cmd->add_option("scene", o.scene_path, "scene file (.toml); default: the built-in Barth sextic");
+// Batch takes a jobs file where the others take a scene, and no scene positional.
+void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = true) {
+  if (scene_positional)
+    cmd->add_option("scene", o.scene_path,
+                    "scene file (.toml or .jsurf), or - for standard input; default: the built-in Barth sextic");
   cmd->add_option("--width", o.width, "image width in pixels (overrides image.width)");
   cmd->add_option("--height", o.height, "image height in pixels (overrides image.height)");
   cmd->add_option("--device", o.device_spec, "device index or name substring (see `algray devices`)");
@@ -129,6 +133,17 @@ int main(int argc, char** argv) {
   probe->add_flag("--json", probe_request.json, "print the report as JSON (for scripts) instead of text");
   probe->add_option("--stats", probe_request.stats_path, "write the report as JSON to this file too");
 
+  BatchRequest batch_request;
+  SceneOptions batch_opts;
+  CLI::App* batch = app.add_subcommand(
+      "batch", "render a TOML list of jobs (sweeps, orbits) in one process with one device and program cache");
+  batch->add_option("jobs", batch_request.jobs_path, "jobs file (.toml), or - for standard input")->required();
+  add_scene_options(batch, batch_opts, false);
+  batch->add_flag("--resume", batch_request.resume, "skip frames whose outputs all exist already");
+  batch->add_option("--log", batch_request.log_path,
+                    "JSON-lines log, one line per frame (default: beside the jobs file, <name>.log.jsonl)");
+  batch->add_option("--stats", batch_request.stats_path, "write a summary of the batch as JSON");
+
   CLI::App* devices = app.add_subcommand("devices", "list OpenCL platforms and devices");
 
   try {
@@ -146,6 +161,14 @@ int main(int argc, char** argv) {
     }
     std::cout << describe_devices(list);
     return kExitOk;
+  }
+
+  if (batch->parsed()) {
+    if (!collect_overrides(batch, batch_opts, batch_request.overrides)) return kExitBadInput;
+    batch_request.device_spec = batch_opts.device_spec;
+    batch_request.use_cache = !batch_opts.no_cache;
+    batch_request.progress = ::isatty(STDERR_FILENO) != 0;
+    return run_batch(batch_request, std::cerr);
   }
 
   if (probe->parsed()) {

@@ -1,0 +1,166 @@
+// Reading TOML files with located errors: typed accessors that throw SceneError naming file:line:column.
+#pragma once
+
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "scene.h"
+
+namespace algray {
+
+// Levenshtein distance, to suggest the key the user probably meant.
+std::size_t edit_distance(const std::string& a, const std::string& b);
+
+// Wraps one TOML text: every accessor checks a node's type and range and fails with its source position and
+// an excerpt of the line. Nodes created by --set carry the override as their source and are named by it.
+class TomlReader {
+ public:
+  TomlReader(std::string source, const std::string& text) : source_(std::move(source)) {
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) lines_.push_back(line);
+  }
+
+  [[noreturn]] void fail(const toml::source_region& region, const std::string& message,
+                         std::size_t column_offset = 0) const {
+    const auto& path = region.path;
+    if (path && path->rfind("--set", 0) == 0) throw SceneError(*path, message);
+    if (region.begin.line == 0) throw SceneError(source_, message);
+    const std::size_t line = region.begin.line;
+    const std::size_t column = region.begin.column + column_offset;
+    std::string excerpt;
+    if (line <= lines_.size()) {
+      excerpt = "  " + lines_[line - 1] + "\n  " + std::string(column > 0 ? column - 1 : 0, ' ') + "^";
+    }
+    throw SceneError(source_ + ":" + std::to_string(line) + ":" + std::to_string(column), message, excerpt);
+  }
+
+  const std::string& line_text(std::size_t line) const {
+    static const std::string empty;
+    return line >= 1 && line <= lines_.size() ? lines_[line - 1] : empty;
+  }
+
+  double number(const toml::node& node, const std::string& what) const {
+    double v;
+    if (auto i = node.value_exact<std::int64_t>())
+      v = static_cast<double>(*i);
+    else if (auto f = node.value_exact<double>())
+      v = *f;
+    else
+      fail(node.source(), what + " must be a number");
+    if (!std::isfinite(v))
+      fail(node.source(), what + " must be finite, not " + std::string(std::isnan(v) ? "nan" : "inf"));
+    return v;
+  }
+
+  long long integer(const toml::node& node, const std::string& what, long long lo, long long hi) const {
+    auto i = node.value_exact<std::int64_t>();
+    if (!i) fail(node.source(), what + " must be an integer");
+    if (*i < lo || *i > hi)
+      fail(node.source(), what + " must be between " + std::to_string(lo) + " and " + std::to_string(hi));
+    return *i;
+  }
+
+  bool boolean(const toml::node& node, const std::string& what) const {
+    auto b = node.value_exact<bool>();
+    if (!b) fail(node.source(), what + " must be true or false");
+    return *b;
+  }
+
+  // A number in [lo, hi].
+  double number_in(const toml::node& node, const std::string& what, double lo, double hi) const {
+    const double v = number(node, what);
+    if (v < lo || v > hi) {
+      std::ostringstream range;
+      range << what << " must be between " << lo << " and " << hi;
+      fail(node.source(), range.str());
+    }
+    return v;
+  }
+
+  std::string string(const toml::node& node, const std::string& what) const {
+    auto s = node.value_exact<std::string>();
+    if (!s) fail(node.source(), what + " must be a string");
+    return *s;
+  }
+
+  glm::dvec3 vec3(const toml::node& node, const std::string& what) const {
+    const toml::array* a = node.as_array();
+    if (!a || a->size() != 3) fail(node.source(), what + " must be an array of 3 numbers");
+    return {number(*a->get(0), what + "[0]"), number(*a->get(1), what + "[1]"), number(*a->get(2), what + "[2]")};
+  }
+
+  glm::dvec4 colour(const toml::node& node, const std::string& what, bool allow_alpha) const {
+    const toml::array* a = node.as_array();
+    if (!a || a->size() < 3 || a->size() > (allow_alpha ? 4u : 3u))
+      fail(node.source(), what + " must be an array of 3" + std::string(allow_alpha ? " or 4" : "") +
+                              " numbers (linear RGB" + (allow_alpha ? "[A]" : "") + ")");
+    glm::dvec4 c{0, 0, 0, 1};
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      c[static_cast<int>(i)] = number(*a->get(i), what);
+      if (c[static_cast<int>(i)] < 0) fail(a->get(i)->source(), what + " components must not be negative");
+    }
+    if (c.a > 1) fail(a->get(3)->source(), what + " alpha must be at most 1");
+    return c;
+  }
+
+  // Rejects keys that are not in `allowed`, suggesting the nearest allowed one.
+  void check_keys(const toml::table& table, const std::string& table_name, const std::set<std::string>& allowed) const {
+    for (auto&& [key, node] : table) {
+      const std::string k(key.str());
+      if (allowed.count(k)) continue;
+      std::string hint;
+      std::size_t best = 3;
+      for (const std::string& a : allowed)
+        if (std::size_t d = edit_distance(k, a); d < best) {
+          best = d;
+          hint = a;
+        }
+      std::string message = "unknown key '" + (table_name.empty() ? k : table_name + "." + k) + "'";
+      if (!hint.empty()) message += " (did you mean '" + hint + "'?)";
+      std::string known;
+      for (const std::string& a : allowed) known += (known.empty() ? "" : ", ") + a;
+      message += "; allowed here: " + known;
+      fail(key.source().begin.line ? key.source() : node.source(), message);
+    }
+  }
+
+  const toml::table* subtable(const toml::table& root, const std::string& name) const {
+    const toml::node* n = root.get(name);
+    if (!n) return nullptr;
+    if (!n->is_table()) fail(n->source(), "'" + name + "' must be a table ([" + name + "])");
+    return n->as_table();
+  }
+
+  // Column of character `offset` of a string value, counting escapes as one character.
+  std::size_t string_column_offset(const toml::node& node, std::size_t offset) const {
+    const std::string& line = line_text(node.source().begin.line);
+    std::size_t col = node.source().begin.column;  // 1-based, at the opening quote
+    if (col == 0 || col > line.size()) return 0;
+    const char quote = line[col - 1];
+    if ((quote != '"' && quote != '\'') || line.compare(col - 1, 3, std::string(3, quote)) == 0) return 0;
+    std::size_t i = col, chars = 0;  // i: 0-based index of the first character inside the quotes
+    while (i < line.size() && chars < offset && line[i] != quote) {
+      if (quote == '"' && line[i] == '\\' && i + 1 < line.size()) {
+        const char e = line[i + 1];
+        i += e == 'u' ? 6 : e == 'U' ? 10 : 2;
+      } else {
+        ++i;
+      }
+      ++chars;
+    }
+    return i + 1 - col;
+  }
+
+ private:
+  std::string source_;
+  std::vector<std::string> lines_;
+};
+
+}  // namespace algray

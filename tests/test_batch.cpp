@@ -1,0 +1,215 @@
+// algray batch: sweeps, orbits, the log, failures that do not stop the rest, resume, and jobs-file errors.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "cli_sandbox.h"
+#include "image_io.h"
+#include "scene_fixtures.h"
+
+using namespace algray::testing;
+
+namespace {
+
+// A sphere of radius r (a parameter), so a sweep visibly changes the picture.
+const std::string kBall =
+    "[surface]\nequation = \"x^2+y^2+z^2-r^2\"\n[parameters]\nr = 1\n[extent]\nradius = 2\n"
+    "[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nfov_y = 45\n"
+    "[[light]]\nposition = [3, 4, 5]\n";
+
+std::vector<nlohmann::json> read_log(const fs::path& p) {
+  std::vector<nlohmann::json> lines;
+  std::istringstream in(read_text(p));
+  for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
+  return lines;
+}
+
+const std::string kSmall = "[defaults]\nset = { image = { width = 24, height = 24 } }\n";
+
+}  // namespace
+
+TEST_CASE("a 10-frame sweep writes 10 images and a log line per frame, in one program cache", "[batch][cli]") {
+  Sandbox box;
+  write_text(box.work / "ball.toml", kBall);
+  write_text(box.work / "jobs.toml", kSmall +
+                                         "[[job]]\nname = \"grow\"\nscene = \"ball.toml\"\n"
+                                         "output = \"grow_{frame:02}.png\"\n"
+                                         "sweep.r = { from = 0.5, to = 1.4, steps = 10 }\n");
+  const Result r = box.run("batch jobs.toml --stats summary.json");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  std::string first, last;
+  for (int i = 0; i < 10; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "grow_%02d.png", i);
+    INFO(name);
+    REQUIRE(fs::exists(box.work / name));
+    if (i == 0) first = read_text(box.work / name);
+    if (i == 9) last = read_text(box.work / name);
+  }
+  CHECK(first != last);
+  const std::vector<nlohmann::json> log = read_log(box.work / "jobs.log.jsonl");
+  REQUIRE(log.size() == 10);
+  for (int i = 0; i < 10; ++i) {
+    INFO("frame " << i);
+    CHECK(log[i]["job"] == "grow");
+    CHECK(log[i]["frame"] == i);
+    CHECK(log[i]["status"] == "ok");
+    CHECK(std::stod(log[i]["set"]["r"].get<std::string>()) == Approx(0.5 + 0.1 * i));
+    CHECK(log[i]["stats"]["pixels"]["count"] == 24 * 24);
+    // One process, one cache: after the first frame every program comes from memory.
+    if (i > 0)
+      for (const auto& p : log[i]["stats"]["programs"]) CHECK(p["origin"] == "memory");
+  }
+  // The ball grows with r.
+  CHECK(log[9]["stats"]["pixels"]["hits"].get<int>() > log[0]["stats"]["pixels"]["hits"].get<int>());
+  const nlohmann::json summary = nlohmann::json::parse(read_text(box.work / "summary.json"));
+  CHECK(summary["frames"]["ok"] == 10);
+  CHECK(summary["frames"]["failed"] == 0);
+}
+
+TEST_CASE("a job that fails in the middle of a batch does not stop the others", "[batch][cli]") {
+  Sandbox box;
+  write_text(box.work / "ball.toml", kBall);
+  write_text(box.work / "jobs.toml", kSmall +
+                                         "[[job]]\nscene = \"ball.toml\"\noutput = \"a.png\"\n"
+                                         "[[job]]\nname = \"bad\"\nscene = \"ball.toml\"\nset = { r = \"huge\" }\n"
+                                         "output = \"b.png\"\n"
+                                         "[[job]]\nname = \"missing\"\nscene = \"nowhere.toml\"\noutput = \"c.png\"\n"
+                                         "[[job]]\nscene = \"ball.toml\"\noutput = \"d_{frame}.png\"\n"
+                                         "sweep.r = { from = 0.5, to = 1, steps = 2 }\n");
+  const Result r = box.run("batch jobs.toml");
+  CHECK(r.exit_code == 1);
+  CHECK(fs::exists(box.work / "a.png"));
+  CHECK(!fs::exists(box.work / "b.png"));
+  CHECK(!fs::exists(box.work / "c.png"));
+  CHECK(fs::exists(box.work / "d_0.png"));
+  CHECK(fs::exists(box.work / "d_1.png"));
+  CHECK_THAT(r.err, Catch::Contains("job bad frame 0 failed"));
+  CHECK_THAT(r.err, Catch::Contains("'r' must be a number"));
+  CHECK_THAT(r.err, Catch::Contains("nowhere.toml"));
+  CHECK_THAT(r.err, Catch::Contains("2 of 5 frames failed"));
+  const std::vector<nlohmann::json> log = read_log(box.work / "jobs.log.jsonl");
+  REQUIRE(log.size() == 5);
+  CHECK(log[0]["status"] == "ok");
+  CHECK(log[1]["status"] == "failed");
+  CHECK_THAT(log[1]["error"].get<std::string>(), Catch::Contains("must be a number"));
+  CHECK(log[2]["status"] == "failed");
+  CHECK(log[3]["status"] == "ok");
+  CHECK(log[4]["status"] == "ok");
+}
+
+TEST_CASE("--resume skips frames whose outputs exist and renders the rest", "[batch][cli]") {
+  Sandbox box;
+  write_text(box.work / "ball.toml", kBall);
+  write_text(box.work / "jobs.toml",
+             kSmall +
+                 "[[job]]\nscene = \"ball.toml\"\noutput = [\"f_{frame}.png\", \"f_{frame}.exr\"]\n"
+                 "sweep.r = { from = 0.5, to = 1, steps = 4 }\n");
+  REQUIRE(box.run("batch jobs.toml").exit_code == 0);
+  // A frame with one of its two outputs missing counts as not done.
+  fs::remove(box.work / "f_2.exr");
+  const auto before = fs::last_write_time(box.work / "f_0.png");
+  const Result again = box.run("batch jobs.toml --resume");
+  INFO(again.err);
+  REQUIRE(again.exit_code == 0);
+  CHECK(fs::exists(box.work / "f_2.exr"));
+  CHECK(fs::last_write_time(box.work / "f_0.png") == before);
+  const std::vector<nlohmann::json> log = read_log(box.work / "jobs.log.jsonl");
+  REQUIRE(log.size() == 8);  // --resume appends to the log
+  CHECK(log[4]["status"] == "skipped");
+  CHECK(log[5]["status"] == "skipped");
+  CHECK(log[6]["status"] == "ok");
+  CHECK(log[6]["frame"] == 2);
+  CHECK(log[7]["status"] == "skipped");
+}
+
+TEST_CASE("an orbit turns the camera, and the lights with it, about the look-at point", "[batch][cli]") {
+  Sandbox box;
+  write_text(box.work / "ball.toml", kBall);
+  write_text(box.work / "jobs.toml",
+             kSmall +
+                 "[[job]]\nname = \"studio\"\nscene = \"ball.toml\"\noutput = \"o_{angle}.exr\"\n"
+                 "orbit = { frames = 4 }\n"
+                 "[[job]]\nname = \"fixed\"\nscene = \"ball.toml\"\noutput = \"w_{angle}.exr\"\n"
+                 "orbit = { frames = 4, lights = \"world\" }\n");
+  const Result r = box.run("batch jobs.toml");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const std::vector<nlohmann::json> log = read_log(box.work / "jobs.log.jsonl");
+  REQUIRE(log.size() == 8);
+  // About the up axis (y) through the origin: the eye (0, 0, 5) goes to (5, 0, 0), (0, 0, -5), (-5, 0, 0).
+  const double expected[4][3] = {{0, 0, 5}, {5, 0, 0}, {0, 0, -5}, {-5, 0, 0}};
+  for (int i = 0; i < 4; ++i) {
+    INFO("frame " << i);
+    for (int k = 0; k < 3; ++k) CHECK(log[i]["camera"]["eye"][k].get<double>() == Approx(expected[i][k]).margin(1e-9));
+  }
+  const auto mean_red = [&](const char* name) {
+    const algray::FrameImage img = algray::read_exr(box.work / name);
+    double sum = 0;  // over the sphere's pixels, not the white background
+    int count = 0;
+    for (std::size_t p = 0; p < img.depth.size(); ++p)
+      if (std::isfinite(img.depth[p])) {
+        sum += img.rgba[4 * p];
+        ++count;
+      }
+    REQUIRE(count > 50);
+    return sum / count;
+  };
+  // Lights turning with the camera light the sphere the same way from every side; lights fixed in the world
+  // leave the far side, seen at 180 degrees, in the dark (the light is at +z, in front of the first view).
+  CHECK(mean_red("o_180.exr") == Approx(mean_red("o_0.exr")).epsilon(0.01));
+  CHECK(mean_red("w_0.exr") == Approx(mean_red("o_0.exr")).epsilon(0.001));
+  CHECK(mean_red("w_180.exr") < 0.8 * mean_red("w_0.exr"));
+}
+
+TEST_CASE("jobs files with errors are refused before anything renders, with file, line and column",
+          "[batch][cli][errors]") {
+  Sandbox box;
+  write_text(box.work / "ball.toml", kBall);
+  struct Case {
+    std::string jobs, message;
+  };
+  const Case cases[] = {
+      {"[[job]]\nscene = \"ball.toml\"\nouput = \"x.png\"\n", "did you mean 'output'"},
+      {"[[job]]\nscene = \"ball.toml\"\noutput = \"same.png\"\nsweep.r = { from = 1, to = 2, steps = 3 }\n",
+       "no {frame}"},
+      {"[[job]]\nscene = \"ball.toml\"\noutput = \"x_{frames}.png\"\n", "unknown placeholder {frames}"},
+      {"[[job]]\nscene = \"ball.toml\"\noutput = \"x_{frame}.png\"\nsweep.r = { from = 1, steps = 3 }\n", "needs 'to'"},
+      {"[[job]]\nscene = \"ball.toml\"\noutput = \"x_{frame}.png\"\nframes = 2\n"
+       "sweep.r = { from = 1, to = 2, steps = 3 }\n",
+       "gives 3 frames but the job has 2"},
+      {"[[job]]\noutput = \"x.png\"\n", "needs a scene"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.jobs);
+    write_text(box.work / "jobs.toml", c.jobs);
+    const Result r = box.run("batch jobs.toml");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("jobs.toml:"));
+    CHECK_THAT(r.err, Catch::Contains(c.message));
+    CHECK(!fs::exists(box.work / "jobs.log.jsonl"));
+  }
+}
+
+TEST_CASE("every command takes its input on standard input and --set for list keys", "[batch][cli]") {
+  Sandbox box;
+  write_text(box.work / "ball.toml", kBall);
+  write_text(box.in / "jobs.toml",
+             kSmall + "[[job]]\nscene = \"" + (box.work / "ball.toml").string() + "\"\noutput = \"piped.png\"\n");
+  const Result batch = box.run("batch - --set light.0.intensity=0.5 --log piped.jsonl", box.in / "jobs.toml");
+  INFO(batch.err);
+  CHECK(batch.exit_code == 0);
+  CHECK(fs::exists(box.work / "piped.png"));
+  const std::vector<nlohmann::json> log = read_log(box.work / "piped.jsonl");
+  REQUIRE(log.size() == 1);
+  CHECK(log[0]["set"]["light.0.intensity"] == "0.5");
+
+  const Result render =
+      box.run("render - --width 16 --height 16 -o stdin.png --stats stdin.json", box.work / "ball.toml");
+  CHECK(render.exit_code == 0);
+  CHECK(nlohmann::json::parse(read_text(box.work / "stdin.json"))["scene"] == "<stdin>");
+  const Result probe = box.run("probe - --pixel 8,8 --width 16 --height 16 --stats probe.json", box.work / "ball.toml");
+  INFO(probe.err);
+  CHECK(probe.exit_code == 0);
+  CHECK(nlohmann::json::parse(read_text(box.work / "probe.json"))["surfaces"][0]["solvers"][0]["found"] == true);
+}
