@@ -145,6 +145,8 @@ int main(int argc, char** argv) {
   batch->add_option("--stats", batch_request.stats_path, "write a summary of the batch as JSON");
 
   CLI::App* devices = app.add_subcommand("devices", "list OpenCL platforms and devices");
+  std::string devices_stats;
+  devices->add_option("--stats", devices_stats, "write the list as JSON too");
 
   try {
     app.parse(argc, argv);
@@ -160,6 +162,26 @@ int main(int argc, char** argv) {
       return kExitFailure;
     }
     std::cout << describe_devices(list);
+    if (!devices_stats.empty()) {
+      nlohmann::json j = nlohmann::json::array();
+      for (const DeviceInfo& d : list)
+        j.push_back({{"index", d.index},
+                     {"platform", d.platform_name},
+                     {"platform_version", d.platform_version},
+                     {"name", d.name},
+                     {"vendor", d.vendor},
+                     {"version", d.version},
+                     {"driver", d.driver_version},
+                     {"type", d.type},
+                     {"compute_units", d.compute_units},
+                     {"fp64", d.fp64}});
+      try {
+        check_output_writable(devices_stats);
+        write_text_file(devices_stats, j.dump(2) + "\n");
+      } catch (const std::exception& e) {
+        return report_error(e, std::cerr);
+      }
+    }
     return kExitOk;
   }
 

@@ -191,7 +191,7 @@ TEST_CASE("jobs files with errors are refused before anything renders, with file
   }
 }
 
-TEST_CASE("every command takes its input on standard input and --set for list keys", "[batch][cli]") {
+TEST_CASE("every command takes its input on standard input, --set for list keys, and --stats", "[batch][cli]") {
   Sandbox box;
   write_text(box.work / "ball.toml", kBall);
   write_text(box.in / "jobs.toml",
@@ -212,4 +212,8 @@ TEST_CASE("every command takes its input on standard input and --set for list ke
   INFO(probe.err);
   CHECK(probe.exit_code == 0);
   CHECK(nlohmann::json::parse(read_text(box.work / "probe.json"))["surfaces"][0]["solvers"][0]["found"] == true);
+  REQUIRE(box.run("devices --stats devices.json").exit_code == 0);
+  const nlohmann::json devices = nlohmann::json::parse(read_text(box.work / "devices.json"));
+  REQUIRE(!devices.empty());
+  CHECK(devices[0]["compute_units"].get<int>() > 0);
 }
