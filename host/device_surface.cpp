@@ -38,6 +38,10 @@ void KernelArgs::real_vec(const glm::dvec3& v) {
     kernel_.setArg(index_++, cl_float4{{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0}});
 }
 
+void KernelArgs::ray_basis(const RayBasis& b) {
+  for (const glm::dvec3* v : {&b.o00, &b.ou, &b.ov, &b.d00, &b.du, &b.dv}) real_vec(*v);
+}
+
 void KernelArgs::real(double v) {
   if (double_)
     kernel_.setArg(index_++, v);

@@ -26,6 +26,8 @@ class KernelArgs {
  public:
   KernelArgs(cl::Kernel& k, Precision p) : kernel_(k), double_(p == Precision::Double) {}
   void real_vec(const glm::dvec3& v);
+  // ray_o00 .. ray_dv, in the order camera_ray() takes them (kernels/ray.h).
+  void ray_basis(const RayBasis& b);
   void real(double v);
   template <typename T>
   void plain(const T& v) {

@@ -111,12 +111,7 @@ SolverTrace trace_probe(ClSession& session, ProgramCache& cache, const Scene& sc
   // The same basis the primary pass builds for a render at the scene's size without antialiasing.
   const RayBasis b = make_ray_basis(scene.camera, scene.image.width, scene.image.height);
   KernelArgs args(kernel, config.precision);
-  args.real_vec(b.o00);
-  args.real_vec(b.ou);
-  args.real_vec(b.ov);
-  args.real_vec(b.d00);
-  args.real_vec(b.du);
-  args.real_vec(b.dv);
+  args.ray_basis(b);
   args.plain(static_cast<cl_uint>(target.px));
   args.plain(static_cast<cl_uint>(target.py));
   args.plain(static_cast<cl_int>(target.given_ray ? 1 : 0));

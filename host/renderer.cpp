@@ -38,8 +38,8 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 // kernel traced them; secondary rays in double, which a float kernel traced rounded).
 template <typename RayOf>
 ShadowData trace_shadows(const Scene& scene, const RenderPlan& plan,
-                         const std::vector<std::unique_ptr<ShadowTracer>>& tracers,
-                         const std::vector<HitRecord>& hits, RayOf ray, PassStats& stats) {
+                         const std::vector<std::unique_ptr<ShadowTracer>>& tracers, const std::vector<HitRecord>& hits,
+                         RayOf ray, PassStats& stats) {
   const auto start = std::chrono::steady_clock::now();
   ShadowData data;
   std::vector<glm::dvec3> points;
@@ -112,7 +112,7 @@ struct Renderer::Passes {
   Precision precision;
   std::vector<std::unique_ptr<DeviceSurface>> surfaces;  // one per scene surface
   RenderResult& result;
-  std::vector<PassStats> stats;  // one per planned pass, in plan order
+  std::vector<PassStats> stats;                        // one per planned pass, in plan order
   std::vector<std::unique_ptr<ShadowTracer>> shadows;  // one per surface, when the plan has a shadow pass
   std::vector<std::unique_ptr<RayTracer>> rays;        // one per surface, when it has a secondary pass
 
@@ -148,8 +148,8 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
     if (PassStats* stats = passes.stats_of(name)) {
       if (passes.rays.empty())
         for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-          passes.rays.push_back(std::make_unique<RayTracer>(session_, cache_, result.plan.find(name)->kernels[i],
-                                                            *passes.surfaces[i]));
+          passes.rays.push_back(
+              std::make_unique<RayTracer>(session_, cache_, result.plan.find(name)->kernels[i], *passes.surfaces[i]));
           result.programs.push_back(passes.rays.back()->program());
         }
       for (const auto& tracer : passes.rays) {
@@ -164,8 +164,8 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
     return pixel_ray(result.basis, single, static_cast<int>(i % width), static_cast<int>(i / width));
   };
   if (!passes.shadows.empty())
-    result.shadows = trace_shadows(scene, result.plan, passes.shadows, result.hits.records, camera_ray,
-                                   *passes.stats_of("shadow"));
+    result.shadows =
+        trace_shadows(scene, result.plan, passes.shadows, result.hits.records, camera_ray, *passes.stats_of("shadow"));
   std::vector<Bounce> first;
   for (std::size_t i = 0; i < result.hits.records.size(); ++i)
     if (result.hits.records[i].flags & ALGRAY_HIT_FOUND)
@@ -202,14 +202,8 @@ void Renderer::run_primary(Passes& passes, bool show_progress) {
     pass.program_keys.push_back(record.key);
     pass.program_ms.push_back(0);
     cl::Buffer out(session_.context, CL_MEM_WRITE_ONLY, pixels * sizeof(HitRecord));
-    const RayBasis& b = result.basis;
     KernelArgs args(kernel, surface.precision());
-    args.real_vec(b.o00);
-    args.real_vec(b.ou);
-    args.real_vec(b.ov);
-    args.real_vec(b.d00);
-    args.real_vec(b.du);
-    args.real_vec(b.dv);
+    args.ray_basis(result.basis);
     surface.set_extent_args(args);
     surface.set_surface_args(args);
     args.plain(static_cast<cl_uint>(width));
@@ -234,8 +228,8 @@ void Renderer::run_primary(Passes& passes, bool show_progress) {
         pass.program_ms[s] += ms_between(done);
         ++pass.launches;
         if (show_progress) {
-          std::fprintf(stderr, "\rrendering %s: %3d%% (%d/%d tiles)", scene.name.c_str(),
-                       100 * pass.launches / tiles, pass.launches, tiles);
+          std::fprintf(stderr, "\rrendering %s: %3d%% (%d/%d tiles)", scene.name.c_str(), 100 * pass.launches / tiles,
+                       pass.launches, tiles);
           std::fflush(stderr);
         }
       }
@@ -269,8 +263,9 @@ void Renderer::trace_batch(Passes& passes, SecondaryBatch& batch) {
   }
   stats.wall_ms += ms_since(start);
   if (!passes.shadows.empty())
-    batch.shadows = trace_shadows(passes.scene, passes.result.plan, passes.shadows, batch.hits,
-                                  [&](std::size_t i) { return batch.rays[i]; }, *passes.stats_of("shadow"));
+    batch.shadows = trace_shadows(
+        passes.scene, passes.result.plan, passes.shadows, batch.hits, [&](std::size_t i) { return batch.rays[i]; },
+        *passes.stats_of("shadow"));
 }
 
 void Renderer::run_bounces(Passes& passes, std::vector<Bounce> current, bool refinement) {
@@ -300,8 +295,8 @@ void Renderer::run_bounces(Passes& passes, std::vector<Bounce> current, bool ref
         const glm::dvec3 n(b.hit.normal_x, b.hit.normal_y, b.hit.normal_z);  // faces the incoming ray
         const glm::dvec3 d = b.ray.direction;
         // Off the surface on the side the new ray leaves into, as shadow rays are, so it cannot find its own hit.
-        const PixelRay ray = k == 0 ? PixelRay{p + offset * n, d - 2 * glm::dot(d, n) * n}
-                                    : PixelRay{p - offset * n, d};
+        const PixelRay ray =
+            k == 0 ? PixelRay{p + offset * n, d - 2 * glm::dot(d, n) * n} : PixelRay{p - offset * n, d};
         batch.sample.push_back(b.sample);
         batch.weight.push_back(b.weight * share);
         batch.rays.push_back(ray);

@@ -152,15 +152,7 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
     iso.hi = iso.lo + width;
     iso.f_lo = cur[0];
     iso.f_hi = cur[DEGREE];
-    if (cur[0] == 0) {
-      PROBE_STEP(iso, -1, ALGRAY_STEP_EXACT_ZERO, level);
-      iso.status = ISOLATION_EXACT;
-      return iso;
-    }
-    if (crossed_at_left_end(&iso, start_sign)) {
-      PROBE_STEP(iso, -1, ALGRAY_STEP_CROSSED, level);
-      return iso;
-    }
+    if (settled_at_left_end(&iso, start_sign, level PROBE_ARG)) return iso;
     const int v = sign_variations(cur);
     if (v == 1 && cur[DEGREE] != 0 && refinable_in_float(cur)) {
       PROBE_STEP(iso, v, ALGRAY_STEP_ISOLATED, level);
@@ -168,9 +160,8 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
       return iso;
     }
     if (v >= 1) {
-      const int located = interval_located(width, iso.lo, t_in, len);
-      if (!located && level < REAL_MAX_HALVINGS) {
-        PROBE_STEP(iso, v, ALGRAY_STEP_SPLIT, level);
+      const int next = halve_or_settle(&iso, v, level, width, t_in, len PROBE_ARG);
+      if (next == INTERVAL_HALVE) {
         casteljau_halve(cur, cur_lo, sib, sib_lo);
         ++level;
         idx *= 2;
@@ -178,23 +169,11 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
         sib_idx = idx + 1;
         continue;
       }
-      if (settle_cluster(&iso, located)) {
-        PROBE_STEP(iso, v, ALGRAY_STEP_CLUSTER_ROOT, level);
-        return iso;
-      }
-      PROBE_STEP(iso, v, ALGRAY_STEP_CLUSTER_SKIP, level);
+      if (next == INTERVAL_SETTLED) return iso;
     } else {
       PROBE_STEP(iso, v, ALGRAY_STEP_NO_ROOT, level);
     }
-    if (!next_interval(&level, &idx)) {
-      /* Intervals are half open; the far end is the one point left to look at. */
-      iso.status = root[DEGREE] == 0 ? ISOLATION_EXACT : ISOLATION_NONE;
-      iso.lo = iso.hi = 1;
-      iso.f_lo = iso.f_hi = 0;
-      PROBE(ALGRAY_EVENT_STEP, -1, iso.status == ISOLATION_EXACT ? ALGRAY_STEP_END_ZERO : ALGRAY_STEP_END_NONE, 0u,
-            (REAL)1, (REAL)1, root[DEGREE], root[DEGREE]);
-      return iso;
-    }
+    if (!next_interval(&level, &idx)) return isolation_at_far_end(iso, root[DEGREE] == 0, root[DEGREE] PROBE_ARG);
     if (sib_level == level && sib_idx == idx)
       coefs_copy(cur, cur_lo, sib, sib_lo);
     else

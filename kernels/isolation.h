@@ -61,6 +61,49 @@ int crossed_at_left_end(Isolation* iso, int start_sign) {
   return 1;
 }
 
+/* The checks every subdividing method makes first on an interval (iso.lo, iso.f_lo set): P exactly zero at its
+ * left end, or of the other sign there than at t_in. Returns 1 when it settled iso->status. */
+int settled_at_left_end(Isolation* iso, int start_sign, int level PROBE_PARAM) {
+  if (iso->f_lo == 0) {
+    PROBE_STEP(*iso, -1, ALGRAY_STEP_EXACT_ZERO, level);
+    iso->status = ISOLATION_EXACT;
+    return 1;
+  }
+  if (crossed_at_left_end(iso, start_sign)) {
+    PROBE_STEP(*iso, -1, ALGRAY_STEP_CROSSED, level);
+    return 1;
+  }
+  return 0;
+}
+
+/* What to do with an interval that may hold several roots (`count` of them, as the method counts). */
+#define INTERVAL_HALVE 0   /* halve it: go one level down, left half first */
+#define INTERVAL_SETTLED 1 /* a cluster with a sign change: iso->status is set */
+#define INTERVAL_NEXT 2    /* a cluster without one: go on to the next interval */
+int halve_or_settle(Isolation* iso, int count, int level, REAL width, REAL t_in, REAL len PROBE_PARAM) {
+  const int located = interval_located(width, iso->lo, t_in, len);
+  if (!located && level < REAL_MAX_HALVINGS) {
+    PROBE_STEP(*iso, count, ALGRAY_STEP_SPLIT, level);
+    return INTERVAL_HALVE;
+  }
+  if (settle_cluster(iso, located)) {
+    PROBE_STEP(*iso, count, ALGRAY_STEP_CLUSTER_ROOT, level);
+    return INTERVAL_SETTLED;
+  }
+  PROBE_STEP(*iso, count, ALGRAY_STEP_CLUSTER_SKIP, level);
+  return INTERVAL_NEXT;
+}
+
+/* Every interval has been searched. They are half open, so the far end is the one point left: a root when
+ * `zero` (P there is f_end). */
+Isolation isolation_at_far_end(Isolation iso, int zero, REAL f_end PROBE_PARAM) {
+  iso.status = zero ? ISOLATION_EXACT : ISOLATION_NONE;
+  PROBE(ALGRAY_EVENT_STEP, -1, zero ? ALGRAY_STEP_END_ZERO : ALGRAY_STEP_END_NONE, 0u, (REAL)1, (REAL)1, f_end, f_end);
+  iso.lo = iso.hi = 1;
+  iso.f_lo = iso.f_hi = 0;
+  return iso;
+}
+
 /* The next dyadic interval (level, idx) in depth-first, left-first order: climb while a right child, then
  * step right. Returns 0 when the whole interval has been searched. */
 int next_interval(int* level, ulong* idx) {

@@ -31,16 +31,8 @@ Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
     power_on_interval(p, s0 + iso.lo * len_s, width * len_s, a1);
     iso.f_lo = a1[0];
     iso.f_hi = power_value(a1, (REAL)1);
-    if (a1[0] == 0) {
-      PROBE_STEP(iso, -1, ALGRAY_STEP_EXACT_ZERO, level);
-      iso.status = ISOLATION_EXACT;
-      return iso;
-    }
     if (iso.steps == 1) start_sign = (a1[0] > 0) - (a1[0] < 0);
-    if (crossed_at_left_end(&iso, start_sign)) {
-      PROBE_STEP(iso, -1, ALGRAY_STEP_CROSSED, level);
-      return iso;
-    }
+    if (settled_at_left_end(&iso, start_sign, level PROBE_ARG)) return iso;
     const int v = descartes_unit_interval(a1);
     if (v == 1 && iso.f_hi != 0) {
       PROBE_STEP(iso, v, ALGRAY_STEP_ISOLATED, level);
@@ -49,30 +41,18 @@ Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
     }
     /* v counts roots in (lo, hi); a root exactly at hi is found as the right neighbour's EXACT case. */
     if (v >= 1) {
-      const int located = interval_located(width, iso.lo, t_in, len);
-      if (!located && level < REAL_MAX_HALVINGS) {
-        PROBE_STEP(iso, v, ALGRAY_STEP_SPLIT, level);
+      const int next = halve_or_settle(&iso, v, level, width, t_in, len PROBE_ARG);
+      if (next == INTERVAL_HALVE) {
         ++level;
         idx *= 2;
         continue;
       }
-      if (settle_cluster(&iso, located)) {
-        PROBE_STEP(iso, v, ALGRAY_STEP_CLUSTER_ROOT, level);
-        return iso;
-      }
-      PROBE_STEP(iso, v, ALGRAY_STEP_CLUSTER_SKIP, level);
+      if (next == INTERVAL_SETTLED) return iso;
     } else {
       PROBE_STEP(iso, v, ALGRAY_STEP_NO_ROOT, level);
     }
-    if (!next_interval(&level, &idx)) {
-      /* The last interval visited is the rightmost one: a root exactly at its far end is the one point left. */
-      iso.status = iso.f_hi == 0 ? ISOLATION_EXACT : ISOLATION_NONE;
-      PROBE(ALGRAY_EVENT_STEP, -1, iso.status == ISOLATION_EXACT ? ALGRAY_STEP_END_ZERO : ALGRAY_STEP_END_NONE, 0u,
-            (REAL)1, (REAL)1, iso.f_hi, iso.f_hi);
-      iso.lo = iso.hi = 1;
-      iso.f_lo = iso.f_hi = 0;
-      return iso;
-    }
+    /* The last interval visited is the rightmost one, so its f_hi is P at the far end. */
+    if (!next_interval(&level, &idx)) return isolation_at_far_end(iso, iso.f_hi == 0, iso.f_hi PROBE_ARG);
   }
 }
 

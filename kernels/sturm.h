@@ -203,15 +203,7 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
     const int v_hi = sturm_variations(seq, iso.hi, &f_hi, &noise_hi);
     iso.f_lo = f_lo;
     iso.f_hi = f_hi;
-    if (f_lo == 0) {
-      PROBE_STEP(iso, -1, ALGRAY_STEP_EXACT_ZERO, level);
-      iso.status = ISOLATION_EXACT;
-      return iso;
-    }
-    if (crossed_at_left_end(&iso, start_sign)) {
-      PROBE_STEP(iso, -1, ALGRAY_STEP_CROSSED, level);
-      return iso;
-    }
+    if (settled_at_left_end(&iso, start_sign, level PROBE_ARG)) return iso;
     /* Distinct roots in (lo, hi): the count is of (lo, hi], and a root exactly at hi belongs to the next
      * interval, which finds it as an exact zero at its left end. */
     const int roots = v_lo - v_hi - (f_hi == 0);
@@ -231,19 +223,16 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
      * there with what may be a second root just before it (measured: the smaller of a pair 2^-20 apart,
      * lost): only halving sorts these out. */
     if (roots != 0 || crosses || f_hi == 0) {
-      const int located = interval_located(width, iso.lo, t_in, len);
-      if (!located && level < REAL_MAX_HALVINGS) {
-        PROBE_STEP(iso, roots, ALGRAY_STEP_SPLIT, level);
+      const int next = halve_or_settle(&iso, roots, level, width, t_in, len PROBE_ARG);
+      if (next == INTERVAL_HALVE) {
         ++level;
         idx *= 2;
         continue;
       }
-      if (settle_cluster(&iso, located)) {
-        PROBE_STEP(iso, roots, ALGRAY_STEP_CLUSTER_ROOT, level);
+      if (next == INTERVAL_SETTLED) {
         sturm_bracket(&iso, a1);
         return iso;
       }
-      PROBE_STEP(iso, roots, ALGRAY_STEP_CLUSTER_SKIP, level);
     } else {
       PROBE_STEP(iso, roots, ALGRAY_STEP_NO_ROOT, level);
     }
@@ -251,12 +240,7 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
       /* Intervals are half open; the far end is the one point left to look at. A root within rounding of it
        * may have come out just outside, where the counts, reading the same value, agree: it is numerically
        * at 1. */
-      iso.status = fabs(f_hi) <= noise_hi ? ISOLATION_EXACT : ISOLATION_NONE;
-      PROBE(ALGRAY_EVENT_STEP, -1, iso.status == ISOLATION_EXACT ? ALGRAY_STEP_END_ZERO : ALGRAY_STEP_END_NONE, 0u,
-            (REAL)1, (REAL)1, f_hi, f_hi);
-      iso.lo = iso.hi = 1;
-      iso.f_lo = iso.f_hi = 0;
-      return iso;
+      return isolation_at_far_end(iso, fabs(f_hi) <= noise_hi, f_hi PROBE_ARG);
     }
     f_lo = f_hi;
     noise_lo = noise_hi;

@@ -1,6 +1,7 @@
 // Tests for EXR/PNG output: round trips, sRGB encoding, atomic replacement and cleanup after signals.
 #include "image_io.h"
 #include "noisy_image.h"
+#include "temp_dir.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wconversion"
@@ -37,27 +38,7 @@ using algray::OutputError;
 
 namespace {
 
-class TempDir {
- public:
-  TempDir() {
-    static int counter = 0;
-    std::random_device rd;
-    path_ = fs::temp_directory_path() / ("algray_test_image_io_" + std::to_string(::getpid()) + "_" +
-                                         std::to_string(++counter) + "_" + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
+using algray::testing::TempDir;
 
 std::vector<std::string> list_dir(const fs::path& dir) {
   std::vector<std::string> names;
