@@ -130,6 +130,9 @@ int main(int argc, char** argv) {
   probe->add_option("--plot", probe_request.plot_path,
                     "draw P*(t) on [t_in, t_out] with the isolating interval, the root and solver_ref's roots "
                     "(.svg or .png)");
+  std::string plot_range_text;
+  probe->add_option("--plot-range", plot_range_text,
+                    "what --plot shows: segment (default), isolating (the isolating interval), or T0,T1");
   probe->add_flag("--json", probe_request.json, "print the report as JSON (for scripts) instead of text");
   probe->add_option("--stats", probe_request.stats_path, "write the report as JSON to this file too");
 
@@ -218,6 +221,16 @@ int main(int argc, char** argv) {
     } else {
       std::cerr << "algray: probe needs --pixel X,Y or --ray ox,oy,oz,dx,dy,dz\n";
       return kExitBadInput;
+    }
+    if (plot_range_text == "isolating") {
+      req.plot_range.kind = PlotRange::Kind::Isolating;
+    } else if (!plot_range_text.empty() && plot_range_text != "segment") {
+      if (!parse_numbers(plot_range_text, 2, v) || !(v[0] < v[1])) {
+        std::cerr << "algray: --plot-range " << plot_range_text
+                  << ": expected segment, isolating, or two increasing numbers T0,T1\n";
+        return kExitBadInput;
+      }
+      req.plot_range = {PlotRange::Kind::Given, v[0], v[1]};
     }
     return run_probe(req, std::cout, std::cerr);
   }

@@ -250,15 +250,27 @@ nlohmann::json reference_json(const ProbeReference& ref) {
 // P*(t) from solver_ref's exact restriction, sampled evenly and at the isolating intervals' ends. Not at the
 // roots: a sample there is 0 to rounding, and the plot's log floor would follow it down to 1e-12 of the
 // largest value, spending most of the height on decades that only the roots' neighbourhoods reach.
-ProbePlot make_plot(const Scene& scene, const ProbeTarget& target, const SurfaceProbe& probe) {
+ProbePlot make_plot(const Scene& scene, const ProbeTarget& target, const SurfaceProbe& probe, const PlotRange& range) {
   const SolverTrace& first = probe.traces.front();
   ProbePlot plot;
-  plot.title = scene.name + ", " + target_text(target) + ": P*(t) on [t_in, t_out]";
   plot.t_in = first.t_in;
   plot.t_out = first.t_out;
+  std::string shown = "[t_in, t_out]";
+  if (range.kind == PlotRange::Kind::Given) {
+    plot.t_in = range.from;
+    plot.t_out = range.to;
+    shown = "[" + num(range.from, 10) + ", " + num(range.to, 10) + "]";
+  } else if (range.kind == PlotRange::Kind::Isolating && first.isolation_status != 0) {
+    const double lo = first.t_at(first.iso_lo), hi = first.t_at(first.iso_hi);
+    const double margin = hi > lo ? (hi - lo) / 10 : 1e-6 * std::max(1.0, std::fabs(lo));
+    plot.t_in = std::max(first.t_in, lo - margin);
+    plot.t_out = std::min(first.t_out, hi + margin);
+    shown = "the isolating interval";
+  }
+  plot.title = scene.name + ", " + target_text(target) + ": P*(t) on " + shown;
   std::vector<double> ts;
   const int samples = 1500;
-  for (int i = 0; i <= samples; ++i) ts.push_back(first.t_in + (first.t_out - first.t_in) * i / samples);
+  for (int i = 0; i <= samples; ++i) ts.push_back(plot.t_in + (plot.t_out - plot.t_in) * i / samples);
   const bool several = probe.traces.size() > 1;
   for (const SolverTrace& tr : probe.traces) {
     const std::string who = several ? " (" + solver_name(tr.config) + ")" : "";
@@ -279,7 +291,7 @@ ProbePlot make_plot(const Scene& scene, const ProbeTarget& target, const Surface
   std::sort(ts.begin(), ts.end());
   ts.erase(std::unique(ts.begin(), ts.end()), ts.end());
   for (double t : ts) {
-    if (t < first.t_in || t > first.t_out) continue;
+    if (t < plot.t_in || t > plot.t_out) continue;
     plot.t.push_back(t);
     plot.value.push_back(evaluate(probe.reference.certificate.restricted, t));
   }
@@ -417,7 +429,7 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
         err << "algray: " << *req.plot_path << " not written: the ray misses the extent, so there is nothing to plot\n";
         return kExitFailure;
       }
-      write_probe_plot(*req.plot_path, make_plot(scene, req.target, *hit));
+      write_probe_plot(*req.plot_path, make_plot(scene, req.target, *hit, req.plot_range));
     }
   } catch (const std::exception& e) {
     return report_error(e, err);

@@ -13,6 +13,13 @@
 
 namespace algray {
 
+// The stretch of the ray the plot shows: the whole segment [t_in, t_out], the isolating interval of the scene's
+// solver (with a tenth of its width either side, to show its ends), or a given [from, to].
+struct PlotRange {
+  enum class Kind { Segment, Isolating, Given } kind = Kind::Segment;
+  double from = 0, to = 0;
+};
+
 struct ProbeRequest {
   std::optional<std::string> scene_path;  // unset: the built-in default scene
   std::vector<Override> overrides;        // --set and the solver flags, in order
@@ -20,8 +27,9 @@ struct ProbeRequest {
   ProbeTarget target;
   bool all_solvers = false;              // every isolation x refinement, side by side
   std::optional<std::string> plot_path;  // .svg or .png
-  bool json = false;                     // JSON on stdout instead of text
-  std::optional<std::string> stats_path; // the JSON report written to a file as well
+  PlotRange plot_range;
+  bool json = false;                      // JSON on stdout instead of text
+  std::optional<std::string> stats_path;  // the JSON report written to a file as well
   bool use_cache = true;
 };
 

@@ -209,6 +209,17 @@ TEST_CASE("probe --plot writes a valid SVG and PNG, and --json the same story", 
   REQUIRE(bytes.size() > 1000);
   CHECK(bytes.compare(0, 8, std::string("\x89PNG\r\n\x1a\n", 8)) == 0);
 
+  // Zoomed on the isolating interval, x1 is inside the plot and the other three roots are not.
+  const Result zoom = box.run("probe " + scene + ray + " --plot zoom.svg --plot-range isolating");
+  REQUIRE(zoom.exit_code == 0);
+  const std::string zoomed = read_text(box.work / "zoom.svg");
+  std::size_t left_out = 0;
+  for (std::size_t at = zoomed.find("outside the plot"); at != std::string::npos;
+       at = zoomed.find("outside the plot", at + 1))
+    ++left_out;
+  CHECK(left_out == 3);
+  CHECK(box.run("probe " + scene + ray + " --plot z.svg --plot-range 3,1").exit_code == 2);
+
   const Result json = box.run("probe " + scene + ray + " --json");
   REQUIRE(json.exit_code == 0);
   const nlohmann::json j = nlohmann::json::parse(json.out);
