@@ -27,7 +27,7 @@ SWEEP_FROM, SWEEP_TO = 1.0, 2.9
 
 
 def sweep_values(frames):
-    return [SWEEP_FROM + (SWEEP_TO - SWEEP_FROM) * i / (frames - 1) for i in range(frames)]
+    return [SWEEP_FROM + (SWEEP_TO - SWEEP_FROM) * i / max(frames - 1, 1) for i in range(frames)]
 
 
 def run_batch(binary, workdir, values, size, preview, env):

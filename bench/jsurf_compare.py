@@ -105,7 +105,7 @@ def main():
                                      "--height", str(args.size), "--set", "antialias.samples=1",
                                      "--set", "antialias.adaptive=false"], capture_output=True, text=True)
             if result.returncode != 0:
-                rows.append((name, None, None, None, result.stderr.strip().splitlines()[0]))
+                rows.append((name, None, None, None, (result.stderr.strip().splitlines() or ["no message"])[0]))
                 continue
             background = background_of(f)
             _, _, a = read_png(ours)
@@ -127,6 +127,8 @@ def main():
 
     ok = [r for r in rows if r[1] is not None]
     ious = [r[1] for r in ok]
+    if not ious:
+        sys.exit("no file rendered: nothing to compare")
     lines = [
         "## jsurf framing: algray against jsurf-alggeo on its examples (issue 7)",
         "",

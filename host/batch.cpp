@@ -2,12 +2,15 @@
 #include "batch.h"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -22,32 +25,17 @@ namespace fs = std::filesystem;
 
 const std::set<std::string> kBatchTopKeys{"defaults", "job"};
 const std::set<std::string> kJobKeys{"name", "scene", "set", "output", "stats", "frames", "sweep", "orbit"};
+// What every job may share; frames, sweeps and orbits belong to one job.
+const std::set<std::string> kDefaultsKeys{"scene", "set", "output", "stats"};
 const std::set<std::string> kSweepKeys{"from", "to", "steps"};
 const std::set<std::string> kOrbitKeys{"frames", "degrees", "axis", "lights"};
-
-std::string format_number(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 // A TOML value as the text of an override's value, which apply_override reads back as TOML.
 std::string toml_text(const TomlReader& r, const toml::node& n) {
   if (auto i = n.value_exact<std::int64_t>()) return std::to_string(*i);
-  if (auto d = n.value_exact<double>()) {
-    std::string s = format_number(*d);
-    if (s.find_first_of(".eEin") == std::string::npos) s += ".0";
-    return s;
-  }
+  if (auto d = n.value_exact<double>()) return toml_number(*d);
   if (auto b = n.value_exact<bool>()) return *b ? "true" : "false";
-  if (auto s = n.value_exact<std::string>()) {
-    std::string q = "\"";
-    for (char c : *s) {
-      if (c == '"' || c == '\\') q += '\\';
-      q += c;
-    }
-    return q + "\"";
-  }
+  if (auto s = n.value_exact<std::string>()) return toml_quoted(*s);
   if (const toml::array* a = n.as_array()) {
     std::string out = "[";
     for (std::size_t k = 0; k < a->size(); ++k) out += (k ? ", " : "") + toml_text(r, *a->get(k));
@@ -57,13 +45,18 @@ std::string toml_text(const TomlReader& r, const toml::node& n) {
 }
 
 // set = { mu = 1, image = { width = 512 }, "light.0.intensity" = 0.5 }: nested tables become dotted keys.
+// "jobs.toml:7:9": where a node of the jobs file is, for the messages of what it causes later.
+std::string origin_of(const TomlReader& r, const toml::node& n) {
+  return r.source() + ":" + std::to_string(n.source().begin.line) + ":" + std::to_string(n.source().begin.column);
+}
+
 void collect_sets(const TomlReader& r, const toml::table& t, const std::string& prefix, std::vector<Override>& out) {
   for (auto&& [key, node] : t) {
     const std::string k = prefix + std::string(key.str());
     if (const toml::table* sub = node.as_table())
       collect_sets(r, *sub, k + ".", out);
     else
-      out.push_back({k, toml_text(r, node)});
+      out.push_back({k, toml_text(r, node), origin_of(r, node)});
   }
 }
 
@@ -134,6 +127,7 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
         if (!s->get(k)) r.fail(node.source(), what + " needs '" + k + "'");
       Sweep sweep;
       sweep.key = std::string(key.str());
+      sweep.origin = origin_of(r, node);
       sweep.from = r.number(*s->get("from"), what + ".from");
       sweep.to = r.number(*s->get("to"), what + ".to");
       agree(static_cast<int>(r.integer(*s->get("steps"), what + ".steps", 1, 1000000)), node, what);
@@ -173,11 +167,22 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
   for (const std::string& o : job.outputs) {
     try {
       expand_pattern(o, job, 0);
+      format_from_extension(o);
     } catch (const SceneError& e) {
       r.fail(output->source(), e.message);
+    } catch (const OutputError& e) {
+      r.fail(output->source(), e.what());
     }
   }
+  job.output_origin = origin_of(r, *output);
   return job;
+}
+
+// The shortest text that reads back as v: 0.3, not 0.29999999999999999; 180, not 1.8e+02.
+std::string shortest_text(double v) {
+  char buf[40];
+  const auto end = std::to_chars(buf, buf + sizeof buf, v).ptr;
+  return std::string(buf, end);
 }
 
 double sweep_value(const Sweep& s, int frame, int frames) {
@@ -197,7 +202,8 @@ bool file_exists(const std::string& path) {
   return fs::is_regular_file(path, ec);
 }
 
-// The log gets one line per frame, flushed as written, so a crash loses at most the frame it was on.
+// The log gets one line per frame, flushed as written, so a crash loses at most the frame it was on. It is the
+// one file written in place, not through a temporary: it grows while the batch runs, and --resume appends.
 class JsonLinesLog {
  public:
   JsonLinesLog(const std::string& path, bool append) : out_(path, append ? std::ios::app : std::ios::trunc) {
@@ -206,6 +212,7 @@ class JsonLinesLog {
   void write(const nlohmann::json& j) {
     out_ << j.dump() << "\n";
     out_.flush();
+    if (!out_) throw OutputError("cannot write the batch log (disk full?)");
   }
 
  private:
@@ -230,7 +237,7 @@ std::vector<BatchJob> load_jobs(const std::string& text, const std::string& sour
   }
   r.check_keys(root, "", kBatchTopKeys);
   const toml::table* defaults = r.subtable(root, "defaults");
-  if (defaults) r.check_keys(*defaults, "defaults", kJobKeys);
+  if (defaults) r.check_keys(*defaults, "defaults", kDefaultsKeys);
   const toml::node* jobs = root.get("job");
   if (!jobs) r.fail(root.source(), "no jobs: add [[job]] tables, each with a scene and an output");
   const toml::array* list = jobs->as_array();
@@ -238,6 +245,22 @@ std::vector<BatchJob> load_jobs(const std::string& text, const std::string& sour
   std::vector<BatchJob> out;
   for (std::size_t i = 0; i < list->size(); ++i)
     out.push_back(read_job(r, defaults, *list->get(i)->as_table(), i, base_dir));
+  // Two frames writing one file would leave only the last: a pattern whose {value} or {angle} repeats, or two
+  // jobs with the same pattern.
+  std::map<std::string, std::string> writer;  // file -> "job frame"
+  for (const BatchJob& job : out)
+    for (int frame = 0; frame < job.frames; ++frame) {
+      std::vector<std::string> files;
+      for (const std::string& o : job.outputs) files.push_back(expand_pattern(o, job, frame));
+      if (job.stats) files.push_back(expand_pattern(*job.stats, job, frame));
+      for (const std::string& f : files) {
+        const std::string who = "job " + job.name + " frame " + std::to_string(frame);
+        const auto [it, fresh] = writer.emplace(f, who);
+        if (!fresh)
+          throw SceneError(job.output_origin, who + " would write " + f + ", which " + it->second +
+                                                  " writes too: give each frame its own file name");
+      }
+    }
   return out;
 }
 
@@ -256,16 +279,14 @@ std::string expand_pattern(const std::string& pattern, const BatchJob& job, int 
       out += job.name;
     } else if (field == "frame") {
       out += std::to_string(frame);
-    } else if (field.rfind("frame:0", 0) == 0 && field.size() > 7 &&
-               field.find_first_not_of("0123456789", 7) == std::string::npos && std::stoi(field.substr(7)) <= 12) {
+    } else if (field.rfind("frame:0", 0) == 0 && field.size() > 7 && field.size() <= 9 &&
+               field.find_first_not_of("0123456789", 7) == std::string::npos) {
       std::snprintf(buf, sizeof buf, "%0*d", std::stoi(field.substr(7)), frame);
       out += buf;
     } else if (field == "value" && !job.sweeps.empty()) {
-      std::snprintf(buf, sizeof buf, "%.6g", sweep_value(job.sweeps.front(), frame, job.frames));
-      out += buf;
+      out += shortest_text(sweep_value(job.sweeps.front(), frame, job.frames));
     } else if (field == "angle" && job.orbit) {
-      std::snprintf(buf, sizeof buf, "%.6g", orbit_angle(*job.orbit, frame, job.frames));
-      out += buf;
+      out += shortest_text(orbit_angle(*job.orbit, frame, job.frames));
     } else {
       throw SceneError(job.name, "unknown placeholder {" + field + "} in output pattern '" + pattern +
                                      "': use {name}, {frame}, {frame:03}" + (job.sweeps.empty() ? "" : ", {value}") +
@@ -278,7 +299,7 @@ std::string expand_pattern(const std::string& pattern, const BatchJob& job, int 
 
 std::vector<Override> frame_overrides(const BatchJob& job, int frame) {
   std::vector<Override> out = job.overrides;
-  for (const Sweep& s : job.sweeps) out.push_back({s.key, format_number(sweep_value(s, frame, job.frames))});
+  for (const Sweep& s : job.sweeps) out.push_back({s.key, toml_number(sweep_value(s, frame, job.frames)), s.origin});
   return out;
 }
 
@@ -372,7 +393,7 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
         }
         Scene scene = load_scene_file(job.scene, overrides);
         if (!warned) {
-          for (const std::string& w : scene.warnings) err << "algray: warning: job " << job.name << ": " << w << "\n";
+          print_warnings(scene, err, "job " + job.name + ": ");
           warned = true;
         }
         if (job.orbit) {
@@ -385,7 +406,7 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
         render.outputs = outputs;
         render.stats_path = stats;
         check_outputs(scene, render);
-        entry["stats"] = render_scene(scene, render, context);
+        entry["stats"] = render_scene(scene, render, context, start);
         entry["status"] = "ok";
         ++ok;
         ++job_ok;

@@ -14,6 +14,7 @@ namespace algray {
 // `to` in `steps` evenly spaced values, both ends included.
 struct Sweep {
   std::string key;
+  std::string origin;  // where the jobs file gives it, for messages
   double from = 0, to = 0;
 };
 
@@ -31,6 +32,7 @@ struct BatchJob {
   std::string scene;  // a path, resolved against the jobs file's directory
   std::vector<Override> overrides;
   std::vector<std::string> outputs;  // patterns, resolved like the scene
+  std::string output_origin;         // where the jobs file gives them, for messages
   std::optional<std::string> stats;  // pattern of a per-frame stats file
   int frames = 1;
   std::vector<Sweep> sweeps;  // all swept together, frame by frame

@@ -36,10 +36,6 @@ constexpr double kIntervalOpacity = 0.4;
 constexpr Rgb8 kOutOfExtent{70, 70, 70};
 constexpr Rgb8 kPanel{246, 246, 246};
 
-float srgb_to_linear(float c) {
-  return c <= 0.04045f ? c / 12.92f : static_cast<float>(std::pow((c + 0.055) / 1.055, 2.4));
-}
-
 std::array<float, 3> unit(Rgb8 c) { return {c.r / 255.0f, c.g / 255.0f, c.b / 255.0f}; }
 
 std::string hex(Rgb8 c) {
@@ -205,7 +201,7 @@ class Canvas {
     const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
     image.rgba.resize(4 * n);
     for (std::size_t i = 0; i < n; ++i) {
-      for (std::size_t c = 0; c < 3; ++c) image.rgba[4 * i + c] = srgb_to_linear(rgb_[3 * i + c]);
+      for (std::size_t c = 0; c < 3; ++c) image.rgba[4 * i + c] = static_cast<float>(srgb_to_linear(rgb_[3 * i + c]));
       image.rgba[4 * i + 3] = 1.0f;
     }
     return image;
@@ -897,15 +893,17 @@ FrameImage probe_plot_image(const ProbePlot& plot) {
   return rasterise(draw_probe_plot(plot, probe_plot_geometry(plot)));
 }
 
-void write_probe_plot(const fs::path& path, const ProbePlot& plot) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-  // Check the name before drawing, so a wrong name costs nothing and writes nothing.
+void check_probe_plot_path(const fs::path& path) {
+  const std::string ext = lowercase_extension(path);
   if (ext != ".svg" && ext != ".png")
     throw OutputError("unsupported plot extension '" + path.extension().string() + "' in '" + path.string() +
                       "'; use .svg or .png");
-  if (ext == ".svg")
+}
+
+void write_probe_plot(const fs::path& path, const ProbePlot& plot) {
+  // Check the name before drawing, so a wrong name costs nothing and writes nothing.
+  check_probe_plot_path(path);
+  if (lowercase_extension(path) == ".svg")
     write_text_file(path, probe_plot_svg(plot));
   else
     write_png(path, probe_plot_image(plot));

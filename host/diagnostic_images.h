@@ -53,6 +53,8 @@ ProbePlotGeometry probe_plot_geometry(const ProbePlot& plot);
 // non-finite or reversed range).
 std::string probe_plot_svg(const ProbePlot& plot);   // a standalone SVG 1.1 document
 FrameImage probe_plot_image(const ProbePlot& plot);  // linear RGBA, text in a built-in capitals-only font
+// Throws OutputError unless the name ends in .svg or .png (any case).
+void check_probe_plot_path(const std::filesystem::path& path);
 // .svg or .png by extension (case-insensitive), anything else throws OutputError; written atomically.
 void write_probe_plot(const std::filesystem::path& path, const ProbePlot& plot);
 

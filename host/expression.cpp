@@ -15,8 +15,12 @@ EquationError::EquationError(std::size_t pos, const std::string& message)
 
 namespace {
 
+// Functions of constants besides sqrt, which has its own exact case.
+constexpr const char* kConstantFunctions[] = {"sin", "cos", "tan", "asin", "acos",  "atan",
+                                              "exp", "log", "abs", "sign", "floor", "ceil"};
+
 bool is_constant_function(std::string_view name) {
-  for (const char* f : {"sin", "cos", "tan", "asin", "acos", "atan", "exp", "log", "abs", "sign", "floor", "ceil"})
+  for (const char* f : kConstantFunctions)
     if (name == f) return true;
   return false;
 }
@@ -401,11 +405,14 @@ class Parser {
 
 }  // namespace
 
+bool is_reserved_name(std::string_view name) {
+  return name == "x" || name == "y" || name == "z" || name == "sqrt" || is_constant_function(name);
+}
+
 Polynomial parse_equation(std::string_view text, const std::map<std::string, double>& parameters) {
-  for (const char* reserved : {"x", "y", "z", "sqrt", "sin", "cos", "tan", "asin", "acos", "atan", "exp", "log", "abs",
-                               "sign", "floor", "ceil"})
-    if (parameters.count(reserved))
-      throw EquationError(0, std::string("a parameter may not be named '") + reserved + "': the name is reserved");
+  for (const auto& [name, value] : parameters)
+    if (is_reserved_name(name))
+      throw EquationError(0, "a parameter may not be named '" + name + "': the name is reserved");
   return Parser(text, parameters).parse();
 }
 

@@ -33,4 +33,7 @@ struct EquationError : std::runtime_error {
 // exceed degree 1000, so that a typo cannot make the expansion run for hours.
 Polynomial parse_equation(std::string_view text, const std::map<std::string, double>& parameters);
 
+// x, y, z and the function names: no parameter may be called so.
+bool is_reserved_name(std::string_view name);
+
 }  // namespace algray

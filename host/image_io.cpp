@@ -372,6 +372,8 @@ void encode_text(const fs::path& file, const std::string& text) {
   });
 }
 
+}  // namespace
+
 std::string lowercase_extension(const fs::path& p) {
   std::string ext = p.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -379,7 +381,10 @@ std::string lowercase_extension(const fs::path& p) {
   return ext;
 }
 
-}  // namespace
+double srgb_to_linear(double c) {
+  c = std::clamp(c, 0.0, 1.0);
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
 
 ImageFormat format_from_extension(const fs::path& p) {
   const std::string ext = lowercase_extension(p);

@@ -48,6 +48,12 @@ struct FrameImage {
 
 enum class ImageFormat { Exr, Png };
 
+// ".png" for "a/B.PNG": the extension, lower case, with its dot; "" without one.
+std::string lowercase_extension(const std::filesystem::path& p);
+
+// An sRGB-encoded value in [0, 1] (a display colour, as other programs write them) as linear light.
+double srgb_to_linear(double c);
+
 // Case-insensitive .exr / .png; anything else throws OutputError.
 ImageFormat format_from_extension(const std::filesystem::path& p);
 

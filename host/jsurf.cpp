@@ -11,21 +11,35 @@
 #include <sstream>
 
 #include "expression.h"
+#include "image_io.h"
 #include "scene.h"
+#include "toml_reader.h"
 
 namespace algray {
 namespace {
 
-// One property with where its value starts, for error messages.
+// Where a character of the file is: 1-based line and column.
+struct Position {
+  int line = 0, column = 0;
+};
+
+// One property's value, with the position of each of its characters (after continuation lines are joined and
+// escapes resolved), so that an error anywhere inside it points at the right line and column.
 struct Property {
   std::string value;
-  int line = 0, column = 0;  // 1-based, of the value's first character
-  std::string line_text;     // the physical line it starts on
+  std::vector<Position> positions;  // one per character of value, plus one past the end
 };
 
 class Properties {
  public:
-  Properties(const std::string& text, std::string source) : source_(std::move(source)) { parse(text); }
+  Properties(const std::string& text, std::string source) : source_(std::move(source)) {
+    std::istringstream in(text);
+    for (std::string l; std::getline(in, l);) {
+      if (!l.empty() && l.back() == '\r') l.pop_back();
+      lines_.push_back(l);
+    }
+    parse();
+  }
 
   const Property* get(const std::string& key) const {
     const auto it = values_.find(key);
@@ -33,14 +47,18 @@ class Properties {
     used_.insert(key);
     return &it->second;
   }
-  [[noreturn]] void fail(const Property& p, const std::string& key, const std::string& message) const {
-    const std::string caret = std::string(static_cast<std::size_t>(std::max(p.column - 1, 0)), ' ') + "^";
-    throw SceneError(source_ + ":" + std::to_string(p.line) + ":" + std::to_string(p.column), key + ": " + message,
-                     p.line_text + "\n" + caret);
+  // An error at character `offset` of the value.
+  [[noreturn]] void fail(const Property& p, const std::string& key, const std::string& message,
+                         std::size_t offset = 0) const {
+    const Position at = p.positions[std::min(offset, p.positions.size() - 1)];
+    const std::string caret = std::string(static_cast<std::size_t>(std::max(at.column - 1, 0)), ' ') + "^";
+    throw SceneError(source_ + ":" + std::to_string(at.line) + ":" + std::to_string(at.column), key + ": " + message,
+                     line_text(at.line) + "\n" + caret);
   }
   [[noreturn]] void fail_missing(const std::string& key, const std::string& message) const {
     throw SceneError(source_, key + ": " + message);
   }
+  int line_of(const Property& p) const { return p.positions.front().line; }
   std::vector<std::string> unused() const {
     std::vector<std::string> keys;
     for (const auto& [key, p] : values_)
@@ -56,28 +74,38 @@ class Properties {
   const std::string& source() const { return source_; }
 
  private:
+  const std::string& line_text(int line) const {
+    static const std::string none;
+    return line >= 1 && static_cast<std::size_t>(line) <= lines_.size() ? lines_[static_cast<std::size_t>(line - 1)]
+                                                                        : none;
+  }
+
   // java.util.Properties rules: # and ! comments, a trailing odd backslash continues the line (leading blanks of
   // the next one dropped), the key ends at an unescaped '=', ':' or blank, and \t \n \r \f \uXXXX escapes.
-  void parse(const std::string& text) {
-    std::vector<std::string> lines;
-    std::istringstream in(text);
-    for (std::string l; std::getline(in, l);) {
-      if (!l.empty() && l.back() == '\r') l.pop_back();
-      lines.push_back(l);
-    }
-    for (std::size_t i = 0; i < lines.size(); ++i) {
-      const std::string& first = lines[i];
+  void parse() {
+    for (std::size_t i = 0; i < lines_.size(); ++i) {
+      const std::string& first = lines_[i];
       const std::size_t start = first.find_first_not_of(" \t\f");
       if (start == std::string::npos || first[start] == '#' || first[start] == '!') continue;
-      const int line_number = static_cast<int>(i) + 1;
-      std::string logical = first.substr(start);
-      int column_offset = static_cast<int>(start);
-      while (ends_in_continuation(logical) && i + 1 < lines.size()) {
+      // The logical line, each character with its place in the file.
+      std::string logical;
+      std::vector<Position> where;
+      auto append = [&](std::size_t line, std::size_t from) {
+        for (std::size_t c = from; c < lines_[line].size(); ++c) {
+          logical += lines_[line][c];
+          where.push_back({static_cast<int>(line) + 1, static_cast<int>(c) + 1});
+        }
+      };
+      append(i, start);
+      while (ends_in_continuation(logical) && i + 1 < lines_.size()) {
         logical.pop_back();
-        const std::string& next = lines[++i];
-        const std::size_t s = next.find_first_not_of(" \t\f");
-        logical += s == std::string::npos ? "" : next.substr(s);
+        where.pop_back();
+        ++i;
+        const std::size_t s = lines_[i].find_first_not_of(" \t\f");
+        if (s != std::string::npos) append(i, s);
       }
+      const Position end =
+          where.empty() ? Position{static_cast<int>(i) + 1, 1} : Position{where.back().line, where.back().column + 1};
       std::size_t k = 0;
       std::string key;
       while (k < logical.size() && logical[k] != '=' && logical[k] != ':' && logical[k] != ' ' && logical[k] != '\t') {
@@ -87,12 +115,7 @@ class Properties {
       while (k < logical.size() && (logical[k] == ' ' || logical[k] == '\t')) ++k;
       if (k < logical.size() && (logical[k] == '=' || logical[k] == ':')) ++k;
       while (k < logical.size() && (logical[k] == ' ' || logical[k] == '\t')) ++k;
-      Property p;
-      p.value = unescape(logical.substr(k));
-      p.line = line_number;
-      p.column = column_offset + static_cast<int>(k) + 1;
-      p.line_text = first;
-      values_[key] = p;  // the last occurrence wins, as in Java
+      values_[key] = unescape(logical, where, k, end);  // the last occurrence wins, as in Java
     }
   }
   static bool ends_in_continuation(const std::string& s) {
@@ -100,34 +123,37 @@ class Properties {
     for (auto it = s.rbegin(); it != s.rend() && *it == '\\'; ++it) ++backslashes;
     return backslashes % 2 == 1;
   }
-  static std::string unescape(const std::string& s) {
-    std::string out;
-    for (std::size_t i = 0; i < s.size(); ++i) {
+  static Property unescape(const std::string& s, const std::vector<Position>& where, std::size_t from, Position end) {
+    Property p;
+    for (std::size_t i = from; i < s.size(); ++i) {
+      p.positions.push_back(where[i]);
       if (s[i] != '\\' || i + 1 == s.size()) {
-        out += s[i];
+        p.value += s[i];
         continue;
       }
       const char c = s[++i];
-      if (c == 't')
-        out += '\t';
-      else if (c == 'n')
-        out += '\n';
-      else if (c == 'r')
-        out += '\r';
-      else if (c == 'f')
-        out += '\f';
-      else if (c == 'u' && i + 4 < s.size() && s.find_first_not_of("0123456789abcdefABCDEF", i + 1) >= i + 5) {
+      if (c == 't') {
+        p.value += '\t';
+      } else if (c == 'n') {
+        p.value += '\n';
+      } else if (c == 'r') {
+        p.value += '\r';
+      } else if (c == 'f') {
+        p.value += '\f';
+      } else if (c == 'u' && i + 4 < s.size() && s.find_first_not_of("0123456789abcdefABCDEF", i + 1) >= i + 5) {
         const unsigned code = static_cast<unsigned>(std::stoul(s.substr(i + 1, 4), nullptr, 16));
         i += 4;
-        out += code < 0x80 ? static_cast<char>(code) : '?';  // equations and numbers are ASCII
+        p.value += code < 0x80 ? static_cast<char>(code) : '?';  // equations and numbers are ASCII
       } else {
-        out += c;
+        p.value += c;
       }
     }
-    return out;
+    p.positions.push_back(end);
+    return p;
   }
 
   std::string source_;
+  std::vector<std::string> lines_;
   std::map<std::string, Property> values_;
   mutable std::set<std::string> used_;
 };
@@ -199,33 +225,11 @@ bool is_affine(const glm::dmat4& m) {
   return std::fabs(m[0][3]) + std::fabs(m[1][3]) + std::fabs(m[2][3]) + std::fabs(m[3][3] - 1) < 1e-9;
 }
 
-// jsurf's colours are display values in 0..1, shaded without gamma; algray's are linear.
-double srgb_to_linear(double c) {
-  c = std::clamp(c, 0.0, 1.0);
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-}
-
-std::string toml_number(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  std::string s = buf;
-  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
-  return s;
-}
-
 std::string toml_vector(const glm::dvec3& v) {
   return "[" + toml_number(v.x) + ", " + toml_number(v.y) + ", " + toml_number(v.z) + "]";
 }
 
-std::string toml_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
+// jsurf's colours are display values in 0..1, shaded without gamma; algray's are linear.
 glm::dvec3 colour_or(const Properties& props, const std::string& key, glm::dvec3 fallback) {
   const Property* p = props.get(key);
   glm::dvec3 c = fallback;
@@ -243,7 +247,7 @@ double factor_or(const Properties& props, const std::string& key, double fallbac
   if (v >= 0 && v <= 1) return v;
   const Property* p = props.get(key);
   if (v < 0) props.fail(*p, key, "must not be negative");
-  warnings.push_back(props.source() + ":" + std::to_string(p->line) + ": " + key + " = " + p->value +
+  warnings.push_back(props.source() + ":" + std::to_string(props.line_of(*p)) + ": " + key + " = " + p->value +
                      " is above 1; algray's materials stop at 1, so it renders as 1");
   return 1;
 }
@@ -266,17 +270,16 @@ std::string jsurf_to_toml(const std::string& text, const std::string& source, st
   for (const std::string& key : props.keys_with_prefix("surface_parameter_")) {
     const Property* p = props.get(key);
     const std::string name = key.substr(std::string("surface_parameter_").size());
-    if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_'))
-      props.fail(*p, key, "a parameter name must start with a letter");
+    if (!is_identifier(name))
+      props.fail(*p, key, "'" + name + "' is not a parameter name (a letter or _, then letters, digits or _)");
+    if (is_reserved_name(name)) props.fail(*p, key, "'" + name + "' is reserved: x, y, z and function names");
     parameters[name] = numbers(props, key, *p, 1)[0];
   }
   // Checked here so that an error points into the .jsurf file, not into the TOML made from it.
   try {
     parse_equation(equation->value, parameters);
   } catch (const EquationError& e) {
-    Property at = *equation;
-    at.column += static_cast<int>(e.position);
-    props.fail(at, "surface_equation", e.what());
+    props.fail(*equation, "surface_equation", e.what(), e.position);
   }
 
   // Frames. jsurf clips to the unit sphere of its clip space and evaluates the equation at 10^scale_factor times
@@ -284,6 +287,8 @@ std::string jsurf_to_toml(const std::string& text, const std::string& source, st
   // (world-to-camera). algray keeps the equation's own coordinates as the world, so the camera and lights move
   // instead: camera point p maps to 10^s R C^-1 p.
   const double scale = std::pow(10.0, number_or(props, "scale_factor", 0.0));
+  if (!(scale > 0 && std::isfinite(scale) && std::isfinite(1 / scale)))
+    props.fail(*props.get("scale_factor"), "scale_factor", "10^scale_factor must be a finite, nonzero radius");
   const Property* rotation_at = nullptr;
   const glm::dmat4 rotation = matrix_or_identity(props, "rotation_matrix", &rotation_at);
   if (rotation_at &&
@@ -298,7 +303,7 @@ std::string jsurf_to_toml(const std::string& text, const std::string& source, st
   for (const char* ignored : {"transform_matrix", "surface_transform_matrix"}) {
     const Property* where = nullptr;
     if (!is_identity(matrix_or_identity(props, ignored, &where)))
-      warnings.push_back(source + ":" + std::to_string(where->line) + ": " + ignored +
+      warnings.push_back(source + ":" + std::to_string(props.line_of(*where)) + ": " + ignored +
                          " is ignored, as SURFER ignores it (jsurf would apply it on top of rotation_matrix and "
                          "scale_factor, which SURFER also writes)");
   }
@@ -323,8 +328,8 @@ std::string jsurf_to_toml(const std::string& text, const std::string& source, st
 
   std::ostringstream toml;
   toml << "# Translated from " << source << " (SURFER/jsurf)\n\n[surface]\nname = "
-       << toml_string(source.substr(source.find_last_of('/') == std::string::npos ? 0 : source.find_last_of('/') + 1))
-       << "\nequation = " << toml_string(equation->value) << "\n";
+       << toml_quoted(source.substr(source.find_last_of('/') == std::string::npos ? 0 : source.find_last_of('/') + 1))
+       << "\nequation = " << toml_quoted(equation->value) << "\n";
   if (!parameters.empty()) {
     toml << "\n[parameters]\n";
     for (const auto& [name, value] : parameters) toml << name << " = " << toml_number(value) << "\n";
@@ -386,7 +391,8 @@ std::string jsurf_to_toml(const std::string& text, const std::string& source, st
     warn("no light is ON: jsurf shows only the ambient term, algray lights the surface with a headlight");
 
   for (const std::string& key : props.unused())
-    warnings.push_back(source + ":" + std::to_string(props.get(key)->line) + ": unknown key " + key + " is ignored");
+    warnings.push_back(source + ":" + std::to_string(props.line_of(*props.get(key))) + ": unknown key " + key +
+                       " is ignored");
   return toml.str();
 }
 

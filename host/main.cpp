@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <iostream>
 
 #include "batch.h"
@@ -69,7 +70,7 @@ bool collect_overrides(const CLI::App* cmd, const SceneOptions& o, std::vector<O
   return true;
 }
 
-// "a,b,c" into exactly n numbers.
+// "a,b,c" into exactly n finite numbers.
 bool parse_numbers(const std::string& text, std::size_t n, std::vector<double>& out) {
   out.clear();
   std::size_t start = 0;
@@ -79,7 +80,7 @@ bool parse_numbers(const std::string& text, std::size_t n, std::vector<double>& 
     try {
       std::size_t used = 0;
       out.push_back(std::stod(part, &used));
-      if (used != part.size()) return false;
+      if (used != part.size() || !std::isfinite(out.back())) return false;
     } catch (const std::exception&) {
       return false;
     }
@@ -204,7 +205,8 @@ int main(int argc, char** argv) {
     req.use_cache = !probe_opts.no_cache;
     std::vector<double> v;
     if (!pixel_text.empty()) {
-      if (!parse_numbers(pixel_text, 2, v) || v[0] != static_cast<int>(v[0]) || v[1] != static_cast<int>(v[1])) {
+      if (!parse_numbers(pixel_text, 2, v) || std::fabs(v[0]) > 1e9 || std::fabs(v[1]) > 1e9 ||
+          v[0] != std::floor(v[0]) || v[1] != std::floor(v[1])) {
         std::cerr << "algray: --pixel " << pixel_text << ": expected two integers X,Y\n";
         return kExitBadInput;
       }
@@ -220,6 +222,10 @@ int main(int argc, char** argv) {
       req.target.direction = {v[3], v[4], v[5]};
     } else {
       std::cerr << "algray: probe needs --pixel X,Y or --ray ox,oy,oz,dx,dy,dz\n";
+      return kExitBadInput;
+    }
+    if (!plot_range_text.empty() && !req.plot_path) {
+      std::cerr << "algray: --plot-range goes with --plot\n";
       return kExitBadInput;
     }
     if (plot_range_text == "isolating") {

@@ -54,8 +54,8 @@ struct SolverTrace {
   // The same polynomial in the power basis of s, t = t_in + s (t_out - t_in); for ALGRAY_BASIS_POWER_EYE, of t.
   std::vector<double> power;
   std::vector<ProbeStep> steps;
-  std::vector<ProbeIterate> chain_iterates;  // derivative chain only
-  int isolation_status = 0;                  // 0 none, 1 bracket, 2 exact (ALGRAY_EVENT_ISOLATED)
+  std::vector<ProbeIterate> chain_iterates;     // derivative chain only
+  int isolation_status = ALGRAY_ISOLATED_NONE;  // ALGRAY_ISOLATED_* (ALGRAY_EVENT_ISOLATED)
   bool halving_limit = false;
   double iso_lo = 0, iso_hi = 0, iso_f_lo = 0, iso_f_hi = 0;
   std::vector<ProbeIterate> iterates;

@@ -47,7 +47,9 @@ double evaluate(const std::vector<mpq_class>& poly, double t) {
 }
 
 const char* status_name(int status) {
-  return status == 1 ? "bracket" : status == 2 ? "exact (root at the interval's left end)" : "none";
+  return status == ALGRAY_ISOLATED_BRACKET ? "bracket"
+         : status == ALGRAY_ISOLATED_EXACT ? "exact (root at the interval's left end)"
+                                           : "none";
 }
 
 // The scene's solver first, then, when asked, every other valid isolation x refinement.
@@ -119,7 +121,8 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
           << "\n";
   }
   out << "isolation result: " << status_name(tr.isolation_status);
-  if (tr.isolation_status != 0) out << " on [" << num(tr.t_at(tr.iso_lo)) << ", " << num(tr.t_at(tr.iso_hi)) << "]";
+  if (tr.isolation_status != ALGRAY_ISOLATED_NONE)
+    out << " on [" << num(tr.t_at(tr.iso_lo)) << ", " << num(tr.t_at(tr.iso_hi)) << "]";
   if (tr.halving_limit) out << " (an interval reached the halving limit)";
   out << "\n";
   if (!tr.iterates.empty()) {
@@ -145,8 +148,9 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
   const RayCertificate& cert = ref.certificate;
   if (tr.found() && cert.answer.kind != ref::Classification::Miss && cert.cls != PixelClass::OutsideExtent) {
     const double error = std::fabs(tr.t - cert.answer.t_nearest);
-    out << "vs solver_ref: |t - t_ref| = " << num(error, 3) << " (relative "
-        << num(error / std::fabs(cert.answer.t_nearest), 3) << ")\n";
+    out << "vs solver_ref: |t - t_ref| = " << num(error, 3);
+    if (cert.answer.t_nearest != 0) out << " (relative " << num(error / std::fabs(cert.answer.t_nearest), 3) << ")";
+    out << "\n";
   } else if (!tr.found() && cert.answer.kind == ref::Classification::Miss) {
     out << "vs solver_ref: agrees, no root\n";
   } else if (tr.found() != (cert.answer.kind != ref::Classification::Miss)) {
@@ -260,7 +264,7 @@ ProbePlot make_plot(const Scene& scene, const ProbeTarget& target, const Surface
     plot.t_in = range.from;
     plot.t_out = range.to;
     shown = "[" + num(range.from, 10) + ", " + num(range.to, 10) + "]";
-  } else if (range.kind == PlotRange::Kind::Isolating && first.isolation_status != 0) {
+  } else if (range.kind == PlotRange::Kind::Isolating && first.isolation_status != ALGRAY_ISOLATED_NONE) {
     const double lo = first.t_at(first.iso_lo), hi = first.t_at(first.iso_hi);
     const double margin = hi > lo ? (hi - lo) / 10 : 1e-6 * std::max(1.0, std::fabs(lo));
     plot.t_in = std::max(first.t_in, lo - margin);
@@ -274,7 +278,7 @@ ProbePlot make_plot(const Scene& scene, const ProbeTarget& target, const Surface
   const bool several = probe.traces.size() > 1;
   for (const SolverTrace& tr : probe.traces) {
     const std::string who = several ? " (" + solver_name(tr.config) + ")" : "";
-    if (tr.isolation_status != 0) {
+    if (tr.isolation_status != ALGRAY_ISOLATED_NONE) {
       const double lo = tr.t_at(tr.iso_lo), hi = tr.t_at(tr.iso_hi);
       plot.intervals.push_back({lo, hi});
       plot.markers.push_back({PlotMarker::Kind::IsolationEnd, lo, "isolating lo" + who});
@@ -387,12 +391,11 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
       throw SceneError("--pixel", "pixel (" + std::to_string(req.target.px) + ", " + std::to_string(req.target.py) +
                                       ") is outside the " + std::to_string(scene.image.width) + "x" +
                                       std::to_string(scene.image.height) + " image");
-    if (req.target.given_ray && !(glm::length(req.target.direction) > 0))
+    const glm::dvec3& d = req.target.direction;
+    if (req.target.given_ray && !(std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) > 0))
       throw SceneError("--ray", "the direction must be nonzero");
     if (req.plot_path) {
-      std::string ext = std::filesystem::path(*req.plot_path).extension().string();
-      for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-      if (ext != ".svg" && ext != ".png") throw OutputError(*req.plot_path + ": a plot is .svg or .png");
+      check_probe_plot_path(*req.plot_path);
       check_output_writable(*req.plot_path);
     }
     if (req.stats_path) check_output_writable(*req.stats_path);

@@ -78,6 +78,7 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
 // Wall time of each step of the command, for --stats.
 class PhaseTimer {
  public:
+  explicit PhaseTimer(std::chrono::steady_clock::time_point start) : start_(start), last_(start) {}
   void mark(const std::string& phase) {
     const auto now = std::chrono::steady_clock::now();
     phases_.push_back({phase, std::chrono::duration<double, std::milli>(now - last_).count()});
@@ -93,7 +94,7 @@ class PhaseTimer {
   }
 
  private:
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_ = start_;
+  std::chrono::steady_clock::time_point start_, last_;
   std::vector<std::pair<std::string, double>> phases_;
 };
 
@@ -217,8 +218,8 @@ Scene load_scene(const std::optional<std::string>& path, const std::vector<Overr
   return load_scene_file(*path, overrides);
 }
 
-void print_warnings(const Scene& scene, std::ostream& err) {
-  for (const std::string& w : scene.warnings) err << "algray: warning: " << w << "\n";
+void print_warnings(const Scene& scene, std::ostream& err, const std::string& prefix) {
+  for (const std::string& w : scene.warnings) err << "algray: warning: " << prefix << w << "\n";
 }
 
 void check_outputs(const Scene& scene, const RenderRequest& req) {
@@ -236,8 +237,10 @@ void check_outputs(const Scene& scene, const RenderRequest& req) {
   }
 }
 
-nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, RenderContext& context) {
-  PhaseTimer timer;
+nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, RenderContext& context,
+                            std::chrono::steady_clock::time_point started) {
+  PhaseTimer timer(started);
+  timer.mark("scene");  // reading and checking it, before this call
   FrameImage image;
   RenderResult result;
   DeviceInfo device;
@@ -260,17 +263,18 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
     image = shade_frame(scene, result);
   }
   add_metadata(image, scene, result, device);
+  timer.mark("shade");
   if (!req.aovs.empty() || req.heatmap_path) {
     const SolverWork work = solver_work(result);
     add_solver_aovs(image, work, req.aovs);
     if (req.heatmap_path) {
       const std::string per =
           work.samples > 1 ? " (sum over " + std::to_string(work.samples * work.samples) + " samples)" : "";
-      write_image(*req.heatmap_path, work_heatmap(work.width, work.height, work.total(), work.in_extent,
+      write_image(*req.heatmap_path, work_heatmap(work.width, work.height, work.total(), work.in_extent(),
                                                   "isolation steps + refinement iterations per pixel" + per));
     }
+    timer.mark("diagnostics");
   }
-  timer.mark("shade");
   for (const std::string& out : req.outputs) write_image(out, image);
   timer.mark("write");
   nlohmann::json stats = stats_json(scene, req, result, device, timer);
@@ -291,6 +295,7 @@ int report_error(const std::exception& e, std::ostream& err) {
 }
 
 int run_render(const RenderRequest& req, std::ostream& err) {
+  const auto started = std::chrono::steady_clock::now();
   // Everything the user gave is checked before any device work, so bad input costs nothing and writes nothing.
   Scene scene;
   try {
@@ -302,7 +307,7 @@ int run_render(const RenderRequest& req, std::ostream& err) {
   }
   try {
     RenderContext context(req.device_spec, req.use_cache);
-    render_scene(scene, req, context);
+    render_scene(scene, req, context, started);
   } catch (const std::exception& e) {
     return report_error(e, err);
   }

@@ -1,6 +1,7 @@
 // One `algray render` invocation end to end: scene, device, kernels, shading, image files and stats.
 #pragma once
 
+#include <chrono>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -58,7 +59,7 @@ class RenderContext {
 Scene load_scene(const std::optional<std::string>& path, const std::vector<Override>& overrides);
 
 // The scene's warnings, one "algray: warning: ..." line each.
-void print_warnings(const Scene& scene, std::ostream& err);
+void print_warnings(const Scene& scene, std::ostream& err, const std::string& prefix = "");
 
 // Bad input in the request's outputs (unknown format, missing or unwritable directory), found before any work:
 // throws OutputError or SceneError.
@@ -66,7 +67,9 @@ void check_outputs(const Scene& scene, const RenderRequest& request);
 
 // Renders `scene` on the context's device and writes the request's images, heat map and stats file; returns
 // the stats. Throws on failure; outputs already written stay complete (each is replaced atomically).
-nlohmann::json render_scene(const Scene& scene, const RenderRequest& request, RenderContext& context);
+// `started`: when the command began, before the scene was read; the stats' phases and total count from there.
+nlohmann::json render_scene(const Scene& scene, const RenderRequest& request, RenderContext& context,
+                            std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now());
 
 // Prints a failure as the CLI does and returns its exit code: bad input (scene, output path, device) is 2,
 // anything else 1.

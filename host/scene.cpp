@@ -13,6 +13,7 @@
 
 #include "embedded_files.h"
 #include "expression.h"
+#include "image_io.h"
 #include "jsurf.h"
 #include "toml_reader.h"
 
@@ -42,11 +43,6 @@ const std::set<std::string> kAntialiasKeys{"samples", "adaptive", "threshold"};
 const std::set<std::string> kRenderKeys{"precision",      "tolerance", "isolation", "refinement", "ray_origin",
                                         "max_iterations", "tile_size", "preview",   "max_depth"};
 
-bool is_identifier(const std::string& s) {
-  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
-  return std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isalnum(c) || c == '_'; });
-}
-
 // Merges `from` into `into`; tables merge key by key, anything else replaces.
 void merge_tables(toml::table& into, toml::table&& from) {
   for (auto&& [key, node] : from) {
@@ -64,7 +60,7 @@ bool is_index(const std::string& s) {
 }
 
 void apply_override(toml::table& root, const Override& o) {
-  const std::string label = "--set " + o.key + "=" + o.value;
+  const std::string label = (o.origin.empty() ? "--set " : o.origin + ": set ") + o.key + "=" + o.value;
   // A bare name is a parameter; any other key is a dotted path into the scene.
   const std::string key = o.key.find('.') == std::string::npos ? "parameters." + o.key : o.key;
   std::vector<std::string> parts;
@@ -258,8 +254,9 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
   if (const toml::table* params = r.subtable(root, "parameters")) {
     for (auto&& [key, node] : *params) {
       const std::string name(key.str());
-      if (!is_identifier(name) || name == "x" || name == "y" || name == "z" || name == "sqrt")
-        r.fail(key.source(), "parameter name '" + name + "' must be an identifier other than x, y, z and sqrt");
+      if (!is_identifier(name) || is_reserved_name(name))
+        r.fail(key.source(), "parameter name '" + name +
+                                 "' must be an identifier other than x, y, z and the function names (sqrt, sin, ...)");
       scene.parameters[name] = r.number(node, "parameter '" + name + "'");
     }
   }
@@ -509,9 +506,7 @@ Scene load_scene_file(const std::string& path, const std::vector<Override>& over
   if (!in) throw SceneError(path, "cannot read the scene file");
   std::ostringstream text;
   text << in.rdbuf();
-  std::string extension = std::filesystem::path(path).extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == ".jsurf") return load_jsurf_text(text.str(), path, overrides);
+  if (lowercase_extension(path) == ".jsurf") return load_jsurf_text(text.str(), path, overrides);
   return load_scene_text(text.str(), path, overrides);
 }
 

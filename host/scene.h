@@ -142,6 +142,8 @@ struct Scene {
 struct Override {
   std::string key;
   std::string value;
+  // Where it was written, for messages ("jobs.toml:7:9"); empty for the command line's --set.
+  std::string origin = {};
 };
 
 // A .toml scene, or a SURFER/jsurf .jsurf file (by extension, any case), translated with jsurf's framing.

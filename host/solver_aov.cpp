@@ -48,6 +48,12 @@ std::vector<std::uint32_t> SolverWork::total() const {
   return sum;
 }
 
+std::vector<std::uint8_t> SolverWork::in_extent() const {
+  std::vector<std::uint8_t> in(flags.size());
+  for (std::size_t i = 0; i < in.size(); ++i) in[i] = (flags[i] & ALGRAY_HIT_IN_EXTENT) != 0;
+  return in;
+}
+
 SolverWork solver_work(const RenderResult& result) {
   const HitBuffer& hits = result.hits;
   SolverWork w;
@@ -59,7 +65,6 @@ SolverWork solver_work(const RenderResult& result) {
   w.refine_iterations.assign(n, 0);
   w.flags.assign(n, 0);
   w.classification.assign(n, 0);
-  w.in_extent.assign(n, 0);
   for (int ty = 0; ty < hits.height; ++ty) {
     for (int tx = 0; tx < hits.width; ++tx) {
       const HitRecord& h = hits.at(tx, ty);
@@ -68,7 +73,6 @@ SolverWork solver_work(const RenderResult& result) {
       w.refine_iterations[i] += h.work >> 16;
       w.flags[i] |= h.flags;
       w.classification[i] = std::max(w.classification[i], static_cast<std::uint32_t>(solver_class(h)));
-      w.in_extent[i] |= (h.flags & ALGRAY_HIT_IN_EXTENT) != 0;
     }
   }
   return w;

@@ -33,9 +33,9 @@ SolverClass solver_class(const HitRecord& hit);
 struct SolverWork {
   int width = 0, height = 0;
   std::vector<std::uint32_t> isolation_steps, refine_iterations, flags, classification;
-  std::vector<std::uint8_t> in_extent;       // 1 when some sample met the extent
-  int samples = 1;                           // per side
-  std::vector<std::uint32_t> total() const;  // isolation steps + refinement iterations
+  int samples = 1;                              // per side
+  std::vector<std::uint32_t> total() const;     // isolation steps + refinement iterations
+  std::vector<std::uint8_t> in_extent() const;  // 1 where some sample met the extent
 };
 SolverWork solver_work(const RenderResult& result);
 

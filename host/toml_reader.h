@@ -15,6 +15,13 @@
 
 namespace algray {
 
+// A string or a float as TOML text, read back exactly: control characters escaped, floats to 17 digits.
+std::string toml_quoted(const std::string& s);
+std::string toml_number(double v);
+
+// A letter or _, then letters, digits or _: a bare TOML key segment, and a parameter name.
+bool is_identifier(const std::string& s);
+
 // Levenshtein distance, to suggest the key the user probably meant.
 std::size_t edit_distance(const std::string& a, const std::string& b);
 
@@ -30,7 +37,8 @@ class TomlReader {
   [[noreturn]] void fail(const toml::source_region& region, const std::string& message,
                          std::size_t column_offset = 0) const {
     const auto& path = region.path;
-    if (path && path->rfind("--set", 0) == 0) throw SceneError(*path, message);
+    // A node from an override carries the override as its path: it has no line of this text to show.
+    if (path && *path != source_) throw SceneError(*path, message);
     if (region.begin.line == 0) throw SceneError(source_, message);
     const std::size_t line = region.begin.line;
     const std::size_t column = region.begin.column + column_offset;
@@ -40,6 +48,8 @@ class TomlReader {
     }
     throw SceneError(source_ + ":" + std::to_string(line) + ":" + std::to_string(column), message, excerpt);
   }
+
+  const std::string& source() const { return source_; }
 
   const std::string& line_text(std::size_t line) const {
     static const std::string empty;

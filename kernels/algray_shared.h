@@ -61,10 +61,15 @@ typedef struct {
                                        interval's ends lo, hi as fractions of [t_in, t_out], and P there */
 #define ALGRAY_EVENT_CHAIN_ITERATE 4 /* derivative chain: one Newton/bisection step on the derivative of order
                                        `level`; values: x, its value there, then the bracket lo, hi (fractions) */
-#define ALGRAY_EVENT_ISOLATED 5     /* the isolation's result. decision: 0 none, 1 bracket, 2 exact; count: 1 at
-                                       the halving limit; values: lo, hi, P(lo), P(hi) */
+#define ALGRAY_EVENT_ISOLATED 5     /* the isolation's result. decision: ALGRAY_ISOLATED_*; count: 1 at the
+                                       halving limit; values: lo, hi, P(lo), P(hi) */
 #define ALGRAY_EVENT_ITERATE 6      /* a refinement iterate. count: its number; values: y, P(y), and the bracket
                                        (y in [0, 1] across the isolating interval) */
+
+/* What an isolation found (kernels/isolation.h's Isolation.status) */
+#define ALGRAY_ISOLATED_NONE 0    /* certified: no root in [t_in, t_out] (up to the tolerance) */
+#define ALGRAY_ISOLATED_BRACKET 1 /* one root (or an odd cluster) bracketed by a sign change on [lo, hi] */
+#define ALGRAY_ISOLATED_EXACT 2   /* the polynomial is exactly zero at lo */
 
 #define ALGRAY_BASIS_BERNSTEIN 1     /* Bernstein basis of s in [0, 1] over [t_in, t_out] */
 #define ALGRAY_BASIS_POWER_SEGMENT 2 /* power basis of s in [0, 1] over [t_in, t_out] */

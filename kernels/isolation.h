@@ -6,9 +6,9 @@
 #include "real.h"
 #include "restrict.h"
 
-#define ISOLATION_NONE 0     /* certified: no root in [t_in, t_out] (up to the tolerance) */
-#define ISOLATION_BRACKET 1  /* one root (or an odd cluster) bracketed by a sign change on [lo, hi] */
-#define ISOLATION_EXACT 2    /* the polynomial is exactly zero at lo */
+#define ISOLATION_NONE ALGRAY_ISOLATED_NONE
+#define ISOLATION_BRACKET ALGRAY_ISOLATED_BRACKET
+#define ISOLATION_EXACT ALGRAY_ISOLATED_EXACT
 
 /* lo, hi are fractions of [t_in, t_out]; f_lo, f_hi the polynomial's values there in the method's scaling. */
 typedef struct {

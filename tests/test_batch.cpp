@@ -75,6 +75,8 @@ TEST_CASE("a job that fails in the middle of a batch does not stop the others", 
                                          "[[job]]\nname = \"bad\"\nscene = \"ball.toml\"\nset = { r = \"huge\" }\n"
                                          "output = \"b.png\"\n"
                                          "[[job]]\nname = \"missing\"\nscene = \"nowhere.toml\"\noutput = \"c.png\"\n"
+                                         "[[job]]\nname = \"typo\"\nscene = \"ball.toml\"\noutput = \"t_{frame}.png\"\n"
+                                         "sweep.\"camera.fov_yy\" = { from = 30, to = 40, steps = 2 }\n"
                                          "[[job]]\nscene = \"ball.toml\"\noutput = \"d_{frame}.png\"\n"
                                          "sweep.r = { from = 0.5, to = 1, steps = 2 }\n");
   const Result r = box.run("batch jobs.toml");
@@ -87,15 +89,20 @@ TEST_CASE("a job that fails in the middle of a batch does not stop the others", 
   CHECK_THAT(r.err, Catch::Contains("job bad frame 0 failed"));
   CHECK_THAT(r.err, Catch::Contains("'r' must be a number"));
   CHECK_THAT(r.err, Catch::Contains("nowhere.toml"));
-  CHECK_THAT(r.err, Catch::Contains("2 of 5 frames failed"));
+  // A value the jobs file sets is named by its place there, not as a --set argument.
+  CHECK_THAT(r.err, Catch::Contains("jobs.toml:9:13: set r=\"huge\""));
+  CHECK_THAT(r.err, Catch::Contains("jobs.toml:19:25: set camera.fov_yy=30"));
+  CHECK_THAT(r.err, Catch::Contains("4 of 7 frames failed"));
   const std::vector<nlohmann::json> log = read_log(box.work / "jobs.log.jsonl");
-  REQUIRE(log.size() == 5);
+  REQUIRE(log.size() == 7);
   CHECK(log[0]["status"] == "ok");
   CHECK(log[1]["status"] == "failed");
   CHECK_THAT(log[1]["error"].get<std::string>(), Catch::Contains("must be a number"));
   CHECK(log[2]["status"] == "failed");
-  CHECK(log[3]["status"] == "ok");
-  CHECK(log[4]["status"] == "ok");
+  CHECK(log[3]["status"] == "failed");
+  CHECK(log[4]["status"] == "failed");
+  CHECK(log[5]["status"] == "ok");
+  CHECK(log[6]["status"] == "ok");
 }
 
 TEST_CASE("--resume skips frames whose outputs exist and renders the rest", "[batch][cli]") {
@@ -179,6 +186,15 @@ TEST_CASE("jobs files with errors are refused before anything renders, with file
        "sweep.r = { from = 1, to = 2, steps = 3 }\n",
        "gives 3 frames but the job has 2"},
       {"[[job]]\noutput = \"x.png\"\n", "needs a scene"},
+      {"[defaults]\nframes = 3\n[[job]]\nscene = \"ball.toml\"\noutput = \"x.png\"\n", "unknown key 'defaults.frames'"},
+      // Three frames of one value, and two jobs with one name: each file written twice.
+      {"[[job]]\nscene = \"ball.toml\"\noutput = \"v_{value}.png\"\nsweep.r = { from = 1, to = 1, steps = 3 }\n",
+       "writes too"},
+      {"[[job]]\nscene = \"ball.toml\"\noutput = \"same.png\"\n[[job]]\nscene = \"ball.toml\"\noutput = \"same.png\"\n",
+       "writes too"},
+      {"[[job]]\nscene = \"ball.toml\"\noutput = \"g.gif\"\n", "unsupported output extension"},
+      {"[[job]]\nscene = \"ball.toml\"\noutput = \"f_{frame:0999}.png\"\nframes = 2\norbit = {}\n",
+       "unknown placeholder {frame:0999}"},
   };
   for (const Case& c : cases) {
     INFO(c.jobs);

@@ -153,10 +153,18 @@ TEST_CASE("bad .jsurf files get located errors; unsupported or ignored features 
     throw std::logic_error("unreachable");
   };
   CHECK_THAT(error_of("background_color=1 1 1\n").message, Catch::Contains("surface_equation"));
-  // Line 2, the value starts at column 14; the equation error at its offset within.
+  // Line 3: the value starts at column 20, and "qq" 6 characters into it.
   const SceneError eq = error_of("# a comment\nscale_factor=0.1\nsurface_equation = x^2 + qq\n");
   CHECK(eq.where == "bad.jsurf:3:26");
   CHECK_THAT(eq.message, Catch::Contains("qq"));
+  // The same on a continued line, and after an escape: positions are the file's, not the joined line's.
+  CHECK(error_of("surface_equation = x^2 + \\\n    y^2 + qq\n").where == "bad.jsurf:2:11");
+  CHECK(error_of("surface_equation = \\u0078 + qq\n").where == "bad.jsurf:1:29");
+  CHECK_THAT(error_of(jsurf_file("surface_equation=x\nscale_factor=400\n")).message, Catch::Contains("finite"));
+  CHECK_THAT(error_of(jsurf_file("surface_equation=x\nsurface_parameter_a.b=1\n")).message,
+             Catch::Contains("not a parameter name"));
+  CHECK_THAT(error_of(jsurf_file("surface_equation=x\nsurface_parameter_log=1\n")).message,
+             Catch::Contains("reserved"));
   const SceneError number = error_of(jsurf_file("surface_equation=x\nscale_factor=big\n"));
   CHECK_THAT(number.where, Catch::Contains("bad.jsurf:"));
   CHECK_THAT(number.message, Catch::Contains("'big' is not a number"));

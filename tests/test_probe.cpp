@@ -6,9 +6,11 @@
 
 #include "cli_sandbox.h"
 #include "image_io.h"
+#include "kernel_sources.h"
 #include "probe_report.h"
 #include "render_plan.h"
 #include "renderer.h"
+#include "temp_dir.h"
 #include "test_support.h"
 
 using namespace algray;
@@ -119,7 +121,7 @@ TEST_CASE("the probe names the smallest root of the Fig. 8 torus ray and the iso
       CHECK((tr.steps[i].decision == ALGRAY_STEP_SPLIT || tr.steps[i].decision == ALGRAY_STEP_NO_ROOT));
     }
     CHECK(tr.steps.size() == tr.isolation_steps());
-    CHECK(tr.isolation_status == 1);
+    CHECK(tr.isolation_status == ALGRAY_ISOLATED_BRACKET);
     CHECK(tr.iso_lo == last.lo);
     CHECK(tr.iso_hi == last.hi);
 
@@ -219,6 +221,11 @@ TEST_CASE("probe --plot writes a valid SVG and PNG, and --json the same story", 
     ++left_out;
   CHECK(left_out == 3);
   CHECK(box.run("probe " + scene + ray + " --plot z.svg --plot-range 3,1").exit_code == 2);
+  CHECK(box.run("probe " + scene + ray + " --plot z.svg --plot-range 0,inf").exit_code == 2);
+  CHECK(box.run("probe " + scene + ray + " --plot-range isolating").exit_code == 2);
+  CHECK(!fs::exists(box.work / "z.svg"));
+  CHECK(box.run("probe " + scene + " --ray 0,nan,10,0,0,-1").exit_code == 2);
+  CHECK(box.run("probe " + scene + " --pixel 1e30,2").exit_code == 2);
 
   const Result json = box.run("probe " + scene + ray + " --json");
   REQUIRE(json.exit_code == 0);
@@ -296,4 +303,41 @@ TEST_CASE("render --aov adds the solver channels asked for and --heatmap draws t
   CHECK(bad.exit_code == 2);
   CHECK(bad.err.find("colour") != std::string::npos);
   CHECK(!fs::exists(box.work / "bad.exr"));
+}
+
+TEST_CASE("render builds contain no probe code: the hooks compile to nothing unless ALGRAY_PROBE", "[probe]") {
+  // The C preprocessor stands in for the OpenCL compiler's: the kernels are C99 to it. Every kernel a render
+  // builds, with every isolation method; the probe kernel itself must show the hooks, or the test proves nothing.
+  algray::testing::TempDir dir("preprocess");
+  const auto preprocessed = [&](const std::string& file, const KernelConfig& config) {
+    const std::filesystem::path source = dir / "kernel.c", out = dir / "kernel.i";
+    {
+      std::ofstream s(source);
+      s << assemble_kernel_source(file);
+    }
+    std::string defines;
+    std::istringstream options(config.build_options());
+    for (std::string word; options >> word;)
+      if (word == "-D" && options >> word) defines += " -D" + word;
+    const std::string cmd = "cpp -P" + defines + " " + source.string() + " -o " + out.string() + " 2>&1";
+    REQUIRE(std::system(cmd.c_str()) == 0);
+    return algray::testing::read_text(out);
+  };
+  for (Isolation isolation :
+       {Isolation::Bernstein, Isolation::PowerDescartes, Isolation::Sturm, Isolation::DerivativeChain}) {
+    KernelConfig config;
+    config.degree = 6;
+    config.isolation = isolation;
+    INFO(to_string(isolation));
+    const std::string probe = preprocessed("probe.cl", config);
+    CHECK(probe.find("probe_record(") != std::string::npos);
+    for (const char* file : {"primary.cl", "shadow.cl", "trace.cl"}) {
+      INFO(file);
+      const std::string render = preprocessed(file, config);
+      REQUIRE(render.find("__kernel") != std::string::npos);
+      CHECK(render.find("probe_record") == std::string::npos);
+      CHECK(render.find("ProbeLog") == std::string::npos);
+      CHECK(render.find("probe_log") == std::string::npos);
+    }
+  }
 }

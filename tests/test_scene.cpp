@@ -178,6 +178,8 @@ TEST_CASE("nan and inf are rejected where they are written", "[scene][errors]") 
   check_error(sphere_with({{7, "eye = [inf, 0, 0]"}}), "t.toml:7:8", "must be finite, not inf");
   check_error(sphere_with({}, {"[parameters]", "k = nan"}), "t.toml:12:5", "parameter 'k' must be finite");
   check_error(sphere_with({}, {"[parameters]", "k = -inf"}), "t.toml:12:5", "parameter 'k' must be finite");
+  // A reserved name is refused at the key, even when the equation does not use it.
+  check_error(sphere_with({}, {"[parameters]", "log = 1"}), "t.toml:12:1", "must be an identifier other than");
 }
 
 TEST_CASE("empty extents are rejected", "[scene][errors]") {

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "temp_dir.h"
+
 namespace algray::testing {
 
 namespace fs = std::filesystem;
@@ -36,15 +38,6 @@ inline void write_text(const fs::path& p, const std::string& text) {
   std::ofstream out(p, std::ios::binary | std::ios::trunc);
   out << text;
   REQUIRE(out.good());
-}
-
-inline fs::path unique_temp_dir(const std::string& tag) {
-  static std::atomic<int> counter{0};
-  const std::string name = "algray-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" +
-                           std::to_string(std::random_device{}());
-  const fs::path dir = fs::temp_directory_path() / name;
-  fs::create_directories(dir);
-  return dir;
 }
 
 // Compiled kernels are shared by all tests of this run but never by the user's own cache.

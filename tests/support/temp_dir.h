@@ -1,9 +1,10 @@
-// A fresh directory under the system temp dir for one test, removed with everything in it afterwards.
+// Fresh directories under the system temp dir for tests, removed with everything in them afterwards.
 #pragma once
 
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -11,15 +12,20 @@
 
 namespace algray::testing {
 
+// A new directory, unique across processes and threads.
+inline std::filesystem::path unique_temp_dir(const std::string& tag) {
+  static std::atomic<int> counter{0};
+  const std::string name = "algray-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" +
+                           std::to_string(std::random_device{}());
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / name;
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// unique_temp_dir() for one test, removed with everything in it afterwards.
 class TempDir {
  public:
-  explicit TempDir(const std::string& tag = "test") {
-    static int counter = 0;
-    std::random_device rd;
-    path_ = std::filesystem::temp_directory_path() / ("algray_" + tag + "_" + std::to_string(::getpid()) + "_" +
-                                                      std::to_string(++counter) + "_" + std::to_string(rd()));
-    std::filesystem::create_directories(path_);
-  }
+  explicit TempDir(const std::string& tag = "test") : path_(unique_temp_dir(tag)) {}
   ~TempDir() {
     std::error_code ignored;
     std::filesystem::remove_all(path_, ignored);
