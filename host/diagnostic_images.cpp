@@ -140,7 +140,9 @@ int text_width(std::size_t chars, int scale) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Raster canvas. Pixels hold sRGB-encoded values and blending happens there, as SVG renderers do, so the
+// Raster canvas. The PNG form exists because `--plot x.png` is asked for: CI artefact pages, issue trackers
+// and image viewers show PNG where SVG often is not. It draws the same display list as the SVG, so the two
+// cannot drift apart. Pixels hold sRGB-encoded values and blending happens there, as SVG renderers do, so the
 // PNG looks like the SVG; the conversion to linear happens once, in to_frame().
 
 enum class Anchor { Start, Middle, End };

@@ -83,6 +83,9 @@ void apply_override(toml::table& root, const Override& o) {
     check_identifier(parts[i]);
     toml::node* at = target->get(parts[i]);
     if (at && at->is_table()) {
+      if (is_index(parts[i + 1]))
+        throw SceneError(label, "'" + parts[i] + "' is a single [" + parts[i] + "] table, not a list: leave out the " +
+                                    "index, as in " + parts[i] + "." + (i + 2 < parts.size() ? parts[i + 2] : "KEY"));
       target = at->as_table();
       ++i;
       continue;

@@ -322,6 +322,7 @@ TEST_CASE("--set reaches into [[surface]] and [[light]] lists by index, and says
   const Scene second = algray::load_scene_text(two, "two.toml", {{"surface.1.equation", "\"z\""}});
   CHECK(second.surfaces[0].polynomial == equation("x"));
   CHECK(second.surfaces[1].polynomial == equation("z"));
+  CHECK_THAT(error_of(text, {{"surface.0.equation", "\"x\""}}).message, Catch::Contains("single [surface] table"));
   // A single [surface] table is still reachable without an index.
   CHECK(algray::load_scene_text(text, "t.toml", {{"surface.equation", "\"x^2+y^2+z^2-4\""}}).surface().polynomial ==
         equation("x^2+y^2+z^2-4"));
