@@ -8,9 +8,6 @@
 namespace algray {
 namespace {
 
-// Enough for the longest logs: plain regula falsi's 1000 iterations after 52 levels of halving.
-constexpr cl_uint kProbeCapacity = 16384;
-
 std::vector<double> read_reals(ClSession& session, const cl::Buffer& buffer, std::size_t count, Precision precision) {
   std::vector<double> out(count);
   if (count == 0) return out;
@@ -92,7 +89,8 @@ std::vector<double> bernstein_to_power(const std::vector<double>& b, const std::
 }
 
 SolverTrace trace_probe(ClSession& session, ProgramCache& cache, const Scene& scene, std::size_t surface_index,
-                        KernelConfig config, const ProbeTarget& target) {
+                        KernelConfig config, const ProbeTarget& target, std::uint32_t capacity) {
+  const cl_uint log_capacity = std::max<std::uint32_t>(capacity, 1);
   config.entry = "probe";
   SolverTrace trace;
   trace.config = config;
@@ -104,8 +102,8 @@ SolverTrace trace_probe(ClSession& session, ProgramCache& cache, const Scene& sc
   cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, sizeof(HitRecord));
   const std::size_t real_size = config.precision == Precision::Double ? sizeof(double) : sizeof(float);
   cl::Buffer ray_out(ctx, CL_MEM_WRITE_ONLY, 8 * real_size);
-  cl::Buffer events(ctx, CL_MEM_WRITE_ONLY, kProbeCapacity * sizeof(ProbeEvent));
-  cl::Buffer values(ctx, CL_MEM_WRITE_ONLY, 4 * kProbeCapacity * real_size);
+  cl::Buffer events(ctx, CL_MEM_WRITE_ONLY, log_capacity * sizeof(ProbeEvent));
+  cl::Buffer values(ctx, CL_MEM_WRITE_ONLY, 4 * log_capacity * real_size);
   cl::Buffer count(ctx, CL_MEM_WRITE_ONLY, sizeof(cl_uint));
 
   // The same basis the primary pass builds for a render at the scene's size without antialiasing.
@@ -123,7 +121,7 @@ SolverTrace trace_probe(ClSession& session, ProgramCache& cache, const Scene& sc
   args.plain(ray_out);
   args.plain(events);
   args.plain(values);
-  args.plain(kProbeCapacity);
+  args.plain(log_capacity);
   args.plain(count);
   session.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(1), cl::NullRange);
   session.queue.finish();
@@ -133,7 +131,7 @@ SolverTrace trace_probe(ClSession& session, ProgramCache& cache, const Scene& sc
   trace.ray.origin = {ray[0], ray[1], ray[2]};
   trace.ray.direction = {ray[4], ray[5], ray[6]};
   session.queue.enqueueReadBuffer(count, CL_TRUE, 0, sizeof(cl_uint), &trace.events_offered);
-  trace.events_recorded = std::min<std::uint32_t>(trace.events_offered, kProbeCapacity);
+  trace.events_recorded = std::min<std::uint32_t>(trace.events_offered, log_capacity);
   std::vector<ProbeEvent> log(trace.events_recorded);
   if (!log.empty()) session.queue.enqueueReadBuffer(events, CL_TRUE, 0, log.size() * sizeof(ProbeEvent), log.data());
   decode_events(log, read_reals(session, values, 4 * log.size(), config.precision), trace);

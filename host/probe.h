@@ -72,8 +72,11 @@ struct SolverTrace {
 
 // Builds (or fetches) the probe program for `config` (its entry is replaced by "probe") and traces the ray
 // against surface `surface` of the scene. Image size and camera come from the scene, as in a render.
+// Events the log keeps by default: plain regula falsi's 1000 iterations after 52 levels of halving fit; a
+// longer log (the derivative chain at high degree) is cut, and events_offered says by how much.
+inline constexpr std::uint32_t kProbeLogCapacity = 16384;
 SolverTrace trace_probe(ClSession& session, ProgramCache& cache, const Scene& scene, std::size_t surface,
-                        KernelConfig config, const ProbeTarget& target);
+                        KernelConfig config, const ProbeTarget& target, std::uint32_t capacity = kProbeLogCapacity);
 
 // Bernstein coefficients b_k (of s in [0, 1]) in the power basis of s, in long double.
 std::vector<double> bernstein_to_power(const std::vector<double>& b, const std::vector<double>& b_lo);

@@ -140,6 +140,31 @@ TEST_CASE("the probe names the smallest root of the Fig. 8 torus ray and the iso
   }
 }
 
+TEST_CASE("a log too short for the ray keeps its first events and says how many it lost", "[probe]") {
+  ClSession& session = device_session();
+  const Scene scene = torus_scene();
+  ProbeTarget target;
+  target.given_ray = true;
+  target.origin = {-5, 0, kHeight};
+  target.direction = {1, 0, 0};
+  const KernelConfig config = primary_config(scene, Precision::Double);
+  const SolverTrace full = trace_probe(session, probe_cache(), scene, 0, config, target);
+  const SolverTrace cut = trace_probe(session, probe_cache(), scene, 0, config, target, 8);
+  REQUIRE(full.events_offered == full.events_recorded);
+  CHECK(cut.events_offered == full.events_offered);
+  CHECK(cut.events_recorded == 8);
+  // The first events are the same: the segment and the 5 coefficients, then the first steps.
+  CHECK(cut.t_in == full.t_in);
+  CHECK(cut.coefficients == full.coefficients);
+  CHECK(cut.steps.size() == 2);
+  CHECK(cut.iterates.empty());
+  // The hit record does not depend on the log.
+  CHECK(std::memcmp(&cut.hit, &full.hit, sizeof(HitRecord)) == 0);
+  std::ostringstream report;
+  print_probe(report, scene, target, {SurfaceProbe{0, {cut}, probe_reference(scene, 0, cut.ray, Precision::Double)}});
+  CHECK_THAT(report.str(), Catch::Contains("kept the first 8 of " + std::to_string(full.events_offered)));
+}
+
 TEST_CASE("a probed pixel gets the render's hit record bit for bit", "[probe]") {
   ClSession& session = device_session();
   struct Case {
