@@ -2,6 +2,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <sstream>
 
 #include "cli_sandbox.h"
@@ -320,6 +321,29 @@ TEST_CASE("render --aov adds the solver channels asked for and --heatmap draws t
   };
   CHECK(be32(16) >= 64);
   CHECK(be32(20) >= 48);
+
+  // A plane of multiplicity 3 seen square on: every root lands exactly on the midpoint of the segment, a
+  // subdivision point, so every hit is an exact zero (class 3). A double plane at z = 0.1 is mostly invisible
+  // (class 1); where rounding splits its double root into two real ones, it shows.
+  const auto classes_of = [&](const std::string& equation) {
+    write_text(box.in / "plane.toml", "[surface]\nequation = \"" + equation +
+                                          "\"\n[extent]\nradius = 1\n[camera]\nprojection = \"orthographic\"\n"
+                                          "eye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nheight = 2.5\n"
+                                          "[image]\nwidth = 32\nheight = 32\n");
+    REQUIRE(box.run("render " + quoted((box.in / "plane.toml").string()) + " -o plane.exr --aov classification")
+                .exit_code == 0);
+    const FrameImage image = read_exr(box.work / "plane.exr");  // kept: a loop over a temporary's member dangles
+    std::map<std::uint32_t, int> count;
+    for (std::uint32_t c : image.uint_channels.at(0).values) ++count[c];
+    return count;
+  };
+  const auto triple = classes_of("z^3");
+  CHECK(triple.count(0) == 1);
+  CHECK(triple.count(3) == 1);
+  CHECK(triple.size() == 2);  // outside the extent, or an exact zero
+  auto twice = classes_of("(z-0.1)^2");
+  CHECK(twice[1] > twice[2] + twice[3]);
+  CHECK(twice[1] > 400);
 
   // Without --aov there are no solver channels; an unknown name is bad input.
   REQUIRE(box.run("render " + scene + " -o plain.exr").exit_code == 0);
