@@ -55,15 +55,21 @@ double fig8_root(int i) {
   return xs[i] + 5.0;
 }
 
+// The Fig. 8 ray itself: along x at height kHeight, from x = -5.
+ProbeTarget fig8_ray() {
+  ProbeTarget target;
+  target.given_ray = true;
+  target.origin = {-5, 0, kHeight};
+  target.direction = {1, 0, 0};
+  return target;
+}
+
 }  // namespace
 
 TEST_CASE("the probe names the smallest root of the Fig. 8 torus ray and the isolation that found it", "[probe]") {
   ClSession& session = device_session();
   const Scene scene = torus_scene();
-  ProbeTarget target;
-  target.given_ray = true;
-  target.origin = {-5, 0, kHeight};
-  target.direction = {1, 0, 0};
+  const ProbeTarget target = fig8_ray();
   const double x1 = fig8_root(0), x2 = fig8_root(1);
 
   const ProbeReference ref = probe_reference(scene, 0, {target.origin, target.direction}, Precision::Double);
@@ -144,10 +150,7 @@ TEST_CASE("the probe names the smallest root of the Fig. 8 torus ray and the iso
 TEST_CASE("a log too short for the ray keeps its first events and says how many it lost", "[probe]") {
   ClSession& session = device_session();
   const Scene scene = torus_scene();
-  ProbeTarget target;
-  target.given_ray = true;
-  target.origin = {-5, 0, kHeight};
-  target.direction = {1, 0, 0};
+  const ProbeTarget target = fig8_ray();
   const KernelConfig config = primary_config(scene, Precision::Double);
   const SolverTrace full = trace_probe(session, probe_cache(), scene, 0, config, target);
   const SolverTrace cut = trace_probe(session, probe_cache(), scene, 0, config, target, 8);
