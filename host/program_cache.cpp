@@ -1,8 +1,11 @@
 // Program cache: in memory, then on disk (verified before use, rebuilt when stale or corrupt), then compiled.
 #include "program_cache.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
@@ -14,7 +17,11 @@
 namespace algray {
 namespace {
 
-constexpr char kMagic[] = "algray-program-binary-v1\n";
+// v2 added the payload's length and checksum to the header: v1 entries cut short by a full disk or a crash reached
+// cl::Program unchecked and crashed PoCL.
+constexpr char kMagic[] = "algray-program-binary-v2\n";
+// No device binary comes near this; a larger file is not ours, and reading it would only waste memory.
+constexpr std::uintmax_t kMaxEntryBytes = 512ull << 20;
 
 std::uint64_t fnv1a(const std::string& s) {
   std::uint64_t h = 1469598103934665603ull;
@@ -104,14 +111,9 @@ cl::Program ProgramCache::build_from_source(ClSession& session, const std::strin
 
 bool ProgramCache::load_from_disk(ClSession& session, const std::filesystem::path& file, const std::string& identity,
                                   const std::string& options, cl::Program& out) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return false;
-  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string header = kMagic + identity + "--\n";
-  // The stored identity must match exactly: a hash collision or an entry from another driver is never trusted.
-  if (content.size() <= header.size() || content.compare(0, header.size(), header) != 0) return false;
-  const cl::Program::Binaries binaries{
-      std::vector<unsigned char>(content.begin() + static_cast<std::ptrdiff_t>(header.size()), content.end())};
+  std::string payload;
+  if (!read_entry(file, identity, payload)) return false;
+  const cl::Program::Binaries binaries{std::vector<unsigned char>(payload.begin(), payload.end())};
   try {
     std::vector<cl_int> status;
     cl::Program program(session.context, {session.info.device}, binaries, &status);
@@ -120,8 +122,47 @@ bool ProgramCache::load_from_disk(ClSession& session, const std::filesystem::pat
     out = program;
     return true;
   } catch (const cl::Error&) {
-    return false;  // corrupt or stale: the caller rebuilds from source and overwrites it
+    return false;  // stale for this driver after all: the caller rebuilds from source and overwrites it
   }
+}
+
+std::string ProgramCache::entry_header(const std::string& identity, const std::string& payload) {
+  return kMagic + identity + "payload-bytes=" + std::to_string(payload.size()) +
+         "\npayload-fnv1a64=" + hex64(fnv1a(payload)) + "\n--\n";
+}
+
+bool ProgramCache::read_entry(const std::filesystem::path& file, const std::string& identity, std::string& payload) {
+  // Anything but a regular file of sane size under the entry's name (a directory, a FIFO, a huge file) is not an
+  // entry: reading a directory throws from inside the stream, and a FIFO would block.
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::symlink_status(file, ec);
+  if (ec || !std::filesystem::exists(status)) return false;
+  if (!std::filesystem::is_regular_file(status)) {
+    std::filesystem::remove(file, ec);  // an empty directory or a stray link goes; anything else stays, unused
+    return false;
+  }
+  const std::uintmax_t size = std::filesystem::file_size(file, ec);
+  if (ec || size > kMaxEntryBytes) return false;
+  std::string content;
+  try {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return false;
+    content.resize(static_cast<std::size_t>(size));
+    in.read(content.data(), static_cast<std::streamsize>(size));
+    if (static_cast<std::uintmax_t>(in.gcount()) != size) return false;
+  } catch (const std::exception&) {
+    return false;
+  }
+  // The header names the identity exactly (a hash collision or another driver's entry is never trusted) and the
+  // payload's length and checksum, so a truncated or damaged entry is caught before OpenCL sees a byte of it.
+  const std::string prefix = kMagic + identity + "payload-bytes=";
+  if (content.compare(0, prefix.size(), prefix) != 0) return false;
+  const std::size_t end = content.find("\n--\n", prefix.size());
+  if (end == std::string::npos || end > prefix.size() + 64) return false;
+  const std::size_t body = end + 4;
+  payload.assign(content, body, std::string::npos);
+  if (payload.empty()) return false;
+  return content.compare(0, body, entry_header(identity, payload)) == 0;
 }
 
 void ProgramCache::store_on_disk(const cl::Program& program, const std::filesystem::path& file,
@@ -131,19 +172,31 @@ void ProgramCache::store_on_disk(const cl::Program& program, const std::filesyst
     const auto binaries = program.getInfo<CL_PROGRAM_BINARIES>();
     if (binaries.empty() || binaries[0].empty()) return;
     std::filesystem::create_directories(dir_);
-    const std::filesystem::path tmp = file.string() + ".tmp-" + std::to_string(::getpid());
-    {
-      std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-      out << kMagic << identity << "--\n";
-      out.write(reinterpret_cast<const char*>(binaries[0].data()), static_cast<std::streamsize>(binaries[0].size()));
-      if (!out) {
-        std::filesystem::remove(tmp);
-        return;
-      }
-    }
-    std::filesystem::rename(tmp, file);
+    const std::string payload(binaries[0].begin(), binaries[0].end());
+    write_entry(file, entry_header(identity, payload) + payload);
   } catch (const std::exception&) {
   }
+}
+
+bool ProgramCache::write_entry(const std::filesystem::path& file, const std::string& content) {
+  // Written in full and fsync'd before the rename, so that no crash or power cut can leave a short entry under the
+  // final name; pid and counter keep concurrent writers (threads or processes) apart.
+  static std::atomic<unsigned> counter{0};
+  const std::string tmp = file.string() + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(++counter);
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return false;
+  bool ok = true;
+  for (std::size_t done = 0; ok && done < content.size();) {
+    const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    ok = n > 0;
+    if (ok) done += static_cast<std::size_t>(n);
+  }
+  ok = ok && ::fsync(fd) == 0;
+  ok = ::close(fd) == 0 && ok;
+  ok = ok && ::rename(tmp.c_str(), file.c_str()) == 0;
+  if (!ok) ::unlink(tmp.c_str());
+  return ok;
 }
 
 }  // namespace algray

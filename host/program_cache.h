@@ -41,6 +41,12 @@ class ProgramCache {
                       const std::string& options, cl::Program& out);
   void store_on_disk(const cl::Program& program, const std::filesystem::path& file, const std::string& identity);
 
+  // An entry on disk: a text header (magic, identity, payload length and checksum), then the device binary.
+  static std::string entry_header(const std::string& identity, const std::string& payload);
+  // The payload of a well-formed entry for `identity`; false for anything missing, foreign, short or damaged.
+  static bool read_entry(const std::filesystem::path& file, const std::string& identity, std::string& payload);
+  static bool write_entry(const std::filesystem::path& file, const std::string& content);
+
   bool enabled_;
   std::filesystem::path dir_;
   std::map<std::string, cl::Program> memory_;  // keyed by device identity + options + source hash
