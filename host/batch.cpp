@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <charconv>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -13,6 +14,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <system_error>
 
 #include "image_io.h"
 #include "render_job.h"
@@ -186,7 +188,11 @@ std::string shortest_text(double v) {
 }
 
 double sweep_value(const Sweep& s, int frame, int frames) {
-  return frames == 1 ? s.from : s.from + (s.to - s.from) * frame / (frames - 1);
+  if (frames == 1) return s.from;
+  const double t = static_cast<double>(frame) / (frames - 1);
+  // to - from overflows for ends near +-DBL_MAX; the weighted form stays between the ends.
+  const double span = s.to - s.from;
+  return std::isfinite(span) ? s.from + span * frame / (frames - 1) : s.from * (1 - t) + s.to * t;
 }
 
 double orbit_angle(const Orbit& o, int frame, int frames) { return o.degrees * frame / frames; }
@@ -206,16 +212,26 @@ bool file_exists(const std::string& path) {
 // one file written in place, not through a temporary: it grows while the batch runs, and --resume appends.
 class JsonLinesLog {
  public:
-  JsonLinesLog(const std::string& path, bool append) : out_(path, append ? std::ios::app : std::ios::trunc) {
+  // Failing to write a line (a full disk) stops the batch: later frames would fail alike, and --resume needs
+  // to know what was done.
+  struct WriteFailed : std::runtime_error {
+    using std::runtime_error::runtime_error;
+  };
+
+  JsonLinesLog(const std::string& path, bool append) : path_(path), out_(path, append ? std::ios::app : std::ios::trunc) {
     if (!out_) throw OutputError("cannot write the batch log " + path);
   }
   void write(const nlohmann::json& j) {
+    errno = 0;
     out_ << j.dump() << "\n";
     out_.flush();
-    if (!out_) throw OutputError("cannot write the batch log (disk full?)");
+    if (!out_)
+      throw WriteFailed("cannot write the batch log " + path_ + ": " +
+                        (errno ? std::error_code(errno, std::generic_category()).message() : "write failed"));
   }
 
  private:
+  std::string path_;
   std::ofstream out_;
 };
 
@@ -229,6 +245,7 @@ std::string seconds(double ms) {
 
 std::vector<BatchJob> load_jobs(const std::string& text, const std::string& source, const std::string& base_dir) {
   TomlReader r(source, text);
+  check_toml_shape(text, source);
   toml::table root;
   try {
     root = toml::parse(text, source);
@@ -325,15 +342,9 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
   try {
     std::string text, base_dir;
     if (req.jobs_path == "-") {
-      std::ostringstream s;
-      s << std::cin.rdbuf();
-      text = s.str();
+      text = read_input_stream(std::cin, "<stdin>", "jobs file");
     } else {
-      std::ifstream in(req.jobs_path, std::ios::binary);
-      if (!in) throw SceneError(req.jobs_path, "cannot read the jobs file");
-      std::ostringstream s;
-      s << in.rdbuf();
-      text = s.str();
+      text = read_input_file(req.jobs_path, "jobs file");
       base_dir = fs::path(req.jobs_path).parent_path().string();
     }
     jobs = load_jobs(text, req.jobs_path == "-" ? "<stdin>" : req.jobs_path, base_dir);
@@ -343,6 +354,18 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
                    : (fs::path(base_dir) / (fs::path(req.jobs_path).stem().string() + ".log.jsonl")).string();
     check_output_writable(log_path);
     if (req.stats_path) check_output_writable(*req.stats_path);
+    // No file the batch writes may be one it reads, or another it writes, by any name.
+    std::vector<RoleAndPath> inputs{{"jobs file", req.jobs_path}}, outputs{{"--log", log_path}};
+    if (req.stats_path) outputs.push_back({"--stats", *req.stats_path});
+    for (const BatchJob& job : jobs) {
+      inputs.push_back({"scene of job " + job.name, job.scene});
+      for (int frame = 0; frame < job.frames; ++frame) {
+        const std::string who = "job " + job.name + " frame " + std::to_string(frame);
+        for (const std::string& o : job.outputs) outputs.push_back({who + " output", expand_pattern(o, job, frame)});
+        if (job.stats) outputs.push_back({who + " stats", expand_pattern(*job.stats, job, frame)});
+      }
+    }
+    check_distinct_files(inputs, outputs);
   } catch (const std::exception& e) {
     return report_error(e, err);
   }
@@ -363,94 +386,101 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
   };
   int done = 0, ok = 0, failed = 0, skipped = 0;
   nlohmann::json summary_jobs = nlohmann::json::array();
-  for (const BatchJob& job : jobs) {
-    int job_ok = 0, job_failed = 0, job_skipped = 0;
-    std::vector<double> frame_ms;
-    bool warned = false;
-    for (int frame = 0; frame < job.frames; ++frame, ++done) {
-      const auto start = std::chrono::steady_clock::now();
-      nlohmann::json entry = {{"job", job.name}, {"frame", frame}, {"frames", job.frames}, {"scene", job.scene}};
-      std::vector<std::string> outputs;
-      try {
-        for (const std::string& o : job.outputs) outputs.push_back(expand_pattern(o, job, frame));
-        std::optional<std::string> stats;
-        if (job.stats) stats = expand_pattern(*job.stats, job, frame);
-        entry["outputs"] = outputs;
-        std::vector<Override> overrides = frame_overrides(job, frame);
-        overrides.insert(overrides.end(), req.overrides.begin(), req.overrides.end());
-        nlohmann::json set = nlohmann::json::object();
-        for (const Override& o : overrides) set[o.key] = o.value;
-        entry["set"] = set;
-        const bool complete =
-            std::all_of(outputs.begin(), outputs.end(), file_exists) && (!stats || file_exists(*stats));
-        if (req.resume && complete) {
-          entry["status"] = "skipped";
-          entry["reason"] = "--resume: every output exists";
+  try {
+    for (const BatchJob& job : jobs) {
+      int job_ok = 0, job_failed = 0, job_skipped = 0;
+      std::vector<double> frame_ms;
+      bool warned = false;
+      for (int frame = 0; frame < job.frames; ++frame, ++done) {
+        const auto start = std::chrono::steady_clock::now();
+        nlohmann::json entry = {{"job", job.name}, {"frame", frame}, {"frames", job.frames}, {"scene", job.scene}};
+        std::vector<std::string> outputs;
+        try {
+          for (const std::string& o : job.outputs) outputs.push_back(expand_pattern(o, job, frame));
+          std::optional<std::string> stats;
+          if (job.stats) stats = expand_pattern(*job.stats, job, frame);
+          entry["outputs"] = outputs;
+          std::vector<Override> overrides = frame_overrides(job, frame);
+          overrides.insert(overrides.end(), req.overrides.begin(), req.overrides.end());
+          nlohmann::json set = nlohmann::json::object();
+          for (const Override& o : overrides) set[o.key] = o.value;
+          entry["set"] = set;
+          const bool complete =
+              std::all_of(outputs.begin(), outputs.end(), file_exists) && (!stats || file_exists(*stats));
+          if (req.resume && complete) {
+            entry["status"] = "skipped";
+            entry["reason"] = "--resume: every output exists";
+            log.write(entry);
+            ++skipped;
+            ++job_skipped;
+            continue;
+          }
+          Scene scene = load_scene_file(job.scene, overrides);
+          if (!warned) {
+            print_warnings(scene, err, "job " + job.name + ": ");
+            warned = true;
+          }
+          if (job.orbit) {
+            apply_orbit(scene, *job.orbit, frame, job.frames);
+            entry["camera"] = {{"eye", {scene.camera.eye.x, scene.camera.eye.y, scene.camera.eye.z}},
+                               {"up", {scene.camera.up.x, scene.camera.up.y, scene.camera.up.z}},
+                               {"angle", orbit_angle(*job.orbit, frame, job.frames)}};
+          }
+          RenderRequest render;
+          render.outputs = outputs;
+          render.stats_path = stats;
+          check_outputs(scene, render);
+          entry["stats"] = render_scene(scene, render, context, start);
+          entry["status"] = "ok";
+          ++ok;
+          ++job_ok;
+        } catch (const DeviceError& e) {
+          // No frame can run without the device: stop here rather than fail every remaining frame alike.
+          err << "algray: " << e.what() << "\n";
+          entry["status"] = "failed";
+          entry["error"] = e.what();
           log.write(entry);
-          ++skipped;
-          ++job_skipped;
-          continue;
+          return kExitBadInput;
+        } catch (const std::exception& e) {
+          std::ostringstream message;
+          report_error(e, message);
+          err << "algray: job " << job.name << " frame " << frame << " failed:\n" << message.str();
+          entry["status"] = "failed";
+          entry["error"] = message.str();
+          ++failed;
+          ++job_failed;
         }
-        Scene scene = load_scene_file(job.scene, overrides);
-        if (!warned) {
-          print_warnings(scene, err, "job " + job.name + ": ");
-          warned = true;
-        }
-        if (job.orbit) {
-          apply_orbit(scene, *job.orbit, frame, job.frames);
-          entry["camera"] = {{"eye", {scene.camera.eye.x, scene.camera.eye.y, scene.camera.eye.z}},
-                             {"up", {scene.camera.up.x, scene.camera.up.y, scene.camera.up.z}},
-                             {"angle", orbit_angle(*job.orbit, frame, job.frames)}};
-        }
-        RenderRequest render;
-        render.outputs = outputs;
-        render.stats_path = stats;
-        check_outputs(scene, render);
-        entry["stats"] = render_scene(scene, render, context, start);
-        entry["status"] = "ok";
-        ++ok;
-        ++job_ok;
-      } catch (const DeviceError& e) {
-        // No frame can run without the device: stop here rather than fail every remaining frame alike.
-        err << "algray: " << e.what() << "\n";
-        entry["status"] = "failed";
-        entry["error"] = e.what();
+        const double ms = ms_since(start);
+        frame_ms.push_back(ms);
+        entry["ms"] = ms;
         log.write(entry);
-        return kExitBadInput;
-      } catch (const std::exception& e) {
-        std::ostringstream message;
-        report_error(e, message);
-        err << "algray: job " << job.name << " frame " << frame << " failed:\n" << message.str();
-        entry["status"] = "failed";
-        entry["error"] = message.str();
-        ++failed;
-        ++job_failed;
+        if (req.progress) {
+          const double elapsed = ms_since(batch_start);
+          const double eta = elapsed / (done + 1) * (total - done - 1);
+          std::fprintf(stderr, "\r[%*d/%d] %s frame %d/%d: %s %s | elapsed %s, eta %s   ",
+                       static_cast<int>(std::to_string(total).size()), done + 1, total, job.name.c_str(), frame + 1,
+                       job.frames, entry["status"].get<std::string>().c_str(), seconds(ms).c_str(),
+                       seconds(elapsed).c_str(), seconds(eta).c_str());
+          std::fflush(stderr);
+        }
       }
-      const double ms = ms_since(start);
-      frame_ms.push_back(ms);
-      entry["ms"] = ms;
-      log.write(entry);
-      if (req.progress) {
-        const double elapsed = ms_since(batch_start);
-        const double eta = elapsed / (done + 1) * (total - done - 1);
-        std::fprintf(stderr, "\r[%*d/%d] %s frame %d/%d: %s %s | elapsed %s, eta %s   ",
-                     static_cast<int>(std::to_string(total).size()), done + 1, total, job.name.c_str(), frame + 1,
-                     job.frames, entry["status"].get<std::string>().c_str(), seconds(ms).c_str(),
-                     seconds(elapsed).c_str(), seconds(eta).c_str());
-        std::fflush(stderr);
+      nlohmann::json j = {
+          {"name", job.name}, {"frames", job.frames}, {"ok", job_ok}, {"failed", job_failed}, {"skipped", job_skipped}};
+      if (!frame_ms.empty()) {
+        std::vector<double> sorted = frame_ms;
+        std::sort(sorted.begin(), sorted.end());
+        j["median_frame_ms"] = sorted[sorted.size() / 2];
+        double sum = 0;
+        for (double v : frame_ms) sum += v;
+        j["total_ms"] = sum;
       }
+      summary_jobs.push_back(j);
     }
-    nlohmann::json j = {
-        {"name", job.name}, {"frames", job.frames}, {"ok", job_ok}, {"failed", job_failed}, {"skipped", job_skipped}};
-    if (!frame_ms.empty()) {
-      std::vector<double> sorted = frame_ms;
-      std::sort(sorted.begin(), sorted.end());
-      j["median_frame_ms"] = sorted[sorted.size() / 2];
-      double sum = 0;
-      for (double v : frame_ms) sum += v;
-      j["total_ms"] = sum;
-    }
-    summary_jobs.push_back(j);
+  } catch (const JsonLinesLog::WriteFailed& e) {
+    if (req.progress) std::fprintf(stderr, "\n");
+    err << "algray: " << e.what() << "\nalgray: stopped after " << done << " of " << total << " frames (" << ok
+        << " rendered, " << failed << " failed); --resume continues where the images end\n";
+    return kExitFailure;
   }
   if (req.progress) std::fprintf(stderr, "\n");
   const nlohmann::json summary = {{"jobs_file", req.jobs_path},
@@ -462,7 +492,9 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
     try {
       write_text_file(*req.stats_path, summary.dump(2) + "\n");
     } catch (const std::exception& e) {
-      return report_error(e, err);
+      // After the frames: a failure to write, not bad input.
+      err << "algray: the frames are done, but the batch stats were not written: " << e.what() << "\n";
+      return kExitFailure;
     }
   }
   if (failed) err << "algray: " << failed << " of " << total << " frames failed (see " << log_path << ")\n";

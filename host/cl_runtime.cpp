@@ -55,6 +55,8 @@ std::vector<DeviceInfo> enumerate_devices() {
       info.type = type_name(d.getInfo<CL_DEVICE_TYPE>());
       info.compute_units = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
       info.fp64 = d.getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>() != 0;
+      info.global_mem_bytes = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+      info.max_alloc_bytes = d.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
       info.device = d;
       out.push_back(std::move(info));
     }

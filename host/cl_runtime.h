@@ -2,6 +2,7 @@
 #pragma once
 
 #include <CL/opencl.hpp>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -19,6 +20,8 @@ struct DeviceInfo {
   std::string type;  // "GPU", "CPU", "accelerator", ...
   unsigned compute_units = 0;
   bool fp64 = false;
+  std::uint64_t global_mem_bytes = 0;  // CL_DEVICE_GLOBAL_MEM_SIZE
+  std::uint64_t max_alloc_bytes = 0;   // CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest single buffer
   cl::Device device;
 };
 

@@ -1,9 +1,11 @@
 // Recursive-descent parser that expands an equation into an exact Polynomial.
 #include "expression.h"
 
+#include <algorithm>
 #include <cfloat>
 #include <climits>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -26,7 +28,6 @@ bool is_constant_function(std::string_view name) {
 }
 
 constexpr unsigned max_exponent = 1000;
-constexpr int max_power_degree = 1000;
 // Keeps hostile input such as 100000 nested parentheses from overflowing the stack.
 constexpr int max_nesting = 500;
 
@@ -186,10 +187,18 @@ mpq_class exact_rational_long(long double v) {
   return r;
 }
 
+// The largest coefficient's size in bits, numerator and denominator together: what an expansion's cost grows with.
+std::size_t coefficient_bits(const Polynomial& p) {
+  std::size_t bits = 0;
+  for (const auto& [exponents, c] : p.terms())
+    bits = std::max(bits, mpz_sizeinbase(c.get_num_mpz_t(), 2) + mpz_sizeinbase(c.get_den_mpz_t(), 2));
+  return bits;
+}
+
 class Parser {
  public:
-  Parser(std::string_view text, const std::map<std::string, double>& parameters)
-      : params_(parameters), tokens_(tokenize(text)) {}
+  Parser(std::string_view text, const std::map<std::string, double>& parameters, int max_degree)
+      : params_(parameters), tokens_(tokenize(text)), max_degree_(max_degree) {}
 
   Polynomial parse() {
     if (peek().kind == Tok::End) throw EquationError(0, "empty equation");
@@ -203,8 +212,41 @@ class Parser {
  private:
   const std::map<std::string, double>& params_;
   std::vector<Token> tokens_;
+  int max_degree_;
   std::size_t next_ = 0;
   int depth_ = 0;
+
+  // Checked before a product or power is expanded: its degree, the size its coefficients would reach (a
+  // product's coefficients are sums of products, hence the log2 of the number of terms), and the work of the
+  // expansion, terms x terms x bits, which bounds its time (about a second per 1e9 on this project's machines).
+  void check_growth(std::size_t pos, const char* what, long long degree, double bits, double work) const {
+    if (degree > max_degree_)
+      throw EquationError(pos, std::string("this ") + what + " would have degree " + std::to_string(degree) +
+                                   "; algray renders degrees up to " + std::to_string(max_degree_));
+    if (bits > static_cast<double>(kMaxCoefficientBits))
+      throw EquationError(pos, std::string("the coefficients of this ") + what + " would have about " +
+                                   std::to_string(static_cast<long long>(bits * 0.30103)) + " digits; at most " +
+                                   std::to_string(static_cast<long long>(kMaxCoefficientBits * 0.30103)) +
+                                   " are allowed");
+    if (work > kMaxExpansionWork) {
+      char text[160];
+      std::snprintf(text, sizeof text, "expanding this %s would take too long (about %.1e coefficient bit operations, "
+                                       "at most %.0e); simplify it or use fewer digits", what, work, kMaxExpansionWork);
+      throw EquationError(pos, text);
+    }
+  }
+  static constexpr double kMaxExpansionWork = 4e9;
+  static double terms(const Polynomial& p) { return static_cast<double>(p.terms().size()); }
+  // At most how many terms p^k has: no more than the monomials of its degree in x, y, z, nor than the multisets of
+  // k of p's terms.
+  static double power_terms_bound(const Polynomial& p, unsigned k) {
+    const double d = std::max(p.degree(), 0) * static_cast<double>(k);
+    const double dense = (d + 1) * (d + 2) * (d + 3) / 6;
+    double multisets = 1;  // C(n + k - 1, k), stopped once it passes the dense bound
+    for (unsigned i = 1; i <= k && multisets < dense; ++i) multisets = multisets * (terms(p) + i - 1) / i;
+    return std::min(dense, multisets);
+  }
+  static double log2_terms(const Polynomial& p) { return std::log2(static_cast<double>(p.terms().size()) + 1); }
 
   struct DepthGuard {
     int& depth;
@@ -260,8 +302,13 @@ class Parser {
   Polynomial term() {
     Polynomial lhs = unary();
     for (;;) {
-      if (accept(Tok::Star)) {
-        lhs = lhs * unary();
+      if (peek().kind == Tok::Star) {
+        const std::size_t pos = take().pos;
+        const Polynomial rhs = unary();
+        const double bits = static_cast<double>(coefficient_bits(lhs) + coefficient_bits(rhs));
+        check_growth(pos, "product", static_cast<long long>(lhs.degree()) + rhs.degree(),
+                     bits + std::min(log2_terms(lhs), log2_terms(rhs)), terms(lhs) * terms(rhs) * bits);
+        lhs = lhs * rhs;
       } else if (accept(Tok::Slash)) {
         const std::size_t pos = peek().pos;
         const std::optional<mpq_class> divisor = unary().constant_value();
@@ -287,10 +334,10 @@ class Parser {
     if (!accept(Tok::Caret)) return base;
     const std::size_t pos = peek().pos;
     const unsigned e = exponent(unary(), pos);
-    if (static_cast<long long>(base.degree()) * e > max_power_degree)
-      throw EquationError(pos, "this power would have degree " +
-                                   std::to_string(static_cast<long long>(base.degree()) * e) + ", more than " +
-                                   std::to_string(max_power_degree));
+    // Repeated squaring: the last product, of two halves, dominates the work.
+    const double bits = static_cast<double>(e) * (static_cast<double>(coefficient_bits(base)) + log2_terms(base));
+    const double half = power_terms_bound(base, e / 2);
+    check_growth(pos, "power", static_cast<long long>(base.degree()) * e, bits, e < 2 ? 0 : half * half * bits);
     return base.pow(e);
   }
 
@@ -409,11 +456,11 @@ bool is_reserved_name(std::string_view name) {
   return name == "x" || name == "y" || name == "z" || name == "sqrt" || is_constant_function(name);
 }
 
-Polynomial parse_equation(std::string_view text, const std::map<std::string, double>& parameters) {
+Polynomial parse_equation(std::string_view text, const std::map<std::string, double>& parameters, int max_degree) {
   for (const auto& [name, value] : parameters)
     if (is_reserved_name(name))
       throw EquationError(0, "a parameter may not be named '" + name + "': the name is reserved");
-  return Parser(text, parameters).parse();
+  return Parser(text, parameters, max_degree).parse();
 }
 
 }  // namespace algray

@@ -29,9 +29,13 @@ struct EquationError : std::runtime_error {
 //   power   := primary (('^' | '**') unary)?          right-associative; the exponent must be a
 //                                                     constant non-negative integer <= 1000
 //   primary := number | x | y | z | parameter | function '(' expr ')' | '(' expr ')'
-// Zero polynomials and degree limits are left to the caller, except that a single power may not
-// exceed degree 1000, so that a typo cannot make the expansion run for hours.
-Polynomial parse_equation(std::string_view text, const std::map<std::string, double>& parameters);
+// Zero polynomials are left to the caller. The degree is bounded while parsing: a power or product whose degree
+// would exceed `max_degree` is an error at its exponent or operator before anything is expanded, and so is one
+// whose coefficients would grow past kMaxCoefficientBits, so that no input makes the expansion run for minutes.
+inline constexpr int kDefaultMaxEquationDegree = 32;  // the kernels' limit; scene.cpp passes kMaxDegree itself
+inline constexpr std::size_t kMaxCoefficientBits = std::size_t{1} << 16;
+Polynomial parse_equation(std::string_view text, const std::map<std::string, double>& parameters,
+                          int max_degree = kDefaultMaxEquationDegree);
 
 // x, y, z and the function names: no parameter may be called so.
 bool is_reserved_name(std::string_view name);

@@ -1,6 +1,7 @@
 // The .jsurf importer: Java properties parsed with positions, checked, and written out as an algray scene.
 #include "jsurf.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -57,6 +58,13 @@ class Properties {
   }
   [[noreturn]] void fail_missing(const std::string& key, const std::string& message) const {
     throw SceneError(source_, key + ": " + message);
+  }
+  // Where the value of `p` starts, for the translated TOML's lines made from it.
+  JsurfOrigin origin(const Property& p, const std::string& key) const {
+    const Position at = p.positions.front();
+    const std::string caret = std::string(static_cast<std::size_t>(std::max(at.column - 1, 0)), ' ') + "^";
+    return {source_ + ":" + std::to_string(at.line) + ":" + std::to_string(at.column), key,
+            line_text(at.line) + "\n" + caret};
   }
   int line_of(const Property& p) const { return p.positions.front().line; }
   std::vector<std::string> unused() const {
@@ -259,7 +267,8 @@ bool looks_like_jsurf(const std::string& text) {
   return std::regex_search(text, key);
 }
 
-std::string jsurf_to_toml(const std::string& text, const std::string& source, std::vector<std::string>& warnings) {
+std::string jsurf_to_toml(const std::string& text, const std::string& source, std::vector<std::string>& warnings,
+                          std::map<int, JsurfOrigin>* origins) {
   const Properties props(text, source);
   const auto warn = [&](const std::string& message) { warnings.push_back(source + ": " + message); };
 
@@ -326,48 +335,68 @@ std::string jsurf_to_toml(const std::string& text, const std::string& source, st
     props.fail(*props.get("camera_fov_y"), "camera_fov_y", "must be between 0 and 180 degrees");
   if (!(height > 0)) props.fail(*props.get("camera_height"), "camera_height", "must be positive");
 
+  // Each TOML line that carries a value from the file records the property it came from, so that an error the
+  // scene reader finds in it (a radius of 1e308, say) points into the .jsurf, not into text the user never saw.
   std::ostringstream toml;
-  toml << "# Translated from " << source << " (SURFER/jsurf)\n\n[surface]\nname = "
-       << toml_quoted(source.substr(source.find_last_of('/') == std::string::npos ? 0 : source.find_last_of('/') + 1))
-       << "\nequation = " << toml_quoted(equation->value) << "\n";
+  int line = 1;
+  const auto emit = [&](const std::string& lines, std::initializer_list<std::string> keys = {}) {
+    for (const std::string& key : keys)
+      if (const Property* p = props.get(key); p && origins) {
+        (*origins)[line] = props.origin(*p, key);
+        break;
+      }
+    toml << lines;
+    line += static_cast<int>(std::count(lines.begin(), lines.end(), '\n'));
+  };
+  // The camera and everything placed in camera space depend on all three framing properties.
+  const std::initializer_list<std::string> framing = {"scale_factor", "rotation_matrix", "camera_transform"};
+  emit("# Translated from " + source + " (SURFER/jsurf)\n\n[surface]\nname = " +
+       toml_quoted(source.substr(source.find_last_of('/') == std::string::npos ? 0 : source.find_last_of('/') + 1)) +
+       "\n");
+  emit("equation = " + toml_quoted(equation->value) + "\n", {"surface_equation"});
   if (!parameters.empty()) {
-    toml << "\n[parameters]\n";
-    for (const auto& [name, value] : parameters) toml << name << " = " << toml_number(value) << "\n";
+    emit("\n[parameters]\n");
+    for (const auto& [name, value] : parameters)
+      emit(name + " = " + toml_number(value) + "\n", {"surface_parameter_" + name});
   }
-  toml << "\n[extent]  # jsurf's clip sphere: radius 1 in clip space\ntype = \"sphere\"\ncentre = [0.0, 0.0, 0.0]\n"
-       << "radius = " << toml_number(scale) << "\n";
-  toml << "\n[camera]\nprojection = \"" << projection << "\"\neye = " << toml_vector(eye)
-       << "\nlook_at = " << toml_vector(eye + forward) << "\nup = " << toml_vector(up) << "\n";
+  emit("\n[extent]  # jsurf's clip sphere: radius 1 in clip space\ntype = \"sphere\"\ncentre = [0.0, 0.0, 0.0]\n");
+  emit("radius = " + toml_number(scale) + "\n", {"scale_factor"});
+  emit("\n[camera]\nprojection = \"" + projection + "\"\n", {"camera_type"});
+  emit("eye = " + toml_vector(eye) + "\n", framing);
+  emit("look_at = " + toml_vector(eye + forward) + "\n", framing);
+  emit("up = " + toml_vector(up) + "\n", framing);
   if (projection == "perspective")
-    toml << "fov_y = " << toml_number(fov_y) << "\n";
+    emit("fov_y = " + toml_number(fov_y) + "\n", {"camera_fov_y"});
   else
-    toml << "height = " << toml_number(height * scale) << "\n";
+    emit("height = " + toml_number(height * scale) + "\n", {"camera_height", "scale_factor"});
 
   // jsurf renders square images, 512 pixels by default; a background is required by jsurf, white here.
-  toml << "\n[image]\nwidth = 512\nheight = 512\n";
+  emit("\n[image]\nwidth = 512\nheight = 512\n");
   const glm::dvec3 background = colour_or(props, "background_color", glm::dvec3(1));
-  toml << "background = " << toml_vector(background) << "\n";
+  emit("background = " + toml_vector(background) + "\n", {"background_color"});
   // jsurf's default quality: one ray per pixel, more where neighbouring colours differ.
-  toml << "\n[antialias]\nsamples = 2\nadaptive = true\nthreshold = 0.3\n";
+  emit("\n[antialias]\nsamples = 2\nadaptive = true\nthreshold = 0.3\n");
 
   // Materials. jsurf shades with Blinn's half vector, algray with Phong's mirror vector: a Blinn exponent of 4n
   // gives about the highlight of a Phong exponent n.
-  toml << "\n[material.front]\n";
   for (const char* side : {"front", "back"}) {
     const std::string prefix = std::string(side) + "_material_";
-    if (std::string(side) == "back") toml << "\n[material.back]\n";
+    emit("\n[material." + std::string(side) + "]\n");
     const glm::dvec3 colour = colour_or(props, prefix + "color", glm::dvec3(0.5));
     // 2011 files spell the key specular_iIntensity; the SURFER that wrote them meant the specular intensity.
     const double specular_typo = number_or(props, prefix + "specular_iIntensity", 0.9);
     const double specular = props.get(prefix + "specular_intensity")
                                 ? factor_or(props, prefix + "specular_intensity", 0.9, warnings)
                                 : std::clamp(specular_typo, 0.0, 1.0);
-    toml << "colour = " << toml_vector(colour) << "\n"
-         << "ambient = " << toml_number(factor_or(props, prefix + "ambient_intensity", 0.1, warnings)) << "\n"
-         << "diffuse = " << toml_number(factor_or(props, prefix + "diffuse_intensity", 0.23232, warnings)) << "\n"
-         << "specular = " << toml_number(specular) << "\n"
-         << "exponent = " << toml_number(std::clamp(number_or(props, prefix + "shininess", 1.0) / 4, 1.0, 10000.0))
-         << "\n";
+    emit("colour = " + toml_vector(colour) + "\n", {prefix + "color"});
+    emit("ambient = " + toml_number(factor_or(props, prefix + "ambient_intensity", 0.1, warnings)) + "\n",
+         {prefix + "ambient_intensity"});
+    emit("diffuse = " + toml_number(factor_or(props, prefix + "diffuse_intensity", 0.23232, warnings)) + "\n",
+         {prefix + "diffuse_intensity"});
+    emit("specular = " + toml_number(specular) + "\n", {prefix + "specular_intensity", prefix + "specular_iIntensity"});
+    emit("exponent = " + toml_number(std::clamp(number_or(props, prefix + "shininess", 1.0) / 4, 1.0, 10000.0)) +
+             "\n",
+         {prefix + "shininess"});
   }
 
   // Lights: camera-space points, so they keep their place relative to the viewer; no shadows in jsurf.
@@ -383,9 +412,11 @@ std::string jsurf_to_toml(const std::string& text, const std::string& source, st
     if (status->value != "ON") props.fail(*status, "light_status_" + i, "expected ON or OFF");
     if (intensity < 0) props.fail(*props.get("light_intensity_" + i), "light_intensity_" + i, "must not be negative");
     ++lights;
-    toml << "\n[[light]]  # light_" << n
-         << "\ntype = \"point\"\nposition = " << toml_vector(glm::dvec3(camera_to_world * glm::dvec4(position, 1)))
-         << "\ncolour = " << toml_vector(colour) << "\nintensity = " << toml_number(intensity) << "\nshadows = false\n";
+    emit("\n[[light]]  # light_" + i + "\ntype = \"point\"\n", {"light_status_" + i});
+    emit("position = " + toml_vector(glm::dvec3(camera_to_world * glm::dvec4(position, 1))) + "\n",
+         {"light_position_" + i, "scale_factor", "rotation_matrix", "camera_transform"});
+    emit("colour = " + toml_vector(colour) + "\n", {"light_color_" + i});
+    emit("intensity = " + toml_number(intensity) + "\nshadows = false\n", {"light_intensity_" + i});
   }
   if (lights == 0)
     warn("no light is ON: jsurf shows only the ambient term, algray lights the surface with a headlight");

@@ -231,7 +231,8 @@ int main(int argc, char** argv) {
     if (plot_range_text == "isolating") {
       req.plot_range.kind = PlotRange::Kind::Isolating;
     } else if (!plot_range_text.empty() && plot_range_text != "segment") {
-      if (!parse_numbers(plot_range_text, 2, v) || !(v[0] < v[1])) {
+      // The width must be finite too: the plot divides by it.
+      if (!parse_numbers(plot_range_text, 2, v) || !(v[0] < v[1]) || !std::isfinite(v[1] - v[0])) {
         std::cerr << "algray: --plot-range " << plot_range_text
                   << ": expected segment, isolating, or two increasing numbers T0,T1\n";
         return kExitBadInput;

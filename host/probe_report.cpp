@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <initializer_list>
 #include <sstream>
 
@@ -399,9 +400,26 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
       check_output_writable(*req.plot_path);
     }
     if (req.stats_path) check_output_writable(*req.stats_path);
+    std::vector<RoleAndPath> outputs;
+    if (req.stats_path) outputs.push_back({"--stats", *req.stats_path});
+    if (req.plot_path) outputs.push_back({"--plot", *req.plot_path});
+    check_distinct_files({{"scene file", req.scene_path.value_or("")}}, outputs);
   } catch (const std::exception& e) {
     return report_error(e, err);
   }
+  // Paths were checked above: a write that fails from here on is a failure (exit 1), not bad input.
+  std::vector<std::string> written;
+  const auto write_or_report = [&](const std::string& path, const std::function<void()>& write) {
+    try {
+      write();
+      written.push_back(path);
+    } catch (const std::exception& e) {
+      std::string done;
+      for (const std::string& w : written) done += (done.empty() ? "" : ", ") + w;
+      throw IncompleteOutputError(std::string(e.what()) + "\n  written: " + (done.empty() ? "nothing" : done) +
+                                  "\n  not written: " + path);
+    }
+  };
   try {
     RenderContext context(req.device_spec, req.use_cache);
     ClSession& session = context.session();
@@ -418,7 +436,8 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
     if (req.json || req.stats_path) {
       const nlohmann::json j = probe_json(scene, req.target, probes);
       if (req.json) out << j.dump(2) << "\n";
-      if (req.stats_path) write_text_file(*req.stats_path, j.dump(2) + "\n");
+      if (req.stats_path)
+        write_or_report(*req.stats_path, [&] { write_text_file(*req.stats_path, j.dump(2) + "\n"); });
     }
     if (!req.json) print_probe(out, scene, req.target, probes);
     if (req.plot_path) {
@@ -432,7 +451,8 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
         err << "algray: " << *req.plot_path << " not written: the ray misses the extent, so there is nothing to plot\n";
         return kExitFailure;
       }
-      write_probe_plot(*req.plot_path, make_plot(scene, req.target, *hit, req.plot_range));
+      const auto plot = make_plot(scene, req.target, *hit, req.plot_range);
+      write_or_report(*req.plot_path, [&] { write_probe_plot(*req.plot_path, plot); });
     }
   } catch (const std::exception& e) {
     return report_error(e, err);

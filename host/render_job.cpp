@@ -1,6 +1,7 @@
 // The render command: validates everything before any work, renders, then writes images and stats atomically.
 #include "render_job.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -8,8 +9,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -23,6 +26,12 @@
 
 namespace algray {
 namespace {
+
+std::string join(const std::vector<std::string>& parts, const std::string& separator) {
+  std::string out;
+  for (const std::string& p : parts) out += (out.empty() ? "" : separator) + p;
+  return out;
+}
 
 std::string vec_text(const glm::dvec3& v) {
   char buf[128];
@@ -188,6 +197,37 @@ void check_output_writable(const std::string& path) {
   if (::access(dir.c_str(), W_OK) != 0) throw OutputError(path + ": directory '" + dir.string() + "' is not writable");
 }
 
+namespace {
+
+// Two names of one file give one identity: its device and inode when it exists, else its normalised absolute path.
+std::string file_identity(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0)
+    return "inode " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+  std::error_code ec;
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(std::filesystem::absolute(path, ec), ec);
+  return "path " + (ec ? std::filesystem::path(path).lexically_normal().string() : canonical.string());
+}
+
+}  // namespace
+
+void check_distinct_files(const std::vector<RoleAndPath>& inputs, const std::vector<RoleAndPath>& outputs) {
+  // Each file's identity, and whether it is an input.
+  std::map<std::string, std::pair<const RoleAndPath*, bool>> seen;
+  for (const RoleAndPath& in : inputs)
+    if (!in.path.empty() && in.path != "-") seen.emplace(file_identity(in.path), std::make_pair(&in, true));
+  for (const RoleAndPath& out : outputs) {
+    const auto [it, fresh] = seen.emplace(file_identity(out.path), std::make_pair(&out, false));
+    if (fresh) continue;
+    const RoleAndPath& other = *it->second.first;
+    if (it->second.second)
+      throw OutputError(out.role + " " + out.path + " is the " + other.role + " " + other.path +
+                        ": writing it would destroy the input");
+    throw OutputError(out.role + " " + out.path + " and " + other.role + " " + other.path +
+                      " are the same file: give each output its own name");
+  }
+}
+
 RenderContext::RenderContext(std::string device_spec, bool use_cache)
     : device_spec_(std::move(device_spec)), use_cache_(use_cache) {}
 
@@ -210,10 +250,9 @@ Scene load_scene(const std::optional<std::string>& path, const std::vector<Overr
     static bool consumed = false;
     if (consumed) throw SceneError("<stdin>", "standard input was already read");
     consumed = true;
-    std::ostringstream text;
-    text << std::cin.rdbuf();
-    if (looks_like_jsurf(text.str())) return load_jsurf_text(text.str(), "<stdin>", overrides);
-    return load_scene_text(text.str(), "<stdin>", overrides);
+    const std::string text = read_input_stream(std::cin, "<stdin>", "scene file");
+    if (looks_like_jsurf(text)) return load_jsurf_text(text, "<stdin>", overrides);
+    return load_scene_text(text, "<stdin>", overrides);
   }
   return load_scene_file(*path, overrides);
 }
@@ -221,6 +260,19 @@ Scene load_scene(const std::optional<std::string>& path, const std::vector<Overr
 void print_warnings(const Scene& scene, std::ostream& err, const std::string& prefix) {
   for (const std::string& w : scene.warnings) err << "algray: warning: " << prefix << w << "\n";
 }
+
+namespace {
+
+// In the order render_scene writes them.
+std::vector<RoleAndPath> request_outputs(const RenderRequest& req) {
+  std::vector<RoleAndPath> out;
+  if (req.heatmap_path) out.push_back({"--heatmap", *req.heatmap_path});
+  for (const std::string& o : req.outputs) out.push_back({"output", o});
+  if (req.stats_path) out.push_back({"--stats", *req.stats_path});
+  return out;
+}
+
+}  // namespace
 
 void check_outputs(const Scene& scene, const RenderRequest& req) {
   if (req.reference && scene.surfaces.size() > 1)
@@ -235,6 +287,7 @@ void check_outputs(const Scene& scene, const RenderRequest& req) {
     format_from_extension(*req.heatmap_path);
     check_output_writable(*req.heatmap_path);
   }
+  check_distinct_files({{"scene file", req.scene_path.value_or("")}}, request_outputs(req));
 }
 
 nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, RenderContext& context,
@@ -264,21 +317,44 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
   }
   add_metadata(image, scene, result, device);
   timer.mark("shade");
+  // Every path was checked before rendering, so a write that fails now (a full disk) is a failure, not bad input:
+  // the message says which files were written and which were not.
+  std::vector<std::string> written;
+  const auto write_or_report = [&](const std::string& path, const std::function<void()>& write) {
+    try {
+      write();
+      written.push_back(path);
+    } catch (const std::exception& e) {
+      std::string unwritten;
+      bool after = false;
+      for (const RoleAndPath& o : request_outputs(req)) {
+        if (o.path == path) after = true;
+        else if (after) unwritten += (unwritten.empty() ? "" : ", ") + o.path;
+      }
+      std::string message = e.what();
+      message += "\n  written: " + (written.empty() ? std::string("nothing") : join(written, ", "));
+      message += "\n  not written: " + path + (unwritten.empty() ? "" : ", " + unwritten);
+      throw IncompleteOutputError(message);
+    }
+  };
   if (!req.aovs.empty() || req.heatmap_path) {
     const SolverWork work = solver_work(result);
     add_solver_aovs(image, work, req.aovs);
     if (req.heatmap_path) {
       const std::string per =
           work.samples > 1 ? " (sum over " + std::to_string(work.samples * work.samples) + " samples)" : "";
-      write_image(*req.heatmap_path, work_heatmap(work.width, work.height, work.total(), work.in_extent(),
-                                                  "isolation steps + refinement iterations per pixel" + per));
+      write_or_report(*req.heatmap_path, [&] {
+        write_image(*req.heatmap_path, work_heatmap(work.width, work.height, work.total(), work.in_extent(),
+                                                    "isolation steps + refinement iterations per pixel" + per));
+      });
     }
     timer.mark("diagnostics");
   }
-  for (const std::string& out : req.outputs) write_image(out, image);
+  for (const std::string& out : req.outputs) write_or_report(out, [&] { write_image(out, image); });
   timer.mark("write");
   nlohmann::json stats = stats_json(scene, req, result, device, timer);
-  if (req.stats_path) write_text_file(*req.stats_path, stats.dump(2) + "\n");
+  if (req.stats_path)
+    write_or_report(*req.stats_path, [&] { write_text_file(*req.stats_path, stats.dump(2) + "\n"); });
   return stats;
 }
 

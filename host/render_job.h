@@ -34,6 +34,22 @@ struct RenderRequest {
   std::optional<std::string> heatmap_path;  // --heatmap: solver work per pixel as a picture
 };
 
+// A file a command reads or writes, named by its role for messages: {"--stats", "s.json"}.
+struct RoleAndPath {
+  std::string role;
+  std::string path;
+};
+
+// Throws OutputError when an output is one of the inputs, or two outputs are one file, by any spelling (a/../b,
+// a hard or symbolic link): the run would destroy its own input or write one file twice.
+void check_distinct_files(const std::vector<RoleAndPath>& inputs, const std::vector<RoleAndPath>& outputs);
+
+// The render finished but not every file was written (a full disk, say): a failure (exit 1), not bad input. The
+// message names what was written and what was not.
+struct IncompleteOutputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 // Throws OutputError when `path` cannot be written (missing or unwritable directory, or a directory itself): bad
 // input, found before any work.
 void check_output_writable(const std::string& path);

@@ -2,6 +2,7 @@
 #include "render_plan.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <limits>
 
 #include "algray_shared.h"
@@ -145,7 +146,62 @@ nlohmann::json RenderPlan::json() const {
   for (const PlannedBuffer& b : buffers) j["buffers"].push_back({{"name", b.name}, {"bytes", b.bytes}});
   j["shadow_lights"] = shadow_lights;
   j["skipped"] = skipped;
+  j["estimated_memory_bytes"] = estimated_memory_bytes();
   return j;
+}
+
+std::uint64_t RenderPlan::buffer_bytes() const {
+  std::uint64_t sum = 0;
+  for (const PlannedBuffer& b : buffers) sum += b.bytes;
+  return sum;
+}
+
+std::uint64_t RenderPlan::estimated_memory_bytes() const {
+  constexpr std::uint64_t kBase = 128ull << 20;  // the process, the OpenCL runtime and its compiler
+  constexpr std::uint64_t kFilmBytesPerPixel = 64;  // colour, depth, normal, and the writers' half/8-bit copies
+  const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
+  return kBase + buffer_bytes() + buffer_bytes() / 4 + kFilmBytesPerPixel * pixels;
+}
+
+namespace {
+
+// MemAvailable from /proc/meminfo: what can be allocated without swapping; 0 when unknown.
+std::uint64_t available_host_memory() {
+  std::FILE* f = std::fopen("/proc/meminfo", "r");
+  if (!f) return 0;
+  char line[256];
+  unsigned long long kb = 0;
+  while (std::fgets(line, sizeof line, f))
+    if (std::sscanf(line, "MemAvailable: %llu kB", &kb) == 1) break;
+  std::fclose(f);
+  return static_cast<std::uint64_t>(kb) * 1024;
+}
+
+std::string gigabytes(std::uint64_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f GB", static_cast<double>(bytes) / 1e9);
+  return buf;
+}
+
+}  // namespace
+
+void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device) {
+  const std::string what = "a " + std::to_string(plan.width) + "x" + std::to_string(plan.height) + " render with " +
+                           std::to_string(plan.samples) + "x" + std::to_string(plan.samples) +
+                           " samples per pixel needs about ";
+  const std::string advice = ": render a smaller image or with fewer antialiasing samples";
+  const std::uint64_t need = plan.estimated_memory_bytes();
+  if (const std::uint64_t available = available_host_memory(); available && need > available)
+    throw DeviceError(what + gigabytes(need) + " of memory, and this machine has " + gigabytes(available) +
+                      " available" + advice);
+  if (device.type == "CPU") return;  // its buffers are in the memory counted above
+  if (device.global_mem_bytes && plan.buffer_bytes() > device.global_mem_bytes)
+    throw DeviceError(what + gigabytes(plan.buffer_bytes()) + " of device memory, and " + device.name + " has " +
+                      gigabytes(device.global_mem_bytes) + advice);
+  for (const PlannedBuffer& b : plan.buffers)
+    if (device.max_alloc_bytes && b.bytes > device.max_alloc_bytes)
+      throw DeviceError(what + "a buffer of " + gigabytes(b.bytes) + " (" + b.name + "), and " + device.name +
+                        " allocates at most " + gigabytes(device.max_alloc_bytes) + " at once" + advice);
 }
 
 }  // namespace algray

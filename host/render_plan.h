@@ -2,10 +2,12 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "cl_runtime.h"
 #include "kernel_config.h"
 #include "scene.h"
 
@@ -38,7 +40,18 @@ struct RenderPlan {
 
   const PlannedPass* find(const std::string& name) const;
   nlohmann::json json() const;
+
+  // The buffers together, and the peak memory of the whole render on the host: the buffers, their staging on
+  // the host, the film and the writers' copies. Calibrated on the Barth sextic in full mode with PoCL (256^2 to
+  // 1024^2: peak RSS about 80 MB + 0.9 x the buffers); kept on the generous side.
+  std::uint64_t buffer_bytes() const;
+  std::uint64_t estimated_memory_bytes() const;
 };
+
+// Throws DeviceError, naming the estimate, when the plan cannot fit: more than the machine's available memory,
+// or, on a device with its own memory, more than that memory or its largest allocation. Called before anything
+// is allocated, so that a 32768 x 32768 render with antialiasing is refused at once rather than killed later.
+void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device);
 
 // The passes and buffers `scene` calls for in `precision`. The primary pass is always there; the shadow pass
 // only when a light casts shadows and the scene is not a preview.

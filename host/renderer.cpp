@@ -127,6 +127,7 @@ RenderResult Renderer::render(const Scene& scene, bool show_progress) {
   RenderResult result;
   const Precision precision = resolve_precision(scene, session_.info);
   result.plan = make_render_plan(scene, precision);
+  check_plan_fits(result.plan, session_.info);
   result.config = primary_config(scene, precision);
   Passes passes{scene, precision, {}, result, std::vector<PassStats>(result.plan.passes.size()), {}, {}};
   for (std::size_t i = 0; i < scene.surfaces.size(); ++i)

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -60,7 +61,9 @@ bool is_index(const std::string& s) {
 }
 
 void apply_override(toml::table& root, const Override& o) {
-  const std::string label = (o.origin.empty() ? "--set " : o.origin + ": set ") + o.key + "=" + o.value;
+  // A hostile key or value may be megabytes long: messages show its start.
+  const auto shown = [](const std::string& t) { return t.size() <= 120 ? t : t.substr(0, 100) + "...(" + std::to_string(t.size()) + " characters)"; };
+  const std::string label = (o.origin.empty() ? "--set " : o.origin + ": set ") + shown(o.key) + "=" + shown(o.value);
   // A bare name is a parameter; any other key is a dotted path into the scene.
   const std::string key = o.key.find('.') == std::string::npos ? "parameters." + o.key : o.key;
   std::vector<std::string> parts;
@@ -70,9 +73,12 @@ void apply_override(toml::table& root, const Override& o) {
     if (dot == std::string::npos) break;
     start = dot + 1;
   }
+  if (parts.size() > kMaxTomlKeyParts)
+    throw SceneError(label, "the key has " + std::to_string(parts.size()) + " parts; at most " +
+                                std::to_string(kMaxTomlKeyParts) + " are allowed");
   const auto check_identifier = [&](const std::string& part) {
     if (!is_identifier(part))
-      throw SceneError(label, "'" + o.key + "' is not a dotted scene key such as camera.fov_y or light.0.intensity");
+      throw SceneError(label, "'" + shown(o.key) + "' is not a dotted scene key such as camera.fov_y or light.0.intensity");
   };
   // Walk down the existing tables. A list of tables ([[surface]], [[light]]) is reached by index, as in
   // light.0.intensity, and the override applies inside that one table: merging at the list would replace the
@@ -102,7 +108,7 @@ void apply_override(toml::table& root, const Override& o) {
                                   (list.size() == 1 ? "" : "s") + ", indexed from 0: there is no " + list_name + "." +
                                   parts[i + 1]);
     if (i + 2 == parts.size())
-      throw SceneError(label, "'" + o.key + "' names a whole [[" + list_name + "]] table; set one of its keys");
+      throw SceneError(label, "'" + shown(o.key) + "' names a whole [[" + list_name + "]] table; set one of its keys");
     target = at->as_array()->get(index)->as_table();
     i += 2;
   }
@@ -116,6 +122,11 @@ void apply_override(toml::table& root, const Override& o) {
   }
   // Parsed as the TOML line `key = value`, every node it creates carries the override as its source, so errors
   // name it. A value that is not TOML (render.precision=float) is taken as a string.
+  try {
+    check_toml_shape(rest + " = " + o.value, label);
+  } catch (const SceneError& e) {
+    throw SceneError(label, e.message);  // the line and column are of a line the user never wrote
+  }
   toml::table parsed;
   try {
     parsed = toml::parse(rest + " = " + o.value, label);
@@ -172,7 +183,7 @@ SceneSurface read_surface(const TomlReader& r, const toml::table& surface,
   if (equation) {
     out.equation = r.string(*equation, "surface.equation");
     try {
-      out.polynomial = parse_equation(out.equation, parameters);
+      out.polynomial = parse_equation(out.equation, parameters, kMaxDegree);
     } catch (const EquationError& e) {
       r.fail(equation->source(),
              std::string(e.what()) + " (at character " + std::to_string(e.position + 1) + " of the equation)",
@@ -226,7 +237,7 @@ Light read_light(const TomlReader& r, const toml::table& t) {
   }
   if (light.kind == LightKind::Disc) {
     if (!t.get("radius")) r.fail(t.source(), "a disc light needs a radius");
-    light.radius = r.number(*t.get("radius"), "light.radius");
+    light.radius = r.coordinate(*t.get("radius"), "light.radius");
     if (!(light.radius > 0)) r.fail(t.get("radius")->source(), "light.radius must be positive");
     if (const toml::node* n = t.get("normal")) {
       light.normal = r.vec3(*n, "light.normal");
@@ -241,7 +252,7 @@ Light read_light(const TomlReader& r, const toml::table& t) {
   }
   if (const toml::node* n = t.get("colour")) light.colour = glm::dvec3(r.colour(*n, "light.colour", false));
   if (const toml::node* n = t.get("intensity")) {
-    light.intensity = r.number(*n, "light.intensity");
+    light.intensity = r.coordinate(*n, "light.intensity");
     if (light.intensity < 0) r.fail(n->source(), "light.intensity must not be negative");
   }
   if (const toml::node* n = t.get("shadows")) light.shadows = r.boolean(*n, "light.shadows");
@@ -295,8 +306,10 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
     if (const toml::node* n = extent->get("centre")) scene.extent.centre = r.vec3(*n, "extent.centre");
     const toml::node* radius = extent->get("radius");
     if (!radius) r.fail(extent->source(), "a sphere extent needs a radius");
-    scene.extent.radius = r.number(*radius, "extent.radius");
+    scene.extent.radius = r.coordinate(*radius, "extent.radius");
     if (scene.extent.radius <= 0) r.fail(radius->source(), "the extent is empty: radius must be positive");
+    if (scene.extent.radius < 1 / kMaxCoordinate)
+      r.fail(radius->source(), "the extent is too small to render: its radius must be at least 1e-18");
   } else if (type == "box") {
     scene.extent.kind = ExtentKind::Box;
     for (const char* k : {"centre", "radius"})
@@ -310,6 +323,8 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
     for (int i = 0; i < 3; ++i)
       if (!(scene.extent.min[i] < scene.extent.max[i]))
         r.fail(mx->source(), std::string("the extent is empty: max.") + "xyz"[i] + " must exceed min." + "xyz"[i]);
+    if (scene.extent.unit_scale() < 1 / kMaxCoordinate)
+      r.fail(mx->source(), "the extent is too small to render: its half-diagonal must be at least 1e-18");
   } else {
     r.fail(extent->get("type")->source(), "extent.type must be \"sphere\" or \"box\"");
   }
@@ -346,7 +361,7 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
   if (const toml::node* n = camera->get("height")) {
     if (cam.projection != Projection::Orthographic)
       r.fail(n->source(), "camera.height applies to orthographic cameras");
-    cam.ortho_height = r.number(*n, "camera.height");
+    cam.ortho_height = r.coordinate(*n, "camera.height");
     if (!(cam.ortho_height > 0)) r.fail(n->source(), "degenerate camera: height must be positive");
   } else if (cam.projection == Projection::Orthographic) {
     r.fail(camera->source(), "an orthographic camera needs camera.height (the view height in world units)");
@@ -479,6 +494,7 @@ std::vector<glm::dvec3> Light::sample_points() const {
 
 Scene load_scene_text(const std::string& text, const std::string& source_name, const std::vector<Override>& overrides) {
   TomlReader reader(source_name, text);
+  check_toml_shape(text, source_name);
   toml::table root;
   try {
     root = toml::parse(text, source_name);
@@ -497,20 +513,61 @@ Scene load_scene_text(const std::string& text, const std::string& source_name, c
 
 Scene load_jsurf_text(const std::string& text, const std::string& source_name, const std::vector<Override>& overrides) {
   std::vector<std::string> warnings;
-  const std::string toml = jsurf_to_toml(text, source_name, warnings);
-  Scene scene = load_scene_text(toml, source_name + " (translated to TOML)", overrides);
+  std::map<int, JsurfOrigin> origins;
+  const std::string toml = jsurf_to_toml(text, source_name, warnings, &origins);
+  const std::string translated = source_name + " (translated to TOML)";
+  Scene scene;
+  try {
+    scene = load_scene_text(toml, translated, overrides);
+  } catch (const SceneError& e) {
+    // An override's error names the override; any other names a line of the translation, which the user never
+    // saw: point at the .jsurf property that line came from instead.
+    if (e.where.compare(0, translated.size(), translated) != 0) throw;
+    int line = 0;
+    if (e.where.size() > translated.size() + 1 && e.where[translated.size()] == ':')
+      line = std::atoi(e.where.c_str() + translated.size() + 1);
+    if (const auto it = origins.find(line); it != origins.end())
+      throw SceneError(it->second.where, it->second.key + ": " + e.message, it->second.excerpt);
+    throw SceneError(source_name, e.message);
+  }
   scene.source = source_name;
   scene.warnings = std::move(warnings);
   return scene;
 }
 
-Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides) {
+std::string read_input_stream(std::istream& in, const std::string& source, const std::string& what) {
+  std::string text;
+  char buf[65536];
+  while (in) {
+    in.read(buf, sizeof buf);
+    text.append(buf, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxInputBytes)
+      throw SceneError(source, "the " + what + " is larger than " + std::to_string(kMaxInputBytes >> 20) +
+                                   " MiB; " + what + "s are small text files");
+  }
+  if (in.bad()) throw SceneError(source, "cannot read the " + what);
+  return text;
+}
+
+std::string read_input_file(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw SceneError(path, "is a directory, not a " + what);
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path, "cannot read the scene file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (lowercase_extension(path) == ".jsurf") return load_jsurf_text(text.str(), path, overrides);
-  return load_scene_text(text.str(), path, overrides);
+  if (!in) {
+    const bool exists = std::filesystem::exists(path, ec);
+    throw SceneError(path, "cannot read the " + what + (exists ? "" : ": no such file"));
+  }
+  try {
+    return read_input_stream(in, path, what);
+  } catch (const std::ios_base::failure&) {
+    throw SceneError(path, "cannot read the " + what);
+  }
+}
+
+Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides) {
+  const std::string text = read_input_file(path, "scene file");
+  if (lowercase_extension(path) == ".jsurf") return load_jsurf_text(text, path, overrides);
+  return load_scene_text(text, path, overrides);
 }
 
 Scene default_scene(const std::vector<Override>& overrides) {

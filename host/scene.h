@@ -2,6 +2,7 @@
 #pragma once
 
 #include <glm/glm.hpp>
+#include <istream>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -153,5 +154,15 @@ Scene load_scene_text(const std::string& text, const std::string& source_name,
 Scene load_jsurf_text(const std::string& text, const std::string& source_name,
                       const std::vector<Override>& overrides = {});
 Scene default_scene(const std::vector<Override>& overrides = {});
+
+// Scenes and jobs files are small text; a larger input is refused after reading one byte past this, so that
+// `algray render /dev/zero` or a mistyped path to a video fails at once instead of filling the memory.
+inline constexpr std::size_t kMaxInputBytes = std::size_t{4} << 20;
+
+// The whole of a text input (`what`: "scene file", "jobs file"); SceneError naming `path` when it is missing, a
+// directory, unreadable or larger than kMaxInputBytes.
+std::string read_input_file(const std::string& path, const std::string& what);
+// The same from a stream such as standard input, named `source` in messages.
+std::string read_input_stream(std::istream& in, const std::string& source, const std::string& what);
 
 }  // namespace algray

@@ -22,6 +22,17 @@ std::string toml_number(double v);
 // A letter or _, then letters, digits or _: a bare TOML key segment, and a parameter name.
 bool is_identifier(const std::string& s);
 
+// Limits on the shape of TOML text that check_toml_shape enforces before toml++ sees it: its parser recurses per
+// key part and per nested value, and a hostile file must get an error, not a stack overflow.
+inline constexpr std::size_t kMaxTomlKeyParts = 32;
+// The largest scene coordinate or length, and (its inverse) the smallest extent: see TomlReader::coordinate.
+inline constexpr double kMaxCoordinate = 1e18;
+inline constexpr int kMaxTomlNesting = 64;
+
+// Throws SceneError at source:line:column when a dotted key has more than kMaxTomlKeyParts parts or arrays and
+// inline tables nest deeper than kMaxTomlNesting.
+void check_toml_shape(const std::string& text, const std::string& source);
+
 // Levenshtein distance, to suggest the key the user probably meant.
 std::size_t edit_distance(const std::string& a, const std::string& b);
 
@@ -100,10 +111,23 @@ class TomlReader {
     return *s;
   }
 
+  // A point or vector of the scene: each component within +-kMaxCoordinate.
   glm::dvec3 vec3(const toml::node& node, const std::string& what) const {
     const toml::array* a = node.as_array();
     if (!a || a->size() != 3) fail(node.source(), what + " must be an array of 3 numbers");
-    return {number(*a->get(0), what + "[0]"), number(*a->get(1), what + "[1]"), number(*a->get(2), what + "[2]")};
+    glm::dvec3 v;
+    for (int i = 0; i < 3; ++i)
+      v[i] = coordinate(*a->get(static_cast<std::size_t>(i)), what + "[" + std::to_string(i) + "]");
+    return v;
+  }
+
+  // A coordinate or length of the scene. Beyond kMaxCoordinate, squared lengths overflow float, and the rays, extent
+  // and lights would turn into inf and nan somewhere between here and the kernels.
+  double coordinate(const toml::node& node, const std::string& what) const {
+    const double v = number(node, what);
+    if (std::fabs(v) > kMaxCoordinate)
+      fail(node.source(), what + " is too large: scene coordinates and lengths must be within +-1e18");
+    return v;
   }
 
   glm::dvec4 colour(const toml::node& node, const std::string& what, bool allow_alpha) const {
