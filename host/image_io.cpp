@@ -1,4 +1,5 @@
-// EXR, PNG and text output through temp-file-and-rename, signal-time cleanup of temp files, and EXR read-back.
+// EXR, PNG and text output through temp-file-and-rename, signal-time and stale temp-file cleanup, and read-back of
+// EXR images and PNG text.
 #include "image_io.h"
 
 // OpenEXR/Imath headers trip -Wconversion/-Wshadow when not reached through -isystem.
@@ -19,6 +20,7 @@
 #include <half.h>
 #pragma GCC diagnostic pop
 #include <fcntl.h>
+#include <limits.h>
 #include <png.h>
 #include <signal.h>
 #include <unistd.h>
@@ -27,6 +29,7 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <csetjmp>
 #include <csignal>
@@ -39,6 +42,8 @@
 #include <set>
 #include <system_error>
 #include <thread>
+
+#include "version.h"
 
 namespace algray {
 namespace fs = std::filesystem;
@@ -73,16 +78,22 @@ extern "C" void cleanup_then_reraise(int sig) {
 
 std::string errno_text(int err) { return std::error_code(err, std::generic_category()).message(); }
 
+// ".NAME.tmp-": what every temporary for `destination` starts with, before "<pid>-<counter>".
+std::string temp_prefix(const fs::path& destination) {
+  std::string prefix = ".";
+  // Stay under NAME_MAX even for long destination names; uniqueness comes from pid and counter.
+  prefix.append(destination.filename().string(), 0, 200);
+  prefix += ".tmp-";
+  return prefix;
+}
+
 // Owns one temporary file for its lifetime: registered for signal cleanup before the file can
 // exist, removed on destruction unless it was committed by renaming.
 class TempFile {
  public:
   explicit TempFile(const fs::path& destination) {
-    std::string stem = destination.filename().string();
-    // Stay under NAME_MAX even for long destination names; uniqueness comes from pid and counter.
-    if (stem.size() > 200) stem.resize(200);
     path_ = destination.parent_path() /
-            ("." + stem + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(++g_temp_counter));
+            (temp_prefix(destination) + std::to_string(::getpid()) + "-" + std::to_string(++g_temp_counter));
     const std::string& text = path_.native();
     if (text.size() >= kPathCapacity) return;  // too long to register; a truncated path could unlink a stranger
     for (std::size_t i = 0; i < kSlotCount; ++i) {
@@ -108,7 +119,7 @@ class TempFile {
   const fs::path& path() const { return path_; }
 
   void commit(const fs::path& destination) {
-    if (::rename(path_.c_str(), destination.c_str()) != 0) throw OutputError("rename failed: " + errno_text(errno));
+    if (::rename(path_.c_str(), destination.c_str()) != 0) throw WriteError("rename failed: " + errno_text(errno));
     committed_ = true;
     release_slot();
   }
@@ -130,11 +141,11 @@ class TempFile {
 // file under the destination name.
 void sync_file(const fs::path& p) {
   const int fd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw OutputError("cannot reopen temporary file for fsync: " + errno_text(errno));
+  if (fd < 0) throw WriteError("cannot reopen temporary file for fsync: " + errno_text(errno));
   const int rc = ::fsync(fd);
   const int err = errno;
   ::close(fd);
-  if (rc != 0) throw OutputError("fsync failed: " + errno_text(err));
+  if (rc != 0) throw WriteError("fsync failed: " + errno_text(err));
 }
 
 // Best effort: makes the rename itself durable; failure here does not make the image wrong.
@@ -145,26 +156,61 @@ void sync_directory(const fs::path& dir) {
   ::close(fd);
 }
 
-void write_atomically(const fs::path& path, const std::function<void(const fs::path&)>& write_to) {
-  const std::string where = "cannot write '" + path.string() + "': ";
-  try {
-    std::error_code ec;
-    const fs::path destination = fs::absolute(path, ec);
-    if (ec) throw OutputError("cannot resolve path: " + ec.message());
-    if (!destination.has_filename()) throw OutputError("path names no file");
-    const fs::path dir = destination.parent_path();
-    const fs::file_status dir_status = fs::status(dir, ec);
-    if (!fs::exists(dir_status)) throw OutputError("directory '" + dir.string() + "' does not exist");
-    if (!fs::is_directory(dir_status)) throw OutputError("'" + dir.string() + "' is not a directory");
-    if (fs::is_directory(fs::status(destination, ec))) throw OutputError("destination is a directory");
+std::string cannot_write(const fs::path& path) { return "cannot write '" + path.string() + "': "; }
 
+// Whether `name` (a file name in some directory) is one of destination's temporaries: temp_prefix, then
+// "<pid>-<counter>" in decimal. Returns the pid, or 0 for any other name.
+pid_t temp_file_pid(const std::string& name, const std::string& prefix) {
+  if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) return 0;
+  const std::string rest = name.substr(prefix.size());
+  const std::size_t dash = rest.find('-');
+  if (dash == 0 || dash == std::string::npos || dash + 1 == rest.size()) return 0;
+  auto digits = [](const std::string& t) {
+    return std::all_of(t.begin(), t.end(), [](unsigned char c) { return c >= '0' && c <= '9'; });
+  };
+  const std::string pid_text = rest.substr(0, dash);
+  if (!digits(pid_text) || !digits(rest.substr(dash + 1)) || pid_text.size() > 9) return 0;
+  return static_cast<pid_t>(std::stol(pid_text));
+}
+
+// How long a dead pid's temporary must have been left alone before it is removed; see write_image's comment.
+constexpr auto kStaleTempAge = std::chrono::seconds(60);
+
+// Best effort: a temporary that cannot be listed, read or removed is left as it was.
+void remove_stale_temps(const fs::path& destination) {
+  const std::string prefix = temp_prefix(destination);
+  const pid_t self = ::getpid();
+  std::error_code ec;
+  fs::directory_iterator it(destination.parent_path(), ec);
+  for (const fs::directory_iterator end; !ec && it != end; it.increment(ec)) {
+    const pid_t pid = temp_file_pid(it->path().filename().string(), prefix);
+    // Our own pid: another thread of this process is writing it.
+    if (pid <= 0 || pid == self) continue;
+    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    std::error_code file_ec;
+    if (!it->is_regular_file(file_ec)) continue;
+    const auto modified = it->last_write_time(file_ec);
+    if (file_ec || fs::file_time_type::clock::now() - modified < kStaleTempAge) continue;
+    fs::remove(it->path(), file_ec);
+  }
+}
+
+void write_atomically(const fs::path& path, const std::function<void(const fs::path&)>& write_to) {
+  check_output_path(path);
+  const fs::path destination = fs::absolute(path);
+  remove_stale_temps(destination);
+  // What write_to throws as OutputError is the image's fault, found before the file is touched; anything
+  // else failed on the way to the disk.
+  try {
     TempFile temp(destination);
     write_to(temp.path());
     sync_file(temp.path());
     temp.commit(destination);
-    sync_directory(dir);
+    sync_directory(destination.parent_path());
+  } catch (const OutputError& e) {
+    throw OutputError(cannot_write(path) + e.what());
   } catch (const std::exception& e) {
-    throw OutputError(where + e.what());
+    throw WriteError(cannot_write(path) + e.what());
   }
 }
 
@@ -251,9 +297,18 @@ void encode_exr(const fs::path& file, const FrameImage& image) {
 
   if (image.world_to_camera) Imf::addWorldToCamera(header, to_m44(*image.world_to_camera));
   if (image.world_to_ndc) Imf::addWorldToNDC(header, to_m44(*image.world_to_ndc));
+  // The renderer's colours are linear Rec.709 (sRGB primaries) with a D65 white.
+  Imf::addChromaticities(header, Imf::Chromaticities(Imath::V2f(0.64f, 0.33f), Imath::V2f(0.30f, 0.60f),
+                                                     Imath::V2f(0.15f, 0.06f), Imath::V2f(0.3127f, 0.3290f)));
+  // OpenEXR 3.1 has no addSoftware(); this is the attribute newer versions define under that name.
+  header.insert("software", Imf::StringAttribute(image.software.empty() ? version_string() : image.software));
+  if (!image.comments.empty()) Imf::addComments(header, image.comments);
   // A clash would silently overwrite (same type) or throw deep inside OpenEXR (other type); refuse early.
   auto check_attribute_name = [&](const std::string& name) {
     if (name.empty()) throw OutputError("attribute with an empty name");
+    // Refused even when the field is empty, so that it is never written one way in one file and the other in the next.
+    if (name == "software" || name == "comments")
+      throw OutputError("attribute '" + name + "' comes from FrameImage::" + name + ", not from string_attributes");
     if (header.find(name) != header.end()) throw OutputError("attribute name '" + name + "' is already in use");
   };
   for (const auto& [name, value] : image.string_attributes) {
@@ -307,7 +362,7 @@ void png_ignore_warning(png_structp, png_const_charp) {}
 // libpng reports errors by longjmp, which must not cross objects with destructors; so this function
 // holds none and the caller owns every buffer.
 bool encode_png_stream(std::FILE* fp, png_uint_32 width, png_uint_32 height, int color_type, png_bytepp rows,
-                       PngErrorState* error) {
+                       png_textp text, int text_count, PngErrorState* error) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, error, png_error_to_state, png_ignore_warning);
   if (!png) return false;
   png_infop info = png_create_info_struct(png);
@@ -324,6 +379,8 @@ bool encode_png_stream(std::FILE* fp, png_uint_32 width, png_uint_32 height, int
                PNG_FILTER_TYPE_DEFAULT);
   // gAMA and cHRM alongside sRGB keep old decoders that ignore sRGB close to correct.
   png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+  // Before the image data, so that a reader wanting only the text can stop early.
+  png_set_text(png, info, text, text_count);
   png_write_info(png, info);
   png_write_image(png, rows);
   png_write_end(png, info);
@@ -335,14 +392,107 @@ bool encode_png_stream(std::FILE* fp, png_uint_32 width, png_uint_32 height, int
 // write: buffered data can still fail to reach the file there (e.g. disk full).
 void write_with_stdio(const fs::path& file, const std::function<void(std::FILE*)>& write) {
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> fp(std::fopen(file.c_str(), "wb"), &std::fclose);
-  if (!fp) throw OutputError("cannot create temporary file: " + errno_text(errno));
+  if (!fp) throw WriteError("cannot create temporary file: " + errno_text(errno));
   write(fp.get());
-  if (std::fflush(fp.get()) != 0) throw OutputError("write failed: " + errno_text(errno));
-  if (std::fclose(fp.release()) != 0) throw OutputError("close failed: " + errno_text(errno));
+  if (std::fflush(fp.get()) != 0) throw WriteError("write failed: " + errno_text(errno));
+  if (std::fclose(fp.release()) != 0) throw WriteError("close failed: " + errno_text(errno));
+}
+
+// PNG keywords are Latin-1; keeping to printable ASCII spares every reader the question of encoding.
+void check_png_key(const std::string& key) {
+  const bool printable = std::all_of(key.begin(), key.end(), [](unsigned char c) { return c >= 32 && c <= 126; });
+  if (key.empty() || key.size() > 79 || !printable || key.front() == ' ' || key.back() == ' ' ||
+      key.find("  ") != std::string::npos)
+    throw OutputError("PNG text key '" + key +
+                      "' is not 1 to 79 printable ASCII characters without leading, trailing or double spaces");
+}
+
+bool is_ascii(const std::string& s) {
+  return std::all_of(s.begin(), s.end(), [](unsigned char c) { return c < 128; });
+}
+
+bool is_utf8(const std::string& s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    std::size_t extra = 0;
+    std::uint32_t code = 0, min = 0;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    } else if ((c & 0xE0) == 0xC0) {
+      extra = 1, code = c & 0x1Fu, min = 0x80;
+    } else if ((c & 0xF0) == 0xE0) {
+      extra = 2, code = c & 0x0Fu, min = 0x800;
+    } else if ((c & 0xF8) == 0xF0) {
+      extra = 3, code = c & 0x07u, min = 0x10000;
+    } else {
+      return false;
+    }
+    if (s.size() - i <= extra) return false;
+    for (std::size_t k = 1; k <= extra; ++k) {
+      const auto cc = static_cast<unsigned char>(s[i + k]);
+      if ((cc & 0xC0) != 0x80) return false;
+      code = (code << 6) | (cc & 0x3Fu);
+    }
+    // Overlong forms, surrogates and values past U+10FFFF are not UTF-8.
+    if (code < min || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return false;
+    i += extra + 1;
+  }
+  return true;
+}
+
+void check_png_value(const std::string& key, const std::string& value) {
+  if (value.find('\0') != std::string::npos) throw OutputError("PNG text '" + key + "' contains a NUL byte");
+  if (!is_utf8(value)) throw OutputError("PNG text '" + key + "' is not valid UTF-8");
+  if (value.size() > kMaxPngTextBytes)
+    throw OutputError("PNG text '" + key + "' is " + std::to_string(value.size()) + " bytes; at most " +
+                      std::to_string(kMaxPngTextBytes) + " are written");
+}
+
+// Software, Comment and png_text in order, checked; throws OutputError before any file exists.
+std::vector<std::pair<std::string, std::string>> png_text_entries(const FrameImage& image) {
+  std::vector<std::pair<std::string, std::string>> entries;
+  entries.emplace_back("Software", image.software.empty() ? version_string() : image.software);
+  if (!image.comments.empty()) entries.emplace_back("Comment", image.comments);
+  std::set<std::string> used = {"Software", "Comment"};
+  for (const auto& [key, value] : image.png_text) {
+    check_png_key(key);
+    if (key == "Software" || key == "Comment")
+      throw OutputError("PNG text '" + key + "' comes from FrameImage::" + (key == "Software" ? "software" : "comments") +
+                        ", not from png_text");
+    if (!used.insert(key).second) throw OutputError("PNG text key '" + key + "' is given twice");
+    entries.emplace_back(key, value);
+  }
+  for (const auto& [key, value] : entries) check_png_value(key, value);
+  return entries;
+}
+
+// Points into `entries`, which must outlive the result; png_set_text copies, never writes through them.
+std::vector<png_text> png_text_chunks(const std::vector<std::pair<std::string, std::string>>& entries) {
+  // Compressing a few hundred bytes gains nothing; a scene of a few KB shrinks to a third.
+  constexpr std::size_t kCompressAbove = 1024;
+  std::vector<png_text> chunks(entries.size());
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const auto& [key, value] = entries[i];
+    png_text& t = chunks[i];
+    t.key = const_cast<png_charp>(key.c_str());
+    t.text = const_cast<png_charp>(value.c_str());
+    t.text_length = value.size();
+    t.lang = nullptr;
+    t.lang_key = nullptr;
+    if (is_ascii(value) && value.size() <= kCompressAbove)
+      t.compression = PNG_TEXT_COMPRESSION_NONE;  // tEXt: ASCII is Latin-1 too
+    else
+      t.compression = value.size() > kCompressAbove ? PNG_ITXT_COMPRESSION_zTXt : PNG_ITXT_COMPRESSION_NONE;
+  }
+  return chunks;
 }
 
 void encode_png(const fs::path& file, const FrameImage& image) {
   const std::size_t n = checked_pixel_count(image);
+  const std::vector<std::pair<std::string, std::string>> entries = png_text_entries(image);
+  std::vector<png_text> text = png_text_chunks(entries);
   bool opaque = true;
   for (std::size_t i = 0; i < n && opaque; ++i) opaque = encode_alpha(image.rgba[4 * i + 3]) == 255;
   const std::size_t channels = opaque ? 3 : 4;
@@ -359,8 +509,9 @@ void encode_png(const fs::path& file, const FrameImage& image) {
   write_with_stdio(file, [&](std::FILE* fp) {
     PngErrorState error;
     if (!encode_png_stream(fp, static_cast<png_uint_32>(image.width), static_cast<png_uint_32>(image.height),
-                           opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA, rows.data(), &error)) {
-      throw OutputError(std::string("libpng: ") + error.message);
+                           opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA, rows.data(), text.data(),
+                           static_cast<int>(text.size()), &error)) {
+      throw WriteError(std::string("libpng: ") + error.message);
     }
   });
 }
@@ -368,8 +519,63 @@ void encode_png(const fs::path& file, const FrameImage& image) {
 void encode_text(const fs::path& file, const std::string& text) {
   write_with_stdio(file, [&](std::FILE* fp) {
     if (std::fwrite(text.data(), 1, text.size(), fp) != text.size())
-      throw OutputError("write failed: " + errno_text(errno));
+      throw WriteError("write failed: " + errno_text(errno));
   });
+}
+
+// PNG reading: two steps, each a function holding nothing with a destructor, because libpng errors arrive by
+// longjmp; the caller owns the structs, the file and the row buffer.
+
+constexpr png_byte kPngSignature[8] = {137, 80, 78, 71, 13, 10, 26, 10};
+
+// libpng's own reader says only "Read Error" for a file that ends early.
+void png_read_from_file(png_structp png, png_bytep data, std::size_t length) {
+  auto* fp = static_cast<std::FILE*>(png_get_io_ptr(png));
+  if (std::fread(data, 1, length, fp) == length) return;
+  png_error(png, std::feof(fp) ? "the file ends early (truncated)" : "read failed");
+}
+
+bool png_read_head(png_structp png, png_infop info, std::FILE* fp, int* passes) {
+  if (setjmp(png_jmpbuf(png))) return false;
+  png_set_read_fn(png, fp, png_read_from_file);
+  png_set_sig_bytes(png, sizeof kPngSignature);
+  // A damaged text chunk is an error rather than silently dropped: it may be the scene the caller wants.
+  png_set_benign_errors(png, 0);
+  png_set_crc_action(png, PNG_CRC_ERROR_QUIT, PNG_CRC_ERROR_QUIT);
+  png_set_chunk_malloc_max(png, kMaxPngTextBytes + 4096);  // the key and chunk header besides the text
+  // Every ancillary chunk but the text is skipped unread, so that an odd colour profile cannot fail the read.
+  png_set_keep_unknown_chunks(png, PNG_HANDLE_CHUNK_NEVER, nullptr, -1);
+  static constexpr png_byte text_chunks[] = "tEXt\0zTXt\0iTXt";
+  png_set_keep_unknown_chunks(png, PNG_HANDLE_CHUNK_AS_DEFAULT, text_chunks, 3);
+  png_read_info(png, info);
+  *passes = png_set_interlace_handling(png);
+  png_read_update_info(png, info);
+  return true;
+}
+
+// Decodes the rows one at a time into `row` (the text after the image data comes only after them), then
+// reads to IEND.
+bool png_read_rest(png_structp png, png_infop info, png_bytep row, int passes) {
+  if (setjmp(png_jmpbuf(png))) return false;
+  const png_uint_32 height = png_get_image_height(png, info);
+  for (int pass = 0; pass < passes; ++pass)
+    for (png_uint_32 y = 0; y < height; ++y) png_read_row(png, row, nullptr);
+  png_read_end(png, info);
+  return true;
+}
+
+std::string latin1_to_utf8(const char* text) {
+  std::string out;
+  for (const char* p = text; *p; ++p) {
+    const auto c = static_cast<unsigned char>(*p);
+    if (c < 0x80) {
+      out += static_cast<char>(c);
+    } else {
+      out += static_cast<char>(0xC0 | (c >> 6));
+      out += static_cast<char>(0x80 | (c & 0x3F));
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -392,6 +598,34 @@ ImageFormat format_from_extension(const fs::path& p) {
   if (ext == ".png") return ImageFormat::Png;
   throw OutputError("unsupported output extension '" + p.extension().string() + "' in '" + p.string() +
                     "'; use .exr or .png");
+}
+
+void check_output_path(const fs::path& path) {
+  const std::string where = cannot_write(path);
+  if (!path.has_filename()) throw OutputError(where + "the path names no file");
+  // The directory as the user wrote it reads better in a message than its absolute form.
+  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  std::error_code ec;
+  const fs::file_status dir_status = fs::status(dir, ec);
+  if (dir_status.type() == fs::file_type::not_found)
+    throw OutputError(where + "directory '" + dir.string() + "' does not exist");
+  if (ec) throw OutputError(where + "cannot examine directory '" + dir.string() + "': " + ec.message());
+  if (!fs::is_directory(dir_status)) throw OutputError(where + "'" + dir.string() + "' is not a directory");
+  // Also catches a read-only file system (EROFS), even for root.
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw OutputError(where + "directory '" + dir.string() + "' is not writable: " + errno_text(errno));
+  if (fs::is_directory(fs::status(path, ec))) throw OutputError(where + "it is a directory");
+
+  const std::size_t name_length = path.filename().native().size();
+  const long name_max = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  if (name_max > 0 && name_length > static_cast<std::size_t>(name_max))
+    throw OutputError(where + "the file name is " + std::to_string(name_length) + " bytes long; the file system of '" +
+                      dir.string() + "' allows at most " + std::to_string(name_max));
+  const fs::path absolute = fs::absolute(path, ec);
+  if (ec) throw OutputError(where + "cannot resolve the path: " + ec.message());
+  if (absolute.native().size() >= PATH_MAX)
+    throw OutputError(where + "the path is " + std::to_string(absolute.native().size()) +
+                      " bytes long; the system allows at most " + std::to_string(PATH_MAX - 1));
 }
 
 void write_image(const fs::path& path, const FrameImage& image) {
@@ -492,18 +726,75 @@ FrameImage read_exr(const fs::path& path) {
     in.readPixels(window.min.y, window.max.y);
 
     for (auto it = header.begin(); it != header.end(); ++it) {
+      const std::string name = it.name();
       if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) {
-        image.string_attributes.emplace_back(it.name(), s->value());
+        if (name == "software")
+          image.software = s->value();
+        else if (name == "comments")
+          image.comments = s->value();
+        else
+          image.string_attributes.emplace_back(name, s->value());
       } else if (const auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&it.attribute())) {
         image.double_attributes.emplace_back(it.name(), d->value());
       }
     }
     if (Imf::hasWorldToCamera(header)) image.world_to_camera = from_m44(Imf::worldToCamera(header));
     if (Imf::hasWorldToNDC(header)) image.world_to_ndc = from_m44(Imf::worldToNDC(header));
+    if (Imf::hasChromaticities(header)) {
+      const Imf::Chromaticities& c = Imf::chromaticities(header);
+      image.chromaticities = std::array<float, 8>{c.red.x,  c.red.y,  c.green.x, c.green.y,
+                                                  c.blue.x, c.blue.y, c.white.x, c.white.y};
+    }
     return image;
   } catch (const std::exception& e) {
     throw OutputError("cannot read '" + path.string() + "': " + e.what());
   }
+}
+
+bool is_png_file(const fs::path& path) {
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> fp(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!fp) return false;
+  png_byte head[sizeof kPngSignature];
+  return std::fread(head, 1, sizeof head, fp.get()) == sizeof head && std::memcmp(head, kPngSignature, sizeof head) == 0;
+}
+
+std::vector<std::pair<std::string, std::string>> read_png_text(const fs::path& path) {
+  const std::string where = "cannot read '" + path.string() + "'";
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> fp(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!fp) throw OutputError(where + ": " + errno_text(errno));
+  png_byte head[sizeof kPngSignature];
+  if (std::fread(head, 1, sizeof head, fp.get()) != sizeof head || std::memcmp(head, kPngSignature, sizeof head) != 0)
+    throw OutputError(where + ": not a PNG file (no PNG signature)");
+
+  struct Reader {
+    png_structp png = nullptr;
+    png_infop info = nullptr;
+    ~Reader() { png_destroy_read_struct(&png, info ? &info : nullptr, nullptr); }
+  } reader;
+  PngErrorState error;
+  reader.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &error, png_error_to_state, png_ignore_warning);
+  if (reader.png) reader.info = png_create_info_struct(reader.png);
+  if (!reader.png || !reader.info) throw OutputError(where + ": out of memory for libpng");
+
+  int passes = 1;
+  if (!png_read_head(reader.png, reader.info, fp.get(), &passes)) throw OutputError(where + " as PNG: " + error.message);
+  std::vector<png_byte> row(png_get_rowbytes(reader.png, reader.info));
+  if (!png_read_rest(reader.png, reader.info, row.data(), passes))
+    throw OutputError(where + " as PNG: " + error.message);
+
+  png_textp text = nullptr;
+  const int count = png_get_text(reader.png, reader.info, &text, nullptr);
+  std::vector<std::pair<std::string, std::string>> out;
+  for (int i = 0; i < count; ++i) {
+    const png_text& t = text[i];
+    const bool utf8 = t.compression == PNG_ITXT_COMPRESSION_NONE || t.compression == PNG_ITXT_COMPRESSION_zTXt;
+    std::string value = t.text ? (utf8 ? std::string(t.text) : latin1_to_utf8(t.text)) : std::string();
+    if (value.size() > kMaxPngTextBytes)
+      throw OutputError(where + ": PNG text '" + std::string(t.key) + "' is longer than " +
+                        std::to_string(kMaxPngTextBytes) + " bytes");
+    out.emplace_back(latin1_to_utf8(t.key), std::move(value));
+  }
+  return out;
 }
 
 }  // namespace algray

@@ -1,7 +1,9 @@
-// Tests for EXR/PNG output: round trips, sRGB encoding, atomic replacement and cleanup after signals.
+// Tests for EXR/PNG output: round trips, header and text metadata, sRGB encoding, atomic replacement, the kinds
+// of failure, and cleanup after signals and of stale temporaries.
 #include "image_io.h"
 #include "noisy_image.h"
 #include "temp_dir.h"
+#include "version.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wconversion"
@@ -9,32 +11,42 @@
 #include <ImfChannelList.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
+#include <ImfStandardAttributes.h>
+#include <ImfStringAttribute.h>
 #include <half.h>
 #pragma GCC diagnostic pop
 #include <png.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <catch2/catch.hpp>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csetjmp>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <limits>
 #include <optional>
 #include <random>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace fs = std::filesystem;
 using algray::FrameImage;
 using algray::OutputError;
+using algray::WriteError;
 
 namespace {
 
@@ -194,6 +206,144 @@ std::optional<int> wait_child(pid_t child) {
   return status;
 }
 
+
+// PNG chunk surgery for the reader tests: a file as its chunks, and back with correct CRCs.
+struct PngChunk {
+  std::string type, data;
+};
+
+std::uint32_t png_crc(const std::string& bytes) {
+  std::uint32_t crc = 0xFFFFFFFFu;
+  for (unsigned char b : bytes) {
+    crc ^= b;
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+std::string be32(std::uint32_t v) {
+  return {static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8), static_cast<char>(v)};
+}
+
+std::vector<PngChunk> split_png(const std::string& file) {
+  std::vector<PngChunk> chunks;
+  std::size_t at = 8;
+  while (at + 12 <= file.size()) {
+    const auto byte = [&](std::size_t i) { return static_cast<std::uint32_t>(static_cast<unsigned char>(file[i])); };
+    const std::uint32_t length = byte(at) << 24 | byte(at + 1) << 16 | byte(at + 2) << 8 | byte(at + 3);
+    chunks.push_back({file.substr(at + 4, 4), file.substr(at + 8, length)});
+    at += 12 + length;
+  }
+  return chunks;
+}
+
+std::string join_png(const std::vector<PngChunk>& chunks) {
+  std::string file = "\x89PNG\r\n\x1a\n";
+  for (const PngChunk& c : chunks) {
+    file += be32(static_cast<std::uint32_t>(c.data.size())) + c.type + c.data;
+    file += be32(png_crc(c.type + c.data));
+  }
+  return file;
+}
+
+// `chunk` inserted just before IEND, i.e. after the image data.
+std::string with_chunk_at_end(const std::string& png, const PngChunk& chunk) {
+  std::vector<PngChunk> chunks = split_png(png);
+  REQUIRE(!chunks.empty());
+  REQUIRE(chunks.back().type == "IEND");
+  chunks.insert(chunks.end() - 1, chunk);
+  return join_png(chunks);
+}
+
+// A scene as it will be embedded: several KB, with quotes, backslashes, blank lines, tabs and UTF-8.
+std::string multi_kb_scene() {
+  std::string text =
+      "# Gr\xC3\xBC\xC3\x9F" "e aus K\xC3\xB6ln \xE2\x80\x94 \xCF\x80 \xE2\x89\x88 3.14159, \xF0\x9F\x8C\x80\n"
+      "[surface]\nname = \"Barth \\\"sextic\\\"\"\nequation = '4*(t^2*x^2-y^2)*(t^2*y^2-z^2)'\n\n\t\n";
+  for (int i = 0; text.size() < 6000; ++i)
+    text += "[[light]]\nposition = [" + std::to_string(i) + ", -2.5, 1e3]\nintensity = 0." + std::to_string(i % 10) +
+            "\ncomment = \"line " + std::to_string(i) + " \\u00e9\\n\"\n";
+  return text;
+}
+
+// Runs `write` and says how it failed, so that the checks can come after whatever had to be undone first.
+enum class Outcome { Wrote, OutputErr, WriteErr, OtherErr };
+Outcome outcome_of(const std::function<void()>& write, std::string& message) {
+  try {
+    write();
+    return Outcome::Wrote;
+  } catch (const OutputError& e) {
+    message = e.what();
+    return Outcome::OutputErr;
+  } catch (const WriteError& e) {
+    message = e.what();
+    return Outcome::WriteErr;
+  } catch (const std::exception& e) {
+    message = e.what();
+    return Outcome::OtherErr;
+  }
+}
+
+// Lowers this process's soft file-size limit while it lives, with SIGXFSZ ignored so that a write past the
+// limit fails with EFBIG instead of killing the process. Only files are limited: Catch's pipes are not.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    REQUIRE(::getrlimit(RLIMIT_FSIZE, &saved_) == 0);
+    saved_handler_ = ::signal(SIGXFSZ, SIG_IGN);
+    struct rlimit lowered = saved_;
+    lowered.rlim_cur = bytes;  // the hard limit stays, so the old soft limit can be restored
+    REQUIRE(::setrlimit(RLIMIT_FSIZE, &lowered) == 0);
+  }
+  FileSizeLimit(const FileSizeLimit&) = delete;
+  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+  ~FileSizeLimit() {
+    ::setrlimit(RLIMIT_FSIZE, &saved_);
+    ::signal(SIGXFSZ, saved_handler_);
+  }
+
+ private:
+  struct rlimit saved_ {};
+  void (*saved_handler_)(int) = SIG_DFL;
+};
+
+// A child that only sleeps until killed: a pid that is certainly alive. Killed and reaped on destruction.
+class SleepingChild {
+ public:
+  SleepingChild() : pid_(::fork()) {
+    if (pid_ == 0) {
+      for (;;) ::pause();
+    }
+    REQUIRE(pid_ > 0);
+  }
+  SleepingChild(const SleepingChild&) = delete;
+  SleepingChild& operator=(const SleepingChild&) = delete;
+  ~SleepingChild() {
+    ::kill(pid_, SIGKILL);
+    int status = 0;
+    ::waitpid(pid_, &status, 0);
+  }
+  pid_t pid() const { return pid_; }
+
+ private:
+  pid_t pid_;
+};
+
+// The pid of a child that has exited and been reaped: no process has it, until the system hands it out again.
+pid_t dead_pid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  REQUIRE(child > 0);
+  int status = 0;
+  REQUIRE(::waitpid(child, &status, 0) == child);
+  return child;
+}
+
+// Makes a file as a writer's temporary would be, last modified `age` ago.
+void make_temp_like(const fs::path& p, std::chrono::seconds age) {
+  write_bytes(p, "partial image data");
+  fs::last_write_time(p, fs::file_time_type::clock::now() - age);
+}
 }  // namespace
 
 TEST_CASE("format_from_extension accepts exr and png in any case", "[image_io]") {
@@ -436,7 +586,7 @@ TEST_CASE("a failed write leaves the destination untouched and no temp file", "[
     if (!status) FAIL("image_writer_tool did not exit within 20 s and was killed");
     REQUIRE(WIFEXITED(*status));
     INFO("exit status 127 means " ALGRAY_IMAGE_WRITER_TOOL " could not be executed");
-    CHECK(WEXITSTATUS(*status) == 2);  // both writes reported failure
+    CHECK(WEXITSTATUS(*status) == 2);  // both writes failed with WriteError (an OutputError would count 10)
     CHECK((read_bytes(exr) == original));
     CHECK((read_bytes(png) == original));
     CHECK(list_dir(dir.path()) == std::vector<std::string>{"out.exr", "out.png"});
@@ -494,4 +644,395 @@ TEST_CASE("a writer killed by SIGTERM leaves no temp file behind", "[image_io][s
     fs::remove(dest);
   }
   CHECK(interrupted);
+}
+
+TEST_CASE("the version names the project version and a commit of this repository", "[image_io][version]") {
+  const std::string version = algray::version();
+  CHECK_THAT(version, Catch::Matches("[0-9]+\\.[0-9]+\\.[0-9]+"));
+  const std::string revision = algray::git_revision();
+  CHECK_THAT(revision, Catch::Matches("unknown|[0-9a-f]{7,40}(-dirty)?"));
+  if (revision == "unknown") {
+    CHECK(algray::version_string() == "algray " + version);
+  } else {
+    CHECK(algray::version_string() == "algray " + version + " (git " + revision + ")");
+  }
+  // Built from a checkout, the revision must be known and name a commit that exists here; HEAD itself may have
+  // moved on since the build.
+  if (fs::exists(ALGRAY_SOURCE_DIR "/.git")) {
+    REQUIRE(revision != "unknown");
+    const std::string hash = revision.substr(0, revision.find('-'));
+    const std::string command =
+        "git -C '" ALGRAY_SOURCE_DIR "' cat-file -e '" + hash + "^{commit}' 2>/dev/null";
+    CHECK(std::system(command.c_str()) == 0);
+  }
+}
+
+TEST_CASE("EXR header carries software, comments and Rec.709 chromaticities", "[image_io][exr]") {
+  TempDir dir;
+  FrameImage im = solid_image(3, 2, 0.25f, 0.5f, 1.0f, 1.0f);
+  im.string_attributes = {{"algray/equation", "x^2 + y^2 + z^2 - 1"}};
+
+  SECTION("software defaults to the version string; comments are written when given") {
+    im.comments = "Sphere: x^2 + y^2 + z^2 - 1 = 0\nsecond line, \xC3\xA9";
+    algray::write_exr(dir / "a.exr", im);
+    const FrameImage back = algray::read_exr(dir / "a.exr");
+    CHECK(back.software == algray::version_string());
+    CHECK(back.comments == im.comments);
+    // The two standard attributes come back in their fields only, so writing `back` again cannot clash.
+    CHECK_FALSE(find_attr(back.string_attributes, "software"));
+    CHECK_FALSE(find_attr(back.string_attributes, "comments"));
+    REQUIRE(find_attr(back.string_attributes, "algray/equation"));
+    REQUIRE(back.chromaticities);
+    const std::array<float, 8> rec709 = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+    CHECK(*back.chromaticities == rec709);
+    algray::write_exr(dir / "b.exr", back);
+    CHECK(algray::read_exr(dir / "b.exr").comments == im.comments);
+
+    // What other tools see: the standard names and types.
+    Imf::InputFile file((dir / "a.exr").c_str());
+    const Imf::Header& h = file.header();
+    REQUIRE(h.findTypedAttribute<Imf::StringAttribute>("software"));
+    CHECK(h.findTypedAttribute<Imf::StringAttribute>("software")->value() == algray::version_string());
+    REQUIRE(Imf::hasComments(h));
+    CHECK(Imf::comments(h) == im.comments);
+    REQUIRE(Imf::hasChromaticities(h));
+    CHECK(Imf::chromaticities(h).white == Imath::V2f(0.3127f, 0.3290f));
+  }
+  SECTION("a given software string is kept; no comments means no attribute") {
+    im.software = "some tool 2.0";
+    algray::write_exr(dir / "a.exr", im);
+    const FrameImage back = algray::read_exr(dir / "a.exr");
+    CHECK(back.software == "some tool 2.0");
+    CHECK(back.comments.empty());
+    Imf::InputFile file((dir / "a.exr").c_str());
+    CHECK_FALSE(Imf::hasComments(file.header()));
+  }
+  SECTION("software and comments as string attributes are refused, with nothing written") {
+    for (const char* name : {"software", "comments", "chromaticities"}) {
+      INFO(name);
+      FrameImage clash = im;
+      clash.string_attributes.push_back({name, "x"});
+      CHECK_THROWS_AS(algray::write_exr(dir / "a.exr", clash), OutputError);
+    }
+    FrameImage clash = im;
+    clash.string_attributes.push_back({"comments", "x"});
+    CHECK_THROWS_WITH(algray::write_exr(dir / "a.exr", clash), Catch::Contains("FrameImage::comments"));
+    CHECK(list_dir(dir.path()).empty());
+  }
+}
+
+TEST_CASE("PNG text chunks round trip, the scene compressed", "[image_io][png]") {
+  TempDir dir;
+  FrameImage im = solid_image(5, 4, 0.2f, 0.4f, 0.8f, 1.0f);
+  const std::string scene = multi_kb_scene();
+  REQUIRE(scene.size() > 5000);
+  im.comments = "4*(t^2*x^2-y^2)*(t^2*y^2-z^2) = 0";
+  im.png_text = {{algray::kPngSceneKey, scene},
+                 {"Title", "Barth sextic"},
+                 {"algray:short-utf8", "\xCF\x80 r\xC3\xA9sum\xC3\xA9"},
+                 {"Empty", ""}};
+  const fs::path out = dir / "scene.png";
+  algray::write_png(out, im);
+  CHECK(algray::is_png_file(out));
+
+  const auto text = algray::read_png_text(out);
+  const std::vector<std::pair<std::string, std::string>> expected = {
+      {"Software", algray::version_string()}, {"Comment", im.comments}, {algray::kPngSceneKey, scene},
+      {"Title", "Barth sextic"},              {"algray:short-utf8", "\xCF\x80 r\xC3\xA9sum\xC3\xA9"},
+      {"Empty", ""}};
+  REQUIRE(text.size() == expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    INFO("chunk " << i << ": " << expected[i].first);
+    CHECK(text[i].first == expected[i].first);
+    CHECK((text[i].second == expected[i].second));
+  }
+
+  // The chunk types as other readers see them: ASCII in tEXt, UTF-8 in iTXt, the scene compressed.
+  const std::vector<PngChunk> chunks = split_png(read_bytes(out));
+  auto chunk_for = [&](const std::string& key) -> const PngChunk* {
+    for (const PngChunk& c : chunks)
+      if ((c.type == "tEXt" || c.type == "iTXt" || c.type == "zTXt") && c.data.compare(0, key.size() + 1, key + '\0') == 0)
+        return &c;
+    return nullptr;
+  };
+  REQUIRE(chunk_for("Software"));
+  CHECK(chunk_for("Software")->type == "tEXt");
+  REQUIRE(chunk_for("algray:short-utf8"));
+  CHECK(chunk_for("algray:short-utf8")->type == "iTXt");
+  const PngChunk* scene_chunk = chunk_for(algray::kPngSceneKey);
+  REQUIRE(scene_chunk);
+  CHECK(scene_chunk->type == "iTXt");
+  CHECK(scene_chunk->data.at(std::strlen(algray::kPngSceneKey) + 1) == 1);  // iTXt compression flag
+  CHECK(scene_chunk->data.size() < scene.size() / 2);
+  // Before the image data, so that a reader after the scene can stop early.
+  std::size_t scene_at = 0, idat_at = 0;
+  for (std::size_t i = 0; i < chunks.size(); ++i) {
+    if (&chunks[i] == scene_chunk) scene_at = i;
+    if (chunks[i].type == "IDAT" && idat_at == 0) idat_at = i;
+  }
+  CHECK(scene_at < idat_at);
+
+  // The pixels are unchanged by the text.
+  PngData png;
+  REQUIRE(read_png(out, png));
+  CHECK(png.width == 5);
+  CHECK(int(png.bytes[2]) == 231);  // 0.8 linear in sRGB
+}
+
+TEST_CASE("PNG text that cannot be stored is refused before anything is written", "[image_io][png]") {
+  TempDir dir;
+  const FrameImage base = solid_image(2, 2, 0.5f, 0.5f, 0.5f, 1.0f);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"", "empty key"},
+      {std::string(80, 'k'), "key too long"},
+      {" lead", "leading space"},
+      {"trail ", "trailing space"},
+      {"double  space", "double space"},
+      {"caf\xC3\xA9", "non-ASCII key"},
+      {"tab\tkey", "control character"},
+      {"Software", "reserved for FrameImage::software"},
+      {"Comment", "reserved for FrameImage::comments"},
+      {"nul", std::string("a\0b", 3)},
+      {"latin1", "caf\xE9"},
+      {"overlong", "\xC0\xAF"},
+      {"surrogate", "\xED\xA0\x80"},
+      {"cut", "\xE2\x82"},
+      {"huge", std::string(algray::kMaxPngTextBytes + 1, 'x')},
+  };
+  for (const auto& [key, value] : bad) {
+    INFO("key '" << key << "' value of " << value.size() << " bytes");
+    FrameImage im = base;
+    im.png_text = {{"Fine", "ok"}, {key, value}};
+    CHECK_THROWS_AS(algray::write_png(dir / "t.png", im), OutputError);
+  }
+  FrameImage twice = base;
+  twice.png_text = {{"Title", "a"}, {"Title", "b"}};
+  CHECK_THROWS_WITH(algray::write_png(dir / "t.png", twice), Catch::Contains("twice"));
+  FrameImage bad_comment = base;
+  bad_comment.comments = "caf\xE9";
+  CHECK_THROWS_AS(algray::write_png(dir / "t.png", bad_comment), OutputError);
+  CHECK(list_dir(dir.path()).empty());
+
+  // The limits themselves are accepted.
+  FrameImage edge = base;
+  edge.png_text = {{std::string(79, 'k'), "x"}, {"one space", std::string(algray::kMaxPngTextBytes, 'y')}};
+  algray::write_png(dir / "t.png", edge);
+  const auto text = algray::read_png_text(dir / "t.png");
+  REQUIRE(text.size() == 3);
+  CHECK(text[1].first == std::string(79, 'k'));
+  CHECK(text[2].second.size() == algray::kMaxPngTextBytes);
+}
+
+TEST_CASE("read_png_text reads text after the image data, tEXt as Latin-1, and skips other chunks", "[image_io][png]") {
+  TempDir dir;
+  FrameImage im = solid_image(3, 3, 1.0f, 0.0f, 0.0f, 1.0f);
+  im.software = "writer";
+  algray::write_png(dir / "a.png", im);
+  std::string png = read_bytes(dir / "a.png");
+  png = with_chunk_at_end(png, {"tEXt", std::string("Author") + '\0' + "Andr\xE9 \xA9"});
+  // A colour profile that is garbage and a private chunk must not stop the text from being read.
+  png = with_chunk_at_end(png, {"iCCP", std::string("junk\0\0not zlib at all", 21)});
+  png = with_chunk_at_end(png, {"prVt", "private data"});
+  write_bytes(dir / "b.png", png);
+
+  const auto text = algray::read_png_text(dir / "b.png");
+  REQUIRE(text.size() == 2);
+  CHECK(text[0] == std::pair<std::string, std::string>{"Software", "writer"});
+  CHECK(text[1] == std::pair<std::string, std::string>{"Author", "Andr\xC3\xA9 \xC2\xA9"});
+}
+
+TEST_CASE("read_png_text throws OutputError on damaged or foreign files, never crashes", "[image_io][png]") {
+  TempDir dir;
+  FrameImage im = solid_image(16, 16, 0.3f, 0.6f, 0.9f, 1.0f);
+  im.png_text = {{algray::kPngSceneKey, multi_kb_scene()}, {"Title", "t"}};
+  algray::write_png(dir / "good.png", im);
+  const std::string good = read_bytes(dir / "good.png");
+  REQUIRE(algray::read_png_text(dir / "good.png").size() == 3);
+
+  auto expect_failure = [&](const std::string& name, const std::string& bytes, const std::string& why) {
+    INFO(name << ": " << why);
+    write_bytes(dir / name, bytes);
+    CHECK_THROWS_AS(algray::read_png_text(dir / name), OutputError);
+    CHECK_THROWS_WITH(algray::read_png_text(dir / name), Catch::Contains(name));
+  };
+  SECTION("truncated anywhere") {
+    const std::vector<PngChunk> chunks = split_png(good);
+    std::size_t idat_end = 8;
+    for (const PngChunk& c : chunks) {
+      idat_end += 12 + c.data.size();
+      if (c.type == "IDAT") break;
+    }
+    for (const std::size_t length : {std::size_t{0}, std::size_t{7}, std::size_t{8}, std::size_t{20}, std::size_t{40},
+                                     good.size() / 3, good.size() / 2, idat_end - 5, good.size() - 12, good.size() - 1})
+      expect_failure("cut-" + std::to_string(length) + ".png", good.substr(0, length),
+                     "cut to " + std::to_string(length) + " of " + std::to_string(good.size()) + " bytes");
+    CHECK_THROWS_WITH(algray::read_png_text(dir / ("cut-" + std::to_string(good.size() / 2) + ".png")),
+                      Catch::Contains("truncated"));
+    CHECK_FALSE(algray::is_png_file(dir / "cut-7.png"));
+    CHECK(algray::is_png_file(dir / "cut-8.png"));
+  }
+  SECTION("not a PNG") {
+    expect_failure("text.png", "[surface]\nequation = \"x\"\n", "a scene named .png");
+    expect_failure("empty.png", "", "empty");
+    CHECK_THROWS_WITH(algray::read_png_text(dir / "text.png"), Catch::Contains("not a PNG"));
+    CHECK_FALSE(algray::is_png_file(dir / "text.png"));
+    CHECK_THROWS_AS(algray::read_png_text(dir / "missing.png"), OutputError);
+    CHECK_FALSE(algray::is_png_file(dir / "missing.png"));
+    CHECK_FALSE(algray::is_png_file(dir.path()));
+  }
+  SECTION("a text chunk with a bad CRC is an error, not silently dropped") {
+    std::string bad = with_chunk_at_end(good, {"tEXt", std::string("Note\0hello", 10)});
+    bad[bad.size() - 12 - 4 - 1] ^= 0x20;  // last byte of the tEXt data, before its CRC and IEND
+    expect_failure("crc.png", bad, "bad CRC");
+    CHECK_THROWS_WITH(algray::read_png_text(dir / "crc.png"), Catch::Contains("CRC"));
+  }
+  SECTION("a text chunk larger than the cap") {
+    const std::string huge = "Big" + std::string(1, '\0') + std::string(algray::kMaxPngTextBytes + 8192, 'z');
+    expect_failure("huge.png", with_chunk_at_end(good, {"tEXt", huge}), "tEXt over the cap");
+    std::string lying = good.substr(0, 33);  // signature and IHDR
+    lying += be32(0x7FFFFFFFu) + "tEXt" + "abc";
+    expect_failure("lying.png", lying, "chunk length far past the end of the file");
+  }
+  SECTION("random damage: each flip returns or throws OutputError") {
+    std::mt19937 rng(20240611);
+    for (int trial = 0; trial < 300; ++trial) {
+      std::string bytes = good;
+      const int flips = 1 + static_cast<int>(rng() % 4);
+      for (int f = 0; f < flips; ++f) bytes[rng() % bytes.size()] ^= static_cast<char>(1 + rng() % 255);
+      write_bytes(dir / "fuzz.png", bytes);
+      std::string message;
+      const Outcome got = outcome_of([&] { (void)algray::read_png_text(dir / "fuzz.png"); }, message);
+      INFO("trial " << trial << ": " << message);
+      CHECK((got == Outcome::Wrote || got == Outcome::OutputErr));
+    }
+  }
+}
+
+TEST_CASE("a write that fails on the way to the disk is a WriteError, not an OutputError", "[image_io][atomic]") {
+  static_assert(!std::is_base_of_v<OutputError, WriteError> && !std::is_base_of_v<WriteError, OutputError>,
+                "the CLI tells bad input from failed writes by type");
+  TempDir dir;
+  const std::string original = "original bytes that must survive\n";
+  const fs::path exr = dir / "out.exr", png = dir / "out.png", json = dir / "out.json";
+  for (const fs::path& p : {exr, png, json}) write_bytes(p, original);
+  // Noise does not compress, so each file outgrows the limit whatever the format.
+  const FrameImage im = noisy_image(128, 3);
+  const std::string text(20000, 't');
+  std::string exr_message, png_message, json_message, bad_message;
+  Outcome exr_outcome, png_outcome, json_outcome, bad_outcome;
+  {
+    const FileSizeLimit limit(4096);
+    exr_outcome = outcome_of([&] { algray::write_exr(exr, im); }, exr_message);
+    png_outcome = outcome_of([&] { algray::write_png(png, im); }, png_message);
+    json_outcome = outcome_of([&] { algray::write_text_file(json, text); }, json_message);
+    // Under the same limit, bad input is still reported as bad input.
+    bad_outcome = outcome_of([&] { algray::write_png(dir / "missing" / "x.png", im); }, bad_message);
+  }
+  CHECK(exr_outcome == Outcome::WriteErr);
+  CHECK(png_outcome == Outcome::WriteErr);
+  CHECK(json_outcome == Outcome::WriteErr);
+  CHECK(bad_outcome == Outcome::OutputErr);
+  CHECK_THAT(png_message, Catch::StartsWith("cannot write '" + png.string() + "': "));
+  CHECK_THAT(json_message, Catch::Contains("File too large"));
+  INFO(exr_message);
+  for (const fs::path& p : {exr, png, json}) CHECK(read_bytes(p) == original);
+  CHECK(list_dir(dir.path()) == std::vector<std::string>{"out.exr", "out.json", "out.png"});
+}
+
+TEST_CASE("check_output_path finds path problems before anything is written", "[image_io][atomic]") {
+  TempDir dir;
+  write_bytes(dir / "file", "x");
+  fs::create_directory(dir / "sub");
+  const FrameImage im = solid_image(2, 2, 0.5f, 0.5f, 0.5f, 1.0f);
+  using Catch::Contains;
+
+  CHECK_NOTHROW(algray::check_output_path(dir / "fine.png"));
+  CHECK_THROWS_WITH(algray::check_output_path(dir / "missing" / "a.png"),
+                    Contains("cannot write '") && Contains("missing") && Contains("does not exist"));
+  CHECK_THROWS_WITH(algray::check_output_path(dir / "file" / "a.png"), Contains("file"));
+  CHECK_THROWS_AS(algray::check_output_path(dir / "file" / "a.png"), OutputError);
+  CHECK_THROWS_WITH(algray::check_output_path(dir / "sub"), Contains("is a directory"));
+  CHECK_THROWS_AS(algray::check_output_path(dir.path().string() + "/"), OutputError);
+
+  const long name_max = ::pathconf(dir.path().c_str(), _PC_NAME_MAX);
+  REQUIRE(name_max > 0);
+  const std::string longest = std::string(static_cast<std::size_t>(name_max) - 4, 'n') + ".png";
+  const std::string too_long = std::string(static_cast<std::size_t>(name_max) - 3, 'n') + ".png";
+  CHECK_THROWS_WITH(algray::check_output_path(dir / too_long),
+                    Contains("file name is " + std::to_string(too_long.size()) + " bytes") &&
+                        Contains(std::to_string(name_max)));
+  // The writers make the same check, as bad input, and leave nothing behind.
+  CHECK_THROWS_AS(algray::write_png(dir / too_long, im), OutputError);
+  CHECK_THROWS_AS(algray::write_text_file(dir / too_long, "x"), OutputError);
+  // The longest name still works: its temporary's name is cut to fit.
+  CHECK_NOTHROW(algray::check_output_path(dir / longest));
+  algray::write_png(dir / longest, im);
+  CHECK(list_dir(dir.path()) == std::vector<std::string>{"file", longest, "sub"});
+}
+
+TEST_CASE("temporaries of dead writers are removed by the next write to that name", "[image_io][stale]") {
+  TempDir dir;
+  const FrameImage im = solid_image(2, 2, 0.5f, 0.5f, 0.5f, 1.0f);
+  const pid_t dead = dead_pid();
+  const SleepingChild live;
+  const std::string d = std::to_string(dead), l = std::to_string(live.pid()), self = std::to_string(::getpid());
+  const auto old = std::chrono::seconds(600), fresh = std::chrono::seconds(0);
+
+  make_temp_like(dir / (".out.png.tmp-" + d + "-1"), old);    // removed: dead, long untouched
+  make_temp_like(dir / (".out.png.tmp-" + d + "-27"), old);   // removed too
+  make_temp_like(dir / (".out.png.tmp-" + d + "-2"), fresh);  // kept: might be another machine's live writer
+  make_temp_like(dir / (".out.png.tmp-" + l + "-1"), old);    // kept: a live writer
+  // Kept: this process's, another thread's (a counter this process will not reach here, so no write reuses it).
+  make_temp_like(dir / (".out.png.tmp-" + self + "-987654"), old);
+  make_temp_like(dir / (".other.png.tmp-" + d + "-1"), old);  // kept: another destination's
+  make_temp_like(dir / (".out.png.tmp-" + d + "-x"), old);    // kept: not a temporary's name
+  make_temp_like(dir / (".out.png.tmp-" + d), old);           // kept: not a temporary's name
+  make_temp_like(dir / ("out.png.tmp-" + d + "-1"), old);     // kept: not hidden, so not ours
+  const std::vector<std::string> kept = {
+      ".other.png.tmp-" + d + "-1", ".out.png.tmp-" + d,         ".out.png.tmp-" + d + "-2",
+      ".out.png.tmp-" + d + "-x",   ".out.png.tmp-" + l + "-1",  ".out.png.tmp-" + self + "-987654",
+      "out.png",                    "out.png.tmp-" + d + "-1"};
+
+  algray::write_png(dir / "out.png", im);
+  std::vector<std::string> expected = kept;
+  std::sort(expected.begin(), expected.end());
+  CHECK(list_dir(dir.path()) == expected);
+
+  SECTION("a long name's temporaries are matched by the same 200-byte cut") {
+    const std::string name = std::string(230, 'L') + ".exr";
+    const std::string stale = "." + name.substr(0, 200) + ".tmp-" + d + "-3";
+    make_temp_like(dir / stale, old);
+    algray::write_exr(dir / name, im);
+    CHECK_FALSE(fs::exists(dir / stale));
+    CHECK(fs::exists(dir / name));
+  }
+}
+
+TEST_CASE("a writer killed by SIGKILL leaves a temporary that a later write removes", "[image_io][stale]") {
+  TempDir dir;
+  const fs::path dest = dir / "killed.exr";
+  // Large noise keeps the write going long enough to be caught with its temporary open.
+  const pid_t child = spawn_writer({"2048", "5", dest.string()});
+  REQUIRE(child >= 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (!has_temp_file(dir.path()) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  ::kill(child, SIGKILL);
+  const std::optional<int> status = wait_child(child);
+  REQUIRE(status);
+  if (!has_temp_file(dir.path())) {
+    // The write finished (renamed) before the kill landed: nothing to clean up, nothing this test can show.
+    WARN("image_writer_tool renamed its file before SIGKILL; the stale-temporary case was not exercised");
+    CHECK(fs::exists(dest));
+    return;
+  }
+  CHECK(WIFSIGNALED(*status));  // SIGKILL runs no handler, so the temporary stays
+  CHECK_FALSE(fs::exists(dest));
+  std::string temp_name;
+  for (const auto& name : list_dir(dir.path())) temp_name = name;
+  CHECK_THAT(temp_name, Catch::StartsWith(".killed.exr.tmp-" + std::to_string(child) + "-"));
+  fs::last_write_time(dir / temp_name, fs::file_time_type::clock::now() - std::chrono::minutes(5));
+
+  algray::write_exr(dest, solid_image(2, 2, 0.5f, 0.5f, 0.5f, 1.0f));
+  CHECK(list_dir(dir.path()) == std::vector<std::string>{"killed.exr"});
 }
