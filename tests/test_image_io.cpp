@@ -656,9 +656,9 @@ TEST_CASE("the version names the project version and a commit of this repository
   } else {
     CHECK(algray::version_string() == "algray " + version + " (git " + revision + ")");
   }
-  // Built from a checkout, the revision must be known and name a commit that exists here; HEAD itself may have
-  // moved on since the build.
-  if (fs::exists(ALGRAY_SOURCE_DIR "/.git")) {
+  // Built from a checkout git can read, the revision must be known and name a commit that exists here; HEAD
+  // itself may have moved on since the build.
+  if (std::system("git -C '" ALGRAY_SOURCE_DIR "' rev-parse --verify -q HEAD >/dev/null 2>&1") == 0) {
     REQUIRE(revision != "unknown");
     const std::string hash = revision.substr(0, revision.find('-'));
     const std::string command =
