@@ -19,6 +19,7 @@
 #include "image_io.h"
 #include "render_job.h"
 #include "toml_reader.h"
+#include "version.h"
 
 namespace algray {
 namespace {
@@ -393,7 +394,11 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
       bool warned = false;
       for (int frame = 0; frame < job.frames; ++frame, ++done) {
         const auto start = std::chrono::steady_clock::now();
-        nlohmann::json entry = {{"job", job.name}, {"frame", frame}, {"frames", job.frames}, {"scene", job.scene}};
+        nlohmann::json entry = {{"version", version_string()},
+                              {"job", job.name},
+                              {"frame", frame},
+                              {"frames", job.frames},
+                              {"scene", job.scene}};
         std::vector<std::string> outputs;
         try {
           for (const std::string& o : job.outputs) outputs.push_back(expand_pattern(o, job, frame));
@@ -483,7 +488,8 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
     return kExitFailure;
   }
   if (req.progress) std::fprintf(stderr, "\n");
-  const nlohmann::json summary = {{"jobs_file", req.jobs_path},
+  const nlohmann::json summary = {{"version", version_string()},
+                                  {"jobs_file", req.jobs_path},
                                   {"log", log_path},
                                   {"frames", {{"total", total}, {"ok", ok}, {"failed", failed}, {"skipped", skipped}}},
                                   {"jobs", summary_jobs},

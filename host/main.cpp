@@ -10,6 +10,7 @@
 #include "image_io.h"
 #include "probe_report.h"
 #include "render_job.h"
+#include "version.h"
 
 namespace {
 
@@ -96,6 +97,7 @@ int main(int argc, char** argv) {
   install_output_cleanup_handlers();
 
   CLI::App app{"algray: ray tracing of real algebraic surfaces P(x,y,z) = 0 on any OpenCL device"};
+  app.set_version_flag("--version", version_string(), "print the version and the git revision, and exit");
   app.require_subcommand(1);
 
   RenderRequest request;
@@ -167,9 +169,9 @@ int main(int argc, char** argv) {
     }
     std::cout << describe_devices(list);
     if (!devices_stats.empty()) {
-      nlohmann::json j = nlohmann::json::array();
+      nlohmann::json j = {{"version", version_string()}, {"devices", nlohmann::json::array()}};
       for (const DeviceInfo& d : list)
-        j.push_back({{"index", d.index},
+        j["devices"].push_back({{"index", d.index},
                      {"platform", d.platform_name},
                      {"platform_version", d.platform_version},
                      {"name", d.name},
@@ -178,7 +180,9 @@ int main(int argc, char** argv) {
                      {"driver", d.driver_version},
                      {"type", d.type},
                      {"compute_units", d.compute_units},
-                     {"fp64", d.fp64}});
+                     {"fp64", d.fp64},
+                     {"global_mem_bytes", d.global_mem_bytes},
+                     {"max_alloc_bytes", d.max_alloc_bytes}});
       try {
         check_output_writable(devices_stats);
         write_text_file(devices_stats, j.dump(2) + "\n");

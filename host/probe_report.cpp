@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "diagnostic_images.h"
+#include "version.h"
 #include "image_io.h"
 #include "render_job.h"
 #include "render_plan.h"
@@ -362,7 +363,7 @@ void print_probe(std::ostream& out, const Scene& scene, const ProbeTarget& targe
 }
 
 nlohmann::json probe_json(const Scene& scene, const ProbeTarget& target, const std::vector<SurfaceProbe>& probes) {
-  nlohmann::json j = {{"scene", scene.source}, {"name", scene.name}};
+  nlohmann::json j = {{"version", version_string()}, {"scene", scene.source}, {"name", scene.name}};
   if (target.given_ray)
     j["ray"] = {{"origin", {target.origin.x, target.origin.y, target.origin.z}},
                 {"direction", {target.direction.x, target.direction.y, target.direction.z}}};

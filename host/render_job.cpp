@@ -23,6 +23,7 @@
 #include "reference_render.h"
 #include "renderer.h"
 #include "shade.h"
+#include "version.h"
 
 namespace algray {
 namespace {
@@ -80,6 +81,18 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
       // The ray basis above is per antialiasing sample: pixel (px, py) averages samples x samples rays.
       {"algray/antialiasSamples", r.plan.samples},
   };
+  // The scene itself, as TOML that renders this image again: in the EXR header, and in a PNG text chunk that
+  // `algray render image.png` reads back (as realsurf reloads its PNGs).
+  const std::string scene_toml = scene_to_toml(scene);
+  img.string_attributes.push_back({"algray/sceneToml", scene_toml});
+  if (scene_toml.size() <= kMaxPngTextBytes) img.png_text.push_back({kPngSceneKey, scene_toml});
+  img.software = version_string();
+  std::string equations;
+  for (const SceneSurface& s : scene.surfaces) equations += (equations.empty() ? "" : "; ") + s.equation;
+  img.comments = scene.name + ": " + equations + " = 0, rendered by algray";
+  // A name from a file name need not be UTF-8, which PNG text must be; the comment is for people, so '?' will do.
+  for (char& ch : img.comments)
+    if (static_cast<unsigned char>(ch) >= 0x80 || static_cast<unsigned char>(ch) < 0x20) ch = '?';
   img.world_to_camera = world_to_camera_matrix(b, cam.eye);
   img.world_to_ndc = world_to_ndc_matrix(cam, b, scene.image.width, scene.image.height);
 }
@@ -110,6 +123,7 @@ class PhaseTimer {
 nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const RenderResult& r, const DeviceInfo& device,
                           const PhaseTimer& timer) {
   nlohmann::json j;
+  j["version"] = version_string();
   j["scene"] = scene.source;
   j["name"] = scene.name;
   j["outputs"] = req.outputs;
@@ -188,14 +202,7 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
 }  // namespace
 
 // An output that cannot be written is bad input, found before any rendering.
-void check_output_writable(const std::string& path) {
-  const std::filesystem::path p(path);
-  const std::filesystem::path dir = p.parent_path().empty() ? std::filesystem::path(".") : p.parent_path();
-  if (!std::filesystem::is_directory(dir))
-    throw OutputError(path + ": directory '" + dir.string() + "' does not exist");
-  if (std::filesystem::is_directory(p)) throw OutputError(path + " is a directory");
-  if (::access(dir.c_str(), W_OK) != 0) throw OutputError(path + ": directory '" + dir.string() + "' is not writable");
-}
+void check_output_writable(const std::string& path) { check_output_path(path); }
 
 namespace {
 
@@ -245,6 +252,19 @@ ProgramCache& RenderContext::cache() {
 
 Scene load_scene(const std::optional<std::string>& path, const std::vector<Override>& overrides) {
   if (!path) return default_scene(overrides);
+  if (*path != "-" && is_png_file(*path)) {
+    // A PNG that algray rendered carries its scene: render it again, with any new overrides on top.
+    std::vector<std::pair<std::string, std::string>> texts;
+    try {
+      texts = read_png_text(*path);
+    } catch (const OutputError& e) {
+      throw SceneError(*path, e.what());
+    }
+    for (const auto& [key, text] : texts)
+      if (key == kPngSceneKey) return load_scene_text(text, *path + " (the scene in its " + kPngSceneKey + " text)", overrides);
+    throw SceneError(*path, std::string("this PNG carries no algray scene (no ") + kPngSceneKey +
+                                " text chunk): only images written by algray render can be rendered again");
+  }
   if (*path == "-") {
     // Standard input can be read once: a second "-" in the same process is an error, not an empty scene.
     static bool consumed = false;

@@ -191,6 +191,7 @@ SceneSurface read_surface(const TomlReader& r, const toml::table& surface,
     }
   } else if (terms) {
     out.polynomial = polynomial_from_terms(r, *terms);
+    out.from_terms = true;
     out.equation = out.polynomial.to_string();
   } else {
     r.fail(surface.source(), "[surface] needs an equation or a list of terms");
@@ -241,8 +242,8 @@ Light read_light(const TomlReader& r, const toml::table& t) {
     if (!(light.radius > 0)) r.fail(t.get("radius")->source(), "light.radius must be positive");
     if (const toml::node* n = t.get("normal")) {
       light.normal = r.vec3(*n, "light.normal");
-      if (glm::length(light.normal) <= 0) r.fail(n->source(), "light.normal must not be zero");
-      light.normal = glm::normalize(light.normal);
+      // Kept as written (normalised where it is used), so that scene_to_toml writes back what was read.
+      if (!(glm::length(light.normal) > 0)) r.fail(n->source(), "light.normal must not be zero");
     }
   }
   if (light.kind != LightKind::Point) {
@@ -467,8 +468,9 @@ std::vector<glm::dvec3> Light::sample_points() const {
   std::vector<glm::dvec3> points;
   const int n = samples;
   // An orthonormal frame of the disc's plane.
-  const glm::dvec3 a = std::fabs(normal.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-  const glm::dvec3 e1 = glm::normalize(glm::cross(normal, a)), e2 = glm::cross(normal, e1);
+  const glm::dvec3 unit = glm::normalize(normal);
+  const glm::dvec3 a = std::fabs(unit.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+  const glm::dvec3 e1 = glm::normalize(glm::cross(unit, a)), e2 = glm::cross(unit, e1);
   for (int j = 0; j < n; ++j) {
     for (int i = 0; i < n; ++i) {
       const double u = (i + 0.5) / n * 2 - 1, v = (j + 0.5) / n * 2 - 1;  // cell centres in [-1, 1]^2
@@ -533,6 +535,109 @@ Scene load_jsurf_text(const std::string& text, const std::string& source_name, c
   scene.source = source_name;
   scene.warnings = std::move(warnings);
   return scene;
+}
+
+namespace {
+
+std::string toml_vec(const glm::dvec3& v) {
+  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + std::string.
+  std::string out = "[";
+  out += toml_number(v.x);
+  out += ", ";
+  out += toml_number(v.y);
+  out += ", ";
+  out += toml_number(v.z);
+  out += "]";
+  return out;
+}
+
+void write_material(std::ostringstream& out, const std::string& table, const Material& m) {
+  out << "\n[" << table << "]\ncolour = " << toml_vec(m.colour) << "\nambient = " << toml_number(m.ambient)
+      << "\ndiffuse = " << toml_number(m.diffuse) << "\nspecular = " << toml_number(m.specular)
+      << "\nexponent = " << toml_number(m.exponent) << "\nreflectivity = " << toml_number(m.reflectivity)
+      << "\ntransparency = " << toml_number(m.transparency) << "\n";
+}
+
+const char* light_type(LightKind k) {
+  switch (k) {
+    case LightKind::Rectangle:
+      return "rectangle";
+    case LightKind::Disc:
+      return "disc";
+    case LightKind::Point:
+      break;
+  }
+  return "point";
+}
+
+}  // namespace
+
+std::string scene_to_toml(const Scene& scene) {
+  std::ostringstream out;
+  std::string origin = scene.name + ", as algray rendered it (from " + scene.source + ")";
+  for (char& ch : origin)
+    // A comment ends at the line's end, and TOML text must be UTF-8, which a file name need not be.
+    if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) >= 0x7f) ch = '?';
+  out << "# " << origin << "\n";
+  if (!scene.parameters.empty()) {
+    out << "\n[parameters]\n";
+    for (const auto& [name, value] : scene.parameters) out << name << " = " << toml_number(value) << "\n";
+  }
+  const bool several = scene.surfaces.size() > 1;
+  for (const SceneSurface& s : scene.surfaces) {
+    out << (several ? "\n[[surface]]\n" : "\n[surface]\n");
+    if (!s.name.empty()) out << "name = " << toml_quoted(s.name) << "\n";
+    if (s.from_terms) {
+      // Each coefficient as the double it was read as: the equation text made from them rounds.
+      out << "terms = [";
+      const char* sep = "";
+      for (const auto& [e, c] : s.polynomial.terms()) {
+        out << sep << "[" << e[0] << ", " << e[1] << ", " << e[2] << ", " << toml_number(nearest_double(c)) << "]";
+        sep = ", ";
+      }
+      out << "]\n";
+    } else {
+      out << "equation = " << toml_quoted(s.equation) << "\n";
+    }
+    write_material(out, "surface.material.front", s.materials.front);
+    write_material(out, "surface.material.back", s.materials.back);
+  }
+  const Extent& e = scene.extent;
+  if (e.kind == ExtentKind::Sphere)
+    out << "\n[extent]\ntype = \"sphere\"\ncentre = " << toml_vec(e.centre) << "\nradius = " << toml_number(e.radius)
+        << "\n";
+  else
+    out << "\n[extent]\ntype = \"box\"\nmin = " << toml_vec(e.min) << "\nmax = " << toml_vec(e.max) << "\n";
+  const CameraSpec& c = scene.camera;
+  const bool perspective = c.projection == Projection::Perspective;
+  out << "\n[camera]\nprojection = \"" << (perspective ? "perspective" : "orthographic") << "\"\neye = "
+      << toml_vec(c.eye) << "\nlook_at = " << toml_vec(c.look_at) << "\nup = " << toml_vec(c.up) << "\n"
+      << (perspective ? "fov_y = " + toml_number(c.fov_y_degrees) : "height = " + toml_number(c.ortho_height))
+      << "\n";
+  const glm::dvec4& bg = scene.image.background;
+  out << "\n[image]\nwidth = " << scene.image.width << "\nheight = " << scene.image.height << "\nbackground = ["
+      << toml_number(bg.r) << ", " << toml_number(bg.g) << ", " << toml_number(bg.b) << ", " << toml_number(bg.a)
+      << "]\n";
+  for (const Light& l : scene.lights) {
+    out << "\n[[light]]\ntype = \"" << light_type(l.kind) << "\"\nposition = " << toml_vec(l.position) << "\n";
+    if (l.kind == LightKind::Rectangle)
+      out << "edge_u = " << toml_vec(l.edge_u) << "\nedge_v = " << toml_vec(l.edge_v) << "\n";
+    if (l.kind == LightKind::Disc) out << "normal = " << toml_vec(l.normal) << "\nradius = " << toml_number(l.radius) << "\n";
+    if (l.kind != LightKind::Point) out << "samples = " << l.samples << "\n";
+    out << "colour = " << toml_vec(l.colour) << "\nintensity = " << toml_number(l.intensity)
+        << "\nshadows = " << (l.shadows ? "true" : "false") << "\n";
+  }
+  const Antialias& aa = scene.antialias;
+  out << "\n[antialias]\nsamples = " << aa.samples << "\nadaptive = " << (aa.adaptive ? "true" : "false")
+      << "\nthreshold = " << toml_number(aa.threshold) << "\n";
+  const RenderSettings& rs = scene.render;
+  out << "\n[render]\nprecision = \"" << (rs.precision ? to_string(*rs.precision) : std::string("auto"))
+      << "\"\ntolerance = " << toml_number(rs.tolerance) << "\nisolation = \"" << to_string(rs.isolation)
+      << "\"\nrefinement = \"" << to_string(rs.refinement) << "\"\nray_origin = \"" << to_string(rs.ray_origin)
+      << "\"\npreview = " << (rs.preview ? "true" : "false") << "\nmax_depth = " << rs.max_depth << "\n";
+  if (rs.max_iterations) out << "max_iterations = " << rs.max_iterations << "\n";
+  if (rs.tile_size) out << "tile_size = " << rs.tile_size << "\n";
+  return out.str();
 }
 
 std::string read_input_stream(std::istream& in, const std::string& source, const std::string& what) {

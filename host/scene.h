@@ -72,7 +72,7 @@ struct Light {
   LightKind kind = LightKind::Point;
   glm::dvec3 position{0};           // the point, or the area's centre
   glm::dvec3 edge_u{0}, edge_v{0};  // rectangle: its two edges (full length), centred on position
-  glm::dvec3 normal{0, 0, 1};       // disc: its plane's normal
+  glm::dvec3 normal{0, 0, 1};       // disc: its plane's normal, as written (not necessarily unit)
   double radius = 0;                // disc
   int samples = 1;                  // n: n x n points for an area light; 1 for a point light
   glm::dvec3 colour{1};
@@ -112,6 +112,7 @@ struct RenderSettings {
 struct SceneSurface {
   std::string name;
   std::string equation;  // as written, or generated from the term list
+  bool from_terms = false;  // given as surface.terms: exact doubles, which the generated equation may round
   Polynomial polynomial;
   Materials materials;
 };
@@ -154,6 +155,11 @@ Scene load_scene_text(const std::string& text, const std::string& source_name,
 Scene load_jsurf_text(const std::string& text, const std::string& source_name,
                       const std::vector<Override>& overrides = {});
 Scene default_scene(const std::vector<Override>& overrides = {});
+
+// The scene as TOML that reads back to the same Scene, value for value (floats to 17 digits, the equations as
+// written with their parameters): what PNG files embed so that `algray render image.png` renders them again, and
+// what holds a scene after --set, an orbit or a .jsurf translation. Comments and the source's layout are lost.
+std::string scene_to_toml(const Scene& scene);
 
 // Scenes and jobs files are small text; a larger input is refused after reading one byte past this, so that
 // `algray render /dev/zero` or a mistyped path to a video fails at once instead of filling the memory.

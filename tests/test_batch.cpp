@@ -229,7 +229,9 @@ TEST_CASE("every command takes its input on standard input, --set for list keys,
   CHECK(probe.exit_code == 0);
   CHECK(nlohmann::json::parse(read_text(box.work / "probe.json"))["surfaces"][0]["solvers"][0]["found"] == true);
   REQUIRE(box.run("devices --stats devices.json").exit_code == 0);
-  const nlohmann::json devices = nlohmann::json::parse(read_text(box.work / "devices.json"));
+  const nlohmann::json stats = nlohmann::json::parse(read_text(box.work / "devices.json"));
+  CHECK_THAT(stats["version"].get<std::string>(), Catch::StartsWith("algray "));
+  const nlohmann::json& devices = stats["devices"];
   REQUIRE(!devices.empty());
   CHECK(devices[0]["compute_units"].get<int>() > 0);
 }

@@ -15,9 +15,10 @@
 #include <string>
 #include <vector>
 
-#include "image_io.h"
 #include "cli_sandbox.h"
+#include "image_io.h"
 #include "scene_fixtures.h"
+#include "version.h"
 
 namespace fs = std::filesystem;
 
@@ -147,7 +148,8 @@ TEST_CASE("bad input exits 2 with a located message and writes nothing", "[cli][
       {"division by a variable", 3, "equation = \"x/y\"", ":3:15", "division by a variable"},
       {"negative power", 3, "equation = \"x^-2\"", ":3:15", "negative exponent"},
       {"nan", 5, "radius = nan", ":5:10", "must be finite, not nan"},
-      {"degree 33", 3, "equation = \"x^33\"", ":3:12", "degree 33 exceeds the supported maximum 32"},
+      {"degree 33", 3, "equation = \"x^33\"", ":3:15", "this power would have degree 33"},
+      {"degree 33 by terms", 3, "terms = [[33, 0, 0, 1.0]]", ":3:9", "degree 33 exceeds the supported maximum 32"},
       {"zero polynomial", 3, "equation = \"x-x\"", ":3:12", "identically zero"},
       {"empty extent", 5, "radius = 0", ":5:10", "the extent is empty"},
       {"degenerate camera", 8, "look_at = [0, 0, 5]", ":8:11", "look_at coincides with eye"},
@@ -311,4 +313,64 @@ TEST_CASE("a kernel that fails to build exits 1 with the build log and the optio
   CHECK(message.find("build log:") != std::string::npos);
   CHECK(message.find("primary.cl") != std::string::npos);  // the log names the file and line of the error
   CHECK_FALSE(fs::exists(box.work / "out.png"));
+}
+
+TEST_CASE("--version prints the version and git revision; stats, logs and images carry it", "[cli][conventions]") {
+  Sandbox box;
+  const Result v = box.run("--version");
+  INFO(v.err);
+  REQUIRE(v.exit_code == 0);
+  CHECK_THAT(v.out, Catch::StartsWith(std::string("algray ") + algray::version()));
+  const std::string version = v.out.substr(0, v.out.find('\n'));
+  CHECK(version == algray::version_string());
+
+  require_device();
+  REQUIRE(box.run("render -o out.exr -o out.png --preview " + kTiny + " --stats s.json").exit_code == 0);
+  CHECK(box.stats()["version"] == version);
+  const algray::FrameImage exr = algray::read_exr(box.work / "out.exr");
+  CHECK(exr.software == version);
+  CHECK_THAT(exr.comments, Catch::Contains("Barth sextic") && Catch::Contains("= 0"));
+  REQUIRE(exr.chromaticities);
+  CHECK((*exr.chromaticities)[0] == Approx(0.64));  // Rec.709 red x
+  CHECK((*exr.chromaticities)[6] == Approx(0.3127));  // D65 white x
+  std::map<std::string, std::string> png;
+  for (const auto& [key, text] : algray::read_png_text(box.work / "out.png")) png[key] = text;
+  CHECK(png["Software"] == version);
+  CHECK_THAT(png[algray::kPngSceneKey], Catch::Contains("[surface]") && Catch::Contains("[camera]"));
+
+  REQUIRE(box.run("probe --pixel 3,3 " + kTiny + " --stats p.json").exit_code == 0);
+  CHECK(box.stats("p.json")["version"] == version);
+  REQUIRE(box.run("devices --stats d.json").exit_code == 0);
+  CHECK(box.stats("d.json")["version"] == version);
+}
+
+TEST_CASE("a PNG that algray wrote renders again from the scene it carries", "[cli][conventions]") {
+  require_device();
+  Sandbox box;
+  // An orbit-like change and a --set the scene file does not have: the PNG must carry the scene as rendered.
+  const std::string first = "render " + scene_file("torus.toml") + " -o a.png -o a.exr " + kTiny +
+                            " --preview --set camera.eye=[1.5,4,3] --set camera.fov_y=35";
+  REQUIRE(box.run(first).exit_code == 0);
+  const Result again = box.run("render a.png -o b.exr");
+  INFO(again.err);
+  REQUIRE(again.exit_code == 0);
+  const algray::FrameImage a = algray::read_exr(box.work / "a.exr"), b = algray::read_exr(box.work / "b.exr");
+  REQUIRE(a.width == b.width);
+  CHECK(a.rgba == b.rgba);
+  CHECK(a.depth == b.depth);
+  // Overrides still apply on top of the embedded scene.
+  REQUIRE(box.run("render a.png -o c.exr --width 8 --height 6").exit_code == 0);
+  CHECK(algray::read_exr(box.work / "c.exr").width == 8);
+  // The image may not overwrite itself, and a PNG from elsewhere is refused with a reason.
+  const Result self = box.run("render a.png -o a.png");
+  CHECK(self.exit_code == 2);
+  CHECK_THAT(self.err, Catch::Contains("is the scene file"));
+  algray::FrameImage plain;
+  plain.width = plain.height = 2;
+  plain.rgba.assign(16, 0.5f);
+  algray::write_png(box.work / "plain.png", plain);
+  const Result foreign = box.run("render plain.png -o d.exr");
+  CHECK(foreign.exit_code == 2);
+  CHECK_THAT(foreign.err, Catch::Contains("carries no algray scene"));
+  CHECK_FALSE(fs::exists(box.work / "d.exr"));
 }

@@ -356,6 +356,9 @@ TEST_CASE("semantic errors", "[expression][errors]") {
   check_error("x + 1e-400", 4, "outside the range of double");
   check_error("x + 1e-99999999999999999999", 4, "outside the range of double");
   check_error("x", 0, "reserved", {{"x", 1.0}});
-  CHECK_NOTHROW(parse("x^1000"));
+  // The degree is bounded while parsing, at the kernels' limit unless the caller says otherwise.
+  CHECK_NOTHROW(parse("x^32"));
+  check_error("x^33", 2, "degree 33; algray renders degrees up to 32");
+  CHECK(algray::parse_equation("x^1000", {}, 1000).degree() == 1000);
   CHECK_NOTHROW(parse("x + 0e999"));
 }

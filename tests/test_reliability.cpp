@@ -1,0 +1,367 @@
+// Hostile input, full disks and damaged caches: each case a failure once found in algray, now a clear error or a render.
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cli_sandbox.h"
+#include "expression.h"
+#include "image_io.h"
+#include "scene_fixtures.h"
+
+namespace fs = std::filesystem;
+using namespace algray::testing;
+
+namespace {
+
+const std::string kTiny = "--width 16 --height 12";
+
+// A dotted key of `parts` parts: a.a.a...
+std::string dotted_key(int parts) {
+  std::string key = "a";
+  for (int i = 1; i < parts; ++i) key += ".a";
+  return key;
+}
+
+// The cache entries (program binaries) a render left in `dir`.
+std::vector<fs::path> cache_entries(const fs::path& dir) {
+  std::vector<fs::path> out;
+  if (!fs::exists(dir)) return out;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".bin") out.push_back(e.path());
+  return out;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+const std::string kBall =
+    "[surface]\nequation = \"x^2+y^2+z^2-r^2\"\n[parameters]\nr = 1\n[extent]\nradius = 2\n"
+    "[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nfov_y = 45\n";
+
+}  // namespace
+
+TEST_CASE("a damaged program-cache entry is rebuilt, never handed to OpenCL", "[reliability][cache]") {
+  require_device();
+  Sandbox box;
+  box.cache = box.root / "cache";  // this test's own cache, so its entry is the only one
+  const std::string render = "render --preview -o out.png " + kTiny + " --stats s.json";  // one kernel
+  REQUIRE(box.run(render).exit_code == 0);
+  const std::vector<fs::path> entries = cache_entries(box.cache);
+  REQUIRE(entries.size() == 1);
+  const fs::path entry = entries[0];
+  const std::string good = read_text(entry);
+  REQUIRE(good.size() > 100);
+  const std::string reference = read_text(box.work / "out.png");
+
+  struct Damage {
+    const char* what;
+    std::function<void()> apply;
+  };
+  const std::vector<Damage> damages = {
+      {"cut to half its size", [&] { fs::resize_file(entry, good.size() / 2); }},
+      {"cut to its header", [&] { fs::resize_file(entry, good.find("\n--\n") + 4); }},
+      {"one payload byte flipped",
+       [&] {
+         std::string bad = good;
+         bad[bad.size() - bad.size() / 3] ^= 0x5a;
+         write_text(entry, bad);
+       }},
+      {"empty", [&] { write_text(entry, ""); }},
+      {"a directory", [&] {
+         fs::remove(entry);
+         fs::create_directory(entry);
+       }}};
+  for (const Damage& d : damages) {
+    SECTION(d.what) {
+      d.apply();
+      const Result r = box.run(render);
+      INFO(r.err);
+      REQUIRE(r.exit_code == 0);
+      CHECK(box.stats()["programs"][0]["origin"] == "built");
+      CHECK(read_text(box.work / "out.png") == reference);
+      // Rebuilt and stored again: the next run loads it from disk.
+      const Result again = box.run(render);
+      REQUIRE(again.exit_code == 0);
+      CHECK(box.stats()["programs"][0]["origin"] == "disk");
+      CHECK(read_text(entry) == good);
+    }
+  }
+}
+
+TEST_CASE("keys nested 50,000 deep get a located error, not a stack overflow", "[reliability][errors]") {
+  Sandbox box;
+  const std::string deep = dotted_key(50000);
+  SECTION("in a scene file") {
+    const fs::path scene = box.scene("deep.toml", sphere_with({{1, deep + " = 1"}}));
+    const Result r = box.run("render " + quoted(scene.string()) + " -o out.png");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::StartsWith(scene.string() + ":1:1: error: ") && Catch::Contains("more than 32 parts"));
+  }
+  SECTION("in --set") {
+    const Result r = box.run("render -o out.png --set " + deep + "=1");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::StartsWith("--set a.a.a") && Catch::Contains("at most 32"));
+    CHECK(r.err.size() < 1000);  // the key is shown shortened, not 100,000 characters of it
+  }
+  SECTION("in an --set value") {
+    const Result r = box.run("render -o out.png --set 'camera.x={" + deep + "=1}'");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("more than 32 parts"));
+  }
+  SECTION("in arrays nested 50,000 deep") {
+    const fs::path scene =
+        box.scene("deep.toml", sphere_with({{1, "a = " + std::string(50000, '[') + std::string(50000, ']')}}));
+    const Result r = box.run("render " + quoted(scene.string()) + " -o out.png");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::StartsWith(scene.string() + ":1:") && Catch::Contains("nested more than"));
+  }
+  SECTION("in a jobs file") {
+    write_text(box.work / "jobs.toml", "[[job]]\nscene = \"s.toml\"\noutput = \"o.png\"\n" + deep + " = 2\n");
+    const Result r = box.run("batch jobs.toml");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::StartsWith("jobs.toml:4:1: error: "));
+    CHECK(box.work_files() == std::vector<std::string>{"jobs.toml"});
+  }
+  CHECK_FALSE(fs::exists(box.work / "out.png"));
+}
+
+TEST_CASE("an equation of too high a degree is refused at its exponent before it is expanded",
+          "[reliability][errors][expression]") {
+  struct Case {
+    const char* equation;
+    std::size_t position;  // 0-based, where the error points
+    const char* phrase;
+  };
+  const std::vector<Case> cases = {
+      {"(x+y+z+1)^1000", 10, "degree 1000"},
+      {"(x+y+z+1)^65", 10, "degree 65"},
+      {"(x^2+y^2+z^2-1)^10*(x+y)^13", 18, "product would have degree 33"},
+      {"((x+y+z+1)^8)^8", 14, "degree 64"},
+      {"x*(10^300)^1000", 11, "digits"},
+      {"((9^1000)^1000)^1000*x", 10, "digits"},
+      // Within the degree, but with coefficients so long that the expansion would take minutes.
+      {"(x+y+z+0.123456789012345678901234567890123456789012345678901234567890)^32", 71, "too long"},
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    INFO("case " << i << ": " << cases[i].equation);
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      algray::parse_equation(cases[i].equation, {}, 32);
+      FAIL("accepted");
+    } catch (const algray::EquationError& e) {
+      CHECK(e.position == cases[i].position);
+      CHECK_THAT(e.what(), Catch::Contains(cases[i].phrase));
+    }
+    CHECK(seconds_since(start) < 0.5);
+  }
+  // The bound is the degree of the result, not of the text: these stay within it and expand.
+  CHECK(algray::parse_equation("(x+y+z+1)^32", {}, 32).degree() == 32);
+  CHECK(algray::parse_equation("(x^2+y^2+z^2-1)^16*1", {}, 32).degree() == 32);
+}
+
+TEST_CASE("an endless scene file or standard input is refused after a few MB", "[reliability][errors]") {
+  Sandbox box;
+  const auto start = std::chrono::steady_clock::now();
+  const Result file = box.run("render /dev/zero -o out.png");
+  CHECK(file.exit_code == 2);
+  CHECK_THAT(file.err, Catch::StartsWith("/dev/zero: error: the scene file is larger than 4 MiB"));
+  const Result piped = box.run("render - -o out.png", "/dev/zero");
+  CHECK(piped.exit_code == 2);
+  CHECK_THAT(piped.err, Catch::StartsWith("<stdin>: error: the scene file is larger than 4 MiB"));
+  const Result jobs = box.run("batch /dev/zero");
+  CHECK(jobs.exit_code == 2);
+  CHECK_THAT(jobs.err, Catch::Contains("the jobs file is larger than 4 MiB"));
+  CHECK(seconds_since(start) < 20);
+  CHECK(box.work_files().empty());
+}
+
+TEST_CASE("a directory as the scene says so", "[reliability][errors]") {
+  Sandbox box;
+  const Result r = box.run("render " + quoted(box.in.string()) + " -o out.png");
+  CHECK(r.exit_code == 2);
+  CHECK_THAT(r.err, Catch::StartsWith(box.in.string() + ": error: is a directory, not a scene file"));
+  const Result jobs = box.run("batch " + quoted(box.in.string()));
+  CHECK(jobs.exit_code == 2);
+  CHECK_THAT(jobs.err, Catch::Contains("is a directory, not a jobs file"));
+}
+
+TEST_CASE("no output may be an input or another output of the same run", "[reliability][errors]") {
+  Sandbox box;
+  const std::string scene_text = sphere_with({});
+  const fs::path scene = box.scene("s.toml", scene_text);
+  const std::string s = quoted(scene.string());
+  struct Case {
+    const char* what;
+    std::string args;
+    const char* phrase;
+  };
+  const std::vector<Case> cases = {
+      {"--stats on the scene", "render " + s + " -o out.png --stats " + s, "is the scene file"},
+      {"--stats on the scene, other spelling",
+       "render " + s + " -o out.png --stats " + quoted((box.in / "." / "s.toml").string()), "is the scene file"},
+      {"--stats on an output", "render " + s + " -o out.png --stats ./out.png", "are the same file"},
+      {"one output twice", "render " + s + " -o out.exr -o ../work/out.exr", "are the same file"},
+      {"--heatmap on an output", "render " + s + " -o out.png --heatmap out.png", "are the same file"},
+      {"probe --stats on the scene", "probe " + s + " --pixel 1,1 --stats " + s, "is the scene file"},
+      {"probe --plot on --stats", "probe " + s + " --pixel 1,1 --stats p.png --plot p.png", "are the same file"},
+  };
+  for (const Case& c : cases) {
+    SECTION(c.what) {
+      const Result r = box.run(c.args);
+      INFO(r.err);
+      CHECK(r.exit_code == 2);
+      CHECK_THAT(r.err, Catch::Contains(c.phrase));
+      CHECK(read_text(scene) == scene_text);
+      CHECK(box.work_files().empty());
+    }
+  }
+  SECTION("a hard link to the scene") {
+    fs::create_hard_link(scene, box.work / "linked.png");
+    const Result r = box.run("render " + s + " -o linked.png");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("is the scene file"));
+    CHECK(read_text(scene) == scene_text);
+  }
+  SECTION("batch: a job's stats on its scene, the log on the jobs file") {
+    write_text(box.work / "ball.toml", kBall);
+    const std::string jobs = "[[job]]\nscene = \"ball.toml\"\noutput = \"b.png\"\nstats = \"ball.toml\"\n";
+    write_text(box.work / "jobs.toml", jobs);
+    Result r = box.run("batch jobs.toml");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("is the scene of job"));
+    CHECK(read_text(box.work / "ball.toml") == kBall);
+    write_text(box.work / "jobs.toml", "[[job]]\nscene = \"ball.toml\"\noutput = \"b.png\"\n");
+    r = box.run("batch jobs.toml --log jobs.toml");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--log jobs.toml is the jobs file"));
+    CHECK(read_text(box.work / "jobs.toml") == "[[job]]\nscene = \"ball.toml\"\noutput = \"b.png\"\n");
+    r = box.run("batch jobs.toml --stats ball.toml");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--stats ball.toml is the scene of job"));
+    CHECK_FALSE(fs::exists(box.work / "b.png"));
+  }
+}
+
+TEST_CASE("a write that fails after rendering exits 1 and names what was and was not written",
+          "[reliability][output]") {
+  require_device();
+  Sandbox box;
+  // The EXR with its channels is far larger than the PNG: a file size limit between the two lets the first
+  // through and stops the second. With SIGXFSZ ignored the write fails with EFBIG, as on a full disk.
+  const std::string args = "render -o small.png -o big.exr --stats s.json --width 64 --height 64";
+  REQUIRE(box.run(args).exit_code == 0);  // also puts the kernel into the cache
+  const std::uintmax_t limit_kib = fs::file_size(box.work / "small.png") / 1024 + 2;
+  REQUIRE(fs::file_size(box.work / "big.exr") > limit_kib * 1024);
+  for (const char* f : {"small.png", "big.exr", "s.json"}) fs::remove(box.work / f);
+  const std::string limited =
+      "bash -c " + quoted("trap '' XFSZ; ulimit -f " + std::to_string(limit_kib) + "; exec \"$0\" \"$@\"") + " ";
+  const std::string cmd = "cd " + quoted(box.work.string()) + " && ALGRAY_CACHE_DIR=" + quoted(box.cache.string()) +
+                          " " + limited + quoted(ALGRAY_BINARY) +
+                          " " + args + " 2>" +
+                          quoted((box.in / "err.txt").string());
+  const int status = std::system(cmd.c_str());
+  REQUIRE(WIFEXITED(status));
+  const std::string err = read_text(box.in / "err.txt");
+  INFO(err);
+  CHECK(WEXITSTATUS(status) == 1);
+  CHECK_THAT(err, Catch::Contains("big.exr"));
+  CHECK_THAT(err, Catch::Contains("written: small.png"));
+  CHECK_THAT(err, Catch::Contains("not written: big.exr, s.json"));
+  CHECK(fs::exists(box.work / "small.png"));
+  // Nothing half-written is left: no partial EXR, no temporary file.
+  CHECK(box.work_files() == std::vector<std::string>{"small.png"});
+}
+
+TEST_CASE("batch --log on a full disk stops with exit 1 and a message, not an abort", "[reliability][output]") {
+  require_device();
+  Sandbox box;
+  write_text(box.work / "ball.toml", kBall);
+  write_text(box.work / "jobs.toml",
+             "[[job]]\nscene = \"ball.toml\"\noutput = \"b{frame}.png\"\nframes = 3\nset = { image = { width = 8, "
+             "height = 8 } }\nsweep.r = { from = 0.5, to = 1, steps = 3 }\n");
+  const Result r = box.run("batch jobs.toml --log /dev/full");
+  INFO(r.err);
+  CHECK(r.exit_code == 1);
+  CHECK_THAT(r.err, Catch::Contains("cannot write the batch log /dev/full: No space left on device"));
+  CHECK_THAT(r.err, Catch::Contains("stopped after"));
+}
+
+TEST_CASE("huge numbers get located errors with exit 2, or render", "[reliability][errors]") {
+  Sandbox box;
+  SECTION("a box extent of +-1e200") {
+    const fs::path scene = box.scene(
+        "box.toml", sphere_with({{5, "type = \"box\"\nmin = [-1e200, -1, -1]\nmax = [1e200, 1, 1]"}}));
+    const Result r = box.run("render " + quoted(scene.string()) + " -o out.png");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::StartsWith(scene.string() + ":6:8: error: extent.min[0] is too large"));
+  }
+  SECTION("an eye at 1e300") {
+    const fs::path scene = box.scene("eye.toml", sphere_with({{7, "eye = [0, 0, 1e300]"}}));
+    const Result r = box.run("render " + quoted(scene.string()) + " -o out.png");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::StartsWith(scene.string() + ":7:") && Catch::Contains("camera.eye[2] is too large"));
+  }
+  SECTION("a sweep from -1.7e308 to 1.7e308 sweeps finite values") {
+    require_device();
+    write_text(box.work / "ball.toml", kBall);
+    write_text(box.work / "jobs.toml",
+               "[[job]]\nscene = \"ball.toml\"\noutput = \"b{frame}.png\"\nset = { image = { width = 8, height = 8 } "
+               "}\nsweep.r = { from = -1.7e308, to = 1.7e308, steps = 3 }\n");
+    const Result r = box.run("batch jobs.toml");
+    INFO(r.err);
+    CHECK((r.exit_code == 0 || r.exit_code == 1));  // frames may fail on such a surface, but the batch runs
+    std::istringstream log(read_text(box.work / "jobs.log.jsonl"));
+    int lines = 0;
+    for (std::string line; std::getline(log, line); ++lines) {
+      const nlohmann::json j = nlohmann::json::parse(line);
+      const double r_value = std::stod(j["set"]["r"].get<std::string>());
+      INFO(line);
+      CHECK(std::isfinite(r_value));
+    }
+    CHECK(lines == 3);
+  }
+  SECTION("--plot-range -1e308,1e308") {
+    const Result r = box.run("probe --pixel 1,1 --plot p.svg --plot-range -1e308,1e308");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--plot-range -1e308,1e308: expected"));
+  }
+  SECTION("a 300-character file name") {
+    const Result r = box.run("render -o " + std::string(300, 'a') + ".png");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("the file name is 304 bytes long"));
+  }
+}
+
+TEST_CASE("an error in what a .jsurf file translates to points into the .jsurf", "[reliability][errors][jsurf]") {
+  Sandbox box;
+  const fs::path file = box.scene("big.jsurf",
+                                  "surface_equation=x^2+y^2+z^2-1\n"
+                                  "scale_factor=308\n"
+                                  "light_status_0=ON\n");
+  const Result r = box.run("render " + quoted(file.string()) + " -o out.png");
+  INFO(r.err);
+  CHECK(r.exit_code == 2);
+  CHECK_THAT(r.err, Catch::StartsWith(file.string() + ":2:14: error: scale_factor: "));
+  CHECK_THAT(r.err, Catch::Contains("scale_factor=308"));  // the excerpt is the .jsurf line
+  CHECK_THAT(r.err, !Catch::Contains("translated"));
+}
+
+TEST_CASE("a render too large for the memory is refused up front, naming the estimate", "[reliability][errors]") {
+  require_device();
+  Sandbox box;
+  const auto start = std::chrono::steady_clock::now();
+  const Result r = box.run("render -o out.exr --width 32768 --height 32768 --set antialias.samples=2");
+  INFO(r.err);
+  CHECK(r.exit_code == 2);
+  CHECK_THAT(r.err, Catch::Contains("needs about") && Catch::Contains(" GB of memory") &&
+                        Catch::Contains("32768x32768 render with 2x2 samples"));
+  CHECK(seconds_since(start) < 30);
+  CHECK(box.work_files().empty());
+}
