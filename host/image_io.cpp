@@ -43,6 +43,7 @@
 #include <system_error>
 #include <thread>
 
+#include "temp_files.h"
 #include "version.h"
 
 namespace algray {
@@ -66,7 +67,6 @@ struct TempSlot {
 static_assert(std::atomic<int>::is_always_lock_free, "signal handler needs lock-free atomics");
 
 TempSlot g_slots[kSlotCount];
-std::atomic<unsigned long> g_temp_counter{0};
 
 extern "C" void cleanup_then_reraise(int sig) {
   for (TempSlot& slot : g_slots) {
@@ -92,8 +92,7 @@ std::string temp_prefix(const fs::path& destination) {
 class TempFile {
  public:
   explicit TempFile(const fs::path& destination) {
-    path_ = destination.parent_path() /
-            (temp_prefix(destination) + std::to_string(::getpid()) + "-" + std::to_string(++g_temp_counter));
+    path_ = destination.parent_path() / temp_file_name(temp_prefix(destination));
     const std::string& text = path_.native();
     if (text.size() >= kPathCapacity) return;  // too long to register; a truncated path could unlink a stranger
     for (std::size_t i = 0; i < kSlotCount; ++i) {
@@ -158,47 +157,10 @@ void sync_directory(const fs::path& dir) {
 
 std::string cannot_write(const fs::path& path) { return "cannot write '" + path.string() + "': "; }
 
-// Whether `name` (a file name in some directory) is one of destination's temporaries: temp_prefix, then
-// "<pid>-<counter>" in decimal. Returns the pid, or 0 for any other name.
-pid_t temp_file_pid(const std::string& name, const std::string& prefix) {
-  if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) return 0;
-  const std::string rest = name.substr(prefix.size());
-  const std::size_t dash = rest.find('-');
-  if (dash == 0 || dash == std::string::npos || dash + 1 == rest.size()) return 0;
-  auto digits = [](const std::string& t) {
-    return std::all_of(t.begin(), t.end(), [](unsigned char c) { return c >= '0' && c <= '9'; });
-  };
-  const std::string pid_text = rest.substr(0, dash);
-  if (!digits(pid_text) || !digits(rest.substr(dash + 1)) || pid_text.size() > 9) return 0;
-  return static_cast<pid_t>(std::stol(pid_text));
-}
-
-// How long a dead pid's temporary must have been left alone before it is removed; see write_image's comment.
-constexpr auto kStaleTempAge = std::chrono::seconds(60);
-
-// Best effort: a temporary that cannot be listed, read or removed is left as it was.
-void remove_stale_temps(const fs::path& destination) {
-  const std::string prefix = temp_prefix(destination);
-  const pid_t self = ::getpid();
-  std::error_code ec;
-  fs::directory_iterator it(destination.parent_path(), ec);
-  for (const fs::directory_iterator end; !ec && it != end; it.increment(ec)) {
-    const pid_t pid = temp_file_pid(it->path().filename().string(), prefix);
-    // Our own pid: another thread of this process is writing it.
-    if (pid <= 0 || pid == self) continue;
-    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;
-    std::error_code file_ec;
-    if (!it->is_regular_file(file_ec)) continue;
-    const auto modified = it->last_write_time(file_ec);
-    if (file_ec || fs::file_time_type::clock::now() - modified < kStaleTempAge) continue;
-    fs::remove(it->path(), file_ec);
-  }
-}
-
 void write_atomically(const fs::path& path, const std::function<void(const fs::path&)>& write_to) {
   check_output_path(path);
   const fs::path destination = fs::absolute(path);
-  remove_stale_temps(destination);
+  remove_stale_temps(destination.parent_path(), temp_prefix(destination));
   // What write_to throws as OutputError is the image's fault, found before the file is touched; anything
   // else failed on the way to the disk.
   try {

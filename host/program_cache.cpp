@@ -4,7 +4,6 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstdint>
@@ -13,6 +12,7 @@
 #include <sstream>
 
 #include "kernel_sources.h"
+#include "temp_files.h"
 
 namespace algray {
 namespace {
@@ -181,8 +181,9 @@ void ProgramCache::store_on_disk(const cl::Program& program, const std::filesyst
 bool ProgramCache::write_entry(const std::filesystem::path& file, const std::string& content) {
   // Written in full and fsync'd before the rename, so that no crash or power cut can leave a short entry under the
   // final name; pid and counter keep concurrent writers (threads or processes) apart.
-  static std::atomic<unsigned> counter{0};
-  const std::string tmp = file.string() + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(++counter);
+  const std::string prefix = file.filename().string() + ".tmp-";
+  remove_stale_temps(file.parent_path(), prefix);  // left by writers killed mid-write
+  const std::string tmp = (file.parent_path() / temp_file_name(prefix)).string();
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) return false;
   bool ok = true;

@@ -1,4 +1,7 @@
 // Hostile input, full disks and damaged caches: each case a failure once found in algray, now a clear error or a render.
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <cmath>
@@ -78,8 +81,16 @@ TEST_CASE("a damaged program-cache entry is rebuilt, never handed to OpenCL", "[
          fs::remove(entry);
          fs::create_directory(entry);
        }}};
+  // A temporary entry that a writer killed by SIGKILL left (a reaped child's pid is dead), old enough to be stale.
+  const pid_t dead = fork();
+  if (dead == 0) _exit(0);
+  REQUIRE(dead > 0);
+  REQUIRE(waitpid(dead, nullptr, 0) == dead);
+  const fs::path leftover = entry.string() + ".tmp-" + std::to_string(dead) + "-1";
   for (const Damage& d : damages) {
     SECTION(d.what) {
+      write_text(leftover, "half an entry");
+      fs::last_write_time(leftover, fs::file_time_type::clock::now() - std::chrono::minutes(5));
       d.apply();
       const Result r = box.run(render);
       INFO(r.err);
@@ -91,6 +102,7 @@ TEST_CASE("a damaged program-cache entry is rebuilt, never handed to OpenCL", "[
       REQUIRE(again.exit_code == 0);
       CHECK(box.stats()["programs"][0]["origin"] == "disk");
       CHECK(read_text(entry) == good);
+      CHECK_FALSE(fs::exists(leftover));  // the rebuild's write removed it
     }
   }
 }
