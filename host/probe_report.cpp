@@ -409,18 +409,10 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
     return report_error(e, err);
   }
   // Paths were checked above: a write that fails from here on is a failure (exit 1), not bad input.
-  std::vector<std::string> written;
-  const auto write_or_report = [&](const std::string& path, const std::function<void()>& write) {
-    try {
-      write();
-      written.push_back(path);
-    } catch (const std::exception& e) {
-      std::string done;
-      for (const std::string& w : written) done += (done.empty() ? "" : ", ") + w;
-      throw IncompleteOutputError(std::string(e.what()) + "\n  written: " + (done.empty() ? "nothing" : done) +
-                                  "\n  not written: " + path);
-    }
-  };
+  std::vector<std::string> planned;
+  if (req.stats_path) planned.push_back(*req.stats_path);
+  if (req.plot_path) planned.push_back(*req.plot_path);
+  OutputWriter writer(planned);
   try {
     RenderContext context(req.device_spec, req.use_cache);
     ClSession& session = context.session();
@@ -438,7 +430,7 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
       const nlohmann::json j = probe_json(scene, req.target, probes);
       if (req.json) out << j.dump(2) << "\n";
       if (req.stats_path)
-        write_or_report(*req.stats_path, [&] { write_text_file(*req.stats_path, j.dump(2) + "\n"); });
+        writer.write(*req.stats_path, [&] { write_text_file(*req.stats_path, j.dump(2) + "\n"); });
     }
     if (!req.json) print_probe(out, scene, req.target, probes);
     if (req.plot_path) {
@@ -453,7 +445,7 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
         return kExitFailure;
       }
       const auto plot = make_plot(scene, req.target, *hit, req.plot_range);
-      write_or_report(*req.plot_path, [&] { write_probe_plot(*req.plot_path, plot); });
+      writer.write(*req.plot_path, [&] { write_probe_plot(*req.plot_path, plot); });
     }
   } catch (const std::exception& e) {
     return report_error(e, err);

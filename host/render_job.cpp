@@ -235,6 +235,25 @@ void check_distinct_files(const std::vector<RoleAndPath>& inputs, const std::vec
   }
 }
 
+void OutputWriter::write(const std::string& path, const std::function<void()>& write_file) {
+  try {
+    write_file();
+    written_.push_back(path);
+  } catch (const std::exception& e) {
+    std::string message = e.what();
+    message += "\n  written: " + (written_.empty() ? std::string("nothing") : join(written_, ", "));
+    std::vector<std::string> unwritten;
+    bool after = false;
+    for (const std::string& p : planned_) {
+      after = after || p == path;
+      if (after) unwritten.push_back(p);
+    }
+    if (unwritten.empty()) unwritten.push_back(path);
+    message += "\n  not written: " + join(unwritten, ", ");
+    throw IncompleteOutputError(message);
+  }
+}
+
 RenderContext::RenderContext(std::string device_spec, bool use_cache)
     : device_spec_(std::move(device_spec)), use_cache_(use_cache) {}
 
@@ -337,44 +356,28 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
   }
   add_metadata(image, scene, result, device);
   timer.mark("shade");
-  // Every path was checked before rendering, so a write that fails now (a full disk) is a failure, not bad input:
-  // the message says which files were written and which were not.
-  std::vector<std::string> written;
-  const auto write_or_report = [&](const std::string& path, const std::function<void()>& write) {
-    try {
-      write();
-      written.push_back(path);
-    } catch (const std::exception& e) {
-      std::string unwritten;
-      bool after = false;
-      for (const RoleAndPath& o : request_outputs(req)) {
-        if (o.path == path) after = true;
-        else if (after) unwritten += (unwritten.empty() ? "" : ", ") + o.path;
-      }
-      std::string message = e.what();
-      message += "\n  written: " + (written.empty() ? std::string("nothing") : join(written, ", "));
-      message += "\n  not written: " + path + (unwritten.empty() ? "" : ", " + unwritten);
-      throw IncompleteOutputError(message);
-    }
-  };
+  // Every path was checked before rendering, so a write that fails now (a full disk) is a failure, not bad input.
+  std::vector<std::string> planned;
+  for (const RoleAndPath& o : request_outputs(req)) planned.push_back(o.path);
+  OutputWriter writer(planned);
   if (!req.aovs.empty() || req.heatmap_path) {
     const SolverWork work = solver_work(result);
     add_solver_aovs(image, work, req.aovs);
     if (req.heatmap_path) {
       const std::string per =
           work.samples > 1 ? " (sum over " + std::to_string(work.samples * work.samples) + " samples)" : "";
-      write_or_report(*req.heatmap_path, [&] {
+      writer.write(*req.heatmap_path, [&] {
         write_image(*req.heatmap_path, work_heatmap(work.width, work.height, work.total(), work.in_extent(),
                                                     "isolation steps + refinement iterations per pixel" + per));
       });
     }
     timer.mark("diagnostics");
   }
-  for (const std::string& out : req.outputs) write_or_report(out, [&] { write_image(out, image); });
+  for (const std::string& out : req.outputs) writer.write(out, [&] { write_image(out, image); });
   timer.mark("write");
   nlohmann::json stats = stats_json(scene, req, result, device, timer);
   if (req.stats_path)
-    write_or_report(*req.stats_path, [&] { write_text_file(*req.stats_path, stats.dump(2) + "\n"); });
+    writer.write(*req.stats_path, [&] { write_text_file(*req.stats_path, stats.dump(2) + "\n"); });
   return stats;
 }
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -48,6 +49,18 @@ void check_distinct_files(const std::vector<RoleAndPath>& inputs, const std::vec
 // message names what was written and what was not.
 struct IncompleteOutputError : std::runtime_error {
   using std::runtime_error::runtime_error;
+};
+
+// Writes a command's outputs one after another once its work is done. A failure then is not bad input: it throws
+// IncompleteOutputError with the reason, what was written and what was not (this one and those planned after it).
+class OutputWriter {
+ public:
+  explicit OutputWriter(std::vector<std::string> planned) : planned_(std::move(planned)) {}
+  void write(const std::string& path, const std::function<void()>& write_file);
+
+ private:
+  std::vector<std::string> planned_;  // every output, in the order they are written
+  std::vector<std::string> written_;
 };
 
 // Throws OutputError when `path` cannot be written (missing or unwritable directory, or a directory itself): bad

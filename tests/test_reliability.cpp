@@ -48,6 +48,14 @@ const std::string kBall =
     "[surface]\nequation = \"x^2+y^2+z^2-r^2\"\n[parameters]\nr = 1\n[extent]\nradius = 2\n"
     "[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nfov_y = 45\n";
 
+// ball.toml and jobs.toml in the sandbox: a 3-frame sweep of the ball's radius over `range` ("from = a, to = b").
+void write_ball_sweep(const Sandbox& box, const std::string& range) {
+  write_text(box.work / "ball.toml", kBall);
+  write_text(box.work / "jobs.toml", "[[job]]\nscene = \"ball.toml\"\noutput = \"b{frame}.png\"\n"
+                                     "set = { image = { width = 8, height = 8 } }\nsweep.r = { " + range +
+                                         ", steps = 3 }\n");
+}
+
 }  // namespace
 
 TEST_CASE("a damaged program-cache entry is rebuilt, never handed to OpenCL", "[reliability][cache]") {
@@ -294,10 +302,7 @@ TEST_CASE("a write that fails after rendering exits 1 and names what was and was
 TEST_CASE("batch --log on a full disk stops with exit 1 and a message, not an abort", "[reliability][output]") {
   require_device();
   Sandbox box;
-  write_text(box.work / "ball.toml", kBall);
-  write_text(box.work / "jobs.toml",
-             "[[job]]\nscene = \"ball.toml\"\noutput = \"b{frame}.png\"\nframes = 3\nset = { image = { width = 8, "
-             "height = 8 } }\nsweep.r = { from = 0.5, to = 1, steps = 3 }\n");
+  write_ball_sweep(box, "from = 0.5, to = 1");
   const Result r = box.run("batch jobs.toml --log /dev/full");
   INFO(r.err);
   CHECK(r.exit_code == 1);
@@ -322,10 +327,7 @@ TEST_CASE("huge numbers get located errors with exit 2, or render", "[reliabilit
   }
   SECTION("a sweep from -1.7e308 to 1.7e308 sweeps finite values") {
     require_device();
-    write_text(box.work / "ball.toml", kBall);
-    write_text(box.work / "jobs.toml",
-               "[[job]]\nscene = \"ball.toml\"\noutput = \"b{frame}.png\"\nset = { image = { width = 8, height = 8 } "
-               "}\nsweep.r = { from = -1.7e308, to = 1.7e308, steps = 3 }\n");
+    write_ball_sweep(box, "from = -1.7e308, to = 1.7e308");
     const Result r = box.run("batch jobs.toml");
     INFO(r.err);
     CHECK((r.exit_code == 0 || r.exit_code == 1));  // frames may fail on such a surface, but the batch runs
