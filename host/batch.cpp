@@ -367,6 +367,9 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
       }
     }
     check_distinct_files(inputs, outputs);
+    // Every frame's paths are checked now, as render checks its own, so that a bad one is bad input (exit 2)
+    // before anything renders rather than a failure of each frame.
+    for (const RoleAndPath& o : outputs) check_output_writable(o.path);
   } catch (const std::exception& e) {
     return report_error(e, err);
   }

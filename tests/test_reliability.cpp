@@ -350,6 +350,13 @@ TEST_CASE("huge numbers get located errors with exit 2, or render", "[reliabilit
     const Result r = box.run("render -o " + std::string(300, 'a') + ".png");
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("the file name is 304 bytes long"));
+    write_ball_sweep(box, "from = 0.5, to = 1");
+    write_text(box.work / "jobs.toml", read_text(box.work / "jobs.toml") + "stats = \"" + std::string(300, 's') +
+                                           "{frame}.json\"\n");
+    const Result batch = box.run("batch jobs.toml");
+    CHECK(batch.exit_code == 2);
+    CHECK_THAT(batch.err, Catch::Contains("the file name is 306 bytes long"));
+    CHECK_FALSE(fs::exists(box.work / "b0.png"));
   }
 }
 
