@@ -1,0 +1,58 @@
+# Runs one fuzz target for a fixed time from a fresh copy of its seeds; fails on any finding or if it did not fuzz.
+#
+# cmake -DFUZZER=path -DKIND=equation|scene|jsurf|jobs -DSOURCE_DIR=repo -DWORK=scratch-dir [-DSECONDS=30]
+#       [-DDICT=file] -P run_fuzz.cmake
+# WORK is emptied first; the corpus grows there, never in the repository. A crash, leak, timeout or out-of-memory
+# input is kept in WORK (crash-*, leak-*, timeout-*, oom-*) and printed in hex, so that a CI log alone reproduces it.
+
+foreach(var FUZZER KIND SOURCE_DIR WORK)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "run_fuzz.cmake needs -D${var}=...")
+  endif()
+endforeach()
+if(NOT DEFINED SECONDS)
+  set(SECONDS 30)
+endif()
+
+file(REMOVE_RECURSE ${WORK})
+execute_process(COMMAND ${CMAKE_COMMAND} -DKIND=${KIND} -DSOURCE_DIR=${SOURCE_DIR} -DOUT=${WORK}/corpus
+                        -P ${CMAKE_CURRENT_LIST_DIR}/make_seeds.cmake
+                COMMAND_ERROR_IS_FATAL ANY)
+
+set(args -max_total_time=${SECONDS} -max_len=65536 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
+         -artifact_prefix=${WORK}/)
+if(DEFINED DICT)
+  list(APPEND args -dict=${DICT})
+endif()
+execute_process(COMMAND ${FUZZER} ${args} ${WORK}/corpus
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+file(WRITE ${WORK}/fuzzer.log "${out}")
+
+file(GLOB artifacts ${WORK}/crash-* ${WORK}/leak-* ${WORK}/timeout-* ${WORK}/oom-*)
+if(NOT rc EQUAL 0 OR artifacts)
+  message("${out}")
+  foreach(a ${artifacts})
+    file(SIZE ${a} size)
+    file(READ ${a} hex LIMIT 4096 HEX)
+    message("reproducer ${a} (${size} bytes; first 4096 in hex):\n${hex}")
+  endforeach()
+  message(FATAL_ERROR "${KIND}: the fuzzer found a problem (exit ${rc}); rerun one input with: ${FUZZER} <file>")
+endif()
+
+# A run that never got going (no seeds read, few inputs executed) must not pass as "found nothing".
+set(seeds 0)
+if(out MATCHES "INFO: seed corpus: files: ([0-9]+)")
+  set(seeds ${CMAKE_MATCH_1})
+endif()
+set(runs 0)
+if(out MATCHES "Done ([0-9]+) runs in ([0-9]+) second")
+  set(runs ${CMAKE_MATCH_1})
+  set(secs ${CMAKE_MATCH_2})
+endif()
+if(seeds EQUAL 0 OR runs LESS 100)
+  message("${out}")
+  message(FATAL_ERROR "${KIND}: the fuzzer read ${seeds} seeds and ran ${runs} inputs; it did not really fuzz")
+endif()
+string(REGEX MATCHALL "#[0-9]+[ \t]+[A-Z]+[ \t]+cov: [0-9]+ ft: [0-9]+ corp: [0-9]+/[0-9]+[a-zA-Z]*" statuses "${out}")
+list(POP_BACK statuses final)
+message(STATUS "${KIND}: ${seeds} seeds, ${runs} runs in ${secs} s, no findings; last: ${final}")
