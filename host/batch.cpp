@@ -219,7 +219,8 @@ class JsonLinesLog {
     using std::runtime_error::runtime_error;
   };
 
-  JsonLinesLog(const std::string& path, bool append) : path_(path), out_(path, append ? std::ios::app : std::ios::trunc) {
+  JsonLinesLog(const std::string& path, bool append)
+      : path_(path), out_(path, append ? std::ios::app : std::ios::trunc) {
     if (!out_) throw OutputError("cannot write the batch log " + path);
   }
   void write(const nlohmann::json& j) {

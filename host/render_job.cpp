@@ -280,7 +280,8 @@ Scene load_scene(const std::optional<std::string>& path, const std::vector<Overr
       throw SceneError(*path, e.what());
     }
     for (const auto& [key, text] : texts)
-      if (key == kPngSceneKey) return load_scene_text(text, *path + " (the scene in its " + kPngSceneKey + " text)", overrides);
+      if (key == kPngSceneKey)
+        return load_scene_text(text, *path + " (the scene in its " + kPngSceneKey + " text)", overrides);
     throw SceneError(*path, std::string("this PNG carries no algray scene (no ") + kPngSceneKey +
                                 " text chunk): only images written by algray render can be rendered again");
   }

@@ -62,7 +62,9 @@ bool is_index(const std::string& s) {
 
 void apply_override(toml::table& root, const Override& o) {
   // A hostile key or value may be megabytes long: messages show its start.
-  const auto shown = [](const std::string& t) { return t.size() <= 120 ? t : t.substr(0, 100) + "...(" + std::to_string(t.size()) + " characters)"; };
+  const auto shown = [](const std::string& t) {
+    return t.size() <= 120 ? t : t.substr(0, 100) + "...(" + std::to_string(t.size()) + " characters)";
+  };
   const std::string label = (o.origin.empty() ? "--set " : o.origin + ": set ") + shown(o.key) + "=" + shown(o.value);
   // A bare name is a parameter; any other key is a dotted path into the scene.
   const std::string key = o.key.find('.') == std::string::npos ? "parameters." + o.key : o.key;
@@ -78,7 +80,8 @@ void apply_override(toml::table& root, const Override& o) {
                                 std::to_string(kMaxTomlKeyParts) + " are allowed");
   const auto check_identifier = [&](const std::string& part) {
     if (!is_identifier(part))
-      throw SceneError(label, "'" + shown(o.key) + "' is not a dotted scene key such as camera.fov_y or light.0.intensity");
+      throw SceneError(label,
+                       "'" + shown(o.key) + "' is not a dotted scene key such as camera.fov_y or light.0.intensity");
   };
   // Walk down the existing tables. A list of tables ([[surface]], [[light]]) is reached by index, as in
   // light.0.intensity, and the override applies inside that one table: merging at the list would replace the
@@ -622,7 +625,8 @@ std::string scene_to_toml(const Scene& scene) {
     out << "\n[[light]]\ntype = \"" << light_type(l.kind) << "\"\nposition = " << toml_vec(l.position) << "\n";
     if (l.kind == LightKind::Rectangle)
       out << "edge_u = " << toml_vec(l.edge_u) << "\nedge_v = " << toml_vec(l.edge_v) << "\n";
-    if (l.kind == LightKind::Disc) out << "normal = " << toml_vec(l.normal) << "\nradius = " << toml_number(l.radius) << "\n";
+    if (l.kind == LightKind::Disc)
+      out << "normal = " << toml_vec(l.normal) << "\nradius = " << toml_number(l.radius) << "\n";
     if (l.kind != LightKind::Point) out << "samples = " << l.samples << "\n";
     out << "colour = " << toml_vec(l.colour) << "\nintensity = " << toml_number(l.intensity)
         << "\nshadows = " << (l.shadows ? "true" : "false") << "\n";

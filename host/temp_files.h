@@ -1,4 +1,5 @@
-// Temporary files named "<prefix><pid>-<counter>" beside their destination, and the removal of those a dead process left.
+// Temporary files named "<prefix><pid>-<counter>" beside their destination, and the removal of those a dead process
+// left.
 #pragma once
 
 #include <filesystem>

@@ -1,4 +1,4 @@
-// Hostile input, full disks and damaged caches: each case a failure once found in algray, now a clear error or a render.
+// Hostile input, full disks, damaged caches: each a failure once found in algray, now an error or a render.
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -51,9 +51,10 @@ const std::string kBall =
 // ball.toml and jobs.toml in the sandbox: a 3-frame sweep of the ball's radius over `range` ("from = a, to = b").
 void write_ball_sweep(const Sandbox& box, const std::string& range) {
   write_text(box.work / "ball.toml", kBall);
-  write_text(box.work / "jobs.toml", "[[job]]\nscene = \"ball.toml\"\noutput = \"b{frame}.png\"\n"
-                                     "set = { image = { width = 8, height = 8 } }\nsweep.r = { " + range +
-                                         ", steps = 3 }\n");
+  write_text(box.work / "jobs.toml",
+             "[[job]]\nscene = \"ball.toml\"\noutput = \"b{frame}.png\"\n"
+             "set = { image = { width = 8, height = 8 } }\nsweep.r = { " +
+                 range + ", steps = 3 }\n");
 }
 
 }  // namespace
@@ -75,20 +76,19 @@ TEST_CASE("a damaged program-cache entry is rebuilt, never handed to OpenCL", "[
     const char* what;
     std::function<void()> apply;
   };
-  const std::vector<Damage> damages = {
-      {"cut to half its size", [&] { fs::resize_file(entry, good.size() / 2); }},
-      {"cut to its header", [&] { fs::resize_file(entry, good.find("\n--\n") + 4); }},
-      {"one payload byte flipped",
-       [&] {
-         std::string bad = good;
-         bad[bad.size() - bad.size() / 3] ^= 0x5a;
-         write_text(entry, bad);
-       }},
-      {"empty", [&] { write_text(entry, ""); }},
-      {"a directory", [&] {
-         fs::remove(entry);
-         fs::create_directory(entry);
-       }}};
+  const std::vector<Damage> damages = {{"cut to half its size", [&] { fs::resize_file(entry, good.size() / 2); }},
+                                       {"cut to its header", [&] { fs::resize_file(entry, good.find("\n--\n") + 4); }},
+                                       {"one payload byte flipped",
+                                        [&] {
+                                          std::string bad = good;
+                                          bad[bad.size() - bad.size() / 3] ^= 0x5a;
+                                          write_text(entry, bad);
+                                        }},
+                                       {"empty", [&] { write_text(entry, ""); }},
+                                       {"a directory", [&] {
+                                          fs::remove(entry);
+                                          fs::create_directory(entry);
+                                        }}};
   // A temporary entry that a writer killed by SIGKILL left (a reaped child's pid is dead), old enough to be stale.
   const pid_t dead = fork();
   if (dead == 0) _exit(0);
@@ -283,8 +283,7 @@ TEST_CASE("a write that fails after rendering exits 1 and names what was and was
   const std::string limited =
       "bash -c " + quoted("trap '' XFSZ; ulimit -f " + std::to_string(limit_kib) + "; exec \"$0\" \"$@\"") + " ";
   const std::string cmd = "cd " + quoted(box.work.string()) + " && ALGRAY_CACHE_DIR=" + quoted(box.cache.string()) +
-                          " " + limited + quoted(ALGRAY_BINARY) +
-                          " " + args + " 2>" +
+                          " " + limited + quoted(ALGRAY_BINARY) + " " + args + " 2>" +
                           quoted((box.in / "err.txt").string());
   const int status = std::system(cmd.c_str());
   REQUIRE(WIFEXITED(status));
@@ -313,8 +312,8 @@ TEST_CASE("batch --log on a full disk stops with exit 1 and a message, not an ab
 TEST_CASE("huge numbers get located errors with exit 2, or render", "[reliability][errors]") {
   Sandbox box;
   SECTION("a box extent of +-1e200") {
-    const fs::path scene = box.scene(
-        "box.toml", sphere_with({{5, "type = \"box\"\nmin = [-1e200, -1, -1]\nmax = [1e200, 1, 1]"}}));
+    const fs::path scene =
+        box.scene("box.toml", sphere_with({{5, "type = \"box\"\nmin = [-1e200, -1, -1]\nmax = [1e200, 1, 1]"}}));
     const Result r = box.run("render " + quoted(scene.string()) + " -o out.png");
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::StartsWith(scene.string() + ":6:8: error: extent.min[0] is too large"));
@@ -351,8 +350,8 @@ TEST_CASE("huge numbers get located errors with exit 2, or render", "[reliabilit
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("the file name is 304 bytes long"));
     write_ball_sweep(box, "from = 0.5, to = 1");
-    write_text(box.work / "jobs.toml", read_text(box.work / "jobs.toml") + "stats = \"" + std::string(300, 's') +
-                                           "{frame}.json\"\n");
+    write_text(box.work / "jobs.toml",
+               read_text(box.work / "jobs.toml") + "stats = \"" + std::string(300, 's') + "{frame}.json\"\n");
     const Result batch = box.run("batch jobs.toml");
     CHECK(batch.exit_code == 2);
     CHECK_THAT(batch.err, Catch::Contains("the file name is 306 bytes long"));

@@ -169,7 +169,8 @@ TEST_CASE("the polynomial must have degree 1 to 32", "[scene][errors]") {
   // Too high a power is reported at its exponent, before it is expanded; the rest at the equation value, whose
   // opening quote is column 12.
   check_error(sphere_with({{3, "equation = \"x^33\""}}), "t.toml:3:15", "this power would have degree 33");
-  check_error(sphere_with({{3, "terms = [[33, 0, 0, 1.0]]"}}), "t.toml:3:9", "degree 33 exceeds the supported maximum 32");
+  check_error(sphere_with({{3, "terms = [[33, 0, 0, 1.0]]"}}), "t.toml:3:9",
+              "degree 33 exceeds the supported maximum 32");
   check_error(sphere_with({{3, "equation = \"x-x\""}}), "t.toml:3:12", "identically zero");
   check_error(sphere_with({{3, "equation = \"2\""}}), "t.toml:3:12", "nonzero constant");
   CHECK_NOTHROW(algray::load_scene_text(sphere_with({{3, "equation = \"x^32+y-1\""}}), "t.toml"));
