@@ -177,6 +177,13 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
       r.fail(output->source(), e.what());
     }
   }
+  if (job.stats) {
+    try {
+      expand_pattern(*job.stats, job, 0);
+    } catch (const SceneError& e) {
+      r.fail(get("stats")->source(), e.message);
+    }
+  }
   job.output_origin = origin_of(r, *output);
   return job;
 }

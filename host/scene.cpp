@@ -134,9 +134,13 @@ void apply_override(toml::table& root, const Override& o) {
   try {
     parsed = toml::parse(rest + " = " + o.value, label);
   } catch (const toml::parse_error&) {
-    if (o.value.find_first_of("'\n") != std::string::npos)
+    // As a literal string it must still be TOML: no quote, no line break, no control character, valid UTF-8.
+    try {
+      if (o.value.find_first_of("'\n") != std::string::npos) throw std::invalid_argument("quote or line break");
+      parsed = toml::parse(rest + " = '" + o.value + "'", label);
+    } catch (const std::exception&) {
       throw SceneError(label, "value is neither valid TOML nor a plain string");
-    parsed = toml::parse(rest + " = '" + o.value + "'", label);
+    }
   }
   merge_tables(*target, std::move(parsed));
 }

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "batch.h"
 #include "cli_sandbox.h"
 #include "expression.h"
 #include "image_io.h"
@@ -384,4 +385,26 @@ TEST_CASE("a render too large for the memory is refused up front, naming the est
                         Catch::Contains("32768x32768 render with 2x2 samples"));
   CHECK(seconds_since(start) < 30);
   CHECK(box.work_files().empty());
+}
+
+TEST_CASE("what the one-hour fuzz runs found is refused with a located error", "[reliability][errors][fuzz]") {
+  // fuzz_scene: an --set value that is neither TOML nor valid as a literal string (bytes that are not UTF-8)
+  // escaped as toml::parse_error from the second parse and terminated the process.
+  const std::string text = sphere_with({});
+  try {
+    algray::load_scene_text(text, "t.toml", {{"r", std::string("0],\xff\xff]]")}});
+    FAIL("accepted");
+  } catch (const algray::SceneError& e) {
+    CHECK(e.where == "--set r=0],\xff\xff]]");
+    CHECK_THAT(e.message, Catch::Contains("neither valid TOML nor a plain string"));
+  }
+  // fuzz_jobs: a stats pattern's unknown placeholder was reported under the job's name, not where it is written.
+  try {
+    algray::load_jobs("[[job]]\nname = \"one\"\nscene = \"s.toml\"\noutput = \"o.png\"\nstats = \"{$name}.json\"\n",
+                      "jobs.toml", "/tmp");
+    FAIL("accepted");
+  } catch (const algray::SceneError& e) {
+    CHECK(e.where == "jobs.toml:5:9");
+    CHECK_THAT(e.message, Catch::Contains("unknown placeholder {$name}"));
+  }
 }
