@@ -9,6 +9,8 @@ packages=(
   catch2 libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgmp-dev
   python3
+  clang libclang-rt-14-dev  # the sanitizer tree and libFuzzer targets of scripts/test.sh
+  help2man                  # the man page
 )
 
 missing=()
