@@ -1,7 +1,7 @@
 // libFuzzer target for parse_equation: leading "#name=value" lines are parameters, the rest is the equation.
 //
 // Expected: a Polynomial of degree <= kDefaultMaxEquationDegree, or EquationError at a position inside the text.
-// Anything else escaping (std::bad_alloc, std::domain_error, ...), a sanitizer report, a leak or a 10-s input is a
+// Anything else escaping (std::bad_alloc, std::domain_error, ...), a sanitizer report, a leak or a 60-s input is a
 // finding.
 #include <cmath>
 #include <cstdint>

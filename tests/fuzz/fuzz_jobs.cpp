@@ -1,7 +1,7 @@
 // libFuzzer target for load_jobs: the whole input is a batch jobs file; scenes are named, never opened.
 //
 // Expected: jobs with at least one frame and one output each, or SceneError located in fuzz_jobs.toml. Anything
-// else escaping, a sanitizer report, a leak or a 10-s input is a finding.
+// else escaping, a sanitizer report, a leak or a 60-s input is a finding.
 #include <cstdint>
 #include <string>
 

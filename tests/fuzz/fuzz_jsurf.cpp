@@ -1,7 +1,7 @@
 // libFuzzer target for load_jsurf_text: the whole input is a .jsurf (Java properties) file.
 //
 // Expected: a valid Scene, or SceneError located in fuzz.jsurf itself, never in the TOML it is translated to (the
-// user never saw that). Anything else escaping, a sanitizer report, a leak or a 10-s input is a finding.
+// user never saw that). Anything else escaping, a sanitizer report, a leak or a 60-s input is a finding.
 #include <cstdint>
 #include <string>
 

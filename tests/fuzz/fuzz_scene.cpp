@@ -1,7 +1,7 @@
 // libFuzzer target for load_scene_text: leading "--set key=value" lines are overrides, the rest is the TOML scene.
 //
 // Expected: a valid Scene, or SceneError located in fuzz.toml or naming the override. Anything else escaping, a
-// sanitizer report, a leak or a 10-s input is a finding.
+// sanitizer report, a leak or a 60-s input is a finding.
 #include <cstdint>
 #include <string>
 #include <string_view>
