@@ -213,6 +213,7 @@ class Parser {
   const std::map<std::string, double>& params_;
   std::vector<Token> tokens_;
   int max_degree_;
+  double spent_work_ = 0;  // the expansion work admitted so far, against kMaxExpansionWork
   std::size_t next_ = 0;
   int depth_ = 0;
 
@@ -221,7 +222,7 @@ class Parser {
   // expansion, terms x terms x (kTermOverhead + bits), which bounds its time: measured in a Release build on
   // this project's 2-core machines, 1.2 to 2.4 ns per unit ((x+y+z+1)^32: 1.9e8 units, 0.46 s; with a 9-digit
   // constant: 1.9e9, 2.3 s).
-  void check_growth(std::size_t pos, const char* what, long long degree, double bits, double work) const {
+  void check_growth(std::size_t pos, const char* what, long long degree, double bits, double work) {
     if (degree > max_degree_)
       throw EquationError(pos, std::string("this ") + what + " would have degree " + std::to_string(degree) +
                                    "; algray renders degrees up to " + std::to_string(max_degree_));
@@ -230,10 +231,13 @@ class Parser {
                                    std::to_string(static_cast<long long>(bits * 0.30103)) + " digits; at most " +
                                    std::to_string(static_cast<long long>(kMaxCoefficientBits * 0.30103)) +
                                    " are allowed");
-    if (work > kMaxExpansionWork) {
-      char text[160];
-      std::snprintf(text, sizeof text, "expanding this %s would take too long (about %.1e coefficient bit operations, "
-                                       "at most %.0e); simplify it or use fewer digits", what, work, kMaxExpansionWork);
+    // The budget is the whole equation's: 40 admissible powers in a sum must not cost 40 times one.
+    spent_work_ += work;
+    if (work > kMaxExpansionWork || spent_work_ > kMaxExpansionWork) {
+      char text[256];
+      std::snprintf(text, sizeof text, "expanding this %s would take too long (about %.1e coefficient bit operations "
+                                       "for the equation so far, at most %.0e); simplify it or use fewer digits",
+                    what, spent_work_, kMaxExpansionWork);
       throw EquationError(pos, text);
     }
   }
