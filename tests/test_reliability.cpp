@@ -180,7 +180,7 @@ TEST_CASE("an equation of too high a degree is refused at its exponent before it
       CHECK(e.position == cases[i].position);
       CHECK_THAT(e.what(), Catch::Contains(cases[i].phrase));
     }
-    CHECK(seconds_since(start) < 0.5);
+    CHECK(seconds_since(start) < 2);  // refused before expanding: milliseconds, with room for a loaded sanitizer build
   }
   // The bound is the degree of the result, not of the text: these stay within it and expand.
   CHECK(algray::parse_equation("(x+y+z+1)^32", {}, 32).degree() == 32);
