@@ -233,10 +233,6 @@ bool is_affine(const glm::dmat4& m) {
   return std::fabs(m[0][3]) + std::fabs(m[1][3]) + std::fabs(m[2][3]) + std::fabs(m[3][3] - 1) < 1e-9;
 }
 
-std::string toml_vector(const glm::dvec3& v) {
-  return "[" + toml_number(v.x) + ", " + toml_number(v.y) + ", " + toml_number(v.z) + "]";
-}
-
 // jsurf's colours are display values in 0..1, shaded without gamma; algray's are linear.
 glm::dvec3 colour_or(const Properties& props, const std::string& key, glm::dvec3 fallback) {
   const Property* p = props.get(key);

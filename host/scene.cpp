@@ -546,20 +546,8 @@ Scene load_jsurf_text(const std::string& text, const std::string& source_name, c
 
 namespace {
 
-std::string toml_vec(const glm::dvec3& v) {
-  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + std::string.
-  std::string out = "[";
-  out += toml_number(v.x);
-  out += ", ";
-  out += toml_number(v.y);
-  out += ", ";
-  out += toml_number(v.z);
-  out += "]";
-  return out;
-}
-
 void write_material(std::ostringstream& out, const std::string& table, const Material& m) {
-  out << "\n[" << table << "]\ncolour = " << toml_vec(m.colour) << "\nambient = " << toml_number(m.ambient)
+  out << "\n[" << table << "]\ncolour = " << toml_vector(m.colour) << "\nambient = " << toml_number(m.ambient)
       << "\ndiffuse = " << toml_number(m.diffuse) << "\nspecular = " << toml_number(m.specular)
       << "\nexponent = " << toml_number(m.exponent) << "\nreflectivity = " << toml_number(m.reflectivity)
       << "\ntransparency = " << toml_number(m.transparency) << "\n";
@@ -611,14 +599,14 @@ std::string scene_to_toml(const Scene& scene) {
   }
   const Extent& e = scene.extent;
   if (e.kind == ExtentKind::Sphere)
-    out << "\n[extent]\ntype = \"sphere\"\ncentre = " << toml_vec(e.centre) << "\nradius = " << toml_number(e.radius)
+    out << "\n[extent]\ntype = \"sphere\"\ncentre = " << toml_vector(e.centre) << "\nradius = " << toml_number(e.radius)
         << "\n";
   else
-    out << "\n[extent]\ntype = \"box\"\nmin = " << toml_vec(e.min) << "\nmax = " << toml_vec(e.max) << "\n";
+    out << "\n[extent]\ntype = \"box\"\nmin = " << toml_vector(e.min) << "\nmax = " << toml_vector(e.max) << "\n";
   const CameraSpec& c = scene.camera;
   const bool perspective = c.projection == Projection::Perspective;
   out << "\n[camera]\nprojection = \"" << (perspective ? "perspective" : "orthographic") << "\"\neye = "
-      << toml_vec(c.eye) << "\nlook_at = " << toml_vec(c.look_at) << "\nup = " << toml_vec(c.up) << "\n"
+      << toml_vector(c.eye) << "\nlook_at = " << toml_vector(c.look_at) << "\nup = " << toml_vector(c.up) << "\n"
       << (perspective ? "fov_y = " + toml_number(c.fov_y_degrees) : "height = " + toml_number(c.ortho_height))
       << "\n";
   const glm::dvec4& bg = scene.image.background;
@@ -626,13 +614,13 @@ std::string scene_to_toml(const Scene& scene) {
       << toml_number(bg.r) << ", " << toml_number(bg.g) << ", " << toml_number(bg.b) << ", " << toml_number(bg.a)
       << "]\n";
   for (const Light& l : scene.lights) {
-    out << "\n[[light]]\ntype = \"" << light_type(l.kind) << "\"\nposition = " << toml_vec(l.position) << "\n";
+    out << "\n[[light]]\ntype = \"" << light_type(l.kind) << "\"\nposition = " << toml_vector(l.position) << "\n";
     if (l.kind == LightKind::Rectangle)
-      out << "edge_u = " << toml_vec(l.edge_u) << "\nedge_v = " << toml_vec(l.edge_v) << "\n";
+      out << "edge_u = " << toml_vector(l.edge_u) << "\nedge_v = " << toml_vector(l.edge_v) << "\n";
     if (l.kind == LightKind::Disc)
-      out << "normal = " << toml_vec(l.normal) << "\nradius = " << toml_number(l.radius) << "\n";
+      out << "normal = " << toml_vector(l.normal) << "\nradius = " << toml_number(l.radius) << "\n";
     if (l.kind != LightKind::Point) out << "samples = " << l.samples << "\n";
-    out << "colour = " << toml_vec(l.colour) << "\nintensity = " << toml_number(l.intensity)
+    out << "colour = " << toml_vector(l.colour) << "\nintensity = " << toml_number(l.intensity)
         << "\nshadows = " << (l.shadows ? "true" : "false") << "\n";
   }
   const Antialias& aa = scene.antialias;

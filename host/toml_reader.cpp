@@ -34,6 +34,18 @@ std::string toml_number(double v) {
   return s;
 }
 
+std::string toml_vector(const glm::dvec3& v) {
+  // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "[" + std::string.
+  std::string out = "[";
+  out += toml_number(v.x);
+  out += ", ";
+  out += toml_number(v.y);
+  out += ", ";
+  out += toml_number(v.z);
+  out += "]";
+  return out;
+}
+
 bool is_identifier(const std::string& s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
   return std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isalnum(c) || c == '_'; });

@@ -18,6 +18,7 @@ namespace algray {
 // A string or a float as TOML text, read back exactly: control characters escaped, floats to 17 digits.
 std::string toml_quoted(const std::string& s);
 std::string toml_number(double v);
+std::string toml_vector(const glm::dvec3& v);  // [x, y, z], each as toml_number
 
 // A letter or _, then letters, digits or _: a bare TOML key segment, and a parameter name.
 bool is_identifier(const std::string& s);
