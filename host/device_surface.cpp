@@ -5,6 +5,7 @@
 #include <array>
 
 #include "algray_shared.h"
+#include "screen_form.h"
 
 namespace algray {
 namespace {
@@ -115,6 +116,21 @@ void DeviceSurface::set_surface_args(KernelArgs& args) const {
   args.plain(static_cast<cl_uint>(data_.coefficients.size()));
   args.plain(binomials_);
   args.plain(data_.even_axes);
+}
+
+cl::Buffer DeviceSurface::set_screen_args(KernelArgs& args, const cl::Context& ctx, const KernelConfig& config,
+                                          const RayBasis& basis, int width, int height, int row0, int rows) const {
+  if (config.ray_origin != RayOrigin::Screen) return {};
+  const ScreenGeometry geometry = screen_geometry(basis, width, height, extent_);
+  std::vector<std::uint32_t> exponents(data_.exponents.begin(), data_.exponents.end());
+  const ScreenForm form(exponents, data_.coefficients, data_.degree, geometry);
+  cl::Buffer buffer = real_buffer(ctx, form.rows(row0, rows, height), precision_);
+  args.plain(buffer);
+  args.plain(static_cast<cl_uint>(row0));
+  args.real(geometry.t0);
+  args.real(geometry.xi_scale);
+  args.real(geometry.xi_offset);
+  return buffer;
 }
 
 }  // namespace algray

@@ -56,6 +56,11 @@ class DeviceSurface {
   // Extent and surface arguments, in the order primary.cl and shadow.cl declare them.
   void set_extent_args(KernelArgs& args) const;
   void set_surface_args(KernelArgs& args) const;
+  // A screen-form build's extra primary and probe arguments (SCREEN_ROWS_PARAM in kernels/surface.h): rows
+  // row0 .. row0 + rows - 1 of the width x height camera image of `basis`. Sets nothing for other builds. The
+  // kernel reads the returned buffer: keep it until the launches are done.
+  cl::Buffer set_screen_args(KernelArgs& args, const cl::Context& ctx, const KernelConfig& config,
+                             const RayBasis& basis, int width, int height, int row0, int rows) const;
 
  private:
   Precision precision_;

@@ -65,8 +65,14 @@ int kernel_id(const std::array<std::pair<Enum, int>, N>& table, Enum value) {
     if (e == value) return id;
   return 0;
 }
-constexpr std::array<std::pair<const char*, RayOrigin>, 2> kOrigins{
-    {{"extent", RayOrigin::Extent}, {"eye", RayOrigin::Eye}}};
+constexpr std::array<std::pair<const char*, RayOrigin>, 4> kOrigins{{{"auto", RayOrigin::Auto},
+                                                                      {"extent", RayOrigin::Extent},
+                                                                      {"eye", RayOrigin::Eye},
+                                                                      {"screen", RayOrigin::Screen}}};
+// Auto never reaches a kernel: primary_config resolves it.
+constexpr std::array<std::pair<RayOrigin, int>, 3> kOriginIds{{{RayOrigin::Extent, ALGRAY_ORIGIN_EXTENT},
+                                                               {RayOrigin::Eye, ALGRAY_ORIGIN_EYE},
+                                                               {RayOrigin::Screen, ALGRAY_ORIGIN_SCREEN}}};
 
 std::string hex_double(double v) {
   char buf[64];
@@ -94,7 +100,7 @@ int default_max_iterations(Refinement r) { return r == Refinement::RegulaFalsi ?
 std::string KernelConfig::build_options() const {
   const int isolation_id = kernel_id(kIsolationIds, isolation);
   const int refinement_id = kernel_id(kRefinementIds, refinement);
-  const int origin_id = ray_origin == RayOrigin::Extent ? ALGRAY_ORIGIN_EXTENT : ALGRAY_ORIGIN_EYE;
+  const int origin_id = kernel_id(kOriginIds, ray_origin);
   // Hexadecimal literals carry the tolerance bit for bit; float builds get a float literal, as devices
   // without fp64 need not accept double constants.
   const std::string tolerance_literal =

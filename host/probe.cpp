@@ -92,6 +92,8 @@ SolverTrace trace_probe(ClSession& session, ProgramCache& cache, const Scene& sc
                         KernelConfig config, const ProbeTarget& target, std::uint32_t capacity) {
   const cl_uint log_capacity = std::max<std::uint32_t>(capacity, 1);
   config.entry = "probe";
+  // A given ray is traced as the trace kernel traces it: the screen form is the camera rays' alone.
+  if (target.given_ray && config.ray_origin == RayOrigin::Screen) config.ray_origin = RayOrigin::Extent;
   SolverTrace trace;
   trace.config = config;
   ProgramRecord record;
@@ -117,6 +119,9 @@ SolverTrace trace_probe(ClSession& session, ProgramCache& cache, const Scene& sc
   args.real_vec(target.direction);
   surface.set_extent_args(args);
   surface.set_surface_args(args);
+  // The render computes every row; the probe only its own, with the same arithmetic.
+  const cl::Buffer screen_rows = surface.set_screen_args(args, ctx, config, b, scene.image.width, scene.image.height,
+                                                         static_cast<int>(target.py), 1);
   args.plain(out);
   args.plain(ray_out);
   args.plain(events);

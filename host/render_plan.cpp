@@ -6,8 +6,15 @@
 #include <limits>
 
 #include "algray_shared.h"
+#include "screen_form.h"
 
 namespace algray {
+
+bool screen_form_applies(const Scene& scene, Precision precision, int degree) {
+  if (precision != Precision::Double || degree > kScreenMaxDegree) return false;
+  const RayBasis basis = make_ray_basis(scene.camera, scene.image.width, scene.image.height);
+  return screen_geometry(basis, scene.image.width, scene.image.height, scene.extent).well_placed;
+}
 
 KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t surface) {
   KernelConfig config;
@@ -17,6 +24,8 @@ KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t
   config.isolation = scene.render.isolation;
   config.refinement = scene.render.refinement;
   config.ray_origin = scene.render.ray_origin;
+  if (config.ray_origin == RayOrigin::Auto)
+    config.ray_origin = screen_form_applies(scene, precision, config.degree) ? RayOrigin::Screen : RayOrigin::Extent;
   // Below a few units of roundoff the stopping rule can never trigger.
   const double eps =
       precision == Precision::Double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();
@@ -52,7 +61,10 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
   for (std::size_t i = 0; i < scene.surfaces.size(); ++i) primary.push_back(primary_config(scene, precision, i));
   auto with_entry = [&](const std::string& entry) {
     std::vector<KernelConfig> configs = primary;
-    for (KernelConfig& c : configs) c.entry = entry;
+    for (KernelConfig& c : configs) {
+      c.entry = entry;
+      if (c.ray_origin == RayOrigin::Screen) c.ray_origin = RayOrigin::Extent;  // the screen form is camera rays'
+    }
     return configs;
   };
   plan.passes.push_back({"primary", plan.samples > 1 ? "camera rays, " + std::to_string(plan.samples) + "x" +

@@ -207,6 +207,8 @@ void Renderer::run_primary(Passes& passes, bool show_progress) {
     args.ray_basis(result.basis);
     surface.set_extent_args(args);
     surface.set_surface_args(args);
+    const cl::Buffer screen_rows = surface.set_screen_args(args, session_.context, result.plan.find("primary")->kernels[s],
+                                                           result.basis, width, height, 0, height);
     args.plain(static_cast<cl_uint>(width));
     const cl_uint tile_arg = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
     args.skip(4);

@@ -442,6 +442,8 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
       if (rs.ray_origin == RayOrigin::Eye && rs.isolation == Isolation::Bernstein)
         r.fail(n->source(),
                "render.ray_origin = \"eye\" needs a power-basis isolation (descartes, sturm or derivative-chain)");
+      if (rs.ray_origin == RayOrigin::Screen && rs.precision == Precision::Mixed)
+        r.fail(n->source(), "render.ray_origin = \"screen\" is built in float or double, not mixed precision");
     }
     if (const toml::node* n = render->get("max_iterations"))
       rs.max_iterations = static_cast<int>(r.integer(*n, "render.max_iterations", 1, 1000000));

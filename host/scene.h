@@ -100,7 +100,7 @@ struct RenderSettings {
   double tolerance = 1e-9;
   Isolation isolation = Isolation::Bernstein;
   Refinement refinement = Refinement::Brent;
-  RayOrigin ray_origin = RayOrigin::Extent;
+  RayOrigin ray_origin = RayOrigin::Auto;
   int max_iterations = 0;  // 0: the refinement's default (default_max_iterations)
   int tile_size = 0;       // pixels per side of a dispatched tile; 0 chooses by device type
   bool preview = false;    // primary rays only: lights shade, but cast no shadows (the paper's preview mode)

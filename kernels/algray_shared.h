@@ -39,6 +39,8 @@ typedef cl_int algray_i32;
 #define ALGRAY_REFINEMENT_NEWTON 5     /* Newton's method, safeguarded by the bracket */
 #define ALGRAY_ORIGIN_EXTENT 1         /* P*(t) built around the middle of [t_in, t_out] (well conditioned) */
 #define ALGRAY_ORIGIN_EYE 2            /* P*(t) built around the ray origin, as the paper does */
+#define ALGRAY_ORIGIN_SCREEN 3         /* camera rays: P*(t) from its Taylor coefficients where the ray crosses the
+                                          extent's middle, given per image row as polynomials in the column */
 
 /* Per-pixel result of the primary kernel; 32 bytes. */
 typedef struct {

@@ -9,18 +9,24 @@
 /* One tile of the image per launch: global size (tile_w, tile_h), results at out[py * image_width + px].
  * The polynomial is given in unit coordinates u = (p - centre) * inv_scale, with max |coefficient| = 1.
  * binomials[n * (DEGREE + 1) + k] = C(n, k) for 0 <= k <= n <= DEGREE (zero elsewhere).
- * even_axes: bit 0, 1, 2 set when every exponent of x, y, z in the polynomial is even. */
+ * even_axes: bit 0, 1, 2 set when every exponent of x, y, z in the polynomial is even.
+ * Screen builds also take the image rows' polynomials (SCREEN_ROWS_PARAM, surface.h). */
 __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, REAL4 ray_du, REAL4 ray_dv,
                       REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
                       __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
-                      __constant const REAL* binomials, uint even_axes, uint image_width, uint tile_x0, uint tile_y0,
+                      __constant const REAL* binomials, uint even_axes SCREEN_ROWS_PARAM, uint image_width,
+                      uint tile_x0, uint tile_y0,
                       uint tile_w, uint tile_h, __global HitRecord* out) {
   const uint gx = get_global_id(0), gy = get_global_id(1);
   if (gx >= tile_w || gy >= tile_h) return;
   const uint px = tile_x0 + gx, py = tile_y0 + gy;
 
   const Ray ray = camera_ray(px, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
+#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
+  REAL taylor[NCOEF];
+  const REAL taylor_t = screen_ray_taylor(px, py, SCREEN_ROWS_ARG, taylor);
+#endif
   const SurfaceHit hit = trace_surface(ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                       mono_exps, mono_coefs, mono_count, binomials, even_axes);
+                                       mono_exps, mono_coefs, mono_count, binomials, even_axes SCREEN_ARG);
   out[(size_t)py * image_width + px] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
 }

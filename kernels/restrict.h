@@ -327,4 +327,43 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
   acc_store(out, out_lo, acc_x);
 }
 
+/* The screen form (RAY_ORIGIN=screen): P*(t) = sum_k taylor[k] (t - t0)^k around a point of the ray near the
+ * extent's middle. Over the segment t - t0 runs linearly from tau_in to tau_out, so Horner's scheme in t - t0 on
+ * the homogeneous accumulators gives the coefficients in the isolation's basis directly: D linear steps instead
+ * of one per monomial. */
+void restrict_from_taylor(const REAL* taylor, REAL tau_in, REAL tau_out, __constant const REAL* binomials,
+                          REAL* out) {
+  Acc acc[ACC_SLOTS];
+#if RESTRICT_BERNSTEIN
+  const REAL l0 = tau_in, l1 = tau_out;
+#else
+  const REAL l0 = tau_in, l1 = tau_out - tau_in;
+#endif
+  acc_set_constant(acc, taylor[DEGREE], 0);
+  ALGRAY_UNROLL
+  for (int k = DEGREE - 1; k >= 0; --k) {
+    acc_mul_linear(acc, l0, l1);
+    acc_add_constant(acc, DEGREE - k, taylor[k], 0, binomials);
+  }
+  acc_store(out, out, acc);
+}
+
+/* The Taylor coefficients of one camera ray from its image row's polynomials in the column xi (in [-1, 1]):
+ * row[j * NCOEF + k] is the xi^j coefficient of taylor[k]. One vector Horner step per power of xi. */
+void screen_taylor(__global const REAL* row, REAL xi, REAL* taylor) {
+#if DEGREE <= 15
+  /* Lanes above the degree read the next power's coefficients; they never reach taylor[0..DEGREE]. The host
+   * pads the rows' buffer so that the last power loads as one vector. */
+  PolyVec h = VEC_LOAD(row + DEGREE * NCOEF);
+  ALGRAY_UNROLL
+  for (int j = DEGREE - 1; j >= 0; --j) h = h * xi + VEC_LOAD(row + j * NCOEF);
+  vec_store(taylor, h);
+#else
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) taylor[k] = row[DEGREE * NCOEF + k];
+  for (int j = DEGREE - 1; j >= 0; --j) ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) taylor[k] = taylor[k] * xi + row[j * NCOEF + k];
+#endif
+}
+
 #endif /* ALGRAY_RESTRICT_H */

@@ -6,6 +6,10 @@
 #include "restrict.h"
 #include "surface.h"
 
+#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
+#error "the screen form is for camera rays; the host builds this kernel with RAY_ORIGIN=extent"
+#endif
+
 /* One work-item per surface point. points[i].xyz is the point (world), normals[i].xyz its unit normal on the
  * side the camera sees; light_points[0 .. light_count) are the light's sample points. Bit s of occluded[i]
  * is set when sample s is hidden: by the surface's own side facing away from it, or by a root of P*(t) on

@@ -12,6 +12,32 @@
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EYE && ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
 #error "RAY_ORIGIN=eye needs a power-basis isolation method"
 #endif
+#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && ALGRAY_COMPENSATED
+#error "RAY_ORIGIN=screen is built in plain float or double"
+#endif
+
+/* The screen form hands each camera ray's Taylor coefficients, about t = taylor_t, to the solver; other builds
+ * take nothing more. */
+#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
+#define SCREEN_PARAM , const REAL *taylor, REAL taylor_t
+#define SCREEN_ARG , taylor, taylor_t
+/* The kernel arguments of the screen form: rows[(py - row0) * NCOEF * NCOEF + j * NCOEF + k] is the xi^j
+ * coefficient of row py's taylor[k], expanded about t = taylor_t; a pixel's xi = (px + 1/2) * xi_scale + xi_offset. */
+#define SCREEN_ROWS_PARAM , __global const REAL *screen_rows, uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset
+#define SCREEN_ROWS_ARG screen_rows, screen_row0, screen_t, xi_scale, xi_offset
+
+/* Pixel (px, py)'s Taylor coefficients; returns the t they are expanded about. */
+REAL screen_ray_taylor(uint px, uint py, __global const REAL* rows, uint row0, REAL t0, REAL xi_scale,
+                       REAL xi_offset, REAL* taylor) {
+  const REAL xi = ((REAL)px + (REAL)0.5) * xi_scale + xi_offset;
+  screen_taylor(rows + (size_t)(py - row0) * (NCOEF * NCOEF), xi, taylor);
+  return t0;
+}
+#else
+#define SCREEN_PARAM
+#define SCREEN_ARG
+#define SCREEN_ROWS_PARAM
+#endif
 
 /* The outcome of isolating and refining the smallest root of P*(t) on [t_in, t_out]. */
 typedef struct {
@@ -72,9 +98,26 @@ SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
  * returns, the other only asks whether there is anything to refine. */
 Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
                              __global const REAL* coefs, uint count, __constant const REAL* binomials,
-                             uint even_axes, REAL* iso_c PROBE_PARAM) {
+                             uint even_axes, REAL* iso_c SCREEN_PARAM PROBE_PARAM) {
   REAL root[NCOEF], root_lo[NCOEF];
-#if RAY_ORIGIN == ALGRAY_ORIGIN_EYE
+#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
+  /* The same coefficients the extent construction computes from the monomials, from D + 1 numbers instead. */
+  (void)o;
+  (void)d;
+  (void)exps;
+  (void)coefs;
+  (void)count;
+  (void)even_axes;
+  restrict_from_taylor(taylor, t_in - taylor_t, t_out - taylor_t, binomials, root);
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+  bernstein_from_scaled(root, root_lo, binomials);
+  probe_coefficients(root, root_lo, ALGRAY_BASIS_BERNSTEIN PROBE_ARG);
+  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
+#else
+  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_SEGMENT PROBE_ARG);
+  return isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c PROBE_ARG);
+#endif
+#elif RAY_ORIGIN == ALGRAY_ORIGIN_EYE
   /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(o.x, d.x, even_axes & 1),
                   axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root, root_lo);
@@ -101,7 +144,7 @@ Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global c
 
 SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                          __global const uint* exps, __global const REAL* coefs, uint count,
-                         __constant const REAL* binomials, uint even_axes PROBE_PARAM) {
+                         __constant const REAL* binomials, uint even_axes SCREEN_PARAM PROBE_PARAM) {
   SurfaceHit h;
   h.root.t = INFINITY;
   h.root.f_before = 0;
@@ -120,7 +163,7 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
 
   REAL iso_c[NCOEF];
   const Isolation iso =
-      isolate_on_segment(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, iso_c PROBE_ARG);
+      isolate_on_segment(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, iso_c SCREEN_ARG PROBE_ARG);
   h.root = refine_isolated(iso, iso_c, t_in, t_out, binomials PROBE_ARG);
   h.root.flags |= ALGRAY_HIT_IN_EXTENT;
   if (h.root.flags & ALGRAY_HIT_FOUND) h.u = o + h.root.t * d;

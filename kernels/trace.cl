@@ -6,6 +6,10 @@
 #include "restrict.h"
 #include "surface.h"
 
+#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
+#error "the screen form is for camera rays; the host builds this kernel with RAY_ORIGIN=extent"
+#endif
+
 /* Ray i is origins[i].xyz + t * directions[i].xyz, t >= 0, in world coordinates; its hit goes to out[i] as the
  * primary kernel writes it (t, depth, normal facing the ray, side, work). */
 __kernel void trace(__global const REAL4* origins, __global const REAL4* directions, uint count,

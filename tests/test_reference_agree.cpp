@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <random>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -54,7 +56,48 @@ void check_scene(Renderer& renderer, const std::filesystem::path& file, const ch
 
 using testing::scene_files;
 
+// A seeded random surface of exactly `degree` in the unit sphere, seen from outside: x^n + y^n + z^n fixes the
+// degree, then 3n random monomials of lower degrees with coefficients in [-1, 1] (the bench's family).
+std::string random_scene(int degree, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> coefficient(-1, 1);
+  std::ostringstream s;
+  s.precision(17);
+  s << "[surface]\nterms = [[" << degree << ", 0, 0, 1], [0, " << degree << ", 0, 1], [0, 0, " << degree
+    << ", 1], [0, 0, 0, -0.25]";
+  for (int m = 0; m < 3 * degree; ++m) {
+    const int total = std::uniform_int_distribution<int>(1, std::max(1, degree - 1))(rng);
+    const int i = std::uniform_int_distribution<int>(0, total)(rng);
+    const int j = std::uniform_int_distribution<int>(0, total - i)(rng);
+    s << ", [" << i << ", " << j << ", " << total - i - j << ", " << coefficient(rng) << "]";
+  }
+  s << "]\n[extent]\ntype = \"sphere\"\nradius = 1\n[camera]\neye = [1.2, 0.9, 2.6]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n"
+    << "fov_y = 45\n[image]\nwidth = 64\nheight = 48\n[render]\nprecision = \"double\"\npreview = true\n"
+    << "ray_origin = \"auto\"\n";
+  return s.str();
+}
+
 }  // namespace
+
+TEST_CASE("the screen form meets the double line on seeded random surfaces up to its degree limit", "[reference]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  for (int degree = 1; degree <= kScreenMaxDegree; ++degree)
+    for (unsigned seed : {1000u + static_cast<unsigned>(degree), 77u * static_cast<unsigned>(degree)}) {
+      const Scene scene = load_scene_text(random_scene(degree, seed), "random");
+      const RenderResult kernel = renderer.render(scene, false);
+      REQUIRE(kernel.config.ray_origin == RayOrigin::Screen);
+      const ReferenceComparison c = compare_with_reference(kernel.hits, render_reference(scene, Precision::Double));
+      INFO("degree " << degree << " seed " << seed << ": " << c.disagreements << " of " << c.certified
+                     << " certified pixels disagree (first at " << c.disagree_x << "," << c.disagree_y
+                     << "); worst relative depth error " << c.worst_depth << " at " << c.worst_x << "," << c.worst_y);
+      CHECK(c.certified > 64 * 48 / 10);
+      CHECK(static_cast<double>(c.disagreements) <=
+            testing::kDoubleImage.disagreement_share * static_cast<double>(c.certified));
+      CHECK(c.worst_depth <= testing::kDoubleImage.depth_error);
+    }
+}
 
 TEST_CASE("every scene agrees with the certified reference within issue 3's thresholds", "[reference]") {
   ClSession& session = testing::device_session();
