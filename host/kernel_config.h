@@ -12,8 +12,8 @@ enum class Precision { Float, Double, Mixed };
 inline constexpr int kMaxMixedDegree = 15;
 enum class Isolation { Bernstein, PowerDescartes, Sturm, DerivativeChain };
 enum class Refinement { Brent, Bisection, RegulaFalsi, Illinois, Newton };
-// Where P*(t) is built around: Auto (scenes only) is Screen for camera rays where that is measured to keep every
-// digit (screen_form_applies in render_plan.h), else Extent.
+// Where P*(t) is built around: Auto (scenes only) is Screen for camera rays where it applies (screen_form_applies
+// in render_plan.h), else Extent.
 enum class RayOrigin { Auto, Extent, Eye, Screen };
 
 std::string to_string(Precision p);

@@ -10,8 +10,8 @@
 
 namespace algray {
 
-bool screen_form_applies(const Scene& scene, Precision precision, int degree) {
-  if (precision != Precision::Double || degree > kScreenMaxDegree) return false;
+bool screen_form_applies(const Scene& scene, Precision precision) {
+  if (precision != Precision::Double) return false;
   const RayBasis basis = make_ray_basis(scene.camera, scene.image.width, scene.image.height);
   return screen_geometry(basis, scene.image.width, scene.image.height, scene.extent).well_placed;
 }
@@ -25,7 +25,7 @@ KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t
   config.refinement = scene.render.refinement;
   config.ray_origin = scene.render.ray_origin;
   if (config.ray_origin == RayOrigin::Auto)
-    config.ray_origin = screen_form_applies(scene, precision, config.degree) ? RayOrigin::Screen : RayOrigin::Extent;
+    config.ray_origin = screen_form_applies(scene, precision) ? RayOrigin::Screen : RayOrigin::Extent;
   // Below a few units of roundoff the stopping rule can never trigger.
   const double eps =
       precision == Precision::Double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();

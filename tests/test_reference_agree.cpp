@@ -58,7 +58,7 @@ using testing::scene_files;
 
 // A seeded random surface of exactly `degree` in the unit sphere, seen from outside: x^n + y^n + z^n fixes the
 // degree, then 3n random monomials of lower degrees with coefficients in [-1, 1] (the bench's family).
-std::string random_scene(int degree, unsigned seed) {
+std::string random_scene(int degree, unsigned seed, Precision precision) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> coefficient(-1, 1);
   std::ostringstream s;
@@ -72,20 +72,20 @@ std::string random_scene(int degree, unsigned seed) {
     s << ", [" << i << ", " << j << ", " << total - i - j << ", " << coefficient(rng) << "]";
   }
   s << "]\n[extent]\ntype = \"sphere\"\nradius = 1\n[camera]\neye = [1.2, 0.9, 2.6]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n"
-    << "fov_y = 45\n[image]\nwidth = 64\nheight = 48\n[render]\nprecision = \"double\"\npreview = true\n"
+    << "fov_y = 45\n[image]\nwidth = 64\nheight = 48\n[render]\nprecision = \"" << to_string(precision) << "\"\npreview = true\n"
     << "ray_origin = \"auto\"\n";
   return s.str();
 }
 
 }  // namespace
 
-TEST_CASE("the screen form meets the double line on seeded random surfaces up to its degree limit", "[reference]") {
+TEST_CASE("the screen form meets the double line on seeded random surfaces of every degree", "[reference]") {
   ClSession& session = testing::device_session();
   ProgramCache cache(false);
   Renderer renderer(session, cache);
-  for (int degree = 1; degree <= kScreenMaxDegree; ++degree)
+  for (int degree = 1; degree <= kMaxDegree; ++degree)
     for (unsigned seed : {1000u + static_cast<unsigned>(degree), 77u * static_cast<unsigned>(degree)}) {
-      const Scene scene = load_scene_text(random_scene(degree, seed), "random");
+      const Scene scene = load_scene_text(random_scene(degree, seed, Precision::Double), "random");
       const RenderResult kernel = renderer.render(scene, false);
       REQUIRE(kernel.config.ray_origin == RayOrigin::Screen);
       const ReferenceComparison c = compare_with_reference(kernel.hits, render_reference(scene, Precision::Double));
@@ -97,6 +97,25 @@ TEST_CASE("the screen form meets the double line on seeded random surfaces up to
             testing::kDoubleImage.disagreement_share * static_cast<double>(c.certified));
       CHECK(c.worst_depth <= testing::kDoubleImage.depth_error);
     }
+}
+
+TEST_CASE("auto builds camera rays in the screen form in double only, and never the other kernels", "[reference]") {
+  const Scene base = load_scene_text(random_scene(6, 1006, Precision::Double), "random");
+  const RenderPlan plan = make_render_plan(base, Precision::Double);
+  CHECK(plan.find("primary")->kernels.at(0).ray_origin == RayOrigin::Screen);
+  for (Precision p : {Precision::Float, Precision::Mixed})
+    CHECK(make_render_plan(base, p).find("primary")->kernels.at(0).ray_origin == RayOrigin::Extent);
+  // The eye inside the extent: expansion points would lie on both sides of it, far from some rays' segments.
+  const Scene inside =
+      load_scene_text(random_scene(6, 1006, Precision::Double), "random", {{"camera.eye", "[0.2, 0.1, 0.5]"}});
+  CHECK(make_render_plan(inside, Precision::Double).find("primary")->kernels.at(0).ray_origin == RayOrigin::Extent);
+  const Scene full = load_scene_text(random_scene(6, 1006, Precision::Double) +
+                                         "[[light]]\nposition = [3, 3, 3]\n[antialias]\nsamples = 2\nadaptive = true\n",
+                                     "random", {{"render.preview", "false"}});
+  const RenderPlan full_plan = make_render_plan(full, Precision::Double);
+  REQUIRE(full_plan.passes.size() == 3);  // primary, shadow, antialias
+  for (const PlannedPass& pass : full_plan.passes)
+    CHECK(pass.kernels.at(0).ray_origin == (pass.name == "primary" ? RayOrigin::Screen : RayOrigin::Extent));
 }
 
 TEST_CASE("every scene agrees with the certified reference within issue 3's thresholds", "[reference]") {
