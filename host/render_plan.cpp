@@ -47,8 +47,10 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
   RenderPlan plan;
   plan.width = scene.image.width;
   plan.height = scene.image.height;
-  const bool adaptive = scene.antialias.adaptive && scene.antialias.samples > 1;
-  plan.samples = adaptive ? 1 : scene.antialias.samples;
+  // Preview mode is the paper's quick look: one camera ray per pixel, whatever the scene's antialiasing.
+  const int samples = scene.render.preview ? 1 : scene.antialias.samples;
+  const bool adaptive = scene.antialias.adaptive && samples > 1;
+  plan.samples = adaptive ? 1 : samples;
   if (adaptive) {
     plan.refine_samples = scene.antialias.samples;
     plan.refine_threshold = scene.antialias.threshold;
@@ -138,7 +140,9 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
                            trace});
     plan.buffers.push_back({"antialias rays (at most)", rays * plan.refine_samples * plan.refine_samples * 8 * real_size});
   } else {
-    plan.skipped.push_back("antialias: " + std::string(scene.antialias.samples > 1 ? "uniform supersampling"
+    plan.skipped.push_back("antialias: " + std::string(scene.render.preview && scene.antialias.samples > 1
+                                                          ? "preview mode traces one camera ray per pixel"
+                                                          : scene.antialias.samples > 1 ? "uniform supersampling"
                                                                                      : "off (one ray per pixel)"));
   }
   return plan;

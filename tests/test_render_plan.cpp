@@ -108,6 +108,20 @@ TEST_CASE("antialiasing traces samples x samples camera rays per pixel, and no m
   }
 }
 
+TEST_CASE("preview mode traces one camera ray per pixel whatever the scene's antialiasing", "[plan]") {
+  require_device();
+  for (const char* adaptive : {"false", "true"}) {
+    INFO("antialias.adaptive = " << adaptive);
+    const nlohmann::json s =
+        stats_of_unit_sphere({"[antialias]", "samples = 3", std::string("adaptive = ") + adaptive}, "--preview");
+    REQUIRE(names_of(s.at("passes")) == std::vector<std::string>{"primary"});
+    CHECK(s.at("passes")[0].at("rays").get<long>() == 40L * 30);
+    CHECK(s.at("plan").at("traced").at("width").get<int>() == 40);
+    const std::string skipped = s.at("plan").at("skipped").dump();
+    CHECK(skipped.find("antialias: preview mode traces one camera ray per pixel") != std::string::npos);
+  }
+}
+
 TEST_CASE("reflection and transmission passes run only for materials that ask, and never in preview", "[plan]") {
   require_device();
   struct EffectCase {
