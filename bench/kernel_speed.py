@@ -1,0 +1,92 @@
+#!/usr/bin/env python3
+"""Primary-kernel speed of two algray binaries side by side: rays/s per degree on seeded random surfaces and
+kernel ms on the paper's surfaces, each pair of runs interleaved, with the ratio's median and spread."""
+import argparse
+import random
+import statistics
+import tempfile
+from pathlib import Path
+
+from bench_common import ROOT, machine, run_render
+
+PAPER_SURFACES = ["barth_sextic", "cusp_catastrophe", "torus", "tooth", "lemniscate", "tanglecube", "barth_decic"]
+
+
+def random_surface(degree, seed, side):
+    """A seeded random surface of exactly `degree` in the unit sphere: x^n + y^n + z^n - 1/4, then 3n random
+    monomials of lower degrees with coefficients in [-1, 1] (the family of solver_bench's per-degree table)."""
+    rng = random.Random(seed)
+    terms = [[degree, 0, 0, 1], [0, degree, 0, 1], [0, 0, degree, 1], [0, 0, 0, -0.25]]
+    for _ in range(3 * degree):
+        total = rng.randint(1, max(1, degree - 1))
+        i = rng.randint(0, total)
+        j = rng.randint(0, total - i)
+        terms.append([i, j, total - i - j, rng.uniform(-1, 1)])
+    return (f"[surface]\nname = \"random degree {degree}\"\nterms = {terms}\n"
+            "[extent]\ntype = \"sphere\"\nradius = 1\n"
+            "[camera]\neye = [1.2, 0.9, 2.6]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nfov_y = 45\n"
+            f"[image]\nwidth = {side}\nheight = {side}\n")
+
+
+def kernel_ms(stats):
+    return next(p["kernel_ms"] for p in stats["passes"] if p["name"] == "primary")
+
+
+def compare(binaries, scene, args, repeat, workdir):
+    """Kernel ms of each binary, interleaved A B A B ...; one warm-up each first (fills the program caches)."""
+    for b in binaries:
+        run_render(b, scene, args, None, workdir)
+    times = [[] for _ in binaries]
+    for _ in range(repeat):
+        for k, b in enumerate(binaries):
+            times[k].append(kernel_ms(run_render(b, scene, args, None, workdir)[1]))
+    ratios = [new / old for old, new in zip(times[0], times[1])]
+    return [statistics.median(t) for t in times], statistics.median(ratios), min(ratios), max(ratios)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--baseline", required=True, help="the algray binary to compare against")
+    ap.add_argument("--algray", default=str(ROOT / "build/host/algray"))
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--side", type=int, default=512, help="random surfaces: side x side rays")
+    ap.add_argument("--degrees", default="1-32", help="e.g. 1-32 or 2,6,10")
+    ap.add_argument("--only", choices=["degrees", "surfaces"])
+    ap.add_argument("--precision", default="double")
+    a = ap.parse_args()
+    if "-" in a.degrees:
+        lo, hi = (int(x) for x in a.degrees.split("-"))
+        degrees = list(range(lo, hi + 1))
+    else:
+        degrees = [int(x) for x in a.degrees.split(",")]
+    binaries = [a.baseline, a.algray]
+    print(f"Machine: {machine()}. Baseline `{a.baseline}`, current `{a.algray}`; kernel ms of the primary pass, "
+          f"median of {a.repeat} interleaved runs each after one warm-up; ratio = current/baseline time per pair "
+          f"(median, min-max). Precision {a.precision}.\n")
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        if a.only != "surfaces":
+            print("| degree | baseline Mrays/s | current Mrays/s | speed-up (median) | min-max |")
+            print("|---|---|---|---|---|")
+            rays = a.side * a.side
+            for d in degrees:
+                scene = work / f"random{d}.toml"
+                scene.write_text(random_surface(d, 1000 + d, a.side))
+                (old, new), ratio, lo, hi = compare(binaries, scene, ["--set", f"render.precision={a.precision}"],
+                                                    a.repeat, work)
+                print(f"| {d} | {rays / old / 1e3:.2f} | {rays / new / 1e3:.2f} | {1 / ratio:.2f}x | "
+                      f"{1 / hi:.2f}-{1 / lo:.2f} |", flush=True)
+            print()
+        if a.only != "degrees":
+            print("| surface (1024x768 preview, one ray per pixel) | baseline kernel ms | current kernel ms | speed-up (median) | min-max |")
+            print("|---|---|---|---|---|")
+            for name in PAPER_SURFACES:
+                # One ray per pixel in both: a baseline from before preview dropped antialiasing traced 2x2.
+                args = ["--preview", "--width", "1024", "--height", "768", "--set", f"render.precision={a.precision}",
+                        "--set", "antialias.samples=1"]
+                (old, new), ratio, lo, hi = compare(binaries, ROOT / "scenes" / f"{name}.toml", args, a.repeat, work)
+                print(f"| {name} | {old:.1f} | {new:.1f} | {1 / ratio:.2f}x | {1 / hi:.2f}-{1 / lo:.2f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
