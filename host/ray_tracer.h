@@ -15,7 +15,8 @@ struct TracedBatch {
   double kernel_ms = 0;
 };
 
-// Built once per render, then asked once per batch of rays.
+// Built once per render, then asked once per batch of rays. Its device buffers grow to the largest batch and
+// are then reused.
 class RayTracer {
  public:
   RayTracer(ClSession& session, ProgramCache& cache, const KernelConfig& config, const DeviceSurface& surface);
@@ -27,6 +28,10 @@ class RayTracer {
   const DeviceSurface& surface_;
   ProgramRecord record_;
   cl::Kernel kernel_;
+  std::size_t capacity_ = 0;
+  cl::Buffer origins_, directions_, out_;
+  std::vector<double> staging_;  // REAL4 values before the upload, in double or (staging_float_) float
+  std::vector<float> staging_float_;
 };
 
 }  // namespace algray

@@ -106,6 +106,16 @@ class PhaseTimer {
     phases_.push_back({phase, std::chrono::duration<double, std::milli>(now - last_).count()});
     last_ = now;
   }
+  // Moves `ms` of the last phase named `from` to a phase `to` (work done inside it, as the shading is inside
+  // the render), so that the phases still add up to the total.
+  void move(const std::string& from, const std::string& to, double ms) {
+    for (auto it = phases_.rbegin(); it != phases_.rend(); ++it)
+      if (it->first == from) {
+        it->second -= ms;
+        break;
+      }
+    phases_.push_back({to, ms});
+  }
   double total_ms() const {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
   }
@@ -155,13 +165,6 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
                              {"build_ms", p.build_ms},
                              {"kernel_ms", kernel_ms}});
   }
-  std::uint64_t hits = 0, budget = 0, steps = 0, iterations = 0;
-  for (const HitRecord& h : r.hits.records) {
-    hits += (h.flags & ALGRAY_HIT_FOUND) != 0;
-    budget += (h.flags & ALGRAY_HIT_BUDGET) != 0;
-    steps += h.work & 0xffffu;
-    iterations += h.work >> 16;
-  }
   j["plan"] = r.plan.json();
   for (const PassStats& p : r.passes) {
     nlohmann::json kernels = nlohmann::json::array();
@@ -178,22 +181,22 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
                            {"kernel_ms", p.kernel_ms},
                            {"wall_ms", p.wall_ms}});
   }
-  j["primary_rays"] = {{"count", r.hits.records.size()},
-                       {"hits", hits},
-                       {"depth_limited", budget},
-                       {"isolation_steps", steps},
-                       {"refine_iterations", iterations}};
+  const PrimarySummary& p = r.primary;
+  j["primary_rays"] = {{"count", p.rays},
+                       {"hits", p.hits},
+                       {"depth_limited", p.depth_limited},
+                       {"isolation_steps", p.isolation_steps},
+                       {"refine_iterations", p.refine_iterations}};
   // A pixel shows the surface when any of its antialiasing samples hit it.
-  const int samples = std::max(r.plan.samples, 1);
-  std::uint64_t covered = 0;
-  for (int y = 0; y < r.hits.height; y += samples)
-    for (int x = 0; x < r.hits.width; x += samples) {
-      bool any = false;
-      for (int sy = 0; sy < samples; ++sy)
-        for (int sx = 0; sx < samples; ++sx) any |= (r.hits.at(x + sx, y + sy).flags & ALGRAY_HIT_FOUND) != 0;
-      covered += any;
-    }
-  j["pixels"] = {{"count", (r.hits.width / samples) * (r.hits.height / samples)}, {"hits", covered}};
+  j["pixels"] = {{"count", p.pixels}, {"hits", p.pixels_hit}};
+  // Where the render's time went: device time of the launches, the passes' wall time (launches, staging and
+  // readback), and the host's shading, which runs tile by tile inside the render.
+  double kernel_ms = 0, passes_ms = 0;
+  for (const PassStats& pass : r.passes) {
+    kernel_ms += pass.kernel_ms;
+    passes_ms += pass.wall_ms;
+  }
+  j["render_ms"] = {{"kernel", kernel_ms}, {"passes_wall", passes_ms}, {"host_shading", r.shade_ms}};
   j["phases_ms"] = timer.json();
   j["total_ms"] = timer.total_ms();
   return j;
@@ -337,6 +340,8 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
   FrameImage image;
   RenderResult result;
   DeviceInfo device;
+  const bool diagnostics = !req.aovs.empty() || req.heatmap_path;
+  SolverWork work;  // per output pixel: the solver channels and the heat map are pictures of the whole image
   if (req.reference) {
     // No device: exact arithmetic on the CPU, rays rebuilt in the precision the kernels would use.
     device.name = "CPU reference (solver_ref, exact arithmetic)";
@@ -344,25 +349,36 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
     ReferenceResult ref = render_reference(scene, scene.render.precision.value_or(Precision::Double));
     timer.mark("render");
     result = std::move(ref.render);
+    result.primary = summarise_hits(result.hits, result.plan.samples);
     image = shade_frame(scene, result);
     image.uint_channels.push_back({"reference.class", std::move(ref.classes)});
+    if (diagnostics) work = solver_work(result);
+    timer.mark("shade");
   } else {
     ClSession& session = context.session();
     device = session.info;
     timer.mark("device");
     Renderer renderer(session, context.cache());
-    result = renderer.render(scene, req.progress);
+    RenderOptions options;
+    options.show_progress = req.progress;
+    if (diagnostics) {
+      options.on_primary_tile = [&](const PrimaryTile& tile) {
+        if (work.isolation_steps.empty()) work = empty_solver_work(scene.image.width, scene.image.height, tile.samples);
+        add_tile_work(work, tile);
+      };
+    }
+    result = renderer.render(scene, options);
     timer.mark("render");
-    image = shade_frame(scene, result);
+    timer.move("render", "shade", result.shade_ms);
+    image = std::move(result.image);
   }
   add_metadata(image, scene, result, device);
-  timer.mark("shade");
+  timer.mark("metadata");
   // Every path was checked before rendering, so a write that fails now (a full disk) is a failure, not bad input.
   std::vector<std::string> planned;
   for (const RoleAndPath& o : request_outputs(req)) planned.push_back(o.path);
   OutputWriter writer(planned);
-  if (!req.aovs.empty() || req.heatmap_path) {
-    const SolverWork work = solver_work(result);
+  if (diagnostics) {
     add_solver_aovs(image, work, req.aovs);
     if (req.heatmap_path) {
       const std::string per =

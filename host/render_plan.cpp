@@ -43,10 +43,11 @@ const PlannedPass* RenderPlan::find(const std::string& name) const {
   return nullptr;
 }
 
-RenderPlan make_render_plan(const Scene& scene, Precision precision) {
+RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size) {
   RenderPlan plan;
   plan.width = scene.image.width;
   plan.height = scene.image.height;
+  plan.tile_size = tile_size > 0 ? tile_size : scene.render.tile_size > 0 ? scene.render.tile_size : 1024;
   // Preview mode is the paper's quick look: one camera ray per pixel, whatever the scene's antialiasing.
   const int samples = scene.render.preview ? 1 : scene.antialias.samples;
   const bool adaptive = scene.antialias.adaptive && samples > 1;
@@ -55,7 +56,8 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
     plan.refine_samples = scene.antialias.samples;
     plan.refine_threshold = scene.antialias.threshold;
   }
-  const std::size_t rays = static_cast<std::size_t>(plan.trace_width()) * plan.trace_height();
+  // The device holds one tile's camera rays, and one batch of other rays at a time.
+  const std::size_t rays = plan.tile_rays();
   const std::size_t real_size = precision == Precision::Double ? sizeof(double) : sizeof(float);
 
   // Every pass has one kernel per surface: each surface's degree specialises its own.
@@ -98,11 +100,12 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
                            std::to_string(plan.shadow_lights.size()) + " shadow-casting light(s), " +
                                std::to_string(points) + " sample point(s) per lit surface point",
                            shadow});
-    // Sized for every ray hitting; the pass allocates for the hits there are.
-    plan.buffers.push_back({"shading points (at most)", rays * 4 * real_size});
-    plan.buffers.push_back({"shading normals (at most)", rays * 4 * sizeof(float)});
+    // A batch of surface points at a time, asked about each light in turn.
+    const std::size_t batch = std::min(rays, kBatchRays);
+    plan.buffers.push_back({"shading points (per batch)", batch * 4 * real_size});
+    plan.buffers.push_back({"shading normals (per batch)", batch * 4 * sizeof(float)});
     plan.buffers.push_back({"light sample points", points * 4 * real_size});
-    plan.buffers.push_back({"occlusion masks (at most)", rays * plan.shadow_lights.size() * sizeof(cl_ulong)});
+    plan.buffers.push_back({"occlusion masks (per batch)", batch * sizeof(cl_ulong)});
   }
   // Secondary rays: one pass per effect a material asks for, sharing the one "trace" kernel.
   const std::vector<KernelConfig> trace = with_entry("trace");
@@ -130,21 +133,44 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision) {
     else {
       plan.passes.push_back(
           {name, std::string(effect.why) + ", up to depth " + std::to_string(scene.render.max_depth), trace});
-      plan.buffers.push_back({name + " rays per bounce (at most)", rays * 8 * real_size});
-      plan.buffers.push_back({name + " hits per bounce (at most)", rays * sizeof(HitRecord)});
+      // Each bounce can double a tile's rays; they are traced in batches of at most kBatchRays.
+      const std::size_t batch = rays << std::min(scene.render.max_depth - 1, 8) < kBatchRays
+                                    ? rays << std::min(scene.render.max_depth - 1, 8)
+                                    : kBatchRays;
+      plan.buffers.push_back({name + " rays (per batch)", batch * 8 * real_size});
+      plan.buffers.push_back({name + " hits (per batch)", batch * sizeof(HitRecord)});
     }
   }
   if (adaptive) {
     const std::string n = std::to_string(plan.refine_samples);
     plan.passes.push_back({"antialias", n + "x" + n + " camera rays in pixels whose colour differs from a neighbour's",
                            trace});
-    plan.buffers.push_back({"antialias rays (at most)", rays * plan.refine_samples * plan.refine_samples * 8 * real_size});
+    const std::size_t batch =
+        std::min(rays * static_cast<std::size_t>(plan.refine_samples * plan.refine_samples), kBatchRays);
+    plan.buffers.push_back({"antialias rays (per batch)", batch * 8 * real_size});
+    plan.buffers.push_back({"antialias hits (per batch)", batch * sizeof(HitRecord)});
   } else {
     plan.skipped.push_back("antialias: " + std::string(scene.render.preview && scene.antialias.samples > 1
                                                           ? "preview mode traces one camera ray per pixel"
                                                           : scene.antialias.samples > 1 ? "uniform supersampling"
                                                                                      : "off (one ray per pixel)"));
   }
+  // The host's share of one tile's work, per camera ray of the tile: its hit record (twice, and which surface,
+  // with several), the shadow answers (an index each way, a mask per light), what its bounces bring back; and
+  // per ray of the batch in flight (rays, hits, weights, staging, the rays waiting for the next bounce), about
+  // 100 bytes for shadow rays alone and 600 with bounces.
+  const bool several = scene.surfaces.size() > 1;
+  const bool shadows = plan.find("shadow") != nullptr;
+  const bool bounces = plan.find("reflection") || plan.find("transmission");
+  std::uint64_t per_ray = sizeof(HitRecord) * (several ? 2 : 1) + (several ? 1 : 0);
+  if (shadows) per_ray += 8 + 8 * plan.shadow_lights.size();
+  if (bounces) per_ray += 3 * sizeof(double);
+  if (adaptive) per_ray += 4 * sizeof(double);  // a refined pixel's colour and alpha
+  const std::uint64_t batch = std::min<std::uint64_t>(
+      kBatchRays, static_cast<std::uint64_t>(rays) * (adaptive ? plan.refine_samples * plan.refine_samples : 1) *
+                      (bounces ? 2 : 1));
+  const std::uint64_t per_batch_ray = bounces || adaptive ? 600 : shadows ? 100 : 0;
+  plan.tile_host_bytes = rays * per_ray + batch * per_batch_ray;
   return plan;
 }
 
@@ -154,6 +180,9 @@ nlohmann::json RenderPlan::json() const {
   j["antialias_samples"] = samples;
   j["adaptive_antialias_samples"] = refine_samples;
   j["traced"] = {{"width", trace_width()}, {"height", trace_height()}};
+  j["tile"] = {{"size", tile_size}, {"pixels", tile_pixels()}, {"rays", tile_rays()}};
+  j["film_bytes"] = film_bytes();
+  j["tile_host_bytes"] = tile_host_bytes;
   for (const PlannedPass& p : passes) {
     nlohmann::json kernels = nlohmann::json::array();
     for (const KernelConfig& k : p.kernels) kernels.push_back(k.key());
@@ -172,11 +201,16 @@ std::uint64_t RenderPlan::buffer_bytes() const {
   return sum;
 }
 
+std::uint64_t RenderPlan::film_bytes() const {
+  const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
+  // RGBA, depth and normal in float; adaptive antialiasing's choice of pixels, a byte each.
+  return pixels * (kFilmBytesPerPixel + (refine_samples > 1 ? 1 : 0));
+}
+
 std::uint64_t RenderPlan::estimated_memory_bytes() const {
   constexpr std::uint64_t kBase = 128ull << 20;  // the process, the OpenCL runtime and its compiler
-  constexpr std::uint64_t kFilmBytesPerPixel = 64;  // colour, depth, normal, and the writers' half/8-bit copies
-  const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
-  return kBase + buffer_bytes() + buffer_bytes() / 4 + kFilmBytesPerPixel * pixels;
+  constexpr std::uint64_t kWriters = 32ull << 20;  // the image writers convert and compress a strip of lines at a time
+  return kBase + kWriters + film_bytes() + tile_host_bytes + buffer_bytes();
 }
 
 namespace {
@@ -205,7 +239,7 @@ void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device) {
   const std::string what = "a " + std::to_string(plan.width) + "x" + std::to_string(plan.height) + " render with " +
                            std::to_string(plan.samples) + "x" + std::to_string(plan.samples) +
                            " samples per pixel needs about ";
-  const std::string advice = ": render a smaller image or with fewer antialiasing samples";
+  const std::string advice = ": render a smaller image (or with a smaller render.tile_size)";
   const std::uint64_t need = plan.estimated_memory_bytes();
   if (const std::uint64_t available = available_host_memory(); available && need > available)
     throw DeviceError(what + gigabytes(need) + " of memory, and this machine has " + gigabytes(available) +

@@ -1,6 +1,7 @@
 // The render plan: which passes a scene needs, the kernel each builds and the buffers each allocates.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
@@ -25,8 +26,25 @@ struct PlannedBuffer {
   std::size_t bytes = 0;
 };
 
+// Rays per launch of the shadow and trace kernels, and per group of bounces: large enough that PoCL's ~2 ms a
+// launch is small beside the work, small enough that one batch's staging stays near 64 MB (about 250 bytes a ray,
+// host and device together) whatever the tile, the antialiasing and the bounces.
+inline constexpr std::size_t kBatchRays = std::size_t{1} << 18;
+
+// Bytes per output pixel of the film: RGBA, depth and normal, in float.
+inline constexpr std::uint64_t kFilmBytesPerPixel = 32;
+
 struct RenderPlan {
   int width = 0, height = 0;  // the output image
+  // Side of a tile in traced rays; a tile holds whole pixels, tile_pixels() per side. The render works through
+  // every pass one tile at a time, so its memory is the film plus one tile's work.
+  int tile_size = 1024;
+  int tile_pixels() const { return std::max(1, tile_size / samples); }
+  // Camera rays of the largest tile.
+  std::size_t tile_rays() const {
+    return static_cast<std::size_t>(std::min(tile_pixels(), width)) * samples * std::min(tile_pixels(), height) *
+           samples;
+  }
   int samples = 1;            // antialiasing: samples x samples camera rays per pixel, traced as one grid
   int refine_samples = 0;     // adaptive antialiasing: n x n rays later, in pixels that differ (0: off)
   double refine_threshold = 0;
@@ -41,10 +59,14 @@ struct RenderPlan {
   const PlannedPass* find(const std::string& name) const;
   nlohmann::json json() const;
 
-  // The buffers together, and the peak memory of the whole render on the host: the buffers, their staging on
-  // the host, the film and the writers' copies. Calibrated on the Barth sextic in full mode with PoCL (256^2 to
-  // 1024^2: peak RSS about 80 MB + 0.9 x the buffers); kept on the generous side.
+  std::uint64_t tile_host_bytes = 0;  // the host's share of one tile's work (hits, shadow answers, a batch)
+
+  // The device buffers together (one tile's and one batch's), the film, and the peak memory of the whole render
+  // on the host: a base for the process and the OpenCL runtime, the film, one tile's work on the host and on
+  // the device (which on a CPU is host memory too), and the writers' strips. Checked against peak RSS by
+  // bench/memory.py (bench/RESULTS.md, "Memory: tile by tile"); kept on the generous side.
   std::uint64_t buffer_bytes() const;
+  std::uint64_t film_bytes() const;
   std::uint64_t estimated_memory_bytes() const;
 };
 
@@ -55,7 +77,8 @@ void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device);
 
 // The passes and buffers `scene` calls for in `precision`. The primary pass is always there; the shadow pass
 // only when a light casts shadows and the scene is not a preview.
-RenderPlan make_render_plan(const Scene& scene, Precision precision);
+// tile_size: the tile side in traced rays; 0 takes the scene's render.tile_size, or 1024 when it has none.
+RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size = 0);
 
 // Whether RayOrigin::Auto means the screen form for camera rays: in double, with the camera outside the extent,
 // facing its centre. Measured to keep the double line at every degree; in float it found the wrong sheet on the

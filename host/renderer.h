@@ -1,7 +1,8 @@
-// Dispatch of the primary kernel over an image in tiles, and the surface data the kernels read.
+// The render of a plan, tile by tile through every pass into a film, and the records tests and tools may keep.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -9,6 +10,7 @@
 #include "camera.h"
 #include "cl_runtime.h"
 #include "device_surface.h"
+#include "image_io.h"
 #include "program_cache.h"
 #include "render_plan.h"
 #include "scene.h"
@@ -45,12 +47,14 @@ struct ShadowData {
   std::vector<LightOcclusion> occlusion;  // one per shadow-casting light
 };
 
-// One bounce's reflection or transmission rays: where each adds to the image and what it found.
+// One group of reflection, transmission or antialias rays: where each adds to the image and what it found.
 struct SecondaryBatch {
   std::string pass;                   // "reflection", "transmission", or "antialias" (camera rays)
   int depth = 1;                      // 1: spawned by the camera rays' hits; 0 for antialias batches
   bool refinement = false;            // part of adaptive antialiasing: replaces its pixel's first colour
-  std::vector<std::uint32_t> sample;  // the traced camera ray (index into RenderResult::hits) it contributes to
+  // The traced camera ray it contributes to (index into RenderResult::hits), or for refinement batches the
+  // pixel. While a tile renders, the index is the tile's own.
+  std::vector<std::uint32_t> sample;
   std::vector<double> weight;         // its share of that ray's colour
   std::vector<PixelRay> rays;
   std::vector<HitRecord> hits;
@@ -58,15 +62,49 @@ struct SecondaryBatch {
   ShadowData shadows;
 };
 
+// Totals over the camera rays of the primary pass, for --stats, gathered tile by tile.
+struct PrimarySummary {
+  std::uint64_t rays = 0, hits = 0, depth_limited = 0, isolation_steps = 0, refine_iterations = 0;
+  std::uint64_t pixels = 0, pixels_hit = 0;  // output pixels, and those some antialiasing sample hit
+  // A block of whole pixels: width x height records, row-major, `samples` x `samples` per pixel.
+  void add(const HitRecord* records, int width, int height, int samples);
+};
+PrimarySummary summarise_hits(const HitBuffer& hits, int samples);
+
+// One tile's camera rays as the primary pass left them, whole pixels of the traced grid, handed to
+// RenderOptions::on_primary_tile before the tile's buffers are reused.
+struct PrimaryTile {
+  int x0 = 0, y0 = 0, width = 0, height = 0;  // in traced rays: plan.samples per pixel side
+  int samples = 1;
+  const HitRecord* hits = nullptr;  // width x height, row-major
+};
+
+struct RenderOptions {
+  bool show_progress = false;  // per-tile progress on stderr (for terminals)
+  // Keep every ray's record in RenderResult (hits, shadows, secondary, refined), for tests and tools. Their
+  // memory grows with pixels x samples x bounces; without them only the film and the totals are kept.
+  bool keep_records = false;
+  std::function<void(const PrimaryTile&)> on_primary_tile;  // e.g. the solver channels
+  // Rays per launch of the shadow and trace kernels and per group of bounces. Only tests change it: the image
+  // must not depend on it.
+  std::size_t batch_rays = kBatchRays;
+};
+
 struct RenderResult {
   RenderPlan plan;
-  HitBuffer hits;       // one record per traced ray: plan.trace_width() x plan.trace_height()
   KernelConfig config;  // of the first surface's primary pass, with precision and tolerance as used
   RayBasis basis;       // of the traced rays (per antialiasing sample, not per pixel)
   std::vector<ProgramRecord> programs;
   std::vector<PassStats> passes;
-  ShadowData shadows;                    // of the camera rays' hits
-  std::vector<SecondaryBatch> secondary;  // in the order traced: by depth, reflection before transmission
+  // The film: RGBA, depth and normal per output pixel, as shade_frame would make them from the records.
+  FrameImage image;
+  PrimarySummary primary;
+  double shade_ms = 0;  // host shading (and the gathering of rays for the passes) within the render
+
+  // Kept only with RenderOptions::keep_records:
+  HitBuffer hits;                         // one record per traced ray: plan.trace_width() x plan.trace_height()
+  ShadowData shadows;                     // of the camera rays' hits
+  std::vector<SecondaryBatch> secondary;  // per tile, in the order traced: by depth, reflection first
   // Adaptive antialiasing: 1 for the pixels (of hits) whose colour is the antialias batch's rays, not their own.
   std::vector<std::uint8_t> refined;
 };
@@ -78,26 +116,35 @@ Precision resolve_precision(const Scene& scene, const DeviceInfo& device);
 // The world-space point a hit record stands for on the ray that produced it.
 glm::dvec3 hit_point(const PixelRay& ray, const HitRecord& hit);
 
-// Tile side for a device when the scene leaves it open. GPUs get launches short enough for display watchdogs;
-// CPUs (PoCL) lose ~2 ms per launch and idle cores at each launch's tail, so they get few, large launches:
-// measured on the Barth sextic at 1024x768, 256-pixel tiles 137 ms, one 1024-pixel tile 109 ms.
+// Tile side, in traced rays, for a device when the scene leaves it open. GPUs get launches short enough for
+// display watchdogs; CPUs (PoCL) lose ~2 ms per launch and idle cores at each launch's tail, so they get few,
+// large launches: measured on the Barth sextic at 1024x768, 256-ray tiles 137 ms, one 1024-ray tile 109 ms.
 int default_tile_size(const DeviceInfo& device);
 
 class Renderer {
  public:
   Renderer(ClSession& session, ProgramCache& cache) : session_(session), cache_(cache) {}
-  // Runs every pass of the scene's plan. show_progress: print per-tile progress to stderr (for terminals).
+  // Runs every pass of the scene's plan, tile by tile, into the film. Each tile's camera rays, shadow rays and
+  // bounces are traced and shaded before the next tile starts, so memory holds the film and one tile's work.
+  RenderResult render(const Scene& scene, const RenderOptions& options);
+  // The same render keeping every ray's record (tests and tools). show_progress: print per-tile progress.
   RenderResult render(const Scene& scene, bool show_progress);
 
  private:
   struct Passes;
   struct Bounce;
-  void run_primary(Passes& passes, bool show_progress);
+  struct Tile;
+  void prepare_passes(Passes& passes);
+  // The primary kernels' arguments for a band of tiles (a row of them), but the tile's own.
+  void set_band_args(Passes& passes, const Tile& first);
+  void trace_primary(Passes& passes, const Tile& tile);
   void trace_batch(Passes& passes, SecondaryBatch& batch);
-  // Reflection and transmission rays, bounce by bounce, from the hits in `current`.
-  void run_bounces(Passes& passes, std::vector<Bounce> current, bool refinement);
-  // Adaptive antialiasing: n x n more camera rays in the pixels that differ from a neighbour.
-  void run_antialias(Passes& passes);
+  // The camera rays' shadows and bounces of one tile, and its pixels in the film.
+  void finish_tile(Passes& passes, const Tile& tile);
+  // Reflection and transmission rays, bounce by bounce from `depth`, from the hits in `current`.
+  void run_bounces(Passes& passes, const Tile& tile, std::vector<Bounce> current, int depth, bool refinement);
+  // Adaptive antialiasing in one tile: n x n more camera rays in the pixels `refine` marks.
+  void refine_tile(Passes& passes, const Tile& tile, const std::vector<std::uint8_t>& refine);
 
   ClSession& session_;
   ProgramCache& cache_;

@@ -11,52 +11,65 @@
 namespace algray {
 namespace {
 
-struct LightSamples {
-  const Light* light;
-  std::vector<glm::dvec3> points;
-};
-
-// A batch's shadow answers, looked up by the index of a hit in its batch.
-class ShadowLookup {
- public:
-  ShadowLookup(const ShadowData& data, std::size_t batch_size, const std::vector<Light>& lights)
-      : by_light_(lights.size(), nullptr) {
-    if (data.points.empty()) return;
-    point_of_hit_.assign(batch_size, UINT32_MAX);
-    for (std::size_t k = 0; k < data.points.size(); ++k) point_of_hit_[data.points[k]] = static_cast<std::uint32_t>(k);
-    for (const LightOcclusion& o : data.occlusion) by_light_[static_cast<std::size_t>(o.light)] = &o;
+// Runs work(begin, end) over [0, count) in contiguous parts, one per core. Below `grain` items a thread costs
+// more than it saves (starting one is ~50 us), so small counts run here.
+template <typename Work>
+void parallel_ranges(std::size_t count, std::size_t grain, const Work& work) {
+  const std::size_t cores = std::clamp(std::thread::hardware_concurrency(), 1u, 16u);
+  const std::size_t parts = std::min(cores, std::max<std::size_t>(1, count / grain));
+  if (parts <= 1) {
+    work(std::size_t{0}, count);
+    return;
   }
-  // Bit s set when the shadow pass found light point s of light `light` hidden from hit `hit`.
-  std::uint64_t hidden(std::size_t light, std::size_t hit) const {
-    const LightOcclusion* o = by_light_[light];
-    if (!o || point_of_hit_.empty() || point_of_hit_[hit] == UINT32_MAX) return 0;
-    return o->masks[point_of_hit_[hit]];
-  }
+  std::vector<std::thread> workers;
+  for (std::size_t p = 1; p < parts; ++p) workers.emplace_back(work, count * p / parts, count * (p + 1) / parts);
+  work(std::size_t{0}, count / parts);
+  for (std::thread& w : workers) w.join();
+}
 
- private:
-  std::vector<const LightOcclusion*> by_light_;
-  std::vector<std::uint32_t> point_of_hit_;
-};
+}  // namespace
+
+ShadowLookup::ShadowLookup(const ShadowData& data, std::size_t batch_size, std::size_t light_count)
+    : by_light_(light_count, nullptr) {
+  if (data.points.empty()) return;
+  point_of_hit_.assign(batch_size, UINT32_MAX);
+  for (std::size_t k = 0; k < data.points.size(); ++k) point_of_hit_[data.points[k]] = static_cast<std::uint32_t>(k);
+  for (const LightOcclusion& o : data.occlusion) by_light_[static_cast<std::size_t>(o.light)] = &o;
+}
+
+Shader::Shader(const Scene& scene, const RenderPlan& plan, const RayBasis& basis, Precision precision)
+    : scene_(scene),
+      basis_(basis),
+      single_(precision != Precision::Double),
+      samples_(std::max(plan.samples, 1)),
+      transmits_(plan.find("transmission") != nullptr) {
+  // Highlights below 1/4096 of full strength are skipped: they cannot show, and pow() dominates shading.
+  for (const SceneSurface& surface : scene.surfaces)
+    for (const Material* m : {&surface.materials.front, &surface.materials.back})
+      highlight_cutoff_.push_back(std::pow(1.0 / 4096, 1 / m->exponent));
+  for (const Light& light : scene.lights) lights_.push_back({&light, light.sample_points()});
+}
 
 // Colour of one traced ray that hit the surface: the side's own colour (times 1 - transparency, the rest
 // coming from the transmission pass), lit by every light's points that the shadow pass left visible.
-glm::dvec3 shade_hit(const Scene& scene, const std::vector<LightSamples>& lights, const HitRecord& h, int surface,
-                     const glm::dvec3& point, const glm::dvec3& to_eye, const ShadowLookup& shadows,
-                     std::size_t hit_index, bool transmits) {
-  const Materials& sides = scene.surfaces[static_cast<std::size_t>(surface)].materials;
+glm::dvec3 Shader::shade_hit(const HitRecord& h, int surface, const PixelRay& ray, const ShadowLookup& shadows,
+                             std::size_t hit_index) const {
+  const Materials& sides = scene_.surfaces[static_cast<std::size_t>(surface)].materials;
   const Material& m = (h.flags & ALGRAY_HIT_BACK) ? sides.back : sides.front;
   const glm::dvec3 n(h.normal_x, h.normal_y, h.normal_z);
+  const glm::dvec3 to_eye = -glm::normalize(ray.direction);
   // Without a transmission pass (preview, max_depth = 0) nothing is seen through: the side shows opaque.
-  const double own = transmits ? 1 - m.transparency : 1.0;
-  if (lights.empty()) {
+  const double own = transmits_ ? 1 - m.transparency : 1.0;
+  if (lights_.empty()) {
     const double facing = std::fabs(glm::dot(n, to_eye));
     return own * m.colour * (kPreviewAmbient + (1 - kPreviewAmbient) * facing);
   }
-  // Highlights below 1/4096 of full strength are skipped: they cannot show, and pow() dominates shading.
-  const double highlight_cutoff = std::pow(1.0 / 4096, 1 / m.exponent);
+  const glm::dvec3 point = hit_point(ray, h);
+  const double highlight_cutoff =
+      highlight_cutoff_[static_cast<std::size_t>(2 * surface + ((h.flags & ALGRAY_HIT_BACK) ? 1 : 0))];
   glm::dvec3 c = m.ambient * m.colour;
-  for (std::size_t li = 0; li < lights.size(); ++li) {
-    const LightSamples& ls = lights[li];
+  for (std::size_t li = 0; li < lights_.size(); ++li) {
+    const LightSamples& ls = lights_[li];
     const std::uint64_t hidden = shadows.hidden(li, hit_index);
     double diffuse = 0, specular = 0;
     for (std::size_t s = 0; s < ls.points.size(); ++s) {
@@ -75,102 +88,125 @@ glm::dvec3 shade_hit(const Scene& scene, const std::vector<LightSamples>& lights
   return own * c;
 }
 
-}  // namespace
+void Shader::add_batch(const SecondaryBatch& batch, std::vector<glm::dvec3>& colour, std::vector<double>& alpha) const {
+  const ShadowLookup shadows(batch.shadows, batch.hits.size(), scene_.lights.size());
+  const glm::dvec3 background(scene_.image.background);
+  // Shaded in parallel, then added in ray order: a sample's sum must not depend on the threads.
+  std::vector<glm::dvec3> seen(batch.hits.size());
+  parallel_ranges(batch.hits.size(), 2048, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const HitRecord& h = batch.hits[i];
+      seen[i] = (h.flags & ALGRAY_HIT_FOUND)
+                    ? shade_hit(h, batch.hit_surface.empty() ? 0 : batch.hit_surface[i], batch.rays[i], shadows, i)
+                    : background;
+    }
+  });
+  const bool camera_rays = batch.pass == "antialias";
+  for (std::size_t i = 0; i < batch.hits.size(); ++i) {
+    colour[batch.sample[i]] += batch.weight[i] * seen[i];
+    if (camera_rays)
+      alpha[batch.sample[i]] +=
+          batch.weight[i] * ((batch.hits[i].flags & ALGRAY_HIT_FOUND) ? 1.0 : scene_.image.background.a);
+  }
+}
+
+void Shader::resolve(const TracedBlock& block, FrameImage& film) const {
+  const int samples = samples_;
+  const double weight = 1.0 / (samples * samples);
+  const int px0 = block.x0 / samples, py0 = block.y0 / samples;
+  const int pixels_x = block.width / samples, pixels_y = block.height / samples;
+  // Rows are independent; shading a 1024x768 frame on one core costs as much as a fifth of the kernel.
+  parallel_ranges(static_cast<std::size_t>(pixels_y), 8, [&](std::size_t row_begin, std::size_t row_end) {
+    for (int y = static_cast<int>(row_begin); y < static_cast<int>(row_end); ++y) {
+      for (int x = 0; x < pixels_x; ++x) {
+        const std::size_t i = static_cast<std::size_t>(py0 + y) * film.width + px0 + x;
+        float depth = std::numeric_limits<float>::infinity();
+        float normal[3] = {0, 0, 0};
+        glm::dvec4 sum(0);
+        for (int sy = 0; sy < samples; ++sy) {
+          for (int sx = 0; sx < samples; ++sx) {
+            const int bx = x * samples + sx, by = y * samples + sy;
+            const std::size_t k = static_cast<std::size_t>(by) * block.width + bx;
+            const HitRecord& h = block.hits[k];
+            if (!(h.flags & ALGRAY_HIT_FOUND)) {
+              sum += scene_.image.background;
+              continue;
+            }
+            const PixelRay ray = pixel_ray(basis_, single_, block.x0 + bx, block.y0 + by);
+            glm::dvec3 colour = shade_hit(h, block.surface ? block.surface[k] : 0, ray, *block.shadows, k);
+            if (block.secondary) colour += block.secondary[k];
+            sum += glm::dvec4(colour, 1);
+            if (h.depth < depth) {
+              depth = h.depth;
+              normal[0] = h.normal_x;
+              normal[1] = h.normal_y;
+              normal[2] = h.normal_z;
+            }
+          }
+        }
+        for (int c = 0; c < 4; ++c) film.rgba[4 * i + c] = static_cast<float>(sum[c] * weight);
+        film.depth[i] = depth;
+        for (int c = 0; c < 3; ++c) film.normal[3 * i + c] = normal[c];
+      }
+    }
+  });
+}
+
+void Shader::resolve_refined(std::size_t pixel, const glm::dvec3& colour, double alpha, FrameImage& film) const {
+  // Refinement runs with one first ray per pixel, so the weight of the box filter is 1.
+  const double weight = 1.0 / (samples_ * samples_);
+  glm::dvec4 sum(0);
+  sum += glm::dvec4(colour, alpha);
+  for (int c = 0; c < 4; ++c) film.rgba[4 * pixel + c] = static_cast<float>(sum[c] * weight);
+}
 
 glm::dvec3 pixel_direction(const RayBasis& basis, int px, int py) {
   const double fx = px + 0.5, fy = py + 0.5;
   return glm::normalize(basis.d00 + fx * basis.du + fy * basis.dv);
 }
 
+FrameImage make_film(const RenderPlan& plan) {
+  FrameImage film;
+  film.width = plan.width;
+  film.height = plan.height;
+  const std::size_t n = static_cast<std::size_t>(film.width) * film.height;
+  film.rgba.assign(4 * n, 0.0f);
+  film.depth.assign(n, std::numeric_limits<float>::infinity());
+  film.normal.assign(3 * n, 0.0f);
+  return film;
+}
+
 FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
   const HitBuffer& hits = result.hits;
-  const int samples = result.plan.samples;
-  FrameImage img;
-  img.width = hits.width / samples;
-  img.height = hits.height / samples;
-  const std::size_t n = static_cast<std::size_t>(img.width) * img.height;
-  img.rgba.assign(4 * n, 0.0f);
-  img.depth.assign(n, std::numeric_limits<float>::infinity());
-  img.normal.assign(3 * n, 0.0f);
-
-  std::vector<LightSamples> lights;
-  for (const Light& light : scene.lights) lights.push_back({&light, light.sample_points()});
-  const ShadowLookup primary_shadows(result.shadows, hits.records.size(), scene.lights);
-  const bool single = result.config.precision != Precision::Double;
-  const bool transmits = result.plan.find("transmission") != nullptr;
+  const Shader shader(scene, result.plan, result.basis, result.config.precision);
+  RenderPlan plan = result.plan;
+  plan.width = hits.width / std::max(plan.samples, 1);
+  plan.height = hits.height / std::max(plan.samples, 1);
+  FrameImage img = make_film(plan);
 
   // What reflection and transmission rays add to each traced camera ray: their weight times what they met.
   // Adaptive antialiasing's camera rays are such contributions too, with weights 1/n^2; they also carry alpha.
   std::vector<glm::dvec3> secondary(result.secondary.empty() ? 0 : hits.records.size(), glm::dvec3(0));
   std::vector<glm::dvec3> refined_colour(result.refined.empty() ? 0 : hits.records.size(), glm::dvec3(0));
   std::vector<double> refined_alpha(refined_colour.size(), 0.0);
+  std::vector<double> no_alpha;
   for (const SecondaryBatch& batch : result.secondary) {
-    const ShadowLookup batch_shadows(batch.shadows, batch.hits.size(), scene.lights);
-    for (std::size_t i = 0; i < batch.hits.size(); ++i) {
-      const HitRecord& h = batch.hits[i];
-      const glm::dvec3 seen = (h.flags & ALGRAY_HIT_FOUND)
-                                  ? shade_hit(scene, lights, h, batch.hit_surface.empty() ? 0 : batch.hit_surface[i],
-                                              hit_point(batch.rays[i], h), -glm::normalize(batch.rays[i].direction),
-                                              batch_shadows, i, transmits)
-                                  : glm::dvec3(scene.image.background);
-      (batch.refinement ? refined_colour : secondary)[batch.sample[i]] += batch.weight[i] * seen;
-      if (batch.pass == "antialias")
-        refined_alpha[batch.sample[i]] +=
-            batch.weight[i] * ((h.flags & ALGRAY_HIT_FOUND) ? 1.0 : scene.image.background.a);
-    }
+    if (batch.refinement)
+      shader.add_batch(batch, refined_colour, refined_alpha);
+    else
+      shader.add_batch(batch, secondary, no_alpha);
   }
-  const double weight = 1.0 / (samples * samples);
-
-  // Rows are independent; shading a 1024x768 frame on one core costs as much as a fifth of the kernel.
-  auto shade_rows = [&](int y_begin, int y_end) {
-    for (int y = y_begin; y < y_end; ++y) {
-      for (int x = 0; x < img.width; ++x) {
-        const std::size_t i = static_cast<std::size_t>(y) * img.width + x;
-        glm::dvec4 sum(0);
-        for (int sy = 0; sy < samples; ++sy) {
-          for (int sx = 0; sx < samples; ++sx) {
-            const int tx = x * samples + sx, ty = y * samples + sy;
-            const std::size_t k = static_cast<std::size_t>(ty) * hits.width + tx;
-            const HitRecord& h = hits.records[k];
-            if (!result.refined.empty() && result.refined[k]) {
-              // Its colour is what the antialias batch's n x n rays (and their bounces) saw.
-              sum += glm::dvec4(refined_colour[k], refined_alpha[k]);
-              if (h.flags & ALGRAY_HIT_FOUND) {
-                img.depth[i] = h.depth;
-                img.normal[3 * i] = h.normal_x;
-                img.normal[3 * i + 1] = h.normal_y;
-                img.normal[3 * i + 2] = h.normal_z;
-              }
-              continue;
-            }
-            if (!(h.flags & ALGRAY_HIT_FOUND)) {
-              sum += scene.image.background;
-              continue;
-            }
-            const PixelRay ray = pixel_ray(result.basis, single, tx, ty);
-            const glm::dvec3 to_eye = -glm::normalize(ray.direction);
-            glm::dvec3 colour = shade_hit(scene, lights, h, hits.surface_of(k), hit_point(ray, h), to_eye,
-                                          primary_shadows, k, transmits);
-            if (!secondary.empty()) colour += secondary[k];
-            sum += glm::dvec4(colour, 1);
-            if (h.depth < img.depth[i]) {
-              img.depth[i] = h.depth;
-              img.normal[3 * i] = h.normal_x;
-              img.normal[3 * i + 1] = h.normal_y;
-              img.normal[3 * i + 2] = h.normal_z;
-            }
-          }
-        }
-        for (int c = 0; c < 4; ++c) img.rgba[4 * i + c] = static_cast<float>(sum[c] * weight);
-      }
-    }
-  };
-  const int threads = static_cast<int>(std::clamp(std::thread::hardware_concurrency(), 1u, 16u));
-  std::vector<std::thread> workers;
-  for (int t = 1; t < threads; ++t)
-    workers.emplace_back(shade_rows, img.height * t / threads, img.height * (t + 1) / threads);
-  shade_rows(0, img.height / threads);
-  for (std::thread& w : workers) w.join();
+  const ShadowLookup shadows(result.shadows, hits.records.size(), scene.lights.size());
+  TracedBlock block;
+  block.width = hits.width;
+  block.height = hits.height;
+  block.hits = hits.records.data();
+  block.surface = hits.surface.empty() ? nullptr : hits.surface.data();
+  block.shadows = &shadows;
+  block.secondary = secondary.empty() ? nullptr : secondary.data();
+  shader.resolve(block, img);
+  for (std::size_t k = 0; k < result.refined.size(); ++k)
+    if (result.refined[k]) shader.resolve_refined(k, refined_colour[k], refined_alpha[k], img);
   return img;
 }
 

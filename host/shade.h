@@ -1,6 +1,9 @@
 // Turning hit records into colours: Phong lighting with the shadow pass's answers, or a headlight without lights.
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include "camera.h"
 #include "image_io.h"
 #include "renderer.h"
@@ -12,9 +15,67 @@ namespace algray {
 // visible.
 inline constexpr double kPreviewAmbient = 0.2;
 
-// RGBA, depth, normals and the solver-statistics channels of the output image: every traced ray shaded, then
-// the antialiasing samples of each pixel averaged (a box filter). Depth and normal are those of the pixel's
-// nearest sample; the solver channels add up the work of all its samples.
+// A batch's shadow answers, looked up by the index of a hit in its batch.
+class ShadowLookup {
+ public:
+  ShadowLookup(const ShadowData& data, std::size_t batch_size, std::size_t light_count);
+  // Bit s set when the shadow pass found light point s of light `light` hidden from hit `hit`.
+  std::uint64_t hidden(std::size_t light, std::size_t hit) const {
+    const LightOcclusion* o = by_light_[light];
+    if (!o || point_of_hit_.empty() || point_of_hit_[hit] == UINT32_MAX) return 0;
+    return o->masks[point_of_hit_[hit]];
+  }
+
+ private:
+  std::vector<const LightOcclusion*> by_light_;
+  std::vector<std::uint32_t> point_of_hit_;
+};
+
+// A block of whole pixels of the traced grid and what the passes found there: what the film is made of.
+struct TracedBlock {
+  int x0 = 0, y0 = 0, width = 0, height = 0;  // in traced rays: plan.samples per pixel side
+  const HitRecord* hits = nullptr;            // width x height, row-major
+  const std::uint8_t* surface = nullptr;      // which surface each hit; null when the scene has one
+  const ShadowLookup* shadows = nullptr;      // of these hits
+  const glm::dvec3* secondary = nullptr;      // per ray, what its bounces brought back; null without bounces
+};
+
+// The lights and materials of one render, shared by the film and by shade_frame, so both shade alike.
+class Shader {
+ public:
+  Shader(const Scene& scene, const RenderPlan& plan, const RayBasis& basis, Precision precision);
+  // Adds what each ray of `batch` saw, times its weight, to colour[sample]: its hit shaded with the batch's
+  // shadows, or the background. Antialias batches also add their alpha to alpha[sample].
+  void add_batch(const SecondaryBatch& batch, std::vector<glm::dvec3>& colour, std::vector<double>& alpha) const;
+  // RGBA, depth and normal of the block's pixels: every ray shaded, then each pixel's antialiasing samples
+  // averaged (a box filter). Depth and normal are those of the pixel's nearest sample.
+  void resolve(const TracedBlock& block, FrameImage& film) const;
+  // Adaptive antialiasing: the colour of output pixel `pixel` becomes what its n x n rays (and their bounces)
+  // saw; depth and normal stay the first ray's.
+  void resolve_refined(std::size_t pixel, const glm::dvec3& colour, double alpha, FrameImage& film) const;
+
+ private:
+  struct LightSamples {
+    const Light* light;
+    std::vector<glm::dvec3> points;
+  };
+  glm::dvec3 shade_hit(const HitRecord& h, int surface, const PixelRay& ray, const ShadowLookup& shadows,
+                       std::size_t hit_index) const;
+
+  const Scene& scene_;
+  RayBasis basis_;
+  bool single_;
+  int samples_;
+  bool transmits_;
+  std::vector<LightSamples> lights_;
+  std::vector<double> highlight_cutoff_;  // per surface, front then back: (r.v) below this adds no highlight
+};
+
+// The film with its RGBA, depth and normal channels for the plan's output size: transparent black, no depth.
+FrameImage make_film(const RenderPlan& plan);
+
+// The output image from a render's records (RenderOptions::keep_records, or the reference's hits), as the
+// renderer's film is made.
 FrameImage shade_frame(const Scene& scene, const RenderResult& result);
 
 // Unit direction of pixel (px, py)'s ray, in double (the kernels compute the same ray in their own precision).

@@ -54,20 +54,24 @@ std::vector<std::uint8_t> SolverWork::in_extent() const {
   return in;
 }
 
-SolverWork solver_work(const RenderResult& result) {
-  const HitBuffer& hits = result.hits;
+SolverWork empty_solver_work(int width, int height, int samples) {
   SolverWork w;
-  w.samples = std::max(result.plan.samples, 1);
-  w.width = hits.width / w.samples;
-  w.height = hits.height / w.samples;
+  w.samples = std::max(samples, 1);
+  w.width = width;
+  w.height = height;
   const std::size_t n = static_cast<std::size_t>(w.width) * w.height;
   w.isolation_steps.assign(n, 0);
   w.refine_iterations.assign(n, 0);
   w.flags.assign(n, 0);
   w.classification.assign(n, 0);
-  for (int ty = 0; ty < hits.height; ++ty) {
-    for (int tx = 0; tx < hits.width; ++tx) {
-      const HitRecord& h = hits.at(tx, ty);
+  return w;
+}
+
+void add_tile_work(SolverWork& w, const PrimaryTile& tile) {
+  for (int y = 0; y < tile.height; ++y) {
+    for (int x = 0; x < tile.width; ++x) {
+      const HitRecord& h = tile.hits[static_cast<std::size_t>(y) * tile.width + x];
+      const int tx = tile.x0 + x, ty = tile.y0 + y;
       const std::size_t i = static_cast<std::size_t>(ty / w.samples) * w.width + tx / w.samples;
       w.isolation_steps[i] += h.work & 0xffffu;
       w.refine_iterations[i] += h.work >> 16;
@@ -75,6 +79,18 @@ SolverWork solver_work(const RenderResult& result) {
       w.classification[i] = std::max(w.classification[i], static_cast<std::uint32_t>(solver_class(h)));
     }
   }
+}
+
+SolverWork solver_work(const RenderResult& result) {
+  const HitBuffer& hits = result.hits;
+  const int samples = std::max(result.plan.samples, 1);
+  SolverWork w = empty_solver_work(hits.width / samples, hits.height / samples, samples);
+  PrimaryTile whole;
+  whole.width = hits.width;
+  whole.height = hits.height;
+  whole.samples = samples;
+  whole.hits = hits.records.data();
+  add_tile_work(w, whole);
   return w;
 }
 

@@ -37,6 +37,11 @@ struct SolverWork {
   std::vector<std::uint32_t> total() const;     // isolation steps + refinement iterations
   std::vector<std::uint8_t> in_extent() const;  // 1 where some sample met the extent
 };
+// Zeros for a width x height image of `samples` x `samples` rays per pixel, for add_tile_work to fill.
+SolverWork empty_solver_work(int width, int height, int samples);
+// Adds one tile's camera rays, as the renderer hands them over (RenderOptions::on_primary_tile).
+void add_tile_work(SolverWork& work, const PrimaryTile& tile);
+// From a render's records (RenderOptions::keep_records, or the reference's hits).
 SolverWork solver_work(const RenderResult& result);
 
 // solver.refineIterations, solver.isolationSteps, solver.class and solver.flags, as asked.

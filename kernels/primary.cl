@@ -6,7 +6,8 @@
 #include "restrict.h"
 #include "surface.h"
 
-/* One tile of the image per launch: global size (tile_w, tile_h), results at out[py * image_width + px].
+/* One tile of the image per launch: global size (tile_w, tile_h), results at out[gy * tile_w + gx], the tile's own
+ * buffer, for pixel (px, py) = (tile_x0 + gx, tile_y0 + gy).
  * The polynomial is given in unit coordinates u = (p - centre) * inv_scale, with max |coefficient| = 1.
  * binomials[n * (DEGREE + 1) + k] = C(n, k) for 0 <= k <= n <= DEGREE (zero elsewhere).
  * even_axes: bit 0, 1, 2 set when every exponent of x, y, z in the polynomial is even.
@@ -14,7 +15,7 @@
 __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, REAL4 ray_du, REAL4 ray_dv,
                       REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
                       __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
-                      __constant const REAL* binomials, uint even_axes SCREEN_ROWS_PARAM, uint image_width,
+                      __constant const REAL* binomials, uint even_axes SCREEN_ROWS_PARAM,
                       uint tile_x0, uint tile_y0,
                       uint tile_w, uint tile_h, __global HitRecord* out) {
   const uint gx = get_global_id(0), gy = get_global_id(1);
@@ -28,5 +29,5 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
 #endif
   const SurfaceHit hit = trace_surface(ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
                                        mono_exps, mono_coefs, mono_count, binomials, even_axes SCREEN_ARG);
-  out[(size_t)py * image_width + px] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
+  out[(size_t)gy * tile_w + gx] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
 }

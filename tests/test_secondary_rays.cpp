@@ -1,6 +1,8 @@
-// Reflection and transmission rays against spheres, whose hits are known in closed form.
+// Reflection and transmission rays against spheres, whose hits are known in closed form; tiled renders against one
+// tile.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -124,4 +126,128 @@ TEST_CASE("a transparent side without a transmission pass shows opaque, not dark
     CHECK(a.rgba[centre] > 0.1f);
     CHECK(a.rgba[centre] == b.rgba[centre]);
   }
+}
+
+namespace {
+
+// Bit for bit: the same floats, NaNs and signed zeros included.
+template <typename T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+// The first pixel where two films differ, for the failure message.
+std::string first_difference(const FrameImage& a, const FrameImage& b) {
+  for (std::size_t i = 0; i < a.depth.size() && i < b.depth.size(); ++i) {
+    const bool differs = std::memcmp(&a.rgba[4 * i], &b.rgba[4 * i], 4 * sizeof(float)) != 0 ||
+                         std::memcmp(&a.depth[i], &b.depth[i], sizeof(float)) != 0 ||
+                         std::memcmp(&a.normal[3 * i], &b.normal[3 * i], 3 * sizeof(float)) != 0;
+    if (differs)
+      return "pixel " + std::to_string(i % a.width) + "," + std::to_string(i / a.width) + ": red " +
+             std::to_string(a.rgba[4 * i]) + " against " + std::to_string(b.rgba[4 * i]);
+  }
+  return "none";
+}
+
+Scene ball_and_ring(const std::vector<Override>& overrides) {
+  std::vector<Override> all = {{"image.width", "72"}, {"image.height", "54"}};
+  all.insert(all.end(), overrides.begin(), overrides.end());
+  return load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/examples/ball_and_ring.toml", all);
+}
+
+}  // namespace
+
+TEST_CASE("tiles and batches change no pixel: small ones render the one-tile image bit for bit", "[secondary][tiles]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  // Full mode with everything that crosses a tile's border or fills a batch: two surfaces, a reflective ball
+  // and a transparent ring (bounces), an area light's shadows, and adaptive antialiasing, whose choice at a
+  // tile's edge depends on the neighbouring tile's first colours; then the same with uniform 2x2 supersampling.
+  for (const char* adaptive : {"true", "false"}) {
+    Scene scene =
+        ball_and_ring({{"antialias.adaptive", adaptive}, {"antialias.samples", adaptive[0] == 't' ? "3" : "2"}});
+    scene.render.tile_size = 4096;  // one tile
+    RenderOptions whole;
+    whole.keep_records = true;
+    const RenderResult one = renderer.render(scene, whole);
+    std::vector<std::string> passes;
+    for (const PassStats& p : one.passes) {
+      passes.push_back(p.name);
+      CHECK(p.rays > 0);
+    }
+    CHECK(passes == (adaptive[0] == 't'
+                         ? std::vector<std::string>{"primary", "shadow", "reflection", "transmission", "antialias"}
+                         : std::vector<std::string>{"primary", "shadow", "reflection", "transmission"}));
+    CHECK(one.passes[0].launches == 2);  // one tile, one kernel per surface
+    // The film is what shade_frame makes of the records.
+    const FrameImage from_records = shade_frame(scene, one);
+    INFO("adaptive " << adaptive << ": film against shade_frame, first difference "
+                     << first_difference(one.image, from_records));
+    CHECK(same_bits(one.image.rgba, from_records.rgba));
+    CHECK(same_bits(one.image.depth, from_records.depth));
+    CHECK(same_bits(one.image.normal, from_records.normal));
+
+    // Tiles of 8 and 13 traced rays a side (not dividing the image), batches of 1000 and of 37 rays, so that
+    // shadow points, antialias rays and bounces are split into groups.
+    const struct {
+      int tile;
+      std::size_t batch;
+    } splits[] = {{8, 1000}, {13, 37}, {4096, 37}};
+    for (const auto& split : splits) {
+      scene.render.tile_size = split.tile;
+      RenderOptions options;
+      options.keep_records = true;
+      options.batch_rays = split.batch;
+      const RenderResult tiled = renderer.render(scene, options);
+      INFO("adaptive " << adaptive << ", tile " << split.tile << ", batches of " << split.batch
+                       << " rays: first difference " << first_difference(one.image, tiled.image));
+      CHECK(tiled.passes[0].launches > (split.tile < 4096 ? 2 * 20 : 1));
+      CHECK(same_bits(one.image.rgba, tiled.image.rgba));
+      CHECK(same_bits(one.image.depth, tiled.image.depth));
+      CHECK(same_bits(one.image.normal, tiled.image.normal));
+      CHECK(same_bits(one.hits.records, tiled.hits.records));
+      CHECK(same_bits(one.hits.surface, tiled.hits.surface));
+      CHECK(same_bits(one.refined, tiled.refined));
+      REQUIRE(tiled.passes.size() == one.passes.size());
+      for (std::size_t p = 0; p < one.passes.size(); ++p) {
+        INFO("pass " << one.passes[p].name);
+        CHECK(tiled.passes[p].rays == one.passes[p].rays);
+      }
+      std::size_t largest = 0;
+      for (const SecondaryBatch& b : tiled.secondary) largest = std::max(largest, b.rays.size());
+      CHECK(largest <= std::max<std::size_t>(split.batch, 9));  // whole pixels: a refined one has 9 rays
+    }
+  }
+}
+
+TEST_CASE("without records a render keeps the film and the totals, not every ray", "[secondary][tiles]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  Scene scene = ball_and_ring({});
+  scene.render.tile_size = 16;
+  RenderOptions options;
+  std::size_t tiles = 0, camera_rays = 0;
+  options.on_primary_tile = [&](const PrimaryTile& tile) {
+    ++tiles;
+    camera_rays += static_cast<std::size_t>(tile.width) * tile.height;
+    CHECK(tile.width <= 16);
+    CHECK(tile.height <= 16);
+  };
+  const RenderResult lean = renderer.render(scene, options);
+  CHECK(lean.hits.records.empty());
+  CHECK(lean.secondary.empty());
+  CHECK(lean.shadows.points.empty());
+  CHECK(tiles == 5 * 4);
+  CHECK(camera_rays == 72u * 54u);
+  CHECK(lean.primary.rays == 72u * 54u);
+  CHECK(lean.primary.pixels == 72u * 54u);
+  CHECK(lean.primary.hits > 0);
+  const RenderResult full = renderer.render(scene, false);
+  CHECK(same_bits(lean.image.rgba, full.image.rgba));
+  const PrimarySummary from_records = summarise_hits(full.hits, full.plan.samples);
+  CHECK(lean.primary.hits == from_records.hits);
+  CHECK(lean.primary.isolation_steps == from_records.isolation_steps);
+  CHECK(lean.primary.pixels_hit == from_records.pixels_hit);
 }

@@ -138,6 +138,8 @@ Tally check_shadow_rays(Precision precision, int rays_per_scene, MakeLight make_
     const RenderPlan plan = make_render_plan(scene, precision);
     KernelConfig config = primary_config(scene, precision);
     config.entry = "shadow";
+    // As the render plan builds it: the screen form is the camera rays' alone.
+    if (config.ray_origin == RayOrigin::Screen) config.ray_origin = RayOrigin::Extent;
     config.refinement = Refinement::Brent;
     config.max_iterations = default_max_iterations(Refinement::Brent);
     const DeviceSurface surface(session.context, scene, precision);
