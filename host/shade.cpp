@@ -47,7 +47,15 @@ Shader::Shader(const Scene& scene, const RenderPlan& plan, const RayBasis& basis
   for (const SceneSurface& surface : scene.surfaces)
     for (const Material* m : {&surface.materials.front, &surface.materials.back})
       highlight_cutoff_.push_back(std::pow(1.0 / 4096, 1 / m->exponent));
-  for (const Light& light : scene.lights) lights_.push_back({&light, light.sample_points()});
+  for (const Light& light : scene.lights) {
+    // Preview shades without shadows, so the sample points of an area light differ only in their angles: the
+    // grid's centre stands for them (the grid is symmetric about it, so the mean of n.l over the points
+    // matches it to first order in the light's size over its distance). Full mode shades every point.
+    if (scene.render.preview)
+      lights_.push_back({&light, {light.position}});
+    else
+      lights_.push_back({&light, light.sample_points()});
+  }
 }
 
 // Colour of one traced ray that hit the surface: the side's own colour (times 1 - transparency, the rest
