@@ -239,10 +239,13 @@ void encode_exr(const fs::path& file, const FrameImage& image) {
     frame.insert(name, Imf::Slice::Make(type, base, origin, w, h, x_stride));
   };
 
-  // Converted here rather than by OpenEXR so the rounding is the one Imath::half documents.
-  std::vector<Imath::half> rgba_half(image.rgba.begin(), image.rgba.end());
+  // Colour is converted to half a strip of lines at a time (below), so a poster needs no second copy of its film:
+  // its slices are set per strip; the float channels are read where they are.
   const char* rgba_names[4] = {"R", "G", "B", "A"};
-  for (std::size_t c = 0; c < 4; ++c) add(rgba_names[c], Imf::HALF, rgba_half.data() + c, 4 * sizeof(Imath::half));
+  for (const char* name : rgba_names) {
+    if (channels.findChannel(name)) throw OutputError(std::string("duplicate channel name '") + name + "'");
+    channels.insert(name, Imf::Channel(Imf::HALF));
+  }
   if (!image.depth.empty()) add("Z", Imf::FLOAT, image.depth.data(), sizeof(float));
   if (!image.normal.empty()) {
     const char* normal_names[3] = {"N.X", "N.Y", "N.Z"};
@@ -282,13 +285,26 @@ void encode_exr(const fs::path& file, const FrameImage& image) {
     header.insert(name, Imf::DoubleAttribute(value));
   }
 
-  // Compression dominates the write; blocks of lines compress in parallel on OpenEXR's threads.
+  // Compression dominates the write; blocks of lines compress in parallel on OpenEXR's threads. A strip holds
+  // about 4 MB of half colour, and at least four ZIP blocks (16 lines) per thread, so the threads stay busy.
   const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   static std::once_flag pool_started;
   std::call_once(pool_started, [threads] { Imf::setGlobalThreadCount(threads); });
   Imf::OutputFile out(file.c_str(), header, threads);
-  out.setFrameBuffer(frame);
-  out.writePixels(image.height);
+  const std::int64_t strip_lines = std::min<std::int64_t>(h, std::max<std::int64_t>(64 * threads, (4 << 20) / (8 * w)));
+  std::vector<Imath::half> rgba_half(static_cast<std::size_t>(4 * w * strip_lines));
+  for (std::int64_t y0 = 0; y0 < h; y0 += strip_lines) {
+    const std::int64_t lines = std::min(strip_lines, h - y0);
+    // Converted here rather than by OpenEXR so the rounding is the one Imath::half documents.
+    const float* from = image.rgba.data() + 4 * w * y0;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(4 * w * lines); ++i) rgba_half[i] = Imath::half(from[i]);
+    Imf::FrameBuffer strip = frame;
+    for (std::size_t c = 0; c < 4; ++c)
+      strip.insert(rgba_names[c], Imf::Slice::Make(Imf::HALF, rgba_half.data() + c, Imath::V2i(0, static_cast<int>(y0)),
+                                                   w, lines, 4 * sizeof(Imath::half)));
+    out.setFrameBuffer(strip);
+    out.writePixels(static_cast<int>(lines));
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -296,12 +312,71 @@ void encode_exr(const fs::path& file, const FrameImage& image) {
 
 std::uint8_t to_byte(double v) { return static_cast<std::uint8_t>(std::lround(v * 255.0)); }
 
-std::uint8_t encode_srgb(float linear) {
+// The sRGB transfer function, rounded to a byte: the definition the fast encoder below is built from.
+std::uint8_t encode_srgb_exactly(float linear) {
   if (!(linear > 0.0f)) return 0;  // also maps NaN to black
   if (linear >= 1.0f) return 255;
   const double l = linear;
   return to_byte(l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055);
 }
+
+// encode_srgb_exactly without a pow() per value (a third of a 1024^2 PNG's write): a table by the float's top
+// bits gives the byte at the bottom of its bucket, and one comparison with the next byte's threshold (the
+// smallest float that reaches it, found by bisection on the exact function) finishes it. A bucket spans a
+// relative 2^-8 of the value, less than one byte step anywhere on the curve, so it holds at most one threshold.
+class SrgbEncoder {
+ public:
+  SrgbEncoder() {
+    threshold_[0] = 0;
+    for (int b = 1; b < 256; ++b) {
+      // Positive floats order like their bit patterns: bisect those for the first one that encodes to >= b.
+      std::uint32_t lo = 0, hi = bits_of(1.0f);
+      while (lo < hi) {
+        const std::uint32_t mid = lo + (hi - lo) / 2;
+        if (encode_srgb_exactly(float_of(mid)) >= b)
+          hi = mid;
+        else
+          lo = mid + 1;
+      }
+      threshold_[b] = float_of(lo);
+    }
+    for (std::uint32_t bucket = 0; bucket < kBuckets; ++bucket)
+      table_[bucket] = encode_srgb_exactly(float_of(bucket << kDroppedBits));
+  }
+  std::uint8_t operator()(float linear) const {
+    if (!(linear > 0.0f)) return 0;
+    if (linear >= 1.0f) return 255;
+    const std::uint8_t b = table_[bits_of(linear) >> kDroppedBits];
+    return b < 255 && linear >= threshold_[b + 1] ? static_cast<std::uint8_t>(b + 1) : b;
+  }
+
+ private:
+  static constexpr int kDroppedBits = 15;                                       // of the 23 mantissa bits, 8 stay
+  static constexpr std::uint32_t kBuckets = (0x3f800000u >> kDroppedBits) + 1;  // every float in [0, 1]
+  static std::uint32_t bits_of(float f) {
+    std::uint32_t u;
+    std::memcpy(&u, &f, sizeof u);
+    return u;
+  }
+  static float float_of(std::uint32_t u) {
+    float f;
+    std::memcpy(&f, &u, sizeof f);
+    return f;
+  }
+  float threshold_[256];
+  std::uint8_t table_[kBuckets];
+};
+
+}  // namespace
+
+std::uint8_t srgb_byte(float linear) {
+  static const SrgbEncoder encoder;
+  return encoder(linear);
+}
+
+namespace {
+
+std::uint8_t encode_srgb(float linear) { return srgb_byte(linear); }
 
 std::uint8_t encode_alpha(float a) {
   if (!(a > 0.0f)) return 0;
@@ -321,10 +396,15 @@ void png_error_to_state(png_structp png, png_const_charp msg) {
 
 void png_ignore_warning(png_structp, png_const_charp) {}
 
+// Fills `count` rows of image data from row y0 on, one after another, into `strip`. Called between libpng's
+// calls, so it may be ordinary C++ as long as it does not throw.
+using FillRows = void (*)(const void* context, png_uint_32 y0, png_uint_32 count, png_bytep strip) noexcept;
+
 // libpng reports errors by longjmp, which must not cross objects with destructors; so this function
-// holds none and the caller owns every buffer.
-bool encode_png_stream(std::FILE* fp, png_uint_32 width, png_uint_32 height, int color_type, png_bytepp rows,
-                       png_textp text, int text_count, PngErrorState* error) {
+// holds none and the caller owns every buffer. The image goes to libpng `strip_rows` rows at a time.
+bool encode_png_stream(std::FILE* fp, png_uint_32 width, png_uint_32 height, int color_type, png_size_t row_bytes,
+                       png_uint_32 strip_rows, png_bytep strip, FillRows fill, const void* context, png_textp text,
+                       int text_count, PngErrorState* error) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, error, png_error_to_state, png_ignore_warning);
   if (!png) return false;
   png_infop info = png_create_info_struct(png);
@@ -337,6 +417,10 @@ bool encode_png_stream(std::FILE* fp, png_uint_32 width, png_uint_32 height, int
     return false;
   }
   png_init_io(png, fp);
+  // zlib level 1 with the Up filter: measured on a 1024^2 render, 10 ms of CPU against 51 ms for libpng's default
+  // (level 6, every filter tried per row), for a file 32% larger (250 KB against 190 KB).
+  png_set_compression_level(png, 1);
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_UP);
   png_set_IHDR(png, info, width, height, 8, color_type, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                PNG_FILTER_TYPE_DEFAULT);
   // gAMA and cHRM alongside sRGB keep old decoders that ignore sRGB close to correct.
@@ -344,7 +428,11 @@ bool encode_png_stream(std::FILE* fp, png_uint_32 width, png_uint_32 height, int
   // Before the image data, so that a reader wanting only the text can stop early.
   png_set_text(png, info, text, text_count);
   png_write_info(png, info);
-  png_write_image(png, rows);
+  for (png_uint_32 y0 = 0; y0 < height; y0 += strip_rows) {
+    const png_uint_32 count = std::min(strip_rows, height - y0);
+    fill(context, y0, count, strip);
+    for (png_uint_32 r = 0; r < count; ++r) png_write_row(png, strip + r * row_bytes);
+  }
   png_write_end(png, info);
   png_destroy_write_struct(&png, &info);
   return true;
@@ -459,20 +547,31 @@ void encode_png(const fs::path& file, const FrameImage& image) {
   for (std::size_t i = 0; i < n && opaque; ++i) opaque = encode_alpha(image.rgba[4 * i + 3]) == 255;
   const std::size_t channels = opaque ? 3 : 4;
 
-  std::vector<png_byte> bytes(n * channels);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t c = 0; c < 3; ++c) bytes[i * channels + c] = encode_srgb(image.rgba[4 * i + c]);
-    if (!opaque) bytes[i * channels + 3] = encode_alpha(image.rgba[4 * i + 3]);
-  }
-  const auto width = static_cast<std::size_t>(image.width);
-  std::vector<png_bytep> rows(static_cast<std::size_t>(image.height));
-  for (std::size_t y = 0; y < rows.size(); ++y) rows[y] = bytes.data() + y * width * channels;
+  // Encoded a strip of about 1 MB at a time, so that a poster needs no 8-bit copy of the whole image.
+  struct Strip {
+    const FrameImage* image;
+    std::size_t channels;
+  } source{&image, channels};
+  const FillRows fill = [](const void* context, png_uint_32 y0, png_uint_32 count, png_bytep strip) noexcept {
+    const Strip& s = *static_cast<const Strip*>(context);
+    const std::size_t first = static_cast<std::size_t>(y0) * static_cast<std::size_t>(s.image->width);
+    const std::size_t pixels = static_cast<std::size_t>(count) * static_cast<std::size_t>(s.image->width);
+    const float* rgba = s.image->rgba.data() + 4 * first;
+    for (std::size_t i = 0; i < pixels; ++i) {
+      for (std::size_t c = 0; c < 3; ++c) strip[i * s.channels + c] = encode_srgb(rgba[4 * i + c]);
+      if (s.channels == 4) strip[i * 4 + 3] = encode_alpha(rgba[4 * i + 3]);
+    }
+  };
+  const std::size_t row_bytes = static_cast<std::size_t>(image.width) * channels;
+  const auto strip_rows = static_cast<png_uint_32>(
+      std::clamp<std::size_t>((1u << 20) / row_bytes, 1, static_cast<std::size_t>(image.height)));
+  std::vector<png_byte> strip(strip_rows * row_bytes);
 
   write_with_stdio(file, [&](std::FILE* fp) {
     PngErrorState error;
     if (!encode_png_stream(fp, static_cast<png_uint_32>(image.width), static_cast<png_uint_32>(image.height),
-                           opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA, rows.data(), text.data(),
-                           static_cast<int>(text.size()), &error)) {
+                           opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA, row_bytes, strip_rows, strip.data(),
+                           fill, &source, text.data(), static_cast<int>(text.size()), &error)) {
       throw WriteError(std::string("libpng: ") + error.message);
     }
   });

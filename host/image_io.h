@@ -81,6 +81,9 @@ std::string lowercase_extension(const std::filesystem::path& p);
 
 // An sRGB-encoded value in [0, 1] (a display colour, as other programs write them) as linear light.
 double srgb_to_linear(double c);
+// The byte write_png stores for a linear value: the sRGB transfer function, times 255, rounded to nearest;
+// 0 for NaN and values <= 0, 255 from 1 on.
+std::uint8_t srgb_byte(float linear);
 
 // Case-insensitive .exr / .png; anything else throws OutputError.
 ImageFormat format_from_extension(const std::filesystem::path& p);

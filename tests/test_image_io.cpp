@@ -1036,3 +1036,92 @@ TEST_CASE("a writer killed by SIGKILL leaves a temporary that a later write remo
   algray::write_exr(dest, solid_image(2, 2, 0.5f, 0.5f, 0.5f, 1.0f));
   CHECK(list_dir(dir.path()) == std::vector<std::string>{"killed.exr"});
 }
+
+namespace {
+
+// The sRGB transfer function, times 255, rounded: what every PNG byte must be.
+int srgb_byte_by_definition(float linear) {
+  if (!(linear > 0.0f)) return 0;
+  if (linear >= 1.0f) return 255;
+  const double l = linear;
+  return static_cast<int>(std::lround(255.0 * (l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055)));
+}
+
+float float_of_bits(std::uint32_t u) {
+  float f;
+  std::memcpy(&f, &u, sizeof f);
+  return f;
+}
+
+}  // namespace
+
+TEST_CASE("the PNG's sRGB bytes are the transfer function's, rounded, at every threshold", "[image_io][png]") {
+  // The encoder is a table: checked on every 61st float of (0, 1) and on the floats next to each change of
+  // byte, where a table is most likely off (every float of (0, 1) was checked once: no difference).
+  int checked = 0, changes = 0, wrong = 0;
+  float first_wrong = 0;
+  auto check = [&](float f) {
+    ++checked;
+    if (int(algray::srgb_byte(f)) == srgb_byte_by_definition(f)) return;
+    if (wrong++ == 0) first_wrong = f;
+  };
+  for (std::uint32_t u = 1; u < 0x3f800000u; u += 61) {
+    check(float_of_bits(u));
+    if (srgb_byte_by_definition(float_of_bits(u)) == srgb_byte_by_definition(float_of_bits(u + 61))) continue;
+    ++changes;
+    for (std::uint32_t v = u + 1; v < u + 61; ++v) check(float_of_bits(v));
+  }
+  INFO(wrong << " of " << checked << " floats encoded wrongly, the first " << first_wrong << " ("
+             << int(algray::srgb_byte(first_wrong)) << " for " << srgb_byte_by_definition(first_wrong) << ")");
+  CHECK(wrong == 0);
+  CHECK(checked > 17000000);
+  CHECK(changes == 255);
+  for (float special : {0.0f, -0.0f, -1.0f, 1.0f, 7.5f, std::numeric_limits<float>::quiet_NaN(),
+                        std::numeric_limits<float>::infinity(), std::numeric_limits<float>::denorm_min()})
+    CHECK(int(algray::srgb_byte(special)) == srgb_byte_by_definition(special));
+}
+
+TEST_CASE("EXR and PNG written in strips read back whole", "[image_io][exr][png]") {
+  // Taller than one strip of either writer (EXR: about 4 MB of half colour; PNG: about 1 MB of bytes), with an
+  // odd last strip, so that a line out of place or a strip written twice shows.
+  TempDir dir;
+  const int width = 1000, height = 1123;
+  FrameImage im;
+  im.width = width;
+  im.height = height;
+  const std::size_t n = static_cast<std::size_t>(width) * height;
+  std::mt19937 rng(20261201);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  im.rgba.resize(4 * n);
+  im.depth.resize(n);
+  im.normal.resize(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) im.rgba[4 * i + c] = unit(rng);
+    im.rgba[4 * i + 3] = (i % 7 == 0) ? 0.5f : 1.0f;
+    im.depth[i] = static_cast<float>(i);  // each line its own values
+    for (int c = 0; c < 3; ++c) im.normal[3 * i + c] = unit(rng);
+  }
+  algray::write_image(dir / "tall.exr", im);
+  algray::write_image(dir / "tall.png", im);
+  const FrameImage back = algray::read_exr(dir / "tall.exr");
+  REQUIRE(back.rgba.size() == im.rgba.size());
+  std::size_t first_wrong = n * 4;
+  for (std::size_t i = im.rgba.size(); i-- > 0;)
+    if (back.rgba[i] != static_cast<float>(Imath::half(im.rgba[i]))) first_wrong = i;
+  INFO("first EXR colour value off: line " << first_wrong / 4 / width);
+  CHECK(first_wrong == n * 4);
+  CHECK(back.depth == im.depth);
+  CHECK(back.normal == im.normal);
+  PngData png;
+  REQUIRE(read_png(dir / "tall.png", png));
+  REQUIRE(png.color_type == PNG_COLOR_TYPE_RGB_ALPHA);
+  REQUIRE(png.bytes.size() == 4 * n);
+  std::size_t png_wrong = n;
+  for (std::size_t i = n; i-- > 0;) {
+    bool same = int(png.bytes[4 * i + 3]) == (i % 7 == 0 ? 128 : 255);
+    for (int c = 0; c < 3; ++c) same = same && int(png.bytes[4 * i + c]) == srgb_byte_by_definition(im.rgba[4 * i + c]);
+    if (!same) png_wrong = i;
+  }
+  INFO("first PNG pixel off: line " << png_wrong / width);
+  CHECK(png_wrong == n);
+}
