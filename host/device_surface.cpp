@@ -118,12 +118,26 @@ void DeviceSurface::set_surface_args(KernelArgs& args) const {
   args.plain(data_.even_axes);
 }
 
+struct DeviceSurface::ScreenCache {
+  ScreenGeometry geometry;
+  int height;
+  ScreenForm form;
+  bool same_camera(const ScreenGeometry& g, int h) const {
+    return h == height && g.oc == geometry.oc && g.ox == geometry.ox && g.oy == geometry.oy && g.dc == geometry.dc &&
+           g.dx == geometry.dx && g.dy == geometry.dy && g.t0 == geometry.t0 && g.xi_scale == geometry.xi_scale;
+  }
+};
+
 cl::Buffer DeviceSurface::set_screen_args(KernelArgs& args, const cl::Context& ctx, const KernelConfig& config,
                                           const RayBasis& basis, int width, int height, int row0, int rows) const {
   if (config.ray_origin != RayOrigin::Screen) return {};
   const ScreenGeometry geometry = screen_geometry(basis, width, height, extent_);
-  std::vector<std::uint32_t> exponents(data_.exponents.begin(), data_.exponents.end());
-  const ScreenForm form(exponents, data_.coefficients, data_.degree, geometry);
+  if (!screen_ || !screen_->same_camera(geometry, height)) {
+    std::vector<std::uint32_t> exponents(data_.exponents.begin(), data_.exponents.end());
+    screen_ = std::make_shared<const ScreenCache>(
+        ScreenCache{geometry, height, ScreenForm(exponents, data_.coefficients, data_.degree, geometry)});
+  }
+  const ScreenForm& form = screen_->form;
   cl::Buffer buffer = real_buffer(ctx, form.rows(row0, rows, height), precision_);
   args.plain(buffer);
   args.plain(static_cast<cl_uint>(row0));

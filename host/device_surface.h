@@ -1,6 +1,7 @@
 // The surface on the device as every kernel takes it, and the helpers that set kernel arguments.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "cl_runtime.h"
@@ -67,6 +68,10 @@ class DeviceSurface {
   Extent extent_;
   SurfaceData data_;
   cl::Buffer exps_, coefs_, binomials_;
+  // The screen form of the last camera set_screen_args saw: a render asks for it band by band, and expanding P
+  // along the rays again for each band would repeat the costliest step.
+  struct ScreenCache;
+  mutable std::shared_ptr<const ScreenCache> screen_;
 };
 
 }  // namespace algray
