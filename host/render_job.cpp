@@ -378,8 +378,9 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
   std::vector<std::string> planned;
   for (const RoleAndPath& o : request_outputs(req)) planned.push_back(o.path);
   OutputWriter writer(planned);
+  // The heat map's colour scale spans the whole image, so it needs every pixel's work before any colour: the
+  // work (16 bytes a pixel) and the picture are whole-image, bounded by the pixels, never by the samples.
   if (diagnostics) {
-    add_solver_aovs(image, work, req.aovs);
     if (req.heatmap_path) {
       const std::string per =
           work.samples > 1 ? " (sum over " + std::to_string(work.samples * work.samples) + " samples)" : "";
@@ -388,6 +389,7 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
                                                     "isolation steps + refinement iterations per pixel" + per));
       });
     }
+    add_solver_aovs(image, std::move(work), req.aovs);
     timer.mark("diagnostics");
   }
   for (const std::string& out : req.outputs) writer.write(out, [&] { write_image(out, image); });

@@ -94,23 +94,24 @@ SolverWork solver_work(const RenderResult& result) {
   return w;
 }
 
-void add_solver_aovs(FrameImage& image, const SolverWork& work, const std::vector<SolverAov>& aovs) {
+void add_solver_aovs(FrameImage& image, SolverWork&& work, const std::vector<SolverAov>& aovs) {
   for (SolverAov aov : aovs) {
     switch (aov) {
       case SolverAov::Iterations:
-        image.uint_channels.push_back({"solver.refineIterations", work.refine_iterations});
+        image.uint_channels.push_back({"solver.refineIterations", std::move(work.refine_iterations)});
         break;
       case SolverAov::Isolation:
-        image.uint_channels.push_back({"solver.isolationSteps", work.isolation_steps});
+        image.uint_channels.push_back({"solver.isolationSteps", std::move(work.isolation_steps)});
         break;
       case SolverAov::Classification:
-        image.uint_channels.push_back({"solver.class", work.classification});
+        image.uint_channels.push_back({"solver.class", std::move(work.classification)});
         break;
       case SolverAov::Flags:
-        image.uint_channels.push_back({"solver.flags", work.flags});
+        image.uint_channels.push_back({"solver.flags", std::move(work.flags)});
         break;
     }
   }
+  work = SolverWork{};
 }
 
 }  // namespace algray

@@ -44,7 +44,8 @@ void add_tile_work(SolverWork& work, const PrimaryTile& tile);
 // From a render's records (RenderOptions::keep_records, or the reference's hits).
 SolverWork solver_work(const RenderResult& result);
 
-// solver.refineIterations, solver.isolationSteps, solver.class and solver.flags, as asked.
-void add_solver_aovs(FrameImage& image, const SolverWork& work, const std::vector<SolverAov>& aovs);
+// solver.refineIterations, solver.isolationSteps, solver.class and solver.flags, as asked: moved from `work`,
+// which is left empty, so that a poster's channels are not held twice.
+void add_solver_aovs(FrameImage& image, SolverWork&& work, const std::vector<SolverAov>& aovs);
 
 }  // namespace algray

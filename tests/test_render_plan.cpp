@@ -1,4 +1,4 @@
-// The render plan, seen through --stats: each effect's pass, kernel and rays exist only when the scene asks.
+// The render plan, seen through --stats: each effect's pass, kernel and rays exist only when asked; its memory.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "cli_sandbox.h"
+#include "render_plan.h"
+#include "scene.h"
 #include "image_io.h"
 #include "scene_fixtures.h"
 
@@ -198,4 +200,43 @@ TEST_CASE("adaptive antialiasing traces n x n rays only where neighbours differ,
   INFO("mean difference " << mean << ", " << far << " pixels off by more than the threshold");
   CHECK(mean < 0.005);
   CHECK(far <= 96 * 72 / 200);  // a feature thinner than a pixel can fall between the first rays
+}
+
+TEST_CASE("a plan's memory grows with the pixels, not with the samples, the lights or the bounces", "[plan][memory]") {
+  // No device: the plan alone. The issue's bound is 40 bytes per output pixel plus 300 MB, whatever the
+  // antialiasing, the lights and the bounces; the film is 32 bytes a pixel, the rest is one tile's work.
+  using algray::Override;
+  const std::vector<std::vector<Override>> settings = {
+      {},  // the scene as shipped: 2x2 antialiasing, two 5x5 area lights with shadows
+      {{"antialias.samples", "1"}},
+      {{"antialias.samples", "16"}},
+      {{"antialias.samples", "8"}, {"antialias.adaptive", "true"}},
+      {{"light.0.samples", "8"}, {"light.1.samples", "8"}},
+      {{"material.front.reflectivity", "0.5"}, {"material.back.transparency", "0.5"}, {"render.max_depth", "8"}},
+  };
+  for (const auto& extra : settings) {
+    std::string what = "the scene as shipped";
+    for (const Override& o : extra) what += ", " + o.key + " = " + o.value;
+    INFO(what);
+    auto plan_at = [&](int side) {
+      std::vector<Override> all = {{"image.width", std::to_string(side)}, {"image.height", std::to_string(side)}};
+      all.insert(all.end(), extra.begin(), extra.end());
+      const algray::Scene scene =
+          algray::load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_sextic.toml", all);
+      return algray::make_render_plan(scene, algray::Precision::Double, 1024);
+    };
+    const algray::RenderPlan small = plan_at(1024), poster = plan_at(8192);
+    // One tile's buffers and host work, whatever the image.
+    CHECK(poster.buffer_bytes() == small.buffer_bytes());
+    CHECK(poster.tile_host_bytes == small.tile_host_bytes);
+    CHECK(poster.buffer_bytes() + poster.tile_host_bytes < (200ull << 20));
+    const std::uint64_t pixels = 8192ull * 8192, small_pixels = 1024ull * 1024;
+    const std::uint64_t per_pixel = poster.refine_samples > 1 ? 33 : 32;
+    CHECK(poster.estimated_memory_bytes() - small.estimated_memory_bytes() == per_pixel * (pixels - small_pixels));
+    CHECK(poster.estimated_memory_bytes() <= 40 * pixels + 300'000'000ull);
+  }
+  // A render the machine cannot hold is still refused on the estimate (test_reliability).
+  const algray::Scene huge = algray::load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_sextic.toml",
+                                                     {{"image.width", "32768"}, {"image.height", "32768"}});
+  CHECK(algray::make_render_plan(huge, algray::Precision::Double).estimated_memory_bytes() > (32ull << 30));
 }

@@ -10,6 +10,7 @@
 #include "renderer.h"
 #include "scene.h"
 #include "shade.h"
+#include "solver_aov.h"
 #include "test_support.h"
 
 using namespace algray;
@@ -229,7 +230,9 @@ TEST_CASE("without records a render keeps the film and the totals, not every ray
   scene.render.tile_size = 16;
   RenderOptions options;
   std::size_t tiles = 0, camera_rays = 0;
+  SolverWork work = empty_solver_work(scene.image.width, scene.image.height, 1);
   options.on_primary_tile = [&](const PrimaryTile& tile) {
+    add_tile_work(work, tile);
     ++tiles;
     camera_rays += static_cast<std::size_t>(tile.width) * tile.height;
     CHECK(tile.width <= 16);
@@ -250,4 +253,10 @@ TEST_CASE("without records a render keeps the film and the totals, not every ray
   CHECK(lean.primary.hits == from_records.hits);
   CHECK(lean.primary.isolation_steps == from_records.isolation_steps);
   CHECK(lean.primary.pixels_hit == from_records.pixels_hit);
+  // The solver channels gathered tile by tile are those of the whole records.
+  const SolverWork whole = solver_work(full);
+  CHECK(work.isolation_steps == whole.isolation_steps);
+  CHECK(work.refine_iterations == whole.refine_iterations);
+  CHECK(work.flags == whole.flags);
+  CHECK(work.classification == whole.classification);
 }
