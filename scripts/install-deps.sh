@@ -9,7 +9,8 @@ packages=(
   catch2 libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgmp-dev
   python3
-  clang libclang-rt-14-dev  # the sanitizer tree and libFuzzer targets of scripts/test.sh
+  clang-15                  # the sanitizer tree and libFuzzer targets of scripts/test.sh: the clang PoCL already
+                            # depends on, with ASan, UBSan and libFuzzer in its libclang-common-15-dev
   help2man                  # the man page
 )
 
