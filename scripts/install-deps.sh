@@ -11,6 +11,7 @@ packages=(
   python3
   clang-15                  # the sanitizer tree and libFuzzer targets of scripts/test.sh: the clang PoCL already
                             # depends on, with ASan, UBSan and libFuzzer in its libclang-common-15-dev
+  ninja-build               # scripts/test.sh builds with Ninja
   help2man                  # the man page
 )
 

@@ -5,9 +5,16 @@ cd "$(dirname "$0")/.."
 
 start=$SECONDS
 phase() { echo "test.sh: $1 ($((SECONDS - start)) s so far)"; }
+# Ninja when it is there (scripts/install-deps.sh installs it): it compiles a target's files while the libraries it
+# links are still being built, where Make waits for each library, so both cores stay busy. A tree that is already
+# configured keeps its generator.
+generator() {
+  if [ ! -f "$1/CMakeCache.txt" ] && command -v ninja >/dev/null; then echo Ninja; fi
+}
 
 scripts/install-deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+gen=$(generator build)
+cmake -S . -B build ${gen:+-G "$gen"} -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(nproc)"
 phase "release build done"
 ctest --test-dir build --output-on-failure --timeout 900
@@ -26,7 +33,9 @@ if [ -z "$cxx" ]; then
        "installs it)" >&2
   exit 1
 fi
-cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER="$cxx" -DALGRAY_SANITIZE=ON -DALGRAY_FUZZ=ON
+gen=$(generator build-sanitize)
+cmake -S . -B build-sanitize ${gen:+-G "$gen"} -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER="$cxx" \
+      -DALGRAY_SANITIZE=ON -DALGRAY_FUZZ=ON
 cmake --build build-sanitize -j"$(nproc)" --target algray_fast_tests algray_fuzzers
 phase "sanitizer build done"
 ctest --test-dir build-sanitize -L fast --output-on-failure --timeout 900
