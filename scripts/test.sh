@@ -4,7 +4,18 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 start=$SECONDS
-phase() { echo "test.sh: $1 ($((SECONDS - start)) s so far)"; }
+# Each phase line gives the wall time so far and the CPU time (user + sys) of everything run so far, apt included:
+# on shared cores the CPU time is the steadier measure of what a change saved.
+# (`times` into a file: in a $(...) subshell it would report the subshell's children, none.)
+times_file=$(mktemp)
+trap 'rm -f "$times_file"' EXIT
+phase() {
+  local cpu
+  times > "$times_file"
+  cpu=$(awk 'NR == 2 { n = 0; for (i = 1; i <= 2; i++) { split($i, t, "m"); n += t[1] * 60 + t[2] } printf "%d", n }' \
+            "$times_file")
+  echo "test.sh: $1 ($((SECONDS - start)) s so far, $cpu s CPU)"
+}
 # Ninja when it is there (scripts/install-deps.sh installs it): it compiles a target's files while the libraries it
 # links are still being built, where Make waits for each library, so both cores stay busy. A tree that is already
 # configured keeps its generator.
@@ -13,6 +24,7 @@ generator() {
 }
 
 scripts/install-deps.sh
+phase "dependencies installed"
 gen=$(generator build)
 cmake -S . -B build ${gen:+-G "$gen"} -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(nproc)"
