@@ -3,6 +3,7 @@
 #include "shade.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <thread>
@@ -11,19 +12,25 @@
 namespace algray {
 namespace {
 
-// Runs work(begin, end) over [0, count) in contiguous parts, one per core. Below `grain` items a thread costs
-// more than it saves (starting one is ~50 us), so small counts run here.
+// Runs work(begin, end) over [0, count) in parts of `grain` items, which the cores take in turn as they finish
+// one: a tile's rows differ widely in how many hits they hold, so equal halves would leave a core idle. Below
+// two parts a thread costs more than it saves (starting one is ~50 us), so small counts run here.
 template <typename Work>
 void parallel_ranges(std::size_t count, std::size_t grain, const Work& work) {
   const std::size_t cores = std::clamp(std::thread::hardware_concurrency(), 1u, 16u);
-  const std::size_t parts = std::min(cores, std::max<std::size_t>(1, count / grain));
-  if (parts <= 1) {
+  const std::size_t parts = (count + grain - 1) / grain;
+  if (cores <= 1 || parts <= 1) {
     work(std::size_t{0}, count);
     return;
   }
+  std::atomic<std::size_t> next{0};
+  auto run = [&] {
+    for (std::size_t part = next++; part < parts; part = next++)
+      work(part * grain, std::min(count, (part + 1) * grain));
+  };
   std::vector<std::thread> workers;
-  for (std::size_t p = 1; p < parts; ++p) workers.emplace_back(work, count * p / parts, count * (p + 1) / parts);
-  work(std::size_t{0}, count / parts);
+  for (std::size_t t = 1; t < std::min(cores, parts); ++t) workers.emplace_back(run);
+  run();
   for (std::thread& w : workers) w.join();
 }
 
