@@ -99,7 +99,7 @@ struct RenderResult {
   // The film: RGBA, depth and normal per output pixel, as shade_frame would make them from the records.
   FrameImage image;
   PrimarySummary primary;
-  double shade_ms = 0;  // host shading (and the gathering of rays for the passes) within the render
+  double shade_ms = 0;  // host shading within the render; gathering a pass's rays is in the pass's wall_ms
 
   // Kept only with RenderOptions::keep_records:
   HitBuffer hits;                         // one record per traced ray: plan.trace_width() x plan.trace_height()

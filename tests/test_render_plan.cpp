@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "cli_sandbox.h"
+#include "image_io.h"
 #include "render_plan.h"
 #include "scene.h"
-#include "image_io.h"
 #include "scene_fixtures.h"
 
 using namespace algray::testing;
