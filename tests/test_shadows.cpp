@@ -127,7 +127,9 @@ Tally check_shadow_rays(Precision precision, int rays_per_scene, MakeLight make_
   precision_value += to_string(precision);
   precision_value += '"';
   for (const char* file : kScenes) {
-    const Scene scene = load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/" + file,
+    std::string path = ALGRAY_SOURCE_DIR "/scenes/";  // appended, not added: the same false warning otherwise
+    path += file;
+    const Scene scene = load_scene_file(path,
                                         {{"image.width", "48"},
                                          {"image.height", "36"},
                                          {"antialias.samples", "1"},
