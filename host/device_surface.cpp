@@ -133,9 +133,8 @@ cl::Buffer DeviceSurface::set_screen_args(KernelArgs& args, const cl::Context& c
   if (config.ray_origin != RayOrigin::Screen) return {};
   const ScreenGeometry geometry = screen_geometry(basis, width, height, extent_);
   if (!screen_ || !screen_->same_camera(geometry, height)) {
-    std::vector<std::uint32_t> exponents(data_.exponents.begin(), data_.exponents.end());
     screen_ = std::make_shared<const ScreenCache>(
-        ScreenCache{geometry, height, ScreenForm(exponents, data_.coefficients, data_.degree, geometry)});
+        ScreenCache{geometry, height, ScreenForm(data_.exponents, data_.coefficients, data_.degree, geometry)});
   }
   const ScreenForm& form = screen_->form;
   cl::Buffer buffer = real_buffer(ctx, form.rows(row0, rows, height), precision_);
