@@ -4,7 +4,7 @@
 For each surface the script reads algray's scene file and writes the same picture for each peer: the equation
 expanded into monomials for POV-Ray's `polynomial { ... sturm }`, clipped by the scene's extent sphere, and a
 .jsurf file for jsurf-alggeo, with the same camera and size. Preview (1024x1024, PNG): `algray --preview`
-(which keeps the scene's 2x2 antialiasing; --preview-samples 1 for one ray per pixel) against POV-Ray with one
+(one camera ray per pixel, whatever the scene's antialiasing) against POV-Ray with one
 shadowless point light and no antialiasing, and against `jsurf-alggeo -q 0` (its lowest quality, one ray per
 pixel). Full mode (1024x768, PNG; the Barth sextic and decic): algray's scene as shipped against
 POV-Ray with the scene's two 5x5 area lights and 2x2 antialiasing. Every time is the whole process, warm (one
@@ -513,11 +513,8 @@ def commands(args, scene_path, stem, mode, work):
     out = {}
     algray = [str(args.algray), "render", str(scene_path), "-o", str(work / f"{stem}_{mode}_algray.png"),
               "--width", str(width), "--height", str(height)]
-    # --preview drops shadows and bounces but keeps the scene's antialiasing (2x2 in the paper's scenes), so
-    # algray traces 4 camera rays per pixel where the peers' previews trace one; --preview-samples 1 evens that.
+    # --preview drops shadows, bounces and antialiasing: one camera ray per pixel, as the peers' previews.
     out["algray"] = algray + (["--preview"] if mode == "preview" else [])
-    if mode == "preview" and args.preview_samples:
-        out["algray"] += ["--set", f"antialias.samples={args.preview_samples}"]
     # POV-Ray: -D no display, +FN8 8-bit PNG; preview without antialiasing. Full mode: +AM1 +R2 traces one ray
     # and then 2x2 more in each pixel that differs from a neighbour by more than the threshold; at the default
     # 0.0 that is every pixel, the nearest POV-Ray comes to algray's 2x2 in every pixel. No jitter.
@@ -679,8 +676,6 @@ def main():
     ap.add_argument("--only", choices=["preview", "full"], help="one of the two comparisons")
     ap.add_argument("--keep", type=Path, help="write the peer scene files and every image here, and keep them")
     ap.add_argument("--json", type=Path, help="write the results as JSON here")
-    ap.add_argument("--preview-samples", type=int, help="algray's antialiasing in preview (--set "
-                    "antialias.samples=N; default: the scene's, 2x2 in the paper's scenes; the peers trace 1)")
     ap.add_argument("--pov-threshold", type=float, default=0.0, help="POV-Ray's antialiasing threshold in full "
                     "mode (default 0.0: every pixel supersampled, as algray's 2x2; POV-Ray's own default is 0.3)")
     args = ap.parse_args()
