@@ -1,6 +1,7 @@
 // Names of the solver choices and the mapping of a KernelConfig onto OpenCL build options.
 #include "kernel_config.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <utility>
@@ -95,6 +96,20 @@ std::string isolation_choices() { return enum_choices(kIsolations); }
 std::string refinement_choices() { return enum_choices(kRefinements); }
 std::string ray_origin_choices() { return enum_choices(kOrigins); }
 
+// OpenCL C's vector widths, and 1 (kernels/lanes.h).
+constexpr std::array<int, 5> kLanes{1, 2, 4, 8, 16};
+bool valid_lanes(int lanes) { return std::find(kLanes.begin(), kLanes.end(), lanes) != kLanes.end(); }
+std::string lanes_choices() {
+  std::string out;
+  for (std::size_t i = 0; i < kLanes.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == kLanes.size() ? " or " : ", ") + std::to_string(kLanes[i]);
+  return out;
+}
+int default_lanes(const std::string& device_type) { return device_type == "CPU" ? 8 : 1; }
+bool lanes_apply(const KernelConfig& c) {
+  return c.entry == "primary" && c.isolation == Isolation::Bernstein && c.refinement == Refinement::Brent;
+}
+
 int default_max_iterations(Refinement r) { return r == Refinement::RegulaFalsi ? 1000 : 100; }
 
 std::string KernelConfig::build_options() const {
@@ -110,7 +125,7 @@ std::string KernelConfig::build_options() const {
          " -D ALGRAY_COMPENSATED=" + (precision == Precision::Mixed ? "1" : "0") +
          " -D ISOLATION=" + std::to_string(isolation_id) + " -D REFINEMENT=" + std::to_string(refinement_id) +
          " -D RAY_ORIGIN=" + std::to_string(origin_id) + " -D TOLERANCE=" + tolerance_literal +
-         " -D MAX_ITERATIONS=" + std::to_string(max_iterations) +
+         " -D MAX_ITERATIONS=" + std::to_string(max_iterations) + " -D LANES=" + std::to_string(lanes) +
          // PoCL prints its compiler's warning count ("4 warnings generated.") straight to stderr on a cold cache;
          // a successful command says nothing, and a failed build still reports its errors and log.
          " -w";
@@ -120,7 +135,7 @@ std::string KernelConfig::key() const {
   return entry + " degree=" + std::to_string(degree) + " precision=" + to_string(precision) +
          " isolation=" + to_string(isolation) + " refinement=" + to_string(refinement) +
          " origin=" + to_string(ray_origin) + " tolerance=" + hex_double(tolerance) +
-         " max_iterations=" + std::to_string(max_iterations);
+         " max_iterations=" + std::to_string(max_iterations) + (lanes != 1 ? " lanes=" + std::to_string(lanes) : "");
 }
 
 }  // namespace algray

@@ -15,6 +15,15 @@ enum class Refinement { Brent, Bisection, RegulaFalsi, Illinois, Newton };
 // Where P*(t) is built around: Auto (scenes only) is Screen for camera rays where it applies (screen_form_applies
 // in render_plan.h), else Extent.
 enum class RayOrigin { Auto, Extent, Eye, Screen };
+struct KernelConfig;
+
+// The lane counts a kernel can be built with, and the one a render uses on a device of `device_type` ("CPU",
+// "GPU", ...) unless the scene sets render.lanes: 8 on a CPU, whose work-items run one after another, 1 on
+// devices that already run work-items in SIMD.
+bool valid_lanes(int lanes);
+std::string lanes_choices();
+int default_lanes(const std::string& device_type);
+bool lanes_apply(const KernelConfig& config);
 
 std::string to_string(Precision p);
 std::string to_string(Isolation i);
@@ -43,6 +52,9 @@ struct KernelConfig {
   RayOrigin ray_origin = RayOrigin::Extent;
   double tolerance = 1e-9;   // the paper's eps: stop when the bracket is <= 4*eps*max(|t|,1)
   int max_iterations = 100;  // see default_max_iterations
+  // Rays per work-item, side by side in vector lanes (kernels/lanes.h): more than 1 only for the primary kernel
+  // with Bernstein isolation and Brent refinement (lanes_apply), where the plan asks for it.
+  int lanes = 1;
 
   // "-D DEGREE=6 -D ALGRAY_DOUBLE=1 ..." with the tolerance as an exact hexadecimal literal.
   std::string build_options() const;

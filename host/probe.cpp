@@ -92,6 +92,9 @@ SolverTrace trace_probe(ClSession& session, ProgramCache& cache, const Scene& sc
                         KernelConfig config, const ProbeTarget& target, std::uint32_t capacity) {
   const cl_uint log_capacity = std::max<std::uint32_t>(capacity, 1);
   config.entry = "probe";
+  // One ray: the lanes' arithmetic is the scalar build's lane for lane (kernels/lanes.h), so one lane is the
+  // render's own code.
+  config.lanes = 1;
   // A given ray is traced as the trace kernel traces it: the screen form is the camera rays' alone.
   if (target.given_ray && config.ray_origin == RayOrigin::Screen) config.ray_origin = RayOrigin::Extent;
   SolverTrace trace;

@@ -43,7 +43,7 @@ const PlannedPass* RenderPlan::find(const std::string& name) const {
   return nullptr;
 }
 
-RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size) {
+RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size, int lanes) {
   RenderPlan plan;
   plan.width = scene.image.width;
   plan.height = scene.image.height;
@@ -62,11 +62,15 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
 
   // Every pass has one kernel per surface: each surface's degree specialises its own.
   std::vector<KernelConfig> primary;
-  for (std::size_t i = 0; i < scene.surfaces.size(); ++i) primary.push_back(primary_config(scene, precision, i));
+  for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+    primary.push_back(primary_config(scene, precision, i));
+    if (lanes_apply(primary.back())) primary.back().lanes = scene.render.lanes > 0 ? scene.render.lanes : lanes;
+  }
   auto with_entry = [&](const std::string& entry) {
     std::vector<KernelConfig> configs = primary;
     for (KernelConfig& c : configs) {
       c.entry = entry;
+      c.lanes = 1;  // lanes are the camera rays' (kernels/primary.cl)
       if (c.ray_origin == RayOrigin::Screen) c.ray_origin = RayOrigin::Extent;  // the screen form is camera rays'
     }
     return configs;

@@ -70,6 +70,19 @@ double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+// A primary launch covers the tile with one work-item per `lanes` pixels of a row (kernels/primary.cl).
+constexpr std::size_t kLaneGroupWidth = 16;
+cl::NDRange primary_global_size(int lanes, int width, int height) {
+  const std::size_t w = static_cast<std::size_t>(width), h = static_cast<std::size_t>(height);
+  if (lanes == 1) return cl::NDRange(w, h);
+  const std::size_t items = (w + static_cast<std::size_t>(lanes) - 1) / static_cast<std::size_t>(lanes);
+  return cl::NDRange((items + kLaneGroupWidth - 1) / kLaneGroupWidth * kLaneGroupWidth, h);
+}
+// Lanes multiply each work-item's private arrays; PoCL keeps a work-group's on one thread's stack and picks
+// work-groups of up to 4096 items on its own, which overflows it (bench/lockstep_lanes crashed so). Rows of 16
+// work-items, 128 pixels at 8 lanes, keep it small; one-lane kernels keep the device's choice.
+cl::NDRange primary_local_size(int lanes) { return lanes == 1 ? cl::NullRange : cl::NDRange(kLaneGroupWidth, 1); }
+
 // Keeps, per ray, the nearer of the hits found so far (surface `best`) and `other`'s hits (surface `index`).
 // The solver work of both is added up, and a depth-limited isolation on either is kept, so the statistics
 // and the solver channels count every surface's kernel.
@@ -155,6 +168,7 @@ struct Renderer::Passes {
   std::vector<PassStats> stats;                          // one per planned pass, in plan order
   std::vector<cl::Kernel> primary;                       // one per surface
   std::vector<cl_uint> primary_tile_arg;                 // per surface: the index of its tile_x0 argument
+  std::vector<int> primary_lanes;                        // per surface: its kernel's camera rays per work-item
   std::vector<cl::Buffer> screen_rows;                   // per surface: a band's rows for screen-form builds
   cl::Buffer primary_out;                                // a tile's hit records on the device
   std::vector<std::unique_ptr<ShadowTracer>> shadows;    // one per surface, when the plan has a shadow pass
@@ -273,7 +287,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   RenderResult result;
   const Precision precision = resolve_precision(scene, session_.info);
   const int tile_side = scene.render.tile_size > 0 ? scene.render.tile_size : default_tile_size(session_.info);
-  result.plan = make_render_plan(scene, precision, tile_side);
+  result.plan = make_render_plan(scene, precision, tile_side, default_lanes(session_.info.type));
   check_plan_fits(result.plan, session_.info);
   result.config = primary_config(scene, precision);
   const RenderPlan& plan = result.plan;
@@ -339,6 +353,7 @@ void Renderer::prepare_passes(Passes& passes) {
     ProgramRecord record;
     passes.primary.push_back(cache_.kernel(session_, plan.find("primary")->kernels[s], &record));
     passes.primary_tile_arg.push_back(0);
+    passes.primary_lanes.push_back(plan.find("primary")->kernels[s].lanes);
     passes.screen_rows.emplace_back();
     result.programs.push_back(record);
     primary.program_keys.push_back(record.key);
@@ -414,10 +429,8 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
     kernel.setArg(tile_arg + 2, static_cast<cl_uint>(tile.trace_w));
     kernel.setArg(tile_arg + 3, static_cast<cl_uint>(tile.trace_h));
     cl::Event done;
-    session_.queue.enqueueNDRangeKernel(
-        kernel, cl::NullRange,
-        cl::NDRange(static_cast<std::size_t>(tile.trace_w), static_cast<std::size_t>(tile.trace_h)), cl::NullRange,
-        nullptr, &done);
+    session_.queue.enqueueNDRangeKernel(kernel, cl::NullRange, primary_global_size(passes.primary_lanes[s], tile.trace_w, tile.trace_h),
+                                        primary_local_size(passes.primary_lanes[s]), nullptr, &done);
     // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
     done.wait();
     pass.kernel_ms += ms_between(done);

@@ -42,7 +42,7 @@ const std::set<std::string> kLightKeys{"type",   "position", "edge_u", "edge_v",
                                        "radius", "samples",  "colour", "intensity", "shadows"};
 const std::set<std::string> kAntialiasKeys{"samples", "adaptive", "threshold"};
 const std::set<std::string> kRenderKeys{"precision",      "tolerance", "isolation", "refinement", "ray_origin",
-                                        "max_iterations", "tile_size", "preview",   "max_depth"};
+                                        "max_iterations", "tile_size", "lanes",     "preview",    "max_depth"};
 
 // Merges `from` into `into`; tables merge key by key, anything else replaces.
 void merge_tables(toml::table& into, toml::table&& from) {
@@ -449,6 +449,12 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
       rs.max_iterations = static_cast<int>(r.integer(*n, "render.max_iterations", 1, 1000000));
     if (const toml::node* n = render->get("tile_size"))
       rs.tile_size = static_cast<int>(r.integer(*n, "render.tile_size", 8, 16384));
+    if (const toml::node* n = render->get("lanes")) {
+      rs.lanes = static_cast<int>(r.integer(*n, "render.lanes", 1, 16));
+      if (!valid_lanes(rs.lanes)) r.fail(n->source(), "render.lanes must be " + lanes_choices());
+      if (rs.lanes > 1 && (rs.isolation != Isolation::Bernstein || rs.refinement != Refinement::Brent))
+        r.fail(n->source(), "render.lanes > 1 needs isolation = \"bernstein\" and refinement = \"brent\"");
+    }
     if (const toml::node* n = render->get("preview")) rs.preview = r.boolean(*n, "render.preview");
     if (const toml::node* n = render->get("max_depth"))
       rs.max_depth = static_cast<int>(r.integer(*n, "render.max_depth", 0, 64));
@@ -635,6 +641,7 @@ std::string scene_to_toml(const Scene& scene) {
       << "\"\npreview = " << (rs.preview ? "true" : "false") << "\nmax_depth = " << rs.max_depth << "\n";
   if (rs.max_iterations) out << "max_iterations = " << rs.max_iterations << "\n";
   if (rs.tile_size) out << "tile_size = " << rs.tile_size << "\n";
+  if (rs.lanes) out << "lanes = " << rs.lanes << "\n";
   return out.str();
 }
 

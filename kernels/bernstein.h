@@ -3,6 +3,7 @@
 #define ALGRAY_BERNSTEIN_H
 
 #include "isolation.h"
+#include "lanes.h"
 
 /* Mixed precision isolates in float-float: every Bernstein coefficient is an unevaluated sum hi + lo, and the
  * *_lo arrays below hold the low parts (other builds never touch them). Rounding the coefficients to float
@@ -189,39 +190,36 @@ void prepare_isolated(REAL* c, __constant const REAL* binomials) {
 }
 
 /* x^DEGREE by repeated multiplication: pown() goes through exp and log on some devices. */
-REAL power_of(REAL x) {
-  REAL p = 1;
+LREAL power_of(LREAL x) {
+  LREAL p = 1;
   ALGRAY_UNROLL
   for (int k = 0; k < DEGREE; ++k) p *= x;
   return p;
 }
 
 /* Value at y in [0,1] of a prepared polynomial in O(n): Horner in y/(1-y), mirrored past 1/2 so the ratio
- * stays at most 1. */
-REAL isolated_value(const REAL* c, REAL y) {
-  if (y <= (REAL)0.5) {
-    const REAL r = y / ((REAL)1 - y);
-    REAL h = c[DEGREE];
-    ALGRAY_UNROLL
-    for (int k = DEGREE - 1; k >= 0; --k) h = h * r + c[k];
-    return h * power_of(1 - y);
-  }
-  const REAL r = ((REAL)1 - y) / y;
-  REAL h = c[0];
+ * stays at most 1. Over lanes (lanes.h), each lane picks its side by selection; the ratio is then one
+ * division of the selected numerator by the selected denominator, the same operations as either side alone. */
+LREAL isolated_value(const LREAL* c, LREAL y) {
+  const LMASK mirrored = !(y <= (REAL)0.5);
+  const LREAL u = LANE_SEL((REAL)1 - y, y, mirrored); /* the factor raised to the power n */
+  const LREAL r = LANE_SEL(y, (REAL)1 - y, mirrored) / u;
+  LREAL h = LANE_SEL(c[DEGREE], c[0], mirrored);
   ALGRAY_UNROLL
-  for (int k = 1; k <= DEGREE; ++k) h = h * r + c[k];
-  return h * power_of(y);
+  for (int k = DEGREE - 1; k >= 0; --k) h = h * r + LANE_SEL(c[k], c[DEGREE - k], mirrored);
+  return h * power_of(u);
 }
 
 /* The size of the terms isolated_value(c, y) sums, sum |c_k| r^k times the same power: its rounding error is
  * a small multiple of REAL_EPS times this, so a value below REAL_EPS times it has no reliable sign. */
-REAL isolated_magnitude(const REAL* c, REAL y) {
-  const int mirrored = y > (REAL)0.5;
-  const REAL r = mirrored ? ((REAL)1 - y) / y : y / ((REAL)1 - y);
-  REAL h = 0;
+LREAL isolated_magnitude(const LREAL* c, LREAL y) {
+  const LMASK mirrored = y > (REAL)0.5;
+  const LREAL u = LANE_SEL((REAL)1 - y, y, mirrored);
+  const LREAL r = LANE_SEL(y, (REAL)1 - y, mirrored) / u;
+  LREAL h = 0;
   ALGRAY_UNROLL
-  for (int k = DEGREE; k >= 0; --k) h = h * r + fabs(c[mirrored ? DEGREE - k : k]);
-  return h * power_of(mirrored ? y : (REAL)1 - y);
+  for (int k = DEGREE; k >= 0; --k) h = h * r + fabs(LANE_SEL(c[k], c[DEGREE - k], mirrored));
+  return h * power_of(u);
 }
 
 /* Value and slope at y in [0,1] of a prepared polynomial, for Newton's method. With r = y/(1-y) and

@@ -1,13 +1,15 @@
 /* The primary-ray kernel: one work-item per pixel, from camera ray to hit distance, normal, side and work. */
 #include "algray_shared.h"
 #include "isolate.h"
+#include "lanes.h"
 #include "ray.h"
 #include "real.h"
 #include "restrict.h"
 #include "surface.h"
 
 /* One tile of the image per launch: global size (tile_w, tile_h), results at out[gy * tile_w + gx], the tile's own
- * buffer, for pixel (px, py) = (tile_x0 + gx, tile_y0 + gy).
+ * buffer, for pixel (px, py) = (tile_x0 + gx, tile_y0 + gy); with LANES > 1, global size (ceil(tile_w / LANES),
+ * tile_h) and LANES pixels of a row per work-item.
  * The polynomial is given in unit coordinates u = (p - centre) * inv_scale, with max |coefficient| = 1.
  * binomials[n * (DEGREE + 1) + k] = C(n, k) for 0 <= k <= n <= DEGREE (zero elsewhere).
  * even_axes: bit 0, 1, 2 set when every exponent of x, y, z in the polynomial is even.
@@ -18,6 +20,7 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
                       __constant const REAL* binomials, uint even_axes SCREEN_ROWS_PARAM,
                       uint tile_x0, uint tile_y0,
                       uint tile_w, uint tile_h, __global HitRecord* out) {
+#if LANES == 1
   const uint gx = get_global_id(0), gy = get_global_id(1);
   if (gx >= tile_w || gy >= tile_h) return;
   const uint px = tile_x0 + gx, py = tile_y0 + gy;
@@ -30,4 +33,35 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
   const SurfaceHit hit = trace_surface(ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
                                        mono_exps, mono_coefs, mono_count, binomials, even_axes SCREEN_ARG);
   out[(size_t)gy * tile_w + gx] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
+#else
+  /* LANES pixels of a row per work-item: each is clipped and isolated on its own, then all are refined, and
+   * their normals taken, together in vector lanes (lanes.h). Global size (ceil(tile_w / LANES), tile_h); the pixels are the same as above. */
+  const uint gx = get_global_id(0), gy = get_global_id(1);
+  const uint x0 = gx * LANES;
+  if (x0 >= tile_w || gy >= tile_h) return;
+  const uint count = min((uint)LANES, tile_w - x0), py = tile_y0 + gy;
+  Ray rays[LANES];
+  SurfaceHit hits[LANES];
+  Isolation iso[LANES];
+  SegmentRoot roots[LANES];
+  REAL t_in[LANES], t_out[LANES], iso_c[LANES][NCOEF];
+  int in_extent[LANES];
+  for (uint j = 0; j < count; ++j) {
+    const uint px = tile_x0 + x0 + j;
+    rays[j] = camera_ray(px, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
+#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
+    REAL taylor[NCOEF];
+    const REAL taylor_t = screen_ray_taylor(px, py, SCREEN_ROWS_ARG, taylor);
+#endif
+    in_extent[j] = isolate_surface(rays[j], extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
+                                   mono_exps, mono_coefs, mono_count, binomials, even_axes, &hits[j], &iso[j],
+                                   &t_in[j], &t_out[j], iso_c[j] SCREEN_ARG);
+  }
+  refine_lanes(count, in_extent, iso, iso_c, t_in, t_out, binomials, roots);
+  for (uint j = 0; j < count; ++j)
+    if (in_extent[j]) finish_surface(&hits[j], roots[j]);
+  HitRecord records[LANES];
+  hit_records_lanes(count, rays, hits, mono_exps, mono_coefs, mono_count, records);
+  for (uint j = 0; j < count; ++j) out[(size_t)gy * tile_w + x0 + j] = records[j];
+#endif
 }

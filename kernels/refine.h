@@ -2,6 +2,7 @@
 #ifndef ALGRAY_REFINE_H
 #define ALGRAY_REFINE_H
 
+#include "lanes.h"
 #include "probe_log.h"
 #include "real.h"
 
@@ -16,59 +17,80 @@
  * orders of magnitude larger than the terms near the root, and a coefficient-sized threshold stopped early
  * there: 726 of 4096 pixels more than 1e-6 deep on (z + x/10)^21 = a (derivative chain, double). It is at most
  * (DEGREE + 1) * scale, which skips computing it far from the root. */
+#if LANES == 1
 int value_within_rounding(const REAL* c, REAL y, REAL fy, REAL scale) {
   if (fabs(fy) > REAL_EPS * (REAL)(DEGREE + 1) * scale) return 0;
   return fabs(fy) <= REAL_EPS * isolated_magnitude(c, y);
 }
+#endif
+
+#if LANES > 1 && (REFINEMENT != ALGRAY_REFINEMENT_BRENT || ISOLATION != ALGRAY_ISOLATION_BERNSTEIN)
+#error "LANES > 1 is built for Bernstein isolation with Brent refinement"
+#endif
 
 #if REFINEMENT == ALGRAY_REFINEMENT_BRENT
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations PROBE_PARAM) {
+/* Dekker-Brent over lanes (lanes.h): each lane where `running` is set refines its own polynomial, and a lane
+ * that has stopped keeps its state, so every lane ends as the scalar loop would, bit for bit. *iterations gets
+ * each lane's count of function evaluations. */
+LREAL refine_root_lanes(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL scale, LMASK running,
+                        LMASK* iterations PROBE_PARAM) {
   /* b: best estimate; c_: contrapoint, f(c_) of the other sign; a: the previous b. */
-  REAL a = 0, fa = f0, b = 1, fb = f1, cp = 0, fc = f0;
-  uint it = 0;
-  for (; it < MAX_ITERATIONS; ++it) {
-    if (fabs(fc) < fabs(fb)) {
-      a = b;
-      fa = fb;
-      b = cp;
-      fb = fc;
-      cp = a;
-      fc = fa;
-    }
-    /* The paper's stopping rule: |P*(b)| at machine precision, or a bracket at most the stopping width. */
-    if (fabs(cp - b) <= tol_y || value_within_rounding(c, b, fb, scale)) break;
-    REAL cand = b;
-    int have = 0;
-    if (fa != fc && fb != fc && fa != fb) {
-      /* inverse quadratic interpolation through (a, fa), (b, fb), (c, fc) */
-      const REAL r = fb / fc, s = fb / fa, q = fa / fc;
-      const REAL num = s * (q * (q - r) * (cp - b) - (r - (REAL)1) * (b - a));
-      const REAL den = (q - (REAL)1) * (r - (REAL)1) * (s - (REAL)1);
-      cand = b - num / den;
-      have = 1;
-    } else if (fa != fb) {
-      cand = b - fb * (b - a) / (fb - fa); /* secant */
-      have = 1;
-    }
+  LREAL a = 0, fa = f0, b = 1, fb = f1, cp = 0, fc = f0;
+  LMASK done = !running;
+  LMASK it = 0;
+  for (int n = 0; n < MAX_ITERATIONS; ++n) {
+    const LMASK swap = !done && fabs(fc) < fabs(fb);
+    a = LANE_SEL(a, b, swap);
+    fa = LANE_SEL(fa, fb, swap);
+    b = LANE_SEL(b, cp, swap);
+    fb = LANE_SEL(fb, fc, swap);
+    cp = LANE_SEL(cp, a, swap);
+    fc = LANE_SEL(fc, fa, swap);
+    /* The paper's stopping rule: |P*(b)| at machine precision, or a bracket at most the stopping width. The
+     * value is within rounding when it is below the terms' rounding error (isolated_magnitude), which is at
+     * most (DEGREE + 1) * scale: only then is the magnitude worth computing. */
+    LMASK stop = fabs(cp - b) <= tol_y;
+    const LMASK small = !done && !stop && !(fabs(fb) > REAL_EPS * (REAL)(DEGREE + 1) * scale);
+    if (LANE_ANY(small)) stop = stop || (small && fabs(fb) <= REAL_EPS * isolated_magnitude(c, b));
+    done = done || stop;
+    if (LANE_ALL(done)) break;
+    /* inverse quadratic interpolation through (a, fa), (b, fb), (c, fc), else the secant */
+    const LMASK quadratic = fa != fc && fb != fc && fa != fb;
+    const LMASK secant = !quadratic && fa != fb;
+    const LREAL r = fb / fc, s = fb / fa, q = fa / fc;
+    const LREAL num = s * (q * (q - r) * (cp - b) - (r - (REAL)1) * (b - a));
+    const LREAL den = (q - (REAL)1) * (r - (REAL)1) * (s - (REAL)1);
+    const LREAL cand = LANE_SEL(LANE_SEL(b, b - fb * (b - a) / (fb - fa), secant), b - num / den, quadratic);
     /* The paper's acceptance rule: the step must stay well inside the bracket and shrink; also toward c. */
-    const REAL step = cand - b;
-    const int accept = have && isfinite(cand) && step * (cp - b) > 0 && fabs(step) < (REAL)0.75 * fabs(cp - b) &&
-                       fabs(step) < (REAL)0.5 * fabs(b - a);
-    REAL next = accept ? cand : b + (REAL)0.5 * (cp - b);
-    if (fabs(next - b) < (REAL)0.5 * tol_y) next = b + copysign((REAL)0.5 * tol_y, cp - b);
-    a = b;
-    fa = fb;
-    b = next;
-    fb = isolated_value(c, b);
-    if ((fb > 0) == (fc > 0)) { /* the sign change is now between a and b */
-      cp = a;
-      fc = fa;
-    }
-    PROBE_ITERATE(it, b, fb, fmin(b, cp), fmax(b, cp));
+    const LREAL step = cand - b;
+    const LMASK accept = (quadratic || secant) && isfinite(cand) && step * (cp - b) > 0 &&
+                         fabs(step) < (REAL)0.75 * fabs(cp - b) && fabs(step) < (REAL)0.5 * fabs(b - a);
+    LREAL next = LANE_SEL(b + (REAL)0.5 * (cp - b), cand, accept);
+    next = LANE_SEL(next, b + copysign((REAL)0.5 * tol_y, cp - b), fabs(next - b) < (REAL)0.5 * tol_y);
+    const LREAL fnext = isolated_value(c, next);
+    /* the sign change is now between a and b */
+    const LMASK moved = !done && (fnext > 0) == (fc > 0);
+    cp = LANE_SEL(cp, b, moved);
+    fc = LANE_SEL(fc, fb, moved);
+    a = LANE_SEL(b, a, done);
+    fa = LANE_SEL(fb, fa, done);
+    b = LANE_SEL(next, b, done);
+    fb = LANE_SEL(fnext, fb, done);
+    it += LANE_SEL((LMASK)0, (LMASK)1, !done);
+    PROBE_ITERATE(n, b, fb, fmin(b, cp), fmax(b, cp));
   }
   *iterations = it;
   return b;
 }
+
+#if LANES == 1
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations PROBE_PARAM) {
+  LMASK it;
+  const REAL y = refine_root_lanes(c, f0, f1, tol_y, scale, 1, &it PROBE_ARG);
+  *iterations = (uint)it;
+  return y;
+}
+#endif
 #elif REFINEMENT == ALGRAY_REFINEMENT_BISECTION
 REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations PROBE_PARAM) {
   REAL lo = 0, hi = 1, flo = f0;

@@ -3,6 +3,7 @@
 #define ALGRAY_SURFACE_H
 
 #include "algray_shared.h"
+#include "lanes.h"
 #include "ray.h"
 #include "real.h"
 
@@ -64,34 +65,90 @@ void probe_coefficients(const REAL* c, const REAL* c_lo, uint basis PROBE_PARAM)
 #define probe_coefficients(c, c_lo, basis) ((void)0)
 #endif
 
-/* Refines what the isolation found; iso_c holds the polynomial on the isolating interval. */
-SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
-                            __constant const REAL* binomials PROBE_PARAM) {
+/* What the refinement of an isolated root needs: its stopping width and the coefficients' size. */
+typedef struct {
+  int refine; /* 0: nothing to refine (no root, or the root is the interval's left end) */
+  REAL tol_y;
+  REAL scale;
+} RefineSetup;
+
+/* The record of what the isolation found, before refinement; iso_c holds the polynomial on the isolating
+ * interval, and is prepared for isolated_value() when setup->refine is set. */
+SegmentRoot isolated_root(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out, __constant const REAL* binomials,
+                          RefineSetup* setup PROBE_PARAM) {
   SegmentRoot r;
   r.t = INFINITY;
   r.f_before = 0;
   r.flags = iso.budget ? ALGRAY_HIT_BUDGET : 0u;
   r.steps = iso.steps;
   r.iterations = 0;
+  setup->refine = 0;
+  setup->tol_y = 0;
+  setup->scale = 0;
   PROBE(ALGRAY_EVENT_ISOLATED, iso.budget, (uint)iso.status, 0u, iso.lo, iso.hi, iso.f_lo, iso.f_hi);
   if (iso.status == ISOLATION_NONE) return r;
   if (iso.status == ISOLATION_EXACT) r.flags |= ALGRAY_HIT_EXACT;
   if (iso.cluster) r.flags |= ALGRAY_HIT_CLUSTER;
-  const REAL len = t_out - t_in;
-  REAL y = 0; /* ISOLATION_EXACT: the root is the interval's left end */
   if (iso.status == ISOLATION_BRACKET) {
+    const REAL len = t_out - t_in;
     const REAL width_t = (iso.hi - iso.lo) * len;
-    const REAL tol_y = stop_width(t_in + iso.lo * len) / width_t;
-    REAL scale = 0;
-    for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(iso_c[k]));
+    setup->refine = 1;
+    setup->tol_y = stop_width(t_in + iso.lo * len) / width_t;
+    for (int k = 0; k <= DEGREE; ++k) setup->scale = fmax(setup->scale, fabs(iso_c[k]));
     prepare_isolated(iso_c, binomials);
-    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, &r.iterations PROBE_ARG);
   }
-  r.t = t_in + (iso.lo + y * (iso.hi - iso.lo)) * len;
-  r.f_before = iso.f_lo;
-  r.flags |= ALGRAY_HIT_FOUND;
   return r;
 }
+
+/* The root at y of the isolating interval (0 when the isolation settled it at the interval's left end). */
+void place_root(SegmentRoot* r, Isolation iso, REAL y, REAL t_in, REAL t_out) {
+  r->t = t_in + (iso.lo + y * (iso.hi - iso.lo)) * (t_out - t_in);
+  r->f_before = iso.f_lo;
+  r->flags |= ALGRAY_HIT_FOUND;
+}
+
+#if LANES == 1
+/* Refines what the isolation found; iso_c holds the polynomial on the isolating interval. */
+SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
+                            __constant const REAL* binomials PROBE_PARAM) {
+  RefineSetup setup;
+  SegmentRoot r = isolated_root(iso, iso_c, t_in, t_out, binomials, &setup PROBE_ARG);
+  if (iso.status == ISOLATION_NONE) return r;
+  const REAL y =
+      setup.refine ? refine_root(iso_c, iso.f_lo, iso.f_hi, setup.tol_y, setup.scale, &r.iterations PROBE_ARG) : 0;
+  place_root(&r, iso, y, t_in, t_out);
+  return r;
+}
+#else
+/* The roots of LANES rays' isolations, refined together in lanes (lanes.h). Lanes from `count` on, and those
+ * whose ray missed the extent (in_extent[j] == 0), are left alone. */
+void refine_lanes(uint count, const int* in_extent, const Isolation* iso, REAL (*iso_c)[NCOEF], const REAL* t_in,
+                  const REAL* t_out, __constant const REAL* binomials, SegmentRoot* roots) {
+  LREAL c[NCOEF], f0 = 0, f1 = 0, tol_y = 0, scale = 0;
+  for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
+  LMASK running = 0;
+  for (uint j = 0; j < count; ++j) {
+    if (!in_extent[j]) continue;
+    RefineSetup setup;
+    roots[j] = isolated_root(iso[j], iso_c[j], t_in[j], t_out[j], binomials, &setup);
+    if (!setup.refine) continue;
+    lane_set_mask(&running, j, 1);
+    for (int k = 0; k <= DEGREE; ++k) lane_set(&c[k], j, iso_c[j][k]);
+    lane_set(&f0, j, iso[j].f_lo);
+    lane_set(&f1, j, iso[j].f_hi);
+    lane_set(&tol_y, j, setup.tol_y);
+    lane_set(&scale, j, setup.scale);
+  }
+  LMASK iterations;
+  const LREAL y = refine_root_lanes(c, f0, f1, tol_y, scale, running, &iterations);
+  for (uint j = 0; j < count; ++j) {
+    if (!in_extent[j] || iso[j].status == ISOLATION_NONE) continue;
+    const int refined = lane_get_mask(running, j) != 0;
+    roots[j].iterations = refined ? (uint)lane_get_mask(iterations, j) : 0u;
+    place_root(&roots[j], iso[j], refined ? lane_get(y, j) : (REAL)0, t_in[j], t_out[j]);
+  }
+}
+#endif
 
 /* Isolates the smallest root of P*(t) on [t_in, t_out] for the ray o + t*d in unit coordinates; iso_c gets
  * the polynomial on the isolating interval. The primary and shadow kernels share this: one refines what it
@@ -142,56 +199,76 @@ Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global c
 #endif
 }
 
+/* The part of trace_surface before the refinement: the ray in unit coordinates, clipped to the extent, and the
+ * isolation of P*(t)'s smallest root on the segment (iso_c: the polynomial on the isolating interval). Returns
+ * 0 when the ray misses the extent; *h is then the whole answer. */
+int isolate_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, __global const uint* exps,
+                    __global const REAL* coefs, uint count, __constant const REAL* binomials, uint even_axes,
+                    SurfaceHit* h, Isolation* iso, REAL* t_in, REAL* t_out, REAL* iso_c SCREEN_PARAM PROBE_PARAM) {
+  h->root.t = INFINITY;
+  h->root.f_before = 0;
+  h->root.flags = 0;
+  h->root.steps = 0;
+  h->root.iterations = 0;
+  /* Unit coordinates keep every point of the extent within |u| <= 1: the conditioning step that makes float usable. */
+  const REAL3 o = (ray.o - centre) * inv_scale;
+  const REAL3 d = ray.d * inv_scale;
+  h->d_unit = d;
+  h->u = o;
+  if (!clip_to_extent(o, d, extent_kind, box_half, t_in, t_out)) return 0;
+  PROBE(ALGRAY_EVENT_SEGMENT, 0, 0u, 0u, *t_in, *t_out, (REAL)0, (REAL)0);
+  h->root.flags = ALGRAY_HIT_IN_EXTENT;
+  *iso = isolate_on_segment(o, d, *t_in, *t_out, exps, coefs, count, binomials, even_axes, iso_c SCREEN_ARG PROBE_ARG);
+  return 1;
+}
+
+/* The hit of a ray that entered the extent, from its refined root. */
+void finish_surface(SurfaceHit* h, SegmentRoot root) {
+  h->root = root;
+  h->root.flags |= ALGRAY_HIT_IN_EXTENT;
+  if (h->root.flags & ALGRAY_HIT_FOUND) h->u = h->u + h->root.t * h->d_unit;
+}
+
+#if LANES == 1
 SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                          __global const uint* exps, __global const REAL* coefs, uint count,
                          __constant const REAL* binomials, uint even_axes SCREEN_PARAM PROBE_PARAM) {
   SurfaceHit h;
-  h.root.t = INFINITY;
-  h.root.f_before = 0;
-  h.root.flags = 0;
-  h.root.steps = 0;
-  h.root.iterations = 0;
-  /* Unit coordinates keep every point of the extent within |u| <= 1: the conditioning step that makes float usable. */
-  const REAL3 o = (ray.o - centre) * inv_scale;
-  const REAL3 d = ray.d * inv_scale;
-  h.d_unit = d;
-  h.u = o;
-  REAL t_in, t_out;
-  if (!clip_to_extent(o, d, extent_kind, box_half, &t_in, &t_out)) return h;
-  PROBE(ALGRAY_EVENT_SEGMENT, 0, 0u, 0u, t_in, t_out, (REAL)0, (REAL)0);
-  h.root.flags = ALGRAY_HIT_IN_EXTENT;
-
-  REAL iso_c[NCOEF];
-  const Isolation iso =
-      isolate_on_segment(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, iso_c SCREEN_ARG PROBE_ARG);
-  h.root = refine_isolated(iso, iso_c, t_in, t_out, binomials PROBE_ARG);
-  h.root.flags |= ALGRAY_HIT_IN_EXTENT;
-  if (h.root.flags & ALGRAY_HIT_FOUND) h.u = o + h.root.t * d;
+  Isolation iso;
+  REAL t_in, t_out, iso_c[NCOEF];
+  if (isolate_surface(ray, centre, inv_scale, box_half, extent_kind, exps, coefs, count, binomials, even_axes, &h,
+                      &iso, &t_in, &t_out, iso_c SCREEN_ARG PROBE_ARG))
+    finish_surface(&h, refine_isolated(iso, iso_c, t_in, t_out, binomials PROBE_ARG));
   return h;
 }
+#endif
 
-/* grad P at u, from the monomials, with a table of powers per axis. */
-REAL3 surface_gradient(REAL3 u, __global const uint* exps, __global const REAL* coefs, uint count) {
-  REAL px[NCOEF], py[NCOEF], pz[NCOEF];
+/* grad P at (x, y, z), from the monomials, with a table of powers per axis; over lanes, each lane's point. */
+void surface_gradient_lanes(LREAL x, LREAL y, LREAL z, __global const uint* exps, __global const REAL* coefs,
+                            uint count, LREAL* gx, LREAL* gy, LREAL* gz) {
+  LREAL px[NCOEF], py[NCOEF], pz[NCOEF];
   px[0] = py[0] = pz[0] = 1;
   for (int n = 1; n <= DEGREE; ++n) {
-    px[n] = px[n - 1] * u.x;
-    py[n] = py[n - 1] * u.y;
-    pz[n] = pz[n - 1] * u.z;
+    px[n] = px[n - 1] * x;
+    py[n] = py[n - 1] * y;
+    pz[n] = pz[n - 1] * z;
   }
-  REAL3 g = (REAL3)(0, 0, 0);
+  LREAL sx = 0, sy = 0, sz = 0;
   for (uint m = 0; m < count; ++m) {
     const uint e = exps[m];
     const int i = (int)(e & 0xffu), j = (int)((e >> 8) & 0xffu), k = (int)((e >> 16) & 0xffu);
     const REAL a = coefs[m];
-    if (i > 0) g.x += a * (REAL)i * px[i - 1] * py[j] * pz[k];
-    if (j > 0) g.y += a * (REAL)j * px[i] * py[j - 1] * pz[k];
-    if (k > 0) g.z += a * (REAL)k * px[i] * py[j] * pz[k - 1];
+    if (i > 0) sx += a * (REAL)i * px[i - 1] * py[j] * pz[k];
+    if (j > 0) sy += a * (REAL)j * px[i] * py[j - 1] * pz[k];
+    if (k > 0) sz += a * (REAL)k * px[i] * py[j] * pz[k - 1];
   }
-  return g;
+  *gx = sx;
+  *gy = sy;
+  *gz = sz;
 }
 
-HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global const REAL* coefs, uint count) {
+/* The hit record of a traced ray, given grad P at its hit (unused when it has none). */
+HitRecord hit_record_with_gradient(Ray ray, SurfaceHit h, REAL3 g) {
   HitRecord r;
   r.flags = h.root.flags;
   r.work = min(h.root.steps, 0xffffu) | (min(h.root.iterations, 0xffffu) << 16);
@@ -205,7 +282,6 @@ HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global 
   r.t_lo = (float)(h.root.t - (REAL)r.t_hi);
   r.depth = (float)(h.root.t * length(ray.d));
   /* Unit coordinates differ from world ones by a translation and a uniform scale: same normal direction. */
-  const REAL3 g = surface_gradient(h.u, exps, coefs, count);
   const REAL glen = length(g);
   REAL3 n = (glen > 0 && isfinite(glen)) ? g / glen : -normalize(ray.d);
   if (dot(n, ray.d) > 0) n = -n;
@@ -217,5 +293,33 @@ HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global 
   if (back) r.flags |= ALGRAY_HIT_BACK;
   return r;
 }
+
+#if LANES == 1
+HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global const REAL* coefs, uint count) {
+  REAL gx = 0, gy = 0, gz = 0;
+  if (h.root.flags & ALGRAY_HIT_FOUND) surface_gradient_lanes(h.u.x, h.u.y, h.u.z, exps, coefs, count, &gx, &gy, &gz);
+  return hit_record_with_gradient(ray, h, (REAL3)(gx, gy, gz));
+}
+#else
+/* The hit records of LANES rays, their gradients taken together in lanes. */
+void hit_records_lanes(uint count, const Ray* rays, const SurfaceHit* hits, __global const uint* exps,
+                       __global const REAL* coefs, uint mono_count, HitRecord* out) {
+  LREAL x = 0, y = 0, z = 0, gx, gy, gz;
+  int any_hit = 0;
+  for (uint j = 0; j < count; ++j)
+    if (hits[j].root.flags & ALGRAY_HIT_FOUND) {
+      lane_set(&x, j, hits[j].u.x);
+      lane_set(&y, j, hits[j].u.y);
+      lane_set(&z, j, hits[j].u.z);
+      any_hit = 1;
+    }
+  if (any_hit) surface_gradient_lanes(x, y, z, exps, coefs, mono_count, &gx, &gy, &gz);
+  for (uint j = 0; j < count; ++j) {
+    REAL3 g = (REAL3)(0, 0, 0);
+    if (hits[j].root.flags & ALGRAY_HIT_FOUND) g = (REAL3)(lane_get(gx, j), lane_get(gy, j), lane_get(gz, j));
+    out[j] = hit_record_with_gradient(rays[j], hits[j], g);
+  }
+}
+#endif
 
 #endif /* ALGRAY_SURFACE_H */

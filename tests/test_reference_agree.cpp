@@ -12,6 +12,7 @@
 
 #include "program_cache.h"
 #include "reference_render.h"
+#include "scene_fixtures.h"
 #include "renderer.h"
 #include "scene.h"
 #include "test_support.h"
@@ -54,28 +55,8 @@ void check_scene(Renderer& renderer, const std::filesystem::path& file, const ch
   CHECK(c.worst_depth <= limit.depth_error);
 }
 
+using testing::random_scene;
 using testing::scene_files;
-
-// A seeded random surface of exactly `degree` in the unit sphere, seen from outside: x^n + y^n + z^n fixes the
-// degree, then 3n random monomials of lower degrees with coefficients in [-1, 1] (the bench's family).
-std::string random_scene(int degree, unsigned seed, Precision precision) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> coefficient(-1, 1);
-  std::ostringstream s;
-  s.precision(17);
-  s << "[surface]\nterms = [[" << degree << ", 0, 0, 1], [0, " << degree << ", 0, 1], [0, 0, " << degree
-    << ", 1], [0, 0, 0, -0.25]";
-  for (int m = 0; m < 3 * degree; ++m) {
-    const int total = std::uniform_int_distribution<int>(1, std::max(1, degree - 1))(rng);
-    const int i = std::uniform_int_distribution<int>(0, total)(rng);
-    const int j = std::uniform_int_distribution<int>(0, total - i)(rng);
-    s << ", [" << i << ", " << j << ", " << total - i - j << ", " << coefficient(rng) << "]";
-  }
-  s << "]\n[extent]\ntype = \"sphere\"\nradius = 1\n[camera]\neye = [1.2, 0.9, 2.6]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n"
-    << "fov_y = 45\n[image]\nwidth = 64\nheight = 48\n[render]\nprecision = \"" << to_string(precision) << "\"\npreview = true\n"
-    << "ray_origin = \"auto\"\n";
-  return s.str();
-}
 
 }  // namespace
 

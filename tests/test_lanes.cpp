@@ -1,0 +1,96 @@
+// The primary kernel traced in vector lanes (render.lanes, kernels/lanes.h) against one ray per work-item: the
+// same hit records bit for bit, on seeded random surfaces, in every precision and with partial lane groups.
+#include <catch2/catch.hpp>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "program_cache.h"
+#include "renderer.h"
+#include "scene.h"
+#include "scene_fixtures.h"
+#include "test_support.h"
+
+using namespace algray;
+
+namespace {
+
+// The random surface at 61 x 37 pixels in tiles of 24: widths 24 and 13, so every tile ends in a partial group
+// of lanes, and rows that start mid-image.
+Scene lanes_scene(int degree, unsigned seed, Precision precision, int lanes, const std::string& origin) {
+  return load_scene_text(testing::random_scene(degree, seed, precision), "random",
+                         {{"image.width", "61"},
+                          {"image.height", "37"},
+                          {"render.tile_size", "24"},
+                          {"render.ray_origin", "\"" + origin + "\""},
+                          {"render.lanes", std::to_string(lanes)}});
+}
+
+// Index of the first record whose bytes differ, or -1.
+long first_difference(const std::vector<HitRecord>& a, const std::vector<HitRecord>& b) {
+  if (a.size() != b.size()) return 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::memcmp(&a[i], &b[i], sizeof(HitRecord)) != 0) return static_cast<long>(i);
+  return -1;
+}
+
+}  // namespace
+
+TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  struct Case {
+    int degree;
+    Precision precision;
+    std::string origin;
+    std::vector<int> lanes;
+  };
+  std::vector<Case> cases;
+  for (int degree : {1, 2, 3, 5, 6, 9, 12, 15, 20, 32}) {
+    cases.push_back({degree, Precision::Double, "auto", {8}});  // the screen form
+    cases.push_back({degree, Precision::Float, "auto", {8}});   // the extent construction
+    if (degree <= kMaxMixedDegree) cases.push_back({degree, Precision::Mixed, "auto", {8}});
+  }
+  cases.push_back({6, Precision::Double, "extent", {2, 4, 8, 16}});
+  cases.push_back({10, Precision::Float, "auto", {2, 4, 16}});
+  std::size_t hits = 0;
+  for (std::size_t index = 0; index < cases.size(); ++index) {
+    const Case& c = cases[index];
+    const unsigned seed = 2000u + static_cast<unsigned>(c.degree);
+    const RenderResult one = renderer.render(lanes_scene(c.degree, seed, c.precision, 1, c.origin), false);
+    REQUIRE(one.plan.find("primary")->kernels.at(0).lanes == 1);
+    for (const HitRecord& h : one.hits.records) hits += (h.flags & ALGRAY_HIT_FOUND) != 0;
+    for (int lanes : c.lanes) {
+      const RenderResult many = renderer.render(lanes_scene(c.degree, seed, c.precision, lanes, c.origin), false);
+      REQUIRE(many.plan.find("primary")->kernels.at(0).lanes == lanes);
+      const long at = first_difference(one.hits.records, many.hits.records);
+      INFO("case " << index << ": degree " << c.degree << ", seed " << seed << ", " << to_string(c.precision) << ", "
+                   << c.origin << ", " << lanes << " lanes: first differing record " << at << " of "
+                   << one.hits.records.size());
+      CHECK(at == -1);
+    }
+  }
+  CHECK(hits > cases.size() * 100);  // the surfaces are in view: the comparison covers refined roots
+}
+
+TEST_CASE("the plan gives lanes to the primary kernel alone, where they apply", "[lanes]") {
+  const std::string text = testing::random_scene(6, 2006, Precision::Double);
+  const Scene full = load_scene_text(text + "[[light]]\nposition = [3, 3, 3]\n", "random",
+                                     {{"render.preview", "false"}, {"material.front.reflectivity", "0.5"}});
+  const RenderPlan plan = make_render_plan(full, Precision::Double, 0, 8);
+  CHECK(plan.find("primary")->kernels.at(0).lanes == 8);
+  CHECK(plan.find("primary")->kernels.at(0).key().find(" lanes=8") != std::string::npos);
+  for (const PlannedPass& pass : plan.passes)
+    if (pass.name != "primary")
+      for (const KernelConfig& k : pass.kernels) CHECK(k.lanes == 1);
+  // A refinement without a lane version keeps one ray per work-item; the scene's setting overrides the device's.
+  const Scene bisection = load_scene_text(text, "random", {{"render.refinement", "\"bisection\""}});
+  CHECK(make_render_plan(bisection, Precision::Double, 0, 8).find("primary")->kernels.at(0).lanes == 1);
+  const Scene four = load_scene_text(text, "random", {{"render.lanes", "4"}});
+  CHECK(make_render_plan(four, Precision::Double, 0, 8).find("primary")->kernels.at(0).lanes == 4);
+  CHECK_THROWS_WITH(load_scene_text(text, "random", {{"render.lanes", "3"}}),
+                    Catch::Contains("render.lanes must be 1, 2, 4, 8 or 16"));
+  CHECK_THROWS_WITH(load_scene_text(text, "random", {{"render.lanes", "8"}, {"render.isolation", "\"sturm\""}}),
+                    Catch::Contains("render.lanes > 1 needs isolation = \"bernstein\" and refinement = \"brent\""));
+}
