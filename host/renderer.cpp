@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <new>
 
 #include "ray_tracer.h"
 #include "shade.h"
@@ -86,10 +87,10 @@ cl::NDRange primary_local_size(int lanes) { return lanes == 1 ? cl::NullRange : 
 // Keeps, per ray, the nearer of the hits found so far (surface `best`) and `other`'s hits (surface `index`).
 // The solver work of both is added up, and a depth-limited isolation on either is kept, so the statistics
 // and the solver channels count every surface's kernel.
-void keep_nearest(std::vector<HitRecord>& best, std::vector<std::uint8_t>& best_surface,
-                  const std::vector<HitRecord>& other, std::uint8_t index) {
-  if (best_surface.size() != best.size()) best_surface.assign(best.size(), 0);
-  for (std::size_t i = 0; i < best.size(); ++i) {
+void keep_nearest(HitRecord* best, std::size_t count, std::vector<std::uint8_t>& best_surface,
+                  const HitRecord* other, std::uint8_t index) {
+  if (best_surface.size() != count) best_surface.assign(count, 0);
+  for (std::size_t i = 0; i < count; ++i) {
     const HitRecord& o = other[i];
     HitRecord& b = best[i];
     const std::uint32_t steps = std::min(0xffffu, (b.work & 0xffffu) + (o.work & 0xffffu));
@@ -127,6 +128,49 @@ std::vector<std::uint8_t> pixels_to_refine(const FrameImage& coarse, double thre
 }
 
 }  // namespace
+
+// Host memory for one tile's hit records, which the primary kernel writes through a CL_MEM_USE_HOST_PTR buffer.
+// On a CPU device the kernel writes this memory itself and mapping it copies nothing; on a GPU the map copies
+// once. Either way the host neither zero-fills a vector of 32 bytes a ray nor copies into it: at 1024^2 that
+// was 32 MB of page faults and a 32 MB copy, about a fifth of a preview's host time.
+class Renderer::TileHits {
+ public:
+  TileHits(const cl::Context& context, cl::CommandQueue& queue, std::size_t capacity)
+      : memory_(static_cast<HitRecord*>(::operator new(capacity * sizeof(HitRecord), kAlignment))),
+        buffer_(context, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, capacity * sizeof(HitRecord), memory_.get()),
+        queue_(queue) {}
+  TileHits(const TileHits&) = delete;
+  TileHits& operator=(const TileHits&) = delete;
+  ~TileHits() {
+    // No throwing from here: the C call, whose failure leaves nothing to undo.
+    if (mapped_) clEnqueueUnmapMemObject(queue_(), buffer_(), mapped_, 0, nullptr, nullptr);
+    clFinish(queue_());
+  }
+  const cl::Buffer& buffer() const { return buffer_; }
+  // The first `count` records as the queue's finished work left them, readable and writable on the host until
+  // release(), which must come before the buffer is written again.
+  HitRecord* map(std::size_t count) {
+    release();
+    mapped_ = static_cast<HitRecord*>(
+        queue_.enqueueMapBuffer(buffer_, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, count * sizeof(HitRecord)));
+    return mapped_;
+  }
+  void release() {
+    if (!mapped_) return;
+    queue_.enqueueUnmapMemObject(buffer_, mapped_);
+    mapped_ = nullptr;
+  }
+
+ private:
+  static constexpr std::align_val_t kAlignment{4096};  // a page: what zero-copy host pointers want
+  struct Free {
+    void operator()(HitRecord* p) const { ::operator delete(p, kAlignment); }
+  };
+  std::unique_ptr<HitRecord, Free> memory_;  // uninitialised: the kernel writes every record it is mapped for
+  cl::Buffer buffer_;
+  cl::CommandQueue& queue_;
+  HitRecord* mapped_ = nullptr;
+};
 
 // A block of whole output pixels and the camera rays that trace it.
 struct Renderer::Tile {
@@ -170,7 +214,8 @@ struct Renderer::Passes {
   std::vector<cl_uint> primary_tile_arg;                 // per surface: the index of its tile_x0 argument
   std::vector<int> primary_lanes;                        // per surface: its kernel's camera rays per work-item
   std::vector<cl::Buffer> screen_rows;                   // per surface: a band's rows for screen-form builds
-  cl::Buffer primary_out;                                // a tile's hit records on the device
+  std::unique_ptr<TileHits> primary_out;                 // a tile's hit records, of the first surface
+  std::unique_ptr<TileHits> other_out;                   // several surfaces: those of the next ones
   std::vector<std::unique_ptr<ShadowTracer>> shadows;    // one per surface, when the plan has a shadow pass
   std::unique_ptr<ShadowPoints> shadow_points;           // a batch's surface points on the device
   std::vector<std::vector<glm::dvec3>> light_points;     // per shadow-casting light of the plan
@@ -179,7 +224,7 @@ struct Renderer::Passes {
   RayBasis fine;  // adaptive antialiasing: the rays of the n-times finer grid
 
   // One tile's work.
-  std::vector<HitRecord> hits, other_hits;  // camera rays, row-major in the tile
+  HitRecord* hits = nullptr;  // camera rays, row-major in the tile: primary_out mapped
   std::vector<std::uint8_t> hit_surface;    // several surfaces: which one each hit
   std::vector<glm::dvec3> secondary;        // per camera ray: what its bounces bring back
   bool any_secondary = false;
@@ -209,11 +254,11 @@ namespace {
 // (camera rays rebuilt exactly as the kernel traced them; secondary rays in double, which a float kernel traced
 // rounded).
 template <typename Passes, typename RayOf>
-ShadowData trace_shadows(Passes& p, const std::vector<HitRecord>& hits, RayOf ray) {
+ShadowData trace_shadows(Passes& p, const HitRecord* hits, std::size_t count, RayOf ray) {
   const auto start = std::chrono::steady_clock::now();
   PassStats& stats = *p.stats_of("shadow");
   ShadowData data;
-  for (std::size_t i = 0; i < hits.size(); ++i)
+  for (std::size_t i = 0; i < count; ++i)
     if (hits[i].flags & ALGRAY_HIT_FOUND) data.points.push_back(static_cast<std::uint32_t>(i));
   const std::vector<int>& lights = p.result.plan.shadow_lights;
   for (int light : lights) data.occlusion.push_back({light, std::vector<std::uint64_t>(data.points.size())});
@@ -362,7 +407,9 @@ void Renderer::prepare_passes(Passes& passes) {
   // The largest tile: a tile's hit records are all the device holds for the camera rays.
   const std::size_t tile_rays = static_cast<std::size_t>(std::min(plan.tile_pixels(), plan.width)) * plan.samples *
                                 std::min(plan.tile_pixels(), plan.height) * plan.samples;
-  passes.primary_out = cl::Buffer(session_.context, CL_MEM_WRITE_ONLY, tile_rays * sizeof(HitRecord));
+  passes.primary_out = std::make_unique<TileHits>(session_.context, session_.queue, tile_rays);
+  if (scene.surfaces.size() > 1)
+    passes.other_out = std::make_unique<TileHits>(session_.context, session_.queue, tile_rays);
 
   if (PassStats* stats = passes.stats_of("shadow")) {
     const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
@@ -410,7 +457,7 @@ void Renderer::set_band_args(Passes& passes, const Tile& first) {
                                 plan.trace_width(), plan.trace_height(), first.trace_y0, first.trace_h);
     passes.primary_tile_arg[s] = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
     args.skip(4);
-    args.plain(passes.primary_out);
+    args.plain((s == 0 ? passes.primary_out : passes.other_out)->buffer());
   }
   passes.stats_of("primary")->wall_ms += ms_since(start);
 }
@@ -418,7 +465,7 @@ void Renderer::set_band_args(Passes& passes, const Tile& first) {
 void Renderer::trace_primary(Passes& passes, const Tile& tile) {
   PassStats& pass = *passes.stats_of("primary");
   const std::size_t rays = tile.rays();
-  passes.hits.resize(rays);
+  passes.primary_out->release();  // the last tile's records: the kernel writes them again
   passes.hit_surface.clear();
   for (std::size_t s = 0; s < passes.surfaces.size(); ++s) {
     const auto start = std::chrono::steady_clock::now();
@@ -437,10 +484,12 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
     pass.program_ms[s] += ms_between(done);
     ++pass.launches;
     if (s == 0) pass.rays += rays;  // each camera ray once, however many surfaces it is tested against
-    std::vector<HitRecord>& into = s == 0 ? passes.hits : passes.other_hits;
-    into.resize(rays);
-    session_.queue.enqueueReadBuffer(passes.primary_out, CL_TRUE, 0, rays * sizeof(HitRecord), into.data());
-    if (s > 0) keep_nearest(passes.hits, passes.hit_surface, passes.other_hits, static_cast<std::uint8_t>(s));
+    if (s == 0) {
+      passes.hits = passes.primary_out->map(rays);
+    } else {
+      keep_nearest(passes.hits, rays, passes.hit_surface, passes.other_out->map(rays), static_cast<std::uint8_t>(s));
+      passes.other_out->release();
+    }
     pass.wall_ms += ms_since(start);
   }
 }
@@ -454,7 +503,8 @@ void Renderer::trace_batch(Passes& passes, SecondaryBatch& batch) {
     if (s == 0)
       batch.hits = std::move(traced.hits);
     else
-      keep_nearest(batch.hits, batch.hit_surface, traced.hits, static_cast<std::uint8_t>(s));
+      keep_nearest(batch.hits.data(), batch.hits.size(), batch.hit_surface, traced.hits.data(),
+                   static_cast<std::uint8_t>(s));
     stats.kernel_ms += traced.kernel_ms;
     stats.program_ms[s] += traced.kernel_ms;
     if (s == 0) stats.rays += batch.rays.size();
@@ -462,7 +512,8 @@ void Renderer::trace_batch(Passes& passes, SecondaryBatch& batch) {
   }
   stats.wall_ms += ms_since(start);
   if (!passes.shadows.empty())
-    batch.shadows = trace_shadows(passes, batch.hits, [&](std::size_t i) { return batch.rays[i]; });
+    batch.shadows =
+        trace_shadows(passes, batch.hits.data(), batch.hits.size(), [&](std::size_t i) { return batch.rays[i]; });
 }
 
 void Renderer::finish_tile(Passes& passes, const Tile& tile) {
@@ -475,10 +526,10 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
     return pixel_ray(result.basis, single, tile.trace_x0 + static_cast<int>(k % tile.trace_w),
                      tile.trace_y0 + static_cast<int>(k / tile.trace_w));
   };
-  result.primary.add(passes.hits.data(), tile.trace_w, tile.trace_h, plan.samples);
+  result.primary.add(passes.hits, tile.trace_w, tile.trace_h, plan.samples);
   if (passes.options.on_primary_tile)
     passes.options.on_primary_tile(
-        {tile.trace_x0, tile.trace_y0, tile.trace_w, tile.trace_h, plan.samples, passes.hits.data()});
+        {tile.trace_x0, tile.trace_y0, tile.trace_w, tile.trace_h, plan.samples, passes.hits});
   if (passes.options.keep_records)
     for (std::size_t k = 0; k < rays; ++k) {
       const std::uint32_t at = tile.ray_in_image(k, grid_width);
@@ -488,7 +539,7 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
 
   ShadowData shadows;
   if (!passes.shadows.empty()) {
-    shadows = trace_shadows(passes, passes.hits, camera_ray);
+    shadows = trace_shadows(passes, passes.hits, rays, camera_ray);
     if (passes.options.keep_records) {
       for (std::uint32_t k : shadows.points) result.shadows.points.push_back(tile.ray_in_image(k, grid_width));
       for (std::size_t l = 0; l < shadows.occlusion.size(); ++l) {
@@ -523,7 +574,7 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
   block.y0 = tile.trace_y0;
   block.width = tile.trace_w;
   block.height = tile.trace_h;
-  block.hits = passes.hits.data();
+  block.hits = passes.hits;
   block.surface = passes.hit_surface.empty() ? nullptr : passes.hit_surface.data();
   block.shadows = &lookup;
   block.secondary = passes.any_secondary ? passes.secondary.data() : nullptr;

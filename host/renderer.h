@@ -134,6 +134,7 @@ class Renderer {
   struct Passes;
   struct Bounce;
   struct Tile;
+  class TileHits;
   void prepare_passes(Passes& passes);
   // The primary kernels' arguments for a band of tiles (a row of them), but the tile's own.
   void set_band_args(Passes& passes, const Tile& first);
