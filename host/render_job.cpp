@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -355,11 +356,26 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
     if (diagnostics) work = solver_work(result);
     timer.mark("shade");
   } else {
+    // The film (16 to 32 bytes a pixel, zero-filled, every page faulted in) is made on another thread while
+    // this one starts the device, which loads the OpenCL driver on one core for tens of milliseconds. Its
+    // depth and normal channels are made only for an EXR output, the one format that stores them. For a PNG
+    // output the sRGB encoder's table (some 40000 pow() calls, built on first use) is made there too.
+    bool depth_and_normal = false, png = false;
+    for (const std::string& out : req.outputs) {
+      depth_and_normal |= format_from_extension(out) == ImageFormat::Exr;
+      png |= format_from_extension(out) == ImageFormat::Png;
+    }
+    const int film_width = scene.image.width, film_height = scene.image.height;
+    std::future<FrameImage> film = std::async(std::launch::async, [=] {
+      if (png) srgb_byte(0.5f);
+      return make_film(film_width, film_height, depth_and_normal);
+    });
     ClSession& session = context.session();
     device = session.info;
     timer.mark("device");
     Renderer renderer(session, context.cache());
     RenderOptions options;
+    options.film = [&film] { return film.get(); };
     options.show_progress = req.progress;
     if (diagnostics) {
       options.on_primary_tile = [&](const PrimaryTile& tile) {

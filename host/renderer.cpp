@@ -343,7 +343,10 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
     passes.surfaces.push_back(std::make_unique<DeviceSurface>(session_.context, scene, precision, i));
   prepare_passes(passes);
   passes.shader = std::make_unique<Shader>(scene, plan, result.basis, precision);
-  result.image = make_film(plan);
+  if (options.film) result.image = options.film();
+  if (result.image.width != plan.width || result.image.height != plan.height ||
+      result.image.rgba.size() != 4 * static_cast<std::size_t>(plan.width) * plan.height)
+    result.image = make_film(plan);
   if (options.keep_records) {
     result.hits.width = trace_width;
     result.hits.height = trace_height;

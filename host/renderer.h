@@ -88,6 +88,11 @@ struct RenderOptions {
   // Rays per launch of the shadow and trace kernels and per group of bounces. Only tests change it: the image
   // must not depend on it.
   std::size_t batch_rays = kBatchRays;
+  // Gives the film to render into, made ahead by the caller: render_scene makes it while the device starts, so
+  // that its zero-filling and page faults overlap the device's start on the other core. Called once; its film
+  // is used when its size is the plan's, and may then lack depth and normal (PNG outputs only); otherwise, or
+  // without it, the render makes its own.
+  std::function<FrameImage()> film;
 };
 
 struct RenderResult {

@@ -160,6 +160,7 @@ void Shader::resolve(const TracedBlock& block, FrameImage& film) const {
           }
         }
         for (int c = 0; c < 4; ++c) film.rgba[4 * i + c] = static_cast<float>(sum[c] * weight);
+        if (film.depth.empty()) continue;  // a film for PNG outputs only
         film.depth[i] = depth;
         for (int c = 0; c < 3; ++c) film.normal[3 * i + c] = normal[c];
       }
@@ -180,14 +181,18 @@ glm::dvec3 pixel_direction(const RayBasis& basis, int px, int py) {
   return glm::normalize(basis.d00 + fx * basis.du + fy * basis.dv);
 }
 
-FrameImage make_film(const RenderPlan& plan) {
+FrameImage make_film(const RenderPlan& plan) { return make_film(plan.width, plan.height, true); }
+
+FrameImage make_film(int width, int height, bool depth_and_normal) {
   FrameImage film;
-  film.width = plan.width;
-  film.height = plan.height;
+  film.width = width;
+  film.height = height;
   const std::size_t n = static_cast<std::size_t>(film.width) * film.height;
   film.rgba.assign(4 * n, 0.0f);
-  film.depth.assign(n, std::numeric_limits<float>::infinity());
-  film.normal.assign(3 * n, 0.0f);
+  if (depth_and_normal) {
+    film.depth.assign(n, std::numeric_limits<float>::infinity());
+    film.normal.assign(3 * n, 0.0f);
+  }
   return film;
 }
 

@@ -73,6 +73,9 @@ class Shader {
 
 // The film with its RGBA, depth and normal channels for the plan's output size: transparent black, no depth.
 FrameImage make_film(const RenderPlan& plan);
+// The same for width x height pixels; without depth_and_normal only RGBA (all a PNG holds), which at 1024^2
+// leaves 16 of the film's 32 MB untouched.
+FrameImage make_film(int width, int height, bool depth_and_normal);
 
 // The output image from a render's records (RenderOptions::keep_records, or the reference's hits), as the
 // renderer's film is made.
