@@ -2,6 +2,7 @@
 // of failure, and cleanup after signals and of stale temporaries.
 #include "image_io.h"
 #include "noisy_image.h"
+#include "png_deflate.h"
 #include "temp_dir.h"
 #include "version.h"
 
@@ -36,6 +37,7 @@
 #include <functional>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <random>
 #include <string>
@@ -445,6 +447,118 @@ TEST_CASE("EXR without optional layers reads back without them", "[image_io][exr
   CHECK(back.float_channels.empty());
   CHECK_FALSE(back.world_to_camera);
   CHECK_FALSE(back.world_to_ndc);
+}
+
+// The byte a PNG holds for an alpha value: linear, rounded to nearest, clamped (NaN and below 0 to 0).
+int expected_alpha_byte(float a) {
+  if (!(a > 0.0f)) return 0;
+  if (a >= 1.0f) return 255;
+  return static_cast<int>(std::lround(a * 255.0));
+}
+
+// Random linear values with the edge cases mixed in: below 0, above 1, NaN, exact 0 and 1.
+FrameImage random_png_image(std::mt19937& rng, int width, int height, bool opaque) {
+  FrameImage im;
+  im.width = width;
+  im.height = height;
+  std::uniform_real_distribution<float> value(-0.2f, 1.3f);
+  std::uniform_int_distribution<int> special(0, 49);
+  auto draw = [&] {
+    switch (special(rng)) {
+      case 0: return std::numeric_limits<float>::quiet_NaN();
+      case 1: return 0.0f;
+      case 2: return 1.0f;
+      default: return value(rng);
+    }
+  };
+  im.rgba.resize(4 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  for (std::size_t i = 0; i < im.rgba.size(); ++i) im.rgba[i] = (opaque && i % 4 == 3) ? 1.0f : draw();
+  // Runs of one colour, which deflate turns into back-references, across band boundaries too.
+  for (std::size_t i = 4; i + 4 <= im.rgba.size() / 3; i += 4)
+    if (special(rng) < 25) std::copy_n(im.rgba.begin() + static_cast<std::ptrdiff_t>(i) - 4, 4, im.rgba.begin() + static_cast<std::ptrdiff_t>(i));
+  return im;
+}
+
+// Every decoded byte is what the image's floats encode to.
+void check_png_pixels(const PngData& png, const FrameImage& im, bool opaque) {
+  REQUIRE(png.width == static_cast<png_uint_32>(im.width));
+  REQUIRE(png.height == static_cast<png_uint_32>(im.height));
+  REQUIRE(png.bit_depth == 8);
+  REQUIRE(png.color_type == (opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA));
+  const std::size_t channels = opaque ? 3 : 4, n = static_cast<std::size_t>(im.width) * im.height;
+  REQUIRE(png.bytes.size() == n * channels);
+  std::size_t wrong = 0, first_wrong = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    bool ok = true;
+    for (std::size_t c = 0; c < 3; ++c) ok &= png.bytes[i * channels + c] == algray::srgb_byte(im.rgba[4 * i + c]);
+    if (!opaque) ok &= int(png.bytes[i * 4 + 3]) == expected_alpha_byte(im.rgba[4 * i + 3]);
+    if (!ok && wrong++ == 0) first_wrong = i;
+  }
+  INFO("first wrong pixel " << first_wrong);
+  CHECK(wrong == 0);
+}
+
+TEST_CASE("PNG image data deflated in parallel bands decodes with libpng to the image's bytes", "[image_io][png]") {
+  TempDir dir;
+  // A fresh seed each run, and a fixed one; the seed is printed with any failure.
+  for (const std::mt19937::result_type seed : {std::mt19937::result_type{1}, std::mt19937::result_type{std::random_device{}()}}) {
+    INFO("seed " << seed);
+    std::mt19937 rng(seed);
+    // Bands are about 256 KB of filtered rows, so the large sizes take many bands on every thread, more than
+    // the writer keeps in memory at once; the small ones one band, with one row or one column.
+    std::vector<std::pair<int, int>> sizes = {{1, 1}, {1, 700}, {700, 1}, {1024, 700}, {2100, 130}};
+    std::uniform_int_distribution<int> side(1, 900);
+    for (int k = 0; k < 4; ++k) sizes.push_back({side(rng), side(rng)});
+    for (const auto& [w, h] : sizes)
+      for (const bool opaque : {true, false}) {
+        INFO(w << "x" << h << (opaque ? " opaque" : " with alpha"));
+        const FrameImage im = random_png_image(rng, w, h, opaque);
+        algray::write_png(dir / "random.png", im);
+        PngData png;
+        REQUIRE(read_png(dir / "random.png", png));
+        check_png_pixels(png, im, opaque);
+      }
+  }
+}
+
+TEST_CASE("write_png_image_data: any band size, thread count and level gives one valid zlib stream",
+          "[image_io][png]") {
+  TempDir dir;
+  for (const std::mt19937::result_type seed : {std::mt19937::result_type{2}, std::mt19937::result_type{std::random_device{}()}}) {
+    INFO("seed " << seed);
+    std::mt19937 rng(seed);
+    std::uniform_int_distribution<int> side(1, 120);
+    for (int k = 0; k < 6; ++k) {
+      const int w = side(rng), h = side(rng);
+      const FrameImage im = random_png_image(rng, w, h, true);
+      const std::size_t row_bytes = 3 * static_cast<std::size_t>(w);
+      const auto rows = [&](std::size_t y0, std::size_t count, unsigned char* out) {
+        for (std::size_t i = 0; i < count * static_cast<std::size_t>(w); ++i)
+          for (std::size_t c = 0; c < 3; ++c) out[3 * i + c] = algray::srgb_byte(im.rgba[4 * (y0 * w + i) + c]);
+      };
+      // Bands of one row to all rows at once, on 1 to 5 threads.
+      for (const std::size_t band_bytes : {std::size_t{1}, row_bytes + 1, 7 * (row_bytes + 1) + 3, std::size_t{1} << 20})
+        for (const unsigned threads : {1u, 2u, 3u, 5u})
+          for (const int level : {1, 6}) {
+            INFO(w << "x" << h << ", bands of " << band_bytes << " bytes, " << threads << " threads, level " << level);
+            const fs::path file = dir / "data.png";
+            {
+              std::unique_ptr<std::FILE, int (*)(std::FILE*)> fp(std::fopen(file.c_str(), "wb"), &std::fclose);
+              REQUIRE(fp);
+              // The signature and IHDR (8-bit RGB) by hand; then what is under test, the data and IEND.
+              const std::string ihdr = be32(static_cast<std::uint32_t>(w)) + be32(static_cast<std::uint32_t>(h)) +
+                                       std::string{'\x08', '\x02', '\0', '\0', '\0'};
+              const std::string head = "\x89PNG\r\n\x1a\n" + be32(13) + "IHDR" + ihdr + be32(png_crc("IHDR" + ihdr));
+              REQUIRE(std::fwrite(head.data(), 1, head.size(), fp.get()) == head.size());
+              algray::write_png_image_data(fp.get(), static_cast<std::size_t>(h), row_bytes, rows, level, band_bytes,
+                                           threads);
+            }
+            PngData png;
+            REQUIRE(read_png(file, png));
+            check_png_pixels(png, im, true);
+          }
+    }
+  }
 }
 
 TEST_CASE("PNG stores sRGB-encoded 8-bit values and the sRGB chunk", "[image_io][png]") {
