@@ -2,13 +2,17 @@
 // film, before the next tile; adaptive antialiasing then refines tile by tile from the film's first colours.
 #include "renderer.h"
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <future>
 #include <memory>
 #include <new>
+#include <utility>
 
 #include "ray_tracer.h"
 #include "shade.h"
@@ -129,15 +133,39 @@ std::vector<std::uint8_t> pixels_to_refine(const FrameImage& coarse, double thre
 
 }  // namespace
 
+// Page-aligned anonymous memory with every page faulted in as it is made (MAP_POPULATE: one system call rather
+// than a fault per page, which the kernel's threads would otherwise take on the render's path).
+class PopulatedPages {
+ public:
+  explicit PopulatedPages(std::size_t bytes) : bytes_(std::max<std::size_t>(bytes, 1)) {
+    void* p = ::mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    data_ = p;
+  }
+  PopulatedPages(PopulatedPages&& other) noexcept
+      : data_(std::exchange(other.data_, nullptr)), bytes_(std::exchange(other.bytes_, 0)) {}
+  PopulatedPages& operator=(PopulatedPages&&) = delete;
+  PopulatedPages(const PopulatedPages&) = delete;
+  ~PopulatedPages() {
+    if (data_) ::munmap(data_, bytes_);
+  }
+  void* data() const { return data_; }
+
+ private:
+  void* data_ = nullptr;
+  std::size_t bytes_;
+};
+
 // Host memory for one tile's hit records, which the primary kernel writes through a CL_MEM_USE_HOST_PTR buffer.
 // On a CPU device the kernel writes this memory itself and mapping it copies nothing; on a GPU the map copies
 // once. Either way the host neither zero-fills a vector of 32 bytes a ray nor copies into it: at 1024^2 that
 // was 32 MB of page faults and a 32 MB copy, about a fifth of a preview's host time.
 class Renderer::TileHits {
  public:
-  TileHits(const cl::Context& context, cl::CommandQueue& queue, std::size_t capacity)
-      : memory_(static_cast<HitRecord*>(::operator new(capacity * sizeof(HitRecord), kAlignment))),
-        buffer_(context, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, capacity * sizeof(HitRecord), memory_.get()),
+  // `memory` holds at least `capacity` records.
+  TileHits(const cl::Context& context, cl::CommandQueue& queue, std::size_t capacity, PopulatedPages memory)
+      : memory_(std::move(memory)),
+        buffer_(context, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, capacity * sizeof(HitRecord), memory_.data()),
         queue_(queue) {}
   TileHits(const TileHits&) = delete;
   TileHits& operator=(const TileHits&) = delete;
@@ -162,11 +190,7 @@ class Renderer::TileHits {
   }
 
  private:
-  static constexpr std::align_val_t kAlignment{4096};  // a page: what zero-copy host pointers want
-  struct Free {
-    void operator()(HitRecord* p) const { ::operator delete(p, kAlignment); }
-  };
-  std::unique_ptr<HitRecord, Free> memory_;  // uninitialised: the kernel writes every record it is mapped for
+  PopulatedPages memory_;  // page-aligned, as zero-copy host pointers want
   cl::Buffer buffer_;
   cl::CommandQueue& queue_;
   HitRecord* mapped_ = nullptr;
@@ -397,6 +421,12 @@ void Renderer::prepare_passes(Passes& passes) {
   RenderResult& result = passes.result;
   const RenderPlan& plan = result.plan;
   PassStats& primary = *passes.stats_of("primary");
+  // The largest tile: a tile's hit records are all the device holds for the camera rays. Their memory (32 MB
+  // at 1024^2) is populated on another thread while this one loads the programs, a core's work either way.
+  const std::size_t tile_rays = static_cast<std::size_t>(std::min(plan.tile_pixels(), plan.width)) * plan.samples *
+                                std::min(plan.tile_pixels(), plan.height) * plan.samples;
+  std::future<PopulatedPages> hit_memory =
+      std::async(std::launch::async, [tile_rays] { return PopulatedPages(tile_rays * sizeof(HitRecord)); });
   for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
     ProgramRecord record;
     passes.primary.push_back(cache_.kernel(session_, plan.find("primary")->kernels[s], &record));
@@ -407,12 +437,10 @@ void Renderer::prepare_passes(Passes& passes) {
     primary.program_keys.push_back(record.key);
     primary.program_ms.push_back(0);
   }
-  // The largest tile: a tile's hit records are all the device holds for the camera rays.
-  const std::size_t tile_rays = static_cast<std::size_t>(std::min(plan.tile_pixels(), plan.width)) * plan.samples *
-                                std::min(plan.tile_pixels(), plan.height) * plan.samples;
-  passes.primary_out = std::make_unique<TileHits>(session_.context, session_.queue, tile_rays);
+  passes.primary_out = std::make_unique<TileHits>(session_.context, session_.queue, tile_rays, hit_memory.get());
   if (scene.surfaces.size() > 1)
-    passes.other_out = std::make_unique<TileHits>(session_.context, session_.queue, tile_rays);
+    passes.other_out = std::make_unique<TileHits>(session_.context, session_.queue, tile_rays,
+                                                  PopulatedPages(tile_rays * sizeof(HitRecord)));
 
   if (PassStats* stats = passes.stats_of("shadow")) {
     const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
