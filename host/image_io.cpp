@@ -370,14 +370,18 @@ class SrgbEncoder {
 
 }  // namespace
 
-std::uint8_t srgb_byte(float linear) {
-  static const SrgbEncoder encoder;
-  return encoder(linear);
-}
-
 namespace {
 
-std::uint8_t encode_srgb(float linear) { return srgb_byte(linear); }
+const SrgbEncoder& srgb_encoder() {
+  static const SrgbEncoder encoder;
+  return encoder;
+}
+
+}  // namespace
+
+std::uint8_t srgb_byte(float linear) { return srgb_encoder()(linear); }
+
+namespace {
 
 std::uint8_t encode_alpha(float a) {
   if (!(a > 0.0f)) return 0;
@@ -540,8 +544,10 @@ void encode_png(const fs::path& file, const FrameImage& image) {
   const auto fill = [&image, channels](std::size_t y0, std::size_t count, unsigned char* out) {
     const std::size_t width = static_cast<std::size_t>(image.width);
     const float* rgba = image.rgba.data() + 4 * y0 * width;
+    // The encoder itself, inlined here, rather than srgb_byte's call and its static's guard per value.
+    const SrgbEncoder& srgb = srgb_encoder();
     for (std::size_t i = 0; i < count * width; ++i) {
-      for (std::size_t c = 0; c < 3; ++c) out[i * channels + c] = encode_srgb(rgba[4 * i + c]);
+      for (std::size_t c = 0; c < 3; ++c) out[i * channels + c] = srgb(rgba[4 * i + c]);
       if (channels == 4) out[i * 4 + 3] = encode_alpha(rgba[4 * i + 3]);
     }
   };
