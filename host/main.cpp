@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
 #include "batch.h"
@@ -89,6 +91,23 @@ bool parse_numbers(const std::string& text, std::size_t n, std::vector<double>& 
     start = comma + 1;
   }
   return out.size() == n;
+}
+
+// Ends the process after a render: its outputs are written, synced and renamed by now. Without the destructors
+// of statics and the exit handlers of the OpenCL driver (PoCL's and LLVM's: about 4 ms of a 1024^2 preview),
+// which free only what the process's exit frees anyway. LeakSanitizer checks at exit, so there it exits.
+[[noreturn]] void end_process(int code) {
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+#if defined(__SANITIZE_ADDRESS__)
+  std::exit(code);
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(leak_sanitizer)
+  std::exit(code);
+#endif
+#endif
+  std::_Exit(code);
 }
 
 }  // namespace
@@ -260,5 +279,5 @@ int main(int argc, char** argv) {
   request.use_cache = !render_opts.no_cache;
   if (!stats_path.empty()) request.stats_path = stats_path;
   request.progress = ::isatty(STDERR_FILENO) != 0;
-  return run_render(request, std::cerr);
+  end_process(run_render(request, std::cerr));
 }
