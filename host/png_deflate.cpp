@@ -37,8 +37,7 @@ std::string zlib_error(int rc, const z_stream& z) {
 
 // Deflates `size` bytes alone (no history from other bands) into `out`, ended by a full flush (byte-aligned,
 // the next band may follow) or, when `last`, by the final block.
-void deflate_alone(const unsigned char* data, std::size_t size, bool last, int level,
-                   std::vector<unsigned char>& out) {
+void deflate_alone(const unsigned char* data, std::size_t size, bool last, int level, std::vector<unsigned char>& out) {
   z_stream z{};
   // -15: raw deflate with the full 32 KB window; the zlib header and trailer are written once for all bands.
   int rc = deflateInit2(&z, level, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY);
@@ -99,9 +98,10 @@ void write_chunk(std::FILE* fp, const char type[4], const std::vector<unsigned c
 
 }  // namespace
 
-void write_png_image_data(std::FILE* fp, std::size_t height, std::size_t row_bytes, const PngRowSource& rows,
-                          int level, std::size_t band_bytes, unsigned threads) {
-  const std::size_t band_rows = std::clamp<std::size_t>(band_bytes / (row_bytes + 1), 1, std::max<std::size_t>(height, 1));
+void write_png_image_data(std::FILE* fp, std::size_t height, std::size_t row_bytes, const PngRowSource& rows, int level,
+                          std::size_t band_bytes, unsigned threads) {
+  const std::size_t band_rows =
+      std::clamp<std::size_t>(band_bytes / (row_bytes + 1), 1, std::max<std::size_t>(height, 1));
   const std::size_t bands = (height + band_rows - 1) / band_rows;
   if (threads == 0) threads = std::clamp(std::thread::hardware_concurrency(), 1u, 16u);
   threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(bands, 1)));

@@ -8,8 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <future>
+#include <limits>
 #include <memory>
 #include <new>
 #include <utility>
@@ -91,8 +91,8 @@ cl::NDRange primary_local_size(int lanes) { return lanes == 1 ? cl::NullRange : 
 // Keeps, per ray, the nearer of the hits found so far (surface `best`) and `other`'s hits (surface `index`).
 // The solver work of both is added up, and a depth-limited isolation on either is kept, so the statistics
 // and the solver channels count every surface's kernel.
-void keep_nearest(HitRecord* best, std::size_t count, std::vector<std::uint8_t>& best_surface,
-                  const HitRecord* other, std::uint8_t index) {
+void keep_nearest(HitRecord* best, std::size_t count, std::vector<std::uint8_t>& best_surface, const HitRecord* other,
+                  std::uint8_t index) {
   if (best_surface.size() != count) best_surface.assign(count, 0);
   for (std::size_t i = 0; i < count; ++i) {
     const HitRecord& o = other[i];
@@ -248,9 +248,9 @@ struct Renderer::Passes {
   RayBasis fine;  // adaptive antialiasing: the rays of the n-times finer grid
 
   // One tile's work.
-  HitRecord* hits = nullptr;  // camera rays, row-major in the tile: primary_out mapped
-  std::vector<std::uint8_t> hit_surface;    // several surfaces: which one each hit
-  std::vector<glm::dvec3> secondary;        // per camera ray: what its bounces bring back
+  HitRecord* hits = nullptr;              // camera rays, row-major in the tile: primary_out mapped
+  std::vector<std::uint8_t> hit_surface;  // several surfaces: which one each hit
+  std::vector<glm::dvec3> secondary;      // per camera ray: what its bounces bring back
   bool any_secondary = false;
   std::vector<glm::dvec3> refined_colour;  // adaptive antialiasing: per pixel of the tile
   std::vector<double> refined_alpha;

@@ -465,17 +465,23 @@ FrameImage random_png_image(std::mt19937& rng, int width, int height, bool opaqu
   std::uniform_int_distribution<int> special(0, 49);
   auto draw = [&] {
     switch (special(rng)) {
-      case 0: return std::numeric_limits<float>::quiet_NaN();
-      case 1: return 0.0f;
-      case 2: return 1.0f;
-      default: return value(rng);
+      case 0:
+        return std::numeric_limits<float>::quiet_NaN();
+      case 1:
+        return 0.0f;
+      case 2:
+        return 1.0f;
+      default:
+        return value(rng);
     }
   };
   im.rgba.resize(4 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
   for (std::size_t i = 0; i < im.rgba.size(); ++i) im.rgba[i] = (opaque && i % 4 == 3) ? 1.0f : draw();
   // Runs of one colour, which deflate turns into back-references, across band boundaries too.
   for (std::size_t i = 4; i + 4 <= im.rgba.size() / 3; i += 4)
-    if (special(rng) < 25) std::copy_n(im.rgba.begin() + static_cast<std::ptrdiff_t>(i) - 4, 4, im.rgba.begin() + static_cast<std::ptrdiff_t>(i));
+    if (special(rng) < 25)
+      std::copy_n(im.rgba.begin() + static_cast<std::ptrdiff_t>(i) - 4, 4,
+                  im.rgba.begin() + static_cast<std::ptrdiff_t>(i));
   return im;
 }
 
@@ -501,7 +507,8 @@ void check_png_pixels(const PngData& png, const FrameImage& im, bool opaque) {
 TEST_CASE("PNG image data deflated in parallel bands decodes with libpng to the image's bytes", "[image_io][png]") {
   TempDir dir;
   // A fresh seed each run, and a fixed one; the seed is printed with any failure.
-  for (const std::mt19937::result_type seed : {std::mt19937::result_type{1}, std::mt19937::result_type{std::random_device{}()}}) {
+  for (const std::mt19937::result_type seed :
+       {std::mt19937::result_type{1}, std::mt19937::result_type{std::random_device{}()}}) {
     INFO("seed " << seed);
     std::mt19937 rng(seed);
     // Bands are about 256 KB of filtered rows, so the large sizes take many bands on every thread, more than
@@ -524,7 +531,8 @@ TEST_CASE("PNG image data deflated in parallel bands decodes with libpng to the 
 TEST_CASE("write_png_image_data: any band size, thread count and level gives one valid zlib stream",
           "[image_io][png]") {
   TempDir dir;
-  for (const std::mt19937::result_type seed : {std::mt19937::result_type{2}, std::mt19937::result_type{std::random_device{}()}}) {
+  for (const std::mt19937::result_type seed :
+       {std::mt19937::result_type{2}, std::mt19937::result_type{std::random_device{}()}}) {
     INFO("seed " << seed);
     std::mt19937 rng(seed);
     std::uniform_int_distribution<int> side(1, 120);
@@ -537,7 +545,8 @@ TEST_CASE("write_png_image_data: any band size, thread count and level gives one
           for (std::size_t c = 0; c < 3; ++c) out[3 * i + c] = algray::srgb_byte(im.rgba[4 * (y0 * w + i) + c]);
       };
       // Bands of one row to all rows at once, on 1 to 5 threads.
-      for (const std::size_t band_bytes : {std::size_t{1}, row_bytes + 1, 7 * (row_bytes + 1) + 3, std::size_t{1} << 20})
+      for (const std::size_t band_bytes :
+           {std::size_t{1}, row_bytes + 1, 7 * (row_bytes + 1) + 3, std::size_t{1} << 20})
         for (const unsigned threads : {1u, 2u, 3u, 5u})
           for (const int level : {1, 6}) {
             INFO(w << "x" << h << ", bands of " << band_bytes << " bytes, " << threads << " threads, level " << level);
