@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -365,17 +366,25 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
       depth_and_normal |= format_from_extension(out) == ImageFormat::Exr;
       png |= format_from_extension(out) == ImageFormat::Png;
     }
+    // Only a film of at most 256 MB (4096^2 RGBA) is made ahead: the render's memory check (check_plan_fits,
+    // which needs the device) must refuse a render too large before its film is allocated, and a larger render
+    // takes seconds, beside which the overlap is noise.
     const int film_width = scene.image.width, film_height = scene.image.height;
-    std::future<FrameImage> film = std::async(std::launch::async, [=] {
-      if (png) srgb_byte(0.5f);
-      return make_film(film_width, film_height, depth_and_normal);
-    });
+    const bool ahead = static_cast<std::uint64_t>(film_width) * static_cast<std::uint64_t>(film_height) *
+                           (depth_and_normal ? 8 : 4) * sizeof(float) <=
+                       (std::uint64_t{256} << 20);
+    std::future<FrameImage> film;
+    if (ahead)
+      film = std::async(std::launch::async, [=] {
+        if (png) srgb_byte(0.5f);
+        return make_film(film_width, film_height, depth_and_normal);
+      });
     ClSession& session = context.session();
     device = session.info;
     timer.mark("device");
     Renderer renderer(session, context.cache());
     RenderOptions options;
-    options.film = [&film] { return film.get(); };
+    if (ahead) options.film = [&film] { return film.get(); };
     options.show_progress = req.progress;
     if (diagnostics) {
       options.on_primary_tile = [&](const PrimaryTile& tile) {
