@@ -562,7 +562,12 @@ void encode_png(const fs::path& file, const FrameImage& image) {
     }
     // zlib level 1 with the Up filter: measured on a 1024^2 render, 10 ms of CPU against 51 ms for libpng's
     // default (level 6, every filter tried per row), for a file 32% larger (250 KB against 190 KB).
-    write_png_image_data(fp, static_cast<std::size_t>(image.height), row_bytes, fill, 1);
+    try {
+      write_png_image_data(fp, static_cast<std::size_t>(image.height), row_bytes, fill, 1);
+    } catch (const WriteError&) {
+      // The message a failed PNG write has always had (libpng's, from when libpng wrote the image data too).
+      throw WriteError("libpng: Write Error");
+    }
   });
 }
 
