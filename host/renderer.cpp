@@ -507,7 +507,8 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
     kernel.setArg(tile_arg + 2, static_cast<cl_uint>(tile.trace_w));
     kernel.setArg(tile_arg + 3, static_cast<cl_uint>(tile.trace_h));
     cl::Event done;
-    session_.queue.enqueueNDRangeKernel(kernel, cl::NullRange, primary_global_size(passes.primary_lanes[s], tile.trace_w, tile.trace_h),
+    session_.queue.enqueueNDRangeKernel(kernel, cl::NullRange,
+                                        primary_global_size(passes.primary_lanes[s], tile.trace_w, tile.trace_h),
                                         primary_local_size(passes.primary_lanes[s]), nullptr, &done);
     // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
     done.wait();
