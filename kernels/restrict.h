@@ -232,37 +232,57 @@ typedef REAL Acc;
 #define acc_store(out, out_lo, c) ((void)(out_lo), poly_copy(out, c))
 #endif
 
-/* c times L^times. With only even exponents every gap is even, and one quadratic pass replaces two linear
- * ones: fewer flops and half the sweeps over c. */
-ALGRAY_INLINE void acc_mul_axis(Acc* c, AxisFactor f, int times) {
+/* How many rays restrict_to_rays expands side by side: -D RESTRICT_RAYS=n before this header, 1 by default.
+ * One ray's Horner scheme is a chain of dependent vector operations, so a core waits on their latency; the
+ * rays of a batch share the walk over the monomials and interleave their chains. Every ray gets exactly the
+ * operations it would get alone. */
+#ifndef RESTRICT_RAYS
+#define RESTRICT_RAYS 1
+#endif
+
+/* One accumulator per ray of the batch. */
+typedef Acc RayAccs[RESTRICT_RAYS][ACC_SLOTS];
+
+/* Every c[r] times its ray's L^times. With only even exponents (the same for every ray: they are the surface's)
+ * every gap is even, and one quadratic pass replaces two linear ones: fewer flops and half the sweeps over c. */
+ALGRAY_INLINE void acc_mul_axis(RayAccs c, const AxisFactor* f, int times) {
 #if ACC_SQUARES
-  if (f.even) {
-    for (int r = 0; r < times; r += 2) acc_mul_quadratic(c, f.q0, f.q1, f.q2);
+  if (f[0].even) {
+    for (int q = 0; q < times; q += 2) ALGRAY_UNROLL
+    for (int r = 0; r < RESTRICT_RAYS; ++r) acc_mul_quadratic(c[r], f[r].q0, f[r].q1, f[r].q2);
     return;
   }
 #endif
-  for (int r = 0; r < times; ++r) acc_mul_linear(c, f.l0, f.l1);
+  for (int q = 0; q < times; ++q) ALGRAY_UNROLL
+  for (int r = 0; r < RESTRICT_RAYS; ++r) acc_mul_linear(c[r], f[r].l0, f[r].l1);
 }
 
-/* c times one^times: degree elevation in the Bernstein form; nothing to do in the power basis. */
-ALGRAY_INLINE void acc_mul_one(Acc* c, int times) {
+/* Every c[r] times one^times: degree elevation in the Bernstein form; nothing to do in the power basis. */
+ALGRAY_INLINE void acc_mul_one(RayAccs c, int times) {
 #if RESTRICT_BERNSTEIN
-  for (int r = 0; r < times; ++r) acc_mul_linear(c, (REAL)1, (REAL)1);
+  for (int q = 0; q < times; ++q) ALGRAY_UNROLL
+  for (int r = 0; r < RESTRICT_RAYS; ++r) acc_mul_linear(c[r], (REAL)1, (REAL)1);
 #else
   (void)c;
   (void)times;
 #endif
 }
 
+/* The other accumulator operations, ray by ray. The batch loops are unrolled so that the accumulators stay in
+ * registers (measured: left as loops, they went through the stack and the batch was slower than one ray). */
+#define FOR_EACH_RAY(statement) \
+  ALGRAY_UNROLL                 \
+  for (int r = 0; r < RESTRICT_RAYS; ++r) statement
+
 /* Monomials arrive sorted by i, then j, then k, all descending, exponents packed as i | j<<8 | k<<16.
  * P = sum_i x^i sum_j y^j sum_k a_ijk z^k w^(D-i-j-k), evaluated as three nested Horner levels, each
  * accumulator homogeneous of one degree so that sums need no elevation.
- * fx, fy, fz: the coordinates' factors along the segment. Result: out[0..DEGREE]; mixed precision also writes
- * out_lo, the low parts of the compensated result (other builds leave it alone). */
-void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint count,
-                     __constant const REAL* binomials, AxisFactor fx, AxisFactor fy, AxisFactor fz, REAL* out,
-                     REAL* out_lo) {
-  Acc acc_z[ACC_SLOTS], acc_y[ACC_SLOTS], acc_x[ACC_SLOTS];
+ * fx[r], fy[r], fz[r]: ray r's coordinates' factors along its segment, r < RESTRICT_RAYS. Result: out[r][0..DEGREE];
+ * mixed precision also writes out_lo[r], the low parts of the compensated result (other builds leave it alone). */
+void restrict_to_rays(__global const uint* exps, __global const REAL* coefs, uint count,
+                      __constant const REAL* binomials, const AxisFactor* fx, const AxisFactor* fy,
+                      const AxisFactor* fz, REAL (*out)[NCOEF], REAL (*out_lo)[NCOEF]) {
+  RayAccs acc_z, acc_y, acc_x;
   int deg_z = -1;             /* degree of acc_z; -1 while the (i, j) group is empty */
   int have_y = 0, have_x = 0; /* acc_y, out hold a partial sum */
   int cur_i = -1, cur_j = -1, cur_k = -1;
@@ -286,11 +306,11 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
       acc_mul_axis(acc_z, fz, cur_k);
       acc_mul_one(acc_z, DEGREE - cur_i - cur_j - (deg_z + cur_k)); /* B_ij has degree D - i - j */
       if (!have_y) {
-        acc_copy(acc_y, acc_z);
+        FOR_EACH_RAY(acc_copy(acc_y[r], acc_z[r]));
         have_y = 1;
       } else {
         acc_mul_axis(acc_y, fy, prev_j - cur_j);
-        acc_add(acc_y, acc_z);
+        FOR_EACH_RAY(acc_add(acc_y[r], acc_z[r]));
       }
       prev_j = cur_j;
       deg_z = -1;
@@ -299,11 +319,11 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
     if (have_y && i != cur_i) {
       acc_mul_axis(acc_y, fy, prev_j);
       if (!have_x) {
-        acc_copy(acc_x, acc_y);
+        FOR_EACH_RAY(acc_copy(acc_x[r], acc_y[r]));
         have_x = 1;
       } else {
         acc_mul_axis(acc_x, fx, prev_i - cur_i);
-        acc_add(acc_x, acc_y);
+        FOR_EACH_RAY(acc_add(acc_x[r], acc_y[r]));
       }
       prev_i = cur_i;
       have_y = 0;
@@ -311,20 +331,40 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
     if (m == count) break;
     /* Add a_ijk to the z-level Horner sum of group (i, j). */
     if (deg_z < 0) {
-      acc_set_constant(acc_z, a, a_lo);
+      FOR_EACH_RAY(acc_set_constant(acc_z[r], a, a_lo));
       deg_z = 0;
     } else {
       acc_mul_axis(acc_z, fz, cur_k - k);
       deg_z += cur_k - k;
-      acc_add_constant(acc_z, deg_z, a, a_lo, binomials);
+      FOR_EACH_RAY(acc_add_constant(acc_z[r], deg_z, a, a_lo, binomials));
     }
     cur_i = i;
     cur_j = j;
     cur_k = k;
   }
-  if (!have_x) acc_set_constant(acc_x, 0, 0); /* no monomials: the host never sends this, but stay defined */
+  /* No monomials: the host never sends this, but stay defined. */
+  if (!have_x) FOR_EACH_RAY(acc_set_constant(acc_x[r], 0, 0));
   acc_mul_axis(acc_x, fx, prev_i);
-  acc_store(out, out_lo, acc_x);
+  FOR_EACH_RAY(acc_store(out[r], out_lo[r], acc_x[r]));
+}
+
+/* One ray: restrict_to_rays with every ray of the batch the same (a build with RESTRICT_RAYS = 1, as every
+ * kernel but the shadow rays', pays nothing for the batch). */
+void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint count,
+                     __constant const REAL* binomials, AxisFactor fx, AxisFactor fy, AxisFactor fz, REAL* out,
+                     REAL* out_lo) {
+  AxisFactor bx[RESTRICT_RAYS], by[RESTRICT_RAYS], bz[RESTRICT_RAYS];
+  REAL c[RESTRICT_RAYS][NCOEF], c_lo[RESTRICT_RAYS][NCOEF];
+  FOR_EACH_RAY({
+    bx[r] = fx;
+    by[r] = fy;
+    bz[r] = fz;
+  });
+  restrict_to_rays(exps, coefs, count, binomials, bx, by, bz, c, c_lo);
+  poly_copy(out, c[0]);
+#if ALGRAY_COMPENSATED
+  poly_copy(out_lo, c_lo[0]);
+#endif
 }
 
 /* The screen form (RAY_ORIGIN=screen): P*(t) = sum_k taylor[k] (t - t0)^k around a point of the ray near the

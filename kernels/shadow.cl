@@ -1,14 +1,30 @@
 /* The shadow-ray kernel: for each lit surface point, which sample points of one light the surface hides. */
 #include "algray_shared.h"
+
+/* Shadow rays restrict P in batches (see RESTRICT_RAYS in restrict.h); the width that measured fastest for the
+ * vector width the degree takes. */
+#if DEGREE <= 7
+#define RESTRICT_RAYS 4
+#else
+#define RESTRICT_RAYS 2
+#endif
+
 #include "isolate.h"
 #include "ray.h"
 #include "real.h"
 #include "restrict.h"
+#include "shadow.h"
 #include "surface.h"
 
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
 #error "the screen form is for camera rays; the host builds this kernel with RAY_ORIGIN=extent"
 #endif
+
+/* Whether the segment, restricted to root (and root_lo, both consumed), holds a root. */
+int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials) {
+  REAL iso_c[NCOEF];
+  return isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c).status != ISOLATION_NONE;
+}
 
 /* One work-item per surface point. points[i].xyz is the point (world), normals[i].xyz its unit normal on the
  * side the camera sees; light_points[0 .. light_count) are the light's sample points. Bit s of occluded[i]
@@ -16,12 +32,10 @@
  * the shadow ray from the offset point to the sample. Bits already set (another surface hid the sample) are
  * not traced again. The shadow ray stops at the first evidence of a root, an isolating interval, and never
  * refines it. offset: how far the origin moves along the normal, in world units. rays_traced counts the
- * shadow rays that reached the root isolation, for the render statistics. */
-__kernel void shadow(__global const REAL4* points, __global const float4* normals, uint point_count,
-                     __global const REAL4* light_points, uint light_count, REAL offset, REAL4 extent_centre,
-                     REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind, __global const uint* mono_exps,
-                     __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
-                     uint even_axes, __global ulong* occluded, __global uint* rays_traced) {
+ * shadow rays that reached the root isolation, for the render statistics.
+ * The answers are shadow_serial's, bit for bit: the segments are restricted RESTRICT_RAYS at a time, each
+ * with the operations it would get alone. */
+__kernel void shadow(SHADOW_KERNEL_PARAMS) {
   const uint i = get_global_id(0);
   if (i >= point_count) return;
   const REAL3 p = points[i].xyz;
@@ -32,28 +46,39 @@ __kernel void shadow(__global const REAL4* points, __global const float4* normal
   const REAL3 o_unit = (o - extent_centre.xyz) * extent_inv_scale;
   ulong mask = occluded[i];
   uint traced = 0;
-  for (uint s = 0; s < light_count; ++s) {
-    const ulong bit = (ulong)1 << s;
-    if (mask & bit) continue;
-    /* A light behind the tangent plane is hidden by the surface itself, whatever the roots say. The plane is
-     * the surface point's, as in the shading, not the offset origin's. */
-    if (dot(light_points[s].xyz - p, n) <= 0) {
-      mask |= bit;
-      continue;
+  /* The batch waiting for its restriction: ray r is light sample sample[r] on [t_in[r], t_out[r]]. */
+  AxisFactor fx[RESTRICT_RAYS], fy[RESTRICT_RAYS], fz[RESTRICT_RAYS];
+  REAL t_in[RESTRICT_RAYS], t_out[RESTRICT_RAYS];
+  uint sample[RESTRICT_RAYS];
+  int pending = 0;
+  /* s == light_count restricts what is left over. */
+  for (uint s = 0; s <= light_count; ++s) {
+    if (s < light_count) {
+      const ulong bit = (ulong)1 << s;
+      if (mask & bit) continue;
+      REAL3 d_unit;
+      const int kind = shadow_segment(p, n, o, o_unit, light_points[s].xyz, extent_inv_scale, extent_kind,
+                                      extent_box_half.xyz, &d_unit, &t_in[pending], &t_out[pending]);
+      if (kind == SHADOW_SELF) mask |= bit;
+      if (kind != SHADOW_TRACE) continue;
+      ++traced;
+      segment_factors(o_unit, d_unit, t_in[pending], t_out[pending], even_axes, &fx[pending], &fy[pending],
+                      &fz[pending]);
+      sample[pending] = s;
+      if (++pending < RESTRICT_RAYS) continue;
     }
-    const REAL3 to_light = light_points[s].xyz - o;
-    /* The segment from the origin (t = 0) to the light sample (t = 1), inside the extent. */
-    const REAL3 d_unit = to_light * extent_inv_scale;
-    REAL t_in, t_out;
-    if (!clip_to_extent(o_unit, d_unit, extent_kind, extent_box_half.xyz, &t_in, &t_out)) continue;
-    t_in = fmax(t_in, (REAL)0);
-    t_out = fmin(t_out, (REAL)1);
-    if (!(t_out > t_in)) continue;
-    ++traced;
-    REAL iso_c[NCOEF];
-    const Isolation iso = isolate_on_segment(o_unit, d_unit, t_in, t_out, mono_exps, mono_coefs, mono_count,
-                                             binomials, even_axes, iso_c);
-    if (iso.status != ISOLATION_NONE) mask |= bit;
+    if (pending == 0) break;
+    /* A short batch repeats its first ray in the empty places, whose answers are not read. */
+    for (int r = pending; r < RESTRICT_RAYS; ++r) {
+      fx[r] = fx[0];
+      fy[r] = fy[0];
+      fz[r] = fz[0];
+    }
+    REAL root[RESTRICT_RAYS][NCOEF], root_lo[RESTRICT_RAYS][NCOEF];
+    restrict_to_rays(mono_exps, mono_coefs, mono_count, binomials, fx, fy, fz, root, root_lo);
+    for (int r = 0; r < pending; ++r)
+      if (segment_has_root(root[r], root_lo[r], t_in[r], t_out[r], binomials)) mask |= (ulong)1 << sample[r];
+    pending = 0;
   }
   occluded[i] = mask;
   if (traced) atomic_add(rays_traced, traced);

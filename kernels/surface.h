@@ -150,6 +150,38 @@ void refine_lanes(uint count, const int* in_extent, const Isolation* iso, REAL (
 }
 #endif
 
+#if RAY_ORIGIN == ALGRAY_ORIGIN_EXTENT
+/* The coordinates' factors of the ray o + t*d restricted to [t_in, t_out] as s in [0, 1], in the isolation's
+ * basis: entry and exit points for the Bernstein form, entry point and chord for the power basis. */
+void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, AxisFactor* fx, AxisFactor* fy,
+                     AxisFactor* fz) {
+  const REAL3 pa = o + t_in * d, pb = o + t_out * d;
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+  const REAL3 l1 = pb;
+#else
+  const REAL3 l1 = pb - pa;
+#endif
+  *fx = axis_factor(pa.x, l1.x, even_axes & 1);
+  *fy = axis_factor(pa.y, l1.y, even_axes & 2);
+  *fz = axis_factor(pa.z, l1.z, even_axes & 4);
+}
+
+/* Isolates the smallest root on [t_in, t_out] from the coefficients restrict_to_ray made of segment_factors'
+ * factors (root, root_lo are consumed); iso_c gets the polynomial on the isolating interval. */
+Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
+                             REAL* iso_c PROBE_PARAM) {
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+  bernstein_from_scaled(root, root_lo, binomials);
+  probe_coefficients(root, root_lo, ALGRAY_BASIS_BERNSTEIN PROBE_ARG);
+  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
+#else
+  (void)binomials;
+  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_SEGMENT PROBE_ARG);
+  return isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c PROBE_ARG);
+#endif
+}
+#endif
+
 /* Isolates the smallest root of P*(t) on [t_in, t_out] for the ray o + t*d in unit coordinates; iso_c gets
  * the polynomial on the isolating interval. The primary and shadow kernels share this: one refines what it
  * returns, the other only asks whether there is anything to refine. */
@@ -181,21 +213,10 @@ Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global c
   probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_EYE PROBE_ARG);
   return isolate_power_basis(root, t_in, t_out - t_in, t_in, t_out, iso_c PROBE_ARG);
 #else
-  /* Entry and exit points: the ray restricted to the interval as s in [0, 1]. */
-  const REAL3 pa = o + t_in * d, pb = o + t_out * d;
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, pb.x, even_axes & 1),
-                  axis_factor(pa.y, pb.y, even_axes & 2), axis_factor(pa.z, pb.z, even_axes & 4), root, root_lo);
-  bernstein_from_scaled(root, root_lo, binomials);
-  probe_coefficients(root, root_lo, ALGRAY_BASIS_BERNSTEIN PROBE_ARG);
-  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
-#else
-  const REAL3 e = pb - pa;
-  restrict_to_ray(exps, coefs, count, binomials, axis_factor(pa.x, e.x, even_axes & 1),
-                  axis_factor(pa.y, e.y, even_axes & 2), axis_factor(pa.z, e.z, even_axes & 4), root, root_lo);
-  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_SEGMENT PROBE_ARG);
-  return isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c PROBE_ARG);
-#endif
+  AxisFactor fx, fy, fz;
+  segment_factors(o, d, t_in, t_out, even_axes, &fx, &fy, &fz);
+  restrict_to_ray(exps, coefs, count, binomials, fx, fy, fz, root, root_lo);
+  return isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c PROBE_ARG);
 #endif
 }
 

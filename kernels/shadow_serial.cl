@@ -1,0 +1,42 @@
+/* The shadow kernel's answers the plain way, one segment at a time through isolate_on_segment: what the tests hold shadow.cl to. */
+#include "algray_shared.h"
+#include "isolate.h"
+#include "ray.h"
+#include "real.h"
+#include "restrict.h"
+#include "shadow.h"
+#include "surface.h"
+
+#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
+#error "the screen form is for camera rays; the host builds this kernel with RAY_ORIGIN=extent"
+#endif
+
+/* The arguments and the result are shadow's (shadow.cl). */
+__kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
+  const uint i = get_global_id(0);
+  if (i >= point_count) return;
+  const REAL3 p = points[i].xyz;
+  const float4 nf = normals[i];
+  const REAL3 n = (REAL3)((REAL)nf.x, (REAL)nf.y, (REAL)nf.z);
+  const REAL3 o = p + offset * n;
+  const REAL3 o_unit = (o - extent_centre.xyz) * extent_inv_scale;
+  ulong mask = occluded[i];
+  uint traced = 0;
+  for (uint s = 0; s < light_count; ++s) {
+    const ulong bit = (ulong)1 << s;
+    if (mask & bit) continue;
+    REAL3 d_unit;
+    REAL t_in, t_out;
+    const int kind = shadow_segment(p, n, o, o_unit, light_points[s].xyz, extent_inv_scale, extent_kind,
+                                    extent_box_half.xyz, &d_unit, &t_in, &t_out);
+    if (kind == SHADOW_SELF) mask |= bit;
+    if (kind != SHADOW_TRACE) continue;
+    ++traced;
+    REAL iso_c[NCOEF];
+    const Isolation iso = isolate_on_segment(o_unit, d_unit, t_in, t_out, mono_exps, mono_coefs, mono_count,
+                                             binomials, even_axes, iso_c);
+    if (iso.status != ISOLATION_NONE) mask |= bit;
+  }
+  occluded[i] = mask;
+  if (traced) atomic_add(rays_traced, traced);
+}

@@ -1,0 +1,157 @@
+// The shadow kernel against shadow_serial, the plain one-segment-at-a-time construction: whatever shortcuts
+// shadow.cl takes, the occlusion masks must be identical on seeded random surfaces, points and lights.
+#include <catch2/catch.hpp>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "device_surface.h"
+#include "program_cache.h"
+#include "render_plan.h"
+#include "scene.h"
+#include "shadow_tracer.h"
+#include "test_support.h"
+
+using namespace algray;
+
+namespace {
+
+constexpr unsigned kSeed = 20261202;
+
+// A random surface of degree `degree` inside the unit sphere: a dozen random monomials, one of full degree, with
+// coefficients in [-1, 1]; with `even`, every exponent even, as the Barth surfaces have (the restriction then
+// steps by squares).
+Scene random_scene(std::mt19937& rng, int degree, bool even, Precision precision, Isolation isolation) {
+  std::uniform_real_distribution<double> coef(-1, 1);
+  std::ostringstream eq;
+  eq.precision(17);
+  const int step = even ? 2 : 1;
+  for (int m = 0; m < 12; ++m) {
+    const int total = m == 0 ? degree : std::uniform_int_distribution<int>(0, degree / step)(rng) * step;
+    const int i = std::uniform_int_distribution<int>(0, total / step)(rng) * step;
+    const int j = std::uniform_int_distribution<int>(0, (total - i) / step)(rng) * step;
+    const int k = total - i - j;
+    eq << (m ? " + " : "") << "(" << coef(rng) << ")*x^" << i << "*y^" << j << "*z^" << k;
+  }
+  std::ostringstream toml;
+  toml << "[surface]\nequation = \"" << eq.str() << "\"\n"
+       << "[extent]\nradius = 1\n"
+       << "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n"
+       << "[render]\nprecision = \"" << to_string(precision) << "\"\nisolation = \"" << to_string(isolation)
+       << "\"\n";
+  return load_scene_text(toml.str(), "random.toml");
+}
+
+struct Counts {
+  long hidden = 0, visible = 0, traced = 0;
+};
+
+// Traces `points` random surface points towards up to 64 random light points with both kernels and requires the
+// same masks and the same count of traced rays. Some bits start set, as when another surface hid the sample.
+Counts check_same_masks(const Scene& scene, Precision precision, Isolation isolation, std::mt19937& rng,
+                        const std::string& what) {
+  ClSession& session = testing::device_session();
+  static ProgramCache cache(false);
+  KernelConfig config = primary_config(scene, precision);
+  config.ray_origin = RayOrigin::Extent;
+  config.isolation = isolation;
+  config.refinement = Refinement::Brent;
+  config.max_iterations = default_max_iterations(Refinement::Brent);
+  const DeviceSurface surface(session.context, scene, precision);
+  const double offset = shadow_offset_unit(precision) * scene.extent.unit_scale();
+  config.entry = "shadow";
+  ShadowTracer batched(session, cache, config, surface, offset);
+  config.entry = "shadow_serial";
+  ShadowTracer serial(session, cache, config, surface, offset);
+
+  const glm::dvec3 centre = scene.extent.unit_centre();
+  const double radius = scene.extent.unit_scale();
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::normal_distribution<double> g;
+  auto in_ball = [&](double r) {
+    for (;;) {
+      const glm::dvec3 v(u(rng), u(rng), u(rng));
+      if (glm::dot(v, v) <= 1) return centre + r * radius * v;
+    }
+  };
+  Counts counts;
+  for (int round = 0; round < 4; ++round) {
+    const int point_count = 500;
+    std::vector<glm::dvec3> points;
+    std::vector<glm::vec3> normals;
+    std::vector<std::uint64_t> hidden;
+    for (int i = 0; i < point_count; ++i) {
+      points.push_back(in_ball(1.1));  // a few outside the extent too
+      normals.push_back(glm::vec3(glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)))));
+      hidden.push_back(std::uniform_int_distribution<int>(0, 3)(rng) == 0 ? rng() : 0u);
+    }
+    const int light_count = std::uniform_int_distribution<int>(1, 64)(rng);
+    std::vector<glm::dvec3> lights;
+    for (int s = 0; s < light_count; ++s) lights.push_back(in_ball(std::uniform_real_distribution<double>(0.3, 4)(rng)));
+    const ShadowAnswer a = batched.trace(points, normals, lights, hidden);
+    const ShadowAnswer b = serial.trace(points, normals, lights, hidden);
+    REQUIRE(a.masks.size() == b.masks.size());
+    int mismatches = 0;
+    for (std::size_t i = 0; i < a.masks.size(); ++i) {
+      if (a.masks[i] == b.masks[i]) continue;
+      if (mismatches++ == 0)
+        UNSCOPED_INFO(what << ", seed " << kSeed << ", round " << round << ", point " << i << " of " << point_count
+                           << " (" << points[i].x << ", " << points[i].y << ", " << points[i].z << "), "
+                           << light_count << " lights: batched mask " << std::hex << a.masks[i] << ", serial "
+                           << b.masks[i] << std::dec);
+    }
+    INFO(what << ", seed " << kSeed << ", round " << round << ": " << mismatches << " masks differ");
+    CHECK(mismatches == 0);
+    CHECK(a.rays_traced == b.rays_traced);
+    counts.traced += a.rays_traced;
+    const std::uint64_t all = light_count == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << light_count) - 1;
+    for (std::size_t i = 0; i < a.masks.size(); ++i)
+      for (int s = 0; s < light_count; ++s) {
+        if (hidden[i] & all & (std::uint64_t{1} << s)) continue;
+        ((a.masks[i] >> s) & 1 ? counts.hidden : counts.visible)++;
+      }
+  }
+  return counts;
+}
+
+}  // namespace
+
+TEST_CASE("batched shadow rays answer as the serial ones, bit for bit, at every vector width and precision",
+          "[shadows]") {
+  // Degrees on each side of the restriction's representations: 8 lanes (up to 7), 16 lanes (up to 15), arrays.
+  struct Case {
+    int degree;
+    bool even;
+  };
+  const Case cases[] = {{1, false}, {2, true}, {5, false}, {6, true}, {7, false},
+                        {10, true}, {13, false}, {15, false}, {18, true}, {21, false}};
+  std::mt19937 rng(kSeed);
+  for (Precision precision : {Precision::Double, Precision::Float, Precision::Mixed}) {
+    for (std::size_t c = 0; c < std::size(cases); ++c) {
+      const Case& k = cases[c];
+      if (precision == Precision::Mixed && k.degree > kMaxMixedDegree) continue;
+      const Scene scene = random_scene(rng, k.degree, k.even, precision, Isolation::Bernstein);
+      std::ostringstream what;
+      what << to_string(precision) << " case " << c << " (degree " << k.degree << (k.even ? ", even" : "") << ")";
+      const Counts n = check_same_masks(scene, precision, Isolation::Bernstein, rng, what.str());
+      INFO(what.str() << ": " << n.traced << " rays traced, " << n.hidden << " samples hidden, " << n.visible
+                      << " visible");
+      // Both answers, and rays for the isolation to decide, so the comparison means something.
+      CHECK(n.traced >= 1000);
+      CHECK(n.hidden >= 100);
+      CHECK(n.visible >= 100);
+    }
+  }
+}
+
+TEST_CASE("batched shadow rays answer as the serial ones with a power-basis isolation and on the Barth sextic",
+          "[shadows]") {
+  std::mt19937 rng(kSeed + 1);
+  for (Precision precision : {Precision::Double, Precision::Float}) {
+    const Scene random = random_scene(rng, 6, false, precision, Isolation::PowerDescartes);
+    check_same_masks(random, precision, Isolation::PowerDescartes, rng, to_string(precision) + " power basis");
+    const Scene barth = load_scene_file(ALGRAY_SOURCE_DIR "/scenes/barth_sextic.toml");
+    check_same_masks(barth, precision, Isolation::Bernstein, rng, to_string(precision) + " Barth sextic");
+  }
+}
