@@ -182,6 +182,29 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
   }
 }
 
+/* Whether isolate_bernstein would find a root at all, read off the signs of the scaled coefficients c (as the
+ * restriction leaves them, before bernstein_from_scaled) where they settle it without subdividing:
+ *  - ISOLATION_NONE when every c_k has one strict sign: the search's first interval has no sign variation, and
+ *    with it the whole of [0,1] is searched. Dividing by the positive C(n,k) keeps each sign, or underflows a
+ *    middle one to zero, which adds no variation; the ends are divided by 1;
+ *  - ISOLATION_BRACKET when an end is zero or the ends differ in sign: a root of P* on the segment, and the
+ *    search reports one too, because every interval it searches keeps c_n as its right end, unrounded, so the
+ *    last one it reaches holds the sign change (or the zero) that it reports;
+ *  - -1 otherwise, NaN included: only the search can tell.
+ * A shadow ray asks for nothing more, so most of its rays skip the division and the search. */
+int bernstein_root_by_signs(const REAL* c) {
+  int positive = 1, negative = 1;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) {
+    positive &= c[k] > 0;
+    negative &= c[k] < 0;
+  }
+  if (positive || negative) return ISOLATION_NONE;
+  const REAL a = c[0], b = c[DEGREE];
+  if (a == 0 || b == 0 || (a < 0 && b > 0) || (a > 0 && b < 0)) return ISOLATION_BRACKET;
+  return -1;
+}
+
 /* Turns Bernstein coefficients into the form isolated_value() expects: c_k * C(n,k). */
 void prepare_isolated(REAL* c, __constant const REAL* binomials) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;

@@ -20,8 +20,13 @@
 #error "the screen form is for camera rays; the host builds this kernel with RAY_ORIGIN=extent"
 #endif
 
-/* Whether the segment, restricted to root (and root_lo, both consumed), holds a root. */
+/* Whether the segment, restricted to root (and root_lo, both consumed), holds a root: what isolate_restricted
+ * reports, without the search when the coefficients' signs already settle it (Bernstein builds). */
 int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials) {
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+  const int by_signs = bernstein_root_by_signs(root);
+  if (by_signs >= 0) return by_signs != ISOLATION_NONE;
+#endif
   REAL iso_c[NCOEF];
   return isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c).status != ISOLATION_NONE;
 }
@@ -34,7 +39,7 @@ int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constan
  * refines it. offset: how far the origin moves along the normal, in world units. rays_traced counts the
  * shadow rays that reached the root isolation, for the render statistics.
  * The answers are shadow_serial's, bit for bit: the segments are restricted RESTRICT_RAYS at a time, each
- * with the operations it would get alone. */
+ * with the operations it would get alone, and the shortcuts return what the search would. */
 __kernel void shadow(SHADOW_KERNEL_PARAMS) {
   const uint i = get_global_id(0);
   if (i >= point_count) return;
