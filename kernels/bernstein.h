@@ -79,6 +79,27 @@ void casteljau_keep_right(REAL* c, REAL* c_lo, REAL x, REAL x_lo) {
 }
 
 /* Halves c at 1/2 in one de Casteljau triangle: c becomes the left half, right the right half. */
+#if DEGREE <= 15 && !ALGRAY_COMPENSATED
+/* Each row of the triangle as one vector operation on a register, instead of a row of scalars through memory
+ * (measured: casteljau_halve was a fifth of the Barth decic's shadow kernel). The same products and sums as
+ * the scalar rows below: 0.5 t_k + 0.5 t_(k+1) per lane. Lanes past the row's end are never read. */
+void casteljau_halve(REAL* c, REAL* c_lo, REAL* right, REAL* right_lo) {
+  (void)c_lo;
+  (void)right_lo;
+  REAL row[ACC_WIDTH];
+  ALGRAY_UNROLL
+  for (int k = 0; k < ACC_WIDTH; ++k) row[k] = k <= DEGREE ? c[k] : (REAL)0;
+  PolyVec t = VEC_LOAD(row);
+  right[DEGREE] = c[DEGREE];
+  ALGRAY_UNROLL
+  for (int r = 1; r <= DEGREE; ++r) {
+    t = (REAL)0.5 * t + (REAL)0.5 * VEC_SHIFT_DOWN(t);
+    VEC_STORE(t, row);
+    c[r] = row[0];
+    right[DEGREE - r] = row[DEGREE - r];
+  }
+}
+#else
 void casteljau_halve(REAL* c, REAL* c_lo, REAL* right, REAL* right_lo) {
   REAL t[NCOEF], t_lo[NCOEF];
   coefs_copy(t, t_lo, c, c_lo);
@@ -100,6 +121,7 @@ void casteljau_halve(REAL* c, REAL* c_lo, REAL* right, REAL* right_lo) {
 #endif
   }
 }
+#endif
 
 /* Coefficients on the dyadic interval [idx/2^level, (idx+1)/2^level], recomputed from the whole interval's. */
 void bernstein_restrict(const REAL* root, const REAL* root_lo, int level, ulong idx, REAL* out, REAL* out_lo) {

@@ -96,6 +96,8 @@ ALGRAY_INLINE void poly_set_constant(REAL* c, REAL a) {
 #define ACC_WIDTH 8
 typedef REAL8 PolyVec;
 #define VEC_SHIFT(c) ((PolyVec)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6))
+/* The other way, lane k from lane k + 1: de Casteljau's halving (bernstein.h). */
+#define VEC_SHIFT_DOWN(c) ((PolyVec)((c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6, (c).s7, (REAL)0))
 #define VEC_LOAD(p) vload8(0, p)
 #define VEC_STORE(v, p) vstore8(v, 0, p)
 #else
@@ -104,6 +106,9 @@ typedef REAL16 PolyVec;
 #define VEC_SHIFT(c)                                                                                                  \
   ((PolyVec)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6, (c).s7, (c).s8, (c).s9, (c).sa, (c).sb, \
              (c).sc, (c).sd, (c).se))
+#define VEC_SHIFT_DOWN(c)                                                                                             \
+  ((PolyVec)((c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6, (c).s7, (c).s8, (c).s9, (c).sa, (c).sb, (c).sc, (c).sd, \
+             (c).se, (c).sf, (REAL)0))
 #define VEC_LOAD(p) vload16(0, p)
 #define VEC_STORE(v, p) vstore16(v, 0, p)
 #endif
