@@ -274,7 +274,7 @@ ALGRAY_INLINE void acc_mul_one(RayAccs c, int times) {
 }
 
 /* The other accumulator operations, ray by ray. The batch loops are unrolled so that the accumulators stay in
- * registers (measured: left as loops, they went through the stack and the batch was slower than one ray). */
+ * registers (measured: left as loops, they went through the stack and the batch gained nothing). */
 #define FOR_EACH_RAY(statement) \
   ALGRAY_UNROLL                 \
   for (int r = 0; r < RESTRICT_RAYS; ++r) statement
