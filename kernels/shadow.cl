@@ -43,12 +43,8 @@ int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constan
 __kernel void shadow(SHADOW_KERNEL_PARAMS) {
   const uint i = get_global_id(0);
   if (i >= point_count) return;
-  const REAL3 p = points[i].xyz;
-  const float4 nf = normals[i];
-  const REAL3 n = (REAL3)((REAL)nf.x, (REAL)nf.y, (REAL)nf.z);
-  /* Off the surface to the camera's side: the point's own root moves behind the ray's start. */
-  const REAL3 o = p + offset * n;
-  const REAL3 o_unit = (o - extent_centre.xyz) * extent_inv_scale;
+  REAL3 p, n, o, o_unit;
+  shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
   ulong mask = occluded[i];
   uint traced = 0;
   /* The batch waiting for its restriction: ray r is light sample sample[r] on [t_in[r], t_out[r]]. */

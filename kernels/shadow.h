@@ -24,6 +24,17 @@ int shadow_segment(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, REAL3 light, REAL ex
   return *t_out > *t_in ? SHADOW_TRACE : SHADOW_CLEAR;
 }
 
+/* Work-item i's surface point p and normal n, and the shadow rays' origin o off the surface to the camera's side
+ * (the point's own root moves behind the ray's start), in world and unit coordinates. */
+void shadow_origin(__global const REAL4* points, __global const float4* normals, uint i, REAL offset,
+                   REAL4 extent_centre, REAL extent_inv_scale, REAL3* p, REAL3* n, REAL3* o, REAL3* o_unit) {
+  *p = points[i].xyz;
+  const float4 nf = normals[i];
+  *n = (REAL3)((REAL)nf.x, (REAL)nf.y, (REAL)nf.z);
+  *o = *p + offset * *n;
+  *o_unit = (*o - extent_centre.xyz) * extent_inv_scale;
+}
+
 /* The kernels' common arguments and the work-item's surface point: see shadow.cl. */
 #define SHADOW_KERNEL_PARAMS                                                                                         \
   __global const REAL4 *points, __global const float4 *normals, uint point_count, __global const REAL4 *light_points, \

@@ -15,11 +15,8 @@
 __kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
   const uint i = get_global_id(0);
   if (i >= point_count) return;
-  const REAL3 p = points[i].xyz;
-  const float4 nf = normals[i];
-  const REAL3 n = (REAL3)((REAL)nf.x, (REAL)nf.y, (REAL)nf.z);
-  const REAL3 o = p + offset * n;
-  const REAL3 o_unit = (o - extent_centre.xyz) * extent_inv_scale;
+  REAL3 p, n, o, o_unit;
+  shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
   ulong mask = occluded[i];
   uint traced = 0;
   for (uint s = 0; s < light_count; ++s) {
