@@ -6,7 +6,6 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <random>
 #include <vector>
@@ -14,6 +13,7 @@
 #include "algray_shared.h"
 #include "program_cache.h"
 #include "solver_ref.h"
+#include "test_seed.h"
 #include "test_support.h"
 #include "tolerances.h"
 
@@ -23,10 +23,7 @@ using Poly = std::vector<mpq_class>;  // power basis in x, poly[i] multiplies x^
 namespace {
 
 // The base seed; ALGRAY_TEST_SEED overrides it, to rerun a reported failure or to sweep seeds by hand.
-const unsigned kSeed = [] {
-  const char* given = std::getenv("ALGRAY_TEST_SEED");
-  return given ? static_cast<unsigned>(std::strtoul(given, nullptr, 10)) : 20261122u;
-}();
+const unsigned kSeed = algray::testing::test_seed(20261122u);
 constexpr int kCases = 1000;
 constexpr int kMaxTestedDegree = 16;
 const char* const kKinds[] = {"separated",   "clustered",      "double root",
