@@ -1,8 +1,11 @@
-// Compares two algray EXR files pixel by pixel: hit/miss disagreements and relative depth differences.
+// Compares two algray EXR files pixel by pixel: hit/miss disagreements, relative depth differences, identical bits.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <exception>
+#include <string>
+#include <vector>
 
 #include "image_io.h"
 
@@ -36,6 +39,29 @@ int main(int argc, char** argv) {
         "(%.2f%% of common hits), worst relative depth difference %.2g\n",
         ref.depth.size(), hit_miss, 100.0 * static_cast<double>(hit_miss) / static_cast<double>(ref.depth.size()), both,
         off_1e6, off_1e3, 100.0 * static_cast<double>(off_1e3) / static_cast<double>(std::max(both, 1L)), worst);
+    // Whether a change kept every stored value (colour, depth, normal, solver channels) bit for bit: the check
+    // for work that must not move an image. NaNs compare by their bits too.
+    const auto same_bits = [](const auto& a, const auto& b) {
+      return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0);
+    };
+    std::vector<std::string> differing;
+    if (!same_bits(test.rgba, ref.rgba)) differing.push_back("RGBA");
+    if (!same_bits(test.depth, ref.depth)) differing.push_back("Z");
+    if (!same_bits(test.normal, ref.normal)) differing.push_back("N");
+    const bool same_layout = test.uint_channels.size() == ref.uint_channels.size() &&
+                             test.float_channels.size() == ref.float_channels.size();
+    if (!same_layout) differing.push_back("(channel lists)");
+    for (std::size_t c = 0; same_layout && c < ref.uint_channels.size(); ++c)
+      if (test.uint_channels[c].name != ref.uint_channels[c].name ||
+          !same_bits(test.uint_channels[c].values, ref.uint_channels[c].values))
+        differing.push_back(ref.uint_channels[c].name);
+    for (std::size_t c = 0; same_layout && c < ref.float_channels.size(); ++c)
+      if (test.float_channels[c].name != ref.float_channels[c].name ||
+          !same_bits(test.float_channels[c].values, ref.float_channels[c].values))
+        differing.push_back(ref.float_channels[c].name);
+    std::string list;
+    for (const std::string& name : differing) list += " " + name;
+    std::printf("channels bit-identical: %s\n", differing.empty() ? "all" : ("no, differing:" + list).c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "exr_compare: %s\n", e.what());
     return 1;
