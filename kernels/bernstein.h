@@ -39,6 +39,9 @@ void bernstein_from_scaled(REAL* c, REAL* c_lo, __constant const REAL* binomials
   }
 }
 
+/* x1 a + x b: de Casteljau's recurrence in plain arithmetic, for REALs and for lanes of them alike. */
+#define CASTELJAU_COMBINE(x1, a, x, b) ((x1) * (a) + (x) * (b))
+
 /* c = x1 a + x b: one step of de Casteljau's recurrence, in the build's arithmetic. */
 ALGRAY_INLINE void casteljau_step(REAL* c, REAL* c_lo, int k, int a, int b, REAL x1, REAL x1_lo, REAL x, REAL x_lo) {
 #if ALGRAY_COMPENSATED
@@ -47,7 +50,7 @@ ALGRAY_INLINE void casteljau_step(REAL* c, REAL* c_lo, int k, int a, int b, REAL
   (void)c_lo;
   (void)x1_lo;
   (void)x_lo;
-  c[k] = x1 * c[a] + x * c[b];
+  c[k] = CASTELJAU_COMBINE(x1, c[a], x, c[b]);
 #endif
 }
 
@@ -93,7 +96,7 @@ void casteljau_halve(REAL* c, REAL* c_lo, REAL* right, REAL* right_lo) {
   right[DEGREE] = c[DEGREE];
   ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r) {
-    t = (REAL)0.5 * t + (REAL)0.5 * VEC_SHIFT_DOWN(t);
+    t = CASTELJAU_COMBINE((REAL)0.5, t, (REAL)0.5, VEC_SHIFT_DOWN(t));
     VEC_STORE(t, row);
     c[r] = row[0];
     right[DEGREE - r] = row[DEGREE - r];
@@ -203,6 +206,167 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
       bernstein_restrict(root, root_lo, level, idx, cur, cur_lo);
   }
 }
+
+#if LANES > 1 && !ALGRAY_COMPENSATED
+/* isolate_bernstein for LANES polynomials at once (lanes.h), lanes where `running` is clear left alone: each
+ * lane takes the scalar search's decisions in its order, with the same arithmetic, so it ends with the scalar
+ * result bit for bit (tests/test_lanes). The search's position (level, idx) and the interval's width are kept
+ * as REALs, exact for these small integers and powers of two, so that all the state is in vector registers.
+ * A halving, a recomputation from `root` and a copy of the cached sibling each cost every lane, so this pays
+ * where neighbouring rays take similar searches (bench/RESULTS.md, "Lock-step lanes"). Mixed precision keeps
+ * the scalar search per lane. */
+
+/* Sign changes between consecutive nonzero coefficients, per lane, as sign_variations counts them. */
+LREAL sign_variations_lanes(const LREAL* c) {
+  LREAL v = 0, prev = 0;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) {
+    const LREAL s = LANE_SEL((LREAL)0, (LREAL)1, c[k] > 0) - LANE_SEL((LREAL)0, (LREAL)1, c[k] < 0);
+    v += LANE_SEL((LREAL)0, (LREAL)1, s * prev < 0);
+    prev = LANE_SEL(prev, s, s != 0);
+  }
+  return v;
+}
+
+/* bernstein_restrict per lane: the coefficients on [idx * width, (idx + 1) * width] from the whole interval's,
+ * into out for the lanes in `take`. */
+void bernstein_restrict_lanes(const LREAL* root, LREAL width, LREAL idx, LMASK take, LREAL* out) {
+  LREAL o[NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) o[k] = root[k];
+  const LREAL lo = idx * width, hi = lo + width;
+  const LMASK left = take && hi < (REAL)1;
+  if (LANE_ANY(left)) {
+    const LREAL x1 = (REAL)1 - hi;
+    LREAL t[NCOEF];
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) t[k] = o[k];
+    ALGRAY_UNROLL
+    for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
+    for (int k = DEGREE; k >= r; --k) t[k] = CASTELJAU_COMBINE(x1, t[k - 1], hi, t[k]);
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) o[k] = LANE_SEL(o[k], t[k], left);
+  }
+  const LMASK right = take && lo > (REAL)0;
+  if (LANE_ANY(right)) {
+    const LREAL x = lo / hi, x1 = (REAL)1 - x;
+    LREAL t[NCOEF];
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) t[k] = o[k];
+    ALGRAY_UNROLL
+    for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE - r; ++k) t[k] = CASTELJAU_COMBINE(x1, t[k], x, t[k + 1]);
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) o[k] = LANE_SEL(o[k], t[k], right);
+  }
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) out[k] = LANE_SEL(out[k], o[k], take);
+}
+
+/* root: each lane's Bernstein coefficients on [t_in, t_out]. On return iso[j] is lane j's Isolation and
+ * cur[j] its coefficients on the isolating interval, for every running lane j < count. */
+void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL t_in, LREAL t_out,
+                             Isolation* iso, REAL (*cur_out)[NCOEF]) {
+  LREAL cur[NCOEF], sib[NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) cur[k] = sib[k] = root[k];
+  const LREAL len = t_out - t_in;
+  const LREAL start_sign = LANE_SEL((LREAL)0, (LREAL)1, root[0] > 0) - LANE_SEL((LREAL)0, (LREAL)1, root[0] < 0);
+  LREAL level = 0, idx = 0, width = 1, sib_level = -1, sib_idx = 0;
+  LREAL status = ISOLATION_NONE, steps = 0, lo = 0, hi = 1, f_lo = 0, f_hi = 0;
+  LMASK budget = 0, cluster = 0, done = !running;
+  for (;;) {
+    const LMASK active = !done;
+    steps += LANE_SEL((LREAL)0, (LREAL)1, active);
+    lo = LANE_SEL(lo, idx * width, active);
+    hi = LANE_SEL(hi, lo + width, active);
+    f_lo = LANE_SEL(f_lo, cur[0], active);
+    f_hi = LANE_SEL(f_hi, cur[DEGREE], active);
+    /* settled_at_left_end: an exact zero, or the other sign than at t_in */
+    const LREAL s = LANE_SEL((LREAL)0, (LREAL)1, f_lo > 0) - LANE_SEL((LREAL)0, (LREAL)1, f_lo < 0);
+    const LMASK exact = active && (f_lo == 0 || (s != 0 && s != start_sign));
+    status = LANE_SEL(status, (LREAL)ISOLATION_EXACT, exact);
+    done = done || exact;
+    const LREAL v = sign_variations_lanes(cur);
+    const LMASK isolated = !done && v == 1 && cur[DEGREE] != 0;
+    status = LANE_SEL(status, (LREAL)ISOLATION_BRACKET, isolated);
+    done = done || isolated;
+    /* halve_or_settle for the lanes that may hold several roots */
+    const LMASK several = !done && v >= 1;
+    const LMASK located = width * len <= (REAL)4 * (REAL)TOLERANCE * fmax(fabs(t_in + lo * len), (LREAL)1);
+    const LMASK halve = several && !located && level < (REAL)REAL_MAX_HALVINGS;
+    const LMASK settle = several && !halve;
+    budget = budget || (settle && !located);
+    const LMASK cluster_root = settle && ((f_lo < 0) != (f_hi < 0));
+    status = LANE_SEL(status, (LREAL)ISOLATION_BRACKET, cluster_root);
+    cluster = cluster || cluster_root;
+    done = done || cluster_root;
+    if (LANE_ALL(done)) break;
+    if (LANE_ANY(halve)) {
+      /* casteljau_halve: the same rows of the triangle */
+      LREAL t[NCOEF], left[NCOEF], right[NCOEF];
+      ALGRAY_UNROLL
+      for (int k = 0; k <= DEGREE; ++k) t[k] = cur[k];
+      left[0] = t[0];
+      right[DEGREE] = t[DEGREE];
+      ALGRAY_UNROLL
+      for (int r = 1; r <= DEGREE; ++r) {
+        ALGRAY_UNROLL
+        for (int k = 0; k <= DEGREE - r; ++k) t[k] = CASTELJAU_COMBINE((REAL)0.5, t[k], (REAL)0.5, t[k + 1]);
+        left[r] = t[0];
+        right[DEGREE - r] = t[DEGREE - r];
+      }
+      ALGRAY_UNROLL
+      for (int k = 0; k <= DEGREE; ++k) {
+        cur[k] = LANE_SEL(cur[k], left[k], halve);
+        sib[k] = LANE_SEL(sib[k], right[k], halve);
+      }
+      level = LANE_SEL(level, level + 1, halve);
+      idx = LANE_SEL(idx, idx * 2, halve);
+      width = LANE_SEL(width, width * (REAL)0.5, halve);
+      sib_level = LANE_SEL(sib_level, level, halve);
+      sib_idx = LANE_SEL(sib_idx, idx + 1, halve);
+    }
+    /* next_interval for the lanes moving on: climb while a right child, then step right */
+    LMASK move = !done && !halve;
+    if (!LANE_ANY(move)) continue;
+    for (;;) {
+      const LMASK climb = move && idx != 2 * floor(idx * (REAL)0.5);
+      if (!LANE_ANY(climb)) break;
+      idx = LANE_SEL(idx, floor(idx * (REAL)0.5), climb);
+      level = LANE_SEL(level, level - 1, climb);
+      width = LANE_SEL(width, width * 2, climb);
+    }
+    /* isolation_at_far_end: the whole interval searched; its far end is a root only where P is zero there */
+    const LMASK finished = move && level == 0;
+    status = LANE_SEL(status, LANE_SEL((LREAL)ISOLATION_NONE, (LREAL)ISOLATION_EXACT, root[DEGREE] == 0), finished);
+    lo = LANE_SEL(lo, (LREAL)1, finished);
+    hi = LANE_SEL(hi, (LREAL)1, finished);
+    f_lo = LANE_SEL(f_lo, (LREAL)0, finished);
+    f_hi = LANE_SEL(f_hi, (LREAL)0, finished);
+    done = done || finished;
+    move = move && !finished;
+    idx = LANE_SEL(idx, idx + 1, move);
+    const LMASK from_sib = move && sib_level == level && sib_idx == idx;
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) cur[k] = LANE_SEL(cur[k], sib[k], from_sib);
+    const LMASK from_root = move && !from_sib;
+    if (LANE_ANY(from_root)) bernstein_restrict_lanes(root, width, idx, from_root, cur);
+  }
+  for (uint j = 0; j < count; ++j) {
+    if (!lane_get_mask(running, j)) continue;
+    iso[j].status = (int)lane_get(status, j);
+    iso[j].budget = lane_get_mask(budget, j) != 0;
+    iso[j].cluster = lane_get_mask(cluster, j) != 0;
+    iso[j].steps = (uint)lane_get(steps, j);
+    iso[j].lo = lane_get(lo, j);
+    iso[j].hi = lane_get(hi, j);
+    iso[j].f_lo = lane_get(f_lo, j);
+    iso[j].f_hi = lane_get(f_hi, j);
+    for (int k = 0; k <= DEGREE; ++k) cur_out[j][k] = lane_get(cur[k], j);
+  }
+}
+#endif
 
 /* Whether isolate_bernstein would find a root at all, read off the signs of the scaled coefficients c (as the
  * restriction leaves them, before bernstein_from_scaled) where they settle it without subdividing:

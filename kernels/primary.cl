@@ -34,8 +34,8 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
                                        mono_exps, mono_coefs, mono_count, binomials, even_axes SCREEN_ARG);
   out[(size_t)gy * tile_w + gx] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
 #else
-  /* LANES pixels of a row per work-item: each is clipped and isolated on its own, then all are refined, and
-   * their normals taken, together in vector lanes (lanes.h). Global size (ceil(tile_w / LANES), tile_h); the pixels are the same as above. */
+  /* LANES pixels of a row per work-item: each is clipped and restricted on its own, then all are isolated,
+   * refined, and their normals taken, together in vector lanes (lanes.h). Global size (ceil(tile_w / LANES), tile_h); the pixels are the same as above. */
   const uint gx = get_global_id(0), gy = get_global_id(1);
   const uint x0 = gx * LANES;
   if (x0 >= tile_w || gy >= tile_h) return;
@@ -46,17 +46,21 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
   SegmentRoot roots[LANES];
   REAL t_in[LANES], t_out[LANES], iso_c[LANES][NCOEF];
   int in_extent[LANES];
+  REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
   for (uint j = 0; j < count; ++j) {
     const uint px = tile_x0 + x0 + j;
     rays[j] = camera_ray(px, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
+    in_extent[j] = enter_surface(rays[j], extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
+                                 &hits[j], &t_in[j], &t_out[j]);
+    if (!in_extent[j]) continue;
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
     REAL taylor[NCOEF];
     const REAL taylor_t = screen_ray_taylor(px, py, SCREEN_ROWS_ARG, taylor);
 #endif
-    in_extent[j] = isolate_surface(rays[j], extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                   mono_exps, mono_coefs, mono_count, binomials, even_axes, &hits[j], &iso[j],
-                                   &t_in[j], &t_out[j], iso_c[j] SCREEN_ARG);
+    segment_coefficients(hits[j].u, hits[j].d_unit, t_in[j], t_out[j], mono_exps, mono_coefs, mono_count,
+                         binomials, even_axes, root[j], root_lo[j] SCREEN_ARG);
   }
+  isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, iso, iso_c);
   refine_lanes(count, in_extent, iso, iso_c, t_in, t_out, binomials, roots);
   for (uint j = 0; j < count; ++j)
     if (in_extent[j]) finish_surface(&hits[j], roots[j]);

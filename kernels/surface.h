@@ -166,29 +166,27 @@ void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, Ax
   *fz = axis_factor(pa.z, l1.z, even_axes & 4);
 }
 
-/* Isolates the smallest root on [t_in, t_out] from the coefficients restrict_to_ray made of segment_factors'
- * factors (root, root_lo are consumed); iso_c gets the polynomial on the isolating interval. */
-Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
-                             REAL* iso_c PROBE_PARAM) {
+#endif
+
+/* The restriction's result (scaled Bernstein coefficients, or a power basis) as the isolation method takes it. */
+void restricted_to_isolation_basis(REAL* root, REAL* root_lo, __constant const REAL* binomials PROBE_PARAM) {
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   bernstein_from_scaled(root, root_lo, binomials);
   probe_coefficients(root, root_lo, ALGRAY_BASIS_BERNSTEIN PROBE_ARG);
-  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
+#elif RAY_ORIGIN == ALGRAY_ORIGIN_EYE
+  (void)binomials;
+  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_EYE PROBE_ARG);
 #else
   (void)binomials;
   probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_SEGMENT PROBE_ARG);
-  return isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c PROBE_ARG);
 #endif
 }
-#endif
 
-/* Isolates the smallest root of P*(t) on [t_in, t_out] for the ray o + t*d in unit coordinates; iso_c gets
- * the polynomial on the isolating interval. The primary and shadow kernels share this: one refines what it
- * returns, the other only asks whether there is anything to refine. */
-Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
-                             __global const REAL* coefs, uint count, __constant const REAL* binomials,
-                             uint even_axes, REAL* iso_c SCREEN_PARAM PROBE_PARAM) {
-  REAL root[NCOEF], root_lo[NCOEF];
+/* P*(t) on [t_in, t_out] for the ray o + t*d in unit coordinates, in the isolation method's basis: Bernstein
+ * coefficients on the segment, or the power basis of the segment (of the whole ray, for RAY_ORIGIN=eye). */
+void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
+                          __global const REAL* coefs, uint count, __constant const REAL* binomials, uint even_axes,
+                          REAL* root, REAL* root_lo SCREEN_PARAM PROBE_PARAM) {
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
   /* The same coefficients the extent construction computes from the monomials, from D + 1 numbers instead. */
   (void)o;
@@ -198,50 +196,110 @@ Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global c
   (void)count;
   (void)even_axes;
   restrict_from_taylor(taylor, t_in - taylor_t, t_out - taylor_t, binomials, root);
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  bernstein_from_scaled(root, root_lo, binomials);
-  probe_coefficients(root, root_lo, ALGRAY_BASIS_BERNSTEIN PROBE_ARG);
-  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
-#else
-  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_SEGMENT PROBE_ARG);
-  return isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c PROBE_ARG);
-#endif
 #elif RAY_ORIGIN == ALGRAY_ORIGIN_EYE
   /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
+  (void)t_in;
+  (void)t_out;
   restrict_to_ray(exps, coefs, count, binomials, axis_factor(o.x, d.x, even_axes & 1),
                   axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root, root_lo);
-  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_EYE PROBE_ARG);
-  return isolate_power_basis(root, t_in, t_out - t_in, t_in, t_out, iso_c PROBE_ARG);
 #else
   AxisFactor fx, fy, fz;
   segment_factors(o, d, t_in, t_out, even_axes, &fx, &fy, &fz);
   restrict_to_ray(exps, coefs, count, binomials, fx, fy, fz, root, root_lo);
-  return isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c PROBE_ARG);
+#endif
+  restricted_to_isolation_basis(root, root_lo, binomials PROBE_ARG);
+}
+
+/* The smallest root of segment_coefficients' polynomial (root, root_lo are consumed); iso_c gets the polynomial
+ * on the isolating interval. */
+Isolation isolate_coefficients(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c PROBE_PARAM) {
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
+#elif RAY_ORIGIN == ALGRAY_ORIGIN_EYE
+  (void)root_lo;
+  return isolate_power_basis(root, t_in, t_out - t_in, t_in, t_out, iso_c PROBE_ARG);
+#else
+  (void)root_lo;
+  return isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c PROBE_ARG);
 #endif
 }
 
-/* The part of trace_surface before the refinement: the ray in unit coordinates, clipped to the extent, and the
- * isolation of P*(t)'s smallest root on the segment (iso_c: the polynomial on the isolating interval). Returns
- * 0 when the ray misses the extent; *h is then the whole answer. */
-int isolate_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, __global const uint* exps,
-                    __global const REAL* coefs, uint count, __constant const REAL* binomials, uint even_axes,
-                    SurfaceHit* h, Isolation* iso, REAL* t_in, REAL* t_out, REAL* iso_c SCREEN_PARAM PROBE_PARAM) {
+/* Isolates the smallest root of P*(t) on [t_in, t_out] for the ray o + t*d in unit coordinates; iso_c gets
+ * the polynomial on the isolating interval. The primary and shadow kernels share this: one refines what it
+ * returns, the other only asks whether there is anything to refine. */
+Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
+                             __global const REAL* coefs, uint count, __constant const REAL* binomials,
+                             uint even_axes, REAL* iso_c SCREEN_PARAM PROBE_PARAM) {
+  REAL root[NCOEF], root_lo[NCOEF];
+  segment_coefficients(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, root, root_lo SCREEN_ARG PROBE_ARG);
+  return isolate_coefficients(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
+}
+
+#if RAY_ORIGIN == ALGRAY_ORIGIN_EXTENT
+/* Isolates the smallest root on [t_in, t_out] from the coefficients restrict_to_rays made of segment_factors'
+ * factors (root, root_lo are consumed), as isolate_on_segment would; iso_c gets the polynomial on the isolating
+ * interval. */
+Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
+                             REAL* iso_c PROBE_PARAM) {
+  restricted_to_isolation_basis(root, root_lo, binomials PROBE_ARG);
+  return isolate_coefficients(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
+}
+#endif
+
+/* The start of trace_surface: the ray in unit coordinates (h->u, h->d_unit), clipped to the extent. Returns 0
+ * when the ray misses the extent; *h is then the whole answer. */
+int enter_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, SurfaceHit* h,
+                  REAL* t_in, REAL* t_out PROBE_PARAM) {
   h->root.t = INFINITY;
   h->root.f_before = 0;
   h->root.flags = 0;
   h->root.steps = 0;
   h->root.iterations = 0;
   /* Unit coordinates keep every point of the extent within |u| <= 1: the conditioning step that makes float usable. */
-  const REAL3 o = (ray.o - centre) * inv_scale;
-  const REAL3 d = ray.d * inv_scale;
-  h->d_unit = d;
-  h->u = o;
-  if (!clip_to_extent(o, d, extent_kind, box_half, t_in, t_out)) return 0;
+  h->u = (ray.o - centre) * inv_scale;
+  h->d_unit = ray.d * inv_scale;
+  if (!clip_to_extent(h->u, h->d_unit, extent_kind, box_half, t_in, t_out)) return 0;
   PROBE(ALGRAY_EVENT_SEGMENT, 0, 0u, 0u, *t_in, *t_out, (REAL)0, (REAL)0);
   h->root.flags = ALGRAY_HIT_IN_EXTENT;
-  *iso = isolate_on_segment(o, d, *t_in, *t_out, exps, coefs, count, binomials, even_axes, iso_c SCREEN_ARG PROBE_ARG);
   return 1;
 }
+
+/* The part of trace_surface before the refinement: enter_surface, then the isolation of P*(t)'s smallest root
+ * on the segment (iso_c: the polynomial on the isolating interval). Returns 0 when the ray misses the extent. */
+int isolate_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, __global const uint* exps,
+                    __global const REAL* coefs, uint count, __constant const REAL* binomials, uint even_axes,
+                    SurfaceHit* h, Isolation* iso, REAL* t_in, REAL* t_out, REAL* iso_c SCREEN_PARAM PROBE_PARAM) {
+  if (!enter_surface(ray, centre, inv_scale, box_half, extent_kind, h, t_in, t_out PROBE_ARG)) return 0;
+  *iso = isolate_on_segment(h->u, h->d_unit, *t_in, *t_out, exps, coefs, count, binomials, even_axes,
+                            iso_c SCREEN_ARG PROBE_ARG);
+  return 1;
+}
+
+#if LANES > 1
+/* The isolations of LANES rays from their segment_coefficients (root, root_lo are consumed): together in lanes
+ * (isolate_bernstein_lanes), or one lane at a time in mixed precision. Lanes from `count` on, and those whose
+ * ray missed the extent (in_extent[j] == 0), are left alone. */
+void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (*root_lo)[NCOEF], const REAL* t_in,
+                   const REAL* t_out, Isolation* iso, REAL (*iso_c)[NCOEF]) {
+#if ALGRAY_COMPENSATED
+  for (uint j = 0; j < count; ++j)
+    if (in_extent[j]) iso[j] = isolate_coefficients(root[j], root_lo[j], t_in[j], t_out[j], iso_c[j]);
+#else
+  (void)root_lo;
+  LREAL c[NCOEF], lane_t_in = 0, lane_t_out = 1;
+  for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
+  LMASK running = 0;
+  for (uint j = 0; j < count; ++j) {
+    if (!in_extent[j]) continue;
+    lane_set_mask(&running, j, 1);
+    for (int k = 0; k <= DEGREE; ++k) lane_set(&c[k], j, root[j][k]);
+    lane_set(&lane_t_in, j, t_in[j]);
+    lane_set(&lane_t_out, j, t_out[j]);
+  }
+  if (LANE_ANY(running)) isolate_bernstein_lanes(count, running, c, lane_t_in, lane_t_out, iso, iso_c);
+#endif
+}
+#endif
 
 /* The hit of a ray that entered the extent, from its refined root. */
 void finish_surface(SurfaceHit* h, SegmentRoot root) {
