@@ -263,10 +263,10 @@ void bernstein_restrict_lanes(const LREAL* root, LREAL width, LREAL idx, LMASK t
   for (int k = 0; k <= DEGREE; ++k) out[k] = LANE_SEL(out[k], o[k], take);
 }
 
-/* root: each lane's Bernstein coefficients on [t_in, t_out]. On return iso[j] is lane j's Isolation and
- * cur[j] its coefficients on the isolating interval, for every running lane j < count. */
+/* root: each lane's Bernstein coefficients on [t_in, t_out]. On return iso[j] is lane j's Isolation for every
+ * running lane j < count, and cur_out holds each lane's coefficients on its isolating interval. */
 void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL t_in, LREAL t_out,
-                             Isolation* iso, REAL (*cur_out)[NCOEF]) {
+                             Isolation* iso, LREAL* cur_out) {
   LREAL cur[NCOEF], sib[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) cur[k] = sib[k] = root[k];
@@ -363,8 +363,9 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     iso[j].hi = lane_get(hi, j);
     iso[j].f_lo = lane_get(f_lo, j);
     iso[j].f_hi = lane_get(f_hi, j);
-    for (int k = 0; k <= DEGREE; ++k) cur_out[j][k] = lane_get(cur[k], j);
   }
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) cur_out[k] = cur[k];
 }
 #endif
 
@@ -391,8 +392,8 @@ int bernstein_root_by_signs(const REAL* c) {
   return -1;
 }
 
-/* Turns Bernstein coefficients into the form isolated_value() expects: c_k * C(n,k). */
-void prepare_isolated(REAL* c, __constant const REAL* binomials) {
+/* Turns Bernstein coefficients into the form isolated_value() expects: c_k * C(n,k); over lanes, each lane's. */
+void prepare_isolated(LREAL* c, __constant const REAL* binomials) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) c[k] *= row[k];

@@ -44,7 +44,8 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
   SurfaceHit hits[LANES];
   Isolation iso[LANES];
   SegmentRoot roots[LANES];
-  REAL t_in[LANES], t_out[LANES], iso_c[LANES][NCOEF];
+  REAL t_in[LANES], t_out[LANES];
+  LREAL iso_c[NCOEF];
   int in_extent[LANES];
   REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
   for (uint j = 0; j < count; ++j) {

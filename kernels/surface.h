@@ -65,17 +65,14 @@ void probe_coefficients(const REAL* c, const REAL* c_lo, uint basis PROBE_PARAM)
 #define probe_coefficients(c, c_lo, basis) ((void)0)
 #endif
 
-/* What the refinement of an isolated root needs: its stopping width and the coefficients' size. */
+/* What the refinement of an isolated root needs besides the coefficients: its stopping width. */
 typedef struct {
   int refine; /* 0: nothing to refine (no root, or the root is the interval's left end) */
   REAL tol_y;
-  REAL scale;
 } RefineSetup;
 
-/* The record of what the isolation found, before refinement; iso_c holds the polynomial on the isolating
- * interval, and is prepared for isolated_value() when setup->refine is set. */
-SegmentRoot isolated_root(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out, __constant const REAL* binomials,
-                          RefineSetup* setup PROBE_PARAM) {
+/* The record of what the isolation found, before refinement. */
+SegmentRoot isolated_root(Isolation iso, REAL t_in, REAL t_out, RefineSetup* setup PROBE_PARAM) {
   SegmentRoot r;
   r.t = INFINITY;
   r.f_before = 0;
@@ -84,7 +81,6 @@ SegmentRoot isolated_root(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out, __c
   r.iterations = 0;
   setup->refine = 0;
   setup->tol_y = 0;
-  setup->scale = 0;
   PROBE(ALGRAY_EVENT_ISOLATED, iso.budget, (uint)iso.status, 0u, iso.lo, iso.hi, iso.f_lo, iso.f_hi);
   if (iso.status == ISOLATION_NONE) return r;
   if (iso.status == ISOLATION_EXACT) r.flags |= ALGRAY_HIT_EXACT;
@@ -94,10 +90,15 @@ SegmentRoot isolated_root(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out, __c
     const REAL width_t = (iso.hi - iso.lo) * len;
     setup->refine = 1;
     setup->tol_y = stop_width(t_in + iso.lo * len) / width_t;
-    for (int k = 0; k <= DEGREE; ++k) setup->scale = fmax(setup->scale, fabs(iso_c[k]));
-    prepare_isolated(iso_c, binomials);
   }
   return r;
+}
+
+/* The size of the isolating interval's coefficients, for the refinement's value stop; over lanes, each lane's. */
+LREAL coefficient_scale(const LREAL* c) {
+  LREAL scale = 0;
+  for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(c[k]));
+  return scale;
 }
 
 /* The root at y of the isolating interval (0 when the isolation settled it at the interval's left end). */
@@ -108,39 +109,46 @@ void place_root(SegmentRoot* r, Isolation iso, REAL y, REAL t_in, REAL t_out) {
 }
 
 #if LANES == 1
-/* Refines what the isolation found; iso_c holds the polynomial on the isolating interval. */
+/* Refines what the isolation found; iso_c holds the polynomial on the isolating interval (consumed). */
 SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
                             __constant const REAL* binomials PROBE_PARAM) {
   RefineSetup setup;
-  SegmentRoot r = isolated_root(iso, iso_c, t_in, t_out, binomials, &setup PROBE_ARG);
+  SegmentRoot r = isolated_root(iso, t_in, t_out, &setup PROBE_ARG);
   if (iso.status == ISOLATION_NONE) return r;
-  const REAL y =
-      setup.refine ? refine_root(iso_c, iso.f_lo, iso.f_hi, setup.tol_y, setup.scale, &r.iterations PROBE_ARG) : 0;
+  REAL y = 0;
+  if (setup.refine) {
+    const REAL scale = coefficient_scale(iso_c);
+    prepare_isolated(iso_c, binomials);
+    y = refine_root(iso_c, iso.f_lo, iso.f_hi, setup.tol_y, scale, &r.iterations PROBE_ARG);
+  }
   place_root(&r, iso, y, t_in, t_out);
   return r;
 }
 #else
-/* The roots of LANES rays' isolations, refined together in lanes (lanes.h). Lanes from `count` on, and those
- * whose ray missed the extent (in_extent[j] == 0), are left alone. */
-void refine_lanes(uint count, const int* in_extent, const Isolation* iso, REAL (*iso_c)[NCOEF], const REAL* t_in,
+/* The roots of LANES rays' isolations, refined together in lanes (lanes.h); c holds each lane's polynomial on its
+ * isolating interval (consumed). Lanes from `count` on, and those whose ray missed the extent (in_extent[j] ==
+ * 0), are left alone. */
+void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL* c, const REAL* t_in,
                   const REAL* t_out, __constant const REAL* binomials, SegmentRoot* roots) {
-  LREAL c[NCOEF], f0 = 0, f1 = 0, tol_y = 0, scale = 0;
-  for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
+  LREAL f0 = 0, f1 = 0, tol_y = 0;
   LMASK running = 0;
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j]) continue;
     RefineSetup setup;
-    roots[j] = isolated_root(iso[j], iso_c[j], t_in[j], t_out[j], binomials, &setup);
+    roots[j] = isolated_root(iso[j], t_in[j], t_out[j], &setup);
     if (!setup.refine) continue;
     lane_set_mask(&running, j, 1);
-    for (int k = 0; k <= DEGREE; ++k) lane_set(&c[k], j, iso_c[j][k]);
     lane_set(&f0, j, iso[j].f_lo);
     lane_set(&f1, j, iso[j].f_hi);
     lane_set(&tol_y, j, setup.tol_y);
-    lane_set(&scale, j, setup.scale);
   }
-  LMASK iterations;
-  const LREAL y = refine_root_lanes(c, f0, f1, tol_y, scale, running, &iterations);
+  LREAL y = 0;
+  LMASK iterations = 0;
+  if (LANE_ANY(running)) {
+    const LREAL scale = coefficient_scale(c);
+    prepare_isolated(c, binomials);
+    y = refine_root_lanes(c, f0, f1, tol_y, scale, running, &iterations);
+  }
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j] || iso[j].status == ISOLATION_NONE) continue;
     const int refined = lane_get_mask(running, j) != 0;
@@ -277,26 +285,32 @@ int isolate_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int e
 
 #if LANES > 1
 /* The isolations of LANES rays from their segment_coefficients (root, root_lo are consumed): together in lanes
- * (isolate_bernstein_lanes), or one lane at a time in mixed precision. Lanes from `count` on, and those whose
- * ray missed the extent (in_extent[j] == 0), are left alone. */
+ * (isolate_bernstein_lanes), or one lane at a time in mixed precision. c gets each lane's polynomial on its
+ * isolating interval, for refine_lanes. Lanes from `count` on, and those whose ray missed the extent
+ * (in_extent[j] == 0), are left alone. */
 void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (*root_lo)[NCOEF], const REAL* t_in,
-                   const REAL* t_out, Isolation* iso, REAL (*iso_c)[NCOEF]) {
+                   const REAL* t_out, Isolation* iso, LREAL* c) {
+  for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
 #if ALGRAY_COMPENSATED
-  for (uint j = 0; j < count; ++j)
-    if (in_extent[j]) iso[j] = isolate_coefficients(root[j], root_lo[j], t_in[j], t_out[j], iso_c[j]);
+  for (uint j = 0; j < count; ++j) {
+    if (!in_extent[j]) continue;
+    REAL iso_c[NCOEF];
+    iso[j] = isolate_coefficients(root[j], root_lo[j], t_in[j], t_out[j], iso_c);
+    for (int k = 0; k <= DEGREE; ++k) lane_set(&c[k], j, iso_c[k]);
+  }
 #else
   (void)root_lo;
-  LREAL c[NCOEF], lane_t_in = 0, lane_t_out = 1;
-  for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
+  LREAL lane_root[NCOEF], lane_t_in = 0, lane_t_out = 1;
+  for (int k = 0; k <= DEGREE; ++k) lane_root[k] = 0;
   LMASK running = 0;
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j]) continue;
     lane_set_mask(&running, j, 1);
-    for (int k = 0; k <= DEGREE; ++k) lane_set(&c[k], j, root[j][k]);
+    for (int k = 0; k <= DEGREE; ++k) lane_set(&lane_root[k], j, root[j][k]);
     lane_set(&lane_t_in, j, t_in[j]);
     lane_set(&lane_t_out, j, t_out[j]);
   }
-  if (LANE_ANY(running)) isolate_bernstein_lanes(count, running, c, lane_t_in, lane_t_out, iso, iso_c);
+  if (LANE_ANY(running)) isolate_bernstein_lanes(count, running, lane_root, lane_t_in, lane_t_out, iso, c);
 #endif
 }
 #endif
