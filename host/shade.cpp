@@ -67,56 +67,139 @@ Shader::Shader(const Scene& scene, const RenderPlan& plan, const RayBasis& basis
   }
 }
 
-// Colour of one traced ray that hit the surface: the side's own colour (times 1 - transparency, the rest
-// coming from the transmission pass), lit by every light's points that the shadow pass left visible.
-glm::dvec3 Shader::shade_hit(const HitRecord& h, int surface, const PixelRay& ray, const ShadowLookup& shadows,
-                             std::size_t hit_index) const {
-  const Materials& sides = scene_.surfaces[static_cast<std::size_t>(surface)].materials;
-  const Material& m = (h.flags & ALGRAY_HIT_BACK) ? sides.back : sides.front;
-  const glm::dvec3 n(h.normal_x, h.normal_y, h.normal_z);
-  const glm::dvec3 to_eye = -glm::normalize(ray.direction);
-  // Without a transmission pass (preview, max_depth = 0) nothing is seen through: the side shows opaque.
-  const double own = transmits_ ? 1 - m.transparency : 1.0;
+const Material& Shader::material_of(const HitToShade& h) const {
+  const Materials& sides = scene_.surfaces[static_cast<std::size_t>(h.surface)].materials;
+  return (h.hit->flags & ALGRAY_HIT_BACK) ? sides.back : sides.front;
+}
+
+void Shader::shade_hits(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows,
+                        glm::dvec3* out) const {
   if (lights_.empty()) {
-    const double facing = std::fabs(glm::dot(n, to_eye));
-    return own * m.colour * (kPreviewAmbient + (1 - kPreviewAmbient) * facing);
+    // The headlight: no lights, nothing to hide, the colour by how squarely the surface faces the eye.
+    for (std::size_t i = 0; i < count; ++i) {
+      const Material& m = material_of(hits[i]);
+      const HitRecord& h = *hits[i].hit;
+      const glm::dvec3 n(h.normal_x, h.normal_y, h.normal_z);
+      const glm::dvec3 to_eye = -glm::normalize(hits[i].ray.direction);
+      const double own = transmits_ ? 1 - m.transparency : 1.0;
+      const double facing = std::fabs(glm::dot(n, to_eye));
+      out[i] = own * m.colour * (kPreviewAmbient + (1 - kPreviewAmbient) * facing);
+    }
+    return;
   }
-  const glm::dvec3 point = hit_point(ray, h);
-  const double highlight_cutoff =
-      highlight_cutoff_[static_cast<std::size_t>(2 * surface + ((h.flags & ALGRAY_HIT_BACK) ? 1 : 0))];
-  glm::dvec3 c = m.ambient * m.colour;
+  for (std::size_t first = 0; first < count; first += kShadeLanes)
+    shade_lanes(hits + first, std::min(kShadeLanes, count - first), shadows, out + first);
+}
+
+// Phong per light point, kShadeLanes hits at a time in arrays: the loops over lanes have no branches, so the
+// compiler runs them in SIMD registers and one hit's square roots and divisions no longer wait on the last
+// one's (they were most of a preview's shading time). Each lane does the scalar formula's operations in its
+// order (glm's normalize is v * (1 / sqrt(v.v)), its dot ((x + y) + z)); with no contraction into fused
+// multiply-adds (-ffp-contract=off) the colours are the scalar code's bit for bit, whatever the vector width.
+void Shader::shade_lanes(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows,
+                         glm::dvec3* out) const {
+  constexpr std::size_t W = kShadeLanes;
+  using Lanes = double[W];
+  Lanes nx, ny, nz, ex, ey, ez, px, py, pz, cr, cg, cb, own, amb, kd, ks, cutoff, mr, mg, mb;
+  const Material* material[W];
+  for (std::size_t j = 0; j < W; ++j) {
+    // Lanes past `count` repeat the first hit, so that every lane computes on ordinary numbers.
+    const HitToShade& q = hits[j < count ? j : 0];
+    const HitRecord& h = *q.hit;
+    const Material& m = material_of(q);
+    material[j] = &m;
+    nx[j] = h.normal_x;
+    ny[j] = h.normal_y;
+    nz[j] = h.normal_z;
+    const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
+    const glm::dvec3& o = q.ray.origin;
+    const glm::dvec3& d = q.ray.direction;
+    ex[j] = d.x;
+    ey[j] = d.y;
+    ez[j] = d.z;
+    px[j] = o.x + t * d.x;
+    py[j] = o.y + t * d.y;
+    pz[j] = o.z + t * d.z;
+    own[j] = transmits_ ? 1 - m.transparency : 1.0;
+    amb[j] = m.ambient;
+    kd[j] = m.diffuse;
+    ks[j] = m.specular;
+    mr[j] = m.colour.r;
+    mg[j] = m.colour.g;
+    mb[j] = m.colour.b;
+    cutoff[j] = highlight_cutoff_[static_cast<std::size_t>(2 * q.surface + ((h.flags & ALGRAY_HIT_BACK) ? 1 : 0))];
+  }
+  for (std::size_t j = 0; j < W; ++j) {
+    const double inv = 1.0 / std::sqrt(ex[j] * ex[j] + ey[j] * ey[j] + ez[j] * ez[j]);
+    ex[j] = -(ex[j] * inv);
+    ey[j] = -(ey[j] * inv);
+    ez[j] = -(ez[j] * inv);
+    cr[j] = amb[j] * mr[j];
+    cg[j] = amb[j] * mg[j];
+    cb[j] = amb[j] * mb[j];
+  }
   for (std::size_t li = 0; li < lights_.size(); ++li) {
     const LightSamples& ls = lights_[li];
-    const std::uint64_t hidden = shadows.hidden(li, hit_index);
-    double diffuse = 0, specular = 0;
+    std::uint64_t hidden[W];
+    for (std::size_t j = 0; j < W; ++j) hidden[j] = j < count ? shadows.hidden(li, hits[j].hit_index) : 0;
+    Lanes diffuse = {}, specular = {}, r_dot_v;
+    bool highlight[W];
     for (std::size_t s = 0; s < ls.points.size(); ++s) {
-      if (hidden >> s & 1u) continue;
-      const glm::dvec3 l = glm::normalize(ls.points[s] - point);
-      const double n_dot_l = glm::dot(n, l);
-      if (n_dot_l <= 0) continue;  // behind the tangent plane: the surface hides it from itself
-      diffuse += n_dot_l;
-      const double r_dot_v = glm::dot(2 * n_dot_l * n - l, to_eye);
-      if (r_dot_v > highlight_cutoff) specular += std::pow(r_dot_v, m.exponent);
+      const glm::dvec3 at = ls.points[s];
+      // The square roots and divisions first, in a loop of arithmetic alone (which vectorises), then the tests.
+      Lanes lx, ly, lz, n_dot_l;
+      for (std::size_t j = 0; j < W; ++j) {
+        lx[j] = at.x - px[j];
+        ly[j] = at.y - py[j];
+        lz[j] = at.z - pz[j];
+        const double inv = 1.0 / std::sqrt(lx[j] * lx[j] + ly[j] * ly[j] + lz[j] * lz[j]);
+        lx[j] *= inv;
+        ly[j] *= inv;
+        lz[j] *= inv;
+        n_dot_l[j] = nx[j] * lx[j] + ny[j] * ly[j] + nz[j] * lz[j];
+        const double twice = 2 * n_dot_l[j];
+        r_dot_v[j] =
+            (twice * nx[j] - lx[j]) * ex[j] + (twice * ny[j] - ly[j]) * ey[j] + (twice * nz[j] - lz[j]) * ez[j];
+      }
+      bool any_highlight = false;
+      for (std::size_t j = 0; j < W; ++j) {
+        // Not hidden by the shadow pass, and in front of the tangent plane (the surface hides it from itself).
+        const bool lit = !(hidden[j] >> s & 1u) && !(n_dot_l[j] <= 0);
+        if (lit) diffuse[j] += n_dot_l[j];
+        highlight[j] = lit && r_dot_v[j] > cutoff[j];
+        any_highlight |= highlight[j];
+      }
+      // pow() only where a highlight can show; below the cutoff it is under 1/4096 of full strength.
+      if (any_highlight)
+        for (std::size_t j = 0; j < count; ++j)
+          if (highlight[j]) specular[j] += std::pow(r_dot_v[j], material[j]->exponent);
     }
     const double share = 1.0 / static_cast<double>(ls.points.size());
-    c += ls.light->intensity * ls.light->colour *
-         (m.diffuse * diffuse * share * m.colour + m.specular * specular * share);
+    const glm::dvec3 light = ls.light->intensity * ls.light->colour;
+    for (std::size_t j = 0; j < W; ++j) {
+      const double d = kd[j] * diffuse[j] * share, sp = ks[j] * specular[j] * share;
+      cr[j] += light.r * (d * mr[j] + sp);
+      cg[j] += light.g * (d * mg[j] + sp);
+      cb[j] += light.b * (d * mb[j] + sp);
+    }
   }
-  return own * c;
+  for (std::size_t j = 0; j < count; ++j) out[j] = glm::dvec3(own[j] * cr[j], own[j] * cg[j], own[j] * cb[j]);
 }
 
 void Shader::add_batch(const SecondaryBatch& batch, std::vector<glm::dvec3>& colour, std::vector<double>& alpha) const {
   const ShadowLookup shadows(batch.shadows, batch.hits.size(), scene_.lights.size());
   const glm::dvec3 background(scene_.image.background);
   // Shaded in parallel, then added in ray order: a sample's sum must not depend on the threads.
-  std::vector<glm::dvec3> seen(batch.hits.size());
+  std::vector<glm::dvec3> seen(batch.hits.size(), background);
   parallel_ranges(batch.hits.size(), 2048, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const HitRecord& h = batch.hits[i];
-      seen[i] = (h.flags & ALGRAY_HIT_FOUND)
-                    ? shade_hit(h, batch.hit_surface.empty() ? 0 : batch.hit_surface[i], batch.rays[i], shadows, i)
-                    : background;
-    }
+    std::vector<HitToShade> found;
+    std::vector<glm::dvec3> shaded;
+    for (std::size_t i = begin; i < end; ++i)
+      if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
+        found.push_back({&batch.hits[i], batch.hit_surface.empty() ? 0 : batch.hit_surface[i], batch.rays[i], i});
+    shaded.resize(found.size());
+    shade_hits(found.data(), found.size(), shadows, shaded.data());
+    for (std::size_t f = 0; f < found.size(); ++f) seen[found[f].hit_index] = shaded[f];
   });
   const bool camera_rays = batch.pass == "antialias";
   for (std::size_t i = 0; i < batch.hits.size(); ++i) {
@@ -134,7 +217,23 @@ void Shader::resolve(const TracedBlock& block, FrameImage& film) const {
   const int pixels_x = block.width / samples, pixels_y = block.height / samples;
   // Rows are independent; shading a 1024x768 frame on one core costs as much as a fifth of the kernel.
   parallel_ranges(static_cast<std::size_t>(pixels_y), 8, [&](std::size_t row_begin, std::size_t row_end) {
+    // A row of pixels' traced rays (samples rows of them) are shaded together first, then summed per pixel.
+    std::vector<HitToShade> found;
+    std::vector<glm::dvec3> shaded;
+    std::vector<std::uint32_t> shaded_at(static_cast<std::size_t>(block.width) * samples);
     for (int y = static_cast<int>(row_begin); y < static_cast<int>(row_end); ++y) {
+      found.clear();
+      for (int sy = 0; sy < samples; ++sy)
+        for (int bx = 0; bx < block.width; ++bx) {
+          const int by = y * samples + sy;
+          const std::size_t k = static_cast<std::size_t>(by) * block.width + bx;
+          if (!(block.hits[k].flags & ALGRAY_HIT_FOUND)) continue;
+          shaded_at[static_cast<std::size_t>(sy) * block.width + bx] = static_cast<std::uint32_t>(found.size());
+          found.push_back({&block.hits[k], block.surface ? block.surface[k] : 0,
+                           pixel_ray(basis_, single_, block.x0 + bx, block.y0 + by), k});
+        }
+      shaded.resize(found.size());
+      shade_hits(found.data(), found.size(), *block.shadows, shaded.data());
       for (int x = 0; x < pixels_x; ++x) {
         const std::size_t i = static_cast<std::size_t>(py0 + y) * film.width + px0 + x;
         float depth = std::numeric_limits<float>::infinity();
@@ -149,8 +248,7 @@ void Shader::resolve(const TracedBlock& block, FrameImage& film) const {
               sum += scene_.image.background;
               continue;
             }
-            const PixelRay ray = pixel_ray(basis_, single_, block.x0 + bx, block.y0 + by);
-            glm::dvec3 colour = shade_hit(h, block.surface ? block.surface[k] : 0, ray, *block.shadows, k);
+            glm::dvec3 colour = shaded[shaded_at[static_cast<std::size_t>(sy) * block.width + bx]];
             if (block.secondary) colour += block.secondary[k];
             sum += glm::dvec4(colour, 1);
             if (h.depth < depth) {

@@ -1,6 +1,7 @@
 // Turning hit records into colours: Phong lighting with the shadow pass's answers, or a headlight without lights.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -14,6 +15,9 @@ namespace algray {
 // Without lights, the share of the colour that does not depend on the angle, so surfaces seen edge-on stay
 // visible.
 inline constexpr double kPreviewAmbient = 0.2;
+
+// Hits shaded side by side (Shader::shade_lanes): 8 doubles are two AVX-512, four AVX or eight SSE2 registers.
+inline constexpr std::size_t kShadeLanes = 8;
 
 // A batch's shadow answers, looked up by the index of a hit in its batch.
 class ShadowLookup {
@@ -53,14 +57,26 @@ class Shader {
   // Adaptive antialiasing: the colour of output pixel `pixel` becomes what its n x n rays (and their bounces)
   // saw; depth and normal stay the first ray's.
   void resolve_refined(std::size_t pixel, const glm::dvec3& colour, double alpha, FrameImage& film) const;
+  // One ray that hit a surface, to be shaded: its record, which surface, the ray, and its index in the batch
+  // of hits that `shadows` answers for.
+  struct HitToShade {
+    const HitRecord* hit;
+    int surface;
+    PixelRay ray;
+    std::size_t hit_index;
+  };
+  // Colour of each of `count` hits: the side's own colour (times 1 - transparency, the rest coming from the
+  // transmission pass), lit by every light's points that the shadow pass left visible.
+  void shade_hits(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const;
 
  private:
   struct LightSamples {
     const Light* light;
     std::vector<glm::dvec3> points;
   };
-  glm::dvec3 shade_hit(const HitRecord& h, int surface, const PixelRay& ray, const ShadowLookup& shadows,
-                       std::size_t hit_index) const;
+  // At most kShadeLanes of them, side by side (count >= 1).
+  void shade_lanes(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const;
+  const Material& material_of(const HitToShade& h) const;
 
   const Scene& scene_;
   RayBasis basis_;
