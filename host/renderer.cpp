@@ -2,6 +2,8 @@
 // film, before the next tile; adaptive antialiasing then refines tile by tile from the film's first colours.
 #include "renderer.h"
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,9 +11,9 @@
 #include <future>
 #include <limits>
 #include <memory>
+#include <new>
 #include <utility>
 
-#include "large_pages.h"
 #include "ray_tracer.h"
 #include "shade.h"
 #include "shadow_tracer.h"
@@ -130,6 +132,32 @@ std::vector<std::uint8_t> pixels_to_refine(const FrameImage& coarse, double thre
 }
 
 }  // namespace
+
+// Page-aligned anonymous memory with every page faulted in as it is made (MAP_POPULATE: one system call rather
+// than a fault per page, which the kernel's threads would otherwise take on the render's path). 4 KB pages on
+// purpose: transparent huge pages populate 4x faster back to back, but on a VM that hands free memory back to
+// its host (Firecracker here) a fresh process's 2 MB pages are often host-faulted, and a 1024^2 preview at a
+// user's pace took 242 ms against 167 (bench/RESULTS.md, "Huge pages tried").
+class PopulatedPages {
+ public:
+  explicit PopulatedPages(std::size_t bytes) : bytes_(std::max<std::size_t>(bytes, 1)) {
+    void* p = ::mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    data_ = p;
+  }
+  PopulatedPages(PopulatedPages&& other) noexcept
+      : data_(std::exchange(other.data_, nullptr)), bytes_(std::exchange(other.bytes_, 0)) {}
+  PopulatedPages& operator=(PopulatedPages&&) = delete;
+  PopulatedPages(const PopulatedPages&) = delete;
+  ~PopulatedPages() {
+    if (data_) ::munmap(data_, bytes_);
+  }
+  void* data() const { return data_; }
+
+ private:
+  void* data_ = nullptr;
+  std::size_t bytes_;
+};
 
 // Host memory for one tile's hit records, which the primary kernel writes through a CL_MEM_USE_HOST_PTR buffer.
 // On a CPU device the kernel writes this memory itself and mapping it copies nothing; on a GPU the map copies

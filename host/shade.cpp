@@ -9,8 +9,6 @@
 #include <thread>
 #include <vector>
 
-#include "large_pages.h"
-
 namespace algray {
 namespace {
 
@@ -288,10 +286,10 @@ FrameImage make_film(int width, int height, bool depth_and_normal) {
   film.width = width;
   film.height = height;
   const std::size_t n = static_cast<std::size_t>(film.width) * film.height;
-  assign_on_huge_pages(film.rgba, 4 * n, 0.0f);
+  film.rgba.assign(4 * n, 0.0f);
   if (depth_and_normal) {
-    assign_on_huge_pages(film.depth, n, std::numeric_limits<float>::infinity());
-    assign_on_huge_pages(film.normal, 3 * n, 0.0f);
+    film.depth.assign(n, std::numeric_limits<float>::infinity());
+    film.normal.assign(3 * n, 0.0f);
   }
   return film;
 }
