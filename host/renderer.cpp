@@ -137,7 +137,7 @@ std::vector<std::uint8_t> pixels_to_refine(const FrameImage& coarse, double thre
 // than a fault per page, which the kernel's threads would otherwise take on the render's path). 4 KB pages on
 // purpose: transparent huge pages populate 4x faster back to back, but on a VM that hands free memory back to
 // its host (Firecracker here) a fresh process's 2 MB pages are often host-faulted, and a 1024^2 preview at a
-// user's pace took 242 ms against 167 (bench/RESULTS.md, "Huge pages tried").
+// user's pace took 242 ms against 167 (bench/RESULTS.md, "Transparent huge pages: tried").
 class PopulatedPages {
  public:
   explicit PopulatedPages(std::size_t bytes) : bytes_(std::max<std::size_t>(bytes, 1)) {

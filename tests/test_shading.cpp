@@ -39,8 +39,7 @@ glm::dvec3 phong(const Scene& scene, const HitRecord& h, const PixelRay& ray, co
   const Material& m = (h.flags & ALGRAY_HIT_BACK) ? sides.back : sides.front;
   const glm::dvec3 n(h.normal_x, h.normal_y, h.normal_z);
   const glm::dvec3 to_eye = -glm::normalize(ray.direction);
-  const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
-  const glm::dvec3 point = ray.origin + t * ray.direction;
+  const glm::dvec3 point = hit_point(ray, h);
   const double cutoff = std::pow(1.0 / 4096, 1 / m.exponent);
   glm::dvec3 c = m.ambient * m.colour;
   for (std::size_t li = 0; li < scene.lights.size(); ++li) {
