@@ -66,7 +66,7 @@ def run_processes(binary, workdir, values, size, preview, env):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--binary", default=ROOT / "build/host/algray")
+    ap.add_argument("--binary", default=ROOT / "build/apps/algray/algray")
     ap.add_argument("--frames", type=int, default=100)
     ap.add_argument("--size", type=int, default=512)
     ap.add_argument("--chunks", type=int, default=10, help="batches the frames are split into, interleaved")

@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 scene=${1:-scenes/barth_sextic.toml}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-algray=build/host/algray
+algray=build/apps/algray/algray
 "$algray" render "$scene" -o "$work/ref.exr" --width 1024 --height 768 --precision double
 while IFS='|' read -r label args; do
   # shellcheck disable=SC2086

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "image_io.h"
+#include "algray/io/image_io.h"
 
 int main(int argc, char** argv) {
   if (argc != 3) {

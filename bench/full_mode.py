@@ -42,7 +42,7 @@ def hours(seconds):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--binary", default=ROOT / "build/host/algray")
+    ap.add_argument("--binary", default=ROOT / "build/apps/algray/algray")
     ap.add_argument("--runs", type=int, default=3, help="warm runs per scene (median reported)")
     ap.add_argument("--scenes", nargs="*", default=list(PAPER_SECONDS), help="scene names")
     ap.add_argument("--output", default=ROOT / "bench/RESULTS.md")

@@ -86,7 +86,7 @@ def find_java_home():
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--binary", default=ROOT / "build/host/algray")
+    ap.add_argument("--binary", default=ROOT / "build/apps/algray/algray")
     ap.add_argument("--size", type=int, default=256)
     ap.add_argument("--output", default=ROOT / "bench/RESULTS.md")
     args = ap.parse_args()

@@ -47,7 +47,7 @@ def compare(binaries, scene, args, repeat, workdir):
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--baseline", required=True, help="the algray binary to compare against")
-    ap.add_argument("--algray", default=str(ROOT / "build/host/algray"))
+    ap.add_argument("--algray", default=str(ROOT / "build/apps/algray/algray"))
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--side", type=int, default=512, help="random surfaces: side x side rays")
     ap.add_argument("--degrees", default="1-32", help="e.g. 1-32 or 2,6,10")

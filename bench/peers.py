@@ -432,7 +432,7 @@ def jsurf_equation(scene):
 
 
 def write_jsurf(scene, path):
-    """jsurf's frame (host/jsurf.cpp reads it the same way): the surface is evaluated at 10^scale_factor times the
+    """jsurf's frame (src/algray/scene/jsurf.cpp reads it the same way): the surface is evaluated at 10^scale_factor times the
     clip-space point, the clip sphere is the unit sphere there, and camera_transform takes clip space to camera
     space (the camera at its origin looking down -z, y up). Lights sit in camera space."""
     r, c = scene["radius"], scene["centre"]
@@ -473,7 +473,7 @@ def write_jsurf(scene, path):
     ]
     for side in ("front", "back"):
         m = scene["material"][side]
-        # Blinn's half-vector exponent near 4x Phong's gives about the same highlight (host/jsurf.cpp).
+        # Blinn's half-vector exponent near 4x Phong's gives about the same highlight (src/algray/scene/jsurf.cpp).
         lines += [f"{side}_material_color={colour(m['colour'])}",
                   f"{side}_material_ambient_intensity={num(m['ambient'])}",
                   f"{side}_material_diffuse_intensity={num(m['diffuse'])}",
@@ -668,7 +668,7 @@ def peer_versions(env):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--algray", type=Path, default=ROOT / "build/host/algray", help="the algray binary")
+    ap.add_argument("--algray", type=Path, default=ROOT / "build/apps/algray/algray", help="the algray binary")
     ap.add_argument("--scenes", type=Path, default=ROOT / "scenes", help="where the surfaces' .toml files are")
     ap.add_argument("--surfaces", nargs="+", default=SURFACES, help="scene names (default: the paper's seven); "
                     f"full mode runs those of them among {', '.join(FULL_SURFACES)}")

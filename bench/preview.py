@@ -30,7 +30,7 @@ def run(binary, scene, precision, env, width, height, workdir):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--binary", default=ROOT / "build/host/algray")
+    ap.add_argument("--binary", default=ROOT / "build/apps/algray/algray")
     ap.add_argument("--runs", type=int, default=5, help="warm runs per scene (median reported)")
     ap.add_argument("--width", type=int, default=1024)
     ap.add_argument("--height", type=int, default=768)

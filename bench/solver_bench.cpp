@@ -17,12 +17,12 @@
 #include <string>
 #include <vector>
 
-#include "image_io.h"
-#include "program_cache.h"
-#include "reference_render.h"
-#include "renderer.h"
-#include "scene.h"
-#include "shade.h"
+#include "algray/io/image_io.h"
+#include "algray/device/program_cache.h"
+#include "algray/render/reference_render.h"
+#include "algray/render/renderer.h"
+#include "algray/scene/scene.h"
+#include "algray/render/shade.h"
 
 using namespace algray;
 using json = nlohmann::json;

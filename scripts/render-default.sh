@@ -6,5 +6,5 @@ scripts/install-deps.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(nproc)"
 mkdir -p out
-./build/host/algray render -o out/barth_sextic.exr -o out/barth_sextic.png --stats out/barth_sextic.json
+./build/apps/algray/algray render -o out/barth_sextic.exr -o out/barth_sextic.png --stats out/barth_sextic.json
 echo "wrote out/barth_sextic.exr, out/barth_sextic.png and out/barth_sextic.json"

@@ -6,7 +6,7 @@
 #include <array>
 #include <vector>
 
-#include "polynomial.h"
+#include "algray/math/polynomial.h"
 
 namespace algray::ref {
 

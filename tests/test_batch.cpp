@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "cli_sandbox.h"
-#include "image_io.h"
+#include "algray/io/image_io.h"
 #include "scene_fixtures.h"
 
 using namespace algray::testing;

@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "cli_sandbox.h"
-#include "image_io.h"
+#include "algray/io/image_io.h"
 #include "scene_fixtures.h"
-#include "version.h"
+#include "algray/util/version.h"
 
 namespace fs = std::filesystem;
 

@@ -4,12 +4,12 @@
 #include <random>
 #include <set>
 
-#include "camera.h"
-#include "expression.h"
-#include "kernel_config.h"
-#include "kernel_sources.h"
-#include "renderer.h"
-#include "scene.h"
+#include "algray/scene/camera.h"
+#include "algray/scene/expression.h"
+#include "algray/device/kernel_config.h"
+#include "algray/device/kernel_sources.h"
+#include "algray/render/renderer.h"
+#include "algray/scene/scene.h"
 
 using namespace algray;
 

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "diagnostic_images.h"
+#include "algray/io/diagnostic_images.h"
 #include "temp_dir.h"
 
 namespace fs = std::filesystem;

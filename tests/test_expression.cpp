@@ -8,8 +8,8 @@
 #include <tuple>
 #include <vector>
 
-#include "expression.h"
-#include "polynomial.h"
+#include "algray/scene/expression.h"
+#include "algray/math/polynomial.h"
 
 using algray::EquationError;
 using algray::parse_equation;

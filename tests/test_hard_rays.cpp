@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "program_cache.h"
-#include "reference_render.h"
-#include "renderer.h"
-#include "scene.h"
-#include "solver_ref.h"
+#include "algray/device/program_cache.h"
+#include "algray/render/reference_render.h"
+#include "algray/render/renderer.h"
+#include "algray/scene/scene.h"
+#include "solver_ref/solver_ref.h"
 #include "test_support.h"
 
 using namespace algray;

@@ -1,11 +1,11 @@
 // Tests for EXR/PNG output: round trips, header and text metadata, sRGB encoding, atomic replacement, the kinds
 // of failure, and cleanup after signals and of stale temporaries.
-#include "image_io.h"
+#include "algray/io/image_io.h"
 #include "noisy_image.h"
-#include "png_deflate.h"
+#include "algray/io/png_deflate.h"
 #include "temp_dir.h"
 #include "test_seed.h"
-#include "version.h"
+#include "algray/util/version.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wconversion"

@@ -3,9 +3,9 @@
 #include <cmath>
 
 #include "cli_sandbox.h"
-#include "render_plan.h"
-#include "renderer.h"
-#include "scene.h"
+#include "algray/render/render_plan.h"
+#include "algray/render/renderer.h"
+#include "algray/scene/scene.h"
 #include "test_support.h"
 
 using namespace algray;

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "program_cache.h"
-#include "renderer.h"
-#include "scene.h"
+#include "algray/device/program_cache.h"
+#include "algray/render/renderer.h"
+#include "algray/scene/scene.h"
 #include "scene_fixtures.h"
 #include "test_support.h"
 

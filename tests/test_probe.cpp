@@ -6,11 +6,11 @@
 #include <sstream>
 
 #include "cli_sandbox.h"
-#include "image_io.h"
-#include "kernel_sources.h"
-#include "probe_report.h"
-#include "render_plan.h"
-#include "renderer.h"
+#include "algray/io/image_io.h"
+#include "algray/device/kernel_sources.h"
+#include "algray/api/probe_report.h"
+#include "algray/render/render_plan.h"
+#include "algray/render/renderer.h"
 #include "temp_dir.h"
 #include "test_support.h"
 

@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "program_cache.h"
-#include "reference_render.h"
+#include "algray/device/program_cache.h"
+#include "algray/render/reference_render.h"
 #include "scene_fixtures.h"
-#include "renderer.h"
-#include "scene.h"
+#include "algray/render/renderer.h"
+#include "algray/scene/scene.h"
 #include "test_support.h"
 #include "tolerances.h"
 

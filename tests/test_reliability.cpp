@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "batch.h"
+#include "algray/api/batch.h"
 #include "cli_sandbox.h"
-#include "expression.h"
-#include "image_io.h"
+#include "algray/scene/expression.h"
+#include "algray/io/image_io.h"
 #include "scene_fixtures.h"
 
 namespace fs = std::filesystem;

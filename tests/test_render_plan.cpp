@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "cli_sandbox.h"
-#include "image_io.h"
-#include "render_plan.h"
-#include "scene.h"
+#include "algray/io/image_io.h"
+#include "algray/render/render_plan.h"
+#include "algray/scene/scene.h"
 #include "scene_fixtures.h"
 
 using namespace algray::testing;

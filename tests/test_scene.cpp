@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "expression.h"
-#include "scene.h"
+#include "algray/scene/expression.h"
+#include "algray/scene/scene.h"
 #include "scene_fixtures.h"
 
 using algray::Override;

@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "program_cache.h"
-#include "renderer.h"
-#include "scene.h"
-#include "shade.h"
-#include "solver_aov.h"
+#include "algray/device/program_cache.h"
+#include "algray/render/renderer.h"
+#include "algray/scene/scene.h"
+#include "algray/render/shade.h"
+#include "algray/render/solver_aov.h"
 #include "test_support.h"
 
 using namespace algray;

@@ -5,10 +5,10 @@
 #include <string>
 #include <vector>
 
-#include "program_cache.h"
-#include "renderer.h"
-#include "scene.h"
-#include "shade.h"
+#include "algray/device/program_cache.h"
+#include "algray/render/renderer.h"
+#include "algray/scene/scene.h"
+#include "algray/render/shade.h"
 #include "test_support.h"
 
 using namespace algray;

@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "device_surface.h"
-#include "program_cache.h"
-#include "render_plan.h"
-#include "scene.h"
-#include "shadow_tracer.h"
+#include "algray/render/device_surface.h"
+#include "algray/device/program_cache.h"
+#include "algray/render/render_plan.h"
+#include "algray/scene/scene.h"
+#include "algray/render/shadow_tracer.h"
 #include "test_support.h"
 
 using namespace algray;

@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "polynomial.h"
-#include "solver_ref.h"
+#include "algray/math/polynomial.h"
+#include "solver_ref/solver_ref.h"
 
 using algray::Polynomial;
 using algray::ref::Answer;

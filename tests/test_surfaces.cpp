@@ -4,9 +4,9 @@
 #include <set>
 #include <string>
 
-#include "program_cache.h"
-#include "renderer.h"
-#include "scene.h"
+#include "algray/device/program_cache.h"
+#include "algray/render/renderer.h"
+#include "algray/scene/scene.h"
 #include "test_support.h"
 
 using namespace algray;

@@ -10,9 +10,9 @@
 #include <random>
 #include <vector>
 
-#include "algray_shared.h"
-#include "program_cache.h"
-#include "solver_ref.h"
+#include "kernels/algray_shared.h"
+#include "algray/device/program_cache.h"
+#include "solver_ref/solver_ref.h"
 #include "test_seed.h"
 #include "test_support.h"
 #include "tolerances.h"

@@ -6,7 +6,7 @@
 #include <string>
 #include <string_view>
 
-#include "scene.h"
+#include "algray/scene/scene.h"
 
 namespace algray::fuzz {
 

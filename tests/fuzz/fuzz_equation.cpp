@@ -10,9 +10,9 @@
 #include <string>
 #include <string_view>
 
-#include "expression.h"
+#include "algray/scene/expression.h"
 #include "fuzz_checks.h"
-#include "toml_reader.h"
+#include "algray/scene/toml_reader.h"
 
 using namespace algray;
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "batch.h"
+#include "algray/api/batch.h"
 #include "fuzz_checks.h"
 
 using namespace algray;

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "fuzz_checks.h"
-#include "scene.h"
+#include "algray/scene/scene.h"
 
 using namespace algray;
 

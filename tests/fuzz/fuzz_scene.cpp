@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "fuzz_checks.h"
-#include "scene.h"
+#include "algray/scene/scene.h"
 
 using namespace algray;
 

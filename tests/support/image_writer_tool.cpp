@@ -19,7 +19,7 @@
 #include <random>
 #include <string>
 
-#include "image_io.h"
+#include "algray/io/image_io.h"
 #include "noisy_image.h"
 
 int main(int argc, char** argv) {

@@ -3,7 +3,7 @@
 
 #include <random>
 
-#include "image_io.h"
+#include "algray/io/image_io.h"
 
 namespace algray::testing {
 

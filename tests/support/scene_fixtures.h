@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "kernel_config.h"
+#include "algray/device/kernel_config.h"
 
 namespace algray::testing {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "cl_runtime.h"
+#include "algray/device/cl_runtime.h"
 
 namespace algray::testing {
 

@@ -1,0 +1,283 @@
+// The algray command line: `algray render`, `algray probe`, `algray batch` and `algray devices`.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+
+#include "algray/api/batch.h"
+#include "algray/device/cl_runtime.h"
+#include "algray/io/image_io.h"
+#include "algray/api/probe_report.h"
+#include "algray/api/render_job.h"
+#include "algray/util/version.h"
+
+namespace {
+
+using namespace algray;
+
+// The options every scene-taking command shares: the scene, its overrides and the device.
+struct SceneOptions {
+  std::string scene_path;
+  std::vector<std::string> sets;
+  int width = 0, height = 0;
+  std::string precision, isolation, refinement, tolerance, max_iterations;
+  std::string device_spec;
+  bool no_cache = false, preview = false;
+};
+
+// Batch takes a jobs file where the others take a scene, and no scene positional.
+void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = true) {
+  if (scene_positional)
+    cmd->add_option("scene", o.scene_path,
+                    "scene file (.toml or .jsurf), or - for standard input; default: the built-in Barth sextic");
+  cmd->add_option("--width", o.width, "image width in pixels (overrides image.width)");
+  cmd->add_option("--height", o.height, "image height in pixels (overrides image.height)");
+  cmd->add_option("--device", o.device_spec, "device index or name substring (see `algray devices`)");
+  cmd->add_option("--precision", o.precision, "float, double or mixed (overrides render.precision)");
+  cmd->add_option("--isolation", o.isolation,
+                  "root isolation: bernstein, descartes, sturm or derivative-chain (overrides render.isolation)");
+  cmd->add_option("--refine", o.refinement,
+                  "root refinement: brent, bisection, regula-falsi, illinois or newton (overrides render.refinement)");
+  cmd->add_option("--tolerance", o.tolerance, "the stopping tolerance eps (overrides render.tolerance)");
+  cmd->add_option("--max-iterations", o.max_iterations,
+                  "the refinement's iteration cap (overrides render.max_iterations)");
+  cmd->add_option("--set", o.sets, "override a scene key: name=value (a bare name is a parameter)");
+  cmd->add_flag("--preview", o.preview,
+                "the paper's preview mode: primary rays only (no shadows); sets render.preview");
+  cmd->add_flag("--no-cache", o.no_cache, "compile kernels from source; neither read nor write the program cache");
+}
+
+// --set first, then the flags, which are overrides like any --set applied last so that they win. Returns false
+// (after saying why) on a malformed --set.
+bool collect_overrides(const CLI::App* cmd, const SceneOptions& o, std::vector<Override>& out) {
+  for (const std::string& s : o.sets) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      std::cerr << "algray: --set " << s << ": expected name=value\n";
+      return false;
+    }
+    out.push_back({s.substr(0, eq), s.substr(eq + 1)});
+  }
+  if (cmd->count("--width")) out.push_back({"image.width", std::to_string(o.width)});
+  if (cmd->count("--height")) out.push_back({"image.height", std::to_string(o.height)});
+  if (!o.precision.empty()) out.push_back({"render.precision", "\"" + o.precision + "\""});
+  if (!o.isolation.empty()) out.push_back({"render.isolation", "\"" + o.isolation + "\""});
+  if (!o.refinement.empty()) out.push_back({"render.refinement", "\"" + o.refinement + "\""});
+  // Numbers pass through as written, so that the scene's own checks report them.
+  if (!o.tolerance.empty()) out.push_back({"render.tolerance", o.tolerance});
+  if (!o.max_iterations.empty()) out.push_back({"render.max_iterations", o.max_iterations});
+  if (o.preview) out.push_back({"render.preview", "true"});
+  return true;
+}
+
+// "a,b,c" into exactly n finite numbers.
+bool parse_numbers(const std::string& text, std::size_t n, std::vector<double>& out) {
+  out.clear();
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = text.find(',', start);
+    const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    try {
+      std::size_t used = 0;
+      out.push_back(std::stod(part, &used));
+      if (used != part.size() || !std::isfinite(out.back())) return false;
+    } catch (const std::exception&) {
+      return false;
+    }
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out.size() == n;
+}
+
+// Ends the process after a render: its outputs are written, synced and renamed by now. Without the destructors
+// of statics and the exit handlers of the OpenCL driver (PoCL's and LLVM's: about 4 ms of a 1024^2 preview),
+// which free only what the process's exit frees anyway. LeakSanitizer checks at exit, so there it exits.
+[[noreturn]] void end_process(int code) {
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
+#if defined(__SANITIZE_ADDRESS__)
+  std::exit(code);
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(leak_sanitizer)
+  std::exit(code);
+#endif
+#endif
+  std::_Exit(code);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  install_output_cleanup_handlers();
+
+  CLI::App app{"algray: ray tracing of real algebraic surfaces P(x,y,z) = 0 on any OpenCL device"};
+  app.set_version_flag("--version", version_string(), "print the version and the git revision, and exit");
+  app.require_subcommand(1);
+
+  RenderRequest request;
+  SceneOptions render_opts;
+  std::string stats_path;
+  CLI::App* render = app.add_subcommand("render", "render a scene (default: the built-in Barth sextic)");
+  add_scene_options(render, render_opts);
+  render->add_option("-o,--output", request.outputs, "output image; .exr or .png by extension; may be repeated")
+      ->default_str("algray.exr");
+  render->add_option("--stats", stats_path, "write render statistics as JSON");
+  render->add_flag(
+      "--reference", request.reference,
+      "solve every pixel exactly on the CPU (solver_ref, all cores, slow); adds a reference.class channel");
+
+  std::string aov_text;
+  render->add_option("--aov", aov_text,
+                     "solver channels for EXR outputs, comma-separated: iterations, isolation, classification, flags");
+  render->add_option("--heatmap", request.heatmap_path,
+                     "write a heat map of solver work per pixel (isolation steps + refinement iterations), .png");
+
+  ProbeRequest probe_request;
+  SceneOptions probe_opts;
+  std::string pixel_text, ray_text;
+  CLI::App* probe = app.add_subcommand(
+      "probe", "trace one ray through the render's own solver code and show every step beside solver_ref's answer");
+  add_scene_options(probe, probe_opts);
+  auto* pixel_opt = probe->add_option("--pixel", pixel_text,
+                                      "X,Y: the pixel's centre ray, as a render without antialiasing traces it");
+  auto* ray_opt = probe->add_option("--ray", ray_text, "ox,oy,oz,dx,dy,dz: a ray o + t d in world coordinates");
+  pixel_opt->excludes(ray_opt);
+  probe->add_flag("--all-solvers", probe_request.all_solvers,
+                  "every isolation x refinement side by side, the scene's own first");
+  probe->add_option("--plot", probe_request.plot_path,
+                    "draw P*(t) on [t_in, t_out] with the isolating interval, the root and solver_ref's roots "
+                    "(.svg or .png)");
+  std::string plot_range_text;
+  probe->add_option("--plot-range", plot_range_text,
+                    "what --plot shows: segment (default), isolating (the isolating interval), or T0,T1");
+  probe->add_flag("--json", probe_request.json, "print the report as JSON (for scripts) instead of text");
+  probe->add_option("--stats", probe_request.stats_path, "write the report as JSON to this file too");
+
+  BatchRequest batch_request;
+  SceneOptions batch_opts;
+  CLI::App* batch = app.add_subcommand(
+      "batch", "render a TOML list of jobs (sweeps, orbits) in one process with one device and program cache");
+  batch->add_option("jobs", batch_request.jobs_path, "jobs file (.toml), or - for standard input")->required();
+  add_scene_options(batch, batch_opts, false);
+  batch->add_flag("--resume", batch_request.resume, "skip frames whose outputs all exist already");
+  batch->add_option("--log", batch_request.log_path,
+                    "JSON-lines log, one line per frame (default: beside the jobs file, <name>.log.jsonl)");
+  batch->add_option("--stats", batch_request.stats_path, "write a summary of the batch as JSON");
+
+  CLI::App* devices = app.add_subcommand("devices", "list OpenCL platforms and devices");
+  std::string devices_stats;
+  devices->add_option("--stats", devices_stats, "write the list as JSON too");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitBadInput;
+  }
+
+  if (devices->parsed()) {
+    const auto list = enumerate_devices();
+    if (list.empty()) {
+      std::cerr << "algray: no OpenCL device found (on Debian: apt-get install pocl-opencl-icd)\n";
+      return kExitFailure;
+    }
+    std::cout << describe_devices(list);
+    if (!devices_stats.empty()) {
+      nlohmann::json j = {{"version", version_string()}, {"devices", nlohmann::json::array()}};
+      for (const DeviceInfo& d : list)
+        j["devices"].push_back({{"index", d.index},
+                     {"platform", d.platform_name},
+                     {"platform_version", d.platform_version},
+                     {"name", d.name},
+                     {"vendor", d.vendor},
+                     {"version", d.version},
+                     {"driver", d.driver_version},
+                     {"type", d.type},
+                     {"compute_units", d.compute_units},
+                     {"fp64", d.fp64},
+                     {"global_mem_bytes", d.global_mem_bytes},
+                     {"max_alloc_bytes", d.max_alloc_bytes}});
+      try {
+        check_output_writable(devices_stats);
+        write_text_file(devices_stats, j.dump(2) + "\n");
+      } catch (const std::exception& e) {
+        return report_error(e, std::cerr);
+      }
+    }
+    return kExitOk;
+  }
+
+  if (batch->parsed()) {
+    if (!collect_overrides(batch, batch_opts, batch_request.overrides)) return kExitBadInput;
+    batch_request.device_spec = batch_opts.device_spec;
+    batch_request.use_cache = !batch_opts.no_cache;
+    batch_request.progress = ::isatty(STDERR_FILENO) != 0;
+    return run_batch(batch_request, std::cerr);
+  }
+
+  if (probe->parsed()) {
+    ProbeRequest& req = probe_request;
+    if (!probe_opts.scene_path.empty()) req.scene_path = probe_opts.scene_path;
+    if (!collect_overrides(probe, probe_opts, req.overrides)) return kExitBadInput;
+    req.device_spec = probe_opts.device_spec;
+    req.use_cache = !probe_opts.no_cache;
+    std::vector<double> v;
+    if (!pixel_text.empty()) {
+      if (!parse_numbers(pixel_text, 2, v) || std::fabs(v[0]) > 1e9 || std::fabs(v[1]) > 1e9 ||
+          v[0] != std::floor(v[0]) || v[1] != std::floor(v[1])) {
+        std::cerr << "algray: --pixel " << pixel_text << ": expected two integers X,Y\n";
+        return kExitBadInput;
+      }
+      req.target.px = static_cast<int>(v[0]);
+      req.target.py = static_cast<int>(v[1]);
+    } else if (!ray_text.empty()) {
+      if (!parse_numbers(ray_text, 6, v)) {
+        std::cerr << "algray: --ray " << ray_text << ": expected six numbers ox,oy,oz,dx,dy,dz\n";
+        return kExitBadInput;
+      }
+      req.target.given_ray = true;
+      req.target.origin = {v[0], v[1], v[2]};
+      req.target.direction = {v[3], v[4], v[5]};
+    } else {
+      std::cerr << "algray: probe needs --pixel X,Y or --ray ox,oy,oz,dx,dy,dz\n";
+      return kExitBadInput;
+    }
+    if (!plot_range_text.empty() && !req.plot_path) {
+      std::cerr << "algray: --plot-range goes with --plot\n";
+      return kExitBadInput;
+    }
+    if (plot_range_text == "isolating") {
+      req.plot_range.kind = PlotRange::Kind::Isolating;
+    } else if (!plot_range_text.empty() && plot_range_text != "segment") {
+      // The width must be finite too: the plot divides by it.
+      if (!parse_numbers(plot_range_text, 2, v) || !(v[0] < v[1]) || !std::isfinite(v[1] - v[0])) {
+        std::cerr << "algray: --plot-range " << plot_range_text
+                  << ": expected segment, isolating, or two increasing numbers T0,T1\n";
+        return kExitBadInput;
+      }
+      req.plot_range = {PlotRange::Kind::Given, v[0], v[1]};
+    }
+    return run_probe(req, std::cout, std::cerr);
+  }
+
+  if (!render_opts.scene_path.empty()) request.scene_path = render_opts.scene_path;
+  if (request.outputs.empty()) request.outputs.push_back("algray.exr");
+  if (!collect_overrides(render, render_opts, request.overrides)) return kExitBadInput;
+  request.device_spec = render_opts.device_spec;
+  if (!aov_text.empty()) {
+    std::string error;
+    if (!parse_aov_list(aov_text, request.aovs, error)) {
+      std::cerr << "algray: --aov " << aov_text << ": " << error << "\n";
+      return kExitBadInput;
+    }
+  }
+  request.use_cache = !render_opts.no_cache;
+  if (!stats_path.empty()) request.stats_path = stats_path;
+  request.progress = ::isatty(STDERR_FILENO) != 0;
+  end_process(run_render(request, std::cerr));
+}

@@ -1,0 +1,521 @@
+// The batch command: jobs file, frames, resume, progress, JSON-lines log; renders share one device and cache.
+#include "algray/api/batch.h"
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <system_error>
+
+#include "algray/io/image_io.h"
+#include "algray/api/render_job.h"
+#include "algray/scene/toml_reader.h"
+#include "algray/util/version.h"
+
+namespace algray {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::set<std::string> kBatchTopKeys{"defaults", "job"};
+const std::set<std::string> kJobKeys{"name", "scene", "set", "output", "stats", "frames", "sweep", "orbit"};
+// What every job may share; frames, sweeps and orbits belong to one job.
+const std::set<std::string> kDefaultsKeys{"scene", "set", "output", "stats"};
+const std::set<std::string> kSweepKeys{"from", "to", "steps"};
+const std::set<std::string> kOrbitKeys{"frames", "degrees", "axis", "lights"};
+
+// A TOML value as the text of an override's value, which apply_override reads back as TOML.
+std::string toml_text(const TomlReader& r, const toml::node& n) {
+  if (auto i = n.value_exact<std::int64_t>()) return std::to_string(*i);
+  if (auto d = n.value_exact<double>()) return toml_number(*d);
+  if (auto b = n.value_exact<bool>()) return *b ? "true" : "false";
+  if (auto s = n.value_exact<std::string>()) return toml_quoted(*s);
+  if (const toml::array* a = n.as_array()) {
+    std::string out = "[";
+    for (std::size_t k = 0; k < a->size(); ++k) out += (k ? ", " : "") + toml_text(r, *a->get(k));
+    return out + "]";
+  }
+  r.fail(n.source(), "a set value must be a number, string, boolean or array");
+}
+
+// set = { mu = 1, image = { width = 512 }, "light.0.intensity" = 0.5 }: nested tables become dotted keys.
+// "jobs.toml:7:9": where a node of the jobs file is, for the messages of what it causes later.
+std::string origin_of(const TomlReader& r, const toml::node& n) {
+  return r.source() + ":" + std::to_string(n.source().begin.line) + ":" + std::to_string(n.source().begin.column);
+}
+
+void collect_sets(const TomlReader& r, const toml::table& t, const std::string& prefix, std::vector<Override>& out) {
+  for (auto&& [key, node] : t) {
+    const std::string k = prefix + std::string(key.str());
+    if (const toml::table* sub = node.as_table())
+      collect_sets(r, *sub, k + ".", out);
+    else
+      out.push_back({k, toml_text(r, node), origin_of(r, node)});
+  }
+}
+
+std::vector<std::string> string_or_list(const TomlReader& r, const toml::node& n, const std::string& what) {
+  if (n.is_string()) return {r.string(n, what)};
+  const toml::array* a = n.as_array();
+  if (!a || a->empty()) r.fail(n.source(), what + " must be a string or a non-empty array of strings");
+  std::vector<std::string> out;
+  for (const toml::node& e : *a) out.push_back(r.string(e, what));
+  return out;
+}
+
+std::string resolve(const std::string& base_dir, const std::string& path) {
+  if (path.empty() || path == "-" || fs::path(path).is_absolute() || base_dir.empty()) return path;
+  return (fs::path(base_dir) / path).lexically_normal().string();
+}
+
+// Reads one [[job]] on top of [defaults].
+BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::table& t, std::size_t index,
+                  const std::string& base_dir) {
+  r.check_keys(t, "job", kJobKeys);
+  const auto get = [&](const char* key) -> const toml::node* {
+    if (const toml::node* n = t.get(key)) return n;
+    return defaults ? defaults->get(key) : nullptr;
+  };
+  BatchJob job;
+  job.line = static_cast<int>(t.source().begin.line);
+  const toml::node* scene = get("scene");
+  if (!scene) r.fail(t.source(), "job " + std::to_string(index) + " needs a scene (a .toml or .jsurf path)");
+  job.scene = r.string(*scene, "job.scene");
+  if (job.scene == "-") r.fail(scene->source(), "a batch job cannot read its scene from standard input");
+  job.scene = resolve(base_dir, job.scene);
+  job.name = get("name") ? r.string(*get("name"), "job.name")
+                         : fs::path(job.scene).stem().string() + "_" + std::to_string(index);
+  if (defaults)
+    if (const toml::node* n = defaults->get("set")) {
+      if (!n->is_table()) r.fail(n->source(), "set must be a table of scene keys and values");
+      collect_sets(r, *n->as_table(), "", job.overrides);
+    }
+  if (const toml::node* n = t.get("set")) {
+    if (!n->is_table()) r.fail(n->source(), "set must be a table of scene keys and values");
+    collect_sets(r, *n->as_table(), "", job.overrides);
+  }
+  const toml::node* output = get("output");
+  if (!output) r.fail(t.source(), "job '" + job.name + "' needs an output (a file name pattern, or a list of them)");
+  for (const std::string& o : string_or_list(r, *output, "job.output")) job.outputs.push_back(resolve(base_dir, o));
+  if (const toml::node* n = get("stats")) job.stats = resolve(base_dir, r.string(*n, "job.stats"));
+
+  std::optional<int> frames;
+  const toml::node* frames_node = t.get("frames");
+  if (frames_node) frames = static_cast<int>(r.integer(*frames_node, "job.frames", 1, 1000000));
+  const auto agree = [&](int n, const toml::node& where, const std::string& what) {
+    if (frames && *frames != n)
+      r.fail(where.source(), what + " gives " + std::to_string(n) + " frames but the job has " +
+                                 std::to_string(*frames) + " (all sweeps and the orbit step together)");
+    frames = n;
+  };
+  if (const toml::node* n = t.get("sweep")) {
+    const toml::table* sweeps = n->as_table();
+    if (!sweeps || sweeps->empty())
+      r.fail(n->source(), "sweep must be a table of keys, each { from = ..., to = ..., steps = ... }");
+    for (auto&& [key, node] : *sweeps) {
+      const std::string what = "sweep." + std::string(key.str());
+      const toml::table* s = node.as_table();
+      if (!s) r.fail(node.source(), what + " must be { from = ..., to = ..., steps = ... }");
+      r.check_keys(*s, what, kSweepKeys);
+      for (const char* k : {"from", "to", "steps"})
+        if (!s->get(k)) r.fail(node.source(), what + " needs '" + k + "'");
+      Sweep sweep;
+      sweep.key = std::string(key.str());
+      sweep.origin = origin_of(r, node);
+      sweep.from = r.number(*s->get("from"), what + ".from");
+      sweep.to = r.number(*s->get("to"), what + ".to");
+      agree(static_cast<int>(r.integer(*s->get("steps"), what + ".steps", 1, 1000000)), node, what);
+      job.sweeps.push_back(sweep);
+    }
+  }
+  if (const toml::node* n = t.get("orbit")) {
+    const toml::table* o = n->as_table();
+    if (!o) r.fail(n->source(), "orbit must be a table { frames, degrees, axis, lights }");
+    r.check_keys(*o, "orbit", kOrbitKeys);
+    Orbit orbit;
+    if (const toml::node* d = o->get("degrees")) orbit.degrees = r.number(*d, "orbit.degrees");
+    if (const toml::node* a = o->get("axis")) {
+      orbit.axis = r.vec3(*a, "orbit.axis");
+      if (!(glm::length(*orbit.axis) > 0)) r.fail(a->source(), "orbit.axis must not be zero");
+    }
+    if (const toml::node* l = o->get("lights")) {
+      const std::string mode = r.string(*l, "orbit.lights");
+      if (mode != "camera" && mode != "world") r.fail(l->source(), "orbit.lights must be \"camera\" or \"world\"");
+      orbit.lights_follow_camera = mode == "camera";
+    }
+    if (const toml::node* f = o->get("frames"))
+      agree(static_cast<int>(r.integer(*f, "orbit.frames", 1, 1000000)), *f, "orbit.frames");
+    else if (!frames)
+      r.fail(n->source(), "orbit needs frames (or a sweep's steps) to know how many views to render");
+    job.orbit = orbit;
+  }
+  job.frames = frames.value_or(1);
+  // Every frame must write its own files: a pattern without {frame}, {value} or {angle} would overwrite itself.
+  if (job.frames > 1)
+    for (const std::string& o : job.outputs)
+      if (o.find("{frame") == std::string::npos && o.find("{value}") == std::string::npos &&
+          o.find("{angle}") == std::string::npos)
+        r.fail(output->source(), "job '" + job.name + "' has " + std::to_string(job.frames) + " frames but output '" +
+                                     o + "' has no {frame} (or {value}, {angle}) to tell them apart");
+  // Patterns are checked now, so that a typo fails the whole batch before any rendering.
+  for (const std::string& o : job.outputs) {
+    try {
+      expand_pattern(o, job, 0);
+      format_from_extension(o);
+    } catch (const SceneError& e) {
+      r.fail(output->source(), e.message);
+    } catch (const OutputError& e) {
+      r.fail(output->source(), e.what());
+    }
+  }
+  if (job.stats) {
+    try {
+      expand_pattern(*job.stats, job, 0);
+    } catch (const SceneError& e) {
+      r.fail(get("stats")->source(), e.message);
+    }
+  }
+  job.output_origin = origin_of(r, *output);
+  return job;
+}
+
+// The shortest text that reads back as v: 0.3, not 0.29999999999999999; 180, not 1.8e+02.
+std::string shortest_text(double v) {
+  char buf[40];
+  const auto end = std::to_chars(buf, buf + sizeof buf, v).ptr;
+  return std::string(buf, end);
+}
+
+double sweep_value(const Sweep& s, int frame, int frames) {
+  if (frames == 1) return s.from;
+  const double t = static_cast<double>(frame) / (frames - 1);
+  // to - from overflows for ends near +-DBL_MAX; the weighted form stays between the ends.
+  const double span = s.to - s.from;
+  return std::isfinite(span) ? s.from + span * frame / (frames - 1) : s.from * (1 - t) + s.to * t;
+}
+
+double orbit_angle(const Orbit& o, int frame, int frames) { return o.degrees * frame / frames; }
+
+// v rotated by `radians` about the unit axis k (Rodrigues).
+glm::dvec3 rotated(const glm::dvec3& v, const glm::dvec3& k, double radians) {
+  const double c = std::cos(radians), s = std::sin(radians);
+  return v * c + glm::cross(k, v) * s + k * glm::dot(k, v) * (1 - c);
+}
+
+bool file_exists(const std::string& path) {
+  std::error_code ec;
+  return fs::is_regular_file(path, ec);
+}
+
+// The log gets one line per frame, flushed as written, so a crash loses at most the frame it was on. It is the
+// one file written in place, not through a temporary: it grows while the batch runs, and --resume appends.
+class JsonLinesLog {
+ public:
+  // Failing to write a line (a full disk) stops the batch: later frames would fail alike, and --resume needs
+  // to know what was done.
+  struct WriteFailed : std::runtime_error {
+    using std::runtime_error::runtime_error;
+  };
+
+  JsonLinesLog(const std::string& path, bool append)
+      : path_(path), out_(path, append ? std::ios::app : std::ios::trunc) {
+    if (!out_) throw OutputError("cannot write the batch log " + path);
+  }
+  void write(const nlohmann::json& j) {
+    errno = 0;
+    out_ << j.dump() << "\n";
+    out_.flush();
+    if (!out_)
+      throw WriteFailed("cannot write the batch log " + path_ + ": " +
+                        (errno ? std::error_code(errno, std::generic_category()).message() : "write failed"));
+  }
+
+ private:
+  std::string path_;
+  std::ofstream out_;
+};
+
+std::string seconds(double ms) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, ms < 10000 ? "%.2f s" : "%.0f s", ms / 1000);
+  return buf;
+}
+
+}  // namespace
+
+std::vector<BatchJob> load_jobs(const std::string& text, const std::string& source, const std::string& base_dir) {
+  TomlReader r(source, text);
+  check_toml_shape(text, source);
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    r.fail(e.source(), std::string(e.description()));
+  }
+  r.check_keys(root, "", kBatchTopKeys);
+  const toml::table* defaults = r.subtable(root, "defaults");
+  if (defaults) r.check_keys(*defaults, "defaults", kDefaultsKeys);
+  const toml::node* jobs = root.get("job");
+  if (!jobs) r.fail(root.source(), "no jobs: add [[job]] tables, each with a scene and an output");
+  const toml::array* list = jobs->as_array();
+  if (!list || !list->is_array_of_tables()) r.fail(jobs->source(), "'job' must be a list of [[job]] tables");
+  std::vector<BatchJob> out;
+  for (std::size_t i = 0; i < list->size(); ++i)
+    out.push_back(read_job(r, defaults, *list->get(i)->as_table(), i, base_dir));
+  // Two frames writing one file would leave only the last: a pattern whose {value} or {angle} repeats, or two
+  // jobs with the same pattern.
+  std::map<std::string, std::string> writer;  // file -> "job frame"
+  for (const BatchJob& job : out)
+    for (int frame = 0; frame < job.frames; ++frame) {
+      std::vector<std::string> files;
+      for (const std::string& o : job.outputs) files.push_back(expand_pattern(o, job, frame));
+      if (job.stats) files.push_back(expand_pattern(*job.stats, job, frame));
+      for (const std::string& f : files) {
+        const std::string who = "job " + job.name + " frame " + std::to_string(frame);
+        const auto [it, fresh] = writer.emplace(f, who);
+        if (!fresh)
+          throw SceneError(job.output_origin, who + " would write " + f + ", which " + it->second +
+                                                  " writes too: give each frame its own file name");
+      }
+    }
+  return out;
+}
+
+std::string expand_pattern(const std::string& pattern, const BatchJob& job, int frame) {
+  std::string out;
+  for (std::size_t i = 0; i < pattern.size(); ++i) {
+    if (pattern[i] != '{') {
+      out += pattern[i];
+      continue;
+    }
+    const std::size_t close = pattern.find('}', i);
+    if (close == std::string::npos) throw SceneError(job.name, "unclosed '{' in output pattern '" + pattern + "'");
+    const std::string field = pattern.substr(i + 1, close - i - 1);
+    char buf[64];
+    if (field == "name") {
+      out += job.name;
+    } else if (field == "frame") {
+      out += std::to_string(frame);
+    } else if (field.rfind("frame:0", 0) == 0 && field.size() > 7 && field.size() <= 9 &&
+               field.find_first_not_of("0123456789", 7) == std::string::npos) {
+      std::snprintf(buf, sizeof buf, "%0*d", std::stoi(field.substr(7)), frame);
+      out += buf;
+    } else if (field == "value" && !job.sweeps.empty()) {
+      out += shortest_text(sweep_value(job.sweeps.front(), frame, job.frames));
+    } else if (field == "angle" && job.orbit) {
+      out += shortest_text(orbit_angle(*job.orbit, frame, job.frames));
+    } else {
+      throw SceneError(job.name, "unknown placeholder {" + field + "} in output pattern '" + pattern +
+                                     "': use {name}, {frame}, {frame:03}" + (job.sweeps.empty() ? "" : ", {value}") +
+                                     (job.orbit ? ", {angle}" : ""));
+    }
+    i = close;
+  }
+  return out;
+}
+
+std::vector<Override> frame_overrides(const BatchJob& job, int frame) {
+  std::vector<Override> out = job.overrides;
+  for (const Sweep& s : job.sweeps) out.push_back({s.key, toml_number(sweep_value(s, frame, job.frames)), s.origin});
+  return out;
+}
+
+void apply_orbit(Scene& scene, const Orbit& orbit, int frame, int frames) {
+  CameraSpec& cam = scene.camera;
+  const glm::dvec3 axis = glm::normalize(orbit.axis.value_or(cam.up));
+  const double radians = orbit_angle(orbit, frame, frames) * 3.14159265358979323846 / 180;
+  const glm::dvec3 pivot = cam.look_at;
+  cam.eye = pivot + rotated(cam.eye - pivot, axis, radians);
+  cam.up = rotated(cam.up, axis, radians);
+  if (!orbit.lights_follow_camera) return;
+  for (Light& l : scene.lights) {
+    l.position = pivot + rotated(l.position - pivot, axis, radians);
+    l.edge_u = rotated(l.edge_u, axis, radians);
+    l.edge_v = rotated(l.edge_v, axis, radians);
+    l.normal = rotated(l.normal, axis, radians);
+  }
+}
+
+int run_batch(const BatchRequest& req, std::ostream& err) {
+  std::vector<BatchJob> jobs;
+  std::string log_path;
+  try {
+    std::string text, base_dir;
+    if (req.jobs_path == "-") {
+      text = read_input_stream(std::cin, "<stdin>", "jobs file");
+    } else {
+      text = read_input_file(req.jobs_path, "jobs file");
+      base_dir = fs::path(req.jobs_path).parent_path().string();
+    }
+    jobs = load_jobs(text, req.jobs_path == "-" ? "<stdin>" : req.jobs_path, base_dir);
+    log_path = req.log_path ? *req.log_path
+               : req.jobs_path == "-"
+                   ? std::string("batch.log.jsonl")
+                   : (fs::path(base_dir) / (fs::path(req.jobs_path).stem().string() + ".log.jsonl")).string();
+    check_output_writable(log_path);
+    if (req.stats_path) check_output_writable(*req.stats_path);
+    // No file the batch writes may be one it reads, or another it writes, by any name.
+    std::vector<RoleAndPath> inputs{{"jobs file", req.jobs_path}}, outputs{{"--log", log_path}};
+    if (req.stats_path) outputs.push_back({"--stats", *req.stats_path});
+    for (const BatchJob& job : jobs) {
+      inputs.push_back({"scene of job " + job.name, job.scene});
+      for (int frame = 0; frame < job.frames; ++frame) {
+        const std::string who = "job " + job.name + " frame " + std::to_string(frame);
+        for (const std::string& o : job.outputs) outputs.push_back({who + " output", expand_pattern(o, job, frame)});
+        if (job.stats) outputs.push_back({who + " stats", expand_pattern(*job.stats, job, frame)});
+      }
+    }
+    check_distinct_files(inputs, outputs);
+    // Every frame's paths are checked now, as render checks its own, so that a bad one is bad input (exit 2)
+    // before anything renders rather than a failure of each frame.
+    for (const RoleAndPath& o : outputs) check_output_writable(o.path);
+  } catch (const std::exception& e) {
+    return report_error(e, err);
+  }
+
+  int total = 0;
+  for (const BatchJob& j : jobs) total += j.frames;
+  std::optional<JsonLinesLog> opened;
+  try {
+    opened.emplace(log_path, req.resume);
+  } catch (const std::exception& e) {
+    return report_error(e, err);
+  }
+  JsonLinesLog& log = *opened;
+  RenderContext context(req.device_spec, req.use_cache);
+  const auto batch_start = std::chrono::steady_clock::now();
+  const auto ms_since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  };
+  int done = 0, ok = 0, failed = 0, skipped = 0;
+  nlohmann::json summary_jobs = nlohmann::json::array();
+  try {
+    for (const BatchJob& job : jobs) {
+      int job_ok = 0, job_failed = 0, job_skipped = 0;
+      std::vector<double> frame_ms;
+      bool warned = false;
+      for (int frame = 0; frame < job.frames; ++frame, ++done) {
+        const auto start = std::chrono::steady_clock::now();
+        nlohmann::json entry = {{"version", version_string()},
+                              {"job", job.name},
+                              {"frame", frame},
+                              {"frames", job.frames},
+                              {"scene", job.scene}};
+        std::vector<std::string> outputs;
+        try {
+          for (const std::string& o : job.outputs) outputs.push_back(expand_pattern(o, job, frame));
+          std::optional<std::string> stats;
+          if (job.stats) stats = expand_pattern(*job.stats, job, frame);
+          entry["outputs"] = outputs;
+          std::vector<Override> overrides = frame_overrides(job, frame);
+          overrides.insert(overrides.end(), req.overrides.begin(), req.overrides.end());
+          nlohmann::json set = nlohmann::json::object();
+          for (const Override& o : overrides) set[o.key] = o.value;
+          entry["set"] = set;
+          const bool complete =
+              std::all_of(outputs.begin(), outputs.end(), file_exists) && (!stats || file_exists(*stats));
+          if (req.resume && complete) {
+            entry["status"] = "skipped";
+            entry["reason"] = "--resume: every output exists";
+            log.write(entry);
+            ++skipped;
+            ++job_skipped;
+            continue;
+          }
+          Scene scene = load_scene_file(job.scene, overrides);
+          if (!warned) {
+            print_warnings(scene, err, "job " + job.name + ": ");
+            warned = true;
+          }
+          if (job.orbit) {
+            apply_orbit(scene, *job.orbit, frame, job.frames);
+            entry["camera"] = {{"eye", {scene.camera.eye.x, scene.camera.eye.y, scene.camera.eye.z}},
+                               {"up", {scene.camera.up.x, scene.camera.up.y, scene.camera.up.z}},
+                               {"angle", orbit_angle(*job.orbit, frame, job.frames)}};
+          }
+          RenderRequest render;
+          render.outputs = outputs;
+          render.stats_path = stats;
+          check_outputs(scene, render);
+          entry["stats"] = render_scene(scene, render, context, start);
+          entry["status"] = "ok";
+          ++ok;
+          ++job_ok;
+        } catch (const DeviceError& e) {
+          // No frame can run without the device: stop here rather than fail every remaining frame alike.
+          err << "algray: " << e.what() << "\n";
+          entry["status"] = "failed";
+          entry["error"] = e.what();
+          log.write(entry);
+          return kExitBadInput;
+        } catch (const std::exception& e) {
+          std::ostringstream message;
+          report_error(e, message);
+          err << "algray: job " << job.name << " frame " << frame << " failed:\n" << message.str();
+          entry["status"] = "failed";
+          entry["error"] = message.str();
+          ++failed;
+          ++job_failed;
+        }
+        const double ms = ms_since(start);
+        frame_ms.push_back(ms);
+        entry["ms"] = ms;
+        log.write(entry);
+        if (req.progress) {
+          const double elapsed = ms_since(batch_start);
+          const double eta = elapsed / (done + 1) * (total - done - 1);
+          std::fprintf(stderr, "\r[%*d/%d] %s frame %d/%d: %s %s | elapsed %s, eta %s   ",
+                       static_cast<int>(std::to_string(total).size()), done + 1, total, job.name.c_str(), frame + 1,
+                       job.frames, entry["status"].get<std::string>().c_str(), seconds(ms).c_str(),
+                       seconds(elapsed).c_str(), seconds(eta).c_str());
+          std::fflush(stderr);
+        }
+      }
+      nlohmann::json j = {
+          {"name", job.name}, {"frames", job.frames}, {"ok", job_ok}, {"failed", job_failed}, {"skipped", job_skipped}};
+      if (!frame_ms.empty()) {
+        std::vector<double> sorted = frame_ms;
+        std::sort(sorted.begin(), sorted.end());
+        j["median_frame_ms"] = sorted[sorted.size() / 2];
+        double sum = 0;
+        for (double v : frame_ms) sum += v;
+        j["total_ms"] = sum;
+      }
+      summary_jobs.push_back(j);
+    }
+  } catch (const JsonLinesLog::WriteFailed& e) {
+    if (req.progress) std::fprintf(stderr, "\n");
+    err << "algray: " << e.what() << "\nalgray: stopped after " << done << " of " << total << " frames (" << ok
+        << " rendered, " << failed << " failed); --resume continues where the images end\n";
+    return kExitFailure;
+  }
+  if (req.progress) std::fprintf(stderr, "\n");
+  const nlohmann::json summary = {{"version", version_string()},
+                                  {"jobs_file", req.jobs_path},
+                                  {"log", log_path},
+                                  {"frames", {{"total", total}, {"ok", ok}, {"failed", failed}, {"skipped", skipped}}},
+                                  {"jobs", summary_jobs},
+                                  {"total_ms", ms_since(batch_start)}};
+  if (req.stats_path) {
+    try {
+      write_text_file(*req.stats_path, summary.dump(2) + "\n");
+    } catch (const std::exception& e) {
+      // After the frames: a failure to write, not bad input.
+      err << "algray: the frames are done, but the batch stats were not written: " << e.what() << "\n";
+      return kExitFailure;
+    }
+  }
+  if (failed) err << "algray: " << failed << " of " << total << " frames failed (see " << log_path << ")\n";
+  return failed ? kExitFailure : kExitOk;
+}
+
+}  // namespace algray

@@ -1,0 +1,460 @@
+// The render command: validates everything before any work, renders, then writes images and stats atomically.
+#include "algray/api/render_job.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <future>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "algray/device/cl_runtime.h"
+#include "algray/io/diagnostic_images.h"
+#include "algray/scene/jsurf.h"
+#include "algray/device/program_cache.h"
+#include "algray/render/reference_render.h"
+#include "algray/render/renderer.h"
+#include "algray/render/shade.h"
+#include "algray/util/version.h"
+
+namespace algray {
+namespace {
+
+std::string join(const std::vector<std::string>& parts, const std::string& separator) {
+  std::string out;
+  for (const std::string& p : parts) out += (out.empty() ? "" : separator) + p;
+  return out;
+}
+
+std::string vec_text(const glm::dvec3& v) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "%.17g %.17g %.17g", v.x, v.y, v.z);
+  return buf;
+}
+
+// Metadata that lets anyone rebuild any pixel's ray from the file and the README's camera convention.
+void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, const DeviceInfo& device) {
+  const RayBasis& b = r.basis;
+  const CameraSpec& cam = scene.camera;
+  img.string_attributes = {
+      {"algray/scene", scene.source},
+      {"algray/name", scene.name},
+      {"algray/equation", scene.surface().equation},
+      {"algray/polynomial", scene.surface().polynomial.to_string()},
+      {"algray/isolation", to_string(r.config.isolation)},
+      {"algray/refinement", to_string(r.config.refinement)},
+      {"algray/rayOrigin", to_string(r.config.ray_origin)},
+      {"algray/precision", to_string(r.config.precision)},
+      {"algray/device", device.name + " (" + device.platform_name + ", " + device.driver_version + ")"},
+      {"algray/camera/projection", cam.projection == Projection::Perspective ? "perspective" : "orthographic"},
+      {"algray/camera/eye", vec_text(cam.eye)},
+      {"algray/camera/lookAt", vec_text(cam.look_at)},
+      {"algray/camera/up", vec_text(cam.up)},
+      {"algray/ray/o00", vec_text(b.o00)},
+      {"algray/ray/ou", vec_text(b.ou)},
+      {"algray/ray/ov", vec_text(b.ov)},
+      {"algray/ray/d00", vec_text(b.d00)},
+      {"algray/ray/du", vec_text(b.du)},
+      {"algray/ray/dv", vec_text(b.dv)},
+      {"algray/extent",
+       scene.extent.kind == ExtentKind::Sphere
+           ? "sphere centre " + vec_text(scene.extent.centre) + " radius " + std::to_string(scene.extent.radius)
+           : "box min " + vec_text(scene.extent.min) + " max " + vec_text(scene.extent.max)},
+  };
+  double kernel_ms = 0;
+  for (const PassStats& p : r.passes) kernel_ms += p.kernel_ms;
+  img.double_attributes = {
+      {"algray/degree", r.config.degree},
+      {"algray/tolerance", r.config.tolerance},
+      {"algray/maxIterations", r.config.max_iterations},
+      {"algray/kernelMs", kernel_ms},
+      {"algray/camera/fovY", cam.fov_y_degrees},
+      {"algray/camera/orthoHeight", cam.ortho_height},
+      // The ray basis above is per antialiasing sample: pixel (px, py) averages samples x samples rays.
+      {"algray/antialiasSamples", r.plan.samples},
+  };
+  // The scene itself, as TOML that renders this image again: in the EXR header, and in a PNG text chunk that
+  // `algray render image.png` reads back (as realsurf reloads its PNGs).
+  const std::string scene_toml = scene_to_toml(scene);
+  img.string_attributes.push_back({"algray/sceneToml", scene_toml});
+  if (scene_toml.size() <= kMaxPngTextBytes) img.png_text.push_back({kPngSceneKey, scene_toml});
+  img.software = version_string();
+  std::string equations;
+  for (const SceneSurface& s : scene.surfaces) equations += (equations.empty() ? "" : "; ") + s.equation;
+  img.comments = scene.name + ": " + equations + " = 0, rendered by algray";
+  // A name from a file name need not be UTF-8, which PNG text must be; the comment is for people, so '?' will do.
+  for (char& ch : img.comments)
+    if (static_cast<unsigned char>(ch) >= 0x80 || static_cast<unsigned char>(ch) < 0x20) ch = '?';
+  img.world_to_camera = world_to_camera_matrix(b, cam.eye);
+  img.world_to_ndc = world_to_ndc_matrix(cam, b, scene.image.width, scene.image.height);
+}
+
+// Wall time of each step of the command, for --stats.
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(std::chrono::steady_clock::time_point start) : start_(start), last_(start) {}
+  void mark(const std::string& phase) {
+    const auto now = std::chrono::steady_clock::now();
+    phases_.push_back({phase, std::chrono::duration<double, std::milli>(now - last_).count()});
+    last_ = now;
+  }
+  // Moves `ms` of the last phase named `from` to a phase `to` (work done inside it, as the shading is inside
+  // the render), so that the phases still add up to the total.
+  void move(const std::string& from, const std::string& to, double ms) {
+    for (auto it = phases_.rbegin(); it != phases_.rend(); ++it)
+      if (it->first == from) {
+        it->second -= ms;
+        break;
+      }
+    phases_.push_back({to, ms});
+  }
+  double total_ms() const {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
+  }
+  nlohmann::json json() const {
+    nlohmann::json j = nlohmann::json::object();
+    for (const auto& [name, ms] : phases_) j[name] = ms;
+    return j;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_, last_;
+  std::vector<std::pair<std::string, double>> phases_;
+};
+
+nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const RenderResult& r, const DeviceInfo& device,
+                          const PhaseTimer& timer) {
+  nlohmann::json j;
+  j["version"] = version_string();
+  j["scene"] = scene.source;
+  j["name"] = scene.name;
+  j["outputs"] = req.outputs;
+  j["image"] = {{"width", scene.image.width}, {"height", scene.image.height}};
+  j["device"] = {{"name", device.name},
+                 {"platform", device.platform_name},
+                 {"type", device.type},
+                 {"fp64", device.fp64},
+                 {"driver", device.driver_version}};
+  j["surface"] = {{"equation", scene.surface().equation}, {"degree", r.config.degree}};
+  for (const SceneSurface& s : scene.surfaces)
+    j["surfaces"].push_back({{"name", s.name}, {"equation", s.equation}, {"degree", s.polynomial.degree()}});
+  j["solver"] = {{"isolation", to_string(r.config.isolation)},
+                 {"refinement", to_string(r.config.refinement)},
+                 {"ray_origin", to_string(r.config.ray_origin)},
+                 {"precision", to_string(r.config.precision)},
+                 {"tolerance", r.config.tolerance},
+                 {"max_iterations", r.config.max_iterations}};
+  j["cache"] = req.use_cache ? ProgramCache::default_directory().string() : "off";
+  for (const ProgramRecord& p : r.programs) {
+    double kernel_ms = 0;
+    for (const PassStats& pass : r.passes)
+      for (std::size_t k = 0; k < pass.program_keys.size(); ++k)
+        if (pass.program_keys[k] == p.key) kernel_ms += pass.program_ms[k];
+    j["programs"].push_back({{"key", p.key},
+                             {"options", p.options},
+                             {"from_cache", p.origin != "built"},
+                             {"origin", p.origin},
+                             {"build_ms", p.build_ms},
+                             {"kernel_ms", kernel_ms}});
+  }
+  j["plan"] = r.plan.json();
+  for (const PassStats& p : r.passes) {
+    nlohmann::json kernels = nlohmann::json::array();
+    for (const std::string& key : p.program_keys) {
+      std::string origin;
+      for (const ProgramRecord& program : r.programs)
+        if (program.key == key) origin = program.origin;
+      kernels.push_back({{"key", key}, {"origin", origin}});
+    }
+    j["passes"].push_back({{"name", p.name},
+                           {"kernels", kernels},
+                           {"rays", p.rays},
+                           {"launches", p.launches},
+                           {"kernel_ms", p.kernel_ms},
+                           {"wall_ms", p.wall_ms}});
+  }
+  const PrimarySummary& p = r.primary;
+  j["primary_rays"] = {{"count", p.rays},
+                       {"hits", p.hits},
+                       {"depth_limited", p.depth_limited},
+                       {"isolation_steps", p.isolation_steps},
+                       {"refine_iterations", p.refine_iterations}};
+  // A pixel shows the surface when any of its antialiasing samples hit it.
+  j["pixels"] = {{"count", p.pixels}, {"hits", p.pixels_hit}};
+  // Where the render's time went: device time of the launches, the passes' wall time (launches, staging and
+  // readback), and the host's shading, which runs tile by tile inside the render.
+  double kernel_ms = 0, passes_ms = 0;
+  for (const PassStats& pass : r.passes) {
+    kernel_ms += pass.kernel_ms;
+    passes_ms += pass.wall_ms;
+  }
+  j["render_ms"] = {{"kernel", kernel_ms}, {"passes_wall", passes_ms}, {"host_shading", r.shade_ms}};
+  j["phases_ms"] = timer.json();
+  j["total_ms"] = timer.total_ms();
+  return j;
+}
+
+}  // namespace
+
+// An output that cannot be written is bad input, found before any rendering.
+void check_output_writable(const std::string& path) { check_output_path(path); }
+
+namespace {
+
+// Two names of one file give one identity: its device and inode when it exists, else its normalised absolute path.
+std::string file_identity(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0)
+    return "inode " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+  std::error_code ec;
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(std::filesystem::absolute(path, ec), ec);
+  return "path " + (ec ? std::filesystem::path(path).lexically_normal().string() : canonical.string());
+}
+
+}  // namespace
+
+void check_distinct_files(const std::vector<RoleAndPath>& inputs, const std::vector<RoleAndPath>& outputs) {
+  // Each file's identity, and whether it is an input.
+  std::map<std::string, std::pair<const RoleAndPath*, bool>> seen;
+  for (const RoleAndPath& in : inputs)
+    if (!in.path.empty() && in.path != "-") seen.emplace(file_identity(in.path), std::make_pair(&in, true));
+  for (const RoleAndPath& out : outputs) {
+    const auto [it, fresh] = seen.emplace(file_identity(out.path), std::make_pair(&out, false));
+    if (fresh) continue;
+    const RoleAndPath& other = *it->second.first;
+    if (it->second.second)
+      throw OutputError(out.role + " " + out.path + " is the " + other.role + " " + other.path +
+                        ": writing it would destroy the input");
+    throw OutputError(out.role + " " + out.path + " and " + other.role + " " + other.path +
+                      " are the same file: give each output its own name");
+  }
+}
+
+void OutputWriter::write(const std::string& path, const std::function<void()>& write_file) {
+  try {
+    write_file();
+    written_.push_back(path);
+  } catch (const std::exception& e) {
+    std::string message = e.what();
+    message += "\n  written: " + (written_.empty() ? std::string("nothing") : join(written_, ", "));
+    std::vector<std::string> unwritten;
+    bool after = false;
+    for (const std::string& p : planned_) {
+      after = after || p == path;
+      if (after) unwritten.push_back(p);
+    }
+    if (unwritten.empty()) unwritten.push_back(path);
+    message += "\n  not written: " + join(unwritten, ", ");
+    throw IncompleteOutputError(message);
+  }
+}
+
+RenderContext::RenderContext(std::string device_spec, bool use_cache)
+    : device_spec_(std::move(device_spec)), use_cache_(use_cache) {}
+
+RenderContext::~RenderContext() = default;
+
+ClSession& RenderContext::session() {
+  if (!session_) session_ = std::make_unique<ClSession>(select_device(device_spec_));
+  return *session_;
+}
+
+ProgramCache& RenderContext::cache() {
+  if (!cache_) cache_ = std::make_unique<ProgramCache>(use_cache_);
+  return *cache_;
+}
+
+Scene load_scene(const std::optional<std::string>& path, const std::vector<Override>& overrides) {
+  if (!path) return default_scene(overrides);
+  if (*path != "-" && is_png_file(*path)) {
+    // A PNG that algray rendered carries its scene: render it again, with any new overrides on top.
+    std::vector<std::pair<std::string, std::string>> texts;
+    try {
+      texts = read_png_text(*path);
+    } catch (const OutputError& e) {
+      throw SceneError(*path, e.what());
+    }
+    for (const auto& [key, text] : texts)
+      if (key == kPngSceneKey)
+        return load_scene_text(text, *path + " (the scene in its " + kPngSceneKey + " text)", overrides);
+    throw SceneError(*path, std::string("this PNG carries no algray scene (no ") + kPngSceneKey +
+                                " text chunk): only images written by algray render can be rendered again");
+  }
+  if (*path == "-") {
+    // Standard input can be read once: a second "-" in the same process is an error, not an empty scene.
+    static bool consumed = false;
+    if (consumed) throw SceneError("<stdin>", "standard input was already read");
+    consumed = true;
+    const std::string text = read_input_stream(std::cin, "<stdin>", "scene file");
+    if (looks_like_jsurf(text)) return load_jsurf_text(text, "<stdin>", overrides);
+    return load_scene_text(text, "<stdin>", overrides);
+  }
+  return load_scene_file(*path, overrides);
+}
+
+void print_warnings(const Scene& scene, std::ostream& err, const std::string& prefix) {
+  for (const std::string& w : scene.warnings) err << "algray: warning: " << prefix << w << "\n";
+}
+
+namespace {
+
+// In the order render_scene writes them.
+std::vector<RoleAndPath> request_outputs(const RenderRequest& req) {
+  std::vector<RoleAndPath> out;
+  if (req.heatmap_path) out.push_back({"--heatmap", *req.heatmap_path});
+  for (const std::string& o : req.outputs) out.push_back({"output", o});
+  if (req.stats_path) out.push_back({"--stats", *req.stats_path});
+  return out;
+}
+
+}  // namespace
+
+void check_outputs(const Scene& scene, const RenderRequest& req) {
+  if (req.reference && scene.surfaces.size() > 1)
+    throw SceneError(scene.source,
+                     "--reference solves one surface; this scene has " + std::to_string(scene.surfaces.size()));
+  for (const std::string& out : req.outputs) {
+    format_from_extension(out);
+    check_output_writable(out);
+  }
+  if (req.stats_path) check_output_writable(*req.stats_path);
+  if (req.heatmap_path) {
+    format_from_extension(*req.heatmap_path);
+    check_output_writable(*req.heatmap_path);
+  }
+  check_distinct_files({{"scene file", req.scene_path.value_or("")}}, request_outputs(req));
+}
+
+nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, RenderContext& context,
+                            std::chrono::steady_clock::time_point started) {
+  PhaseTimer timer(started);
+  timer.mark("scene");  // reading and checking it, before this call
+  FrameImage image;
+  RenderResult result;
+  DeviceInfo device;
+  const bool diagnostics = !req.aovs.empty() || req.heatmap_path;
+  SolverWork work;  // per output pixel: the solver channels and the heat map are pictures of the whole image
+  if (req.reference) {
+    // No device: exact arithmetic on the CPU, rays rebuilt in the precision the kernels would use.
+    device.name = "CPU reference (solver_ref, exact arithmetic)";
+    device.type = "CPU";
+    ReferenceResult ref = render_reference(scene, scene.render.precision.value_or(Precision::Double));
+    timer.mark("render");
+    result = std::move(ref.render);
+    result.primary = summarise_hits(result.hits, result.plan.samples);
+    image = shade_frame(scene, result);
+    image.uint_channels.push_back({"reference.class", std::move(ref.classes)});
+    if (diagnostics) work = solver_work(result);
+    timer.mark("shade");
+  } else {
+    // The film (16 to 32 bytes a pixel, zero-filled, every page faulted in) is made on another thread while
+    // this one starts the device, which loads the OpenCL driver on one core for tens of milliseconds. Its
+    // depth and normal channels are made only for an EXR output, the one format that stores them. For a PNG
+    // output the sRGB encoder's table (some 40000 pow() calls, built on first use) is made there too.
+    bool depth_and_normal = false, png = false;
+    for (const std::string& out : req.outputs) {
+      depth_and_normal |= format_from_extension(out) == ImageFormat::Exr;
+      png |= format_from_extension(out) == ImageFormat::Png;
+    }
+    // Only a film of at most 256 MB (4096^2 RGBA) is made ahead: the render's memory check (check_plan_fits,
+    // which needs the device) must refuse a render too large before its film is allocated, and a larger render
+    // takes seconds, beside which the overlap is noise.
+    const int film_width = scene.image.width, film_height = scene.image.height;
+    const bool ahead = static_cast<std::uint64_t>(film_width) * static_cast<std::uint64_t>(film_height) *
+                           (depth_and_normal ? 8 : 4) * sizeof(float) <=
+                       (std::uint64_t{256} << 20);
+    std::future<FrameImage> film;
+    if (ahead)
+      film = std::async(std::launch::async, [=] {
+        if (png) srgb_byte(0.5f);
+        return make_film(film_width, film_height, depth_and_normal);
+      });
+    ClSession& session = context.session();
+    device = session.info;
+    timer.mark("device");
+    Renderer renderer(session, context.cache());
+    RenderOptions options;
+    if (ahead) options.film = [&film] { return film.get(); };
+    options.show_progress = req.progress;
+    if (diagnostics) {
+      options.on_primary_tile = [&](const PrimaryTile& tile) {
+        if (work.isolation_steps.empty()) work = empty_solver_work(scene.image.width, scene.image.height, tile.samples);
+        add_tile_work(work, tile);
+      };
+    }
+    result = renderer.render(scene, options);
+    timer.mark("render");
+    timer.move("render", "shade", result.shade_ms);
+    image = std::move(result.image);
+  }
+  add_metadata(image, scene, result, device);
+  timer.mark("metadata");
+  // Every path was checked before rendering, so a write that fails now (a full disk) is a failure, not bad input.
+  std::vector<std::string> planned;
+  for (const RoleAndPath& o : request_outputs(req)) planned.push_back(o.path);
+  OutputWriter writer(planned);
+  // The heat map's colour scale spans the whole image, so it needs every pixel's work before any colour: the
+  // work (16 bytes a pixel) and the picture are whole-image, bounded by the pixels, never by the samples.
+  if (diagnostics) {
+    if (req.heatmap_path) {
+      const std::string per =
+          work.samples > 1 ? " (sum over " + std::to_string(work.samples * work.samples) + " samples)" : "";
+      writer.write(*req.heatmap_path, [&] {
+        write_image(*req.heatmap_path, work_heatmap(work.width, work.height, work.total(), work.in_extent(),
+                                                    "isolation steps + refinement iterations per pixel" + per));
+      });
+    }
+    add_solver_aovs(image, std::move(work), req.aovs);
+    timer.mark("diagnostics");
+  }
+  for (const std::string& out : req.outputs) writer.write(out, [&] { write_image(out, image); });
+  timer.mark("write");
+  nlohmann::json stats = stats_json(scene, req, result, device, timer);
+  if (req.stats_path)
+    writer.write(*req.stats_path, [&] { write_text_file(*req.stats_path, stats.dump(2) + "\n"); });
+  return stats;
+}
+
+int report_error(const std::exception& e, std::ostream& err) {
+  if (dynamic_cast<const SceneError*>(&e)) {
+    err << e.what() << "\n";
+    return kExitBadInput;
+  }
+  err << "algray: ";
+  if (const auto* cl_error = dynamic_cast<const cl::Error*>(&e)) err << "OpenCL error " << cl_error->err() << " in ";
+  err << e.what() << "\n";
+  const bool bad_input = dynamic_cast<const OutputError*>(&e) || dynamic_cast<const DeviceError*>(&e);
+  return bad_input ? kExitBadInput : kExitFailure;
+}
+
+int run_render(const RenderRequest& req, std::ostream& err) {
+  const auto started = std::chrono::steady_clock::now();
+  // Everything the user gave is checked before any device work, so bad input costs nothing and writes nothing.
+  Scene scene;
+  try {
+    scene = load_scene(req.scene_path, req.overrides);
+    print_warnings(scene, err);
+    check_outputs(scene, req);
+  } catch (const std::exception& e) {
+    return report_error(e, err);
+  }
+  try {
+    RenderContext context(req.device_spec, req.use_cache);
+    render_scene(scene, req, context, started);
+  } catch (const std::exception& e) {
+    return report_error(e, err);
+  }
+  return kExitOk;
+}
+
+}  // namespace algray

@@ -1,0 +1,110 @@
+// Device enumeration and selection over the OpenCL ICD loader.
+#include "algray/device/cl_runtime.h"
+
+#include <algorithm>
+#include <cctype>
+#include <sstream>
+
+namespace algray {
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+std::string trimmed(std::string s) {
+  while (!s.empty() && (s.back() == '\0' || std::isspace(static_cast<unsigned char>(s.back())))) s.pop_back();
+  return s;
+}
+
+std::string type_name(cl_device_type t) {
+  if (t & CL_DEVICE_TYPE_GPU) return "GPU";
+  if (t & CL_DEVICE_TYPE_CPU) return "CPU";
+  if (t & CL_DEVICE_TYPE_ACCELERATOR) return "accelerator";
+  return "other";
+}
+
+}  // namespace
+
+std::vector<DeviceInfo> enumerate_devices() {
+  std::vector<DeviceInfo> out;
+  std::vector<cl::Platform> platforms;
+  // With no ICD registered the loader reports CL_PLATFORM_NOT_FOUND_KHR; that simply means "no devices".
+  try {
+    cl::Platform::get(&platforms);
+  } catch (const cl::Error&) {
+    return out;
+  }
+  for (const cl::Platform& p : platforms) {
+    std::vector<cl::Device> devices;
+    try {
+      p.getDevices(CL_DEVICE_TYPE_ALL, &devices);
+    } catch (const cl::Error&) {
+      continue;
+    }
+    for (const cl::Device& d : devices) {
+      DeviceInfo info;
+      info.index = static_cast<int>(out.size());
+      info.platform_name = trimmed(p.getInfo<CL_PLATFORM_NAME>());
+      info.platform_version = trimmed(p.getInfo<CL_PLATFORM_VERSION>());
+      info.name = trimmed(d.getInfo<CL_DEVICE_NAME>());
+      info.vendor = trimmed(d.getInfo<CL_DEVICE_VENDOR>());
+      info.version = trimmed(d.getInfo<CL_DEVICE_VERSION>());
+      info.driver_version = trimmed(d.getInfo<CL_DRIVER_VERSION>());
+      info.type = type_name(d.getInfo<CL_DEVICE_TYPE>());
+      info.compute_units = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
+      info.fp64 = d.getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>() != 0;
+      info.global_mem_bytes = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+      info.max_alloc_bytes = d.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+      info.device = d;
+      out.push_back(std::move(info));
+    }
+  }
+  return out;
+}
+
+std::string describe_devices(const std::vector<DeviceInfo>& devices) {
+  std::ostringstream s;
+  std::string platform;
+  for (const DeviceInfo& d : devices) {
+    if (d.platform_name != platform) {
+      platform = d.platform_name;
+      s << "platform: " << d.platform_name << " (" << d.platform_version << ")\n";
+    }
+    s << "  [" << d.index << "] " << d.name << "\n"
+      << "      type " << d.type << ", " << d.compute_units << " compute units, fp64 " << (d.fp64 ? "yes" : "no")
+      << ", " << d.version << ", driver " << d.driver_version << "\n";
+  }
+  return s.str();
+}
+
+DeviceInfo select_device(const std::string& spec) {
+  const std::vector<DeviceInfo> devices = enumerate_devices();
+  if (devices.empty())
+    throw DeviceError(
+        "no OpenCL device found: install an OpenCL driver (for the CPU on Debian: apt-get install "
+        "pocl-opencl-icd) and check with `algray devices`");
+  if (spec.empty()) {
+    for (const DeviceInfo& d : devices)
+      if (d.type == "GPU") return d;
+    return devices.front();
+  }
+  if (std::all_of(spec.begin(), spec.end(), [](unsigned char c) { return std::isdigit(c); })) {
+    const unsigned long index = std::stoul(spec);
+    if (index < devices.size()) return devices[index];
+    throw DeviceError("--device " + spec + ": there are only " + std::to_string(devices.size()) + " devices:\n" +
+                      describe_devices(devices));
+  }
+  const std::string needle = lower(spec);
+  for (const DeviceInfo& d : devices)
+    if (lower(d.name).find(needle) != std::string::npos || lower(d.platform_name).find(needle) != std::string::npos)
+      return d;
+  throw DeviceError("--device " + spec + ": no device or platform name contains it; the devices are:\n" +
+                    describe_devices(devices));
+}
+
+ClSession::ClSession(DeviceInfo chosen)
+    : info(std::move(chosen)), context(info.device), queue(context, info.device, CL_QUEUE_PROFILING_ENABLE) {}
+
+}  // namespace algray

@@ -1,0 +1,38 @@
+// KernelConfig: every choice that changes a kernel's code, turned into build options and a cache key.
+#pragma once
+
+#include <string>
+
+#include "algray/scene/solver_options.h"
+
+namespace algray {
+
+struct KernelConfig;
+
+// The lane count a render uses on a device of `device_type` ("CPU", "GPU", ...) unless the scene sets
+// render.lanes: 8 on a CPU, whose work-items run one after another, 1 on devices that already run work-items in
+// SIMD; and whether a kernel can be built with more than one lane at all.
+int default_lanes(const std::string& device_type);
+bool lanes_apply(const KernelConfig& config);
+
+struct KernelConfig {
+  std::string entry = "primary";  // kernel file (without .cl) and kernel function
+  int degree = 1;
+  Precision precision = Precision::Double;
+  Isolation isolation = Isolation::Bernstein;
+  Refinement refinement = Refinement::Brent;
+  RayOrigin ray_origin = RayOrigin::Extent;
+  double tolerance = 1e-9;   // the paper's eps: stop when the bracket is <= 4*eps*max(|t|,1)
+  int max_iterations = 100;  // see default_max_iterations
+  // Rays per work-item, side by side in vector lanes (kernels/lanes.h): more than 1 only for the primary kernel
+  // with Bernstein isolation and Brent refinement (lanes_apply), where the plan asks for it.
+  int lanes = 1;
+
+  // "-D DEGREE=6 -D ALGRAY_DOUBLE=1 ..." with the tolerance as an exact hexadecimal literal.
+  std::string build_options() const;
+  // Everything above, readable; two configs build the same code iff their keys are equal.
+  std::string key() const;
+  std::string source_file() const { return entry + ".cl"; }
+};
+
+}  // namespace algray

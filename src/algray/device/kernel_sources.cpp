@@ -1,0 +1,64 @@
+// Resolves the kernels' quoted #include lines against the embedded files (or a directory, for kernel work).
+#include "algray/device/kernel_sources.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace algray {
+namespace {
+
+std::string read_kernel_file(const std::string& name) {
+  if (const char* dir = std::getenv("ALGRAY_KERNEL_DIR"); dir && *dir) {
+    std::ifstream in(std::string(dir) + "/" + name, std::ios::binary);
+    if (!in)
+      throw std::runtime_error("ALGRAY_KERNEL_DIR is set but " + std::string(dir) + "/" + name + " cannot be read");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }
+  for (const EmbeddedFile& f : embedded_kernel_files())
+    if (name == f.name) return f.text;
+  throw std::runtime_error("kernel file '" + name + "' is not embedded in this build");
+}
+
+// Every #include is expanded where it stands, even when the file came in before: an earlier copy may sit in a
+// branch of #if that the preprocessor drops, so only the headers' own include guards may skip it.
+void append_with_includes(const std::string& name, std::vector<std::string>& stack, std::string& out) {
+  if (std::find(stack.begin(), stack.end(), name) != stack.end())
+    throw std::runtime_error("kernel file '" + name + "' includes itself");
+  stack.push_back(name);
+  std::istringstream lines(read_kernel_file(name));
+  std::string line;
+  int number = 0;
+  out += "#line 1 \"" + name + "\"\n";
+  while (std::getline(lines, line)) {
+    ++number;
+    const auto first = line.find_first_not_of(" \t");
+    if (first != std::string::npos && line.compare(first, 9, "#include ") == 0) {
+      const auto open = line.find('"', first), close = line.rfind('"');
+      if (open != std::string::npos && close > open) {
+        append_with_includes(line.substr(open + 1, close - open - 1), stack, out);
+        out += "#line " + std::to_string(number + 1) + " \"" + name + "\"\n";
+        continue;
+      }
+    }
+    out += line;
+    out += '\n';
+  }
+  stack.pop_back();
+}
+
+}  // namespace
+
+std::string assemble_kernel_source(const std::string& main_file) {
+  std::vector<std::string> stack;
+  std::string out;
+  append_with_includes(main_file, stack, out);
+  return out;
+}
+
+}  // namespace algray

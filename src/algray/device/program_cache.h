@@ -1,0 +1,55 @@
+// Built OpenCL programs, kept in memory per session and on disk as device binaries keyed by everything they depend on.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include "algray/device/cl_runtime.h"
+#include "algray/device/kernel_config.h"
+
+namespace algray {
+
+// A program that failed to build; the message carries the options, the device and the full build log.
+struct BuildError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct ProgramRecord {
+  std::string key;      // KernelConfig::key()
+  std::string options;  // the build options used
+  std::string origin;   // "built", "memory" or "disk"
+  double build_ms = 0;  // wall time to obtain the program (compile, or load and link a binary)
+};
+
+class ProgramCache {
+ public:
+  // enabled = false is `--no-cache`: every program is compiled from source and nothing is kept or stored.
+  explicit ProgramCache(bool enabled, std::filesystem::path dir = default_directory());
+
+  // The kernel named config.entry, from the cheapest place that has a valid program.
+  cl::Kernel kernel(ClSession& session, const KernelConfig& config, ProgramRecord* record = nullptr);
+
+  // $ALGRAY_CACHE_DIR, else $XDG_CACHE_HOME/algray, else ~/.cache/algray.
+  static std::filesystem::path default_directory();
+
+ private:
+  cl::Program build_from_source(ClSession& session, const std::string& source, const std::string& options,
+                                const std::string& key);
+  bool load_from_disk(ClSession& session, const std::filesystem::path& file, const std::string& identity,
+                      const std::string& options, cl::Program& out);
+  void store_on_disk(const cl::Program& program, const std::filesystem::path& file, const std::string& identity);
+
+  // An entry on disk: a text header (magic, identity, payload length and checksum), then the device binary.
+  static std::string entry_header(const std::string& identity, const std::string& payload);
+  // The payload of a well-formed entry for `identity`; false for anything missing, foreign, short or damaged.
+  static bool read_entry(const std::filesystem::path& file, const std::string& identity, std::string& payload);
+  static bool write_entry(const std::filesystem::path& file, const std::string& content);
+
+  bool enabled_;
+  std::filesystem::path dir_;
+  std::map<std::string, cl::Program> memory_;  // keyed by device identity + options + source hash
+};
+
+}  // namespace algray

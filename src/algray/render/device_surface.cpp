@@ -1,0 +1,149 @@
+// Surface preparation for the kernels, their argument helpers, and the surface's device buffers.
+#include "algray/render/device_surface.h"
+
+#include <algorithm>
+#include <array>
+
+#include "kernels/algray_shared.h"
+#include "algray/render/screen_form.h"
+
+namespace algray {
+namespace {
+
+// C(n, k) for 0 <= k <= n <= degree, row-major with rows of degree + 1 entries, as the kernels expect; sixteen
+// zeros of padding let a kernel read any row as one 16-wide vector.
+std::vector<double> binomial_table(int degree) {
+  const int n1 = degree + 1;
+  std::vector<double> t(static_cast<std::size_t>(n1 * n1 + 16), 0.0);
+  for (int n = 0; n <= degree; ++n) {
+    t[static_cast<std::size_t>(n * n1)] = 1;
+    for (int k = 1; k <= n; ++k)
+      t[static_cast<std::size_t>(n * n1 + k)] = t[static_cast<std::size_t>((n - 1) * n1 + k - 1)] +
+                                                (k < n ? t[static_cast<std::size_t>((n - 1) * n1 + k)] : 0);
+  }
+  return t;
+}
+
+}  // namespace
+
+double ms_between(const cl::Event& e) {
+  const auto start = e.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+  const auto end = e.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+  return static_cast<double>(end - start) * 1e-6;
+}
+
+void KernelArgs::real_vec(const glm::dvec3& v) {
+  if (double_)
+    kernel_.setArg(index_++, cl_double4{{v.x, v.y, v.z, 0}});
+  else
+    kernel_.setArg(index_++, cl_float4{{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0}});
+}
+
+void KernelArgs::ray_basis(const RayBasis& b) {
+  for (const glm::dvec3* v : {&b.o00, &b.ou, &b.ov, &b.d00, &b.du, &b.dv}) real_vec(*v);
+}
+
+void KernelArgs::real(double v) {
+  if (double_)
+    kernel_.setArg(index_++, v);
+  else
+    kernel_.setArg(index_++, static_cast<float>(v));
+}
+
+// Buffer of REAL values from doubles.
+cl::Buffer real_buffer(const cl::Context& ctx, const std::vector<double>& values, Precision precision) {
+  if (precision == Precision::Double)
+    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(double),
+                      const_cast<double*>(values.data()));
+  std::vector<float> f(values.begin(), values.end());
+  return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, f.size() * sizeof(float), f.data());
+}
+
+cl::Buffer real4_buffer(const cl::Context& ctx, const std::vector<glm::dvec3>& values, Precision precision) {
+  std::vector<double> flat;
+  flat.reserve(4 * values.size());
+  for (const glm::dvec3& v : values) flat.insert(flat.end(), {v.x, v.y, v.z, 0});
+  return real_buffer(ctx, flat, precision);
+}
+
+SurfaceData prepare_surface(const Scene& scene, std::size_t surface) {
+  const glm::dvec3 c = scene.extent.unit_centre();
+  const std::array<mpq_class, 3> centre{exact_rational(c.x), exact_rational(c.y), exact_rational(c.z)};
+  // Exact translation and scaling: rounding happens once, to the final coefficients.
+  Polynomial unit =
+      scene.surfaces.at(surface).polynomial.translated_scaled(centre, exact_rational(scene.extent.unit_scale()));
+  mpq_class largest = 0;
+  for (const auto& [e, a] : unit.terms()) largest = std::max<mpq_class>(largest, abs(a));
+  SurfaceData data;
+  data.degree = unit.degree();
+  Polynomial scaled;
+  for (const auto& [e, a] : unit.terms()) scaled.add_term(e[0], e[1], e[2], a / largest);
+  data.even_axes = 7;
+  for (const Monomial& m : scaled.monomials()) {
+    if (m.i % 2) data.even_axes &= ~1u;
+    if (m.j % 2) data.even_axes &= ~2u;
+    if (m.k % 2) data.even_axes &= ~4u;
+    data.exponents.push_back(static_cast<cl_uint>(m.i) | static_cast<cl_uint>(m.j) << 8 |
+                             static_cast<cl_uint>(m.k) << 16);
+    data.coefficients.push_back(m.coef);
+  }
+  return data;
+}
+
+DeviceSurface::DeviceSurface(const cl::Context& ctx, const Scene& scene, Precision precision, std::size_t surface)
+    : precision_(precision), extent_(scene.extent), data_(prepare_surface(scene, surface)) {
+  exps_ = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, data_.exponents.size() * sizeof(cl_uint),
+                     data_.exponents.data());
+  // Mixed precision takes each coefficient as a float pair hi + lo (hi's, then lo's): rounding expanded,
+  // cancelling coefficients to float alone would already change the surface.
+  std::vector<double> coefficient_data = data_.coefficients;
+  if (precision == Precision::Mixed)
+    for (double c : data_.coefficients) coefficient_data.push_back(c - static_cast<double>(static_cast<float>(c)));
+  coefs_ = real_buffer(ctx, coefficient_data, precision);
+  binomials_ = real_buffer(ctx, binomial_table(data_.degree), precision);
+}
+
+void DeviceSurface::set_extent_args(KernelArgs& args) const {
+  args.real_vec(extent_.unit_centre());
+  args.real(1 / extent_.unit_scale());
+  args.real_vec(extent_.unit_box_half());
+  args.plain(static_cast<cl_int>(extent_.kind == ExtentKind::Sphere ? ALGRAY_EXTENT_SPHERE : ALGRAY_EXTENT_BOX));
+}
+
+void DeviceSurface::set_surface_args(KernelArgs& args) const {
+  args.plain(exps_);
+  args.plain(coefs_);
+  args.plain(static_cast<cl_uint>(data_.coefficients.size()));
+  args.plain(binomials_);
+  args.plain(data_.even_axes);
+}
+
+struct DeviceSurface::ScreenCache {
+  ScreenGeometry geometry;
+  int height;
+  ScreenForm form;
+  bool same_camera(const ScreenGeometry& g, int h) const {
+    return h == height && g.oc == geometry.oc && g.ox == geometry.ox && g.oy == geometry.oy && g.dc == geometry.dc &&
+           g.dx == geometry.dx && g.dy == geometry.dy && g.t0 == geometry.t0 && g.xi_scale == geometry.xi_scale;
+  }
+};
+
+cl::Buffer DeviceSurface::set_screen_args(KernelArgs& args, const cl::Context& ctx, const KernelConfig& config,
+                                          const RayBasis& basis, int width, int height, int row0, int rows) const {
+  if (config.ray_origin != RayOrigin::Screen) return {};
+  const ScreenGeometry geometry = screen_geometry(basis, width, height, extent_);
+  if (!screen_ || !screen_->same_camera(geometry, height)) {
+    screen_ = std::make_shared<const ScreenCache>(
+        ScreenCache{geometry, height, ScreenForm(data_.exponents, data_.coefficients, data_.degree, geometry)});
+  }
+  const ScreenForm& form = screen_->form;
+  cl::Buffer buffer = real_buffer(ctx, form.rows(row0, rows, height), precision_);
+  args.plain(buffer);
+  args.plain(static_cast<cl_uint>(row0));
+  args.real(geometry.t0);
+  args.real(geometry.xi_scale);
+  args.real(geometry.xi_offset);
+  return buffer;
+}
+
+}  // namespace algray

@@ -1,0 +1,77 @@
+// The surface on the device as every kernel takes it, and the helpers that set kernel arguments.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "algray/device/cl_runtime.h"
+#include "algray/device/kernel_config.h"
+#include "algray/scene/scene.h"
+
+namespace algray {
+
+// The polynomial as the kernels see it: in unit coordinates of the extent, scaled to max |coefficient| = 1.
+struct SurfaceData {
+  int degree = 0;
+  std::vector<cl_uint> exponents;  // i | j << 8 | k << 16, sorted by i, j, k descending
+  std::vector<double> coefficients;
+  cl_uint even_axes = 0;  // bit a set when every exponent of axis a is even (the kernels then step by squares)
+};
+SurfaceData prepare_surface(const Scene& scene, std::size_t surface = 0);
+
+// Device time of a finished command, in milliseconds (the queue has profiling on).
+double ms_between(const cl::Event& e);
+
+// Sets kernel arguments in declaration order; REAL-typed ones follow the build's precision.
+class KernelArgs {
+ public:
+  KernelArgs(cl::Kernel& k, Precision p) : kernel_(k), double_(p == Precision::Double) {}
+  void real_vec(const glm::dvec3& v);
+  // ray_o00 .. ray_dv, in the order camera_ray() takes them (kernels/ray.h).
+  void ray_basis(const RayBasis& b);
+  void real(double v);
+  template <typename T>
+  void plain(const T& v) {
+    kernel_.setArg(index_++, v);
+  }
+  cl_uint next() const { return index_; }
+  void skip(cl_uint n) { index_ += n; }
+
+ private:
+  cl::Kernel& kernel_;
+  bool double_;
+  cl_uint index_ = 0;
+};
+
+// Buffer of REAL values (double, or float for float and mixed precision) from doubles.
+cl::Buffer real_buffer(const cl::Context& ctx, const std::vector<double>& values, Precision precision);
+// Buffer of REAL4 values (x, y, z, 0) from points or directions.
+cl::Buffer real4_buffer(const cl::Context& ctx, const std::vector<glm::dvec3>& values, Precision precision);
+
+// One surface's buffers in one precision, shared by every pass's kernel.
+class DeviceSurface {
+ public:
+  DeviceSurface(const cl::Context& ctx, const Scene& scene, Precision precision, std::size_t surface = 0);
+  Precision precision() const { return precision_; }
+  const SurfaceData& data() const { return data_; }
+  // Extent and surface arguments, in the order primary.cl and shadow.cl declare them.
+  void set_extent_args(KernelArgs& args) const;
+  void set_surface_args(KernelArgs& args) const;
+  // A screen-form build's extra primary and probe arguments (SCREEN_ROWS_PARAM in kernels/surface.h): rows
+  // row0 .. row0 + rows - 1 of the width x height camera image of `basis`. Sets nothing for other builds. The
+  // kernel reads the returned buffer: keep it until the launches are done.
+  cl::Buffer set_screen_args(KernelArgs& args, const cl::Context& ctx, const KernelConfig& config,
+                             const RayBasis& basis, int width, int height, int row0, int rows) const;
+
+ private:
+  Precision precision_;
+  Extent extent_;
+  SurfaceData data_;
+  cl::Buffer exps_, coefs_, binomials_;
+  // The screen form of the last camera set_screen_args saw: a render asks for it band by band, and expanding P
+  // along the rays again for each band would repeat the costliest step.
+  struct ScreenCache;
+  mutable std::shared_ptr<const ScreenCache> screen_;
+};
+
+}  // namespace algray

@@ -1,0 +1,68 @@
+// Host side of the secondary-ray kernel: uploads rays, launches, reads the hit records back.
+#include "algray/render/ray_tracer.h"
+
+namespace algray {
+
+RayTracer::RayTracer(ClSession& session, ProgramCache& cache, const KernelConfig& config,
+                     const DeviceSurface& surface)
+    : session_(session), surface_(surface) {
+  kernel_ = cache.kernel(session, config, &record_);
+}
+
+TracedBatch RayTracer::trace(const std::vector<PixelRay>& rays) {
+  TracedBatch batch;
+  const std::size_t count = rays.size();
+  batch.hits.resize(count);
+  if (count == 0) return batch;
+  const bool is_double = surface_.precision() == Precision::Double;
+  const std::size_t real4_size = 4 * (is_double ? sizeof(double) : sizeof(float));
+  const cl::Context& ctx = session_.context;
+  if (count > capacity_) {
+    capacity_ = count;
+    origins_ = cl::Buffer(ctx, CL_MEM_READ_ONLY, capacity_ * real4_size);
+    directions_ = cl::Buffer(ctx, CL_MEM_READ_ONLY, capacity_ * real4_size);
+    out_ = cl::Buffer(ctx, CL_MEM_WRITE_ONLY, capacity_ * sizeof(HitRecord));
+  }
+  // As real4_buffer converts: each component rounded to the kernel's REAL on its own.
+  cl::CommandQueue& queue = session_.queue;
+  auto upload = [&](cl::Buffer& buffer, auto vector_of) {
+    if (is_double) {
+      staging_.resize(4 * count);
+      for (std::size_t i = 0; i < count; ++i) {
+        const glm::dvec3& v = vector_of(rays[i]);
+        staging_[4 * i] = v.x;
+        staging_[4 * i + 1] = v.y;
+        staging_[4 * i + 2] = v.z;
+        staging_[4 * i + 3] = 0;
+      }
+      queue.enqueueWriteBuffer(buffer, CL_TRUE, 0, count * real4_size, staging_.data());
+    } else {
+      staging_float_.resize(4 * count);
+      for (std::size_t i = 0; i < count; ++i) {
+        const glm::dvec3& v = vector_of(rays[i]);
+        staging_float_[4 * i] = static_cast<float>(v.x);
+        staging_float_[4 * i + 1] = static_cast<float>(v.y);
+        staging_float_[4 * i + 2] = static_cast<float>(v.z);
+        staging_float_[4 * i + 3] = 0;
+      }
+      queue.enqueueWriteBuffer(buffer, CL_TRUE, 0, count * real4_size, staging_float_.data());
+    }
+  };
+  upload(origins_, [](const PixelRay& r) -> const glm::dvec3& { return r.origin; });
+  upload(directions_, [](const PixelRay& r) -> const glm::dvec3& { return r.direction; });
+  KernelArgs args(kernel_, surface_.precision());
+  args.plain(origins_);
+  args.plain(directions_);
+  args.plain(static_cast<cl_uint>(count));
+  surface_.set_extent_args(args);
+  surface_.set_surface_args(args);
+  args.plain(out_);
+  cl::Event done;
+  queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(count), cl::NullRange, nullptr, &done);
+  done.wait();
+  batch.kernel_ms = ms_between(done);
+  queue.enqueueReadBuffer(out_, CL_TRUE, 0, count * sizeof(HitRecord), batch.hits.data());
+  return batch;
+}
+
+}  // namespace algray

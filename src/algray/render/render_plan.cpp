@@ -1,0 +1,261 @@
+// Derives the render plan from a scene: passes, their kernels and their buffers.
+#include "algray/render/render_plan.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+
+#include "kernels/algray_shared.h"
+#include "algray/render/screen_form.h"
+
+namespace algray {
+
+bool screen_form_applies(const Scene& scene, Precision precision) {
+  if (precision != Precision::Double) return false;
+  const RayBasis basis = make_ray_basis(scene.camera, scene.image.width, scene.image.height);
+  return screen_geometry(basis, scene.image.width, scene.image.height, scene.extent).well_placed;
+}
+
+KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t surface) {
+  KernelConfig config;
+  config.entry = "primary";
+  config.degree = scene.surfaces.at(surface).polynomial.degree();
+  config.precision = precision;
+  config.isolation = scene.render.isolation;
+  config.refinement = scene.render.refinement;
+  config.ray_origin = scene.render.ray_origin;
+  if (config.ray_origin == RayOrigin::Auto)
+    config.ray_origin = screen_form_applies(scene, precision) ? RayOrigin::Screen : RayOrigin::Extent;
+  // Below a few units of roundoff the stopping rule can never trigger.
+  const double eps =
+      precision == Precision::Double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();
+  config.tolerance = std::max(scene.render.tolerance, 2 * eps);
+  config.max_iterations =
+      scene.render.max_iterations > 0 ? scene.render.max_iterations : default_max_iterations(scene.render.refinement);
+  return config;
+}
+
+double shadow_offset_unit(Precision precision) { return precision == Precision::Double ? 1e-6 : 1e-3; }
+
+const PlannedPass* RenderPlan::find(const std::string& name) const {
+  for (const PlannedPass& p : passes)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size, int lanes) {
+  RenderPlan plan;
+  plan.width = scene.image.width;
+  plan.height = scene.image.height;
+  plan.tile_size = tile_size > 0 ? tile_size : scene.render.tile_size > 0 ? scene.render.tile_size : 1024;
+  // Preview mode is the paper's quick look: one camera ray per pixel, whatever the scene's antialiasing.
+  const int samples = scene.render.preview ? 1 : scene.antialias.samples;
+  const bool adaptive = scene.antialias.adaptive && samples > 1;
+  plan.samples = adaptive ? 1 : samples;
+  if (adaptive) {
+    plan.refine_samples = scene.antialias.samples;
+    plan.refine_threshold = scene.antialias.threshold;
+  }
+  // The device holds one tile's camera rays, and one batch of other rays at a time.
+  const std::size_t rays = plan.tile_rays();
+  const std::size_t real_size = precision == Precision::Double ? sizeof(double) : sizeof(float);
+
+  // Every pass has one kernel per surface: each surface's degree specialises its own.
+  std::vector<KernelConfig> primary;
+  for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+    primary.push_back(primary_config(scene, precision, i));
+    if (lanes_apply(primary.back())) primary.back().lanes = scene.render.lanes > 0 ? scene.render.lanes : lanes;
+  }
+  auto with_entry = [&](const std::string& entry) {
+    std::vector<KernelConfig> configs = primary;
+    for (KernelConfig& c : configs) {
+      c.entry = entry;
+      c.lanes = 1;  // lanes are the camera rays' (kernels/primary.cl)
+      if (c.ray_origin == RayOrigin::Screen) c.ray_origin = RayOrigin::Extent;  // the screen form is camera rays'
+    }
+    return configs;
+  };
+  plan.passes.push_back({"primary", plan.samples > 1 ? "camera rays, " + std::to_string(plan.samples) + "x" +
+                                                           std::to_string(plan.samples) + " per pixel"
+                                                     : "camera rays, one per pixel",
+                         primary});
+  plan.buffers.push_back({"primary hits", rays * sizeof(HitRecord)});
+
+  for (std::size_t i = 0; i < scene.lights.size(); ++i)
+    if (scene.lights[i].shadows) plan.shadow_lights.push_back(static_cast<int>(i));
+  if (scene.render.preview) {
+    plan.shadow_lights.clear();
+    plan.skipped.push_back("shadow: preview mode traces primary rays only");
+  } else if (scene.lights.empty()) {
+    plan.skipped.push_back("shadow: no lights (a headlight shades the surface)");
+  } else if (plan.shadow_lights.empty()) {
+    plan.skipped.push_back("shadow: no light casts shadows");
+  }
+  if (!plan.shadow_lights.empty()) {
+    // The shadow kernel isolates roots and never refines them: the refinement is not part of its code.
+    std::vector<KernelConfig> shadow = with_entry("shadow");
+    for (KernelConfig& c : shadow) {
+      c.refinement = Refinement::Brent;
+      c.max_iterations = default_max_iterations(Refinement::Brent);
+    }
+    std::size_t points = 0;
+    for (int i : plan.shadow_lights) points += scene.lights[static_cast<std::size_t>(i)].sample_points().size();
+    plan.passes.push_back({"shadow",
+                           std::to_string(plan.shadow_lights.size()) + " shadow-casting light(s), " +
+                               std::to_string(points) + " sample point(s) per lit surface point",
+                           shadow});
+    // A batch of surface points at a time, asked about each light in turn.
+    const std::size_t batch = std::min(rays, kBatchRays);
+    plan.buffers.push_back({"shading points (per batch)", batch * 4 * real_size});
+    plan.buffers.push_back({"shading normals (per batch)", batch * 4 * sizeof(float)});
+    plan.buffers.push_back({"light sample points", points * 4 * real_size});
+    plan.buffers.push_back({"occlusion masks (per batch)", batch * sizeof(cl_ulong)});
+  }
+  // Secondary rays: one pass per effect a material asks for, sharing the one "trace" kernel.
+  const std::vector<KernelConfig> trace = with_entry("trace");
+  bool reflective = false, transparent = false;
+  for (const SceneSurface& s : scene.surfaces) {
+    reflective |= s.materials.front.reflectivity > 0 || s.materials.back.reflectivity > 0;
+    transparent |= s.materials.front.transparency > 0 || s.materials.back.transparency > 0;
+  }
+  const struct {
+    const char* name;
+    bool wanted;
+    const char* why;
+  } effects[] = {
+      {"reflection", reflective, "mirror rays of reflective sides"},
+      {"transmission", transparent, "rays continued through transparent sides to the next root"},
+  };
+  for (const auto& effect : effects) {
+    const std::string name = effect.name;
+    if (!effect.wanted)
+      plan.skipped.push_back(name + ": no material asks for it");
+    else if (scene.render.preview)
+      plan.skipped.push_back(name + ": preview mode traces primary rays only");
+    else if (scene.render.max_depth == 0)
+      plan.skipped.push_back(name + ": render.max_depth is 0");
+    else {
+      plan.passes.push_back(
+          {name, std::string(effect.why) + ", up to depth " + std::to_string(scene.render.max_depth), trace});
+      // Each bounce can double a tile's rays; they are traced in batches of at most kBatchRays.
+      const std::size_t batch = rays << std::min(scene.render.max_depth - 1, 8) < kBatchRays
+                                    ? rays << std::min(scene.render.max_depth - 1, 8)
+                                    : kBatchRays;
+      plan.buffers.push_back({name + " rays (per batch)", batch * 8 * real_size});
+      plan.buffers.push_back({name + " hits (per batch)", batch * sizeof(HitRecord)});
+    }
+  }
+  if (adaptive) {
+    const std::string n = std::to_string(plan.refine_samples);
+    plan.passes.push_back({"antialias", n + "x" + n + " camera rays in pixels whose colour differs from a neighbour's",
+                           trace});
+    const std::size_t batch =
+        std::min(rays * static_cast<std::size_t>(plan.refine_samples * plan.refine_samples), kBatchRays);
+    plan.buffers.push_back({"antialias rays (per batch)", batch * 8 * real_size});
+    plan.buffers.push_back({"antialias hits (per batch)", batch * sizeof(HitRecord)});
+  } else {
+    plan.skipped.push_back("antialias: " + std::string(scene.render.preview && scene.antialias.samples > 1
+                                                          ? "preview mode traces one camera ray per pixel"
+                                                          : scene.antialias.samples > 1 ? "uniform supersampling"
+                                                                                     : "off (one ray per pixel)"));
+  }
+  // The host's share of one tile's work, per camera ray of the tile: its hit record (twice, and which surface,
+  // with several), the shadow answers (an index each way, a mask per light), what its bounces bring back; and
+  // per ray of the batch in flight (rays, hits, weights, staging, the rays waiting for the next bounce), about
+  // 100 bytes for shadow rays alone and 600 with bounces.
+  const bool several = scene.surfaces.size() > 1;
+  const bool shadows = plan.find("shadow") != nullptr;
+  const bool bounces = plan.find("reflection") || plan.find("transmission");
+  std::uint64_t per_ray = sizeof(HitRecord) * (several ? 2 : 1) + (several ? 1 : 0);
+  if (shadows) per_ray += 8 + 8 * plan.shadow_lights.size();
+  if (bounces) per_ray += 3 * sizeof(double);
+  if (adaptive) per_ray += 4 * sizeof(double);  // a refined pixel's colour and alpha
+  const std::uint64_t batch = std::min<std::uint64_t>(
+      kBatchRays, static_cast<std::uint64_t>(rays) * (adaptive ? plan.refine_samples * plan.refine_samples : 1) *
+                      (bounces ? 2 : 1));
+  const std::uint64_t per_batch_ray = bounces || adaptive ? 600 : shadows ? 100 : 0;
+  plan.tile_host_bytes = rays * per_ray + batch * per_batch_ray;
+  return plan;
+}
+
+nlohmann::json RenderPlan::json() const {
+  nlohmann::json j;
+  j["image"] = {{"width", width}, {"height", height}};
+  j["antialias_samples"] = samples;
+  j["adaptive_antialias_samples"] = refine_samples;
+  j["traced"] = {{"width", trace_width()}, {"height", trace_height()}};
+  j["tile"] = {{"size", tile_size}, {"pixels", tile_pixels()}, {"rays", tile_rays()}};
+  j["film_bytes"] = film_bytes();
+  j["tile_host_bytes"] = tile_host_bytes;
+  for (const PlannedPass& p : passes) {
+    nlohmann::json kernels = nlohmann::json::array();
+    for (const KernelConfig& k : p.kernels) kernels.push_back(k.key());
+    j["passes"].push_back({{"name", p.name}, {"purpose", p.purpose}, {"kernels", kernels}});
+  }
+  for (const PlannedBuffer& b : buffers) j["buffers"].push_back({{"name", b.name}, {"bytes", b.bytes}});
+  j["shadow_lights"] = shadow_lights;
+  j["skipped"] = skipped;
+  j["estimated_memory_bytes"] = estimated_memory_bytes();
+  return j;
+}
+
+std::uint64_t RenderPlan::buffer_bytes() const {
+  std::uint64_t sum = 0;
+  for (const PlannedBuffer& b : buffers) sum += b.bytes;
+  return sum;
+}
+
+std::uint64_t RenderPlan::film_bytes() const {
+  const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
+  // RGBA, depth and normal in float; adaptive antialiasing's choice of pixels, a byte each.
+  return pixels * (kFilmBytesPerPixel + (refine_samples > 1 ? 1 : 0));
+}
+
+std::uint64_t RenderPlan::estimated_memory_bytes() const {
+  constexpr std::uint64_t kBase = 128ull << 20;  // the process, the OpenCL runtime and its compiler
+  constexpr std::uint64_t kWriters = 32ull << 20;  // the image writers convert and compress a strip of lines at a time
+  return kBase + kWriters + film_bytes() + tile_host_bytes + buffer_bytes();
+}
+
+namespace {
+
+// MemAvailable from /proc/meminfo: what can be allocated without swapping; 0 when unknown.
+std::uint64_t available_host_memory() {
+  std::FILE* f = std::fopen("/proc/meminfo", "r");
+  if (!f) return 0;
+  char line[256];
+  unsigned long long kb = 0;
+  while (std::fgets(line, sizeof line, f))
+    if (std::sscanf(line, "MemAvailable: %llu kB", &kb) == 1) break;
+  std::fclose(f);
+  return static_cast<std::uint64_t>(kb) * 1024;
+}
+
+std::string gigabytes(std::uint64_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f GB", static_cast<double>(bytes) / 1e9);
+  return buf;
+}
+
+}  // namespace
+
+void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device) {
+  const std::string what = "a " + std::to_string(plan.width) + "x" + std::to_string(plan.height) + " render with " +
+                           std::to_string(plan.samples) + "x" + std::to_string(plan.samples) +
+                           " samples per pixel needs about ";
+  const std::string advice = ": render a smaller image (or with a smaller render.tile_size)";
+  const std::uint64_t need = plan.estimated_memory_bytes();
+  if (const std::uint64_t available = available_host_memory(); available && need > available)
+    throw DeviceError(what + gigabytes(need) + " of memory, and this machine has " + gigabytes(available) +
+                      " available" + advice);
+  if (device.type == "CPU") return;  // its buffers are in the memory counted above
+  if (device.global_mem_bytes && plan.buffer_bytes() > device.global_mem_bytes)
+    throw DeviceError(what + gigabytes(plan.buffer_bytes()) + " of device memory, and " + device.name + " has " +
+                      gigabytes(device.global_mem_bytes) + advice);
+  for (const PlannedBuffer& b : plan.buffers)
+    if (device.max_alloc_bytes && b.bytes > device.max_alloc_bytes)
+      throw DeviceError(what + "a buffer of " + gigabytes(b.bytes) + " (" + b.name + "), and " + device.name +
+                        " allocates at most " + gigabytes(device.max_alloc_bytes) + " at once" + advice);
+}
+
+}  // namespace algray

@@ -1,0 +1,102 @@
+// The render plan: which passes a scene needs, the kernel each builds and the buffers each allocates.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "algray/device/cl_runtime.h"
+#include "algray/device/kernel_config.h"
+#include "algray/scene/scene.h"
+
+namespace algray {
+
+// One pass: the rays it traces and the kernel it launches. Nothing outside the plan is built or launched.
+struct PlannedPass {
+  std::string name;     // "primary", "shadow", "reflection", "transmission", "antialias"
+  std::string purpose;  // why the scene needs it, for --stats
+  std::vector<KernelConfig> kernels;  // one per surface of the scene, in scene order
+};
+
+struct PlannedBuffer {
+  std::string name;
+  std::size_t bytes = 0;
+};
+
+// Rays per launch of the shadow and trace kernels, and per group of bounces: small enough that one batch's work
+// (some 600 bytes a ray with bounces, host and device together, the rays of the next bounce included) stays near
+// 40 MB whatever the tile, the antialiasing and the bounces. Measured on the Barth sextic in full mode at
+// 1024x768: shadow kernel time alike at 2^14, 2^16 and 2^18 (58, 16 and 8 launches); peak memory with
+// reflection and transmission 90 MB lower at 2^16 than at 2^18.
+inline constexpr std::size_t kBatchRays = std::size_t{1} << 16;
+
+// Bytes per output pixel of the film: RGBA, depth and normal, in float.
+inline constexpr std::uint64_t kFilmBytesPerPixel = 32;
+
+struct RenderPlan {
+  int width = 0, height = 0;  // the output image
+  // Side of a tile in traced rays; a tile holds whole pixels, tile_pixels() per side. The render works through
+  // every pass one tile at a time, so its memory is the film plus one tile's work.
+  int tile_size = 1024;
+  int tile_pixels() const { return std::max(1, tile_size / samples); }
+  // Camera rays of the largest tile.
+  std::size_t tile_rays() const {
+    return static_cast<std::size_t>(std::min(tile_pixels(), width)) * samples * std::min(tile_pixels(), height) *
+           samples;
+  }
+  int samples = 1;            // antialiasing: samples x samples camera rays per pixel, traced as one grid
+  int refine_samples = 0;     // adaptive antialiasing: n x n rays later, in pixels that differ (0: off)
+  double refine_threshold = 0;
+  int trace_width() const { return width * samples; }
+  int trace_height() const { return height * samples; }
+  std::vector<PlannedPass> passes;
+  std::vector<PlannedBuffer> buffers;
+  std::vector<int> shadow_lights;  // indices into Scene::lights whose shadows the shadow pass traces
+  // Everything left out, and why ("shadow: no light casts shadows"), so --stats explains the plan.
+  std::vector<std::string> skipped;
+
+  const PlannedPass* find(const std::string& name) const;
+  nlohmann::json json() const;
+
+  std::uint64_t tile_host_bytes = 0;  // the host's share of one tile's work (hits, shadow answers, a batch)
+
+  // The device buffers together (one tile's and one batch's), the film, and the peak memory of the whole render
+  // on the host: a base for the process and the OpenCL runtime, the film, one tile's work on the host and on
+  // the device (which on a CPU is host memory too), and the writers' strips. Checked against peak RSS by
+  // bench/memory.py (bench/RESULTS.md, "Memory: tile by tile"); kept on the generous side.
+  std::uint64_t buffer_bytes() const;
+  std::uint64_t film_bytes() const;
+  std::uint64_t estimated_memory_bytes() const;
+};
+
+// Throws DeviceError, naming the estimate, when the plan cannot fit: more than the machine's available memory,
+// or, on a device with its own memory, more than that memory or its largest allocation. Called before anything
+// is allocated, so that a 32768 x 32768 render with antialiasing is refused at once rather than killed later.
+void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device);
+
+// The passes and buffers `scene` calls for in `precision`. The primary pass is always there; the shadow pass
+// only when a light casts shadows and the scene is not a preview.
+// tile_size: the tile side in traced rays; 0 takes the scene's render.tile_size, or 1024 when it has none.
+// lanes: camera rays per primary work-item where lanes_apply (kernel_config.h); the scene's render.lanes, when
+// set, comes first.
+RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size = 0, int lanes = 1);
+
+// Whether RayOrigin::Auto means the screen form for camera rays: in double, with the camera outside the extent,
+// facing its centre. Measured to keep the double line at every degree; in float it found the wrong sheet on the
+// Chebyshev nonic and the Roman surface (depth errors 0.15 and 0.08), so float keeps the extent construction
+// (bench/RESULTS.md, "The screen form").
+bool screen_form_applies(const Scene& scene, Precision precision);
+
+// The kernel of the primary pass for one surface of `scene`.
+KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t surface = 0);
+
+// How far a shadow ray's origin is moved off the surface, along the normal to the light's side, in units of
+// the extent's radius (unit coordinates): well above the hit point's error in the precision, well below what
+// shows in an image. Measured with test_shadows' 2000 seeded rays per precision: in float, 1e-4 left 6 origins
+// within rounding of the surface and 4 self-shadowed; in double none down to 1e-13.
+double shadow_offset_unit(Precision precision);
+
+}  // namespace algray

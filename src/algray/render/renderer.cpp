@@ -1,0 +1,729 @@
+// Runs a render plan tile by tile: a tile's camera rays, their shadow rays and bounces, then its pixels in the
+// film, before the next tile; adaptive antialiasing then refines tile by tile from the film's first colours.
+#include "algray/render/renderer.h"
+
+#include <sys/mman.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <future>
+#include <limits>
+#include <memory>
+#include <new>
+#include <utility>
+
+#include "algray/render/ray_tracer.h"
+#include "algray/render/shade.h"
+#include "algray/render/shadow_tracer.h"
+
+namespace algray {
+
+int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 256 : 1024; }
+
+Precision resolve_precision(const Scene& scene, const DeviceInfo& device) {
+  if (!scene.render.precision) return device.fp64 ? Precision::Double : Precision::Float;
+  if (*scene.render.precision == Precision::Double && !device.fp64)
+    throw DeviceError("device '" + device.name + "' has no double precision (cl_khr_fp64); use --precision float");
+  return *scene.render.precision;
+}
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// A primary launch covers the tile with one work-item per `lanes` pixels of a row (kernels/primary.cl).
+constexpr std::size_t kLaneGroupWidth = 16;
+cl::NDRange primary_global_size(int lanes, int width, int height) {
+  const std::size_t w = static_cast<std::size_t>(width), h = static_cast<std::size_t>(height);
+  if (lanes == 1) return cl::NDRange(w, h);
+  const std::size_t items = (w + static_cast<std::size_t>(lanes) - 1) / static_cast<std::size_t>(lanes);
+  return cl::NDRange((items + kLaneGroupWidth - 1) / kLaneGroupWidth * kLaneGroupWidth, h);
+}
+// Lanes multiply each work-item's private arrays; PoCL keeps a work-group's on one thread's stack and picks
+// work-groups of up to 4096 items on its own, which overflows it (bench/lockstep_lanes crashed so). Rows of 16
+// work-items, 128 pixels at 8 lanes, keep it small; one-lane kernels keep the device's choice.
+cl::NDRange primary_local_size(int lanes) { return lanes == 1 ? cl::NullRange : cl::NDRange(kLaneGroupWidth, 1); }
+
+// Keeps, per ray, the nearer of the hits found so far (surface `best`) and `other`'s hits (surface `index`).
+// The solver work of both is added up, and a depth-limited isolation on either is kept, so the statistics
+// and the solver channels count every surface's kernel.
+void keep_nearest(HitRecord* best, std::size_t count, std::vector<std::uint8_t>& best_surface, const HitRecord* other,
+                  std::uint8_t index) {
+  if (best_surface.size() != count) best_surface.assign(count, 0);
+  for (std::size_t i = 0; i < count; ++i) {
+    const HitRecord& o = other[i];
+    HitRecord& b = best[i];
+    const std::uint32_t steps = std::min(0xffffu, (b.work & 0xffffu) + (o.work & 0xffffu));
+    const std::uint32_t iterations = std::min(0xffffu, (b.work >> 16) + (o.work >> 16));
+    const std::uint32_t shared_flags = (b.flags | o.flags) & (ALGRAY_HIT_BUDGET | ALGRAY_HIT_IN_EXTENT);
+    const double tb = static_cast<double>(b.t_hi) + static_cast<double>(b.t_lo);
+    const double to = static_cast<double>(o.t_hi) + static_cast<double>(o.t_lo);
+    if ((o.flags & ALGRAY_HIT_FOUND) && (!(b.flags & ALGRAY_HIT_FOUND) || to < tb)) {
+      b = o;
+      best_surface[i] = index;
+    }
+    b.work = steps | iterations << 16;
+    b.flags |= shared_flags;
+  }
+}
+
+// Adaptive antialiasing's choice, from the film's first colours (one ray per pixel): the pixels whose colour
+// differs from a neighbour's by more than the threshold in some channel. Made for the whole image before any
+// pixel is refined, so a tile's choice at its border sees its neighbours' first colours, as one image would.
+std::vector<std::uint8_t> pixels_to_refine(const FrameImage& coarse, double threshold) {
+  const int w = coarse.width, h = coarse.height;
+  auto differs = [&](int x0, int y0, int x1, int y1) {
+    if (x1 < 0 || y1 < 0 || x1 >= w || y1 >= h) return false;
+    const std::size_t a = 4 * (static_cast<std::size_t>(y0) * w + x0), b = 4 * (static_cast<std::size_t>(y1) * w + x1);
+    for (int c = 0; c < 4; ++c)
+      if (std::fabs(coarse.rgba[a + c] - coarse.rgba[b + c]) > threshold) return true;
+    return false;
+  };
+  std::vector<std::uint8_t> refine(static_cast<std::size_t>(w) * h, 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      refine[static_cast<std::size_t>(y) * w + x] =
+          differs(x, y, x - 1, y) || differs(x, y, x + 1, y) || differs(x, y, x, y - 1) || differs(x, y, x, y + 1);
+  return refine;
+}
+
+}  // namespace
+
+// Page-aligned anonymous memory with every page faulted in as it is made (MAP_POPULATE: one system call rather
+// than a fault per page, which the kernel's threads would otherwise take on the render's path). 4 KB pages on
+// purpose: transparent huge pages populate 4x faster back to back, but on a VM that hands free memory back to
+// its host (Firecracker here) a fresh process's 2 MB pages are often host-faulted, and a 1024^2 preview at a
+// user's pace took 242 ms against 167 (bench/RESULTS.md, "Transparent huge pages: tried").
+class PopulatedPages {
+ public:
+  explicit PopulatedPages(std::size_t bytes) : bytes_(std::max<std::size_t>(bytes, 1)) {
+    void* p = ::mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    data_ = p;
+  }
+  PopulatedPages(PopulatedPages&& other) noexcept
+      : data_(std::exchange(other.data_, nullptr)), bytes_(std::exchange(other.bytes_, 0)) {}
+  PopulatedPages& operator=(PopulatedPages&&) = delete;
+  PopulatedPages(const PopulatedPages&) = delete;
+  ~PopulatedPages() {
+    if (data_) ::munmap(data_, bytes_);
+  }
+  void* data() const { return data_; }
+
+ private:
+  void* data_ = nullptr;
+  std::size_t bytes_;
+};
+
+// Host memory for one tile's hit records, which the primary kernel writes through a CL_MEM_USE_HOST_PTR buffer.
+// On a CPU device the kernel writes this memory itself and mapping it copies nothing; on a GPU the map copies
+// once. Either way the host neither zero-fills a vector of 32 bytes a ray nor copies into it: at 1024^2 that
+// was 32 MB of page faults and a 32 MB copy, about a fifth of a preview's host time.
+class Renderer::TileHits {
+ public:
+  // `memory` holds at least `capacity` records.
+  TileHits(const cl::Context& context, cl::CommandQueue& queue, std::size_t capacity, PopulatedPages memory)
+      : memory_(std::move(memory)),
+        buffer_(context, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, capacity * sizeof(HitRecord), memory_.data()),
+        queue_(queue) {}
+  TileHits(const TileHits&) = delete;
+  TileHits& operator=(const TileHits&) = delete;
+  ~TileHits() {
+    // No throwing from here: the C call, whose failure leaves nothing to undo.
+    if (mapped_) clEnqueueUnmapMemObject(queue_(), buffer_(), mapped_, 0, nullptr, nullptr);
+    clFinish(queue_());
+  }
+  const cl::Buffer& buffer() const { return buffer_; }
+  // The first `count` records as the queue's finished work left them, readable and writable on the host until
+  // release(), which must come before the buffer is written again.
+  HitRecord* map(std::size_t count) {
+    release();
+    mapped_ = static_cast<HitRecord*>(
+        queue_.enqueueMapBuffer(buffer_, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, count * sizeof(HitRecord)));
+    return mapped_;
+  }
+  void release() {
+    if (!mapped_) return;
+    queue_.enqueueUnmapMemObject(buffer_, mapped_);
+    mapped_ = nullptr;
+  }
+
+ private:
+  PopulatedPages memory_;  // page-aligned, as zero-copy host pointers want
+  cl::Buffer buffer_;
+  cl::CommandQueue& queue_;
+  HitRecord* mapped_ = nullptr;
+};
+
+// A block of whole output pixels and the camera rays that trace it.
+struct Renderer::Tile {
+  int x0, y0, width, height;                 // output pixels
+  int trace_x0, trace_y0, trace_w, trace_h;  // traced rays: samples per pixel side
+  std::size_t rays() const { return static_cast<std::size_t>(trace_w) * trace_h; }
+  std::size_t pixels() const { return static_cast<std::size_t>(width) * height; }
+  // A camera ray of the tile (index k of its traced block) in the whole traced grid of `grid_width`.
+  std::uint32_t ray_in_image(std::size_t k, int grid_width) const {
+    return static_cast<std::uint32_t>((trace_y0 + k / trace_w) * static_cast<std::size_t>(grid_width) + trace_x0 +
+                                      k % trace_w);
+  }
+  // A pixel of the tile (index k, row-major) in the whole image of `image_width`.
+  std::size_t pixel_in_image(std::size_t k, int image_width) const {
+    return (y0 + k / width) * static_cast<std::size_t>(image_width) + x0 + k % width;
+  }
+};
+
+// A ray waiting to be continued: the sample it adds to (the tile's camera ray, or pixel when refining), its
+// weight, the ray and its hit.
+struct Renderer::Bounce {
+  std::uint32_t sample;
+  double weight;
+  PixelRay ray;
+  HitRecord hit;
+  std::uint8_t surface;  // which of the scene's surfaces it hit
+};
+
+// What every tile's passes share while a render runs: kernels, tracers, the stats, and one tile's buffers,
+// which the next tile reuses.
+struct Renderer::Passes {
+  Passes(const Scene& s, const RenderOptions& o, Precision p, RenderResult& r)
+      : scene(s), options(o), precision(p), result(r), stats(r.plan.passes.size()) {}
+  const Scene& scene;
+  const RenderOptions& options;
+  Precision precision;
+  RenderResult& result;
+  std::vector<std::unique_ptr<DeviceSurface>> surfaces;  // one per scene surface
+  std::vector<PassStats> stats;                          // one per planned pass, in plan order
+  std::vector<cl::Kernel> primary;                       // one per surface
+  std::vector<cl_uint> primary_tile_arg;                 // per surface: the index of its tile_x0 argument
+  std::vector<int> primary_lanes;                        // per surface: its kernel's camera rays per work-item
+  std::vector<cl::Buffer> screen_rows;                   // per surface: a band's rows for screen-form builds
+  std::unique_ptr<TileHits> primary_out;                 // a tile's hit records, of the first surface
+  std::unique_ptr<TileHits> other_out;                   // several surfaces: those of the next ones
+  std::vector<std::unique_ptr<ShadowTracer>> shadows;    // one per surface, when the plan has a shadow pass
+  std::unique_ptr<ShadowPoints> shadow_points;           // a batch's surface points on the device
+  std::vector<std::vector<glm::dvec3>> light_points;     // per shadow-casting light of the plan
+  std::vector<std::unique_ptr<RayTracer>> rays;          // one per surface, when it has a secondary pass
+  std::unique_ptr<Shader> shader;
+  RayBasis fine;  // adaptive antialiasing: the rays of the n-times finer grid
+
+  // One tile's work.
+  HitRecord* hits = nullptr;              // camera rays, row-major in the tile: primary_out mapped
+  std::vector<std::uint8_t> hit_surface;  // several surfaces: which one each hit
+  std::vector<glm::dvec3> secondary;      // per camera ray: what its bounces bring back
+  bool any_secondary = false;
+  std::vector<glm::dvec3> refined_colour;  // adaptive antialiasing: per pixel of the tile
+  std::vector<double> refined_alpha;
+
+  int tiles_done = 0, tiles_total = 0;
+
+  PassStats* stats_of(const std::string& name) {
+    for (std::size_t i = 0; i < stats.size(); ++i)
+      if (result.plan.passes[i].name == name) return &stats[i];
+    return nullptr;
+  }
+  bool single() const { return precision != Precision::Double; }
+  void progress() {
+    ++tiles_done;
+    if (!options.show_progress) return;
+    std::fprintf(stderr, "\rrendering %s: %3d%% (%d/%d tiles)", scene.name.c_str(), 100 * tiles_done / tiles_total,
+                 tiles_done, tiles_total);
+    std::fflush(stderr);
+  }
+};
+
+namespace {
+
+// Shadow rays from every hit of one batch, in groups of at most batch_rays surface points; ray(i) is the ray of hit i
+// (camera rays rebuilt exactly as the kernel traced them; secondary rays in double, which a float kernel traced
+// rounded).
+template <typename Passes, typename RayOf>
+ShadowData trace_shadows(Passes& p, const HitRecord* hits, std::size_t count, RayOf ray) {
+  const auto start = std::chrono::steady_clock::now();
+  PassStats& stats = *p.stats_of("shadow");
+  ShadowData data;
+  for (std::size_t i = 0; i < count; ++i)
+    if (hits[i].flags & ALGRAY_HIT_FOUND) data.points.push_back(static_cast<std::uint32_t>(i));
+  const std::vector<int>& lights = p.result.plan.shadow_lights;
+  for (int light : lights) data.occlusion.push_back({light, std::vector<std::uint64_t>(data.points.size())});
+  std::vector<glm::dvec3> points;
+  std::vector<glm::vec3> normals;
+  const std::size_t batch_rays = p.options.batch_rays;
+  for (std::size_t begin = 0; begin < data.points.size(); begin += batch_rays) {
+    const std::size_t end = std::min(data.points.size(), begin + batch_rays);
+    points.clear();
+    normals.clear();
+    for (std::size_t k = begin; k < end; ++k) {
+      const HitRecord& h = hits[data.points[k]];
+      points.push_back(hit_point(ray(data.points[k]), h));
+      normals.emplace_back(h.normal_x, h.normal_y, h.normal_z);
+    }
+    p.shadow_points->upload(points, normals);
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+      // Each surface's kernel in turn; a light point one surface hides is not traced against the next. A ray
+      // counts once, from the first surface's kernel, which traces every light point in front of the surface.
+      std::vector<std::uint64_t> hidden;
+      for (std::size_t s = 0; s < p.shadows.size(); ++s) {
+        ShadowAnswer answer = p.shadows[s]->trace(*p.shadow_points, p.light_points[l], hidden);
+        stats.kernel_ms += answer.kernel_ms;
+        stats.program_ms[s] += answer.kernel_ms;
+        ++stats.launches;
+        if (s == 0) stats.rays += answer.rays_traced;
+        hidden = std::move(answer.masks);
+      }
+      std::copy(hidden.begin(), hidden.end(), data.occlusion[l].masks.begin() + static_cast<std::ptrdiff_t>(begin));
+    }
+  }
+  stats.wall_ms += ms_since(start);
+  return data;
+}
+
+// Splits rays waiting for a bounce into groups of whole samples, each of about batch_rays rays, keeping their
+// order. A sample's colour adds up its rays in the order they are traced, and that order is the same whether
+// its group is traced alone or with others, so the split changes no pixel.
+template <typename Bounce>
+std::vector<std::vector<Bounce>> split_by_sample(std::vector<Bounce>& all, std::size_t sample_count,
+                                                 std::size_t batch_rays) {
+  std::vector<std::uint32_t> group(sample_count, 0);  // first the rays per sample, then each sample's group
+  for (const Bounce& b : all) ++group[b.sample];
+  std::uint32_t g = 0;
+  std::size_t filled = 0;
+  for (std::uint32_t& count : group) {
+    if (filled > 0 && filled + count > batch_rays) {
+      ++g;
+      filled = 0;
+    }
+    filled += count;
+    count = g;
+  }
+  std::vector<std::vector<Bounce>> groups(g + 1);
+  for (Bounce& b : all) groups[group[b.sample]].push_back(b);
+  all.clear();
+  all.shrink_to_fit();
+  return groups;
+}
+
+}  // namespace
+
+RenderResult Renderer::render(const Scene& scene, bool show_progress) {
+  RenderOptions options;
+  options.show_progress = show_progress;
+  options.keep_records = true;
+  return render(scene, options);
+}
+
+RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) {
+  RenderResult result;
+  const Precision precision = resolve_precision(scene, session_.info);
+  const int tile_side = scene.render.tile_size > 0 ? scene.render.tile_size : default_tile_size(session_.info);
+  result.plan = make_render_plan(scene, precision, tile_side, default_lanes(session_.info.type));
+  check_plan_fits(result.plan, session_.info);
+  result.config = primary_config(scene, precision);
+  const RenderPlan& plan = result.plan;
+  const int trace_width = plan.trace_width(), trace_height = plan.trace_height();
+  result.basis = make_ray_basis(scene.camera, trace_width, trace_height);
+  Passes passes(scene, options, precision, result);
+  for (std::size_t i = 0; i < scene.surfaces.size(); ++i)
+    passes.surfaces.push_back(std::make_unique<DeviceSurface>(session_.context, scene, precision, i));
+  prepare_passes(passes);
+  passes.shader = std::make_unique<Shader>(scene, plan, result.basis, precision);
+  if (options.film) result.image = options.film();
+  if (result.image.width != plan.width || result.image.height != plan.height ||
+      result.image.rgba.size() != 4 * static_cast<std::size_t>(plan.width) * plan.height)
+    result.image = make_film(plan);
+  if (options.keep_records) {
+    result.hits.width = trace_width;
+    result.hits.height = trace_height;
+    result.hits.records.resize(static_cast<std::size_t>(trace_width) * trace_height);
+    if (scene.surfaces.size() > 1) result.hits.surface.assign(result.hits.records.size(), 0);
+    for (int light : plan.shadow_lights) result.shadows.occlusion.push_back({light, {}});
+  }
+
+  // Row by row of tiles, as the film's lines are laid out.
+  std::vector<Tile> tiles;
+  const int side = plan.tile_pixels(), s = plan.samples;
+  for (int y0 = 0; y0 < plan.height; y0 += side)
+    for (int x0 = 0; x0 < plan.width; x0 += side) {
+      const int w = std::min(side, plan.width - x0), h = std::min(side, plan.height - y0);
+      tiles.push_back({x0, y0, w, h, x0 * s, y0 * s, w * s, h * s});
+    }
+  const bool adaptive = plan.refine_samples > 1;
+  passes.tiles_total = static_cast<int>(tiles.size()) * (adaptive ? 2 : 1);
+  for (std::size_t t = 0; t < tiles.size(); ++t) {
+    const Tile& tile = tiles[t];
+    if (t == 0 || tile.y0 != tiles[t - 1].y0) set_band_args(passes, tile);
+    trace_primary(passes, tile);
+    finish_tile(passes, tile);
+    passes.progress();
+  }
+  if (adaptive) {
+    const auto start = std::chrono::steady_clock::now();
+    passes.fine = make_ray_basis(scene.camera, plan.width * plan.refine_samples, plan.height * plan.refine_samples);
+    const std::vector<std::uint8_t> refine = pixels_to_refine(result.image, plan.refine_threshold);
+    result.shade_ms += ms_since(start);
+    for (const Tile& tile : tiles) {
+      refine_tile(passes, tile, refine);
+      passes.progress();
+    }
+    if (options.keep_records) result.refined = refine;
+  }
+  if (options.show_progress) std::fprintf(stderr, "\n");
+
+  for (std::size_t i = 0; i < passes.stats.size(); ++i) {
+    passes.stats[i].name = plan.passes[i].name;
+    result.passes.push_back(passes.stats[i]);
+  }
+  return result;
+}
+
+void Renderer::prepare_passes(Passes& passes) {
+  const Scene& scene = passes.scene;
+  RenderResult& result = passes.result;
+  const RenderPlan& plan = result.plan;
+  PassStats& primary = *passes.stats_of("primary");
+  // The largest tile: a tile's hit records are all the device holds for the camera rays. Their memory (32 MB
+  // at 1024^2) is populated on another thread while this one loads the programs, a core's work either way.
+  const std::size_t tile_rays = static_cast<std::size_t>(std::min(plan.tile_pixels(), plan.width)) * plan.samples *
+                                std::min(plan.tile_pixels(), plan.height) * plan.samples;
+  std::future<PopulatedPages> hit_memory =
+      std::async(std::launch::async, [tile_rays] { return PopulatedPages(tile_rays * sizeof(HitRecord)); });
+  for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
+    ProgramRecord record;
+    passes.primary.push_back(cache_.kernel(session_, plan.find("primary")->kernels[s], &record));
+    passes.primary_tile_arg.push_back(0);
+    passes.primary_lanes.push_back(plan.find("primary")->kernels[s].lanes);
+    passes.screen_rows.emplace_back();
+    result.programs.push_back(record);
+    primary.program_keys.push_back(record.key);
+    primary.program_ms.push_back(0);
+  }
+  passes.primary_out = std::make_unique<TileHits>(session_.context, session_.queue, tile_rays, hit_memory.get());
+  if (scene.surfaces.size() > 1)
+    passes.other_out = std::make_unique<TileHits>(session_.context, session_.queue, tile_rays,
+                                                  PopulatedPages(tile_rays * sizeof(HitRecord)));
+
+  if (PassStats* stats = passes.stats_of("shadow")) {
+    const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
+    for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+      passes.shadows.push_back(std::make_unique<ShadowTracer>(session_, cache_, plan.find("shadow")->kernels[i],
+                                                              *passes.surfaces[i], offset));
+      result.programs.push_back(passes.shadows.back()->program());
+      stats->program_keys.push_back(passes.shadows.back()->program().key);
+      stats->program_ms.push_back(0);
+    }
+    passes.shadow_points = std::make_unique<ShadowPoints>(session_, passes.precision);
+    for (int light : plan.shadow_lights)
+      passes.light_points.push_back(scene.lights[static_cast<std::size_t>(light)].sample_points());
+  }
+  // Every secondary pass launches the same trace kernels.
+  for (const char* name : {"reflection", "transmission", "antialias"})
+    if (PassStats* stats = passes.stats_of(name)) {
+      if (passes.rays.empty())
+        for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+          passes.rays.push_back(
+              std::make_unique<RayTracer>(session_, cache_, plan.find(name)->kernels[i], *passes.surfaces[i]));
+          result.programs.push_back(passes.rays.back()->program());
+        }
+      for (const auto& tracer : passes.rays) {
+        stats->program_keys.push_back(tracer->program().key);
+        stats->program_ms.push_back(0);
+      }
+    }
+}
+
+void Renderer::set_band_args(Passes& passes, const Tile& first) {
+  RenderResult& result = passes.result;
+  const RenderPlan& plan = result.plan;
+  const auto start = std::chrono::steady_clock::now();
+  for (std::size_t s = 0; s < passes.surfaces.size(); ++s) {
+    const DeviceSurface& surface = *passes.surfaces[s];
+    KernelArgs args(passes.primary[s], surface.precision());
+    args.ray_basis(result.basis);
+    surface.set_extent_args(args);
+    surface.set_surface_args(args);
+    // The screen form's polynomials of the band's rows; the kernel must answer each camera ray alike whatever
+    // tile and band it is in (test_secondary_rays compares renders in small and large tiles bit for bit).
+    passes.screen_rows[s] =
+        surface.set_screen_args(args, session_.context, plan.find("primary")->kernels[s], result.basis,
+                                plan.trace_width(), plan.trace_height(), first.trace_y0, first.trace_h);
+    passes.primary_tile_arg[s] = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
+    args.skip(4);
+    args.plain((s == 0 ? passes.primary_out : passes.other_out)->buffer());
+  }
+  passes.stats_of("primary")->wall_ms += ms_since(start);
+}
+
+void Renderer::trace_primary(Passes& passes, const Tile& tile) {
+  PassStats& pass = *passes.stats_of("primary");
+  const std::size_t rays = tile.rays();
+  passes.primary_out->release();  // the last tile's records: the kernel writes them again
+  passes.hit_surface.clear();
+  for (std::size_t s = 0; s < passes.surfaces.size(); ++s) {
+    const auto start = std::chrono::steady_clock::now();
+    cl::Kernel& kernel = passes.primary[s];
+    const cl_uint tile_arg = passes.primary_tile_arg[s];
+    kernel.setArg(tile_arg, static_cast<cl_uint>(tile.trace_x0));
+    kernel.setArg(tile_arg + 1, static_cast<cl_uint>(tile.trace_y0));
+    kernel.setArg(tile_arg + 2, static_cast<cl_uint>(tile.trace_w));
+    kernel.setArg(tile_arg + 3, static_cast<cl_uint>(tile.trace_h));
+    cl::Event done;
+    session_.queue.enqueueNDRangeKernel(kernel, cl::NullRange,
+                                        primary_global_size(passes.primary_lanes[s], tile.trace_w, tile.trace_h),
+                                        primary_local_size(passes.primary_lanes[s]), nullptr, &done);
+    // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
+    done.wait();
+    pass.kernel_ms += ms_between(done);
+    pass.program_ms[s] += ms_between(done);
+    ++pass.launches;
+    if (s == 0) pass.rays += rays;  // each camera ray once, however many surfaces it is tested against
+    if (s == 0) {
+      passes.hits = passes.primary_out->map(rays);
+    } else {
+      keep_nearest(passes.hits, rays, passes.hit_surface, passes.other_out->map(rays), static_cast<std::uint8_t>(s));
+      passes.other_out->release();
+    }
+    pass.wall_ms += ms_since(start);
+  }
+}
+
+// Traces one batch of secondary rays, then the shadow rays of its hits.
+void Renderer::trace_batch(Passes& passes, SecondaryBatch& batch) {
+  const auto start = std::chrono::steady_clock::now();
+  PassStats& stats = *passes.stats_of(batch.pass);
+  for (std::size_t s = 0; s < passes.rays.size(); ++s) {
+    TracedBatch traced = passes.rays[s]->trace(batch.rays);
+    if (s == 0)
+      batch.hits = std::move(traced.hits);
+    else
+      keep_nearest(batch.hits.data(), batch.hits.size(), batch.hit_surface, traced.hits.data(),
+                   static_cast<std::uint8_t>(s));
+    stats.kernel_ms += traced.kernel_ms;
+    stats.program_ms[s] += traced.kernel_ms;
+    if (s == 0) stats.rays += batch.rays.size();
+    ++stats.launches;
+  }
+  stats.wall_ms += ms_since(start);
+  if (!passes.shadows.empty())
+    batch.shadows =
+        trace_shadows(passes, batch.hits.data(), batch.hits.size(), [&](std::size_t i) { return batch.rays[i]; });
+}
+
+void Renderer::finish_tile(Passes& passes, const Tile& tile) {
+  RenderResult& result = passes.result;
+  const RenderPlan& plan = result.plan;
+  const std::size_t rays = tile.rays();
+  const int grid_width = plan.trace_width();
+  const bool single = passes.single();
+  auto camera_ray = [&](std::size_t k) {
+    return pixel_ray(result.basis, single, tile.trace_x0 + static_cast<int>(k % tile.trace_w),
+                     tile.trace_y0 + static_cast<int>(k / tile.trace_w));
+  };
+  result.primary.add(passes.hits, tile.trace_w, tile.trace_h, plan.samples);
+  if (passes.options.on_primary_tile)
+    passes.options.on_primary_tile(
+        {tile.trace_x0, tile.trace_y0, tile.trace_w, tile.trace_h, plan.samples, passes.hits});
+  if (passes.options.keep_records)
+    for (std::size_t k = 0; k < rays; ++k) {
+      const std::uint32_t at = tile.ray_in_image(k, grid_width);
+      result.hits.records[at] = passes.hits[k];
+      if (!passes.hit_surface.empty()) result.hits.surface[at] = passes.hit_surface[k];
+    }
+
+  ShadowData shadows;
+  if (!passes.shadows.empty()) {
+    shadows = trace_shadows(passes, passes.hits, rays, camera_ray);
+    if (passes.options.keep_records) {
+      for (std::uint32_t k : shadows.points) result.shadows.points.push_back(tile.ray_in_image(k, grid_width));
+      for (std::size_t l = 0; l < shadows.occlusion.size(); ++l) {
+        std::vector<std::uint64_t>& all = result.shadows.occlusion[l].masks;
+        all.insert(all.end(), shadows.occlusion[l].masks.begin(), shadows.occlusion[l].masks.end());
+      }
+    }
+  }
+
+  // Reflection and transmission from the camera rays' hits, batch_rays camera rays at a time.
+  passes.any_secondary = false;
+  if (passes.stats_of("reflection") || passes.stats_of("transmission")) {
+    passes.secondary.assign(rays, glm::dvec3(0));
+    std::vector<Bounce> first;
+    for (std::size_t k = 0; k < rays; ++k) {
+      const HitRecord& h = passes.hits[k];
+      if (!(h.flags & ALGRAY_HIT_FOUND)) continue;
+      first.push_back({static_cast<std::uint32_t>(k), 1.0, camera_ray(k), h,
+                       passes.hit_surface.empty() ? std::uint8_t{0} : passes.hit_surface[k]});
+      if (first.size() == passes.options.batch_rays) {
+        run_bounces(passes, tile, std::move(first), 1, false);
+        first.clear();
+      }
+    }
+    if (!first.empty()) run_bounces(passes, tile, std::move(first), 1, false);
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  const ShadowLookup lookup(shadows, rays, passes.scene.lights.size());
+  TracedBlock block;
+  block.x0 = tile.trace_x0;
+  block.y0 = tile.trace_y0;
+  block.width = tile.trace_w;
+  block.height = tile.trace_h;
+  block.hits = passes.hits;
+  block.surface = passes.hit_surface.empty() ? nullptr : passes.hit_surface.data();
+  block.shadows = &lookup;
+  block.secondary = passes.any_secondary ? passes.secondary.data() : nullptr;
+  passes.shader->resolve(block, result.image);
+  result.shade_ms += ms_since(start);
+}
+
+void Renderer::run_bounces(Passes& passes, const Tile& tile, std::vector<Bounce> current, int depth, bool refinement) {
+  const Scene& scene = passes.scene;
+  RenderResult& result = passes.result;
+  if (current.empty() || depth > scene.render.max_depth) return;
+  const std::size_t samples_in_tile = refinement ? tile.pixels() : tile.rays();
+  if (current.size() > passes.options.batch_rays) {
+    // A group at a time, to the last bounce, so that memory holds one group's rays however many a bounce makes.
+    std::vector<std::vector<Bounce>> groups = split_by_sample(current, samples_in_tile, passes.options.batch_rays);
+    for (std::vector<Bounce>& group : groups) run_bounces(passes, tile, std::move(group), depth, refinement);
+    return;
+  }
+  const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
+  // Below this a bounce cannot change a pixel's 8-bit colour.
+  constexpr double kNegligibleWeight = 1.0 / 512;
+  const double pixel_share =
+      refinement ? static_cast<double>(result.plan.refine_samples) * result.plan.refine_samples : 1.0;
+  const char* const names[2] = {"reflection", "transmission"};
+  const bool wanted[2] = {passes.stats_of(names[0]) != nullptr, passes.stats_of(names[1]) != nullptr};
+  std::vector<Bounce> next;
+  for (int k = 0; k < 2; ++k) {
+    if (!wanted[k]) continue;
+    SecondaryBatch batch;
+    batch.pass = names[k];
+    batch.depth = depth;
+    batch.refinement = refinement;
+    for (const Bounce& b : current) {
+      const Materials& sides = scene.surfaces[b.surface].materials;
+      const Material& m = (b.hit.flags & ALGRAY_HIT_BACK) ? sides.back : sides.front;
+      const double share = k == 0 ? m.reflectivity : m.transparency;
+      // A refined pixel's rays carry 1/n^2 each: the cut-off is on the share of the pixel they stand for.
+      if (b.weight * share * pixel_share < kNegligibleWeight) continue;
+      const glm::dvec3 p = hit_point(b.ray, b.hit);
+      const glm::dvec3 n(b.hit.normal_x, b.hit.normal_y, b.hit.normal_z);  // faces the incoming ray
+      const glm::dvec3 d = b.ray.direction;
+      // Off the surface on the side the new ray leaves into, as shadow rays are, so it cannot find its own hit.
+      const PixelRay ray = k == 0 ? PixelRay{p + offset * n, d - 2 * glm::dot(d, n) * n} : PixelRay{p - offset * n, d};
+      batch.sample.push_back(b.sample);
+      batch.weight.push_back(b.weight * share);
+      batch.rays.push_back(ray);
+    }
+    if (batch.rays.empty()) continue;
+    trace_batch(passes, batch);
+    const auto start = std::chrono::steady_clock::now();
+    passes.shader->add_batch(batch, refinement ? passes.refined_colour : passes.secondary, passes.refined_alpha);
+    passes.any_secondary = true;
+    result.shade_ms += ms_since(start);
+    for (std::size_t i = 0; i < batch.rays.size(); ++i)
+      if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
+        next.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i],
+                        batch.hit_surface.empty() ? std::uint8_t{0} : batch.hit_surface[i]});
+    if (passes.options.keep_records) {
+      for (std::uint32_t& sample : batch.sample)
+        sample = refinement ? static_cast<std::uint32_t>(tile.pixel_in_image(sample, result.plan.width))
+                            : tile.ray_in_image(sample, result.plan.trace_width());
+      result.secondary.push_back(std::move(batch));
+    }
+  }
+  // This bounce's rays are done with before the next bounce's are traced.
+  current.clear();
+  current.shrink_to_fit();
+  run_bounces(passes, tile, std::move(next), depth + 1, refinement);
+}
+
+void Renderer::refine_tile(Passes& passes, const Tile& tile, const std::vector<std::uint8_t>& refine) {
+  RenderResult& result = passes.result;
+  const RenderPlan& plan = result.plan;
+  const int n = plan.refine_samples;
+  std::vector<std::uint32_t> pixels;  // the tile's pixels to refine, row-major
+  for (std::size_t k = 0; k < tile.pixels(); ++k)
+    if (refine[tile.pixel_in_image(k, plan.width)]) pixels.push_back(static_cast<std::uint32_t>(k));
+  if (pixels.empty()) return;
+  passes.refined_colour.assign(tile.pixels(), glm::dvec3(0));
+  passes.refined_alpha.assign(tile.pixels(), 0.0);
+  const bool single = passes.single();
+  // Whole pixels per batch, each with the n x n rays of the n-times finer grid, so that a refined pixel gets
+  // exactly the rays uniform n x n antialiasing would trace.
+  const std::size_t per_batch = std::max<std::size_t>(1, passes.options.batch_rays / (static_cast<std::size_t>(n) * n));
+  for (std::size_t begin = 0; begin < pixels.size(); begin += per_batch) {
+    SecondaryBatch batch;
+    batch.pass = "antialias";
+    batch.depth = 0;
+    batch.refinement = true;
+    for (std::size_t j = begin; j < std::min(pixels.size(), begin + per_batch); ++j) {
+      const int x = tile.x0 + static_cast<int>(pixels[j] % tile.width),
+                y = tile.y0 + static_cast<int>(pixels[j] / tile.width);
+      for (int sy = 0; sy < n; ++sy)
+        for (int sx = 0; sx < n; ++sx) {
+          batch.sample.push_back(pixels[j]);
+          batch.weight.push_back(1.0 / (n * n));
+          batch.rays.push_back(pixel_ray(passes.fine, single, x * n + sx, y * n + sy));
+        }
+    }
+    trace_batch(passes, batch);
+    const auto start = std::chrono::steady_clock::now();
+    passes.shader->add_batch(batch, passes.refined_colour, passes.refined_alpha);
+    result.shade_ms += ms_since(start);
+    std::vector<Bounce> first;
+    for (std::size_t i = 0; i < batch.rays.size(); ++i)
+      if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
+        first.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i],
+                         batch.hit_surface.empty() ? std::uint8_t{0} : batch.hit_surface[i]});
+    if (passes.options.keep_records) {
+      for (std::uint32_t& sample : batch.sample)
+        sample = static_cast<std::uint32_t>(tile.pixel_in_image(sample, plan.width));
+      result.secondary.push_back(std::move(batch));
+    }
+    run_bounces(passes, tile, std::move(first), 1, true);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  for (std::uint32_t k : pixels)
+    passes.shader->resolve_refined(tile.pixel_in_image(k, plan.width), passes.refined_colour[k],
+                                   passes.refined_alpha[k], result.image);
+  result.shade_ms += ms_since(start);
+}
+
+FrameImage shade_frame(const Scene& scene, const RenderResult& result) {
+  const HitBuffer& hits = result.hits;
+  const Shader shader(scene, result.plan, result.basis, result.config.precision);
+  RenderPlan plan = result.plan;
+  plan.width = hits.width / std::max(plan.samples, 1);
+  plan.height = hits.height / std::max(plan.samples, 1);
+  FrameImage img = make_film(plan);
+
+  // What reflection and transmission rays add to each traced camera ray: their weight times what they met.
+  // Adaptive antialiasing's camera rays are such contributions too, with weights 1/n^2; they also carry alpha.
+  std::vector<glm::dvec3> secondary(result.secondary.empty() ? 0 : hits.records.size(), glm::dvec3(0));
+  std::vector<glm::dvec3> refined_colour(result.refined.empty() ? 0 : hits.records.size(), glm::dvec3(0));
+  std::vector<double> refined_alpha(refined_colour.size(), 0.0);
+  std::vector<double> no_alpha;
+  for (const SecondaryBatch& batch : result.secondary) {
+    if (batch.refinement)
+      shader.add_batch(batch, refined_colour, refined_alpha);
+    else
+      shader.add_batch(batch, secondary, no_alpha);
+  }
+  const ShadowLookup shadows(result.shadows, hits.records.size(), scene.lights.size());
+  TracedBlock block;
+  block.width = hits.width;
+  block.height = hits.height;
+  block.hits = hits.records.data();
+  block.surface = hits.surface.empty() ? nullptr : hits.surface.data();
+  block.shadows = &shadows;
+  block.secondary = secondary.empty() ? nullptr : secondary.data();
+  shader.resolve(block, img);
+  for (std::size_t k = 0; k < result.refined.size(); ++k)
+    if (result.refined[k]) shader.resolve_refined(k, refined_colour[k], refined_alpha[k], img);
+  return img;
+}
+
+}  // namespace algray

@@ -1,0 +1,117 @@
+// The render of a plan, tile by tile through every pass into a film, and the records tests and tools may keep.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "kernels/algray_shared.h"
+#include "algray/scene/camera.h"
+#include "algray/device/cl_runtime.h"
+#include "algray/render/device_surface.h"
+#include "algray/io/image_io.h"
+#include "algray/device/program_cache.h"
+#include "algray/render/render_plan.h"
+#include "algray/render/trace_records.h"
+#include "algray/scene/scene.h"
+
+namespace algray {
+
+struct PassStats {
+  std::string name;
+  std::vector<std::string> program_keys;  // ProgramRecord::key of the kernels the pass launched, per surface
+  std::vector<double> program_ms;         // device time of each of those kernels
+  std::uint64_t rays = 0;                 // rays traced, each once however many surfaces it was tested against
+  int launches = 0;
+  double kernel_ms = 0;  // device time summed over launches (profiling events)
+  double wall_ms = 0;
+};
+
+// One tile's camera rays as the primary pass left them, whole pixels of the traced grid, handed to
+// RenderOptions::on_primary_tile before the tile's buffers are reused.
+struct PrimaryTile {
+  int x0 = 0, y0 = 0, width = 0, height = 0;  // in traced rays: plan.samples per pixel side
+  int samples = 1;
+  const HitRecord* hits = nullptr;  // width x height, row-major
+};
+
+struct RenderOptions {
+  bool show_progress = false;  // per-tile progress on stderr (for terminals)
+  // Keep every ray's record in RenderResult (hits, shadows, secondary, refined), for tests and tools. Their
+  // memory grows with pixels x samples x bounces; without them only the film and the totals are kept.
+  bool keep_records = false;
+  std::function<void(const PrimaryTile&)> on_primary_tile;  // e.g. the solver channels
+  // Rays per launch of the shadow and trace kernels and per group of bounces. Only tests change it: the image
+  // must not depend on it.
+  std::size_t batch_rays = kBatchRays;
+  // Gives the film to render into, made ahead by the caller: render_scene makes it while the device starts, so
+  // that its zero-filling and page faults overlap the device's start on the other core. Called once; its film
+  // is used when its size is the plan's, and may then lack depth and normal (PNG outputs only); otherwise, or
+  // without it, the render makes its own.
+  std::function<FrameImage()> film;
+};
+
+struct RenderResult {
+  RenderPlan plan;
+  KernelConfig config;  // of the first surface's primary pass, with precision and tolerance as used
+  RayBasis basis;       // of the traced rays (per antialiasing sample, not per pixel)
+  std::vector<ProgramRecord> programs;
+  std::vector<PassStats> passes;
+  // The film: RGBA, depth and normal per output pixel, as shade_frame would make them from the records.
+  FrameImage image;
+  PrimarySummary primary;
+  double shade_ms = 0;  // host shading within the render; gathering a pass's rays is in the pass's wall_ms
+
+  // Kept only with RenderOptions::keep_records:
+  HitBuffer hits;                         // one record per traced ray: plan.trace_width() x plan.trace_height()
+  ShadowData shadows;                     // of the camera rays' hits
+  std::vector<SecondaryBatch> secondary;  // per tile, in the order traced: by depth, reflection first
+  // Adaptive antialiasing: 1 for the pixels (of hits) whose colour is the antialias batch's rays, not their own.
+  std::vector<std::uint8_t> refined;
+};
+
+// Precision a scene renders in on a device: as asked, or double where fp64 exists. Throws DeviceError when
+// double is asked of a device without fp64.
+Precision resolve_precision(const Scene& scene, const DeviceInfo& device);
+
+// Tile side, in traced rays, for a device when the scene leaves it open. GPUs get launches short enough for
+// display watchdogs; CPUs (PoCL) lose ~2 ms per launch and idle cores at each launch's tail, so they get few,
+// large launches: measured on the Barth sextic at 1024x768, 256-ray tiles 137 ms, one 1024-ray tile 109 ms.
+int default_tile_size(const DeviceInfo& device);
+
+// The output image from a render's records (RenderOptions::keep_records, or the reference's hits), shaded as
+// the renderer shades its film.
+FrameImage shade_frame(const Scene& scene, const RenderResult& result);
+
+class Renderer {
+ public:
+  Renderer(ClSession& session, ProgramCache& cache) : session_(session), cache_(cache) {}
+  // Runs every pass of the scene's plan, tile by tile, into the film. Each tile's camera rays, shadow rays and
+  // bounces are traced and shaded before the next tile starts, so memory holds the film and one tile's work.
+  RenderResult render(const Scene& scene, const RenderOptions& options);
+  // The same render keeping every ray's record (tests and tools). show_progress: print per-tile progress.
+  RenderResult render(const Scene& scene, bool show_progress);
+
+ private:
+  struct Passes;
+  struct Bounce;
+  struct Tile;
+  class TileHits;
+  void prepare_passes(Passes& passes);
+  // The primary kernels' arguments for a band of tiles (a row of them), but the tile's own.
+  void set_band_args(Passes& passes, const Tile& first);
+  void trace_primary(Passes& passes, const Tile& tile);
+  void trace_batch(Passes& passes, SecondaryBatch& batch);
+  // The camera rays' shadows and bounces of one tile, and its pixels in the film.
+  void finish_tile(Passes& passes, const Tile& tile);
+  // Reflection and transmission rays, bounce by bounce from `depth`, from the hits in `current`.
+  void run_bounces(Passes& passes, const Tile& tile, std::vector<Bounce> current, int depth, bool refinement);
+  // Adaptive antialiasing in one tile: n x n more camera rays in the pixels `refine` marks.
+  void refine_tile(Passes& passes, const Tile& tile, const std::vector<std::uint8_t>& refine);
+
+  ClSession& session_;
+  ProgramCache& cache_;
+};
+
+}  // namespace algray

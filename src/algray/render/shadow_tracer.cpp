@@ -1,0 +1,108 @@
+// Host side of the shadow kernel: uploads surface points and light points, launches, reads the masks back.
+#include "algray/render/shadow_tracer.h"
+
+#include <stdexcept>
+
+namespace algray {
+
+void ShadowPoints::upload(const std::vector<glm::dvec3>& points, const std::vector<glm::vec3>& normals) {
+  if (normals.size() != points.size()) throw std::invalid_argument("one normal per surface point");
+  count_ = points.size();
+  if (count_ == 0) return;
+  const bool is_double = precision_ == Precision::Double;
+  const std::size_t real_size = is_double ? sizeof(double) : sizeof(float);
+  const cl::Context& ctx = session_.context;
+  if (count_ > capacity_) {
+    capacity_ = count_;
+    points_ = cl::Buffer(ctx, CL_MEM_READ_ONLY, capacity_ * 4 * real_size);
+    normals_ = cl::Buffer(ctx, CL_MEM_READ_ONLY, capacity_ * 4 * sizeof(float));
+    masks_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, capacity_ * sizeof(cl_ulong));
+  }
+  // As real4_buffer converts: each component rounded to the kernel's REAL on its own.
+  cl::CommandQueue& queue = session_.queue;
+  if (is_double) {
+    staging_.resize(4 * count_);
+    for (std::size_t i = 0; i < count_; ++i) {
+      staging_[4 * i] = points[i].x;
+      staging_[4 * i + 1] = points[i].y;
+      staging_[4 * i + 2] = points[i].z;
+      staging_[4 * i + 3] = 0;
+    }
+    queue.enqueueWriteBuffer(points_, CL_TRUE, 0, 4 * count_ * sizeof(double), staging_.data());
+  } else {
+    staging_float_.resize(4 * count_);
+    for (std::size_t i = 0; i < count_; ++i) {
+      staging_float_[4 * i] = static_cast<float>(points[i].x);
+      staging_float_[4 * i + 1] = static_cast<float>(points[i].y);
+      staging_float_[4 * i + 2] = static_cast<float>(points[i].z);
+      staging_float_[4 * i + 3] = 0;
+    }
+    queue.enqueueWriteBuffer(points_, CL_TRUE, 0, 4 * count_ * sizeof(float), staging_float_.data());
+  }
+  staging_float_.resize(4 * count_);
+  for (std::size_t i = 0; i < count_; ++i) {
+    staging_float_[4 * i] = normals[i].x;
+    staging_float_[4 * i + 1] = normals[i].y;
+    staging_float_[4 * i + 2] = normals[i].z;
+    staging_float_[4 * i + 3] = 0;
+  }
+  queue.enqueueWriteBuffer(normals_, CL_TRUE, 0, 4 * count_ * sizeof(float), staging_float_.data());
+}
+
+ShadowTracer::ShadowTracer(ClSession& session, ProgramCache& cache, const KernelConfig& config,
+                           const DeviceSurface& surface, double offset)
+    : session_(session), surface_(surface), offset_(offset) {
+  kernel_ = cache.kernel(session, config, &record_);
+  traced_ = cl::Buffer(session.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
+}
+
+ShadowAnswer ShadowTracer::trace(const std::vector<glm::dvec3>& points, const std::vector<glm::vec3>& normals,
+                                 const std::vector<glm::dvec3>& light_points,
+                                 const std::vector<std::uint64_t>& already_hidden) {
+  ShadowPoints uploaded(session_, surface_.precision());
+  uploaded.upload(points, normals);
+  return trace(uploaded, light_points, already_hidden);
+}
+
+ShadowAnswer ShadowTracer::trace(ShadowPoints& points, const std::vector<glm::dvec3>& light_points,
+                                 const std::vector<std::uint64_t>& already_hidden) {
+  if (light_points.empty() || light_points.size() > 64)
+    throw std::invalid_argument("a shadow query takes 1 to 64 light points");
+  if (points.precision_ != surface_.precision())
+    throw std::invalid_argument("shadow points uploaded in another precision than the surface's");
+  ShadowAnswer answer;
+  const std::size_t count = points.size();
+  if (!already_hidden.empty() && already_hidden.size() != count)
+    throw std::invalid_argument("one already-hidden mask per surface point");
+  answer.masks = already_hidden.empty() ? std::vector<std::uint64_t>(count, 0) : already_hidden;
+  if (count == 0) return answer;
+
+  const Precision precision = surface_.precision();
+  cl::CommandQueue& queue = session_.queue;
+  queue.enqueueWriteBuffer(points.masks_, CL_TRUE, 0, count * sizeof(cl_ulong), answer.masks.data());
+  const cl::Buffer light_buffer = real4_buffer(session_.context, light_points, precision);
+  cl_uint traced = 0;
+  queue.enqueueWriteBuffer(traced_, CL_TRUE, 0, sizeof(cl_uint), &traced);
+
+  KernelArgs args(kernel_, precision);
+  args.plain(points.points_);
+  args.plain(points.normals_);
+  args.plain(static_cast<cl_uint>(count));
+  args.plain(light_buffer);
+  args.plain(static_cast<cl_uint>(light_points.size()));
+  args.real(offset_);
+  surface_.set_extent_args(args);
+  surface_.set_surface_args(args);
+  args.plain(points.masks_);
+  args.plain(traced_);
+  cl::Event done;
+  queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(count), cl::NullRange, nullptr, &done);
+  done.wait();
+  answer.kernel_ms = ms_between(done);
+  queue.enqueueReadBuffer(points.masks_, CL_TRUE, 0, count * sizeof(cl_ulong), answer.masks.data());
+  queue.enqueueReadBuffer(traced_, CL_TRUE, 0, sizeof(cl_uint), &traced);
+  answer.rays_traced = traced;
+  return answer;
+}
+
+}  // namespace algray

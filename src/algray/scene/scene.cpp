@@ -1,0 +1,690 @@
+// Reads scene TOML into a Scene, checking every key and value and naming file, line and column on error.
+#include "algray/scene/scene.h"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "algray/util/embedded_files.h"
+#include "algray/scene/expression.h"
+#include "algray/util/file_names.h"
+#include "algray/scene/jsurf.h"
+#include "algray/scene/toml_reader.h"
+
+namespace algray {
+namespace {
+
+constexpr int kMaxImageSide = 32768;
+
+std::string format_what(const std::string& where, const std::string& message, const std::string& excerpt) {
+  std::string s = where + ": error: " + message;
+  if (!excerpt.empty()) s += "\n" + excerpt;
+  return s;
+}
+
+const std::set<std::string> kTopKeys{"surface",  "parameters", "extent",    "camera", "image",
+                                     "material", "light",      "antialias", "render"};
+const std::set<std::string> kSurfaceKeys{"name", "equation", "terms", "material"};
+const std::set<std::string> kExtentKeys{"type", "centre", "radius", "min", "max"};
+const std::set<std::string> kCameraKeys{"projection", "eye", "look_at", "up", "fov_y", "height"};
+const std::set<std::string> kImageKeys{"width", "height", "background"};
+const std::set<std::string> kMaterialKeys{"front", "back"};
+const std::set<std::string> kMaterialSideKeys{"colour",   "ambient",      "diffuse",     "specular",
+                                              "exponent", "reflectivity", "transparency"};
+const std::set<std::string> kLightKeys{"type",   "position", "edge_u", "edge_v",    "normal",
+                                       "radius", "samples",  "colour", "intensity", "shadows"};
+const std::set<std::string> kAntialiasKeys{"samples", "adaptive", "threshold"};
+const std::set<std::string> kRenderKeys{"precision",      "tolerance", "isolation", "refinement", "ray_origin",
+                                        "max_iterations", "tile_size", "lanes",     "preview",    "max_depth"};
+
+// Merges `from` into `into`; tables merge key by key, anything else replaces.
+void merge_tables(toml::table& into, toml::table&& from) {
+  for (auto&& [key, node] : from) {
+    toml::node* existing = into.get(key.str());
+    if (existing && existing->is_table() && node.is_table())
+      merge_tables(*existing->as_table(), std::move(*node.as_table()));
+    else
+      into.insert_or_assign(key.str(), std::move(node));
+  }
+}
+
+bool is_index(const std::string& s) {
+  return !s.empty() && s.size() <= 6 &&
+         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
+}
+
+void apply_override(toml::table& root, const Override& o) {
+  // A hostile key or value may be megabytes long: messages show its start.
+  const auto shown = [](const std::string& t) {
+    return t.size() <= 120 ? t : t.substr(0, 100) + "...(" + std::to_string(t.size()) + " characters)";
+  };
+  const std::string label = (o.origin.empty() ? "--set " : o.origin + ": set ") + shown(o.key) + "=" + shown(o.value);
+  // A bare name is a parameter; any other key is a dotted path into the scene.
+  const std::string key = o.key.find('.') == std::string::npos ? "parameters." + o.key : o.key;
+  std::vector<std::string> parts;
+  for (std::size_t start = 0;;) {
+    const std::size_t dot = key.find('.', start);
+    parts.push_back(key.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
+  if (parts.size() > kMaxTomlKeyParts)
+    throw SceneError(label, "the key has " + std::to_string(parts.size()) + " parts; at most " +
+                                std::to_string(kMaxTomlKeyParts) + " are allowed");
+  const auto check_identifier = [&](const std::string& part) {
+    if (!is_identifier(part))
+      throw SceneError(label,
+                       "'" + shown(o.key) + "' is not a dotted scene key such as camera.fov_y or light.0.intensity");
+  };
+  // Walk down the existing tables. A list of tables ([[surface]], [[light]]) is reached by index, as in
+  // light.0.intensity, and the override applies inside that one table: merging at the list would replace the
+  // whole list with a single table.
+  toml::table* target = &root;
+  std::size_t i = 0;
+  while (i + 1 < parts.size()) {
+    check_identifier(parts[i]);
+    toml::node* at = target->get(parts[i]);
+    if (at && at->is_table()) {
+      if (is_index(parts[i + 1]))
+        throw SceneError(label, "'" + parts[i] + "' is a single [" + parts[i] + "] table, not a list: leave out the " +
+                                    "index, as in " + parts[i] + "." + (i + 2 < parts.size() ? parts[i + 2] : "KEY"));
+      target = at->as_table();
+      ++i;
+      continue;
+    }
+    if (!at || !at->is_array_of_tables()) break;
+    const std::string& list_name = parts[i];
+    const toml::array& list = *at->as_array();
+    if (!is_index(parts[i + 1]))
+      throw SceneError(label, "'" + list_name + "' is a list of [[" + list_name +
+                                  "]] tables: name one by its index from 0, as in " + list_name + ".0." + parts[i + 1]);
+    const std::size_t index = std::stoul(parts[i + 1]);
+    if (index >= list.size())
+      throw SceneError(label, "the scene has " + std::to_string(list.size()) + " [[" + list_name + "]] table" +
+                                  (list.size() == 1 ? "" : "s") + ", indexed from 0: there is no " + list_name + "." +
+                                  parts[i + 1]);
+    if (i + 2 == parts.size())
+      throw SceneError(label, "'" + shown(o.key) + "' names a whole [[" + list_name + "]] table; set one of its keys");
+    target = at->as_array()->get(index)->as_table();
+    i += 2;
+  }
+  if (i + 1 == parts.size() && target->get(parts[i]) && target->get(parts[i])->is_array_of_tables())
+    throw SceneError(label, "'" + parts[i] + "' is a list of [[" + parts[i] +
+                                "]] tables: name one by its index from 0, as in " + parts[i] + ".0.KEY");
+  std::string rest;
+  for (std::size_t k = i; k < parts.size(); ++k) {
+    check_identifier(parts[k]);
+    rest += (k > i ? "." : "") + parts[k];
+  }
+  // Parsed as the TOML line `key = value`, every node it creates carries the override as its source, so errors
+  // name it. A value that is not TOML (render.precision=float) is taken as a string.
+  try {
+    check_toml_shape(rest + " = " + o.value, label);
+  } catch (const SceneError& e) {
+    throw SceneError(label, e.message);  // the line and column are of a line the user never wrote
+  }
+  toml::table parsed;
+  try {
+    parsed = toml::parse(rest + " = " + o.value, label);
+  } catch (const toml::parse_error&) {
+    // As a literal string it must still be TOML: no quote, no line break, no control character, valid UTF-8.
+    try {
+      if (o.value.find_first_of("'\n") != std::string::npos) throw std::invalid_argument("quote or line break");
+      parsed = toml::parse(rest + " = '" + o.value + "'", label);
+    } catch (const std::exception&) {
+      throw SceneError(label, "value is neither valid TOML nor a plain string");
+    }
+  }
+  merge_tables(*target, std::move(parsed));
+}
+
+Polynomial polynomial_from_terms(const TomlReader& r, const toml::node& terms_node) {
+  const toml::array* terms = terms_node.as_array();
+  if (!terms || terms->empty()) r.fail(terms_node.source(), "surface.terms must be a non-empty array of [i, j, k, a]");
+  Polynomial p;
+  for (const toml::node& t : *terms) {
+    const toml::array* a = t.as_array();
+    if (!a || a->size() != 4)
+      r.fail(t.source(), "each term must be [i, j, k, a]: exponents of x, y, z and the coefficient");
+    const int i = static_cast<int>(r.integer(*a->get(0), "exponent i", 0, 1000));
+    const int j = static_cast<int>(r.integer(*a->get(1), "exponent j", 0, 1000));
+    const int k = static_cast<int>(r.integer(*a->get(2), "exponent k", 0, 1000));
+    p.add_term(i, j, k, exact_rational(r.number(*a->get(3), "coefficient")));
+  }
+  return p;
+}
+
+void read_material(const TomlReader& r, const toml::table& t, const std::string& name, Material& m) {
+  r.check_keys(t, name, kMaterialSideKeys);
+  if (const toml::node* n = t.get("colour")) m.colour = glm::dvec3(r.colour(*n, name + ".colour", false));
+  if (const toml::node* n = t.get("ambient")) m.ambient = r.number_in(*n, name + ".ambient", 0, 1);
+  if (const toml::node* n = t.get("diffuse")) m.diffuse = r.number_in(*n, name + ".diffuse", 0, 1);
+  if (const toml::node* n = t.get("specular")) m.specular = r.number_in(*n, name + ".specular", 0, 1);
+  if (const toml::node* n = t.get("exponent")) m.exponent = r.number_in(*n, name + ".exponent", 1, 10000);
+  if (const toml::node* n = t.get("reflectivity")) m.reflectivity = r.number_in(*n, name + ".reflectivity", 0, 1);
+  if (const toml::node* n = t.get("transparency")) m.transparency = r.number_in(*n, name + ".transparency", 0, 1);
+}
+
+void read_materials(const TomlReader& r, const toml::table& t, const std::string& name, Materials& m) {
+  r.check_keys(t, name, kMaterialKeys);
+  for (const char* side : {"front", "back"})
+    if (const toml::table* st = r.subtable(t, side))
+      read_material(r, *st, name + "." + side, std::string(side) == "front" ? m.front : m.back);
+}
+
+SceneSurface read_surface(const TomlReader& r, const toml::table& surface,
+                          const std::map<std::string, double>& parameters) {
+  SceneSurface out;
+  r.check_keys(surface, "surface", kSurfaceKeys);
+  const toml::node* equation = surface.get("equation");
+  const toml::node* terms = surface.get("terms");
+  if (equation && terms) r.fail(terms->source(), "give surface.equation or surface.terms, not both");
+  const toml::node& anchor = equation ? *equation : terms ? *terms : static_cast<const toml::node&>(surface);
+  if (equation) {
+    out.equation = r.string(*equation, "surface.equation");
+    try {
+      out.polynomial = parse_equation(out.equation, parameters, kMaxDegree);
+    } catch (const EquationError& e) {
+      r.fail(equation->source(),
+             std::string(e.what()) + " (at character " + std::to_string(e.position + 1) + " of the equation)",
+             r.string_column_offset(*equation, e.position));
+    }
+  } else if (terms) {
+    out.polynomial = polynomial_from_terms(r, *terms);
+    out.from_terms = true;
+    out.equation = out.polynomial.to_string();
+  } else {
+    r.fail(surface.source(), "[surface] needs an equation or a list of terms");
+  }
+  const int degree = out.polynomial.degree();
+  if (degree < 0) r.fail(anchor.source(), "the polynomial is identically zero after expansion");
+  if (degree == 0) r.fail(anchor.source(), "the polynomial is a nonzero constant: it has no points");
+  if (degree > kMaxDegree)
+    r.fail(anchor.source(),
+           "degree " + std::to_string(degree) + " exceeds the supported maximum " + std::to_string(kMaxDegree));
+  if (const toml::node* n = surface.get("name")) out.name = r.string(*n, "surface.name");
+  return out;
+}
+
+Light read_light(const TomlReader& r, const toml::table& t) {
+  r.check_keys(t, "light", kLightKeys);
+  Light light;
+  const std::string type = t.get("type") ? r.string(*t.get("type"), "light.type") : "point";
+  if (type == "point")
+    light.kind = LightKind::Point;
+  else if (type == "rectangle")
+    light.kind = LightKind::Rectangle;
+  else if (type == "disc")
+    light.kind = LightKind::Disc;
+  else
+    r.fail(t.get("type")->source(), "light.type must be \"point\", \"rectangle\" or \"disc\"");
+  const toml::node* position = t.get("position");
+  if (!position) r.fail(t.source(), "a light needs a position (the centre of an area light)");
+  light.position = r.vec3(*position, "light.position");
+  // Keys that belong to another kind of light are mistakes, not things to ignore.
+  const std::set<std::string> own =
+      light.kind == LightKind::Rectangle ? std::set<std::string>{"edge_u", "edge_v", "samples"}
+      : light.kind == LightKind::Disc    ? std::set<std::string>{"normal", "radius", "samples"}
+                                         : std::set<std::string>{};
+  for (const char* key : {"edge_u", "edge_v", "normal", "radius", "samples"})
+    if (const toml::node* n = t.get(key); n && !own.count(key))
+      r.fail(n->source(), std::string("light.") + key + " does not apply to a " + type + " light");
+  if (light.kind == LightKind::Rectangle) {
+    if (!t.get("edge_u") || !t.get("edge_v")) r.fail(t.source(), "a rectangle light needs edge_u and edge_v");
+    light.edge_u = r.vec3(*t.get("edge_u"), "light.edge_u");
+    light.edge_v = r.vec3(*t.get("edge_v"), "light.edge_v");
+    if (glm::length(glm::cross(light.edge_u, light.edge_v)) <= 0)
+      r.fail(t.get("edge_v")->source(), "the rectangle is degenerate: edge_u and edge_v must span an area");
+  }
+  if (light.kind == LightKind::Disc) {
+    if (!t.get("radius")) r.fail(t.source(), "a disc light needs a radius");
+    light.radius = r.coordinate(*t.get("radius"), "light.radius");
+    if (!(light.radius > 0)) r.fail(t.get("radius")->source(), "light.radius must be positive");
+    if (const toml::node* n = t.get("normal")) {
+      light.normal = r.vec3(*n, "light.normal");
+      // Kept as written (normalised where it is used), so that scene_to_toml writes back what was read.
+      if (!(glm::length(light.normal) > 0)) r.fail(n->source(), "light.normal must not be zero");
+    }
+  }
+  if (light.kind != LightKind::Point) {
+    light.samples = 5;  // the paper's 25 points per area light
+    if (const toml::node* n = t.get("samples"))
+      light.samples = static_cast<int>(r.integer(*n, "light.samples", 1, kMaxLightSamplesPerSide));
+  }
+  if (const toml::node* n = t.get("colour")) light.colour = glm::dvec3(r.colour(*n, "light.colour", false));
+  if (const toml::node* n = t.get("intensity")) {
+    light.intensity = r.coordinate(*n, "light.intensity");
+    if (light.intensity < 0) r.fail(n->source(), "light.intensity must not be negative");
+  }
+  if (const toml::node* n = t.get("shadows")) light.shadows = r.boolean(*n, "light.shadows");
+  return light;
+}
+
+Scene interpret(const TomlReader& r, const toml::table& root, const std::string& source) {
+  Scene scene;
+  scene.source = source;
+  r.check_keys(root, "", kTopKeys);
+
+  // Parameters first: the equation refers to them.
+  if (const toml::table* params = r.subtable(root, "parameters")) {
+    for (auto&& [key, node] : *params) {
+      const std::string name(key.str());
+      if (!is_identifier(name) || is_reserved_name(name))
+        r.fail(key.source(), "parameter name '" + name +
+                                 "' must be an identifier other than x, y, z and the function names (sqrt, sin, ...)");
+      scene.parameters[name] = r.number(node, "parameter '" + name + "'");
+    }
+  }
+
+  // One [surface] table, or several [[surface]] tables: the nearest hit among them wins.
+  const toml::node* surface_node = root.get("surface");
+  if (!surface_node) r.fail(root.source(), "missing [surface] table with an equation or a list of terms");
+  std::vector<const toml::table*> surface_tables;
+  if (const toml::table* t = surface_node->as_table()) {
+    surface_tables.push_back(t);
+  } else if (const toml::array* list = surface_node->as_array(); list && list->is_array_of_tables() && !list->empty()) {
+    if (list->size() > kMaxSurfaces)
+      r.fail(surface_node->source(), "at most " + std::to_string(kMaxSurfaces) + " surfaces per scene");
+    for (const toml::node& n : *list) surface_tables.push_back(n.as_table());
+  } else {
+    r.fail(surface_node->source(), "'surface' must be a [surface] table or [[surface]] tables");
+  }
+  for (const toml::table* t : surface_tables) scene.surfaces.push_back(read_surface(r, *t, scene.parameters));
+  if (!scene.surfaces.front().name.empty()) scene.name = scene.surfaces.front().name;
+  int degree = 0;
+  for (const SceneSurface& s : scene.surfaces) degree = std::max(degree, s.polynomial.degree());
+
+  const toml::table* extent = r.subtable(root, "extent");
+  if (!extent)
+    r.fail(root.source(), "missing [extent] table (a sphere with centre and radius, or a box with min and max)");
+  r.check_keys(*extent, "extent", kExtentKeys);
+  const std::string type = extent->get("type") ? r.string(*extent->get("type"), "extent.type") : "sphere";
+  if (type == "sphere") {
+    scene.extent.kind = ExtentKind::Sphere;
+    for (const char* k : {"min", "max"})
+      if (const toml::node* n = extent->get(k))
+        r.fail(n->source(), std::string("extent.") + k + " belongs to a box extent");
+    if (const toml::node* n = extent->get("centre")) scene.extent.centre = r.vec3(*n, "extent.centre");
+    const toml::node* radius = extent->get("radius");
+    if (!radius) r.fail(extent->source(), "a sphere extent needs a radius");
+    scene.extent.radius = r.coordinate(*radius, "extent.radius");
+    if (scene.extent.radius <= 0) r.fail(radius->source(), "the extent is empty: radius must be positive");
+    if (scene.extent.radius < 1 / kMaxCoordinate)
+      r.fail(radius->source(), "the extent is too small to render: its radius must be at least 1e-18");
+  } else if (type == "box") {
+    scene.extent.kind = ExtentKind::Box;
+    for (const char* k : {"centre", "radius"})
+      if (const toml::node* n = extent->get(k))
+        r.fail(n->source(), std::string("extent.") + k + " belongs to a sphere extent");
+    const toml::node* mn = extent->get("min");
+    const toml::node* mx = extent->get("max");
+    if (!mn || !mx) r.fail(extent->source(), "a box extent needs min and max");
+    scene.extent.min = r.vec3(*mn, "extent.min");
+    scene.extent.max = r.vec3(*mx, "extent.max");
+    for (int i = 0; i < 3; ++i)
+      if (!(scene.extent.min[i] < scene.extent.max[i]))
+        r.fail(mx->source(), std::string("the extent is empty: max.") + "xyz"[i] + " must exceed min." + "xyz"[i]);
+    if (scene.extent.unit_scale() < 1 / kMaxCoordinate)
+      r.fail(mx->source(), "the extent is too small to render: its half-diagonal must be at least 1e-18");
+  } else {
+    r.fail(extent->get("type")->source(), "extent.type must be \"sphere\" or \"box\"");
+  }
+
+  const toml::table* camera = r.subtable(root, "camera");
+  if (!camera) r.fail(root.source(), "missing [camera] table (eye, look_at, up)");
+  r.check_keys(*camera, "camera", kCameraKeys);
+  CameraSpec& cam = scene.camera;
+  if (const toml::node* n = camera->get("projection")) {
+    const std::string p = r.string(*n, "camera.projection");
+    if (p == "perspective")
+      cam.projection = Projection::Perspective;
+    else if (p == "orthographic")
+      cam.projection = Projection::Orthographic;
+    else
+      r.fail(n->source(), "camera.projection must be \"perspective\" or \"orthographic\"");
+  }
+  for (const char* k : {"eye", "look_at", "up"})
+    if (!camera->get(k)) r.fail(camera->source(), std::string("camera.") + k + " is required");
+  cam.eye = r.vec3(*camera->get("eye"), "camera.eye");
+  cam.look_at = r.vec3(*camera->get("look_at"), "camera.look_at");
+  cam.up = r.vec3(*camera->get("up"), "camera.up");
+  const glm::dvec3 view = cam.look_at - cam.eye;
+  if (glm::length(view) <= 1e-12 * std::max(1.0, glm::length(cam.eye)))
+    r.fail(camera->get("look_at")->source(), "degenerate camera: look_at coincides with eye");
+  if (glm::length(glm::cross(glm::normalize(view), cam.up)) <= 1e-9 * glm::length(cam.up) || glm::length(cam.up) == 0)
+    r.fail(camera->get("up")->source(), "degenerate camera: up is zero or parallel to the viewing direction");
+  if (const toml::node* n = camera->get("fov_y")) {
+    if (cam.projection != Projection::Perspective) r.fail(n->source(), "camera.fov_y applies to perspective cameras");
+    cam.fov_y_degrees = r.number(*n, "camera.fov_y");
+    if (!(cam.fov_y_degrees > 0 && cam.fov_y_degrees < 180))
+      r.fail(n->source(), "degenerate camera: fov_y must be between 0 and 180 degrees, exclusive");
+  }
+  if (const toml::node* n = camera->get("height")) {
+    if (cam.projection != Projection::Orthographic)
+      r.fail(n->source(), "camera.height applies to orthographic cameras");
+    cam.ortho_height = r.coordinate(*n, "camera.height");
+    if (!(cam.ortho_height > 0)) r.fail(n->source(), "degenerate camera: height must be positive");
+  } else if (cam.projection == Projection::Orthographic) {
+    r.fail(camera->source(), "an orthographic camera needs camera.height (the view height in world units)");
+  }
+
+  if (const toml::table* image = r.subtable(root, "image")) {
+    r.check_keys(*image, "image", kImageKeys);
+    if (const toml::node* n = image->get("width"))
+      scene.image.width = static_cast<int>(r.integer(*n, "image.width", 1, kMaxImageSide));
+    if (const toml::node* n = image->get("height"))
+      scene.image.height = static_cast<int>(r.integer(*n, "image.height", 1, kMaxImageSide));
+    if (const toml::node* n = image->get("background")) scene.image.background = r.colour(*n, "image.background", true);
+  }
+
+  // [material] sets every surface's sides; a surface's own [surface.material] then changes its keys.
+  Materials defaults;
+  if (const toml::table* material = r.subtable(root, "material")) read_materials(r, *material, "material", defaults);
+  for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+    Materials own = defaults;
+    if (const toml::table* material = r.subtable(*surface_tables[i], "material"))
+      read_materials(r, *material, "surface.material", own);
+    scene.surfaces[i].materials = own;
+  }
+
+  if (const toml::node* lights = root.get("light")) {
+    const toml::array* list = lights->as_array();
+    if (!list || !list->is_array_of_tables())
+      r.fail(lights->source(), "lights are written as [[light]] tables, one per light");
+    for (const toml::node& node : *list) scene.lights.push_back(read_light(r, *node.as_table()));
+  }
+
+  if (const toml::table* aa = r.subtable(root, "antialias")) {
+    r.check_keys(*aa, "antialias", kAntialiasKeys);
+    if (const toml::node* n = aa->get("samples"))
+      scene.antialias.samples = static_cast<int>(r.integer(*n, "antialias.samples", 1, 16));
+    if (const toml::node* n = aa->get("adaptive")) scene.antialias.adaptive = r.boolean(*n, "antialias.adaptive");
+    if (const toml::node* n = aa->get("threshold"))
+      scene.antialias.threshold = r.number_in(*n, "antialias.threshold", 0, 1);
+  }
+
+  if (const toml::table* render = r.subtable(root, "render")) {
+    r.check_keys(*render, "render", kRenderKeys);
+    RenderSettings& rs = scene.render;
+    if (const toml::node* n = render->get("precision")) {
+      const std::string p = r.string(*n, "render.precision");
+      Precision value;
+      if (p == "auto")
+        rs.precision.reset();
+      else if (parse_precision(p, value))
+        rs.precision = value;
+      else
+        r.fail(n->source(), "render.precision must be auto, " + precision_choices());
+      if (rs.precision == Precision::Mixed && degree > kMaxMixedDegree)
+        r.fail(n->source(), "mixed precision supports degrees up to " + std::to_string(kMaxMixedDegree) +
+                                "; this surface has degree " + std::to_string(degree));
+    }
+    if (const toml::node* n = render->get("tolerance")) {
+      rs.tolerance = r.number(*n, "render.tolerance");
+      if (!(rs.tolerance > 0 && rs.tolerance <= 0.1)) r.fail(n->source(), "render.tolerance must be in (0, 0.1]");
+    }
+    if (const toml::node* n = render->get("isolation"))
+      if (!parse_isolation(r.string(*n, "render.isolation"), rs.isolation))
+        r.fail(n->source(), "render.isolation must be one of " + isolation_choices());
+    if (const toml::node* n = render->get("refinement"))
+      if (!parse_refinement(r.string(*n, "render.refinement"), rs.refinement))
+        r.fail(n->source(), "render.refinement must be one of " + refinement_choices());
+    if (const toml::node* n = render->get("ray_origin")) {
+      if (!parse_ray_origin(r.string(*n, "render.ray_origin"), rs.ray_origin))
+        r.fail(n->source(), "render.ray_origin must be one of " + ray_origin_choices());
+      if (rs.ray_origin == RayOrigin::Eye && rs.isolation == Isolation::Bernstein)
+        r.fail(n->source(),
+               "render.ray_origin = \"eye\" needs a power-basis isolation (descartes, sturm or derivative-chain)");
+      if (rs.ray_origin == RayOrigin::Screen && rs.precision == Precision::Mixed)
+        r.fail(n->source(), "render.ray_origin = \"screen\" is built in float or double, not mixed precision");
+    }
+    if (const toml::node* n = render->get("max_iterations"))
+      rs.max_iterations = static_cast<int>(r.integer(*n, "render.max_iterations", 1, 1000000));
+    if (const toml::node* n = render->get("tile_size"))
+      rs.tile_size = static_cast<int>(r.integer(*n, "render.tile_size", 8, 16384));
+    if (const toml::node* n = render->get("lanes")) {
+      rs.lanes = static_cast<int>(r.integer(*n, "render.lanes", 1, 16));
+      if (!valid_lanes(rs.lanes)) r.fail(n->source(), "render.lanes must be " + lanes_choices());
+      if (rs.lanes > 1 && (rs.isolation != Isolation::Bernstein || rs.refinement != Refinement::Brent))
+        r.fail(n->source(), "render.lanes > 1 needs isolation = \"bernstein\" and refinement = \"brent\"");
+    }
+    if (const toml::node* n = render->get("preview")) rs.preview = r.boolean(*n, "render.preview");
+    if (const toml::node* n = render->get("max_depth"))
+      rs.max_depth = static_cast<int>(r.integer(*n, "render.max_depth", 0, 64));
+  }
+  return scene;
+}
+
+}  // namespace
+
+SceneError::SceneError(std::string where_, std::string message_, std::string excerpt_)
+    : std::runtime_error(format_what(where_, message_, excerpt_)),
+      where(std::move(where_)),
+      message(std::move(message_)),
+      excerpt(std::move(excerpt_)) {}
+
+glm::dvec3 Extent::unit_centre() const { return kind == ExtentKind::Sphere ? centre : (min + max) * 0.5; }
+
+double Extent::unit_scale() const { return kind == ExtentKind::Sphere ? radius : glm::length(max - min) * 0.5; }
+
+glm::dvec3 Extent::unit_box_half() const {
+  return kind == ExtentKind::Box ? (max - min) * 0.5 / unit_scale() : glm::dvec3(1);
+}
+
+std::vector<glm::dvec3> Light::sample_points() const {
+  if (kind == LightKind::Point) return {position};
+  std::vector<glm::dvec3> points;
+  const int n = samples;
+  // An orthonormal frame of the disc's plane.
+  const glm::dvec3 unit = glm::normalize(normal);
+  const glm::dvec3 a = std::fabs(unit.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+  const glm::dvec3 e1 = glm::normalize(glm::cross(unit, a)), e2 = glm::cross(unit, e1);
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const double u = (i + 0.5) / n * 2 - 1, v = (j + 0.5) / n * 2 - 1;  // cell centres in [-1, 1]^2
+      if (kind == LightKind::Rectangle) {
+        points.push_back(position + 0.5 * u * edge_u + 0.5 * v * edge_v);
+        continue;
+      }
+      // Shirley and Chiu's concentric map: squares around the centre go to rings of equal area.
+      const double pi = 3.14159265358979323846;
+      double r = 0, phi = 0;
+      if (std::fabs(u) > std::fabs(v)) {
+        r = u;
+        phi = pi / 4 * (v / u);
+      } else if (v != 0) {
+        r = v;
+        phi = pi / 2 - pi / 4 * (u / v);
+      }
+      points.push_back(position + radius * r * (std::cos(phi) * e1 + std::sin(phi) * e2));
+    }
+  }
+  return points;
+}
+
+Scene load_scene_text(const std::string& text, const std::string& source_name, const std::vector<Override>& overrides) {
+  TomlReader reader(source_name, text);
+  check_toml_shape(text, source_name);
+  toml::table root;
+  try {
+    root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    reader.fail(e.source(), std::string(e.description()));
+  }
+  for (const Override& o : overrides) apply_override(root, o);
+  Scene scene = interpret(reader, root, source_name);
+  if (scene.name.empty()) {
+    const auto slash = source_name.find_last_of('/');
+    std::string stem = source_name.substr(slash == std::string::npos ? 0 : slash + 1);
+    scene.name = stem.substr(0, stem.rfind('.'));
+  }
+  return scene;
+}
+
+Scene load_jsurf_text(const std::string& text, const std::string& source_name, const std::vector<Override>& overrides) {
+  std::vector<std::string> warnings;
+  std::map<int, JsurfOrigin> origins;
+  const std::string toml = jsurf_to_toml(text, source_name, warnings, &origins);
+  const std::string translated = source_name + " (translated to TOML)";
+  Scene scene;
+  try {
+    scene = load_scene_text(toml, translated, overrides);
+  } catch (const SceneError& e) {
+    // An override's error names the override; any other names a line of the translation, which the user never
+    // saw: point at the .jsurf property that line came from instead.
+    if (e.where.compare(0, translated.size(), translated) != 0) throw;
+    int line = 0;
+    if (e.where.size() > translated.size() + 1 && e.where[translated.size()] == ':')
+      line = std::atoi(e.where.c_str() + translated.size() + 1);
+    if (const auto it = origins.find(line); it != origins.end())
+      throw SceneError(it->second.where, it->second.key + ": " + e.message, it->second.excerpt);
+    throw SceneError(source_name, e.message);
+  }
+  scene.source = source_name;
+  scene.warnings = std::move(warnings);
+  return scene;
+}
+
+namespace {
+
+void write_material(std::ostringstream& out, const std::string& table, const Material& m) {
+  out << "\n[" << table << "]\ncolour = " << toml_vector(m.colour) << "\nambient = " << toml_number(m.ambient)
+      << "\ndiffuse = " << toml_number(m.diffuse) << "\nspecular = " << toml_number(m.specular)
+      << "\nexponent = " << toml_number(m.exponent) << "\nreflectivity = " << toml_number(m.reflectivity)
+      << "\ntransparency = " << toml_number(m.transparency) << "\n";
+}
+
+const char* light_type(LightKind k) {
+  switch (k) {
+    case LightKind::Rectangle:
+      return "rectangle";
+    case LightKind::Disc:
+      return "disc";
+    case LightKind::Point:
+      break;
+  }
+  return "point";
+}
+
+}  // namespace
+
+std::string scene_to_toml(const Scene& scene) {
+  std::ostringstream out;
+  std::string origin = scene.name + ", as algray rendered it (from " + scene.source + ")";
+  for (char& ch : origin)
+    // A comment ends at the line's end, and TOML text must be UTF-8, which a file name need not be.
+    if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) >= 0x7f) ch = '?';
+  out << "# " << origin << "\n";
+  if (!scene.parameters.empty()) {
+    out << "\n[parameters]\n";
+    for (const auto& [name, value] : scene.parameters) out << name << " = " << toml_number(value) << "\n";
+  }
+  const bool several = scene.surfaces.size() > 1;
+  for (const SceneSurface& s : scene.surfaces) {
+    out << (several ? "\n[[surface]]\n" : "\n[surface]\n");
+    if (!s.name.empty()) out << "name = " << toml_quoted(s.name) << "\n";
+    if (s.from_terms) {
+      // Each coefficient as the double it was read as: the equation text made from them rounds.
+      out << "terms = [";
+      const char* sep = "";
+      for (const auto& [e, c] : s.polynomial.terms()) {
+        out << sep << "[" << e[0] << ", " << e[1] << ", " << e[2] << ", " << toml_number(nearest_double(c)) << "]";
+        sep = ", ";
+      }
+      out << "]\n";
+    } else {
+      out << "equation = " << toml_quoted(s.equation) << "\n";
+    }
+    write_material(out, "surface.material.front", s.materials.front);
+    write_material(out, "surface.material.back", s.materials.back);
+  }
+  const Extent& e = scene.extent;
+  if (e.kind == ExtentKind::Sphere)
+    out << "\n[extent]\ntype = \"sphere\"\ncentre = " << toml_vector(e.centre) << "\nradius = " << toml_number(e.radius)
+        << "\n";
+  else
+    out << "\n[extent]\ntype = \"box\"\nmin = " << toml_vector(e.min) << "\nmax = " << toml_vector(e.max) << "\n";
+  const CameraSpec& c = scene.camera;
+  const bool perspective = c.projection == Projection::Perspective;
+  out << "\n[camera]\nprojection = \"" << (perspective ? "perspective" : "orthographic") << "\"\neye = "
+      << toml_vector(c.eye) << "\nlook_at = " << toml_vector(c.look_at) << "\nup = " << toml_vector(c.up) << "\n"
+      << (perspective ? "fov_y = " + toml_number(c.fov_y_degrees) : "height = " + toml_number(c.ortho_height))
+      << "\n";
+  const glm::dvec4& bg = scene.image.background;
+  out << "\n[image]\nwidth = " << scene.image.width << "\nheight = " << scene.image.height << "\nbackground = ["
+      << toml_number(bg.r) << ", " << toml_number(bg.g) << ", " << toml_number(bg.b) << ", " << toml_number(bg.a)
+      << "]\n";
+  for (const Light& l : scene.lights) {
+    out << "\n[[light]]\ntype = \"" << light_type(l.kind) << "\"\nposition = " << toml_vector(l.position) << "\n";
+    if (l.kind == LightKind::Rectangle)
+      out << "edge_u = " << toml_vector(l.edge_u) << "\nedge_v = " << toml_vector(l.edge_v) << "\n";
+    if (l.kind == LightKind::Disc)
+      out << "normal = " << toml_vector(l.normal) << "\nradius = " << toml_number(l.radius) << "\n";
+    if (l.kind != LightKind::Point) out << "samples = " << l.samples << "\n";
+    out << "colour = " << toml_vector(l.colour) << "\nintensity = " << toml_number(l.intensity)
+        << "\nshadows = " << (l.shadows ? "true" : "false") << "\n";
+  }
+  const Antialias& aa = scene.antialias;
+  out << "\n[antialias]\nsamples = " << aa.samples << "\nadaptive = " << (aa.adaptive ? "true" : "false")
+      << "\nthreshold = " << toml_number(aa.threshold) << "\n";
+  const RenderSettings& rs = scene.render;
+  out << "\n[render]\nprecision = \"" << (rs.precision ? to_string(*rs.precision) : std::string("auto"))
+      << "\"\ntolerance = " << toml_number(rs.tolerance) << "\nisolation = \"" << to_string(rs.isolation)
+      << "\"\nrefinement = \"" << to_string(rs.refinement) << "\"\nray_origin = \"" << to_string(rs.ray_origin)
+      << "\"\npreview = " << (rs.preview ? "true" : "false") << "\nmax_depth = " << rs.max_depth << "\n";
+  if (rs.max_iterations) out << "max_iterations = " << rs.max_iterations << "\n";
+  if (rs.tile_size) out << "tile_size = " << rs.tile_size << "\n";
+  if (rs.lanes) out << "lanes = " << rs.lanes << "\n";
+  return out.str();
+}
+
+std::string read_input_stream(std::istream& in, const std::string& source, const std::string& what) {
+  std::string text;
+  char buf[65536];
+  while (in) {
+    in.read(buf, sizeof buf);
+    text.append(buf, static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kMaxInputBytes)
+      throw SceneError(source, "the " + what + " is larger than " + std::to_string(kMaxInputBytes >> 20) +
+                                   " MiB; " + what + "s are small text files");
+  }
+  if (in.bad()) throw SceneError(source, "cannot read the " + what);
+  return text;
+}
+
+std::string read_input_file(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw SceneError(path, "is a directory, not a " + what);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const bool exists = std::filesystem::exists(path, ec);
+    throw SceneError(path, "cannot read the " + what + (exists ? "" : ": no such file"));
+  }
+  try {
+    return read_input_stream(in, path, what);
+  } catch (const std::ios_base::failure&) {
+    throw SceneError(path, "cannot read the " + what);
+  }
+}
+
+Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides) {
+  const std::string text = read_input_file(path, "scene file");
+  if (lowercase_extension(path) == ".jsurf") return load_jsurf_text(text, path, overrides);
+  return load_scene_text(text, path, overrides);
+}
+
+Scene default_scene(const std::vector<Override>& overrides) {
+  for (const EmbeddedFile& f : embedded_scene_files())
+    if (std::string(f.name) == "barth_sextic.toml")
+      return load_scene_text(f.text, "<built-in default scene>", overrides);
+  throw std::logic_error("the default scene was not embedded");
+}
+
+}  // namespace algray

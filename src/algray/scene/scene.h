@@ -1,0 +1,175 @@
+// Scene: the surface, extent, camera, image, colours and render settings read from a TOML file and overrides.
+#pragma once
+
+#include <glm/glm.hpp>
+#include <istream>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "algray/scene/camera.h"
+#include "algray/scene/solver_options.h"
+#include "algray/math/polynomial.h"
+
+namespace algray {
+
+// Bad input. `where` is "file:line:column" (or "--set key=value"), `excerpt` the offending line with a caret.
+struct SceneError : std::runtime_error {
+  SceneError(std::string where, std::string message, std::string excerpt = {});
+  std::string where, message, excerpt;
+};
+
+enum class ExtentKind { Sphere, Box };
+
+struct Extent {
+  ExtentKind kind = ExtentKind::Sphere;
+  glm::dvec3 centre{0};  // sphere
+  double radius = 1;
+  glm::dvec3 min{-1}, max{1};  // box
+
+  // The kernels work in u = (p - unit_centre()) / unit_scale(), where the extent fits in |u| <= 1.
+  glm::dvec3 unit_centre() const;
+  double unit_scale() const;
+  glm::dvec3 unit_box_half() const;  // box half-sizes in unit coordinates
+};
+
+struct ImageSpec {
+  int width = 800;
+  int height = 600;
+  glm::dvec4 background{1, 1, 1, 1};  // linear RGBA
+};
+
+// How a side of the surface reflects light (Phong), plus what it passes on to secondary rays.
+struct Material {
+  glm::dvec3 colour{0.95, 0.65, 0.15};
+  double ambient = 0.15;   // share of the colour lit by the ambient light, shadow or not
+  double diffuse = 0.75;   // Lambertian share per light
+  double specular = 0.35;  // highlight strength per light, in the light's colour
+  double exponent = 40;    // Phong exponent: larger is a smaller, sharper highlight
+  // Share of the mirror ray's colour added to the surface's own (a reflection pass traces the mirror rays).
+  double reflectivity = 0;
+  // Share of the colour seen through the surface, the ray continuing to the next root as in surf and SURFER;
+  // the surface's own colour keeps 1 - transparency (a transmission pass traces the continued rays).
+  double transparency = 0;
+};
+
+// Front: where the ray arrives from P > 0 (outside); back: from P < 0 (inside).
+struct Materials {
+  Material front;
+  Material back = [] {
+    Material m;
+    m.colour = {0.25, 0.45, 0.9};
+    return m;
+  }();
+};
+
+enum class LightKind { Point, Rectangle, Disc };
+
+// A light; area lights are sampled as samples x samples points spread uniformly over their area.
+struct Light {
+  LightKind kind = LightKind::Point;
+  glm::dvec3 position{0};           // the point, or the area's centre
+  glm::dvec3 edge_u{0}, edge_v{0};  // rectangle: its two edges (full length), centred on position
+  glm::dvec3 normal{0, 0, 1};       // disc: its plane's normal, as written (not necessarily unit)
+  double radius = 0;                // disc
+  int samples = 1;                  // n: n x n points for an area light; 1 for a point light
+  glm::dvec3 colour{1};
+  double intensity = 1;
+  bool shadows = true;
+
+  // The light's sample points: cell centres of an n x n grid over the rectangle, or the same grid mapped to
+  // the disc by an area-preserving (concentric) map.
+  std::vector<glm::dvec3> sample_points() const;
+};
+
+// The most points one area light may have: a shadow pass keeps one visibility bit per point in 64 bits.
+inline constexpr int kMaxLightSamplesPerSide = 8;
+
+struct Antialias {
+  int samples = 1;  // n x n supersampling; 1 is off
+  // Adaptive: one ray per pixel first, then n x n only in pixels whose colour differs from a neighbour's by
+  // more than `threshold` in some channel (the antialiasing refinement pass).
+  bool adaptive = false;
+  double threshold = 0.1;
+};
+
+struct RenderSettings {
+  std::optional<Precision> precision;  // unset: double where the device has fp64, else float
+  double tolerance = 1e-9;
+  Isolation isolation = Isolation::Bernstein;
+  Refinement refinement = Refinement::Brent;
+  RayOrigin ray_origin = RayOrigin::Auto;
+  int max_iterations = 0;  // 0: the refinement's default (default_max_iterations)
+  int tile_size = 0;       // pixels per side of a dispatched tile; 0 chooses by device type
+  int lanes = 0;           // camera rays per primary work-item (kernels/lanes.h); 0 chooses by device type
+  bool preview = false;    // primary rays only: lights shade, but cast no shadows (the paper's preview mode)
+  // Secondary bounces after the camera ray: reflection and transmission rays stop after this many.
+  int max_depth = 5;
+};
+
+// One surface of a scene: its polynomial and how its two sides look.
+struct SceneSurface {
+  std::string name;
+  std::string equation;  // as written, or generated from the term list
+  bool from_terms = false;  // given as surface.terms: exact doubles, which the generated equation may round
+  Polynomial polynomial;
+  Materials materials;
+};
+
+// Surfaces one scene may hold; each is traced by its own kernel specialisation.
+inline constexpr std::size_t kMaxSurfaces = 8;
+
+struct Scene {
+  std::string source;  // the scene file's path, or "<built-in default scene>"
+  std::string name;    // the first surface's name, else the file stem
+  std::map<std::string, double> parameters;
+  std::vector<SceneSurface> surfaces;  // at least one; where several meet a ray, the nearest hit wins
+  Extent extent;
+  CameraSpec camera;
+  ImageSpec image;
+  std::vector<Light> lights;  // none: a headlight at the eye shades the surface, without shadows
+  Antialias antialias;
+  RenderSettings render;
+  // What the scene's reader could not render as written (a .jsurf feature algray draws differently, an unknown
+  // key it ignored); commands print them as warnings.
+  std::vector<std::string> warnings;
+
+  // The first surface: the one single-surface tools (the reference solver, the solver benchmarks) work on.
+  const SceneSurface& surface() const { return surfaces.front(); }
+};
+
+// "key=value" from --set (or a flag such as --width): key is a dotted scene key; a key without a dot names a
+// parameter. The value is read as TOML, or as a string when it is not valid TOML.
+struct Override {
+  std::string key;
+  std::string value;
+  // Where it was written, for messages ("jobs.toml:7:9"); empty for the command line's --set.
+  std::string origin = {};
+};
+
+// A .toml scene, or a SURFER/jsurf .jsurf file (by extension, any case), translated with jsurf's framing.
+Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides = {});
+Scene load_scene_text(const std::string& text, const std::string& source_name,
+                      const std::vector<Override>& overrides = {});
+Scene load_jsurf_text(const std::string& text, const std::string& source_name,
+                      const std::vector<Override>& overrides = {});
+Scene default_scene(const std::vector<Override>& overrides = {});
+
+// The scene as TOML that reads back to the same Scene, value for value (floats to 17 digits, the equations as
+// written with their parameters): what PNG files embed so that `algray render image.png` renders them again, and
+// what holds a scene after --set, an orbit or a .jsurf translation. Comments and the source's layout are lost.
+std::string scene_to_toml(const Scene& scene);
+
+// Scenes and jobs files are small text; a larger input is refused after reading one byte past this, so that
+// `algray render /dev/zero` or a mistyped path to a video fails at once instead of filling the memory.
+inline constexpr std::size_t kMaxInputBytes = std::size_t{4} << 20;
+
+// The whole of a text input (`what`: "scene file", "jobs file"); SceneError naming `path` when it is missing, a
+// directory, unreadable or larger than kMaxInputBytes.
+std::string read_input_file(const std::string& path, const std::string& what);
+// The same from a stream such as standard input, named `source` in messages.
+std::string read_input_stream(std::istream& in, const std::string& source, const std::string& what);
+
+}  // namespace algray

@@ -1,0 +1,66 @@
+// Names of the solver choices: parsing, printing and the lists of accepted names.
+#include "algray/scene/solver_options.h"
+
+#include <algorithm>
+
+namespace algray {
+namespace {
+
+template <typename E, std::size_t N>
+bool parse_enum(const std::array<NamedChoice<E>, N>& choices, const std::string& name, E& out) {
+  for (const auto& c : choices)
+    if (name == c.name) {
+      out = c.value;
+      return true;
+    }
+  return false;
+}
+
+template <typename E, std::size_t N>
+std::string enum_name(const std::array<NamedChoice<E>, N>& choices, E value) {
+  for (const auto& c : choices)
+    if (c.value == value) return c.name;
+  return "?";
+}
+
+template <typename E, std::size_t N>
+std::string enum_choices(const std::array<NamedChoice<E>, N>& choices, const char* last = nullptr) {
+  std::string s;
+  for (std::size_t i = 0; i < N; ++i) {
+    if (i > 0 && last && i + 1 == N)
+      s.append(" ").append(last).append(" ");
+    else if (i > 0)
+      s.append(", ");
+    s.append(choices[i].name);
+  }
+  return s;
+}
+
+}  // namespace
+
+std::string to_string(Precision p) { return enum_name(kPrecisions, p); }
+std::string to_string(Isolation i) { return enum_name(kIsolations, i); }
+std::string to_string(Refinement r) { return enum_name(kRefinements, r); }
+std::string to_string(RayOrigin o) { return enum_name(kRayOrigins, o); }
+bool parse_precision(const std::string& n, Precision& out) { return parse_enum(kPrecisions, n, out); }
+bool parse_isolation(const std::string& n, Isolation& out) { return parse_enum(kIsolations, n, out); }
+bool parse_refinement(const std::string& n, Refinement& out) { return parse_enum(kRefinements, n, out); }
+bool parse_ray_origin(const std::string& n, RayOrigin& out) { return parse_enum(kRayOrigins, n, out); }
+std::string precision_choices() { return enum_choices(kPrecisions); }
+std::string isolation_choices(const char* last) { return enum_choices(kIsolations, last); }
+std::string refinement_choices(const char* last) { return enum_choices(kRefinements, last); }
+std::string ray_origin_choices() { return enum_choices(kRayOrigins); }
+
+// OpenCL C's vector widths, and 1 (kernels/lanes.h).
+constexpr std::array<int, 5> kLanes{1, 2, 4, 8, 16};
+bool valid_lanes(int lanes) { return std::find(kLanes.begin(), kLanes.end(), lanes) != kLanes.end(); }
+std::string lanes_choices() {
+  std::string out;
+  for (std::size_t i = 0; i < kLanes.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == kLanes.size() ? " or " : ", ") + std::to_string(kLanes[i]);
+  return out;
+}
+
+int default_max_iterations(Refinement r) { return r == Refinement::RegulaFalsi ? 1000 : 100; }
+
+}  // namespace algray

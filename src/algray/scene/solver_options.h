@@ -1,0 +1,68 @@
+// The solver choices a scene makes (precision, isolation, refinement, ray origin): each list held once, with names.
+#pragma once
+
+#include <array>
+#include <string>
+
+namespace algray {
+
+inline constexpr int kMaxDegree = 32;
+
+// Mixed: float, except that P*(t) is built in compensated float-float arithmetic (degrees up to 15).
+enum class Precision { Float, Double, Mixed };
+inline constexpr int kMaxMixedDegree = 15;
+enum class Isolation { Bernstein, PowerDescartes, Sturm, DerivativeChain };
+enum class Refinement { Brent, Bisection, RegulaFalsi, Illinois, Newton };
+// Where P*(t) is built around: Auto (scenes only) is Screen for camera rays where it applies (screen_form_applies
+// in render_plan.h), else Extent.
+enum class RayOrigin { Auto, Extent, Eye, Screen };
+
+// One choice: its value and its name in scenes, on the command line, in stats and in the probe.
+template <typename E>
+struct NamedChoice {
+  E value;
+  const char* name;
+};
+
+// Every choice of each kind, in the order help text, the probe's --all-solvers, benchmarks and tests list them.
+// Adding a method here (and its kernel id in device/kernel_config.cpp) makes every one of them offer it.
+inline constexpr std::array<NamedChoice<Precision>, 3> kPrecisions{
+    {{Precision::Float, "float"}, {Precision::Double, "double"}, {Precision::Mixed, "mixed"}}};
+inline constexpr std::array<NamedChoice<Isolation>, 4> kIsolations{{{Isolation::Bernstein, "bernstein"},
+                                                                    {Isolation::PowerDescartes, "descartes"},
+                                                                    {Isolation::Sturm, "sturm"},
+                                                                    {Isolation::DerivativeChain, "derivative-chain"}}};
+inline constexpr std::array<NamedChoice<Refinement>, 5> kRefinements{{{Refinement::Brent, "brent"},
+                                                                     {Refinement::Bisection, "bisection"},
+                                                                     {Refinement::RegulaFalsi, "regula-falsi"},
+                                                                     {Refinement::Illinois, "illinois"},
+                                                                     {Refinement::Newton, "newton"}}};
+inline constexpr std::array<NamedChoice<RayOrigin>, 4> kRayOrigins{{{RayOrigin::Auto, "auto"},
+                                                                   {RayOrigin::Extent, "extent"},
+                                                                   {RayOrigin::Eye, "eye"},
+                                                                   {RayOrigin::Screen, "screen"}}};
+
+std::string to_string(Precision p);
+std::string to_string(Isolation i);
+std::string to_string(Refinement r);
+std::string to_string(RayOrigin o);
+// Parsers return false on an unknown name; `choices` then lists the accepted ones.
+bool parse_precision(const std::string& name, Precision& out);
+bool parse_isolation(const std::string& name, Isolation& out);
+bool parse_refinement(const std::string& name, Refinement& out);
+bool parse_ray_origin(const std::string& name, RayOrigin& out);
+// "a, b, c", or with `last` given "a, b or c".
+std::string precision_choices();
+std::string isolation_choices(const char* last = nullptr);
+std::string refinement_choices(const char* last = nullptr);
+std::string ray_origin_choices();
+
+// The lane counts a kernel can be built with (render.lanes; kernels/lanes.h).
+bool valid_lanes(int lanes);
+std::string lanes_choices();
+
+// The refinement's iteration cap unless a scene sets one: 1000 for plain regula falsi, as in the paper (its
+// one-sided convergence needs them), 100 for the others.
+int default_max_iterations(Refinement r);
+
+}  // namespace algray
