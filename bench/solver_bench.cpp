@@ -99,10 +99,10 @@ struct Timed {
 // One untimed run (builds or loads the program), then `runs` timed ones; device time of the launches.
 Timed timed_render(Renderer& renderer, const Scene& scene, int runs) {
   Timed t;
-  t.result = renderer.render(scene, false);
+  t.result = renderer.render_with_records(scene);
   std::vector<double> ms;
   for (int i = 0; i < runs; ++i) {
-    t.result = renderer.render(scene, false);
+    t.result = renderer.render_with_records(scene);
     ms.push_back(kernel_ms(t.result));
   }
   t.median_kernel_ms = median(ms);
@@ -170,9 +170,9 @@ json bench_degrees(ClSession& session, bool quick, const fs::path& cache_dir) {
         // Cold: compiled from source (PoCL's own cache is off, see main). Warm: a binary from the disk cache.
         ProgramCache cold_cache(false);
         Renderer cold(session, cold_cache);
-        const RenderResult first = cold.render(scene, false);
+        const RenderResult first = cold.render_with_records(scene);
         ProgramCache fill(true, cache_dir);
-        Renderer(session, fill).render(scene, false);
+        Renderer(session, fill).render_with_records(scene);
         ProgramCache warm_cache(true, cache_dir);
         Renderer warm(session, warm_cache);
         const Timed t = timed_render(warm, scene, runs);
@@ -188,7 +188,7 @@ json bench_degrees(ClSession& session, bool quick, const fs::path& cache_dir) {
                     {"build_cold_ms", first.programs.at(0).build_ms}};
         // The warm cache's first render loaded the binary from disk; its record says how long that took.
         ProgramCache probe(true, cache_dir);
-        const RenderResult loaded = Renderer(session, probe).render(scene, false);
+        const RenderResult loaded = Renderer(session, probe).render_with_records(scene);
         row["build_warm_ms"] = loaded.programs.at(0).build_ms;
         row["warm_origin"] = loaded.programs.at(0).origin;
         std::fprintf(stderr, "degree %2d %-6s %-28s %10.0f rays/s  build %6.0f / %4.0f ms\n", degree,

@@ -18,6 +18,7 @@
 
 #include "cli_sandbox.h"
 #include "algray/io/image_io.h"
+#include "algray/scene/scene.h"
 #include "scene_fixtures.h"
 #include "algray/util/version.h"
 
@@ -92,6 +93,32 @@ TEST_CASE("the default render writes EXR, PNG and stats", "[cli]") {
   CHECK(s["image"]["height"] == 24);
   // The stats must agree with the image about how many pixels hit the surface.
   CHECK(s["pixels"]["hits"].get<int>() == finite_depths(img));
+}
+
+TEST_CASE("the EXR metadata and the stats name every surface of a scene of several", "[cli]") {
+  require_device();
+  Sandbox box;
+  const std::string scene_path = std::string(ALGRAY_SOURCE_DIR) + "/scenes/examples/ball_and_ring.toml";
+  const algray::Scene scene = algray::load_scene_file(scene_path);
+  REQUIRE(scene.surfaces.size() >= 2);
+  const auto r = box.run("render " + scene_path + " -o out.exr --stats s.json --width 16 --height 12 --preview");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const algray::FrameImage img = algray::read_exr(box.work / "out.exr");
+  std::map<std::string, std::string> text(img.string_attributes.begin(), img.string_attributes.end());
+  std::map<std::string, double> numbers(img.double_attributes.begin(), img.double_attributes.end());
+  CHECK(numbers["algray/surfaces"] == static_cast<double>(scene.surfaces.size()));
+  const nlohmann::json stats = box.stats();
+  REQUIRE(stats["surfaces"].size() == scene.surfaces.size());
+  for (std::size_t k = 0; k < scene.surfaces.size(); ++k) {
+    INFO("surface " << k);
+    const std::string prefix = "algray/surface" + std::to_string(k) + "/";
+    CHECK(text[prefix + "name"] == scene.surfaces[k].name);
+    CHECK(text[prefix + "equation"] == scene.surfaces[k].equation);
+    CHECK(text[prefix + "polynomial"] == scene.surfaces[k].polynomial.to_string());
+    CHECK(numbers[prefix + "degree"] == scene.surfaces[k].polynomial.degree());
+    CHECK(stats["surfaces"][k]["equation"] == scene.surfaces[k].equation);
+  }
 }
 
 TEST_CASE("a second render reuses the compiled program and --no-cache does not", "[cli]") {

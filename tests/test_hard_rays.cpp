@@ -66,7 +66,7 @@ RaySolve solve(const std::string& file, const glm::dvec3& from, const glm::dvec3
                                        {"render.preview", "true"},
                                        {"render.precision", "\"double\""}});
   RaySolve r;
-  const RenderResult result = renderer().render(scene, false);
+  const RenderResult result = renderer().render_with_records(scene);
   r.kernel = result.hits.records[0];
   r.ray = pixel_ray(result.basis, false, 0, 0);
   long double t_in = 0, t_out = 0;

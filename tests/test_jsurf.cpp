@@ -41,7 +41,7 @@ Scene jsurf_scene(const std::string& body, int size = 101) {
 HitBuffer render_hits(const Scene& scene) {
   static ProgramCache cache(true, algray::testing::shared_cache_dir());
   Renderer renderer(device_session(), cache);
-  return renderer.render(scene, false).hits;
+  return renderer.render_with_records(scene).hits;
 }
 
 struct Coverage {

@@ -79,7 +79,7 @@ TEST_CASE("every DEGREE from 1 to 32 builds and finds the smallest root, in floa
       const Scene scene = degree_scene(degree, precision);
       REQUIRE(scene.surface().polynomial.degree() == degree);
       RenderResult result;
-      REQUIRE_NOTHROW(result = renderer.render(scene, false));  // a BuildError prints the options and the log
+      REQUIRE_NOTHROW(result = renderer.render_with_records(scene));  // a BuildError prints the options and the log
       REQUIRE(result.programs.size() == 1);
       CHECK(result.programs[0].origin == "built");
       check_known_root(result, degree, precision);
@@ -109,7 +109,7 @@ TEST_CASE("the paper's power-basis method and plain bisection build and find the
                      << (eye ? " ray_origin=eye" : ""));
       const Scene scene = degree_scene(degree, "double", solver);
       RenderResult result;
-      REQUIRE_NOTHROW(result = renderer.render(scene, false));
+      REQUIRE_NOTHROW(result = renderer.render_with_records(scene));
       check_known_root(result, degree, "double");
     }
   }
@@ -135,7 +135,7 @@ TEST_CASE("power-basis isolation refines a wide bracket to the stopping width at
         INFO("DEGREE=" << degree << " isolation=" << isolation << " precision=" << precision);
         const Scene scene = degree_scene(degree, precision, {{"render.isolation", isolation}}, 64);
         RenderResult result;
-        REQUIRE_NOTHROW(result = renderer.render(scene, false));
+        REQUIRE_NOTHROW(result = renderer.render_with_records(scene));
         check_known_root(result, degree, precision, 64);
       }
     }

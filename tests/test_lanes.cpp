@@ -58,11 +58,11 @@ TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") 
   for (std::size_t index = 0; index < cases.size(); ++index) {
     const Case& c = cases[index];
     const unsigned seed = 2000u + static_cast<unsigned>(c.degree);
-    const RenderResult one = renderer.render(lanes_scene(c.degree, seed, c.precision, 1, c.origin), false);
+    const RenderResult one = renderer.render_with_records(lanes_scene(c.degree, seed, c.precision, 1, c.origin));
     REQUIRE(one.plan.find("primary")->kernels.at(0).lanes == 1);
     for (const HitRecord& h : one.hits.records) hits += (h.flags & ALGRAY_HIT_FOUND) != 0;
     for (int lanes : c.lanes) {
-      const RenderResult many = renderer.render(lanes_scene(c.degree, seed, c.precision, lanes, c.origin), false);
+      const RenderResult many = renderer.render_with_records(lanes_scene(c.degree, seed, c.precision, lanes, c.origin));
       REQUIRE(many.plan.find("primary")->kernels.at(0).lanes == lanes);
       const long at = first_difference(one.hits.records, many.hits.records);
       INFO("case " << index << ": degree " << c.degree << ", seed " << seed << ", " << to_string(c.precision) << ", "
@@ -92,9 +92,8 @@ TEST_CASE("lanes give the one-ray kernel's hit records where groups settle witho
     for (const Precision precision : {Precision::Double, Precision::Float, Precision::Mixed}) {
       const std::string quoted_precision = '"' + std::string(to_string(precision)) + '"';
       const auto render = [&](int lanes) {
-        return renderer.render(
-            load_scene_text(text, "plane", {{"render.precision", quoted_precision}, {"render.lanes", std::to_string(lanes)}}),
-            false);
+        return renderer.render_with_records(
+            load_scene_text(text, "plane", {{"render.precision", quoted_precision}, {"render.lanes", std::to_string(lanes)}}));
       };
       const RenderResult one = render(1), many = render(8);
       REQUIRE(many.plan.find("primary")->kernels.at(0).lanes == 8);

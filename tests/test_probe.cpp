@@ -190,7 +190,7 @@ TEST_CASE("a probed pixel gets the render's hit record bit for bit", "[probe]") 
                                      {"render.refinement", toml_string(to_string(c.refinement))}});
     INFO(to_string(c.precision) << " " << to_string(c.isolation) << " + " << to_string(c.refinement));
     Renderer renderer(session, probe_cache());
-    const RenderResult render = renderer.render(scene, false);
+    const RenderResult render = renderer.render_with_records(scene);
     REQUIRE(render.hits.width == 48);
     const KernelConfig config = primary_config(scene, c.precision);
     int hits = 0, misses_in_extent = 0, compared = 0;

@@ -39,7 +39,7 @@ void check_scene(Renderer& renderer, const std::filesystem::path& file, const ch
                                                       {"render.preview", "true"}});
   const bool is_double = std::string(precision) == "double";
   const bool is_float = !is_double;  // float and mixed both trace float rays
-  const RenderResult kernel = renderer.render(scene, false);
+  const RenderResult kernel = renderer.render_with_records(scene);
   const ReferenceResult ref = render_reference(scene, is_float ? Precision::Float : Precision::Double);
   const ReferenceComparison c = compare_with_reference(kernel.hits, ref);
   std::printf("%-28s %-6s %9ld %9ld %9ld %12ld %9ld %12.3g\n", file.stem().string().c_str(), precision, c.certified,
@@ -67,7 +67,7 @@ TEST_CASE("the screen form meets the double line on seeded random surfaces of ev
   for (int degree = 1; degree <= kMaxDegree; ++degree)
     for (unsigned seed : {1000u + static_cast<unsigned>(degree)}) {  // one seed: the reference costs ~1.5 s a case
       const Scene scene = load_scene_text(random_scene(degree, seed, Precision::Double), "random");
-      const RenderResult kernel = renderer.render(scene, false);
+      const RenderResult kernel = renderer.render_with_records(scene);
       REQUIRE(kernel.config.ray_origin == RayOrigin::Screen);
       const ReferenceComparison c = compare_with_reference(kernel.hits, render_reference(scene, Precision::Double));
       INFO("degree " << degree << " seed " << seed << ": " << c.disagreements << " of " << c.certified

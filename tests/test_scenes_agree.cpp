@@ -184,7 +184,7 @@ TEST_CASE("each scene agrees with an independent CPU check on a seeded sample of
                                          {"render.preview", "true"}};
       overrides.insert(overrides.end(), solver.begin(), solver.end());
       const Scene scene = load_scene_file(file.string(), overrides);
-      const RenderResult result = renderer.render(scene, false);
+      const RenderResult result = renderer.render_with_records(scene);
       const bool is_double = result.config.precision == Precision::Double;
       const Real eps = is_double ? std::numeric_limits<double>::epsilon() : std::numeric_limits<float>::epsilon();
       const Real degree = scene.surface().polynomial.degree();

@@ -87,7 +87,7 @@ TEST_CASE("transmission rays continue to the next root: nested spheres", "[secon
   const Scene scene = sphere_scene("(x^2+y^2+z^2-1)*(x^2+y^2+z^2-4)",
                                    {"[material.front]", "transparency = 0.5", "[material.back]", "transparency = 0.5",
                                     "[render]", "precision = \"double\""});
-  const RenderResult r = renderer.render(scene, false);
+  const RenderResult r = renderer.render_with_records(scene);
   std::size_t checked = 0;
   check_batches(r, {{{0, 0, 0}, 1}, {{0, 0, 0}, 2}}, "transmission", checked);
   int deepest = 0;
@@ -102,7 +102,7 @@ TEST_CASE("reflection rays leave by the mirror direction and find the other sphe
   Renderer renderer(session, cache);
   const Scene scene = sphere_scene("((x-1.3)^2+y^2+z^2-1)*((x+1.3)^2+y^2+z^2-1)",
                                    {"[material.front]", "reflectivity = 0.5", "[render]", "precision = \"double\""});
-  const RenderResult r = renderer.render(scene, false);
+  const RenderResult r = renderer.render_with_records(scene);
   std::size_t checked = 0, hits = 0;
   check_batches(r, {{{1.3, 0, 0}, 1}, {{-1.3, 0, 0}, 1}}, "reflection", checked);
   for (const SecondaryBatch& b : r.secondary)
@@ -120,9 +120,9 @@ TEST_CASE("a transparent side without a transmission pass shows opaque, not dark
     const Scene clear = sphere_scene("x^2+y^2+z^2-1", {"[material.front]", "transparency = 1", "[render]", how});
     Scene opaque = clear;
     opaque.surfaces[0].materials.front.transparency = 0;
-    const RenderResult r = renderer.render(clear, false);
+    const RenderResult r = renderer.render_with_records(clear);
     CHECK(r.plan.find("transmission") == nullptr);
-    const FrameImage a = shade_frame(clear, r), b = shade_frame(opaque, renderer.render(opaque, false));
+    const FrameImage a = shade_frame(clear, r), b = shade_frame(opaque, renderer.render_with_records(opaque));
     const std::size_t centre = 4 * (static_cast<std::size_t>(a.height / 2) * a.width + a.width / 2);
     CHECK(a.rgba[centre] > 0.1f);
     CHECK(a.rgba[centre] == b.rgba[centre]);
@@ -247,7 +247,7 @@ TEST_CASE("without records a render keeps the film and the totals, not every ray
   CHECK(lean.primary.rays == 72u * 54u);
   CHECK(lean.primary.pixels == 72u * 54u);
   CHECK(lean.primary.hits > 0);
-  const RenderResult full = renderer.render(scene, false);
+  const RenderResult full = renderer.render_with_records(scene);
   CHECK(same_bits(lean.image.rgba, full.image.rgba));
   const PrimarySummary from_records = summarise_hits(full.hits, full.plan.samples);
   CHECK(lean.primary.hits == from_records.hits);

@@ -76,7 +76,7 @@ TEST_CASE("every hit's colour is Phong over the light points the shadow pass lef
     for (const char* precision : {"double", "float"}) {
       Scene scene = two_sided_scene(preview);
       scene.render.precision = std::string(precision) == "double" ? Precision::Double : Precision::Float;
-      const RenderResult r = renderer.render(scene, false);
+      const RenderResult r = renderer.render_with_records(scene);
       const ShadowLookup shadows(r.shadows, r.hits.records.size(), scene.lights.size());
       const bool single = scene.render.precision != Precision::Double;
       // The shader itself on every hit at once (whole groups of lanes and a remainder) and one at a time.

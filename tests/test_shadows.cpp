@@ -31,7 +31,7 @@ struct SurfacePoint {
 
 // Every hit of a small primary render of `scene`.
 std::vector<SurfacePoint> surface_points(Renderer& renderer, const Scene& scene) {
-  const RenderResult r = renderer.render(scene, false);
+  const RenderResult r = renderer.render_with_records(scene);
   const bool single = r.config.precision != Precision::Double;
   std::vector<SurfacePoint> points;
   for (int y = 0; y < r.hits.height; ++y)

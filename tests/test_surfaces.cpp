@@ -43,9 +43,9 @@ TEST_CASE("a scene's surfaces each get their own kernel, and the nearest hit win
   REQUIRE(scene.surfaces.size() == 2);
   CHECK(scene.surfaces[0].materials.front.colour == glm::dvec3(1, 0, 0));
   CHECK(scene.surfaces[1].materials.front.colour == glm::dvec3(0, 1, 0));
-  const RenderResult both = renderer.render(scene, false);
-  const RenderResult ball = renderer.render(one_surface(kSphere), false);
-  const RenderResult ring = renderer.render(one_surface(kTorus), false);
+  const RenderResult both = renderer.render_with_records(scene);
+  const RenderResult ball = renderer.render_with_records(one_surface(kSphere));
+  const RenderResult ring = renderer.render_with_records(one_surface(kTorus));
 
   // One primary kernel per surface, specialised by its degree.
   REQUIRE(both.passes.at(0).program_keys.size() == 2);
@@ -84,10 +84,10 @@ TEST_CASE("shadows and bounces see every surface", "[surfaces]") {
   Renderer renderer(session, cache);
   // A low light on +x: the ball shades the far (-x) side of the ring, which alone would be lit there.
   const std::string light = "[[light]]\nposition = [4, 3, 0]\n";
-  const RenderResult both = renderer.render(two_surfaces(light), false);
+  const RenderResult both = renderer.render_with_records(two_surfaces(light));
   Scene ring_alone = one_surface(kTorus);
   ring_alone.lights = two_surfaces(light).lights;
-  const RenderResult ring = renderer.render(ring_alone, false);
+  const RenderResult ring = renderer.render_with_records(ring_alone);
   REQUIRE(both.passes.size() == 2);
   CHECK(both.passes[1].name == "shadow");
   CHECK(both.passes[1].program_keys.size() == 2);
@@ -114,7 +114,7 @@ TEST_CASE("shadows and bounces see every surface", "[surfaces]") {
   Scene mirrors = two_surfaces();
   mirrors.surfaces[1].materials.front.reflectivity = 0.5;
   mirrors.surfaces[1].materials.back.reflectivity = 0.5;
-  const RenderResult bounced = renderer.render(mirrors, false);
+  const RenderResult bounced = renderer.render_with_records(mirrors);
   int ball_in_ring = 0, rays = 0;
   for (const SecondaryBatch& batch : bounced.secondary) {
     REQUIRE(batch.pass == "reflection");

@@ -7,16 +7,16 @@
 #include <cstdlib>
 #include <iostream>
 
-#include "algray/api/batch.h"
-#include "algray/device/cl_runtime.h"
 #include "algray/io/image_io.h"
-#include "algray/api/probe_report.h"
-#include "algray/api/render_job.h"
+#include "algray/scene/solver_options.h"
 #include "algray/util/version.h"
+#include "commands.h"
+#include "exit_codes.h"
 
 namespace {
 
 using namespace algray;
+using namespace algray::cli;
 
 // The options every scene-taking command shares: the scene, its overrides and the device.
 struct SceneOptions {
@@ -124,17 +124,17 @@ int main(int argc, char** argv) {
   std::string stats_path;
   CLI::App* render = app.add_subcommand("render", "render a scene (default: the built-in Barth sextic)");
   add_scene_options(render, render_opts);
-  render->add_option("-o,--output", request.outputs, "output image; .exr or .png by extension; may be repeated")
+  render->add_option("-o,--output", request.outputs.images, "output image; .exr or .png by extension; may be repeated")
       ->default_str("algray.exr");
   render->add_option("--stats", stats_path, "write render statistics as JSON");
   render->add_flag(
-      "--reference", request.reference,
+      "--reference", request.outputs.reference,
       "solve every pixel exactly on the CPU (solver_ref, all cores, slow); adds a reference.class channel");
 
   std::string aov_text;
   render->add_option("--aov", aov_text,
                      "solver channels for EXR outputs, comma-separated: iterations, isolation, classification, flags");
-  render->add_option("--heatmap", request.heatmap_path,
+  render->add_option("--heatmap", request.outputs.heatmap_path,
                      "write a heat map of solver work per pixel (isolation steps + refinement iterations), .png");
 
   ProbeRequest probe_request;
@@ -180,44 +180,13 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kExitBadInput;
   }
 
-  if (devices->parsed()) {
-    const auto list = enumerate_devices();
-    if (list.empty()) {
-      std::cerr << "algray: no OpenCL device found (on Debian: apt-get install pocl-opencl-icd)\n";
-      return kExitFailure;
-    }
-    std::cout << describe_devices(list);
-    if (!devices_stats.empty()) {
-      nlohmann::json j = {{"version", version_string()}, {"devices", nlohmann::json::array()}};
-      for (const DeviceInfo& d : list)
-        j["devices"].push_back({{"index", d.index},
-                     {"platform", d.platform_name},
-                     {"platform_version", d.platform_version},
-                     {"name", d.name},
-                     {"vendor", d.vendor},
-                     {"version", d.version},
-                     {"driver", d.driver_version},
-                     {"type", d.type},
-                     {"compute_units", d.compute_units},
-                     {"fp64", d.fp64},
-                     {"global_mem_bytes", d.global_mem_bytes},
-                     {"max_alloc_bytes", d.max_alloc_bytes}});
-      try {
-        check_output_writable(devices_stats);
-        write_text_file(devices_stats, j.dump(2) + "\n");
-      } catch (const std::exception& e) {
-        return report_error(e, std::cerr);
-      }
-    }
-    return kExitOk;
-  }
+  if (devices->parsed()) return run_devices(devices_stats, std::cout, std::cerr);
 
   if (batch->parsed()) {
     if (!collect_overrides(batch, batch_opts, batch_request.overrides)) return kExitBadInput;
     batch_request.device_spec = batch_opts.device_spec;
     batch_request.use_cache = !batch_opts.no_cache;
-    batch_request.progress = ::isatty(STDERR_FILENO) != 0;
-    return run_batch(batch_request, std::cerr);
+    return run_batch_command(batch_request, ::isatty(STDERR_FILENO) != 0, std::cerr);
   }
 
   if (probe->parsed()) {
@@ -266,18 +235,18 @@ int main(int argc, char** argv) {
   }
 
   if (!render_opts.scene_path.empty()) request.scene_path = render_opts.scene_path;
-  if (request.outputs.empty()) request.outputs.push_back("algray.exr");
+  if (request.outputs.images.empty()) request.outputs.images.push_back("algray.exr");
   if (!collect_overrides(render, render_opts, request.overrides)) return kExitBadInput;
   request.device_spec = render_opts.device_spec;
   if (!aov_text.empty()) {
     std::string error;
-    if (!parse_aov_list(aov_text, request.aovs, error)) {
+    if (!parse_aov_list(aov_text, request.outputs.aovs, error)) {
       std::cerr << "algray: --aov " << aov_text << ": " << error << "\n";
       return kExitBadInput;
     }
   }
   request.use_cache = !render_opts.no_cache;
-  if (!stats_path.empty()) request.stats_path = stats_path;
+  if (!stats_path.empty()) request.outputs.stats_path = stats_path;
   request.progress = ::isatty(STDERR_FILENO) != 0;
   end_process(run_render(request, std::cerr));
 }

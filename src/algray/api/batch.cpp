@@ -1,4 +1,4 @@
-// The batch command: jobs file, frames, resume, progress, JSON-lines log; renders share one device and cache.
+// Batches: jobs file, frames, resume, JSON-lines log; the renders share one device and program cache.
 #include "algray/api/batch.h"
 
 #include <algorithm>
@@ -244,12 +244,6 @@ class JsonLinesLog {
   std::ofstream out_;
 };
 
-std::string seconds(double ms) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, ms < 10000 ? "%.2f s" : "%.0f s", ms / 1000);
-  return buf;
-}
-
 }  // namespace
 
 std::vector<BatchJob> load_jobs(const std::string& text, const std::string& source, const std::string& base_dir) {
@@ -345,7 +339,15 @@ void apply_orbit(Scene& scene, const Orbit& orbit, int frame, int frames) {
   }
 }
 
-int run_batch(const BatchRequest& req, std::ostream& err) {
+BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks) {
+  const auto message = [&](const std::string& text) {
+    if (callbacks.on_message) callbacks.on_message(text);
+  };
+  const auto bad = [&](const std::exception& e) {
+    const ErrorReport report = describe_error(e);
+    message(report.text);
+    return report.bad_input ? BatchOutcome::BadInput : BatchOutcome::Stopped;
+  };
   std::vector<BatchJob> jobs;
   std::string log_path;
   try {
@@ -379,7 +381,7 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
     // before anything renders rather than a failure of each frame.
     for (const RoleAndPath& o : outputs) check_output_writable(o.path);
   } catch (const std::exception& e) {
-    return report_error(e, err);
+    return bad(e);
   }
 
   int total = 0;
@@ -388,7 +390,7 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
   try {
     opened.emplace(log_path, req.resume);
   } catch (const std::exception& e) {
-    return report_error(e, err);
+    return bad(e);
   }
   JsonLinesLog& log = *opened;
   RenderContext context(req.device_spec, req.use_cache);
@@ -433,7 +435,7 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
           }
           Scene scene = load_scene_file(job.scene, overrides);
           if (!warned) {
-            print_warnings(scene, err, "job " + job.name + ": ");
+            for (const std::string& w : scene.warnings) message("algray: warning: job " + job.name + ": " + w + "\n");
             warned = true;
           }
           if (job.orbit) {
@@ -442,27 +444,26 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
                                {"up", {scene.camera.up.x, scene.camera.up.y, scene.camera.up.z}},
                                {"angle", orbit_angle(*job.orbit, frame, job.frames)}};
           }
-          RenderRequest render;
-          render.outputs = outputs;
+          RenderOutputs render;
+          render.images = outputs;
           render.stats_path = stats;
           check_outputs(scene, render);
-          entry["stats"] = render_scene(scene, render, context, start);
+          entry["stats"] = render_scene(scene, render, context, {}, start);
           entry["status"] = "ok";
           ++ok;
           ++job_ok;
         } catch (const DeviceError& e) {
           // No frame can run without the device: stop here rather than fail every remaining frame alike.
-          err << "algray: " << e.what() << "\n";
+          message(std::string("algray: ") + e.what() + "\n");
           entry["status"] = "failed";
           entry["error"] = e.what();
           log.write(entry);
-          return kExitBadInput;
+          return BatchOutcome::BadInput;
         } catch (const std::exception& e) {
-          std::ostringstream message;
-          report_error(e, message);
-          err << "algray: job " << job.name << " frame " << frame << " failed:\n" << message.str();
+          const std::string why = describe_error(e).text;
+          message("algray: job " + job.name + " frame " + std::to_string(frame) + " failed:\n" + why);
           entry["status"] = "failed";
-          entry["error"] = message.str();
+          entry["error"] = why;
           ++failed;
           ++job_failed;
         }
@@ -470,14 +471,10 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
         frame_ms.push_back(ms);
         entry["ms"] = ms;
         log.write(entry);
-        if (req.progress) {
+        if (callbacks.on_frame) {
           const double elapsed = ms_since(batch_start);
-          const double eta = elapsed / (done + 1) * (total - done - 1);
-          std::fprintf(stderr, "\r[%*d/%d] %s frame %d/%d: %s %s | elapsed %s, eta %s   ",
-                       static_cast<int>(std::to_string(total).size()), done + 1, total, job.name.c_str(), frame + 1,
-                       job.frames, entry["status"].get<std::string>().c_str(), seconds(ms).c_str(),
-                       seconds(elapsed).c_str(), seconds(eta).c_str());
-          std::fflush(stderr);
+          callbacks.on_frame({done + 1, total, &job, frame, entry["status"].get<std::string>(), ms, elapsed,
+                              elapsed / (done + 1) * (total - done - 1)});
         }
       }
       nlohmann::json j = {
@@ -493,12 +490,11 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
       summary_jobs.push_back(j);
     }
   } catch (const JsonLinesLog::WriteFailed& e) {
-    if (req.progress) std::fprintf(stderr, "\n");
-    err << "algray: " << e.what() << "\nalgray: stopped after " << done << " of " << total << " frames (" << ok
-        << " rendered, " << failed << " failed); --resume continues where the images end\n";
-    return kExitFailure;
+    message(std::string("algray: ") + e.what() + "\nalgray: stopped after " + std::to_string(done) + " of " +
+            std::to_string(total) + " frames (" + std::to_string(ok) + " rendered, " + std::to_string(failed) +
+            " failed); --resume continues where the images end\n");
+    return BatchOutcome::Stopped;
   }
-  if (req.progress) std::fprintf(stderr, "\n");
   const nlohmann::json summary = {{"version", version_string()},
                                   {"jobs_file", req.jobs_path},
                                   {"log", log_path},
@@ -510,12 +506,14 @@ int run_batch(const BatchRequest& req, std::ostream& err) {
       write_text_file(*req.stats_path, summary.dump(2) + "\n");
     } catch (const std::exception& e) {
       // After the frames: a failure to write, not bad input.
-      err << "algray: the frames are done, but the batch stats were not written: " << e.what() << "\n";
-      return kExitFailure;
+      message(std::string("algray: the frames are done, but the batch stats were not written: ") + e.what() + "\n");
+      return BatchOutcome::Stopped;
     }
   }
-  if (failed) err << "algray: " << failed << " of " << total << " frames failed (see " << log_path << ")\n";
-  return failed ? kExitFailure : kExitOk;
+  if (failed)
+    message("algray: " + std::to_string(failed) + " of " + std::to_string(total) + " frames failed (see " + log_path +
+            ")\n");
+  return failed ? BatchOutcome::FramesFailed : BatchOutcome::Done;
 }
 
 }  // namespace algray

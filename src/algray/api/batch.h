@@ -1,8 +1,8 @@
-// `algray batch`: a TOML list of render jobs with parameter sweeps and camera orbits, run in one process.
+// Batches: a TOML list of render jobs with parameter sweeps and camera orbits, run in one process.
 #pragma once
 
+#include <functional>
 #include <optional>
-#include <ostream>
 #include <string>
 #include <vector>
 
@@ -61,11 +61,30 @@ struct BatchRequest {
   bool resume = false;                    // skip frames whose outputs all exist
   std::optional<std::string> log_path;    // default: beside the jobs file, <stem>.log.jsonl
   std::optional<std::string> stats_path;  // a summary of the whole batch
-  bool progress = false;                  // a progress line on the terminal
 };
 
+// One frame finished (rendered, failed or skipped), for a progress display.
+struct BatchProgress {
+  int done = 0, total = 0;  // frames finished so far, this one included, of all jobs
+  const BatchJob* job = nullptr;
+  int frame = 0;
+  std::string status;  // "ok", "failed" or "skipped"
+  double frame_ms = 0, elapsed_ms = 0, eta_ms = 0;
+};
+
+struct BatchCallbacks {
+  std::function<void(const BatchProgress&)> on_frame;
+  // Lines for the person running the batch: warnings and failures, each ending in a newline.
+  std::function<void(const std::string&)> on_message;
+};
+
+// How a batch ended: every frame done (or skipped), some frames failed (each reported and logged, the rest
+// rendered), the jobs file or its outputs were bad input (nothing rendered), or it stopped early (the device or
+// the log failed).
+enum class BatchOutcome { Done, FramesFailed, BadInput, Stopped };
+
 // Runs every frame of every job, in order, on one device with one program cache. A failing frame is reported
-// and logged, and the rest still run; the exit code is 1 if any failed, 2 if the jobs file itself is bad.
-int run_batch(const BatchRequest& request, std::ostream& err);
+// and logged, and the rest still run.
+BatchOutcome run_batch(const BatchRequest& request, const BatchCallbacks& callbacks);
 
 }  // namespace algray

@@ -1,4 +1,4 @@
-// The probe command: runs the probe kernel per solver and surface, certifies the ray, and reports or plots it.
+// Probe reports: the probe kernel run per solver and surface, the ray certified, and the report as text, JSON or plot.
 #include "algray/api/probe_report.h"
 
 #include <algorithm>
@@ -253,6 +253,8 @@ nlohmann::json reference_json(const ProbeReference& ref) {
   return j;
 }
 
+}  // namespace
+
 // P*(t) from solver_ref's exact restriction, sampled evenly and at the isolating intervals' ends. Not at the
 // roots: a sample there is 0 to rounding, and the plot's log floor would follow it down to 1e-12 of the
 // largest value, spending most of the height on decades that only the roots' neighbourhoods reach.
@@ -303,8 +305,6 @@ ProbePlot make_plot(const Scene& scene, const ProbeTarget& target, const Surface
   }
   return plot;
 }
-
-}  // namespace
 
 ProbeReference probe_reference(const Scene& scene, std::size_t surface, const PixelRay& ray, Precision precision) {
   ProbeReference out;
@@ -383,74 +383,20 @@ nlohmann::json probe_json(const Scene& scene, const ProbeTarget& target, const s
   return j;
 }
 
-int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
-  Scene scene;
-  try {
-    scene = load_scene(req.scene_path, req.overrides);
-    print_warnings(scene, err);
-    if (!req.target.given_ray && (req.target.px < 0 || req.target.py < 0 || req.target.px >= scene.image.width ||
-                                  req.target.py >= scene.image.height))
-      throw SceneError("--pixel", "pixel (" + std::to_string(req.target.px) + ", " + std::to_string(req.target.py) +
-                                      ") is outside the " + std::to_string(scene.image.width) + "x" +
-                                      std::to_string(scene.image.height) + " image");
-    const glm::dvec3& d = req.target.direction;
-    if (req.target.given_ray && !(std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) > 0))
-      throw SceneError("--ray", "the direction must be nonzero");
-    if (req.plot_path) {
-      check_probe_plot_path(*req.plot_path);
-      check_output_writable(*req.plot_path);
-    }
-    if (req.stats_path) check_output_writable(*req.stats_path);
-    std::vector<RoleAndPath> outputs;
-    if (req.stats_path) outputs.push_back({"--stats", *req.stats_path});
-    if (req.plot_path) outputs.push_back({"--plot", *req.plot_path});
-    check_distinct_files({{"scene file", req.scene_path.value_or("")}}, outputs);
-  } catch (const std::exception& e) {
-    return report_error(e, err);
+std::vector<SurfaceProbe> probe_scene(const Scene& scene, const ProbeTarget& target, bool all_solvers,
+                                      RenderContext& context) {
+  ClSession& session = context.session();
+  const Precision precision = resolve_precision(scene, session.info);
+  std::vector<SurfaceProbe> probes;
+  for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
+    SurfaceProbe p;
+    p.surface = s;
+    for (const KernelConfig& c : solver_configs(scene, precision, s, all_solvers))
+      p.traces.push_back(trace_probe(session, context.cache(), scene, s, c, target));
+    p.reference = probe_reference(scene, s, p.traces.front().ray, precision);
+    probes.push_back(std::move(p));
   }
-  // Paths were checked above: a write that fails from here on is a failure (exit 1), not bad input.
-  std::vector<std::string> planned;
-  if (req.stats_path) planned.push_back(*req.stats_path);
-  if (req.plot_path) planned.push_back(*req.plot_path);
-  OutputWriter writer(planned);
-  try {
-    RenderContext context(req.device_spec, req.use_cache);
-    ClSession& session = context.session();
-    const Precision precision = resolve_precision(scene, session.info);
-    std::vector<SurfaceProbe> probes;
-    for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
-      SurfaceProbe p;
-      p.surface = s;
-      for (const KernelConfig& c : solver_configs(scene, precision, s, req.all_solvers))
-        p.traces.push_back(trace_probe(session, context.cache(), scene, s, c, req.target));
-      p.reference = probe_reference(scene, s, p.traces.front().ray, precision);
-      probes.push_back(std::move(p));
-    }
-    if (req.json || req.stats_path) {
-      const nlohmann::json j = probe_json(scene, req.target, probes);
-      if (req.json) out << j.dump(2) << "\n";
-      if (req.stats_path)
-        writer.write(*req.stats_path, [&] { write_text_file(*req.stats_path, j.dump(2) + "\n"); });
-    }
-    if (!req.json) print_probe(out, scene, req.target, probes);
-    if (req.plot_path) {
-      // The surface whose root the render shows (the nearest), else the first the ray meets at all.
-      const SurfaceProbe* hit = nullptr;
-      for (const SurfaceProbe& p : probes) {
-        const SolverTrace& tr = p.traces.front();
-        if (tr.in_extent && (!hit || tr.t < hit->traces.front().t)) hit = &p;
-      }
-      if (!hit) {
-        err << "algray: " << *req.plot_path << " not written: the ray misses the extent, so there is nothing to plot\n";
-        return kExitFailure;
-      }
-      const auto plot = make_plot(scene, req.target, *hit, req.plot_range);
-      writer.write(*req.plot_path, [&] { write_probe_plot(*req.plot_path, plot); });
-    }
-  } catch (const std::exception& e) {
-    return report_error(e, err);
-  }
-  return kExitOk;
+  return probes;
 }
 
 }  // namespace algray

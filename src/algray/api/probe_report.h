@@ -1,4 +1,4 @@
-// `algray probe`: probes one ray with one or every solver, beside solver_ref's certified answer; text, JSON, plot.
+// Probe reports: one ray with one or every solver, beside solver_ref's certified answer; text, JSON, plot.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "algray/api/render_job.h"
+#include "algray/io/diagnostic_images.h"
 #include "algray/render/probe.h"
 #include "algray/render/reference_render.h"
 #include "algray/scene/scene.h"
@@ -18,19 +20,6 @@ namespace algray {
 struct PlotRange {
   enum class Kind { Segment, Isolating, Given } kind = Kind::Segment;
   double from = 0, to = 0;
-};
-
-struct ProbeRequest {
-  std::optional<std::string> scene_path;  // unset: the built-in default scene
-  std::vector<Override> overrides;        // --set and the solver flags, in order
-  std::string device_spec;
-  ProbeTarget target;
-  bool all_solvers = false;              // every isolation x refinement, side by side
-  std::optional<std::string> plot_path;  // .svg or .png
-  PlotRange plot_range;
-  bool json = false;                      // JSON on stdout instead of text
-  std::optional<std::string> stats_path;  // the JSON report written to a file as well
-  bool use_cache = true;
 };
 
 // solver_ref's view of the probed ray: its certificate and every root on the segment.
@@ -57,7 +46,13 @@ void print_probe(std::ostream& out, const Scene& scene, const ProbeTarget& targe
                  const std::vector<SurfaceProbe>& probes);
 nlohmann::json probe_json(const Scene& scene, const ProbeTarget& target, const std::vector<SurfaceProbe>& probes);
 
-// Runs the command; errors go to err, the report to out. Returns the CLI exit code.
-int run_probe(const ProbeRequest& request, std::ostream& out, std::ostream& err);
+// Every solver asked for (the scene's own, or with all_solvers every isolation x refinement) on the target's ray,
+// for each surface, with solver_ref's answer. Throws DeviceError when the device cannot be opened.
+std::vector<SurfaceProbe> probe_scene(const Scene& scene, const ProbeTarget& target, bool all_solvers,
+                                      RenderContext& context);
+
+// The plot of one surface's probe over `range`: P*(t) from solver_ref's exact restriction, with the solver's
+// intervals, its root and the reference's roots.
+ProbePlot make_plot(const Scene& scene, const ProbeTarget& target, const SurfaceProbe& probe, const PlotRange& range);
 
 }  // namespace algray

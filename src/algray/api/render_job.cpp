@@ -1,4 +1,4 @@
-// The render command: validates everything before any work, renders, then writes images and stats atomically.
+// A scene end to end: outputs validated before any work, the frame rendered, then images and stats written atomically.
 #include "algray/api/render_job.h"
 
 #include <sys/stat.h>
@@ -88,6 +88,18 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
   const std::string scene_toml = scene_to_toml(scene);
   img.string_attributes.push_back({"algray/sceneToml", scene_toml});
   if (scene_toml.size() <= kMaxPngTextBytes) img.png_text.push_back({kPngSceneKey, scene_toml});
+  // Every surface of a scene of several, beside the first surface's keys above that single-surface readers use.
+  if (scene.surfaces.size() > 1) {
+    img.double_attributes.push_back({"algray/surfaces", static_cast<double>(scene.surfaces.size())});
+    for (std::size_t k = 0; k < scene.surfaces.size(); ++k) {
+      const SceneSurface& s = scene.surfaces[k];
+      const std::string prefix = "algray/surface" + std::to_string(k) + "/";
+      img.string_attributes.push_back({prefix + "name", s.name});
+      img.string_attributes.push_back({prefix + "equation", s.equation});
+      img.string_attributes.push_back({prefix + "polynomial", s.polynomial.to_string()});
+      img.double_attributes.push_back({prefix + "degree", s.polynomial.degree()});
+    }
+  }
   img.software = version_string();
   std::string equations;
   for (const SceneSurface& s : scene.surfaces) equations += (equations.empty() ? "" : "; ") + s.equation;
@@ -99,46 +111,18 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
   img.world_to_ndc = world_to_ndc_matrix(cam, b, scene.image.width, scene.image.height);
 }
 
-// Wall time of each step of the command, for --stats.
-class PhaseTimer {
- public:
-  explicit PhaseTimer(std::chrono::steady_clock::time_point start) : start_(start), last_(start) {}
-  void mark(const std::string& phase) {
-    const auto now = std::chrono::steady_clock::now();
-    phases_.push_back({phase, std::chrono::duration<double, std::milli>(now - last_).count()});
-    last_ = now;
-  }
-  // Moves `ms` of the last phase named `from` to a phase `to` (work done inside it, as the shading is inside
-  // the render), so that the phases still add up to the total.
-  void move(const std::string& from, const std::string& to, double ms) {
-    for (auto it = phases_.rbegin(); it != phases_.rend(); ++it)
-      if (it->first == from) {
-        it->second -= ms;
-        break;
-      }
-    phases_.push_back({to, ms});
-  }
-  double total_ms() const {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
-  }
-  nlohmann::json json() const {
-    nlohmann::json j = nlohmann::json::object();
-    for (const auto& [name, ms] : phases_) j[name] = ms;
-    return j;
-  }
 
- private:
-  std::chrono::steady_clock::time_point start_, last_;
-  std::vector<std::pair<std::string, double>> phases_;
-};
+}  // namespace
 
-nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const RenderResult& r, const DeviceInfo& device,
-                          const PhaseTimer& timer) {
+nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const std::vector<std::string>& images,
+                           bool cache_used) {
+  const RenderResult& r = frame.result;
+  const DeviceInfo& device = frame.device;
   nlohmann::json j;
   j["version"] = version_string();
   j["scene"] = scene.source;
   j["name"] = scene.name;
-  j["outputs"] = req.outputs;
+  j["outputs"] = images;
   j["image"] = {{"width", scene.image.width}, {"height", scene.image.height}};
   j["device"] = {{"name", device.name},
                  {"platform", device.platform_name},
@@ -154,7 +138,7 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
                  {"precision", to_string(r.config.precision)},
                  {"tolerance", r.config.tolerance},
                  {"max_iterations", r.config.max_iterations}};
-  j["cache"] = req.use_cache ? ProgramCache::default_directory().string() : "off";
+  j["cache"] = cache_used ? ProgramCache::default_directory().string() : "off";
   for (const ProgramRecord& p : r.programs) {
     double kernel_ms = 0;
     for (const PassStats& pass : r.passes)
@@ -199,12 +183,10 @@ nlohmann::json stats_json(const Scene& scene, const RenderRequest& req, const Re
     passes_ms += pass.wall_ms;
   }
   j["render_ms"] = {{"kernel", kernel_ms}, {"passes_wall", passes_ms}, {"host_shading", r.shade_ms}};
-  j["phases_ms"] = timer.json();
-  j["total_ms"] = timer.total_ms();
+  j["phases_ms"] = frame.timer.json();
+  j["total_ms"] = frame.timer.total_ms();
   return j;
 }
-
-}  // namespace
 
 // An output that cannot be written is bad input, found before any rendering.
 void check_output_writable(const std::string& path) { check_output_path(path); }
@@ -274,7 +256,7 @@ ProgramCache& RenderContext::cache() {
   return *cache_;
 }
 
-Scene load_scene(const std::optional<std::string>& path, const std::vector<Override>& overrides) {
+Scene SceneLoader::load(const std::optional<std::string>& path, const std::vector<Override>& overrides) {
   if (!path) return default_scene(overrides);
   if (*path != "-" && is_png_file(*path)) {
     // A PNG that algray rendered carries its scene: render it again, with any new overrides on top.
@@ -291,10 +273,8 @@ Scene load_scene(const std::optional<std::string>& path, const std::vector<Overr
                                 " text chunk): only images written by algray render can be rendered again");
   }
   if (*path == "-") {
-    // Standard input can be read once: a second "-" in the same process is an error, not an empty scene.
-    static bool consumed = false;
-    if (consumed) throw SceneError("<stdin>", "standard input was already read");
-    consumed = true;
+    if (stdin_read_) throw SceneError("<stdin>", "standard input was already read");
+    stdin_read_ = true;
     const std::string text = read_input_stream(std::cin, "<stdin>", "scene file");
     if (looks_like_jsurf(text)) return load_jsurf_text(text, "<stdin>", overrides);
     return load_scene_text(text, "<stdin>", overrides);
@@ -309,42 +289,43 @@ void print_warnings(const Scene& scene, std::ostream& err, const std::string& pr
 namespace {
 
 // In the order render_scene writes them.
-std::vector<RoleAndPath> request_outputs(const RenderRequest& req) {
+std::vector<RoleAndPath> planned_outputs(const RenderOutputs& outputs) {
   std::vector<RoleAndPath> out;
-  if (req.heatmap_path) out.push_back({"--heatmap", *req.heatmap_path});
-  for (const std::string& o : req.outputs) out.push_back({"output", o});
-  if (req.stats_path) out.push_back({"--stats", *req.stats_path});
+  if (outputs.heatmap_path) out.push_back({"--heatmap", *outputs.heatmap_path});
+  for (const std::string& o : outputs.images) out.push_back({"output", o});
+  if (outputs.stats_path) out.push_back({"--stats", *outputs.stats_path});
   return out;
 }
 
 }  // namespace
 
-void check_outputs(const Scene& scene, const RenderRequest& req) {
-  if (req.reference && scene.surfaces.size() > 1)
+void check_outputs(const Scene& scene, const RenderOutputs& outputs, const std::string& scene_path) {
+  if (outputs.reference && scene.surfaces.size() > 1)
     throw SceneError(scene.source,
                      "--reference solves one surface; this scene has " + std::to_string(scene.surfaces.size()));
-  for (const std::string& out : req.outputs) {
+  for (const std::string& out : outputs.images) {
     format_from_extension(out);
     check_output_writable(out);
   }
-  if (req.stats_path) check_output_writable(*req.stats_path);
-  if (req.heatmap_path) {
-    format_from_extension(*req.heatmap_path);
-    check_output_writable(*req.heatmap_path);
+  if (outputs.stats_path) check_output_writable(*outputs.stats_path);
+  if (outputs.heatmap_path) {
+    format_from_extension(*outputs.heatmap_path);
+    check_output_writable(*outputs.heatmap_path);
   }
-  check_distinct_files({{"scene file", req.scene_path.value_or("")}}, request_outputs(req));
+  check_distinct_files({{"scene file", scene_path}}, planned_outputs(outputs));
 }
 
-nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, RenderContext& context,
-                            std::chrono::steady_clock::time_point started) {
-  PhaseTimer timer(started);
+RenderedFrame render_frame(const Scene& scene, const FrameRequest& request, RenderContext& context,
+                           const RenderCallbacks& callbacks, std::chrono::steady_clock::time_point started) {
+  RenderedFrame frame{{}, {}, {}, {}, PhaseTimer(started)};
+  PhaseTimer& timer = frame.timer;
   timer.mark("scene");  // reading and checking it, before this call
-  FrameImage image;
-  RenderResult result;
-  DeviceInfo device;
-  const bool diagnostics = !req.aovs.empty() || req.heatmap_path;
+  FrameImage& image = frame.image;
+  RenderResult& result = frame.result;
+  DeviceInfo& device = frame.device;
+  const bool diagnostics = !request.aovs.empty() || request.heatmap;
   SolverWork work;  // per output pixel: the solver channels and the heat map are pictures of the whole image
-  if (req.reference) {
+  if (request.reference) {
     // No device: exact arithmetic on the CPU, rays rebuilt in the precision the kernels would use.
     device.name = "CPU reference (solver_ref, exact arithmetic)";
     device.type = "CPU";
@@ -361,11 +342,7 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
     // this one starts the device, which loads the OpenCL driver on one core for tens of milliseconds. Its
     // depth and normal channels are made only for an EXR output, the one format that stores them. For a PNG
     // output the sRGB encoder's table (some 40000 pow() calls, built on first use) is made there too.
-    bool depth_and_normal = false, png = false;
-    for (const std::string& out : req.outputs) {
-      depth_and_normal |= format_from_extension(out) == ImageFormat::Exr;
-      png |= format_from_extension(out) == ImageFormat::Png;
-    }
+    const bool depth_and_normal = request.depth_and_normal, png = request.png;
     // Only a film of at most 256 MB (4096^2 RGBA) is made ahead: the render's memory check (check_plan_fits,
     // which needs the device) must refuse a render too large before its film is allocated, and a larger render
     // takes seconds, beside which the overlap is noise.
@@ -385,7 +362,8 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
     Renderer renderer(session, context.cache());
     RenderOptions options;
     if (ahead) options.film = [&film] { return film.get(); };
-    options.show_progress = req.progress;
+    options.on_progress = callbacks.on_progress;
+    options.cancelled = callbacks.cancelled;
     if (diagnostics) {
       options.on_primary_tile = [&](const PrimaryTile& tile) {
         if (work.isolation_steps.empty()) work = empty_solver_work(scene.image.width, scene.image.height, tile.samples);
@@ -399,62 +377,55 @@ nlohmann::json render_scene(const Scene& scene, const RenderRequest& req, Render
   }
   add_metadata(image, scene, result, device);
   timer.mark("metadata");
-  // Every path was checked before rendering, so a write that fails now (a full disk) is a failure, not bad input.
-  std::vector<std::string> planned;
-  for (const RoleAndPath& o : request_outputs(req)) planned.push_back(o.path);
-  OutputWriter writer(planned);
   // The heat map's colour scale spans the whole image, so it needs every pixel's work before any colour: the
   // work (16 bytes a pixel) and the picture are whole-image, bounded by the pixels, never by the samples.
   if (diagnostics) {
-    if (req.heatmap_path) {
+    if (request.heatmap) {
       const std::string per =
           work.samples > 1 ? " (sum over " + std::to_string(work.samples * work.samples) + " samples)" : "";
-      writer.write(*req.heatmap_path, [&] {
-        write_image(*req.heatmap_path, work_heatmap(work.width, work.height, work.total(), work.in_extent(),
-                                                    "isolation steps + refinement iterations per pixel" + per));
-      });
+      frame.heatmap = work_heatmap(work.width, work.height, work.total(), work.in_extent(),
+                                   "isolation steps + refinement iterations per pixel" + per);
     }
-    add_solver_aovs(image, std::move(work), req.aovs);
+    add_solver_aovs(image, std::move(work), request.aovs);
     timer.mark("diagnostics");
   }
-  for (const std::string& out : req.outputs) writer.write(out, [&] { write_image(out, image); });
-  timer.mark("write");
-  nlohmann::json stats = stats_json(scene, req, result, device, timer);
-  if (req.stats_path)
-    writer.write(*req.stats_path, [&] { write_text_file(*req.stats_path, stats.dump(2) + "\n"); });
+  return frame;
+}
+
+nlohmann::json render_scene(const Scene& scene, const RenderOutputs& outputs, RenderContext& context,
+                            const RenderCallbacks& callbacks, std::chrono::steady_clock::time_point started) {
+  FrameRequest request;
+  request.depth_and_normal = false;
+  for (const std::string& out : outputs.images) {
+    request.depth_and_normal |= format_from_extension(out) == ImageFormat::Exr;
+    request.png |= format_from_extension(out) == ImageFormat::Png;
+  }
+  request.reference = outputs.reference;
+  request.aovs = outputs.aovs;
+  request.heatmap = outputs.heatmap_path.has_value();
+  RenderedFrame frame = render_frame(scene, request, context, callbacks, started);
+  // Every path was checked before rendering, so a write that fails now (a full disk) is a failure, not bad input.
+  std::vector<std::string> planned;
+  for (const RoleAndPath& o : planned_outputs(outputs)) planned.push_back(o.path);
+  OutputWriter writer(planned);
+  if (outputs.heatmap_path)
+    writer.write(*outputs.heatmap_path, [&] { write_image(*outputs.heatmap_path, *frame.heatmap); });
+  for (const std::string& out : outputs.images) writer.write(out, [&] { write_image(out, frame.image); });
+  frame.timer.mark("write");
+  nlohmann::json stats = frame_stats(scene, frame, outputs.images, context.uses_cache());
+  if (outputs.stats_path)
+    writer.write(*outputs.stats_path, [&] { write_text_file(*outputs.stats_path, stats.dump(2) + "\n"); });
   return stats;
 }
 
-int report_error(const std::exception& e, std::ostream& err) {
-  if (dynamic_cast<const SceneError*>(&e)) {
-    err << e.what() << "\n";
-    return kExitBadInput;
-  }
-  err << "algray: ";
-  if (const auto* cl_error = dynamic_cast<const cl::Error*>(&e)) err << "OpenCL error " << cl_error->err() << " in ";
-  err << e.what() << "\n";
+ErrorReport describe_error(const std::exception& e) {
+  if (dynamic_cast<const SceneError*>(&e)) return {std::string(e.what()) + "\n", true};
+  std::string text = "algray: ";
+  if (const auto* cl_error = dynamic_cast<const cl::Error*>(&e))
+    text += "OpenCL error " + std::to_string(cl_error->err()) + " in ";
+  text += std::string(e.what()) + "\n";
   const bool bad_input = dynamic_cast<const OutputError*>(&e) || dynamic_cast<const DeviceError*>(&e);
-  return bad_input ? kExitBadInput : kExitFailure;
-}
-
-int run_render(const RenderRequest& req, std::ostream& err) {
-  const auto started = std::chrono::steady_clock::now();
-  // Everything the user gave is checked before any device work, so bad input costs nothing and writes nothing.
-  Scene scene;
-  try {
-    scene = load_scene(req.scene_path, req.overrides);
-    print_warnings(scene, err);
-    check_outputs(scene, req);
-  } catch (const std::exception& e) {
-    return report_error(e, err);
-  }
-  try {
-    RenderContext context(req.device_spec, req.use_cache);
-    render_scene(scene, req, context, started);
-  } catch (const std::exception& e) {
-    return report_error(e, err);
-  }
-  return kExitOk;
+  return {text, bad_input};
 }
 
 }  // namespace algray

@@ -1,4 +1,4 @@
-// One `algray render` invocation end to end: scene, device, kernels, shading, image files and stats.
+// A scene rendered end to end: device, kernels, shading, metadata, image files and stats, for any front end.
 #pragma once
 
 #include <chrono>
@@ -13,27 +13,33 @@
 #include "algray/device/cl_runtime.h"
 #include "algray/device/program_cache.h"
 #include "algray/scene/scene.h"
+#include "algray/render/renderer.h"
 #include "algray/render/solver_aov.h"
 
 namespace algray {
 
-// Exit codes of the CLI: bad input is 2 (nothing written), any other failure is 1.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitFailure = 1;
-inline constexpr int kExitBadInput = 2;
-
-struct RenderRequest {
-  std::optional<std::string> scene_path;    // unset: the built-in default scene
-  std::vector<Override> overrides;          // --set, --width, --height, --precision, in order
-  std::vector<std::string> outputs;         // image files; the format follows each extension
-  std::string device_spec;                  // --device
-  bool use_cache = true;                    // --no-cache turns it off
-  std::optional<std::string> stats_path;    // --stats FILE.json
-  bool progress = false;                    // per-tile progress on stderr
-  bool reference = false;                   // --reference: solve on the CPU with solver_ref instead of a device
-  std::vector<SolverAov> aovs;              // --aov: solver channels added to EXR outputs
-  std::optional<std::string> heatmap_path;  // --heatmap: solver work per pixel as a picture
+// What a render writes besides rendering: the image files, stats, heat map and solver channels.
+struct RenderOutputs {
+  std::vector<std::string> images;          // image files; the format follows each extension
+  std::optional<std::string> stats_path;    // the stats as JSON
+  bool reference = false;                   // solve on the CPU with solver_ref instead of a device
+  std::vector<SolverAov> aovs;              // solver channels added to EXR images
+  std::optional<std::string> heatmap_path;  // solver work per pixel as a picture
 };
+
+// How a render reports back while it runs: after each tile, and whether to stop (RenderCancelled).
+struct RenderCallbacks {
+  std::function<void(const RenderProgress&)> on_progress;
+  std::function<bool()> cancelled;
+};
+
+// A failure as a person reads it, and whether the input was at fault (a scene, an output path, a device: the
+// command line's exit code 2) or not (a failed write, an OpenCL error: 1).
+struct ErrorReport {
+  std::string text;  // one or more lines, each ending in a newline
+  bool bad_input = false;
+};
+ErrorReport describe_error(const std::exception& e);
 
 // A file a command reads or writes, named by its role for messages: {"--stats", "s.json"}.
 struct RoleAndPath {
@@ -75,6 +81,7 @@ class RenderContext {
   ~RenderContext();
   ClSession& session();  // throws DeviceError when the device cannot be opened
   ProgramCache& cache();
+  bool uses_cache() const { return use_cache_; }
 
  private:
   std::string device_spec_;
@@ -83,28 +90,91 @@ class RenderContext {
   std::unique_ptr<ProgramCache> cache_;
 };
 
-// The scene a command names: a scene file, "-" for standard input (once per process), or, when unset, the
-// built-in default. Throws SceneError.
-Scene load_scene(const std::optional<std::string>& path, const std::vector<Override>& overrides);
+// The scene a command names: a scene file, a PNG that algray rendered (its embedded scene), "-" for standard
+// input, or, when unset, the built-in default. Standard input can be read once per loader: a second "-" is an
+// error, not an empty scene. Throws SceneError.
+class SceneLoader {
+ public:
+  Scene load(const std::optional<std::string>& path, const std::vector<Override>& overrides);
+
+ private:
+  bool stdin_read_ = false;
+};
 
 // The scene's warnings, one "algray: warning: ..." line each.
 void print_warnings(const Scene& scene, std::ostream& err, const std::string& prefix = "");
 
-// Bad input in the request's outputs (unknown format, missing or unwritable directory), found before any work:
-// throws OutputError or SceneError.
-void check_outputs(const Scene& scene, const RenderRequest& request);
+// Bad input in the outputs (unknown format, missing or unwritable directory, an output that is the scene file
+// `scene_path` or another output), found before any work: throws OutputError or SceneError.
+void check_outputs(const Scene& scene, const RenderOutputs& outputs, const std::string& scene_path = "");
 
-// Renders `scene` on the context's device and writes the request's images, heat map and stats file; returns
-// the stats. Throws on failure; outputs already written stay complete (each is replaced atomically).
-// `started`: when the command began, before the scene was read; the stats' phases and total count from there.
-nlohmann::json render_scene(const Scene& scene, const RenderRequest& request, RenderContext& context,
+// Wall time of each step of the command, for --stats.
+class PhaseTimer {
+ public:
+  explicit PhaseTimer(std::chrono::steady_clock::time_point start) : start_(start), last_(start) {}
+  void mark(const std::string& phase) {
+    const auto now = std::chrono::steady_clock::now();
+    phases_.push_back({phase, std::chrono::duration<double, std::milli>(now - last_).count()});
+    last_ = now;
+  }
+  // Moves `ms` of the last phase named `from` to a phase `to` (work done inside it, as the shading is inside
+  // the render), so that the phases still add up to the total.
+  void move(const std::string& from, const std::string& to, double ms) {
+    for (auto it = phases_.rbegin(); it != phases_.rend(); ++it)
+      if (it->first == from) {
+        it->second -= ms;
+        break;
+      }
+    phases_.push_back({to, ms});
+  }
+  double total_ms() const {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count();
+  }
+  nlohmann::json json() const {
+    nlohmann::json j = nlohmann::json::object();
+    for (const auto& [name, ms] : phases_) j[name] = ms;
+    return j;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_, last_;
+  std::vector<std::pair<std::string, double>> phases_;
+};
+
+// A rendered frame in memory: the image with its metadata (and solver channels when asked for), the heat map when
+// asked for, and what the stats are made of.
+struct RenderedFrame {
+  FrameImage image;
+  std::optional<FrameImage> heatmap;
+  RenderResult result;  // its image moved into `image`
+  DeviceInfo device;
+  PhaseTimer timer;  // the steps so far, from the command's start; the caller marks its own after
+};
+
+// What render_frame makes besides the colour: whether EXR's depth and normal channels are wanted (a PNG holds
+// neither), the solver channels and the heat map.
+struct FrameRequest {
+  bool depth_and_normal = true;
+  bool png = false;  // a PNG will be written: its sRGB table is made while the device starts
+  bool reference = false;
+  std::vector<SolverAov> aovs;
+  bool heatmap = false;
+};
+
+// Renders `scene` on the context's device (or with solver_ref) into memory. Throws on failure.
+// `started`: when the command began, before the scene was read; the phases count from there.
+RenderedFrame render_frame(const Scene& scene, const FrameRequest& request, RenderContext& context,
+                           const RenderCallbacks& callbacks = {},
+                           std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now());
+
+// The --stats JSON of a frame: version, scene, device, solver, plan, passes, rays and timings.
+nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const std::vector<std::string>& images,
+                           bool cache_used);
+
+// Renders `scene` and writes the images, heat map and stats file; returns the stats. Throws on failure; outputs
+// already written stay complete (each is replaced atomically).
+nlohmann::json render_scene(const Scene& scene, const RenderOutputs& outputs, RenderContext& context,
+                            const RenderCallbacks& callbacks = {},
                             std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now());
-
-// Prints a failure as the CLI does and returns its exit code: bad input (scene, output path, device) is 2,
-// anything else 1.
-int report_error(const std::exception& e, std::ostream& err);
-
-// Runs the request, printing errors (and nothing else on success, unless progress) to `err`.
-int run_render(const RenderRequest& request, std::ostream& err);
 
 }  // namespace algray

@@ -226,13 +226,15 @@ struct Renderer::Passes {
     return nullptr;
   }
   bool single() const { return precision != Precision::Double; }
+  // One more tile done; then, before the next, whether to go on.
   void progress() {
     ++tiles_done;
-    if (!options.show_progress) return;
-    std::fprintf(stderr, "\rrendering %s: %3d%% (%d/%d tiles)", scene.name.c_str(), 100 * tiles_done / tiles_total,
-                 tiles_done, tiles_total);
-    std::fflush(stderr);
+    if (options.on_progress) options.on_progress({tiles_done, tiles_total});
   }
+  void check_cancelled() const {
+    if (options.cancelled && options.cancelled()) throw RenderCancelled("the render was cancelled");
+  }
+
 };
 
 namespace {
@@ -308,9 +310,8 @@ std::vector<std::vector<Bounce>> split_by_sample(std::vector<Bounce>& all, std::
 
 }  // namespace
 
-RenderResult Renderer::render(const Scene& scene, bool show_progress) {
+RenderResult Renderer::render_with_records(const Scene& scene) {
   RenderOptions options;
-  options.show_progress = show_progress;
   options.keep_records = true;
   return render(scene, options);
 }
@@ -354,6 +355,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   passes.tiles_total = static_cast<int>(tiles.size()) * (adaptive ? 2 : 1);
   for (std::size_t t = 0; t < tiles.size(); ++t) {
     const Tile& tile = tiles[t];
+    passes.check_cancelled();
     if (t == 0 || tile.y0 != tiles[t - 1].y0) set_band_args(passes, tile);
     trace_primary(passes, tile);
     finish_tile(passes, tile);
@@ -365,12 +367,12 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
     const std::vector<std::uint8_t> refine = pixels_to_refine(result.image, plan.refine_threshold);
     result.shade_ms += ms_since(start);
     for (const Tile& tile : tiles) {
+      passes.check_cancelled();
       refine_tile(passes, tile, refine);
       passes.progress();
     }
     if (options.keep_records) result.refined = refine;
   }
-  if (options.show_progress) std::fprintf(stderr, "\n");
 
   for (std::size_t i = 0; i < passes.stats.size(); ++i) {
     passes.stats[i].name = plan.passes[i].name;

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -36,8 +37,21 @@ struct PrimaryTile {
   const HitRecord* hits = nullptr;  // width x height, row-major
 };
 
+// How far a render is: reported after each tile (adaptive antialiasing's second sweep counts its tiles again).
+struct RenderProgress {
+  int tiles_done = 0, tiles_total = 0;
+};
+
+// Thrown by a render whose RenderOptions::cancelled said so between two tiles; nothing of it is kept.
+struct RenderCancelled : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 struct RenderOptions {
-  bool show_progress = false;  // per-tile progress on stderr (for terminals)
+  // Called after each tile, on the rendering thread; the command line draws its progress line from it.
+  std::function<void(const RenderProgress&)> on_progress;
+  // Asked before each tile; true stops the render with RenderCancelled (Ctrl-C in a notebook, a closed viewer).
+  std::function<bool()> cancelled;
   // Keep every ray's record in RenderResult (hits, shadows, secondary, refined), for tests and tools. Their
   // memory grows with pixels x samples x bounces; without them only the film and the totals are kept.
   bool keep_records = false;
@@ -90,8 +104,8 @@ class Renderer {
   // Runs every pass of the scene's plan, tile by tile, into the film. Each tile's camera rays, shadow rays and
   // bounces are traced and shaded before the next tile starts, so memory holds the film and one tile's work.
   RenderResult render(const Scene& scene, const RenderOptions& options);
-  // The same render keeping every ray's record (tests and tools). show_progress: print per-tile progress.
-  RenderResult render(const Scene& scene, bool show_progress);
+  // The same render keeping every ray's record (tests and tools).
+  RenderResult render_with_records(const Scene& scene);
 
  private:
   struct Passes;

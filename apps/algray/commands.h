@@ -1,0 +1,45 @@
+// The commands of the command line, each from its parsed request to an exit code (exit_codes.h).
+#pragma once
+
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "algray/api/batch.h"
+#include "algray/api/probe_report.h"
+#include "algray/api/render_job.h"
+#include "algray/scene/scene.h"
+
+namespace algray::cli {
+
+struct RenderRequest {
+  std::optional<std::string> scene_path;  // unset: the built-in default scene
+  std::vector<Override> overrides;        // --set, --width, --height, --precision, in order
+  RenderOutputs outputs;                  // -o, --stats, --reference, --aov, --heatmap
+  std::string device_spec;                // --device
+  bool use_cache = true;                  // --no-cache turns it off
+  bool progress = false;                  // per-tile progress on stderr
+};
+
+struct ProbeRequest {
+  std::optional<std::string> scene_path;  // unset: the built-in default scene
+  std::vector<Override> overrides;        // --set and the solver flags, in order
+  std::string device_spec;
+  ProbeTarget target;
+  bool all_solvers = false;              // every isolation x refinement, side by side
+  std::optional<std::string> plot_path;  // .svg or .png
+  PlotRange plot_range;
+  bool json = false;                      // JSON on stdout instead of text
+  std::optional<std::string> stats_path;  // the JSON report written to a file as well
+  bool use_cache = true;
+};
+
+// Each prints errors (and nothing else on success, unless progress) to `err`; probe's report goes to `out`.
+int run_render(const RenderRequest& request, std::ostream& err);
+int run_probe(const ProbeRequest& request, std::ostream& out, std::ostream& err);
+int run_batch_command(const BatchRequest& request, bool progress, std::ostream& err);
+// `algray devices`: the list on `out`, and as JSON in `stats_path` when given.
+int run_devices(const std::string& stats_path, std::ostream& out, std::ostream& err);
+
+}  // namespace algray::cli
