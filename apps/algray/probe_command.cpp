@@ -1,7 +1,4 @@
 // `algray probe`: one ray's report and plot from the parsed request, failures to exit codes.
-#include <algorithm>
-#include <cmath>
-
 #include "algray/io/image_io.h"
 #include "commands.h"
 #include "exit_codes.h"
@@ -13,14 +10,7 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
   try {
     scene = SceneLoader().load(req.scene_path, req.overrides);
     print_warnings(scene, err);
-    if (!req.target.given_ray && (req.target.px < 0 || req.target.py < 0 || req.target.px >= scene.image.width ||
-                                  req.target.py >= scene.image.height))
-      throw SceneError("--pixel", "pixel (" + std::to_string(req.target.px) + ", " + std::to_string(req.target.py) +
-                                      ") is outside the " + std::to_string(scene.image.width) + "x" +
-                                      std::to_string(scene.image.height) + " image");
-    const glm::dvec3& d = req.target.direction;
-    if (req.target.given_ray && !(std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) > 0))
-      throw SceneError("--ray", "the direction must be nonzero");
+    check_probe_target(scene, req.target);
     if (req.plot_path) {
       check_probe_plot_path(*req.plot_path);
       check_output_writable(*req.plot_path);

@@ -340,6 +340,11 @@ void apply_orbit(Scene& scene, const Orbit& orbit, int frame, int frames) {
 }
 
 BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks) {
+  RenderContext context(req.device_spec, req.use_cache);
+  return run_batch(req, callbacks, context);
+}
+
+BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks, RenderContext& context) {
   const auto message = [&](const std::string& text) {
     if (callbacks.on_message) callbacks.on_message(text);
   };
@@ -393,7 +398,6 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks)
     return bad(e);
   }
   JsonLinesLog& log = *opened;
-  RenderContext context(req.device_spec, req.use_cache);
   const auto batch_start = std::chrono::steady_clock::now();
   const auto ms_since = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();

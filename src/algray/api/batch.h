@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "algray/api/render_job.h"
 #include "algray/scene/scene.h"
 
 namespace algray {
@@ -86,5 +87,7 @@ enum class BatchOutcome { Done, FramesFailed, BadInput, Stopped };
 // Runs every frame of every job, in order, on one device with one program cache. A failing frame is reported
 // and logged, and the rest still run.
 BatchOutcome run_batch(const BatchRequest& request, const BatchCallbacks& callbacks);
+// The same on a device already open (its device_spec and use_cache are then the context's).
+BatchOutcome run_batch(const BatchRequest& request, const BatchCallbacks& callbacks, RenderContext& context);
 
 }  // namespace algray

@@ -383,6 +383,17 @@ nlohmann::json probe_json(const Scene& scene, const ProbeTarget& target, const s
   return j;
 }
 
+void check_probe_target(const Scene& scene, const ProbeTarget& target) {
+  if (!target.given_ray && (target.px < 0 || target.py < 0 || target.px >= scene.image.width ||
+                            target.py >= scene.image.height))
+    throw SceneError("--pixel", "pixel (" + std::to_string(target.px) + ", " + std::to_string(target.py) +
+                                    ") is outside the " + std::to_string(scene.image.width) + "x" +
+                                    std::to_string(scene.image.height) + " image");
+  const glm::dvec3& d = target.direction;
+  if (target.given_ray && !(std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) > 0))
+    throw SceneError("--ray", "the direction must be nonzero");
+}
+
 std::vector<SurfaceProbe> probe_scene(const Scene& scene, const ProbeTarget& target, bool all_solvers,
                                       RenderContext& context) {
   ClSession& session = context.session();

@@ -46,6 +46,10 @@ void print_probe(std::ostream& out, const Scene& scene, const ProbeTarget& targe
                  const std::vector<SurfaceProbe>& probes);
 nlohmann::json probe_json(const Scene& scene, const ProbeTarget& target, const std::vector<SurfaceProbe>& probes);
 
+// Bad input in a probe's target, before any device work: a pixel outside the image, a ray without direction
+// (SceneError naming --pixel or --ray).
+void check_probe_target(const Scene& scene, const ProbeTarget& target);
+
 // Every solver asked for (the scene's own, or with all_solvers every isolation x refinement) on the target's ray,
 // for each surface, with solver_ref's answer. Throws DeviceError when the device cannot be opened.
 std::vector<SurfaceProbe> probe_scene(const Scene& scene, const ProbeTarget& target, bool all_solvers,
