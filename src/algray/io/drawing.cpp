@@ -1,5 +1,5 @@
 // Probe plots (one display list drawn as SVG or rasterised for PNG), work heat maps and the small bitmap font.
-#include "algray/io/diagnostic_images.h"
+#include "algray/io/probe_plot.h"
 
 #include <algorithm>
 #include <array>
