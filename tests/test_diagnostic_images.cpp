@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "algray/io/drawing.h"
+#include "algray/io/heatmap.h"
 #include "algray/io/probe_plot.h"
 #include "temp_dir.h"
 
