@@ -14,7 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "algray/io/diagnostic_images.h"
+#include "algray/io/drawing.h"
+#include "algray/io/heatmap.h"
+#include "algray/io/probe_plot.h"
 #include "temp_dir.h"
 
 namespace fs = std::filesystem;

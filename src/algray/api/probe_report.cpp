@@ -10,7 +10,7 @@
 #include <initializer_list>
 #include <sstream>
 
-#include "algray/io/diagnostic_images.h"
+#include "algray/io/probe_plot.h"
 #include "algray/util/version.h"
 #include "algray/io/image_io.h"
 #include "algray/api/render_job.h"

@@ -19,7 +19,7 @@
 #include <sstream>
 
 #include "algray/device/cl_runtime.h"
-#include "algray/io/diagnostic_images.h"
+#include "algray/io/heatmap.h"
 #include "algray/scene/jsurf.h"
 #include "algray/device/program_cache.h"
 #include "algray/render/reference_render.h"

@@ -1,12 +1,12 @@
-// Diagnostic pictures: the graph of P*(t) along one ray (SVG or PNG) and a heat map of solver work per pixel.
+// The probe plot: P*(t) along one ray with its isolating intervals and roots, as SVG or PNG.
 #pragma once
 
-#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "algray/io/drawing.h"
 #include "algray/io/image_io.h"
 
 namespace algray {
@@ -58,28 +58,8 @@ void check_probe_plot_path(const std::filesystem::path& path);
 // .svg or .png by extension (case-insensitive), anything else throws OutputError; written atomically.
 void write_probe_plot(const std::filesystem::path& path, const ProbePlot& plot);
 
-// sRGB bytes as a PNG reader sees them; the SVG uses the same colours.
-struct Rgb8 {
-  std::uint8_t r = 0, g = 0, b = 0;
-};
+// Exposed so that tests and tools can find the curve and the markers in the picture by their colour.
 Rgb8 probe_curve_colour();
 Rgb8 marker_colour(PlotMarker::Kind kind);
-
-// How work_heatmap maps work to colour: over in-extent pixels only, logarithmic (in 1 + work) when
-// (1 + max) / (1 + min) > 50, since a few pathological pixels would otherwise flatten everything else to
-// the bottom colour.
-struct HeatmapScale {
-  bool logarithmic = false;
-  double min = 0, max = 0;  // 0, 0 when no pixel is in the extent
-  std::size_t pixels = 0;   // in-extent pixels
-};
-HeatmapScale heatmap_scale(const std::vector<std::uint32_t>& work, const std::vector<std::uint8_t>& in_extent);
-
-// work: one value per pixel (row-major, top row first); in_extent: 0 where the pixel's ray missed the extent
-// (drawn as neutral dark grey) — may be empty meaning all in extent. The result holds the map at 1:1 in its
-// top-left width x height pixels, a colour bar with labelled ticks to its right and the caption (with the
-// scale used) below; higher work is brighter. Throws OutputError when the sizes disagree.
-FrameImage work_heatmap(int width, int height, const std::vector<std::uint32_t>& work,
-                        const std::vector<std::uint8_t>& in_extent, const std::string& caption);
 
 }  // namespace algray
