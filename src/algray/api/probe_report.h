@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "algray/api/render_job.h"
-#include "algray/io/diagnostic_images.h"
+#include "algray/io/probe_plot.h"
 #include "algray/render/probe.h"
 #include "algray/render/reference_render.h"
 #include "algray/scene/scene.h"
