@@ -36,11 +36,11 @@ void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = t
   cmd->add_option("--width", o.width, "image width in pixels (overrides image.width)");
   cmd->add_option("--height", o.height, "image height in pixels (overrides image.height)");
   cmd->add_option("--device", o.device_spec, "device index or name substring (see `algray devices`)");
-  cmd->add_option("--precision", o.precision, "float, double or mixed (overrides render.precision)");
+  cmd->add_option("--precision", o.precision, precision_choices("or") + " (overrides render.precision)");
   cmd->add_option("--isolation", o.isolation,
-                  "root isolation: bernstein, descartes, sturm or derivative-chain (overrides render.isolation)");
+                  "root isolation: " + isolation_choices("or") + " (overrides render.isolation)");
   cmd->add_option("--refine", o.refinement,
-                  "root refinement: brent, bisection, regula-falsi, illinois or newton (overrides render.refinement)");
+                  "root refinement: " + refinement_choices("or") + " (overrides render.refinement)");
   cmd->add_option("--tolerance", o.tolerance, "the stopping tolerance eps (overrides render.tolerance)");
   cmd->add_option("--max-iterations", o.max_iterations,
                   "the refinement's iteration cap (overrides render.max_iterations)");
@@ -110,6 +110,168 @@ bool parse_numbers(const std::string& text, std::size_t n, std::vector<double>& 
   std::_Exit(code);
 }
 
+// `algray render`: its options, then the request they make.
+struct RenderCommand {
+  CLI::App* cmd = nullptr;
+  RenderRequest request;
+  SceneOptions scene;
+  std::string stats_path, aov_text;
+
+  void add_to(CLI::App& app) {
+    cmd = app.add_subcommand("render", "render a scene (default: the built-in Barth sextic)");
+    add_scene_options(cmd, scene);
+    cmd->add_option("-o,--output", request.outputs.images, "output image; .exr or .png by extension; may be repeated")
+        ->default_str("algray.exr");
+    cmd->add_option("--stats", stats_path, "write render statistics as JSON");
+    cmd->add_flag(
+        "--reference", request.outputs.reference,
+        "solve every pixel exactly on the CPU (solver_ref, all cores, slow); adds a reference.class channel");
+    cmd->add_option("--aov", aov_text,
+                    "solver channels for EXR outputs, comma-separated: iterations, isolation, classification, flags");
+    cmd->add_option("--heatmap", request.outputs.heatmap_path,
+                    "write a heat map of solver work per pixel (isolation steps + refinement iterations), .png");
+  }
+
+  int run() {
+    if (!scene.scene_path.empty()) request.scene_path = scene.scene_path;
+    if (request.outputs.images.empty()) request.outputs.images.push_back("algray.exr");
+    if (!collect_overrides(cmd, scene, request.overrides)) return kExitBadInput;
+    request.device_spec = scene.device_spec;
+    if (!aov_text.empty()) {
+      std::string error;
+      if (!parse_aov_list(aov_text, request.outputs.aovs, error)) {
+        std::cerr << "algray: --aov " << aov_text << ": " << error << "\n";
+        return kExitBadInput;
+      }
+    }
+    request.use_cache = !scene.no_cache;
+    if (!stats_path.empty()) request.outputs.stats_path = stats_path;
+    request.progress = ::isatty(STDERR_FILENO) != 0;
+    return run_render(request, std::cerr);
+  }
+};
+
+// `algray probe`: its options, the target ray and the plot's range, then the request they make.
+struct ProbeCommand {
+  CLI::App* cmd = nullptr;
+  ProbeRequest request;
+  SceneOptions scene;
+  std::string pixel_text, ray_text, plot_range_text;
+
+  void add_to(CLI::App& app) {
+    cmd = app.add_subcommand(
+        "probe", "trace one ray through the render's own solver code and show every step beside solver_ref's answer");
+    add_scene_options(cmd, scene);
+    auto* pixel_opt = cmd->add_option("--pixel", pixel_text,
+                                      "X,Y: the pixel's centre ray, as a render without antialiasing traces it");
+    auto* ray_opt = cmd->add_option("--ray", ray_text, "ox,oy,oz,dx,dy,dz: a ray o + t d in world coordinates");
+    pixel_opt->excludes(ray_opt);
+    cmd->add_flag("--all-solvers", request.all_solvers,
+                  "every isolation x refinement side by side, the scene's own first");
+    cmd->add_option("--plot", request.plot_path,
+                    "draw P*(t) on [t_in, t_out] with the isolating interval, the root and solver_ref's roots "
+                    "(.svg or .png)");
+    cmd->add_option("--plot-range", plot_range_text,
+                    "what --plot shows: segment (default), isolating (the isolating interval), or T0,T1");
+    cmd->add_flag("--json", request.json, "print the report as JSON (for scripts) instead of text");
+    cmd->add_option("--stats", request.stats_path, "write the report as JSON to this file too");
+  }
+
+  // --pixel or --ray into the request's target; false after saying what is wrong.
+  bool read_target() {
+    std::vector<double> v;
+    if (!pixel_text.empty()) {
+      if (!parse_numbers(pixel_text, 2, v) || std::fabs(v[0]) > 1e9 || std::fabs(v[1]) > 1e9 ||
+          v[0] != std::floor(v[0]) || v[1] != std::floor(v[1])) {
+        std::cerr << "algray: --pixel " << pixel_text << ": expected two integers X,Y\n";
+        return false;
+      }
+      request.target.px = static_cast<int>(v[0]);
+      request.target.py = static_cast<int>(v[1]);
+      return true;
+    }
+    if (!ray_text.empty()) {
+      if (!parse_numbers(ray_text, 6, v)) {
+        std::cerr << "algray: --ray " << ray_text << ": expected six numbers ox,oy,oz,dx,dy,dz\n";
+        return false;
+      }
+      request.target.given_ray = true;
+      request.target.origin = {v[0], v[1], v[2]};
+      request.target.direction = {v[3], v[4], v[5]};
+      return true;
+    }
+    std::cerr << "algray: probe needs --pixel X,Y or --ray ox,oy,oz,dx,dy,dz\n";
+    return false;
+  }
+
+  // --plot-range into the request; false after saying what is wrong.
+  bool read_plot_range() {
+    if (!plot_range_text.empty() && !request.plot_path) {
+      std::cerr << "algray: --plot-range goes with --plot\n";
+      return false;
+    }
+    if (plot_range_text == "isolating") {
+      request.plot_range.kind = PlotRange::Kind::Isolating;
+    } else if (!plot_range_text.empty() && plot_range_text != "segment") {
+      std::vector<double> v;
+      // The width must be finite too: the plot divides by it.
+      if (!parse_numbers(plot_range_text, 2, v) || !(v[0] < v[1]) || !std::isfinite(v[1] - v[0])) {
+        std::cerr << "algray: --plot-range " << plot_range_text
+                  << ": expected segment, isolating, or two increasing numbers T0,T1\n";
+        return false;
+      }
+      request.plot_range = {PlotRange::Kind::Given, v[0], v[1]};
+    }
+    return true;
+  }
+
+  int run() {
+    if (!scene.scene_path.empty()) request.scene_path = scene.scene_path;
+    if (!collect_overrides(cmd, scene, request.overrides)) return kExitBadInput;
+    request.device_spec = scene.device_spec;
+    request.use_cache = !scene.no_cache;
+    if (!read_target() || !read_plot_range()) return kExitBadInput;
+    return run_probe(request, std::cout, std::cerr);
+  }
+};
+
+// `algray batch`: a jobs file where the others take a scene.
+struct BatchCommand {
+  CLI::App* cmd = nullptr;
+  BatchRequest request;
+  SceneOptions scene;
+
+  void add_to(CLI::App& app) {
+    cmd = app.add_subcommand(
+        "batch", "render a TOML list of jobs (sweeps, orbits) in one process with one device and program cache");
+    cmd->add_option("jobs", request.jobs_path, "jobs file (.toml), or - for standard input")->required();
+    add_scene_options(cmd, scene, false);
+    cmd->add_flag("--resume", request.resume, "skip frames whose outputs all exist already");
+    cmd->add_option("--log", request.log_path,
+                    "JSON-lines log, one line per frame (default: beside the jobs file, <name>.log.jsonl)");
+    cmd->add_option("--stats", request.stats_path, "write a summary of the batch as JSON");
+  }
+
+  int run() {
+    if (!collect_overrides(cmd, scene, request.overrides)) return kExitBadInput;
+    request.device_spec = scene.device_spec;
+    request.use_cache = !scene.no_cache;
+    return run_batch_command(request, ::isatty(STDERR_FILENO) != 0, std::cerr);
+  }
+};
+
+struct DevicesCommand {
+  CLI::App* cmd = nullptr;
+  std::string stats_path;
+
+  void add_to(CLI::App& app) {
+    cmd = app.add_subcommand("devices", "list OpenCL platforms and devices");
+    cmd->add_option("--stats", stats_path, "write the list as JSON too");
+  }
+
+  int run() { return run_devices(stats_path, std::cout, std::cerr); }
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -118,60 +280,14 @@ int main(int argc, char** argv) {
   CLI::App app{"algray: ray tracing of real algebraic surfaces P(x,y,z) = 0 on any OpenCL device"};
   app.set_version_flag("--version", version_string(), "print the version and the git revision, and exit");
   app.require_subcommand(1);
-
-  RenderRequest request;
-  SceneOptions render_opts;
-  std::string stats_path;
-  CLI::App* render = app.add_subcommand("render", "render a scene (default: the built-in Barth sextic)");
-  add_scene_options(render, render_opts);
-  render->add_option("-o,--output", request.outputs.images, "output image; .exr or .png by extension; may be repeated")
-      ->default_str("algray.exr");
-  render->add_option("--stats", stats_path, "write render statistics as JSON");
-  render->add_flag(
-      "--reference", request.outputs.reference,
-      "solve every pixel exactly on the CPU (solver_ref, all cores, slow); adds a reference.class channel");
-
-  std::string aov_text;
-  render->add_option("--aov", aov_text,
-                     "solver channels for EXR outputs, comma-separated: iterations, isolation, classification, flags");
-  render->add_option("--heatmap", request.outputs.heatmap_path,
-                     "write a heat map of solver work per pixel (isolation steps + refinement iterations), .png");
-
-  ProbeRequest probe_request;
-  SceneOptions probe_opts;
-  std::string pixel_text, ray_text;
-  CLI::App* probe = app.add_subcommand(
-      "probe", "trace one ray through the render's own solver code and show every step beside solver_ref's answer");
-  add_scene_options(probe, probe_opts);
-  auto* pixel_opt = probe->add_option("--pixel", pixel_text,
-                                      "X,Y: the pixel's centre ray, as a render without antialiasing traces it");
-  auto* ray_opt = probe->add_option("--ray", ray_text, "ox,oy,oz,dx,dy,dz: a ray o + t d in world coordinates");
-  pixel_opt->excludes(ray_opt);
-  probe->add_flag("--all-solvers", probe_request.all_solvers,
-                  "every isolation x refinement side by side, the scene's own first");
-  probe->add_option("--plot", probe_request.plot_path,
-                    "draw P*(t) on [t_in, t_out] with the isolating interval, the root and solver_ref's roots "
-                    "(.svg or .png)");
-  std::string plot_range_text;
-  probe->add_option("--plot-range", plot_range_text,
-                    "what --plot shows: segment (default), isolating (the isolating interval), or T0,T1");
-  probe->add_flag("--json", probe_request.json, "print the report as JSON (for scripts) instead of text");
-  probe->add_option("--stats", probe_request.stats_path, "write the report as JSON to this file too");
-
-  BatchRequest batch_request;
-  SceneOptions batch_opts;
-  CLI::App* batch = app.add_subcommand(
-      "batch", "render a TOML list of jobs (sweeps, orbits) in one process with one device and program cache");
-  batch->add_option("jobs", batch_request.jobs_path, "jobs file (.toml), or - for standard input")->required();
-  add_scene_options(batch, batch_opts, false);
-  batch->add_flag("--resume", batch_request.resume, "skip frames whose outputs all exist already");
-  batch->add_option("--log", batch_request.log_path,
-                    "JSON-lines log, one line per frame (default: beside the jobs file, <name>.log.jsonl)");
-  batch->add_option("--stats", batch_request.stats_path, "write a summary of the batch as JSON");
-
-  CLI::App* devices = app.add_subcommand("devices", "list OpenCL platforms and devices");
-  std::string devices_stats;
-  devices->add_option("--stats", devices_stats, "write the list as JSON too");
+  RenderCommand render;
+  ProbeCommand probe;
+  BatchCommand batch;
+  DevicesCommand devices;
+  render.add_to(app);
+  probe.add_to(app);
+  batch.add_to(app);
+  devices.add_to(app);
 
   try {
     app.parse(argc, argv);
@@ -179,74 +295,8 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitBadInput;
   }
-
-  if (devices->parsed()) return run_devices(devices_stats, std::cout, std::cerr);
-
-  if (batch->parsed()) {
-    if (!collect_overrides(batch, batch_opts, batch_request.overrides)) return kExitBadInput;
-    batch_request.device_spec = batch_opts.device_spec;
-    batch_request.use_cache = !batch_opts.no_cache;
-    return run_batch_command(batch_request, ::isatty(STDERR_FILENO) != 0, std::cerr);
-  }
-
-  if (probe->parsed()) {
-    ProbeRequest& req = probe_request;
-    if (!probe_opts.scene_path.empty()) req.scene_path = probe_opts.scene_path;
-    if (!collect_overrides(probe, probe_opts, req.overrides)) return kExitBadInput;
-    req.device_spec = probe_opts.device_spec;
-    req.use_cache = !probe_opts.no_cache;
-    std::vector<double> v;
-    if (!pixel_text.empty()) {
-      if (!parse_numbers(pixel_text, 2, v) || std::fabs(v[0]) > 1e9 || std::fabs(v[1]) > 1e9 ||
-          v[0] != std::floor(v[0]) || v[1] != std::floor(v[1])) {
-        std::cerr << "algray: --pixel " << pixel_text << ": expected two integers X,Y\n";
-        return kExitBadInput;
-      }
-      req.target.px = static_cast<int>(v[0]);
-      req.target.py = static_cast<int>(v[1]);
-    } else if (!ray_text.empty()) {
-      if (!parse_numbers(ray_text, 6, v)) {
-        std::cerr << "algray: --ray " << ray_text << ": expected six numbers ox,oy,oz,dx,dy,dz\n";
-        return kExitBadInput;
-      }
-      req.target.given_ray = true;
-      req.target.origin = {v[0], v[1], v[2]};
-      req.target.direction = {v[3], v[4], v[5]};
-    } else {
-      std::cerr << "algray: probe needs --pixel X,Y or --ray ox,oy,oz,dx,dy,dz\n";
-      return kExitBadInput;
-    }
-    if (!plot_range_text.empty() && !req.plot_path) {
-      std::cerr << "algray: --plot-range goes with --plot\n";
-      return kExitBadInput;
-    }
-    if (plot_range_text == "isolating") {
-      req.plot_range.kind = PlotRange::Kind::Isolating;
-    } else if (!plot_range_text.empty() && plot_range_text != "segment") {
-      // The width must be finite too: the plot divides by it.
-      if (!parse_numbers(plot_range_text, 2, v) || !(v[0] < v[1]) || !std::isfinite(v[1] - v[0])) {
-        std::cerr << "algray: --plot-range " << plot_range_text
-                  << ": expected segment, isolating, or two increasing numbers T0,T1\n";
-        return kExitBadInput;
-      }
-      req.plot_range = {PlotRange::Kind::Given, v[0], v[1]};
-    }
-    return run_probe(req, std::cout, std::cerr);
-  }
-
-  if (!render_opts.scene_path.empty()) request.scene_path = render_opts.scene_path;
-  if (request.outputs.images.empty()) request.outputs.images.push_back("algray.exr");
-  if (!collect_overrides(render, render_opts, request.overrides)) return kExitBadInput;
-  request.device_spec = render_opts.device_spec;
-  if (!aov_text.empty()) {
-    std::string error;
-    if (!parse_aov_list(aov_text, request.outputs.aovs, error)) {
-      std::cerr << "algray: --aov " << aov_text << ": " << error << "\n";
-      return kExitBadInput;
-    }
-  }
-  request.use_cache = !render_opts.no_cache;
-  if (!stats_path.empty()) request.outputs.stats_path = stats_path;
-  request.progress = ::isatty(STDERR_FILENO) != 0;
-  end_process(run_render(request, std::cerr));
+  if (devices.cmd->parsed()) return devices.run();
+  if (batch.cmd->parsed()) return batch.run();
+  if (probe.cmd->parsed()) return probe.run();
+  end_process(render.run());
 }

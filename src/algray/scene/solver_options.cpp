@@ -46,7 +46,7 @@ bool parse_precision(const std::string& n, Precision& out) { return parse_enum(k
 bool parse_isolation(const std::string& n, Isolation& out) { return parse_enum(kIsolations, n, out); }
 bool parse_refinement(const std::string& n, Refinement& out) { return parse_enum(kRefinements, n, out); }
 bool parse_ray_origin(const std::string& n, RayOrigin& out) { return parse_enum(kRayOrigins, n, out); }
-std::string precision_choices() { return enum_choices(kPrecisions); }
+std::string precision_choices(const char* last) { return enum_choices(kPrecisions, last); }
 std::string isolation_choices(const char* last) { return enum_choices(kIsolations, last); }
 std::string refinement_choices(const char* last) { return enum_choices(kRefinements, last); }
 std::string ray_origin_choices() { return enum_choices(kRayOrigins); }

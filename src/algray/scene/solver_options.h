@@ -52,7 +52,7 @@ bool parse_isolation(const std::string& name, Isolation& out);
 bool parse_refinement(const std::string& name, Refinement& out);
 bool parse_ray_origin(const std::string& name, RayOrigin& out);
 // "a, b, c", or with `last` given "a, b or c".
-std::string precision_choices();
+std::string precision_choices(const char* last = nullptr);
 std::string isolation_choices(const char* last = nullptr);
 std::string refinement_choices(const char* last = nullptr);
 std::string ray_origin_choices();
