@@ -439,9 +439,9 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
     if (const toml::node* n = render->get("ray_origin")) {
       if (!parse_ray_origin(r.string(*n, "render.ray_origin"), rs.ray_origin))
         r.fail(n->source(), "render.ray_origin must be one of " + ray_origin_choices());
-      if (rs.ray_origin == RayOrigin::Eye && rs.isolation == Isolation::Bernstein)
-        r.fail(n->source(),
-               "render.ray_origin = \"eye\" needs a power-basis isolation (descartes, sturm or derivative-chain)");
+      if (rs.ray_origin == RayOrigin::Eye && !isolates_in_power_basis(rs.isolation))
+        r.fail(n->source(), "render.ray_origin = \"eye\" needs a power-basis isolation (" +
+                                power_basis_isolation_choices("or") + ")");
       if (rs.ray_origin == RayOrigin::Screen && rs.precision == Precision::Mixed)
         r.fail(n->source(), "render.ray_origin = \"screen\" is built in float or double, not mixed precision");
     }
