@@ -40,20 +40,16 @@ struct Method {
 // every isolation with Brent, every refinement with Bernstein. The full per-degree run takes every pair.
 std::vector<Method> one_at_a_time() {
   std::vector<Method> m;
-  for (Refinement r :
-       {Refinement::Brent, Refinement::Bisection, Refinement::RegulaFalsi, Refinement::Illinois, Refinement::Newton})
-    m.push_back({Isolation::Bernstein, r});
-  for (Isolation i : {Isolation::PowerDescartes, Isolation::Sturm, Isolation::DerivativeChain})
-    m.push_back({i, Refinement::Brent});
+  for (const NamedChoice<Refinement>& r : kRefinements) m.push_back({Isolation::Bernstein, r.value});
+  for (const NamedChoice<Isolation>& i : kIsolations)
+    if (i.value != Isolation::Bernstein) m.push_back({i.value, Refinement::Brent});
   return m;
 }
 
 std::vector<Method> every_pair() {
   std::vector<Method> m;
-  for (Isolation i : {Isolation::Bernstein, Isolation::PowerDescartes, Isolation::Sturm, Isolation::DerivativeChain})
-    for (Refinement r :
-         {Refinement::Brent, Refinement::Bisection, Refinement::RegulaFalsi, Refinement::Illinois, Refinement::Newton})
-      m.push_back({i, r});
+  for (const NamedChoice<Isolation>& i : kIsolations)
+    for (const NamedChoice<Refinement>& r : kRefinements) m.push_back({i.value, r.value});
   return m;
 }
 
@@ -163,7 +159,8 @@ json bench_degrees(ClSession& session, bool quick, const fs::path& cache_dir) {
   json rows = json::array();
   for (int degree : degrees) {
     const std::string text = random_surface(degree, 1000u + static_cast<unsigned>(degree), side, side);
-    for (Precision precision : {Precision::Float, Precision::Double, Precision::Mixed}) {
+    for (const NamedChoice<Precision>& choice : kPrecisions) {
+      const Precision precision = choice.value;
       if (precision == Precision::Mixed && degree > kMaxMixedDegree) continue;
       for (const Method& m : methods) {
         const Scene scene = load_scene_text(text, "random", solver_overrides(m, precision, 1e-9));

@@ -57,15 +57,25 @@ TEST_CASE("every choice that changes the kernel changes both the build options a
 }
 
 TEST_CASE("solver names round-trip and unknown names are refused", "[config]") {
-  for (Isolation i : {Isolation::Bernstein, Isolation::PowerDescartes}) {
-    Isolation back{};
-    REQUIRE(parse_isolation(to_string(i), back));
-    CHECK(back == i);
+  for (const NamedChoice<Precision>& p : kPrecisions) {
+    Precision back{};
+    REQUIRE(parse_precision(to_string(p.value), back));
+    CHECK(back == p.value);
   }
-  for (Refinement r : {Refinement::Brent, Refinement::Bisection}) {
+  for (const NamedChoice<Isolation>& i : kIsolations) {
+    Isolation back{};
+    REQUIRE(parse_isolation(to_string(i.value), back));
+    CHECK(back == i.value);
+  }
+  for (const NamedChoice<Refinement>& r : kRefinements) {
     Refinement back{};
-    REQUIRE(parse_refinement(to_string(r), back));
-    CHECK(back == r);
+    REQUIRE(parse_refinement(to_string(r.value), back));
+    CHECK(back == r.value);
+  }
+  for (const NamedChoice<RayOrigin>& o : kRayOrigins) {
+    RayOrigin back{};
+    REQUIRE(parse_ray_origin(to_string(o.value), back));
+    CHECK(back == o.value);
   }
   Precision p{};
   CHECK_FALSE(parse_precision("quad", p));

@@ -70,7 +70,8 @@ TEST_CASE("every DEGREE from 1 to 32 builds and finds the smallest root, in floa
   ClSession& session = testing::device_session();
   ProgramCache no_cache(false);  // compile every specialisation from source
   Renderer renderer(session, no_cache);
-  for (const char* precision : {"float", "double", "mixed"}) {
+  for (const NamedChoice<Precision>& choice : kPrecisions) {
+    const char* const precision = choice.name;
     if (std::string(precision) == "double" && !session.info.fp64) FAIL("the test device lacks fp64");
     // Mixed precision exists up to degree 15 (kMaxMixedDegree); the scene layer refuses it above.
     const int max_degree = std::string(precision) == "mixed" ? kMaxMixedDegree : 32;
@@ -127,7 +128,9 @@ TEST_CASE("power-basis isolation refines a wide bracket to the stopping width at
   Renderer renderer(session, no_cache);
   for (const char* precision : {"float", "double"}) {
     if (std::string(precision) == "double" && !session.info.fp64) FAIL("the test device lacks fp64");
-    for (const char* isolation : {"descartes", "sturm", "derivative-chain"}) {
+    for (const NamedChoice<Isolation>& choice : kIsolations) {
+      if (!isolates_in_power_basis(choice.value)) continue;
+      const char* const isolation = choice.name;
       const bool is_double = std::string(precision) == "double", chain = std::string(isolation) == "derivative-chain";
       const int max_degree = is_double ? 24 : chain ? 9 : 13;
       for (int degree : {5, 9, 13, 17, 21, 24}) {

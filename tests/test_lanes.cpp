@@ -89,7 +89,8 @@ TEST_CASE("lanes give the one-ray kernel's hit records where groups settle witho
     text += "look_at = [0, 0, 0]\nup = [0, 1, 0]\nheight = 2.5\n[image]\nwidth = 45\nheight = 32\n";
     // The double plane is mostly invisible by design (a double root has no sign change): few hits there.
     const std::size_t least_hits = equation == "(z-0.1)^2" ? 1 : 100;
-    for (const Precision precision : {Precision::Double, Precision::Float, Precision::Mixed}) {
+    for (const NamedChoice<Precision>& choice : kPrecisions) {
+      const Precision precision = choice.value;
       const std::string quoted_precision = '"' + std::string(to_string(precision)) + '"';
       const auto render = [&](int lanes) {
         return renderer.render_with_records(

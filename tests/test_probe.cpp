@@ -375,8 +375,8 @@ TEST_CASE("render builds contain no probe code: the hooks compile to nothing unl
     REQUIRE(std::system(cmd.c_str()) == 0);
     return algray::testing::read_text(out);
   };
-  for (Isolation isolation :
-       {Isolation::Bernstein, Isolation::PowerDescartes, Isolation::Sturm, Isolation::DerivativeChain}) {
+  for (const NamedChoice<Isolation>& choice : kIsolations) {
+    const Isolation isolation = choice.value;
     KernelConfig config;
     config.degree = 6;
     config.isolation = isolation;

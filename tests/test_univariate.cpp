@@ -289,8 +289,11 @@ TEST_CASE("random polynomials: the kernels' smallest root matches the certified 
   check_solver(solver(Precision::Mixed), std::min(kMaxTestedDegree, kMaxMixedDegree));
 }
 
+// Every method but the default (Bernstein with Brent), which the test case above checks in every precision.
 TEST_CASE("random polynomials: every isolation method", "[univariate][isolation]") {
-  for (Isolation isolation : {Isolation::PowerDescartes, Isolation::Sturm, Isolation::DerivativeChain}) {
+  for (const NamedChoice<Isolation>& choice : kIsolations) {
+    const Isolation isolation = choice.value;
+    if (isolation == Isolation::Bernstein) continue;
     SECTION(to_string(isolation)) {
       check_solver(solver(Precision::Double, isolation), kMaxTestedDegree);
       // Sturm sequences in float break where a remainder's leading coefficient is small: the division loses
@@ -304,8 +307,9 @@ TEST_CASE("random polynomials: every isolation method", "[univariate][isolation]
 }
 
 TEST_CASE("random polynomials: every refinement method", "[univariate][refinement]") {
-  for (Refinement refinement :
-       {Refinement::Bisection, Refinement::RegulaFalsi, Refinement::Illinois, Refinement::Newton}) {
+  for (const NamedChoice<Refinement>& choice : kRefinements) {
+    const Refinement refinement = choice.value;
+    if (refinement == Refinement::Brent) continue;
     SECTION(to_string(refinement)) {
       check_solver(solver(Precision::Double, Isolation::Bernstein, refinement), kMaxTestedDegree);
       check_solver(solver(Precision::Float, Isolation::Bernstein, refinement), kMaxTestedDegree);

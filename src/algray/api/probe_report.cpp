@@ -59,10 +59,11 @@ std::vector<KernelConfig> solver_configs(const Scene& scene, Precision precision
   const KernelConfig own = primary_config(scene, precision, surface);
   std::vector<KernelConfig> configs{own};
   if (!all) return configs;
-  for (Isolation i : {Isolation::Bernstein, Isolation::PowerDescartes, Isolation::Sturm, Isolation::DerivativeChain}) {
-    if (own.ray_origin == RayOrigin::Eye && i == Isolation::Bernstein) continue;  // no Bernstein around the eye
-    for (Refinement r : {Refinement::Brent, Refinement::Bisection, Refinement::RegulaFalsi, Refinement::Illinois,
-                         Refinement::Newton}) {
+  for (const NamedChoice<Isolation>& isolation : kIsolations) {
+    const Isolation i = isolation.value;
+    if (own.ray_origin == RayOrigin::Eye && !isolates_in_power_basis(i)) continue;  // none but these around the eye
+    for (const NamedChoice<Refinement>& refinement : kRefinements) {
+      const Refinement r = refinement.value;
       if (i == own.isolation && r == own.refinement) continue;
       KernelConfig c = own;
       c.isolation = i;

@@ -256,41 +256,43 @@ double factor_or(const Properties& props, const std::string& key, double fallbac
   return 1;
 }
 
-}  // namespace
-
-bool looks_like_jsurf(const std::string& text) {
-  static const std::regex key(R"((^|\n)[ \t\f]*surface_equation[ \t\f]*[=:])");
-  return std::regex_search(text, key);
-}
-
-std::string jsurf_to_toml(const std::string& text, const std::string& source, std::vector<std::string>& warnings,
-                          std::map<int, JsurfOrigin>* origins) {
-  const Properties props(text, source);
-  const auto warn = [&](const std::string& message) { warnings.push_back(source + ": " + message); };
-
-  // The surface and its parameters.
-  const Property* equation = props.get("surface_equation");
-  if (!equation) props.fail_missing("surface_equation", "a .jsurf file must give the surface's equation");
+// The surface's equation and parameters, checked here so that an error points into the .jsurf file, not into
+// the TOML made from it.
+struct JsurfSurface {
+  const Property* equation = nullptr;
   std::map<std::string, double> parameters;
+};
+
+JsurfSurface read_surface(const Properties& props) {
+  JsurfSurface surface;
+  surface.equation = props.get("surface_equation");
+  if (!surface.equation) props.fail_missing("surface_equation", "a .jsurf file must give the surface's equation");
   for (const std::string& key : props.keys_with_prefix("surface_parameter_")) {
     const Property* p = props.get(key);
     const std::string name = key.substr(std::string("surface_parameter_").size());
     if (!is_identifier(name))
       props.fail(*p, key, "'" + name + "' is not a parameter name (a letter or _, then letters, digits or _)");
     if (is_reserved_name(name)) props.fail(*p, key, "'" + name + "' is reserved: x, y, z and function names");
-    parameters[name] = numbers(props, key, *p, 1)[0];
+    surface.parameters[name] = numbers(props, key, *p, 1)[0];
   }
-  // Checked here so that an error points into the .jsurf file, not into the TOML made from it.
   try {
-    parse_equation(equation->value, parameters);
+    parse_equation(surface.equation->value, surface.parameters);
   } catch (const EquationError& e) {
-    props.fail(*equation, "surface_equation", e.what(), e.position);
+    props.fail(*surface.equation, "surface_equation", e.what(), e.position);
   }
+  return surface;
+}
 
-  // Frames. jsurf clips to the unit sphere of its clip space and evaluates the equation at 10^scale_factor times
-  // the clip-space point, after rotation_matrix; the camera sits in clip space through camera_transform
-  // (world-to-camera). algray keeps the equation's own coordinates as the world, so the camera and lights move
-  // instead: camera point p maps to 10^s R C^-1 p.
+// Frames. jsurf clips to the unit sphere of its clip space and evaluates the equation at 10^scale_factor times
+// the clip-space point, after rotation_matrix; the camera sits in clip space through camera_transform
+// (world-to-camera). algray keeps the equation's own coordinates as the world, so the camera and lights move
+// instead: camera point p maps to 10^s R C^-1 p.
+struct Framing {
+  double scale = 1;  // 10^scale_factor: the clip sphere's radius in the world
+  glm::dmat4 camera_to_world{1.0};
+};
+
+Framing read_framing(const Properties& props, std::vector<std::string>& warnings) {
   const double scale = std::pow(10.0, number_or(props, "scale_factor", 0.0));
   if (!(scale > 0 && std::isfinite(scale) && std::isfinite(1 / scale)))
     props.fail(*props.get("scale_factor"), "scale_factor", "10^scale_factor must be a finite, nonzero radius");
@@ -308,94 +310,134 @@ std::string jsurf_to_toml(const std::string& text, const std::string& source, st
   for (const char* ignored : {"transform_matrix", "surface_transform_matrix"}) {
     const Property* where = nullptr;
     if (!is_identity(matrix_or_identity(props, ignored, &where)))
-      warnings.push_back(source + ":" + std::to_string(props.line_of(*where)) + ": " + ignored +
+      warnings.push_back(props.source() + ":" + std::to_string(props.line_of(*where)) + ": " + ignored +
                          " is ignored, as SURFER ignores it (jsurf would apply it on top of rotation_matrix and "
                          "scale_factor, which SURFER also writes)");
   }
   for (const char* unused : {"transform", "surface_transform"}) props.get(unused);  // written by SURFER, read by none
-  const glm::dmat4 camera_to_world = glm::dmat4(glm::dmat3(scale)) * rotation * glm::inverse(camera_transform);
-  const glm::dvec3 eye = glm::dvec3(camera_to_world * glm::dvec4(0, 0, 0, 1));
-  const glm::dvec3 forward = glm::normalize(glm::dvec3(camera_to_world * glm::dvec4(0, 0, -1, 0)));
-  const glm::dvec3 up = glm::normalize(glm::dvec3(camera_to_world * glm::dvec4(0, 1, 0, 0)));
+  return {scale, glm::dmat4(glm::dmat3(scale)) * rotation * glm::inverse(camera_transform)};
+}
 
+struct JsurfCamera {
   std::string projection = "orthographic";
+  double fov_y = 60, height = 2;  // height in clip space
+};
+
+JsurfCamera read_camera(const Properties& props) {
+  JsurfCamera camera;
   if (const Property* p = props.get("camera_type")) {
     if (p->value == "PERSPECTIVE_CAMERA")
-      projection = "perspective";
+      camera.projection = "perspective";
     else if (p->value != "ORTHOGRAPHIC_CAMERA")
       props.fail(*p, "camera_type", "expected ORTHOGRAPHIC_CAMERA or PERSPECTIVE_CAMERA");
   }
-  const double fov_y = number_or(props, "camera_fov_y", 60.0);
-  const double height = number_or(props, "camera_height", 2.0);
-  if (!(fov_y > 0 && fov_y < 180))
+  camera.fov_y = number_or(props, "camera_fov_y", camera.fov_y);
+  camera.height = number_or(props, "camera_height", camera.height);
+  if (!(camera.fov_y > 0 && camera.fov_y < 180))
     props.fail(*props.get("camera_fov_y"), "camera_fov_y", "must be between 0 and 180 degrees");
-  if (!(height > 0)) props.fail(*props.get("camera_height"), "camera_height", "must be positive");
+  if (!(camera.height > 0)) props.fail(*props.get("camera_height"), "camera_height", "must be positive");
+  return camera;
+}
 
-  // Each TOML line that carries a value from the file records the property it came from, so that an error the
-  // scene reader finds in it (a radius of 1e308, say) points into the .jsurf, not into text the user never saw.
-  std::ostringstream toml;
-  int line = 1;
-  const auto emit = [&](const std::string& lines, std::initializer_list<std::string> keys = {}) {
+// The translated TOML. Each line that carries a value from the file records the property it came from, so that
+// an error the scene reader finds in it (a radius of 1e308, say) points into the .jsurf, not into text the user
+// never saw.
+class TranslatedToml {
+ public:
+  TranslatedToml(const Properties& props, std::map<int, JsurfOrigin>* origins) : props_(props), origins_(origins) {}
+
+  // `lines` come from the first of `keys` the file gives.
+  void emit(const std::string& lines, std::initializer_list<std::string> keys = {}) {
     for (const std::string& key : keys)
-      if (const Property* p = props.get(key); p && origins) {
-        (*origins)[line] = props.origin(*p, key);
+      if (const Property* p = props_.get(key); p && origins_) {
+        (*origins_)[line_] = props_.origin(*p, key);
         break;
       }
-    toml << lines;
-    line += static_cast<int>(std::count(lines.begin(), lines.end(), '\n'));
-  };
-  // The camera and everything placed in camera space depend on all three framing properties.
-  const std::initializer_list<std::string> framing = {"scale_factor", "rotation_matrix", "camera_transform"};
-  emit("# Translated from " + source + " (SURFER/jsurf)\n\n[surface]\nname = " +
-       toml_quoted(source.substr(source.find_last_of('/') == std::string::npos ? 0 : source.find_last_of('/') + 1)) +
-       "\n");
-  emit("equation = " + toml_quoted(equation->value) + "\n", {"surface_equation"});
-  if (!parameters.empty()) {
-    emit("\n[parameters]\n");
-    for (const auto& [name, value] : parameters)
-      emit(name + " = " + toml_number(value) + "\n", {"surface_parameter_" + name});
+    toml_ << lines;
+    line_ += static_cast<int>(std::count(lines.begin(), lines.end(), '\n'));
   }
-  emit("\n[extent]  # jsurf's clip sphere: radius 1 in clip space\ntype = \"sphere\"\ncentre = [0.0, 0.0, 0.0]\n");
-  emit("radius = " + toml_number(scale) + "\n", {"scale_factor"});
-  emit("\n[camera]\nprojection = \"" + projection + "\"\n", {"camera_type"});
-  emit("eye = " + toml_vector(eye) + "\n", framing);
-  emit("look_at = " + toml_vector(eye + forward) + "\n", framing);
-  emit("up = " + toml_vector(up) + "\n", framing);
-  if (projection == "perspective")
-    emit("fov_y = " + toml_number(fov_y) + "\n", {"camera_fov_y"});
+  std::string str() const { return toml_.str(); }
+
+ private:
+  const Properties& props_;
+  std::map<int, JsurfOrigin>* origins_;
+  std::ostringstream toml_;
+  int line_ = 1;
+};
+
+void write_surface(TranslatedToml& toml, const std::string& source, const JsurfSurface& surface) {
+  const std::size_t slash = source.find_last_of('/');
+  const std::string file_name = source.substr(slash == std::string::npos ? 0 : slash + 1);
+  toml.emit("# Translated from " + source + " (SURFER/jsurf)\n\n[surface]\nname = " + toml_quoted(file_name) + "\n");
+  toml.emit("equation = " + toml_quoted(surface.equation->value) + "\n", {"surface_equation"});
+  if (!surface.parameters.empty()) {
+    toml.emit("\n[parameters]\n");
+    for (const auto& [name, value] : surface.parameters)
+      toml.emit(name + " = " + toml_number(value) + "\n", {"surface_parameter_" + name});
+  }
+}
+
+void write_extent(TranslatedToml& toml, const Framing& framing) {
+  toml.emit("\n[extent]  # jsurf's clip sphere: radius 1 in clip space\ntype = \"sphere\"\ncentre = [0.0, 0.0, 0.0]\n");
+  toml.emit("radius = " + toml_number(framing.scale) + "\n", {"scale_factor"});
+}
+
+void write_camera(TranslatedToml& toml, const JsurfCamera& camera, const Framing& framing) {
+  const glm::dvec3 eye = glm::dvec3(framing.camera_to_world * glm::dvec4(0, 0, 0, 1));
+  const glm::dvec3 forward = glm::normalize(glm::dvec3(framing.camera_to_world * glm::dvec4(0, 0, -1, 0)));
+  const glm::dvec3 up = glm::normalize(glm::dvec3(framing.camera_to_world * glm::dvec4(0, 1, 0, 0)));
+  // The camera and everything placed in camera space depend on all three framing properties.
+  const std::initializer_list<std::string> framing_keys = {"scale_factor", "rotation_matrix", "camera_transform"};
+  toml.emit("\n[camera]\nprojection = \"" + camera.projection + "\"\n", {"camera_type"});
+  toml.emit("eye = " + toml_vector(eye) + "\n", framing_keys);
+  toml.emit("look_at = " + toml_vector(eye + forward) + "\n", framing_keys);
+  toml.emit("up = " + toml_vector(up) + "\n", framing_keys);
+  if (camera.projection == "perspective")
+    toml.emit("fov_y = " + toml_number(camera.fov_y) + "\n", {"camera_fov_y"});
   else
-    emit("height = " + toml_number(height * scale) + "\n", {"camera_height", "scale_factor"});
+    toml.emit("height = " + toml_number(camera.height * framing.scale) + "\n", {"camera_height", "scale_factor"});
+}
 
-  // jsurf renders square images, 512 pixels by default; a background is required by jsurf, white here.
-  emit("\n[image]\nwidth = 512\nheight = 512\n");
+// jsurf renders square images, 512 pixels by default; a background is required by jsurf, white here.
+void write_image(TranslatedToml& toml, const Properties& props) {
+  toml.emit("\n[image]\nwidth = 512\nheight = 512\n");
   const glm::dvec3 background = colour_or(props, "background_color", glm::dvec3(1));
-  emit("background = " + toml_vector(background) + "\n", {"background_color"});
-  // jsurf's default quality: one ray per pixel, more where neighbouring colours differ.
-  emit("\n[antialias]\nsamples = 2\nadaptive = true\nthreshold = 0.3\n");
+  toml.emit("background = " + toml_vector(background) + "\n", {"background_color"});
+}
 
-  // Materials. jsurf shades with Blinn's half vector, algray with Phong's mirror vector: a Blinn exponent of 4n
-  // gives about the highlight of a Phong exponent n.
+// jsurf's default quality: one ray per pixel, more where neighbouring colours differ.
+void write_antialias(TranslatedToml& toml) {
+  toml.emit("\n[antialias]\nsamples = 2\nadaptive = true\nthreshold = 0.3\n");
+}
+
+// jsurf shades with Blinn's half vector, algray with Phong's mirror vector: a Blinn exponent of 4n gives about
+// the highlight of a Phong exponent n.
+void write_materials(TranslatedToml& toml, const Properties& props, std::vector<std::string>& warnings) {
   for (const char* side : {"front", "back"}) {
     const std::string prefix = std::string(side) + "_material_";
-    emit("\n[material." + std::string(side) + "]\n");
+    toml.emit("\n[material." + std::string(side) + "]\n");
     const glm::dvec3 colour = colour_or(props, prefix + "color", glm::dvec3(0.5));
     // 2011 files spell the key specular_iIntensity; the SURFER that wrote them meant the specular intensity.
     const double specular_typo = number_or(props, prefix + "specular_iIntensity", 0.9);
     const double specular = props.get(prefix + "specular_intensity")
                                 ? factor_or(props, prefix + "specular_intensity", 0.9, warnings)
                                 : std::clamp(specular_typo, 0.0, 1.0);
-    emit("colour = " + toml_vector(colour) + "\n", {prefix + "color"});
-    emit("ambient = " + toml_number(factor_or(props, prefix + "ambient_intensity", 0.1, warnings)) + "\n",
-         {prefix + "ambient_intensity"});
-    emit("diffuse = " + toml_number(factor_or(props, prefix + "diffuse_intensity", 0.23232, warnings)) + "\n",
-         {prefix + "diffuse_intensity"});
-    emit("specular = " + toml_number(specular) + "\n", {prefix + "specular_intensity", prefix + "specular_iIntensity"});
-    emit("exponent = " + toml_number(std::clamp(number_or(props, prefix + "shininess", 1.0) / 4, 1.0, 10000.0)) +
-             "\n",
-         {prefix + "shininess"});
+    toml.emit("colour = " + toml_vector(colour) + "\n", {prefix + "color"});
+    toml.emit("ambient = " + toml_number(factor_or(props, prefix + "ambient_intensity", 0.1, warnings)) + "\n",
+              {prefix + "ambient_intensity"});
+    toml.emit("diffuse = " + toml_number(factor_or(props, prefix + "diffuse_intensity", 0.23232, warnings)) + "\n",
+              {prefix + "diffuse_intensity"});
+    toml.emit("specular = " + toml_number(specular) + "\n",
+              {prefix + "specular_intensity", prefix + "specular_iIntensity"});
+    toml.emit(
+        "exponent = " + toml_number(std::clamp(number_or(props, prefix + "shininess", 1.0) / 4, 1.0, 10000.0)) + "\n",
+        {prefix + "shininess"});
   }
+}
 
-  // Lights: camera-space points, so they keep their place relative to the viewer; no shadows in jsurf.
+// Camera-space points, so they keep their place relative to the viewer; no shadows in jsurf.
+void write_lights(TranslatedToml& toml, const Properties& props, const Framing& framing,
+                  std::vector<std::string>& warnings) {
   int lights = 0;
   for (int n = 0; n < 8; ++n) {
     const std::string i = std::to_string(n);
@@ -408,18 +450,48 @@ std::string jsurf_to_toml(const std::string& text, const std::string& source, st
     if (status->value != "ON") props.fail(*status, "light_status_" + i, "expected ON or OFF");
     if (intensity < 0) props.fail(*props.get("light_intensity_" + i), "light_intensity_" + i, "must not be negative");
     ++lights;
-    emit("\n[[light]]  # light_" + i + "\ntype = \"point\"\n", {"light_status_" + i});
-    emit("position = " + toml_vector(glm::dvec3(camera_to_world * glm::dvec4(position, 1))) + "\n",
-         {"light_position_" + i, "scale_factor", "rotation_matrix", "camera_transform"});
-    emit("colour = " + toml_vector(colour) + "\n", {"light_color_" + i});
-    emit("intensity = " + toml_number(intensity) + "\nshadows = false\n", {"light_intensity_" + i});
+    toml.emit("\n[[light]]  # light_" + i + "\ntype = \"point\"\n", {"light_status_" + i});
+    toml.emit("position = " + toml_vector(glm::dvec3(framing.camera_to_world * glm::dvec4(position, 1))) + "\n",
+              {"light_position_" + i, "scale_factor", "rotation_matrix", "camera_transform"});
+    toml.emit("colour = " + toml_vector(colour) + "\n", {"light_color_" + i});
+    toml.emit("intensity = " + toml_number(intensity) + "\nshadows = false\n", {"light_intensity_" + i});
   }
   if (lights == 0)
-    warn("no light is ON: jsurf shows only the ambient term, algray lights the surface with a headlight");
+    warnings.push_back(
+        props.source() +
+        ": no light is ON: jsurf shows only the ambient term, algray lights the surface with a headlight");
+}
 
+void warn_unused_keys(const Properties& props, std::vector<std::string>& warnings) {
   for (const std::string& key : props.unused())
-    warnings.push_back(source + ":" + std::to_string(props.line_of(*props.get(key))) + ": unknown key " + key +
+    warnings.push_back(props.source() + ":" + std::to_string(props.line_of(*props.get(key))) + ": unknown key " + key +
                        " is ignored");
+}
+
+}  // namespace
+
+bool looks_like_jsurf(const std::string& text) {
+  static const std::regex key(R"((^|\n)[ \t\f]*surface_equation[ \t\f]*[=:])");
+  return std::regex_search(text, key);
+}
+
+// The surface, framing and camera are read and checked first; the image, materials and lights are checked as
+// they are written. Where several properties are wrong, the first in this order is the one reported.
+std::string jsurf_to_toml(const std::string& text, const std::string& source, std::vector<std::string>& warnings,
+                          std::map<int, JsurfOrigin>* origins) {
+  const Properties props(text, source);
+  const JsurfSurface surface = read_surface(props);
+  const Framing framing = read_framing(props, warnings);
+  const JsurfCamera camera = read_camera(props);
+  TranslatedToml toml(props, origins);
+  write_surface(toml, source, surface);
+  write_extent(toml, framing);
+  write_camera(toml, camera, framing);
+  write_image(toml, props);
+  write_antialias(toml);
+  write_materials(toml, props, warnings);
+  write_lights(toml, props, framing, warnings);
+  warn_unused_keys(props, warnings);
   return toml.str();
 }
 

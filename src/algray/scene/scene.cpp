@@ -267,23 +267,22 @@ Light read_light(const TomlReader& r, const toml::table& t) {
   return light;
 }
 
-Scene interpret(const TomlReader& r, const toml::table& root, const std::string& source) {
-  Scene scene;
-  scene.source = source;
-  r.check_keys(root, "", kTopKeys);
-
-  // Parameters first: the equation refers to them.
-  if (const toml::table* params = r.subtable(root, "parameters")) {
-    for (auto&& [key, node] : *params) {
-      const std::string name(key.str());
-      if (!is_identifier(name) || is_reserved_name(name))
-        r.fail(key.source(), "parameter name '" + name +
-                                 "' must be an identifier other than x, y, z and the function names (sqrt, sin, ...)");
-      scene.parameters[name] = r.number(node, "parameter '" + name + "'");
-    }
+// Parameters come first: the equations refer to them.
+void read_parameters(const TomlReader& r, const toml::table& root, std::map<std::string, double>& parameters) {
+  const toml::table* params = r.subtable(root, "parameters");
+  if (!params) return;
+  for (auto&& [key, node] : *params) {
+    const std::string name(key.str());
+    if (!is_identifier(name) || is_reserved_name(name))
+      r.fail(key.source(), "parameter name '" + name +
+                               "' must be an identifier other than x, y, z and the function names (sqrt, sin, ...)");
+    parameters[name] = r.number(node, "parameter '" + name + "'");
   }
+}
 
-  // One [surface] table, or several [[surface]] tables: the nearest hit among them wins.
+// One [surface] table, or several [[surface]] tables: the nearest hit among them wins. Returns the tables, in
+// the order of scene.surfaces, for their own materials.
+std::vector<const toml::table*> read_surfaces(const TomlReader& r, const toml::table& root, Scene& scene) {
   const toml::node* surface_node = root.get("surface");
   if (!surface_node) r.fail(root.source(), "missing [surface] table with an equation or a list of terms");
   std::vector<const toml::table*> surface_tables;
@@ -298,49 +297,58 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
   }
   for (const toml::table* t : surface_tables) scene.surfaces.push_back(read_surface(r, *t, scene.parameters));
   if (!scene.surfaces.front().name.empty()) scene.name = scene.surfaces.front().name;
-  int degree = 0;
-  for (const SceneSurface& s : scene.surfaces) degree = std::max(degree, s.polynomial.degree());
+  return surface_tables;
+}
 
+void read_sphere_extent(const TomlReader& r, const toml::table& extent, Extent& out) {
+  out.kind = ExtentKind::Sphere;
+  for (const char* k : {"min", "max"})
+    if (const toml::node* n = extent.get(k))
+      r.fail(n->source(), std::string("extent.") + k + " belongs to a box extent");
+  if (const toml::node* n = extent.get("centre")) out.centre = r.vec3(*n, "extent.centre");
+  const toml::node* radius = extent.get("radius");
+  if (!radius) r.fail(extent.source(), "a sphere extent needs a radius");
+  out.radius = r.coordinate(*radius, "extent.radius");
+  if (out.radius <= 0) r.fail(radius->source(), "the extent is empty: radius must be positive");
+  if (out.radius < 1 / kMaxCoordinate)
+    r.fail(radius->source(), "the extent is too small to render: its radius must be at least 1e-18");
+}
+
+void read_box_extent(const TomlReader& r, const toml::table& extent, Extent& out) {
+  out.kind = ExtentKind::Box;
+  for (const char* k : {"centre", "radius"})
+    if (const toml::node* n = extent.get(k))
+      r.fail(n->source(), std::string("extent.") + k + " belongs to a sphere extent");
+  const toml::node* mn = extent.get("min");
+  const toml::node* mx = extent.get("max");
+  if (!mn || !mx) r.fail(extent.source(), "a box extent needs min and max");
+  out.min = r.vec3(*mn, "extent.min");
+  out.max = r.vec3(*mx, "extent.max");
+  for (int i = 0; i < 3; ++i)
+    if (!(out.min[i] < out.max[i]))
+      r.fail(mx->source(), std::string("the extent is empty: max.") + "xyz"[i] + " must exceed min." + "xyz"[i]);
+  if (out.unit_scale() < 1 / kMaxCoordinate)
+    r.fail(mx->source(), "the extent is too small to render: its half-diagonal must be at least 1e-18");
+}
+
+void read_extent(const TomlReader& r, const toml::table& root, Extent& out) {
   const toml::table* extent = r.subtable(root, "extent");
   if (!extent)
     r.fail(root.source(), "missing [extent] table (a sphere with centre and radius, or a box with min and max)");
   r.check_keys(*extent, "extent", kExtentKeys);
   const std::string type = extent->get("type") ? r.string(*extent->get("type"), "extent.type") : "sphere";
-  if (type == "sphere") {
-    scene.extent.kind = ExtentKind::Sphere;
-    for (const char* k : {"min", "max"})
-      if (const toml::node* n = extent->get(k))
-        r.fail(n->source(), std::string("extent.") + k + " belongs to a box extent");
-    if (const toml::node* n = extent->get("centre")) scene.extent.centre = r.vec3(*n, "extent.centre");
-    const toml::node* radius = extent->get("radius");
-    if (!radius) r.fail(extent->source(), "a sphere extent needs a radius");
-    scene.extent.radius = r.coordinate(*radius, "extent.radius");
-    if (scene.extent.radius <= 0) r.fail(radius->source(), "the extent is empty: radius must be positive");
-    if (scene.extent.radius < 1 / kMaxCoordinate)
-      r.fail(radius->source(), "the extent is too small to render: its radius must be at least 1e-18");
-  } else if (type == "box") {
-    scene.extent.kind = ExtentKind::Box;
-    for (const char* k : {"centre", "radius"})
-      if (const toml::node* n = extent->get(k))
-        r.fail(n->source(), std::string("extent.") + k + " belongs to a sphere extent");
-    const toml::node* mn = extent->get("min");
-    const toml::node* mx = extent->get("max");
-    if (!mn || !mx) r.fail(extent->source(), "a box extent needs min and max");
-    scene.extent.min = r.vec3(*mn, "extent.min");
-    scene.extent.max = r.vec3(*mx, "extent.max");
-    for (int i = 0; i < 3; ++i)
-      if (!(scene.extent.min[i] < scene.extent.max[i]))
-        r.fail(mx->source(), std::string("the extent is empty: max.") + "xyz"[i] + " must exceed min." + "xyz"[i]);
-    if (scene.extent.unit_scale() < 1 / kMaxCoordinate)
-      r.fail(mx->source(), "the extent is too small to render: its half-diagonal must be at least 1e-18");
-  } else {
+  if (type == "sphere")
+    read_sphere_extent(r, *extent, out);
+  else if (type == "box")
+    read_box_extent(r, *extent, out);
+  else
     r.fail(extent->get("type")->source(), "extent.type must be \"sphere\" or \"box\"");
-  }
+}
 
+void read_camera(const TomlReader& r, const toml::table& root, CameraSpec& cam) {
   const toml::table* camera = r.subtable(root, "camera");
   if (!camera) r.fail(root.source(), "missing [camera] table (eye, look_at, up)");
   r.check_keys(*camera, "camera", kCameraKeys);
-  CameraSpec& cam = scene.camera;
   if (const toml::node* n = camera->get("projection")) {
     const std::string p = r.string(*n, "camera.projection");
     if (p == "perspective")
@@ -350,6 +358,7 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
     else
       r.fail(n->source(), "camera.projection must be \"perspective\" or \"orthographic\"");
   }
+  // Where it looks from and to, and which way is up.
   for (const char* k : {"eye", "look_at", "up"})
     if (!camera->get(k)) r.fail(camera->source(), std::string("camera.") + k + " is required");
   cam.eye = r.vec3(*camera->get("eye"), "camera.eye");
@@ -360,6 +369,7 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
     r.fail(camera->get("look_at")->source(), "degenerate camera: look_at coincides with eye");
   if (glm::length(glm::cross(glm::normalize(view), cam.up)) <= 1e-9 * glm::length(cam.up) || glm::length(cam.up) == 0)
     r.fail(camera->get("up")->source(), "degenerate camera: up is zero or parallel to the viewing direction");
+  // How much it sees: an angle for a perspective camera, a height for an orthographic one.
   if (const toml::node* n = camera->get("fov_y")) {
     if (cam.projection != Projection::Perspective) r.fail(n->source(), "camera.fov_y applies to perspective cameras");
     cam.fov_y_degrees = r.number(*n, "camera.fov_y");
@@ -374,91 +384,122 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
   } else if (cam.projection == Projection::Orthographic) {
     r.fail(camera->source(), "an orthographic camera needs camera.height (the view height in world units)");
   }
+}
 
-  if (const toml::table* image = r.subtable(root, "image")) {
-    r.check_keys(*image, "image", kImageKeys);
-    if (const toml::node* n = image->get("width"))
-      scene.image.width = static_cast<int>(r.integer(*n, "image.width", 1, kMaxImageSide));
-    if (const toml::node* n = image->get("height"))
-      scene.image.height = static_cast<int>(r.integer(*n, "image.height", 1, kMaxImageSide));
-    if (const toml::node* n = image->get("background")) scene.image.background = r.colour(*n, "image.background", true);
-  }
+void read_image(const TomlReader& r, const toml::table& root, ImageSpec& out) {
+  const toml::table* image = r.subtable(root, "image");
+  if (!image) return;
+  r.check_keys(*image, "image", kImageKeys);
+  if (const toml::node* n = image->get("width"))
+    out.width = static_cast<int>(r.integer(*n, "image.width", 1, kMaxImageSide));
+  if (const toml::node* n = image->get("height"))
+    out.height = static_cast<int>(r.integer(*n, "image.height", 1, kMaxImageSide));
+  if (const toml::node* n = image->get("background")) out.background = r.colour(*n, "image.background", true);
+}
 
-  // [material] sets every surface's sides; a surface's own [surface.material] then changes its keys.
+// [material] sets every surface's sides; a surface's own [surface.material] then changes its keys.
+void read_surface_materials(const TomlReader& r, const toml::table& root,
+                            const std::vector<const toml::table*>& surface_tables,
+                            std::vector<SceneSurface>& surfaces) {
   Materials defaults;
   if (const toml::table* material = r.subtable(root, "material")) read_materials(r, *material, "material", defaults);
-  for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+  for (std::size_t i = 0; i < surfaces.size(); ++i) {
     Materials own = defaults;
     if (const toml::table* material = r.subtable(*surface_tables[i], "material"))
       read_materials(r, *material, "surface.material", own);
-    scene.surfaces[i].materials = own;
+    surfaces[i].materials = own;
   }
+}
 
-  if (const toml::node* lights = root.get("light")) {
-    const toml::array* list = lights->as_array();
-    if (!list || !list->is_array_of_tables())
-      r.fail(lights->source(), "lights are written as [[light]] tables, one per light");
-    for (const toml::node& node : *list) scene.lights.push_back(read_light(r, *node.as_table()));
-  }
+void read_lights(const TomlReader& r, const toml::table& root, std::vector<Light>& out) {
+  const toml::node* lights = root.get("light");
+  if (!lights) return;
+  const toml::array* list = lights->as_array();
+  if (!list || !list->is_array_of_tables())
+    r.fail(lights->source(), "lights are written as [[light]] tables, one per light");
+  for (const toml::node& node : *list) out.push_back(read_light(r, *node.as_table()));
+}
 
-  if (const toml::table* aa = r.subtable(root, "antialias")) {
-    r.check_keys(*aa, "antialias", kAntialiasKeys);
-    if (const toml::node* n = aa->get("samples"))
-      scene.antialias.samples = static_cast<int>(r.integer(*n, "antialias.samples", 1, 16));
-    if (const toml::node* n = aa->get("adaptive")) scene.antialias.adaptive = r.boolean(*n, "antialias.adaptive");
-    if (const toml::node* n = aa->get("threshold"))
-      scene.antialias.threshold = r.number_in(*n, "antialias.threshold", 0, 1);
-  }
+void read_antialias(const TomlReader& r, const toml::table& root, Antialias& out) {
+  const toml::table* aa = r.subtable(root, "antialias");
+  if (!aa) return;
+  r.check_keys(*aa, "antialias", kAntialiasKeys);
+  if (const toml::node* n = aa->get("samples"))
+    out.samples = static_cast<int>(r.integer(*n, "antialias.samples", 1, 16));
+  if (const toml::node* n = aa->get("adaptive")) out.adaptive = r.boolean(*n, "antialias.adaptive");
+  if (const toml::node* n = aa->get("threshold")) out.threshold = r.number_in(*n, "antialias.threshold", 0, 1);
+}
 
-  if (const toml::table* render = r.subtable(root, "render")) {
-    r.check_keys(*render, "render", kRenderKeys);
-    RenderSettings& rs = scene.render;
-    if (const toml::node* n = render->get("precision")) {
-      const std::string p = r.string(*n, "render.precision");
-      Precision value;
-      if (p == "auto")
-        rs.precision.reset();
-      else if (parse_precision(p, value))
-        rs.precision = value;
-      else
-        r.fail(n->source(), "render.precision must be auto, " + precision_choices());
-      if (rs.precision == Precision::Mixed && degree > kMaxMixedDegree)
-        r.fail(n->source(), "mixed precision supports degrees up to " + std::to_string(kMaxMixedDegree) +
-                                "; this surface has degree " + std::to_string(degree));
-    }
-    if (const toml::node* n = render->get("tolerance")) {
-      rs.tolerance = r.number(*n, "render.tolerance");
-      if (!(rs.tolerance > 0 && rs.tolerance <= 0.1)) r.fail(n->source(), "render.tolerance must be in (0, 0.1]");
-    }
-    if (const toml::node* n = render->get("isolation"))
-      if (!parse_isolation(r.string(*n, "render.isolation"), rs.isolation))
-        r.fail(n->source(), "render.isolation must be one of " + isolation_choices());
-    if (const toml::node* n = render->get("refinement"))
-      if (!parse_refinement(r.string(*n, "render.refinement"), rs.refinement))
-        r.fail(n->source(), "render.refinement must be one of " + refinement_choices());
-    if (const toml::node* n = render->get("ray_origin")) {
-      if (!parse_ray_origin(r.string(*n, "render.ray_origin"), rs.ray_origin))
-        r.fail(n->source(), "render.ray_origin must be one of " + ray_origin_choices());
-      if (rs.ray_origin == RayOrigin::Eye && rs.isolation == Isolation::Bernstein)
-        r.fail(n->source(),
-               "render.ray_origin = \"eye\" needs a power-basis isolation (descartes, sturm or derivative-chain)");
-      if (rs.ray_origin == RayOrigin::Screen && rs.precision == Precision::Mixed)
-        r.fail(n->source(), "render.ray_origin = \"screen\" is built in float or double, not mixed precision");
-    }
-    if (const toml::node* n = render->get("max_iterations"))
-      rs.max_iterations = static_cast<int>(r.integer(*n, "render.max_iterations", 1, 1000000));
-    if (const toml::node* n = render->get("tile_size"))
-      rs.tile_size = static_cast<int>(r.integer(*n, "render.tile_size", 8, 16384));
-    if (const toml::node* n = render->get("lanes")) {
-      rs.lanes = static_cast<int>(r.integer(*n, "render.lanes", 1, 16));
-      if (!valid_lanes(rs.lanes)) r.fail(n->source(), "render.lanes must be " + lanes_choices());
-      if (rs.lanes > 1 && (rs.isolation != Isolation::Bernstein || rs.refinement != Refinement::Brent))
-        r.fail(n->source(), "render.lanes > 1 needs isolation = \"bernstein\" and refinement = \"brent\"");
-    }
-    if (const toml::node* n = render->get("preview")) rs.preview = r.boolean(*n, "render.preview");
-    if (const toml::node* n = render->get("max_depth"))
-      rs.max_depth = static_cast<int>(r.integer(*n, "render.max_depth", 0, 64));
+// `degree` is the scene's highest, which mixed precision is held to.
+void read_render(const TomlReader& r, const toml::table& root, int degree, RenderSettings& rs) {
+  const toml::table* render = r.subtable(root, "render");
+  if (!render) return;
+  r.check_keys(*render, "render", kRenderKeys);
+  // The solver: precision, tolerance, methods and the point P*(t) is built around.
+  if (const toml::node* n = render->get("precision")) {
+    const std::string p = r.string(*n, "render.precision");
+    Precision value;
+    if (p == "auto")
+      rs.precision.reset();
+    else if (parse_precision(p, value))
+      rs.precision = value;
+    else
+      r.fail(n->source(), "render.precision must be auto, " + precision_choices());
+    if (rs.precision == Precision::Mixed && degree > kMaxMixedDegree)
+      r.fail(n->source(), "mixed precision supports degrees up to " + std::to_string(kMaxMixedDegree) +
+                              "; this surface has degree " + std::to_string(degree));
   }
+  if (const toml::node* n = render->get("tolerance")) {
+    rs.tolerance = r.number(*n, "render.tolerance");
+    if (!(rs.tolerance > 0 && rs.tolerance <= 0.1)) r.fail(n->source(), "render.tolerance must be in (0, 0.1]");
+  }
+  if (const toml::node* n = render->get("isolation"))
+    if (!parse_isolation(r.string(*n, "render.isolation"), rs.isolation))
+      r.fail(n->source(), "render.isolation must be one of " + isolation_choices());
+  if (const toml::node* n = render->get("refinement"))
+    if (!parse_refinement(r.string(*n, "render.refinement"), rs.refinement))
+      r.fail(n->source(), "render.refinement must be one of " + refinement_choices());
+  if (const toml::node* n = render->get("ray_origin")) {
+    if (!parse_ray_origin(r.string(*n, "render.ray_origin"), rs.ray_origin))
+      r.fail(n->source(), "render.ray_origin must be one of " + ray_origin_choices());
+    if (rs.ray_origin == RayOrigin::Eye && !isolates_in_power_basis(rs.isolation))
+      r.fail(n->source(),
+             "render.ray_origin = \"eye\" needs a power-basis isolation (" + power_basis_isolation_choices("or") + ")");
+    if (rs.ray_origin == RayOrigin::Screen && rs.precision == Precision::Mixed)
+      r.fail(n->source(), "render.ray_origin = \"screen\" is built in float or double, not mixed precision");
+  }
+  if (const toml::node* n = render->get("max_iterations"))
+    rs.max_iterations = static_cast<int>(r.integer(*n, "render.max_iterations", 1, 1000000));
+  // How the kernels run and what they trace.
+  if (const toml::node* n = render->get("tile_size"))
+    rs.tile_size = static_cast<int>(r.integer(*n, "render.tile_size", 8, 16384));
+  if (const toml::node* n = render->get("lanes")) {
+    rs.lanes = static_cast<int>(r.integer(*n, "render.lanes", 1, 16));
+    if (!valid_lanes(rs.lanes)) r.fail(n->source(), "render.lanes must be " + lanes_choices());
+    if (rs.lanes > 1 && (rs.isolation != Isolation::Bernstein || rs.refinement != Refinement::Brent))
+      r.fail(n->source(), "render.lanes > 1 needs isolation = \"bernstein\" and refinement = \"brent\"");
+  }
+  if (const toml::node* n = render->get("preview")) rs.preview = r.boolean(*n, "render.preview");
+  if (const toml::node* n = render->get("max_depth"))
+    rs.max_depth = static_cast<int>(r.integer(*n, "render.max_depth", 0, 64));
+}
+
+// Table by table, in a fixed order: where several are wrong, the first of them in this order is reported.
+Scene interpret(const TomlReader& r, const toml::table& root, const std::string& source) {
+  Scene scene;
+  scene.source = source;
+  r.check_keys(root, "", kTopKeys);
+  read_parameters(r, root, scene.parameters);
+  const std::vector<const toml::table*> surface_tables = read_surfaces(r, root, scene);
+  int degree = 0;
+  for (const SceneSurface& s : scene.surfaces) degree = std::max(degree, s.polynomial.degree());
+  read_extent(r, root, scene.extent);
+  read_camera(r, root, scene.camera);
+  read_image(r, root, scene.image);
+  read_surface_materials(r, root, surface_tables, scene.surfaces);
+  read_lights(r, root, scene.lights);
+  read_antialias(r, root, scene.antialias);
+  read_render(r, root, degree, scene.render);
   return scene;
 }
 

@@ -2,6 +2,7 @@
 #include "algray/scene/solver_options.h"
 
 #include <algorithm>
+#include <vector>
 
 namespace algray {
 namespace {
@@ -23,17 +24,26 @@ std::string enum_name(const std::array<NamedChoice<E>, N>& choices, E value) {
   return "?";
 }
 
-template <typename E, std::size_t N>
-std::string enum_choices(const std::array<NamedChoice<E>, N>& choices, const char* last = nullptr) {
+// The names of the choices `keep` accepts, in the table's order.
+template <typename E, std::size_t N, typename Keep>
+std::string enum_choices(const std::array<NamedChoice<E>, N>& choices, const char* last, Keep keep) {
+  std::vector<const char*> names;
+  for (const auto& c : choices)
+    if (keep(c.value)) names.push_back(c.name);
   std::string s;
-  for (std::size_t i = 0; i < N; ++i) {
-    if (i > 0 && last && i + 1 == N)
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0 && last && i + 1 == names.size())
       s.append(" ").append(last).append(" ");
     else if (i > 0)
       s.append(", ");
-    s.append(choices[i].name);
+    s.append(names[i]);
   }
   return s;
+}
+
+template <typename E, std::size_t N>
+std::string enum_choices(const std::array<NamedChoice<E>, N>& choices, const char* last = nullptr) {
+  return enum_choices(choices, last, [](E) { return true; });
 }
 
 }  // namespace
@@ -50,6 +60,10 @@ std::string precision_choices(const char* last) { return enum_choices(kPrecision
 std::string isolation_choices(const char* last) { return enum_choices(kIsolations, last); }
 std::string refinement_choices(const char* last) { return enum_choices(kRefinements, last); }
 std::string ray_origin_choices() { return enum_choices(kRayOrigins); }
+bool isolates_in_power_basis(Isolation i) { return i != Isolation::Bernstein; }
+std::string power_basis_isolation_choices(const char* last) {
+  return enum_choices(kIsolations, last, isolates_in_power_basis);
+}
 
 // OpenCL C's vector widths, and 1 (kernels/lanes.h).
 constexpr std::array<int, 5> kLanes{1, 2, 4, 8, 16};

@@ -56,6 +56,11 @@ std::string precision_choices(const char* last = nullptr);
 std::string isolation_choices(const char* last = nullptr);
 std::string refinement_choices(const char* last = nullptr);
 std::string ray_origin_choices();
+// Whether an isolation works on P*(t) in the power basis, as every one but Bernstein's does: only those take
+// ray_origin = "eye", as the paper's solver does.
+bool isolates_in_power_basis(Isolation i);
+// As isolation_choices, of those alone.
+std::string power_basis_isolation_choices(const char* last = nullptr);
 
 // The lane counts a kernel can be built with (render.lanes; kernels/lanes.h).
 bool valid_lanes(int lanes);
