@@ -344,155 +344,208 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks)
   return run_batch(req, callbacks, context);
 }
 
+namespace {
+
+// The jobs file read and every path the batch will touch checked, before anything renders.
+struct BatchPlan {
+  std::vector<BatchJob> jobs;
+  std::string log_path;
+  int total_frames = 0;
+};
+
+// Throws SceneError or OutputError on bad input: a bad jobs file, or an output that cannot be written or is
+// another input or output by some other name.
+BatchPlan plan_batch(const BatchRequest& req) {
+  BatchPlan plan;
+  std::string text, base_dir;
+  if (req.jobs_path == "-") {
+    text = read_input_stream(std::cin, "<stdin>", "jobs file");
+  } else {
+    text = read_input_file(req.jobs_path, "jobs file");
+    base_dir = fs::path(req.jobs_path).parent_path().string();
+  }
+  plan.jobs = load_jobs(text, req.jobs_path == "-" ? "<stdin>" : req.jobs_path, base_dir);
+  plan.log_path = req.log_path ? *req.log_path
+                  : req.jobs_path == "-"
+                      ? std::string("batch.log.jsonl")
+                      : (fs::path(base_dir) / (fs::path(req.jobs_path).stem().string() + ".log.jsonl")).string();
+  check_output_writable(plan.log_path);
+  if (req.stats_path) check_output_writable(*req.stats_path);
+  // No file the batch writes may be one it reads, or another it writes, by any name.
+  std::vector<RoleAndPath> inputs{{"jobs file", req.jobs_path}}, outputs{{"--log", plan.log_path}};
+  if (req.stats_path) outputs.push_back({"--stats", *req.stats_path});
+  for (const BatchJob& job : plan.jobs) {
+    inputs.push_back({"scene of job " + job.name, job.scene});
+    for (int frame = 0; frame < job.frames; ++frame) {
+      const std::string who = "job " + job.name + " frame " + std::to_string(frame);
+      for (const std::string& o : job.outputs) outputs.push_back({who + " output", expand_pattern(o, job, frame)});
+      if (job.stats) outputs.push_back({who + " stats", expand_pattern(*job.stats, job, frame)});
+    }
+    plan.total_frames += job.frames;
+  }
+  check_distinct_files(inputs, outputs);
+  // Every frame's paths are checked now, as render checks its own, so that a bad one is bad input (exit 2)
+  // before anything renders rather than a failure of each frame.
+  for (const RoleAndPath& o : outputs) check_output_writable(o.path);
+  return plan;
+}
+
+double ms_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+// Frame counts of one job, and the wall time of each frame that ran.
+struct JobTally {
+  int ok = 0, failed = 0, skipped = 0;
+  std::vector<double> frame_ms;
+
+  nlohmann::json json(const BatchJob& job) const {
+    nlohmann::json j = {{"name", job.name}, {"frames", job.frames}, {"ok", ok}, {"failed", failed}, {"skipped", skipped}};
+    if (!frame_ms.empty()) {
+      std::vector<double> sorted = frame_ms;
+      std::sort(sorted.begin(), sorted.end());
+      j["median_frame_ms"] = sorted[sorted.size() / 2];
+      double sum = 0;
+      for (double v : frame_ms) sum += v;
+      j["total_ms"] = sum;
+    }
+    return j;
+  }
+};
+
+// Thrown when no frame can run without the device: the batch stops rather than fail every remaining frame alike.
+struct DeviceLost {
+  std::string message;
+};
+
+// Renders (or, with --resume, skips) one frame, filling its log entry; returns "ok", "failed" or "skipped". A
+// failing frame is reported through `message`; a DeviceError is thrown on as DeviceLost after logging it.
+class FrameRunner {
+ public:
+  FrameRunner(const BatchRequest& req, RenderContext& context, JsonLinesLog& log,
+              const std::function<void(const std::string&)>& message)
+      : req_(req), context_(context), log_(log), message_(message) {}
+
+  std::string run(const BatchJob& job, int frame, bool& warned, nlohmann::json& entry) {
+    const auto start = std::chrono::steady_clock::now();
+    entry = {{"version", version_string()}, {"job", job.name}, {"frame", frame}, {"frames", job.frames},
+             {"scene", job.scene}};
+    try {
+      std::vector<std::string> outputs;
+      for (const std::string& o : job.outputs) outputs.push_back(expand_pattern(o, job, frame));
+      std::optional<std::string> stats;
+      if (job.stats) stats = expand_pattern(*job.stats, job, frame);
+      entry["outputs"] = outputs;
+      std::vector<Override> overrides = frame_overrides(job, frame);
+      overrides.insert(overrides.end(), req_.overrides.begin(), req_.overrides.end());
+      nlohmann::json set = nlohmann::json::object();
+      for (const Override& o : overrides) set[o.key] = o.value;
+      entry["set"] = set;
+      const bool complete =
+          std::all_of(outputs.begin(), outputs.end(), file_exists) && (!stats || file_exists(*stats));
+      if (req_.resume && complete) {
+        entry["status"] = "skipped";
+        entry["reason"] = "--resume: every output exists";
+        log_.write(entry);
+        return "skipped";
+      }
+      Scene scene = load_scene_file(job.scene, overrides);
+      if (!warned) {
+        for (const std::string& w : scene.warnings) message_("algray: warning: job " + job.name + ": " + w + "\n");
+        warned = true;
+      }
+      if (job.orbit) {
+        apply_orbit(scene, *job.orbit, frame, job.frames);
+        entry["camera"] = {{"eye", {scene.camera.eye.x, scene.camera.eye.y, scene.camera.eye.z}},
+                           {"up", {scene.camera.up.x, scene.camera.up.y, scene.camera.up.z}},
+                           {"angle", orbit_angle(*job.orbit, frame, job.frames)}};
+      }
+      RenderOutputs render;
+      render.images = outputs;
+      render.stats_path = stats;
+      check_outputs(scene, render);
+      entry["stats"] = render_scene(scene, render, context_, {}, start);
+      entry["status"] = "ok";
+    } catch (const DeviceError& e) {
+      message_(std::string("algray: ") + e.what() + "\n");
+      entry["status"] = "failed";
+      entry["error"] = e.what();
+      log_.write(entry);
+      throw DeviceLost{e.what()};
+    } catch (const std::exception& e) {
+      const std::string why = describe_error(e).text;
+      message_("algray: job " + job.name + " frame " + std::to_string(frame) + " failed:\n" + why);
+      entry["status"] = "failed";
+      entry["error"] = why;
+    }
+    entry["ms"] = ms_since(start);
+    log_.write(entry);
+    return entry["status"].get<std::string>();
+  }
+
+ private:
+  const BatchRequest& req_;
+  RenderContext& context_;
+  JsonLinesLog& log_;
+  const std::function<void(const std::string&)>& message_;
+};
+
+}  // namespace
+
 BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks, RenderContext& context) {
-  const auto message = [&](const std::string& text) {
+  const std::function<void(const std::string&)> message = [&](const std::string& text) {
     if (callbacks.on_message) callbacks.on_message(text);
   };
-  const auto bad = [&](const std::exception& e) {
+  const auto refused = [&](const std::exception& e) {
     const ErrorReport report = describe_error(e);
     message(report.text);
     return report.bad_input ? BatchOutcome::BadInput : BatchOutcome::Stopped;
   };
-  std::vector<BatchJob> jobs;
-  std::string log_path;
+  BatchPlan plan;
+  std::optional<JsonLinesLog> log;
   try {
-    std::string text, base_dir;
-    if (req.jobs_path == "-") {
-      text = read_input_stream(std::cin, "<stdin>", "jobs file");
-    } else {
-      text = read_input_file(req.jobs_path, "jobs file");
-      base_dir = fs::path(req.jobs_path).parent_path().string();
-    }
-    jobs = load_jobs(text, req.jobs_path == "-" ? "<stdin>" : req.jobs_path, base_dir);
-    log_path = req.log_path ? *req.log_path
-               : req.jobs_path == "-"
-                   ? std::string("batch.log.jsonl")
-                   : (fs::path(base_dir) / (fs::path(req.jobs_path).stem().string() + ".log.jsonl")).string();
-    check_output_writable(log_path);
-    if (req.stats_path) check_output_writable(*req.stats_path);
-    // No file the batch writes may be one it reads, or another it writes, by any name.
-    std::vector<RoleAndPath> inputs{{"jobs file", req.jobs_path}}, outputs{{"--log", log_path}};
-    if (req.stats_path) outputs.push_back({"--stats", *req.stats_path});
-    for (const BatchJob& job : jobs) {
-      inputs.push_back({"scene of job " + job.name, job.scene});
-      for (int frame = 0; frame < job.frames; ++frame) {
-        const std::string who = "job " + job.name + " frame " + std::to_string(frame);
-        for (const std::string& o : job.outputs) outputs.push_back({who + " output", expand_pattern(o, job, frame)});
-        if (job.stats) outputs.push_back({who + " stats", expand_pattern(*job.stats, job, frame)});
-      }
-    }
-    check_distinct_files(inputs, outputs);
-    // Every frame's paths are checked now, as render checks its own, so that a bad one is bad input (exit 2)
-    // before anything renders rather than a failure of each frame.
-    for (const RoleAndPath& o : outputs) check_output_writable(o.path);
+    plan = plan_batch(req);
+    log.emplace(plan.log_path, req.resume);
   } catch (const std::exception& e) {
-    return bad(e);
+    return refused(e);
   }
 
-  int total = 0;
-  for (const BatchJob& j : jobs) total += j.frames;
-  std::optional<JsonLinesLog> opened;
-  try {
-    opened.emplace(log_path, req.resume);
-  } catch (const std::exception& e) {
-    return bad(e);
-  }
-  JsonLinesLog& log = *opened;
+  const int total = plan.total_frames;
   const auto batch_start = std::chrono::steady_clock::now();
-  const auto ms_since = [](std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-  };
   int done = 0, ok = 0, failed = 0, skipped = 0;
   nlohmann::json summary_jobs = nlohmann::json::array();
+  FrameRunner runner(req, context, *log, message);
   try {
-    for (const BatchJob& job : jobs) {
-      int job_ok = 0, job_failed = 0, job_skipped = 0;
-      std::vector<double> frame_ms;
+    for (const BatchJob& job : plan.jobs) {
+      JobTally tally;
       bool warned = false;
       for (int frame = 0; frame < job.frames; ++frame, ++done) {
-        const auto start = std::chrono::steady_clock::now();
-        nlohmann::json entry = {{"version", version_string()},
-                              {"job", job.name},
-                              {"frame", frame},
-                              {"frames", job.frames},
-                              {"scene", job.scene}};
-        std::vector<std::string> outputs;
-        try {
-          for (const std::string& o : job.outputs) outputs.push_back(expand_pattern(o, job, frame));
-          std::optional<std::string> stats;
-          if (job.stats) stats = expand_pattern(*job.stats, job, frame);
-          entry["outputs"] = outputs;
-          std::vector<Override> overrides = frame_overrides(job, frame);
-          overrides.insert(overrides.end(), req.overrides.begin(), req.overrides.end());
-          nlohmann::json set = nlohmann::json::object();
-          for (const Override& o : overrides) set[o.key] = o.value;
-          entry["set"] = set;
-          const bool complete =
-              std::all_of(outputs.begin(), outputs.end(), file_exists) && (!stats || file_exists(*stats));
-          if (req.resume && complete) {
-            entry["status"] = "skipped";
-            entry["reason"] = "--resume: every output exists";
-            log.write(entry);
-            ++skipped;
-            ++job_skipped;
-            continue;
-          }
-          Scene scene = load_scene_file(job.scene, overrides);
-          if (!warned) {
-            for (const std::string& w : scene.warnings) message("algray: warning: job " + job.name + ": " + w + "\n");
-            warned = true;
-          }
-          if (job.orbit) {
-            apply_orbit(scene, *job.orbit, frame, job.frames);
-            entry["camera"] = {{"eye", {scene.camera.eye.x, scene.camera.eye.y, scene.camera.eye.z}},
-                               {"up", {scene.camera.up.x, scene.camera.up.y, scene.camera.up.z}},
-                               {"angle", orbit_angle(*job.orbit, frame, job.frames)}};
-          }
-          RenderOutputs render;
-          render.images = outputs;
-          render.stats_path = stats;
-          check_outputs(scene, render);
-          entry["stats"] = render_scene(scene, render, context, {}, start);
-          entry["status"] = "ok";
-          ++ok;
-          ++job_ok;
-        } catch (const DeviceError& e) {
-          // No frame can run without the device: stop here rather than fail every remaining frame alike.
-          message(std::string("algray: ") + e.what() + "\n");
-          entry["status"] = "failed";
-          entry["error"] = e.what();
-          log.write(entry);
-          return BatchOutcome::BadInput;
-        } catch (const std::exception& e) {
-          const std::string why = describe_error(e).text;
-          message("algray: job " + job.name + " frame " + std::to_string(frame) + " failed:\n" + why);
-          entry["status"] = "failed";
-          entry["error"] = why;
-          ++failed;
-          ++job_failed;
+        nlohmann::json entry;
+        const std::string status = runner.run(job, frame, warned, entry);
+        if (status == "skipped") {
+          ++skipped;
+          ++tally.skipped;
+          continue;
         }
-        const double ms = ms_since(start);
-        frame_ms.push_back(ms);
-        entry["ms"] = ms;
-        log.write(entry);
+        if (status == "ok") {
+          ++ok;
+          ++tally.ok;
+        } else {
+          ++failed;
+          ++tally.failed;
+        }
+        const double ms = entry["ms"].get<double>();
+        tally.frame_ms.push_back(ms);
         if (callbacks.on_frame) {
           const double elapsed = ms_since(batch_start);
-          callbacks.on_frame({done + 1, total, &job, frame, entry["status"].get<std::string>(), ms, elapsed,
+          callbacks.on_frame({done + 1, total, &job, frame, status, ms, elapsed,
                               elapsed / (done + 1) * (total - done - 1)});
         }
       }
-      nlohmann::json j = {
-          {"name", job.name}, {"frames", job.frames}, {"ok", job_ok}, {"failed", job_failed}, {"skipped", job_skipped}};
-      if (!frame_ms.empty()) {
-        std::vector<double> sorted = frame_ms;
-        std::sort(sorted.begin(), sorted.end());
-        j["median_frame_ms"] = sorted[sorted.size() / 2];
-        double sum = 0;
-        for (double v : frame_ms) sum += v;
-        j["total_ms"] = sum;
-      }
-      summary_jobs.push_back(j);
+      summary_jobs.push_back(tally.json(job));
     }
+  } catch (const DeviceLost&) {
+    return BatchOutcome::BadInput;
   } catch (const JsonLinesLog::WriteFailed& e) {
     message(std::string("algray: ") + e.what() + "\nalgray: stopped after " + std::to_string(done) + " of " +
             std::to_string(total) + " frames (" + std::to_string(ok) + " rendered, " + std::to_string(failed) +
@@ -501,7 +554,7 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks,
   }
   const nlohmann::json summary = {{"version", version_string()},
                                   {"jobs_file", req.jobs_path},
-                                  {"log", log_path},
+                                  {"log", plan.log_path},
                                   {"frames", {{"total", total}, {"ok", ok}, {"failed", failed}, {"skipped", skipped}}},
                                   {"jobs", summary_jobs},
                                   {"total_ms", ms_since(batch_start)}};
@@ -515,8 +568,8 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks,
     }
   }
   if (failed)
-    message("algray: " + std::to_string(failed) + " of " + std::to_string(total) + " frames failed (see " + log_path +
-            ")\n");
+    message("algray: " + std::to_string(failed) + " of " + std::to_string(total) + " frames failed (see " +
+            plan.log_path + ")\n");
   return failed ? BatchOutcome::FramesFailed : BatchOutcome::Done;
 }
 
