@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "algray/io/image_io.h"
+#include "algray/render/solver_aov.h"
 #include "algray/scene/solver_options.h"
 #include "algray/util/version.h"
 #include "commands.h"
@@ -126,8 +127,7 @@ struct RenderCommand {
     cmd->add_flag(
         "--reference", request.outputs.reference,
         "solve every pixel exactly on the CPU (solver_ref, all cores, slow); adds a reference.class channel");
-    cmd->add_option("--aov", aov_text,
-                    "solver channels for EXR outputs, comma-separated: iterations, isolation, classification, flags");
+    cmd->add_option("--aov", aov_text, "solver channels for EXR outputs, comma-separated: " + aov_choices());
     cmd->add_option("--heatmap", request.outputs.heatmap_path,
                     "write a heat map of solver work per pixel (isolation steps + refinement iterations), .png");
   }

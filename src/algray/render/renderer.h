@@ -1,4 +1,4 @@
-// The render of a plan, tile by tile through every pass into a film, and the records tests and tools may keep.
+// The render of a plan: tile by tile through every pass into the film, with progress and cancellation callbacks.
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,4 @@
-// Turning hit records into colours: Phong lighting with the shadow pass's answers, or a headlight without lights.
+// Shading: hit records into colours (Phong with the shadow pass's answers, or a headlight), resolved into the film.
 #pragma once
 
 #include <cstddef>

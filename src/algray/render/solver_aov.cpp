@@ -6,28 +6,29 @@
 
 namespace algray {
 
+std::string aov_choices(const char* last) {
+  std::string out;
+  for (std::size_t i = 0; i < kSolverAovs.size(); ++i) {
+    if (i > 0) out += last && i + 1 == kSolverAovs.size() ? std::string(" ") + last + " " : std::string(", ");
+    out += kSolverAovs[i].word;
+  }
+  return out;
+}
+
 bool parse_aov_list(const std::string& text, std::vector<SolverAov>& out, std::string& error) {
   std::istringstream in(text);
   std::string word;
   while (std::getline(in, word, ',')) {
-    SolverAov aov;
-    if (word == "iterations")
-      aov = SolverAov::Iterations;
-    else if (word == "isolation")
-      aov = SolverAov::Isolation;
-    else if (word == "classification")
-      aov = SolverAov::Classification;
-    else if (word == "flags")
-      aov = SolverAov::Flags;
-    else {
-      error =
-          "unknown AOV '" + word + "': expected a comma-separated list of iterations, isolation, classification, flags";
+    const auto known = std::find_if(kSolverAovs.begin(), kSolverAovs.end(),
+                                    [&](const SolverAovName& n) { return word == n.word; });
+    if (known == kSolverAovs.end()) {
+      error = "unknown AOV '" + word + "': expected a comma-separated list of " + aov_choices();
       return false;
     }
-    if (std::find(out.begin(), out.end(), aov) == out.end()) out.push_back(aov);
+    if (std::find(out.begin(), out.end(), known->aov) == out.end()) out.push_back(known->aov);
   }
   if (out.empty()) {
-    error = "empty AOV list: expected iterations, isolation, classification or flags";
+    error = "empty AOV list: expected " + aov_choices("or");
     return false;
   }
   return true;
@@ -96,20 +97,15 @@ SolverWork solver_work(const RenderResult& result) {
 
 void add_solver_aovs(FrameImage& image, SolverWork&& work, const std::vector<SolverAov>& aovs) {
   for (SolverAov aov : aovs) {
+    std::vector<std::uint32_t>* values = nullptr;
     switch (aov) {
-      case SolverAov::Iterations:
-        image.uint_channels.push_back({"solver.refineIterations", std::move(work.refine_iterations)});
-        break;
-      case SolverAov::Isolation:
-        image.uint_channels.push_back({"solver.isolationSteps", std::move(work.isolation_steps)});
-        break;
-      case SolverAov::Classification:
-        image.uint_channels.push_back({"solver.class", std::move(work.classification)});
-        break;
-      case SolverAov::Flags:
-        image.uint_channels.push_back({"solver.flags", std::move(work.flags)});
-        break;
+      case SolverAov::Iterations: values = &work.refine_iterations; break;
+      case SolverAov::Isolation: values = &work.isolation_steps; break;
+      case SolverAov::Classification: values = &work.classification; break;
+      case SolverAov::Flags: values = &work.flags; break;
     }
+    for (const SolverAovName& n : kSolverAovs)
+      if (n.aov == aov) image.uint_channels.push_back({n.channel, std::move(*values)});
   }
   work = SolverWork{};
 }

@@ -1,6 +1,7 @@
 // Per-pixel solver diagnostics of a render: the EXR channels `--aov` asks for and the work `--heatmap` draws.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -11,6 +12,20 @@
 namespace algray {
 
 enum class SolverAov { Iterations, Isolation, Classification, Flags };
+
+// Each solver channel: the word --aov takes and the EXR channel it adds. Adding one here (and filling it in
+// add_solver_aovs) makes --aov, its help text and its errors offer it.
+struct SolverAovName {
+  SolverAov aov;
+  const char* word;
+  const char* channel;
+};
+inline constexpr std::array<SolverAovName, 4> kSolverAovs{{{SolverAov::Iterations, "iterations", "solver.refineIterations"},
+                                                          {SolverAov::Isolation, "isolation", "solver.isolationSteps"},
+                                                          {SolverAov::Classification, "classification", "solver.class"},
+                                                          {SolverAov::Flags, "flags", "solver.flags"}}};
+// "iterations, isolation, classification, flags", or with `last` "... classification or flags".
+std::string aov_choices(const char* last = nullptr);
 
 // "iterations,isolation,classification,flags" (any subset, any order) into the list; false with a message
 // naming the accepted words on anything else.
