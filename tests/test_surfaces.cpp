@@ -117,7 +117,7 @@ TEST_CASE("shadows and bounces see every surface", "[surfaces]") {
   const RenderResult bounced = renderer.render(mirrors, false);
   int ball_in_ring = 0, rays = 0;
   for (const SecondaryBatch& batch : bounced.secondary) {
-    REQUIRE(batch.pass == "reflection");
+    REQUIRE(batch.pass == PassKind::Reflection);
     rays += static_cast<int>(batch.rays.size());
     for (std::size_t i = 0; i < batch.hits.size(); ++i)
       ball_in_ring += (batch.hits[i].flags & ALGRAY_HIT_FOUND) && !batch.hit_surface.empty() && batch.hit_surface[i] == 0;
