@@ -57,8 +57,10 @@ void keep_nearest(HitRecord* best, std::size_t count, std::vector<std::uint8_t>&
   for (std::size_t i = 0; i < count; ++i) {
     const HitRecord& o = other[i];
     HitRecord& b = best[i];
-    const std::uint32_t steps = std::min(0xffffu, (b.work & 0xffffu) + (o.work & 0xffffu));
-    const std::uint32_t iterations = std::min(0xffffu, (b.work >> 16) + (o.work >> 16));
+    const std::uint32_t steps =
+        std::min(ALGRAY_WORK_MAX, ALGRAY_WORK_ISOLATION_STEPS(b.work) + ALGRAY_WORK_ISOLATION_STEPS(o.work));
+    const std::uint32_t iterations =
+        std::min(ALGRAY_WORK_MAX, ALGRAY_WORK_REFINE_ITERATIONS(b.work) + ALGRAY_WORK_REFINE_ITERATIONS(o.work));
     const std::uint32_t shared_flags = (b.flags | o.flags) & (ALGRAY_HIT_BUDGET | ALGRAY_HIT_IN_EXTENT);
     const double tb = static_cast<double>(b.t_hi) + static_cast<double>(b.t_lo);
     const double to = static_cast<double>(o.t_hi) + static_cast<double>(o.t_lo);
@@ -66,7 +68,7 @@ void keep_nearest(HitRecord* best, std::size_t count, std::vector<std::uint8_t>&
       b = o;
       best_surface[i] = index;
     }
-    b.work = steps | iterations << 16;
+    b.work = ALGRAY_WORK_PACK(steps, iterations);
     b.flags |= shared_flags;
   }
 }
