@@ -290,7 +290,7 @@ json bench_fig2(ClSession& session, bool quick, const fs::path& scenes, const fs
         const Timed t = timed_render(renderer, scene, runs);
         const double wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         long iterations = 0;
-        for (const HitRecord& h : t.result.hits.records) iterations += h.work >> 16;
+        for (const HitRecord& h : t.result.hits.records) iterations += ALGRAY_WORK_REFINE_ITERATIONS(h.work);
         rows.push_back({{"surface", name},
                         {"setup", setup.name},
                         {"refinement", to_string(r)},
@@ -341,7 +341,7 @@ json bench_decic(ClSession& session, bool quick, const fs::path& scenes, const f
       std::vector<bool> defect(t.result.hits.records.size(), false);
       for (std::size_t i = 0; i < defect.size(); ++i) {
         const HitRecord& h = t.result.hits.records[i];
-        capped += static_cast<int>(h.work >> 16) >= 1000;
+        capped += static_cast<int>(ALGRAY_WORK_REFINE_ITERATIONS(h.work)) >= 1000;
         const auto cls = static_cast<PixelClass>(reference.classes[i]);
         if (cls != PixelClass::Miss && cls != PixelClass::SimpleRoot) continue;
         const bool hit = (h.flags & ALGRAY_HIT_FOUND) != 0;

@@ -51,8 +51,16 @@ typedef struct {
   algray_f32 normal_y;
   algray_f32 normal_z;
   algray_u32 flags;     /* ALGRAY_HIT_* bits */
-  algray_u32 work;      /* isolation steps in the low 16 bits, refinement iterations in the high 16 bits */
+  algray_u32 work;      /* isolation steps and refinement iterations: ALGRAY_WORK_PACK */
 } HitRecord;
+
+/* HitRecord.work: isolation steps in the low 16 bits, refinement iterations in the high 16. The kernels pack it
+ * and the host reads it only through these, so the layout is written down here alone. A count saturates at
+ * ALGRAY_WORK_MAX rather than spill into the other. */
+#define ALGRAY_WORK_MAX 0xffffu
+#define ALGRAY_WORK_PACK(steps, iterations) ((steps) | ((iterations) << 16)) /* each at most ALGRAY_WORK_MAX */
+#define ALGRAY_WORK_ISOLATION_STEPS(work) ((work) & ALGRAY_WORK_MAX)
+#define ALGRAY_WORK_REFINE_ITERATIONS(work) ((work) >> 16)
 
 /* The probe: kernels/probe.cl records what the solver did on one ray as a list of events, each with four REAL
  * values in a separate buffer (values[4 i .. 4 i + 3] belong to event i). */

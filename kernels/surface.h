@@ -364,7 +364,7 @@ void surface_gradient_lanes(LREAL x, LREAL y, LREAL z, __global const uint* exps
 HitRecord hit_record_with_gradient(Ray ray, SurfaceHit h, REAL3 g) {
   HitRecord r;
   r.flags = h.root.flags;
-  r.work = min(h.root.steps, 0xffffu) | (min(h.root.iterations, 0xffffu) << 16);
+  r.work = ALGRAY_WORK_PACK(min(h.root.steps, ALGRAY_WORK_MAX), min(h.root.iterations, ALGRAY_WORK_MAX));
   r.t_hi = INFINITY;
   r.t_lo = 0;
   r.depth = INFINITY;

@@ -34,6 +34,6 @@ __kernel void univariate(__global const REAL* polys, uint count, __constant cons
   r.depth = r.t_hi;
   r.normal_x = r.normal_y = r.normal_z = 0;
   r.flags = sr.flags;
-  r.work = min(sr.steps, 0xffffu) | (min(sr.iterations, 0xffffu) << 16);
+  r.work = ALGRAY_WORK_PACK(min(sr.steps, ALGRAY_WORK_MAX), min(sr.iterations, ALGRAY_WORK_MAX));
   out[i] = r;
 }

@@ -59,11 +59,11 @@ TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") 
     const Case& c = cases[index];
     const unsigned seed = 2000u + static_cast<unsigned>(c.degree);
     const RenderResult one = renderer.render_with_records(lanes_scene(c.degree, seed, c.precision, 1, c.origin));
-    REQUIRE(one.plan.find("primary")->kernels.at(0).lanes == 1);
+    REQUIRE(one.plan.find(PassKind::Primary)->kernels.at(0).lanes == 1);
     for (const HitRecord& h : one.hits.records) hits += (h.flags & ALGRAY_HIT_FOUND) != 0;
     for (int lanes : c.lanes) {
       const RenderResult many = renderer.render_with_records(lanes_scene(c.degree, seed, c.precision, lanes, c.origin));
-      REQUIRE(many.plan.find("primary")->kernels.at(0).lanes == lanes);
+      REQUIRE(many.plan.find(PassKind::Primary)->kernels.at(0).lanes == lanes);
       const long at = first_difference(one.hits.records, many.hits.records);
       INFO("case " << index << ": degree " << c.degree << ", seed " << seed << ", " << to_string(c.precision) << ", "
                    << c.origin << ", " << lanes << " lanes: first differing record " << at << " of "
@@ -97,7 +97,7 @@ TEST_CASE("lanes give the one-ray kernel's hit records where groups settle witho
             load_scene_text(text, "plane", {{"render.precision", quoted_precision}, {"render.lanes", std::to_string(lanes)}}));
       };
       const RenderResult one = render(1), many = render(8);
-      REQUIRE(many.plan.find("primary")->kernels.at(0).lanes == 8);
+      REQUIRE(many.plan.find(PassKind::Primary)->kernels.at(0).lanes == 8);
       std::size_t found = 0;
       for (const HitRecord& h : one.hits.records) found += (h.flags & ALGRAY_HIT_FOUND) != 0;
       const long at = first_difference(one.hits.records, many.hits.records);
@@ -114,16 +114,16 @@ TEST_CASE("the plan gives lanes to the primary kernel alone, where they apply", 
   const Scene full = load_scene_text(text + "[[light]]\nposition = [3, 3, 3]\n", "random",
                                      {{"render.preview", "false"}, {"material.front.reflectivity", "0.5"}});
   const RenderPlan plan = make_render_plan(full, Precision::Double, 0, 8);
-  CHECK(plan.find("primary")->kernels.at(0).lanes == 8);
-  CHECK(plan.find("primary")->kernels.at(0).key().find(" lanes=8") != std::string::npos);
+  CHECK(plan.find(PassKind::Primary)->kernels.at(0).lanes == 8);
+  CHECK(plan.find(PassKind::Primary)->kernels.at(0).key().find(" lanes=8") != std::string::npos);
   for (const PlannedPass& pass : plan.passes)
-    if (pass.name != "primary")
+    if (pass.kind != PassKind::Primary)
       for (const KernelConfig& k : pass.kernels) CHECK(k.lanes == 1);
   // A refinement without a lane version keeps one ray per work-item; the scene's setting overrides the device's.
   const Scene bisection = load_scene_text(text, "random", {{"render.refinement", "\"bisection\""}});
-  CHECK(make_render_plan(bisection, Precision::Double, 0, 8).find("primary")->kernels.at(0).lanes == 1);
+  CHECK(make_render_plan(bisection, Precision::Double, 0, 8).find(PassKind::Primary)->kernels.at(0).lanes == 1);
   const Scene four = load_scene_text(text, "random", {{"render.lanes", "4"}});
-  CHECK(make_render_plan(four, Precision::Double, 0, 8).find("primary")->kernels.at(0).lanes == 4);
+  CHECK(make_render_plan(four, Precision::Double, 0, 8).find(PassKind::Primary)->kernels.at(0).lanes == 4);
   CHECK_THROWS_WITH(load_scene_text(text, "random", {{"render.lanes", "3"}}),
                     Catch::Contains("render.lanes must be 1, 2, 4, 8 or 16"));
   CHECK_THROWS_WITH(load_scene_text(text, "random", {{"render.lanes", "8"}, {"render.isolation", "\"sturm\""}}),

@@ -83,20 +83,21 @@ TEST_CASE("the screen form meets the double line on seeded random surfaces of ev
 TEST_CASE("auto builds camera rays in the screen form in double only, and never the other kernels", "[reference]") {
   const Scene base = load_scene_text(random_scene(6, 1006, Precision::Double), "random");
   const RenderPlan plan = make_render_plan(base, Precision::Double);
-  CHECK(plan.find("primary")->kernels.at(0).ray_origin == RayOrigin::Screen);
+  CHECK(plan.find(PassKind::Primary)->kernels.at(0).ray_origin == RayOrigin::Screen);
   for (Precision p : {Precision::Float, Precision::Mixed})
-    CHECK(make_render_plan(base, p).find("primary")->kernels.at(0).ray_origin == RayOrigin::Extent);
+    CHECK(make_render_plan(base, p).find(PassKind::Primary)->kernels.at(0).ray_origin == RayOrigin::Extent);
   // The eye inside the extent: expansion points would lie on both sides of it, far from some rays' segments.
   const Scene inside =
       load_scene_text(random_scene(6, 1006, Precision::Double), "random", {{"camera.eye", "[0.2, 0.1, 0.5]"}});
-  CHECK(make_render_plan(inside, Precision::Double).find("primary")->kernels.at(0).ray_origin == RayOrigin::Extent);
+  CHECK(make_render_plan(inside, Precision::Double).find(PassKind::Primary)->kernels.at(0).ray_origin ==
+        RayOrigin::Extent);
   const Scene full = load_scene_text(random_scene(6, 1006, Precision::Double) +
                                          "[[light]]\nposition = [3, 3, 3]\n[antialias]\nsamples = 2\nadaptive = true\n",
                                      "random", {{"render.preview", "false"}});
   const RenderPlan full_plan = make_render_plan(full, Precision::Double);
   REQUIRE(full_plan.passes.size() == 3);  // primary, shadow, antialias
   for (const PlannedPass& pass : full_plan.passes)
-    CHECK(pass.kernels.at(0).ray_origin == (pass.name == "primary" ? RayOrigin::Screen : RayOrigin::Extent));
+    CHECK(pass.kernels.at(0).ray_origin == (pass.kind == PassKind::Primary ? RayOrigin::Screen : RayOrigin::Extent));
 }
 
 TEST_CASE("every scene agrees with the certified reference within issue 3's thresholds", "[reference]") {

@@ -44,8 +44,7 @@ struct Sphere {
 };
 
 // Every ray of every secondary batch against the closed form: hit or miss, and t to 1e-7 of the ray's length.
-void check_batches(const RenderResult& r, const std::vector<Sphere>& spheres, const std::string& pass,
-                   std::size_t& checked) {
+void check_batches(const RenderResult& r, const std::vector<Sphere>& spheres, PassKind pass, std::size_t& checked) {
   for (const SecondaryBatch& batch : r.secondary) {
     if (batch.pass != pass) continue;
     for (std::size_t i = 0; i < batch.rays.size(); ++i) {
@@ -54,8 +53,8 @@ void check_batches(const RenderResult& r, const std::vector<Sphere>& spheres, co
       const HitRecord& h = batch.hits[i];
       const bool hit = (h.flags & ALGRAY_HIT_FOUND) != 0;
       const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
-      INFO(pass << " depth " << batch.depth << " ray " << i << ": expected t " << expected << ", kernel "
-                << (hit ? std::to_string(t) : std::string("miss")));
+      INFO(to_string(pass) << " depth " << batch.depth << " ray " << i << ": expected t " << expected << ", kernel "
+                           << (hit ? std::to_string(t) : std::string("miss")));
       // A ray grazing a sphere may go either way; elsewhere the answer is certain.
       const bool grazing = std::isfinite(expected) && std::fabs(t - expected) > 1e-3 && !hit;
       if (grazing) continue;
@@ -68,7 +67,7 @@ void check_batches(const RenderResult& r, const std::vector<Sphere>& spheres, co
       for (const Sphere& s : spheres)
         if (std::fabs(glm::length(batch.rays[i].origin - s.centre) - s.radius) < 1e-4) from = &s;
       REQUIRE(from != nullptr);
-      if (pass == "reflection") {
+      if (pass == PassKind::Reflection) {
         const glm::dvec3 outward = batch.rays[i].origin - from->centre;
         CHECK(glm::dot(outward, batch.rays[i].direction) >= 0);
       }
@@ -89,7 +88,7 @@ TEST_CASE("transmission rays continue to the next root: nested spheres", "[secon
                                     "[render]", "precision = \"double\""});
   const RenderResult r = renderer.render_with_records(scene);
   std::size_t checked = 0;
-  check_batches(r, {{{0, 0, 0}, 1}, {{0, 0, 0}, 2}}, "transmission", checked);
+  check_batches(r, {{{0, 0, 0}, 1}, {{0, 0, 0}, 2}}, PassKind::Transmission, checked);
   int deepest = 0;
   for (const SecondaryBatch& b : r.secondary) deepest = std::max(deepest, b.depth);
   CHECK(deepest >= 3);  // through the outer sphere, the inner one, and out again
@@ -104,7 +103,7 @@ TEST_CASE("reflection rays leave by the mirror direction and find the other sphe
                                    {"[material.front]", "reflectivity = 0.5", "[render]", "precision = \"double\""});
   const RenderResult r = renderer.render_with_records(scene);
   std::size_t checked = 0, hits = 0;
-  check_batches(r, {{{1.3, 0, 0}, 1}, {{-1.3, 0, 0}, 1}}, "reflection", checked);
+  check_batches(r, {{{1.3, 0, 0}, 1}, {{-1.3, 0, 0}, 1}}, PassKind::Reflection, checked);
   for (const SecondaryBatch& b : r.secondary)
     for (const HitRecord& h : b.hits) hits += (h.flags & ALGRAY_HIT_FOUND) != 0;
   CHECK(checked > 1000);
@@ -121,7 +120,7 @@ TEST_CASE("a transparent side without a transmission pass shows opaque, not dark
     Scene opaque = clear;
     opaque.surfaces[0].materials.front.transparency = 0;
     const RenderResult r = renderer.render_with_records(clear);
-    CHECK(r.plan.find("transmission") == nullptr);
+    CHECK(r.plan.find(PassKind::Transmission) == nullptr);
     const FrameImage a = shade_frame(clear, r), b = shade_frame(opaque, renderer.render_with_records(opaque));
     const std::size_t centre = 4 * (static_cast<std::size_t>(a.height / 2) * a.width + a.width / 2);
     CHECK(a.rgba[centre] > 0.1f);

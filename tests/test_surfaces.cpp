@@ -56,8 +56,9 @@ TEST_CASE("a scene's surfaces each get their own kernel, and the nearest hit win
   CHECK(both.passes[0].rays == both.hits.records.size());
   std::uint64_t work_both = 0, work_apart = 0;
   for (std::size_t i = 0; i < both.hits.records.size(); ++i) {
-    work_both += both.hits.records[i].work & 0xffffu;
-    work_apart += (ball.hits.records[i].work & 0xffffu) + (ring.hits.records[i].work & 0xffffu);
+    work_both += ALGRAY_WORK_ISOLATION_STEPS(both.hits.records[i].work);
+    work_apart +=
+        ALGRAY_WORK_ISOLATION_STEPS(ball.hits.records[i].work) + ALGRAY_WORK_ISOLATION_STEPS(ring.hits.records[i].work);
   }
   CHECK(work_both == work_apart);
 
@@ -117,7 +118,7 @@ TEST_CASE("shadows and bounces see every surface", "[surfaces]") {
   const RenderResult bounced = renderer.render_with_records(mirrors);
   int ball_in_ring = 0, rays = 0;
   for (const SecondaryBatch& batch : bounced.secondary) {
-    REQUIRE(batch.pass == "reflection");
+    REQUIRE(batch.pass == PassKind::Reflection);
     rays += static_cast<int>(batch.rays.size());
     for (std::size_t i = 0; i < batch.hits.size(); ++i)
       ball_in_ring += (batch.hits[i].flags & ALGRAY_HIT_FOUND) && !batch.hit_surface.empty() && batch.hit_surface[i] == 0;

@@ -215,8 +215,8 @@ void check_solver(const KernelConfig& solver, int max_degree) {
         INFO(name << " " << to_string(solver.isolation) << "/" << to_string(solver.refinement) << " degree " << degree
                   << " seed " << kSeed + degree << " case " << c << " (" << kKinds[c % 6] << "): reference "
                   << ref::to_string(a.kind) << " at " << a.t_nearest << " multiplicity " << a.multiplicity
-                  << ", kernel " << (hit ? "hit at " : "miss") << (hit ? t : 0.0) << " after " << (h.work >> 16)
-                  << " refinement iterations");
+                  << ", kernel " << (hit ? "hit at " : "miss") << (hit ? t : 0.0) << " after "
+                  << ALGRAY_WORK_REFINE_ITERATIONS(h.work) << " refinement iterations");
         if (a.kind == ref::Classification::Miss) {
           // Never a root where the reference certifies none, unless P is within the coefficients' rounding noise
           // of zero there: a double root that rounding turned into a close complex pair is numerically a root.
@@ -243,8 +243,8 @@ void check_solver(const KernelConfig& solver, int max_degree) {
               testing::kStopWidthFactor * 4 * config.tolerance + testing::kNoiseFactor * refine_noise / slope;
           // Plain regula falsi may keep one end for good and run out of iterations far from the root: the
           // paper's own finding. Such cases are counted; every other inaccurate root is a failure.
-          const bool capped =
-              solver.refinement == Refinement::RegulaFalsi && static_cast<int>(h.work >> 16) >= config.max_iterations;
+          const bool capped = solver.refinement == Refinement::RegulaFalsi &&
+                              static_cast<int>(ALGRAY_WORK_REFINE_ITERATIONS(h.work)) >= config.max_iterations;
           if (capped && std::fabs(t - a.t_nearest) > allowed) {
             ++stuck_at_cap;
             continue;

@@ -64,8 +64,8 @@ struct SolverTrace {
   std::uint32_t events_offered = 0, events_recorded = 0;  // the log overflowed if they differ
 
   bool found() const { return (hit.flags & ALGRAY_HIT_FOUND) != 0; }
-  std::uint32_t isolation_steps() const { return hit.work & 0xffffu; }
-  std::uint32_t refine_iterations() const { return hit.work >> 16; }
+  std::uint32_t isolation_steps() const { return ALGRAY_WORK_ISOLATION_STEPS(hit.work); }
+  std::uint32_t refine_iterations() const { return ALGRAY_WORK_REFINE_ITERATIONS(hit.work); }
   // A fraction of [t_in, t_out] as a ray parameter, as the kernel maps it.
   double t_at(double fraction) const { return t_in + fraction * (t_out - t_in); }
 };

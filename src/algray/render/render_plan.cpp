@@ -37,9 +37,25 @@ KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t
 
 double shadow_offset_unit(Precision precision) { return precision == Precision::Double ? 1e-6 : 1e-3; }
 
-const PlannedPass* RenderPlan::find(const std::string& name) const {
+std::string to_string(PassKind kind) {
+  switch (kind) {
+    case PassKind::Primary:
+      return "primary";
+    case PassKind::Shadow:
+      return "shadow";
+    case PassKind::Reflection:
+      return "reflection";
+    case PassKind::Transmission:
+      return "transmission";
+    case PassKind::Antialias:
+      return "antialias";
+  }
+  return "?";
+}
+
+const PlannedPass* RenderPlan::find(PassKind kind) const {
   for (const PlannedPass& p : passes)
-    if (p.name == name) return &p;
+    if (p.kind == kind) return &p;
   return nullptr;
 }
 
@@ -75,9 +91,10 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
     }
     return configs;
   };
-  plan.passes.push_back({"primary", plan.samples > 1 ? "camera rays, " + std::to_string(plan.samples) + "x" +
-                                                           std::to_string(plan.samples) + " per pixel"
-                                                     : "camera rays, one per pixel",
+  plan.passes.push_back({PassKind::Primary,
+                         plan.samples > 1 ? "camera rays, " + std::to_string(plan.samples) + "x" +
+                                                std::to_string(plan.samples) + " per pixel"
+                                          : "camera rays, one per pixel",
                          primary});
   plan.buffers.push_back({"primary hits", rays * sizeof(HitRecord)});
 
@@ -100,7 +117,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
     }
     std::size_t points = 0;
     for (int i : plan.shadow_lights) points += scene.lights[static_cast<std::size_t>(i)].sample_points().size();
-    plan.passes.push_back({"shadow",
+    plan.passes.push_back({PassKind::Shadow,
                            std::to_string(plan.shadow_lights.size()) + " shadow-casting light(s), " +
                                std::to_string(points) + " sample point(s) per lit surface point",
                            shadow});
@@ -119,15 +136,15 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
     transparent |= s.materials.front.transparency > 0 || s.materials.back.transparency > 0;
   }
   const struct {
-    const char* name;
+    PassKind kind;
     bool wanted;
     const char* why;
   } effects[] = {
-      {"reflection", reflective, "mirror rays of reflective sides"},
-      {"transmission", transparent, "rays continued through transparent sides to the next root"},
+      {PassKind::Reflection, reflective, "mirror rays of reflective sides"},
+      {PassKind::Transmission, transparent, "rays continued through transparent sides to the next root"},
   };
   for (const auto& effect : effects) {
-    const std::string name = effect.name;
+    const std::string name = to_string(effect.kind);
     if (!effect.wanted)
       plan.skipped.push_back(name + ": no material asks for it");
     else if (scene.render.preview)
@@ -136,7 +153,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
       plan.skipped.push_back(name + ": render.max_depth is 0");
     else {
       plan.passes.push_back(
-          {name, std::string(effect.why) + ", up to depth " + std::to_string(scene.render.max_depth), trace});
+          {effect.kind, std::string(effect.why) + ", up to depth " + std::to_string(scene.render.max_depth), trace});
       // Each bounce can double a tile's rays; they are traced in batches of at most kBatchRays.
       const std::size_t batch = rays << std::min(scene.render.max_depth - 1, 8) < kBatchRays
                                     ? rays << std::min(scene.render.max_depth - 1, 8)
@@ -147,8 +164,8 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
   }
   if (adaptive) {
     const std::string n = std::to_string(plan.refine_samples);
-    plan.passes.push_back({"antialias", n + "x" + n + " camera rays in pixels whose colour differs from a neighbour's",
-                           trace});
+    plan.passes.push_back(
+        {PassKind::Antialias, n + "x" + n + " camera rays in pixels whose colour differs from a neighbour's", trace});
     const std::size_t batch =
         std::min(rays * static_cast<std::size_t>(plan.refine_samples * plan.refine_samples), kBatchRays);
     plan.buffers.push_back({"antialias rays (per batch)", batch * 8 * real_size});
@@ -164,8 +181,8 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
   // per ray of the batch in flight (rays, hits, weights, staging, the rays waiting for the next bounce), about
   // 100 bytes for shadow rays alone and 600 with bounces.
   const bool several = scene.surfaces.size() > 1;
-  const bool shadows = plan.find("shadow") != nullptr;
-  const bool bounces = plan.find("reflection") || plan.find("transmission");
+  const bool shadows = plan.find(PassKind::Shadow) != nullptr;
+  const bool bounces = plan.find(PassKind::Reflection) || plan.find(PassKind::Transmission);
   std::uint64_t per_ray = sizeof(HitRecord) * (several ? 2 : 1) + (several ? 1 : 0);
   if (shadows) per_ray += 8 + 8 * plan.shadow_lights.size();
   if (bounces) per_ray += 3 * sizeof(double);
@@ -190,7 +207,7 @@ nlohmann::json RenderPlan::json() const {
   for (const PlannedPass& p : passes) {
     nlohmann::json kernels = nlohmann::json::array();
     for (const KernelConfig& k : p.kernels) kernels.push_back(k.key());
-    j["passes"].push_back({{"name", p.name}, {"purpose", p.purpose}, {"kernels", kernels}});
+    j["passes"].push_back({{"name", to_string(p.kind)}, {"purpose", p.purpose}, {"kernels", kernels}});
   }
   for (const PlannedBuffer& b : buffers) j["buffers"].push_back({{"name", b.name}, {"bytes", b.bytes}});
   j["shadow_lights"] = shadow_lights;

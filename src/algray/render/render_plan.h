@@ -14,9 +14,17 @@
 
 namespace algray {
 
+// The passes a plan can hold, in the order a plan lists them. The renderer and the shader tell passes apart by
+// kind; the names are only for --stats and messages.
+enum class PassKind { Primary, Shadow, Reflection, Transmission, Antialias };
+
+// The pass's name as --stats and the plan's JSON write it: "primary", "shadow", "reflection", "transmission",
+// "antialias".
+std::string to_string(PassKind kind);
+
 // One pass: the rays it traces and the kernel it launches. Nothing outside the plan is built or launched.
 struct PlannedPass {
-  std::string name;     // "primary", "shadow", "reflection", "transmission", "antialias"
+  PassKind kind = PassKind::Primary;
   std::string purpose;  // why the scene needs it, for --stats
   std::vector<KernelConfig> kernels;  // one per surface of the scene, in scene order
 };
@@ -58,7 +66,7 @@ struct RenderPlan {
   // Everything left out, and why ("shadow: no light casts shadows"), so --stats explains the plan.
   std::vector<std::string> skipped;
 
-  const PlannedPass* find(const std::string& name) const;
+  const PlannedPass* find(PassKind kind) const;  // nullptr when the plan has no such pass
   nlohmann::json json() const;
 
   std::uint64_t tile_host_bytes = 0;  // the host's share of one tile's work (hits, shadow answers, a batch)

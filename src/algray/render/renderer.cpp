@@ -57,8 +57,10 @@ void keep_nearest(HitRecord* best, std::size_t count, std::vector<std::uint8_t>&
   for (std::size_t i = 0; i < count; ++i) {
     const HitRecord& o = other[i];
     HitRecord& b = best[i];
-    const std::uint32_t steps = std::min(0xffffu, (b.work & 0xffffu) + (o.work & 0xffffu));
-    const std::uint32_t iterations = std::min(0xffffu, (b.work >> 16) + (o.work >> 16));
+    const std::uint32_t steps =
+        std::min(ALGRAY_WORK_MAX, ALGRAY_WORK_ISOLATION_STEPS(b.work) + ALGRAY_WORK_ISOLATION_STEPS(o.work));
+    const std::uint32_t iterations =
+        std::min(ALGRAY_WORK_MAX, ALGRAY_WORK_REFINE_ITERATIONS(b.work) + ALGRAY_WORK_REFINE_ITERATIONS(o.work));
     const std::uint32_t shared_flags = (b.flags | o.flags) & (ALGRAY_HIT_BUDGET | ALGRAY_HIT_IN_EXTENT);
     const double tb = static_cast<double>(b.t_hi) + static_cast<double>(b.t_lo);
     const double to = static_cast<double>(o.t_hi) + static_cast<double>(o.t_lo);
@@ -66,7 +68,7 @@ void keep_nearest(HitRecord* best, std::size_t count, std::vector<std::uint8_t>&
       b = o;
       best_surface[i] = index;
     }
-    b.work = steps | iterations << 16;
+    b.work = ALGRAY_WORK_PACK(steps, iterations);
     b.flags |= shared_flags;
   }
 }
@@ -220,9 +222,9 @@ struct Renderer::Passes {
 
   int tiles_done = 0, tiles_total = 0;
 
-  PassStats* stats_of(const std::string& name) {
+  PassStats* stats_of(PassKind kind) {
     for (std::size_t i = 0; i < stats.size(); ++i)
-      if (result.plan.passes[i].name == name) return &stats[i];
+      if (result.plan.passes[i].kind == kind) return &stats[i];
     return nullptr;
   }
   bool single() const { return precision != Precision::Double; }
@@ -245,7 +247,7 @@ namespace {
 template <typename Passes, typename RayOf>
 ShadowData trace_shadows(Passes& p, const HitRecord* hits, std::size_t count, RayOf ray) {
   const auto start = std::chrono::steady_clock::now();
-  PassStats& stats = *p.stats_of("shadow");
+  PassStats& stats = *p.stats_of(PassKind::Shadow);
   ShadowData data;
   for (std::size_t i = 0; i < count; ++i)
     if (hits[i].flags & ALGRAY_HIT_FOUND) data.points.push_back(static_cast<std::uint32_t>(i));
@@ -375,7 +377,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   }
 
   for (std::size_t i = 0; i < passes.stats.size(); ++i) {
-    passes.stats[i].name = plan.passes[i].name;
+    passes.stats[i].name = to_string(plan.passes[i].kind);
     result.passes.push_back(passes.stats[i]);
   }
   return result;
@@ -385,7 +387,7 @@ void Renderer::prepare_passes(Passes& passes) {
   const Scene& scene = passes.scene;
   RenderResult& result = passes.result;
   const RenderPlan& plan = result.plan;
-  PassStats& primary = *passes.stats_of("primary");
+  PassStats& primary = *passes.stats_of(PassKind::Primary);
   // The largest tile: a tile's hit records are all the device holds for the camera rays. Their memory (32 MB
   // at 1024^2) is populated on another thread while this one loads the programs, a core's work either way.
   const std::size_t tile_rays = static_cast<std::size_t>(std::min(plan.tile_pixels(), plan.width)) * plan.samples *
@@ -394,9 +396,9 @@ void Renderer::prepare_passes(Passes& passes) {
       std::async(std::launch::async, [tile_rays] { return PopulatedPages(tile_rays * sizeof(HitRecord)); });
   for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
     ProgramRecord record;
-    passes.primary.push_back(cache_.kernel(session_, plan.find("primary")->kernels[s], &record));
+    passes.primary.push_back(cache_.kernel(session_, plan.find(PassKind::Primary)->kernels[s], &record));
     passes.primary_tile_arg.push_back(0);
-    passes.primary_lanes.push_back(plan.find("primary")->kernels[s].lanes);
+    passes.primary_lanes.push_back(plan.find(PassKind::Primary)->kernels[s].lanes);
     passes.screen_rows.emplace_back();
     result.programs.push_back(record);
     primary.program_keys.push_back(record.key);
@@ -407,10 +409,10 @@ void Renderer::prepare_passes(Passes& passes) {
     passes.other_out = std::make_unique<TileHits>(session_.context, session_.queue, tile_rays,
                                                   PopulatedPages(tile_rays * sizeof(HitRecord)));
 
-  if (PassStats* stats = passes.stats_of("shadow")) {
+  if (PassStats* stats = passes.stats_of(PassKind::Shadow)) {
     const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
     for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-      passes.shadows.push_back(std::make_unique<ShadowTracer>(session_, cache_, plan.find("shadow")->kernels[i],
+      passes.shadows.push_back(std::make_unique<ShadowTracer>(session_, cache_, plan.find(PassKind::Shadow)->kernels[i],
                                                               *passes.surfaces[i], offset));
       result.programs.push_back(passes.shadows.back()->program());
       stats->program_keys.push_back(passes.shadows.back()->program().key);
@@ -421,12 +423,12 @@ void Renderer::prepare_passes(Passes& passes) {
       passes.light_points.push_back(scene.lights[static_cast<std::size_t>(light)].sample_points());
   }
   // Every secondary pass launches the same trace kernels.
-  for (const char* name : {"reflection", "transmission", "antialias"})
-    if (PassStats* stats = passes.stats_of(name)) {
+  for (PassKind kind : {PassKind::Reflection, PassKind::Transmission, PassKind::Antialias})
+    if (PassStats* stats = passes.stats_of(kind)) {
       if (passes.rays.empty())
         for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
           passes.rays.push_back(
-              std::make_unique<RayTracer>(session_, cache_, plan.find(name)->kernels[i], *passes.surfaces[i]));
+              std::make_unique<RayTracer>(session_, cache_, plan.find(kind)->kernels[i], *passes.surfaces[i]));
           result.programs.push_back(passes.rays.back()->program());
         }
       for (const auto& tracer : passes.rays) {
@@ -449,17 +451,17 @@ void Renderer::set_band_args(Passes& passes, const Tile& first) {
     // The screen form's polynomials of the band's rows; the kernel must answer each camera ray alike whatever
     // tile and band it is in (test_secondary_rays compares renders in small and large tiles bit for bit).
     passes.screen_rows[s] =
-        surface.set_screen_args(args, session_.context, plan.find("primary")->kernels[s], result.basis,
+        surface.set_screen_args(args, session_.context, plan.find(PassKind::Primary)->kernels[s], result.basis,
                                 plan.trace_width(), plan.trace_height(), first.trace_y0, first.trace_h);
     passes.primary_tile_arg[s] = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
     args.skip(4);
     args.plain((s == 0 ? passes.primary_out : passes.other_out)->buffer());
   }
-  passes.stats_of("primary")->wall_ms += ms_since(start);
+  passes.stats_of(PassKind::Primary)->wall_ms += ms_since(start);
 }
 
 void Renderer::trace_primary(Passes& passes, const Tile& tile) {
-  PassStats& pass = *passes.stats_of("primary");
+  PassStats& pass = *passes.stats_of(PassKind::Primary);
   const std::size_t rays = tile.rays();
   passes.primary_out->release();  // the last tile's records: the kernel writes them again
   passes.hit_surface.clear();
@@ -548,7 +550,7 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
 
   // Reflection and transmission from the camera rays' hits, batch_rays camera rays at a time.
   passes.any_secondary = false;
-  if (passes.stats_of("reflection") || passes.stats_of("transmission")) {
+  if (passes.stats_of(PassKind::Reflection) || passes.stats_of(PassKind::Transmission)) {
     passes.secondary.assign(rays, glm::dvec3(0));
     std::vector<Bounce> first;
     for (std::size_t k = 0; k < rays; ++k) {
@@ -595,13 +597,13 @@ void Renderer::run_bounces(Passes& passes, const Tile& tile, std::vector<Bounce>
   constexpr double kNegligibleWeight = 1.0 / 512;
   const double pixel_share =
       refinement ? static_cast<double>(result.plan.refine_samples) * result.plan.refine_samples : 1.0;
-  const char* const names[2] = {"reflection", "transmission"};
-  const bool wanted[2] = {passes.stats_of(names[0]) != nullptr, passes.stats_of(names[1]) != nullptr};
+  const PassKind kinds[2] = {PassKind::Reflection, PassKind::Transmission};
+  const bool wanted[2] = {passes.stats_of(kinds[0]) != nullptr, passes.stats_of(kinds[1]) != nullptr};
   std::vector<Bounce> next;
   for (int k = 0; k < 2; ++k) {
     if (!wanted[k]) continue;
     SecondaryBatch batch;
-    batch.pass = names[k];
+    batch.pass = kinds[k];
     batch.depth = depth;
     batch.refinement = refinement;
     for (const Bounce& b : current) {
@@ -658,7 +660,7 @@ void Renderer::refine_tile(Passes& passes, const Tile& tile, const std::vector<s
   const std::size_t per_batch = std::max<std::size_t>(1, passes.options.batch_rays / (static_cast<std::size_t>(n) * n));
   for (std::size_t begin = 0; begin < pixels.size(); begin += per_batch) {
     SecondaryBatch batch;
-    batch.pass = "antialias";
+    batch.pass = PassKind::Antialias;
     batch.depth = 0;
     batch.refinement = true;
     for (std::size_t j = begin; j < std::min(pixels.size(), begin + per_batch); ++j) {

@@ -49,7 +49,7 @@ Shader::Shader(const Scene& scene, const RenderPlan& plan, const RayBasis& basis
       basis_(basis),
       single_(precision != Precision::Double),
       samples_(std::max(plan.samples, 1)),
-      transmits_(plan.find("transmission") != nullptr) {
+      transmits_(plan.find(PassKind::Transmission) != nullptr) {
   // Highlights below 1/4096 of full strength are skipped: they cannot show, and pow() dominates shading.
   for (const SceneSurface& surface : scene.surfaces)
     for (const Material* m : {&surface.materials.front, &surface.materials.back})
@@ -198,7 +198,7 @@ void Shader::add_batch(const SecondaryBatch& batch, std::vector<glm::dvec3>& col
     shade_hits(found.data(), found.size(), shadows, shaded.data());
     for (std::size_t f = 0; f < found.size(); ++f) seen[found[f].hit_index] = shaded[f];
   });
-  const bool camera_rays = batch.pass == "antialias";
+  const bool camera_rays = batch.pass == PassKind::Antialias;
   for (std::size_t i = 0; i < batch.hits.size(); ++i) {
     colour[batch.sample[i]] += batch.weight[i] * seen[i];
     if (camera_rays)

@@ -74,8 +74,8 @@ void add_tile_work(SolverWork& w, const PrimaryTile& tile) {
       const HitRecord& h = tile.hits[static_cast<std::size_t>(y) * tile.width + x];
       const int tx = tile.x0 + x, ty = tile.y0 + y;
       const std::size_t i = static_cast<std::size_t>(ty / w.samples) * w.width + tx / w.samples;
-      w.isolation_steps[i] += h.work & 0xffffu;
-      w.refine_iterations[i] += h.work >> 16;
+      w.isolation_steps[i] += ALGRAY_WORK_ISOLATION_STEPS(h.work);
+      w.refine_iterations[i] += ALGRAY_WORK_REFINE_ITERATIONS(h.work);
       w.flags[i] |= h.flags;
       w.classification[i] = std::max(w.classification[i], static_cast<std::uint32_t>(solver_class(h)));
     }

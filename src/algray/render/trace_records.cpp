@@ -18,8 +18,8 @@ void PrimarySummary::add(const HitRecord* records, int width, int height, int sa
     const HitRecord& h = records[i];
     found += (h.flags & ALGRAY_HIT_FOUND) != 0;
     depth_limited += (h.flags & ALGRAY_HIT_BUDGET) != 0;
-    isolation_steps += h.work & 0xffffu;
-    refine_iterations += h.work >> 16;
+    isolation_steps += ALGRAY_WORK_ISOLATION_STEPS(h.work);
+    refine_iterations += ALGRAY_WORK_REFINE_ITERATIONS(h.work);
   }
   hits += found;
   // A pixel shows the surface when any of its antialiasing samples hit it.

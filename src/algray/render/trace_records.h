@@ -2,9 +2,9 @@
 #pragma once
 
 #include <cstdint>
-#include <string>
 #include <vector>
 
+#include "algray/render/render_plan.h"
 #include "algray/scene/camera.h"
 #include "kernels/algray_shared.h"
 
@@ -32,7 +32,7 @@ struct ShadowData {
 
 // One group of reflection, transmission or antialias rays: where each adds to the image and what it found.
 struct SecondaryBatch {
-  std::string pass;                   // "reflection", "transmission", or "antialias" (camera rays)
+  PassKind pass = PassKind::Reflection;  // Reflection, Transmission, or Antialias (camera rays)
   int depth = 1;                      // 1: spawned by the camera rays' hits; 0 for antialias batches
   bool refinement = false;            // part of adaptive antialiasing: replaces its pixel's first colour
   // The traced camera ray it contributes to (index into RenderResult::hits), or for refinement batches the
