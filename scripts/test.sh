@@ -28,6 +28,8 @@ phase "dependencies installed"
 gen=$(generator build)
 cmake -S . -B build ${gen:+-G "$gen"} -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(nproc)"
+# The Python package into the system Python, where `import algray` finds it; the tests use the build tree's copy.
+scripts/install-python.sh
 phase "release build done"
 # In parallel: tests that assert their own wall time are RUN_SERIAL (TIMED in tests/CMakeLists.txt), and the
 # longest start first (COST), so the single-threaded kernel builds of one test overlap another's.

@@ -110,6 +110,9 @@ struct RenderSettings {
   // Solver channels: "iterations", "isolation", "classification", "flags" (the command line's --aov).
   std::vector<std::string> aovs;
   bool reference = false;  // every pixel solved exactly on the CPU by solver_ref instead of the device
+  // Keep depth and normals (EXR's Z and N channels). Without them the film is half the size, as for a PNG, and
+  // Image::depth() and normal() are empty.
+  bool depth_and_normal = true;
   std::function<void(const Progress&)> on_progress;
   std::function<bool()> cancelled;  // asked before each tile; true stops the render with Cancelled
 };

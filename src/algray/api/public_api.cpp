@@ -183,6 +183,7 @@ Image Renderer::render(const Scene& scene, const RenderSettings& settings) {
     const algray::Scene s = read_scene(*scene.state_, overrides);
     FrameRequest request;
     request.reference = settings.reference;
+    request.depth_and_normal = settings.depth_and_normal;
     if (!settings.aovs.empty()) {
       std::string list, error;
       for (const std::string& a : settings.aovs) list += (list.empty() ? "" : ",") + a;

@@ -1,0 +1,129 @@
+"""algray from Python: scenes, renders into numpy arrays, probes and batches on any OpenCL device.
+
+    import algray
+    scene = algray.Scene.load("scenes/torus.toml")
+    scene.set("camera.fov_y", 30)
+    image = algray.Renderer().render(scene, width=640, height=480, preview=True)
+    image.rgba.shape            # (480, 640, 4), float32, linear colour
+    image.save("torus.png")
+
+It is the renderer the command line runs (the compiled module algray._algray over its C++ API), not a second
+implementation. Errors raise SceneError (with .file, .line, .column), DeviceError or OutputError.
+"""
+import json
+import os
+import tempfile
+
+from . import _toml
+from ._algray import DeviceError, Image, OutputError, Scene, SceneError, _Renderer
+from ._algray import __version__
+from ._algray import devices
+
+__all__ = ["Scene", "Renderer", "Image", "SceneError", "DeviceError", "OutputError", "devices", "explore",
+           "__version__"]
+
+
+def _scene_set(self, key, value):
+    """Sets a dotted scene key, or a parameter by its bare name, as `algray render --set key=value` does. The
+    value may be a Python number, bool, string or list (written as TOML), and returns the scene for chaining."""
+    self._set(key, _toml.value(value))
+    return self
+
+
+def _scene_from_dict(data, name="<dict>"):
+    """A scene from a dict laid out as the TOML file: {"surface": {"equation": ...}, "camera": {...}, ...}."""
+    return Scene.from_toml(_toml.document(data), name)
+
+
+def _scene_from_equation(equation, parameters=None, extent=None, camera=None, name="<equation>", **tables):
+    """The common case by keywords: Scene.from_equation("x^2+y^2+z^2-r^2", parameters={"r": 1},
+    extent={"radius": 2}, camera={"eye": [0, 0, 5]}); further tables (image=, light=[...], render=) as in TOML."""
+    data = {"surface": {"equation": equation}}
+    for key, table in (("parameters", parameters), ("extent", extent), ("camera", camera)):
+        if table:
+            data[key] = table
+    data.update(tables)
+    return _scene_from_dict(data, name)
+
+
+def _scene_to_dict(self):
+    """The scene as the dict its TOML reads to."""
+    return _toml.loads(self.to_toml())
+
+
+Scene.set = _scene_set
+Scene.from_dict = staticmethod(_scene_from_dict)
+Scene.from_equation = staticmethod(_scene_from_equation)
+Scene.to_dict = _scene_to_dict
+
+
+def _image_stats(self):
+    """The --stats dict of the render: passes, kernels (built or from the cache), rays, timings."""
+    return json.loads(self.stats_json)
+
+
+def _image_png(self):
+    """The image as PNG bytes, as `save("x.png")` writes it (Jupyter shows an Image by this)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "image.png")
+        self.save(path)
+        with open(path, "rb") as f:
+            return f.read()
+
+
+Image.stats = property(_image_stats)
+Image._repr_png_ = _image_png
+Image.__repr__ = lambda self: f"<algray.Image {self.width}x{self.height}>"
+
+
+class Renderer:
+    """One OpenCL device, its context and its program cache, kept for every render, probe and batch.
+
+    device: None for the first GPU, else the first device; an index of devices(); or a substring of the device
+    or platform name. precision: "auto" (double where the device has fp64), "double", "float" or "mixed".
+    cache: keep built kernels on disk between processes."""
+
+    def __init__(self, device=None, precision="auto", cache=True):
+        self._renderer = _Renderer("" if device is None else str(device), cache)
+        self.precision = precision
+
+    @property
+    def device(self):
+        return self._renderer.device()
+
+    def render(self, scene, width=0, height=0, preview=False, aov=(), reference=False, depth=True, progress=None):
+        """Renders into memory and returns an Image. width/height 0 keep the scene's size; aov lists solver
+        channels ("iterations", "isolation", "classification", "flags"), found in image.aov; depth=False leaves
+        out depth and normals (image.depth and .normal are None), halving the film, as for a PNG; progress(done,
+        total) is called after each tile. The GIL is released while rendering; Ctrl-C stops the render."""
+        precision = "" if self.precision == "auto" else self.precision
+        return self._renderer.render(scene, width, height, preview, precision, list(aov), reference, depth, progress)
+
+    def probe(self, scene, pixel=None, ray=None, all_solvers=False):
+        """The probe report as a dict: pixel=(x, y) for that pixel's centre ray, or ray=(origin, direction)."""
+        if (pixel is None) == (ray is None):
+            raise ValueError("probe needs pixel=(x, y) or ray=(origin, direction)")
+        if pixel is not None:
+            return json.loads(self._renderer.probe_pixel(scene, int(pixel[0]), int(pixel[1]), all_solvers))
+        origin, direction = ray
+        return json.loads(self._renderer.probe_ray(scene, list(origin), list(direction), all_solvers))
+
+    def batch(self, jobs, progress=None, message=None, resume=False, **render_options):
+        """A jobs file (a path, as `algray batch` takes) run on this device: returns "done", "frames failed",
+        "bad input" or "stopped"; progress(frame_dict) after each frame, message(text) for warnings and
+        failures. Or an iterable of scenes: returns their images, calling progress(index, image) after each."""
+        if isinstance(jobs, (str, os.PathLike)):
+            return self._renderer.batch(os.fspath(jobs), resume, progress, message)
+        images = []
+        for index, scene in enumerate(jobs):
+            images.append(self.render(scene, **render_options))
+            if progress:
+                progress(index, images[-1])
+        return images
+
+
+def explore(scene, renderer=None, width=480, height=360, **sliders):
+    """Sliders for the scene's parameters, the camera's orbit angles and its zoom in Jupyter, re-rendering a
+    preview as they move (ipywidgets). Returns the widget box; see algray.explorer.Explorer."""
+    from .explorer import Explorer
+    return Explorer(scene, renderer or Renderer(), width, height, **sliders).widget

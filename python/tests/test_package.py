@@ -1,0 +1,154 @@
+"""The Python package against the command line: same pixels, arrays, errors, the program cache, Ctrl-C, sliders."""
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import algray
+
+ROOT = os.environ.get("ALGRAY_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+BINARY = os.environ.get("ALGRAY_BINARY")
+EXR_COMPARE = os.environ.get("ALGRAY_EXR_COMPARE")
+TORUS = os.path.join(ROOT, "scenes", "torus.toml")
+
+
+@pytest.fixture(scope="module")
+def renderer():
+    if not algray.devices():
+        pytest.fail("no OpenCL device: these tests need one (on Debian: apt-get install pocl-opencl-icd)")
+    return algray.Renderer()
+
+
+def test_a_render_from_python_is_the_command_lines_render_bit_for_bit(renderer, tmp_path):
+    assert BINARY and EXR_COMPARE, "ALGRAY_BINARY and ALGRAY_EXR_COMPARE must name the built tools (CTest sets them)"
+    for name, preview in (("torus", True), ("tooth", False)):
+        scene = algray.Scene.load(os.path.join(ROOT, "scenes", name + ".toml"))
+        image = renderer.render(scene, width=96, height=72, preview=preview, aov=["iterations", "classification"])
+        image.save(str(tmp_path / "python.exr"))
+        command = [BINARY, "render", scene.source, "--width", "96", "--height", "72", "-o",
+                   str(tmp_path / "cli.exr"), "--aov", "iterations,classification"] + (["--preview"] if preview else [])
+        subprocess.run(command, check=True)
+        compared = subprocess.run([EXR_COMPARE, str(tmp_path / "python.exr"), str(tmp_path / "cli.exr")],
+                                  capture_output=True, text=True, check=True)
+        assert "channels bit-identical: all" in compared.stdout, (name, compared.stdout)
+
+
+def test_the_arrays_have_the_image_shape_and_depth_is_inf_on_misses(renderer):
+    image = renderer.render(algray.Scene.load(TORUS), width=64, height=48, preview=True, aov=["classification"])
+    assert image.rgba.shape == (48, 64, 4) and image.rgba.dtype == np.float32
+    assert image.depth.shape == (48, 64) and image.depth.dtype == np.float32
+    assert image.normal.shape == (48, 64, 3) and image.normal.dtype == np.float32
+    assert image.aov["class"].shape == (48, 64) and image.aov["class"].dtype == np.uint32
+    miss = np.isinf(image.depth)
+    assert 0 < miss.sum() < 48 * 64
+    assert np.all(image.depth[miss] > 0)
+    assert np.all(image.normal[miss] == 0)
+    lengths = np.linalg.norm(image.normal[~miss], axis=1)
+    assert np.allclose(lengths, 1, atol=1e-5)
+    assert not image.rgba.flags.writeable  # a view of the render's own memory
+    assert image.stats["image"] == {"width": 64, "height": 48}
+    assert image._repr_png_().startswith(b"\x89PNG")
+    flat = renderer.render(algray.Scene.load(TORUS), width=64, height=48, preview=True, depth=False)
+    assert flat.depth is None and flat.normal is None
+    assert np.array_equal(flat.rgba, image.rgba)  # the same colours, without the channels a PNG cannot hold
+
+
+def test_a_bad_equation_raises_scene_error_at_its_column():
+    with pytest.raises(algray.SceneError) as caught:
+        algray.Scene.from_toml('[surface]\nequation = "x^2+*y"\n', "bad.toml")
+    e = caught.value
+    assert (e.file, e.line) == ("bad.toml", 2)
+    assert e.column == 17  # the '*' after x^2+ in: equation = "x^2+*y"
+    assert "bad.toml:2:17" in str(e)
+    with pytest.raises(algray.SceneError):
+        algray.Scene.load(TORUS).set("image.width", -3)
+
+
+def test_scenes_from_dicts_keywords_and_set(renderer):
+    scene = algray.Scene.from_equation("x^2+y^2+z^2-r^2", parameters={"r": 1.0}, extent={"radius": 2},
+                                       camera={"eye": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0]})
+    assert scene.parameters == {"r": 1.0}
+    scene.set("r", 0.5).set("camera.fov_y", 30).set("render.isolation", "sturm")
+    assert scene.parameters == {"r": 0.5}
+    assert scene.to_dict()["render"]["isolation"] == "sturm"
+    again = algray.Scene.from_dict(scene.to_dict())
+    assert again.to_toml().split("\n", 1)[1] == scene.to_toml().split("\n", 1)[1]
+
+
+def test_two_renders_through_one_renderer_take_the_second_program_from_memory(renderer):
+    scene = algray.Scene.load(TORUS)
+    first = renderer.render(scene, width=32, height=24, preview=True)
+    second = renderer.render(scene, width=40, height=30, preview=True)
+    assert first.stats["programs"][0]["key"] == second.stats["programs"][0]["key"]
+    assert second.stats["programs"][0]["origin"] == "memory"
+
+
+def test_ctrl_c_cancels_a_render_between_tiles(renderer):
+    scene = algray.Scene.load(TORUS).set("render.tile_size", 32)
+    seen = []
+
+    def interrupt_after_first_tile(done, total):
+        seen.append((done, total))
+        if done == 1:
+            signal.raise_signal(signal.SIGINT)  # what Ctrl-C does: Python's handler runs at the next check
+
+    with pytest.raises(KeyboardInterrupt):
+        renderer.render(scene, width=256, height=256, preview=True, progress=interrupt_after_first_tile)
+    assert seen and seen[-1][0] < seen[-1][1], seen  # stopped before the last tile
+    assert renderer.render(scene, width=32, height=32, preview=True).width == 32  # and the renderer goes on
+
+
+def test_the_explorer_re_renders_when_a_slider_moves(renderer):
+    from algray.explorer import Explorer
+
+    scene = algray.Scene.from_equation("x^2+y^2+z^2-r^2", parameters={"r": 1.0}, extent={"radius": 2},
+                                       camera={"eye": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0]})
+    explorer = Explorer(scene, renderer, width=48, height=36)
+    before = explorer.png
+    hits_before = np.isfinite(explorer.image.depth).sum()
+    explorer.update("r", 0.5)
+    assert explorer.renders == 2 and explorer.png != before
+    assert np.isfinite(explorer.image.depth).sum() < hits_before  # a smaller ball covers fewer pixels
+    explorer.update("azimuth", 90.0)
+    eye = explorer.current_scene().to_dict()["camera"]["eye"]
+    assert eye == pytest.approx([5, 0, 0], abs=1e-9)
+
+
+def test_a_batch_of_scenes_and_a_jobs_file(renderer, tmp_path):
+    scenes = [algray.Scene.load(TORUS).set("r", r) for r in (0.6, 0.9)]
+    done = []
+    images = renderer.batch(scenes, progress=lambda i, image: done.append(i), width=24, height=18, preview=True)
+    assert [i.width for i in images] == [24, 24] and done == [0, 1]
+    (tmp_path / "ball.toml").write_text('[surface]\nequation = "x^2+y^2+z^2-1"\n[extent]\nradius = 2\n'
+                                        "[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n")
+    (tmp_path / "jobs.toml").write_text('[defaults]\nset = { image = { width = 16, height = 12 } }\n[[job]]\n'
+                                        'name = "one"\nscene = "ball.toml"\noutput = "one.png"\n')
+    frames = []
+    assert renderer.batch(str(tmp_path / "jobs.toml"), progress=frames.append) == "done"
+    assert frames[0]["status"] == "ok" and (tmp_path / "one.png").exists()
+
+
+def test_the_gil_is_released_while_rendering(renderer):
+    scene = algray.Scene.load(TORUS)
+    renderer.render(scene, width=16, height=16, preview=True)  # the program built before timing
+    done = threading.Event()
+    ticks = 0
+
+    def render():
+        renderer.render(scene, width=512, height=512, preview=True)
+        done.set()
+
+    worker = threading.Thread(target=render)
+    start = time.perf_counter()
+    worker.start()
+    while not done.is_set():  # this thread runs Python only while the render does not hold the GIL
+        ticks += 1
+        time.sleep(0.001)
+    worker.join()
+    elapsed = time.perf_counter() - start
+    assert ticks >= min(10, elapsed / 0.004), (ticks, elapsed)
