@@ -117,6 +117,14 @@ def test_the_explorer_re_renders_when_a_slider_moves(renderer):
     explorer.update("azimuth", 90.0)
     eye = explorer.current_scene().to_dict()["camera"]["eye"]
     assert eye == pytest.approx([5, 0, 0], abs=1e-9)
+    # The widgets themselves: moving a slider from Python runs its callback, which re-renders into the picture.
+    box = explorer.widget
+    assert set(explorer.sliders) == {"r", "azimuth", "elevation", "zoom"}
+    shown = explorer._picture.value
+    explorer.sliders["zoom"].value = 2.0
+    assert explorer.renders == 4 and explorer.values["zoom"] == 2.0
+    assert explorer._picture.value == explorer.png != shown
+    assert box.children[0] is explorer._picture
 
 
 def test_a_batch_of_scenes_and_a_jobs_file(renderer, tmp_path):
