@@ -16,5 +16,5 @@ if command -v python3 >/dev/null; then
     $SUDO cp -r build/python/algray "$path_site/algray"
   fi
 fi
-python3 -c 'import algray, sys; print("install-python: algray", algray.__version__, "for", sys.executable)'
-/usr/bin/python3 -c 'import algray, sys; print("install-python: algray", algray.__version__, "for", sys.executable)'
+python3 -c 'import algray, sys; print("install-python:", algray.__version__, "for", sys.executable)'
+/usr/bin/python3 -c 'import algray, sys; print("install-python:", algray.__version__, "for", sys.executable)'
