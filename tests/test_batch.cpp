@@ -1,6 +1,8 @@
 // algray batch: sweeps, orbits, the log, failures that do not stop the rest, resume, and jobs-file errors.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <map>
 
 #include "cli_sandbox.h"
 #include "algray/io/image_io.h"
@@ -234,4 +236,124 @@ TEST_CASE("every command takes its input on standard input, --set for list keys,
   const nlohmann::json& devices = stats["devices"];
   REQUIRE(!devices.empty());
   CHECK(devices[0]["compute_units"].get<int>() > 0);
+}
+
+namespace {
+
+// Seven frames over two jobs, so that shards number frames across jobs: grow 0-4 are 0-4, spin 0-1 are 5-6.
+const std::string kTwoJobs = kSmall +
+                             "[[job]]\nname = \"grow\"\nscene = \"ball.toml\"\noutput = \"grow_{frame}.png\"\n"
+                             "sweep.r = { from = 0.5, to = 1.3, steps = 5 }\n"
+                             "[[job]]\nname = \"spin\"\nscene = \"ball.toml\"\noutput = \"spin_{frame}.png\"\n"
+                             "frames = 2\norbit = { degrees = 90 }\n";
+const std::vector<std::string> kTwoJobsImages = {"grow_0.png", "grow_1.png", "grow_2.png", "grow_3.png",
+                                                 "grow_4.png", "spin_0.png", "spin_1.png"};
+
+// Sets environment variables for one scope (the commands a Sandbox runs inherit them).
+class ScopedEnvironment {
+ public:
+  explicit ScopedEnvironment(std::vector<std::pair<std::string, std::string>> vars) : vars_(std::move(vars)) {
+    for (const auto& [name, value] : vars_) ::setenv(name.c_str(), value.c_str(), 1);
+  }
+  ~ScopedEnvironment() {
+    for (const auto& [name, value] : vars_) ::unsetenv(name.c_str());
+  }
+
+ private:
+  std::vector<std::pair<std::string, std::string>> vars_;
+};
+
+}  // namespace
+
+TEST_CASE("shards render every frame exactly once, as one process would, and --merge-logs joins their logs",
+          "[batch][cli][shard]") {
+  Sandbox whole, shards;
+  for (const Sandbox* box : {&whole, &shards}) {
+    write_text(box->work / "ball.toml", kBall);
+    write_text(box->work / "jobs.toml", kTwoJobs);
+  }
+  REQUIRE(whole.run("batch jobs.toml").exit_code == 0);
+  // Two shards by --shard, the third as a Slurm array task would find it.
+  for (int k = 0; k < 2; ++k) {
+    const Result r = shards.run("batch jobs.toml --shard " + std::to_string(k) + "/3");
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+  }
+  {
+    ScopedEnvironment slurm({{"SLURM_ARRAY_TASK_ID", "2"}, {"SLURM_ARRAY_TASK_COUNT", "3"}});
+    const Result r = shards.run("batch jobs.toml");
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+  }
+  std::map<std::string, int> rendered;  // "job/frame" -> times
+  for (int k = 0; k < 3; ++k) {
+    const fs::path log = shards.work / ("jobs.log.shard-" + std::to_string(k) + "-of-3.jsonl");
+    REQUIRE(fs::exists(log));
+    for (const nlohmann::json& entry : read_log(log)) {
+      const int frame = entry["frame"].get<int>();
+      const int number = entry["job"] == "grow" ? frame : 5 + frame;
+      INFO("shard " << k << ": " << entry.dump());
+      CHECK(number % 3 == k);
+      CHECK(entry["shard"] == std::to_string(k) + "/3");
+      CHECK(entry["status"] == "ok");
+      ++rendered[entry["job"].get<std::string>() + "/" + std::to_string(frame)];
+    }
+  }
+  CHECK(rendered.size() == 7);
+  for (const auto& [frame, times] : rendered) {
+    INFO(frame);
+    CHECK(times == 1);
+  }
+  for (const std::string& image : kTwoJobsImages) {
+    INFO(image);
+    REQUIRE(fs::exists(shards.work / image));
+    CHECK(read_text(shards.work / image) == read_text(whole.work / image));
+  }
+  CHECK_FALSE(fs::exists(shards.work / "jobs.log.jsonl"));  // each shard wrote only its own log
+
+  const Result merged = shards.run("batch jobs.toml --merge-logs");
+  INFO(merged.err);
+  REQUIRE(merged.exit_code == 0);
+  const std::vector<nlohmann::json> log = read_log(shards.work / "jobs.log.jsonl");
+  REQUIRE(log.size() == 7);
+  for (std::size_t i = 0; i < log.size(); ++i) {
+    INFO("line " << i);
+    CHECK(log[i]["job"] == (i < 5 ? "grow" : "spin"));
+    CHECK(log[i]["frame"] == static_cast<int>(i < 5 ? i : i - 5));
+  }
+  // A shard that never ran leaves its frames in no log: the merge says which, and fails.
+  fs::remove(shards.work / "jobs.log.shard-1-of-3.jsonl");
+  const Result incomplete = shards.run("batch jobs.toml --merge-logs");
+  CHECK(incomplete.exit_code == 1);
+  CHECK_THAT(incomplete.err, Catch::Contains("2 in no log (grow/1, grow/4)"));
+}
+
+TEST_CASE("a shard comes from --shard or the Slurm array's variables, and a bad one is bad input",
+          "[batch][cli][shard]") {
+  Sandbox box;
+  write_text(box.work / "ball.toml", kBall);
+  write_text(box.work / "jobs.toml", kTwoJobs);
+  for (const char* bad : {"3/3", "-1/2", "1/0", "a/b", "1", "1/2/3"}) {
+    INFO(bad);
+    const Result r = box.run(std::string("batch jobs.toml --shard ") + bad);
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("expected K/N"));
+  }
+  {
+    ScopedEnvironment slurm({{"SLURM_ARRAY_TASK_ID", "5"}, {"SLURM_ARRAY_TASK_COUNT", "3"}});
+    const Result r = box.run("batch jobs.toml");
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("outside its array of 3 tasks"));
+  }
+  std::vector<std::string> files = box.work_files();
+  std::sort(files.begin(), files.end());
+  CHECK(files == std::vector<std::string>{"ball.toml", "jobs.toml"});  // nothing written
+  // --array=1-3: task ids 1 to 3 are shards 0 to 2; --shard wins over the environment.
+  ScopedEnvironment slurm({{"SLURM_ARRAY_TASK_ID", "2"}, {"SLURM_ARRAY_TASK_MIN", "1"}, {"SLURM_ARRAY_TASK_MAX", "3"}});
+  REQUIRE(box.run("batch jobs.toml").exit_code == 0);
+  std::vector<int> frames;
+  for (const nlohmann::json& e : read_log(box.work / "jobs.log.shard-1-of-3.jsonl")) frames.push_back(e["frame"]);
+  CHECK(frames == std::vector<int>{1, 4});  // grow 1 and 4: numbers 1 and 4
+  REQUIRE(box.run("batch jobs.toml --shard 0/2").exit_code == 0);
+  CHECK(fs::exists(box.work / "jobs.log.shard-0-of-2.jsonl"));
 }

@@ -39,6 +39,8 @@ struct ProbeRequest {
 int run_render(const RenderRequest& request, std::ostream& err);
 int run_probe(const ProbeRequest& request, std::ostream& out, std::ostream& err);
 int run_batch_command(const BatchRequest& request, bool progress, std::ostream& err);
+// `algray batch --merge-logs`: the shard logs joined into the batch's log.
+int run_merge_logs(const BatchRequest& request, std::ostream& err);
 // `algray devices`: the list on `out`, and as JSON in `stats_path` when given.
 int run_devices(const std::string& stats_path, std::ostream& out, std::ostream& err);
 

@@ -240,6 +240,8 @@ struct BatchCommand {
   CLI::App* cmd = nullptr;
   BatchRequest request;
   SceneOptions scene;
+  std::string shard_text;
+  bool merge_logs = false;
 
   void add_to(CLI::App& app) {
     cmd = app.add_subcommand(
@@ -250,12 +252,30 @@ struct BatchCommand {
     cmd->add_option("--log", request.log_path,
                     "JSON-lines log, one line per frame (default: beside the jobs file, <name>.log.jsonl)");
     cmd->add_option("--stats", request.stats_path, "write a summary of the batch as JSON");
+    cmd->add_option("--shard", shard_text,
+                    "K/N: render only frames K, K+N, K+2N, ... of all (0 <= K < N), writing the shard's own log and "
+                    "stats; default in a Slurm array job: from SLURM_ARRAY_TASK_ID and _COUNT (or _MIN/_MAX)");
+    cmd->add_flag("--merge-logs", merge_logs,
+                  "render nothing: join the shard logs (<log>.shard-K-of-N) into the batch's log and report "
+                  "frames that no shard rendered");
   }
 
   int run() {
     if (!collect_overrides(cmd, scene, request.overrides)) return kExitBadInput;
     request.device_spec = scene.device_spec;
     request.use_cache = !scene.no_cache;
+    if (merge_logs) return run_merge_logs(request, std::cerr);
+    try {
+      std::string error;
+      BatchShard shard;
+      if (!shard_text.empty() && !parse_shard(shard_text, shard, error)) {
+        std::cerr << "algray: --shard " << shard_text << ": " << error << "\n";
+        return kExitBadInput;
+      }
+      request.shard = shard_text.empty() ? shard_from_slurm_environment() : shard;
+    } catch (const std::exception& e) {
+      return report_error(e, std::cerr);
+    }
     return run_batch_command(request, ::isatty(STDERR_FILENO) != 0, std::cerr);
   }
 };

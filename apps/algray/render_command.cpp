@@ -18,6 +18,20 @@ int report_error(const std::exception& e, std::ostream& err) {
   return report.bad_input ? kExitBadInput : kExitFailure;
 }
 
+namespace {
+
+int exit_code(BatchOutcome outcome) {
+  switch (outcome) {
+    case BatchOutcome::Done: return kExitOk;
+    case BatchOutcome::BadInput: return kExitBadInput;
+    case BatchOutcome::FramesFailed:
+    case BatchOutcome::Stopped: break;
+  }
+  return kExitFailure;
+}
+
+}  // namespace
+
 int run_render(const RenderRequest& req, std::ostream& err) {
   const auto started = std::chrono::steady_clock::now();
   // Everything the user gave is checked before any device work, so bad input costs nothing and writes nothing.
@@ -61,13 +75,13 @@ int run_batch_command(const BatchRequest& request, bool show_progress, std::ostr
                     seconds_text(p.elapsed_ms).c_str(), seconds_text(p.eta_ms).c_str());
       progress.show(line);
     };
-  switch (run_batch(request, callbacks)) {
-    case BatchOutcome::Done: return kExitOk;
-    case BatchOutcome::BadInput: return kExitBadInput;
-    case BatchOutcome::FramesFailed:
-    case BatchOutcome::Stopped: break;
-  }
-  return kExitFailure;
+  return exit_code(run_batch(request, callbacks));
+}
+
+int run_merge_logs(const BatchRequest& request, std::ostream& err) {
+  BatchCallbacks callbacks;
+  callbacks.on_message = [&](const std::string& text) { err << text; };
+  return exit_code(merge_shard_logs(request, callbacks));
 }
 
 int run_devices(const std::string& stats_path, std::ostream& out, std::ostream& err) {

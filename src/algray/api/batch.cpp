@@ -8,11 +8,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <system_error>
 
@@ -344,14 +346,82 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks)
   return run_batch(req, callbacks, context);
 }
 
+bool parse_shard(const std::string& text, BatchShard& out, std::string& error) {
+  const std::size_t slash = text.find('/');
+  int index = -1, count = 0;
+  const auto number = [](const std::string& digits, int& value) {
+    const char* end = digits.data() + digits.size();
+    return !digits.empty() && std::from_chars(digits.data(), end, value).ptr == end;
+  };
+  if (slash == std::string::npos || !number(text.substr(0, slash), index) || !number(text.substr(slash + 1), count) ||
+      count < 1 || index < 0 || index >= count) {
+    error = "expected K/N with 0 <= K < N, such as 0/4 for the first of four shards";
+    return false;
+  }
+  out = {index, count};
+  return true;
+}
+
+std::optional<BatchShard> shard_from_slurm_environment() {
+  const auto variable = [](const char* name) -> std::optional<int> {
+    const char* text = std::getenv(name);
+    if (!text || !*text) return std::nullopt;
+    int value = 0;
+    const char* end = text + std::strlen(text);
+    if (std::from_chars(text, end, value).ptr != end)
+      throw SceneError(name, std::string("not a whole number: '") + text + "'");
+    return value;
+  };
+  const std::optional<int> id = variable("SLURM_ARRAY_TASK_ID");
+  if (!id) return std::nullopt;
+  const std::optional<int> count = variable("SLURM_ARRAY_TASK_COUNT");
+  const std::optional<int> min = variable("SLURM_ARRAY_TASK_MIN"), max = variable("SLURM_ARRAY_TASK_MAX");
+  BatchShard shard;
+  if (min && max) {
+    // An array's task ids run from MIN to MAX (--array=1-4): ids, not counts, say where a task stands.
+    shard = {*id - *min, *max - *min + 1};
+  } else if (count) {
+    shard = {*id, *count};
+  } else {
+    throw SceneError("SLURM_ARRAY_TASK_ID", "set without SLURM_ARRAY_TASK_COUNT or SLURM_ARRAY_TASK_MIN/MAX");
+  }
+  if (shard.count < 1 || shard.index < 0 || shard.index >= shard.count)
+    throw SceneError("SLURM_ARRAY_TASK_ID", "task " + std::to_string(*id) + " is outside its array of " +
+                                                std::to_string(shard.count) + " tasks");
+  return shard;
+}
+
+std::string shard_file(const std::string& path, const BatchShard& shard) {
+  const fs::path p(path);
+  const std::string tag = ".shard-" + std::to_string(shard.index) + "-of-" + std::to_string(shard.count);
+  return (p.parent_path() / (p.stem().string() + tag + p.extension().string())).string();
+}
+
 namespace {
 
 // The jobs file read and every path the batch will touch checked, before anything renders.
 struct BatchPlan {
   std::vector<BatchJob> jobs;
   std::string log_path;
-  int total_frames = 0;
+  std::optional<std::string> stats_path;
+  int total_frames = 0;  // of this shard
 };
+
+// Whether frame `number` of the whole batch (every job's frames in order) is this request's to render.
+bool in_shard(const BatchRequest& req, int number) {
+  return !req.shard || number % req.shard->count == req.shard->index;
+}
+
+// The batch's log before sharding: as given, else beside the jobs file as <stem>.log.jsonl.
+std::string batch_log_path(const BatchRequest& req, const std::string& base_dir) {
+  if (req.log_path) return *req.log_path;
+  if (req.jobs_path == "-") return "batch.log.jsonl";
+  return (fs::path(base_dir) / (fs::path(req.jobs_path).stem().string() + ".log.jsonl")).string();
+}
+
+std::string shard_text(const BatchShard& shard) {
+  return std::to_string(shard.index) + "/" + std::to_string(shard.count);
+}
 
 // Throws SceneError or OutputError on bad input: a bad jobs file, or an output that cannot be written or is
 // another input or output by some other name.
@@ -365,23 +435,24 @@ BatchPlan plan_batch(const BatchRequest& req) {
     base_dir = fs::path(req.jobs_path).parent_path().string();
   }
   plan.jobs = load_jobs(text, req.jobs_path == "-" ? "<stdin>" : req.jobs_path, base_dir);
-  plan.log_path = req.log_path ? *req.log_path
-                  : req.jobs_path == "-"
-                      ? std::string("batch.log.jsonl")
-                      : (fs::path(base_dir) / (fs::path(req.jobs_path).stem().string() + ".log.jsonl")).string();
+  plan.log_path = batch_log_path(req, base_dir);
+  if (req.shard) plan.log_path = shard_file(plan.log_path, *req.shard);
+  if (req.stats_path) plan.stats_path = req.shard ? shard_file(*req.stats_path, *req.shard) : *req.stats_path;
   check_output_writable(plan.log_path);
-  if (req.stats_path) check_output_writable(*req.stats_path);
+  if (plan.stats_path) check_output_writable(*plan.stats_path);
   // No file the batch writes may be one it reads, or another it writes, by any name.
   std::vector<RoleAndPath> inputs{{"jobs file", req.jobs_path}}, outputs{{"--log", plan.log_path}};
-  if (req.stats_path) outputs.push_back({"--stats", *req.stats_path});
+  if (plan.stats_path) outputs.push_back({"--stats", *plan.stats_path});
+  int number = 0;  // of each frame in the whole batch, which decides its shard
   for (const BatchJob& job : plan.jobs) {
     inputs.push_back({"scene of job " + job.name, job.scene});
-    for (int frame = 0; frame < job.frames; ++frame) {
+    for (int frame = 0; frame < job.frames; ++frame, ++number) {
+      if (!in_shard(req, number)) continue;
       const std::string who = "job " + job.name + " frame " + std::to_string(frame);
       for (const std::string& o : job.outputs) outputs.push_back({who + " output", expand_pattern(o, job, frame)});
       if (job.stats) outputs.push_back({who + " stats", expand_pattern(*job.stats, job, frame)});
+      ++plan.total_frames;
     }
-    plan.total_frames += job.frames;
   }
   check_distinct_files(inputs, outputs);
   // Every frame's paths are checked now, as render checks its own, so that a bad one is bad input (exit 2)
@@ -430,6 +501,7 @@ class FrameRunner {
     const auto start = std::chrono::steady_clock::now();
     entry = {{"version", version_string()}, {"job", job.name}, {"frame", frame}, {"frames", job.frames},
              {"scene", job.scene}};
+    if (req_.shard) entry["shard"] = shard_text(*req_.shard);
     try {
       std::vector<std::string> outputs;
       for (const std::string& o : job.outputs) outputs.push_back(expand_pattern(o, job, frame));
@@ -516,12 +588,15 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks,
   nlohmann::json summary_jobs = nlohmann::json::array();
   FrameRunner runner(req, context, *log, message);
   try {
+    int number = 0;
     for (const BatchJob& job : plan.jobs) {
       JobTally tally;
       bool warned = false;
-      for (int frame = 0; frame < job.frames; ++frame, ++done) {
+      for (int frame = 0; frame < job.frames; ++frame) {
+        if (!in_shard(req, number++)) continue;
         nlohmann::json entry;
         const std::string status = runner.run(job, frame, warned, entry);
+        ++done;
         if (status == "skipped") {
           ++skipped;
           ++tally.skipped;
@@ -538,8 +613,7 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks,
         tally.frame_ms.push_back(ms);
         if (callbacks.on_frame) {
           const double elapsed = ms_since(batch_start);
-          callbacks.on_frame({done + 1, total, &job, frame, status, ms, elapsed,
-                              elapsed / (done + 1) * (total - done - 1)});
+          callbacks.on_frame({done, total, &job, frame, status, ms, elapsed, elapsed / done * (total - done)});
         }
       }
       summary_jobs.push_back(tally.json(job));
@@ -555,12 +629,13 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks,
   const nlohmann::json summary = {{"version", version_string()},
                                   {"jobs_file", req.jobs_path},
                                   {"log", plan.log_path},
+                                  {"shard", req.shard ? nlohmann::json(shard_text(*req.shard)) : nlohmann::json()},
                                   {"frames", {{"total", total}, {"ok", ok}, {"failed", failed}, {"skipped", skipped}}},
                                   {"jobs", summary_jobs},
                                   {"total_ms", ms_since(batch_start)}};
-  if (req.stats_path) {
+  if (plan.stats_path) {
     try {
-      write_text_file(*req.stats_path, summary.dump(2) + "\n");
+      write_text_file(*plan.stats_path, summary.dump(2) + "\n");
     } catch (const std::exception& e) {
       // After the frames: a failure to write, not bad input.
       message(std::string("algray: the frames are done, but the batch stats were not written: ") + e.what() + "\n");
@@ -571,6 +646,81 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks,
     message("algray: " + std::to_string(failed) + " of " + std::to_string(total) + " frames failed (see " +
             plan.log_path + ")\n");
   return failed ? BatchOutcome::FramesFailed : BatchOutcome::Done;
+}
+
+BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& callbacks) {
+  const auto message = [&](const std::string& text) {
+    if (callbacks.on_message) callbacks.on_message(text);
+  };
+  BatchRequest whole = req;
+  whole.shard.reset();
+  BatchPlan plan;
+  try {
+    plan = plan_batch(whole);
+  } catch (const std::exception& e) {
+    const ErrorReport report = describe_error(e);
+    message(report.text);
+    return report.bad_input ? BatchOutcome::BadInput : BatchOutcome::Stopped;
+  }
+  // The shard logs beside the batch's log: <stem>.shard-K-of-N<extension>, whatever the shard count.
+  const fs::path log(plan.log_path);
+  const fs::path dir = log.parent_path().empty() ? fs::path(".") : log.parent_path();
+  const auto literal = [](const std::string& text) {
+    return std::regex_replace(text, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)");
+  };
+  const std::regex shard_name(literal(log.stem().string()) + R"(\.shard-[0-9]+-of-[0-9]+)" +
+                              literal(log.extension().string()));
+  std::vector<fs::path> shard_logs;
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
+    if (std::regex_match(e.path().filename().string(), shard_name)) shard_logs.push_back(e.path());
+  std::sort(shard_logs.begin(), shard_logs.end());
+  if (shard_logs.empty()) {
+    message("algray: no shard logs beside " + plan.log_path + " (" + log.stem().string() + ".shard-K-of-N" +
+            log.extension().string() + "): nothing to merge\n");
+    return BatchOutcome::BadInput;
+  }
+  // Each frame's last entry: a later line of a shard's log is a later attempt (--resume appends).
+  std::map<std::pair<std::string, int>, nlohmann::json> last;
+  for (const fs::path& p : shard_logs) {
+    std::ifstream in(p);
+    int line_number = 0;
+    for (std::string line; std::getline(in, line);) {
+      ++line_number;
+      try {
+        nlohmann::json j = nlohmann::json::parse(line);
+        // The key before the move: json's assignment takes its argument by value, evaluated first.
+        std::pair<std::string, int> key{j.at("job").get<std::string>(), j.at("frame").get<int>()};
+        last[std::move(key)] = std::move(j);
+      } catch (const std::exception& e) {
+        message("algray: warning: " + p.string() + ":" + std::to_string(line_number) + ": not a log entry (" +
+                e.what() + "), ignored\n");
+      }
+    }
+  }
+  std::string merged;
+  int missing = 0, failed = 0, total = 0;
+  std::string missing_names;
+  for (const BatchJob& job : plan.jobs)
+    for (int frame = 0; frame < job.frames; ++frame, ++total) {
+      const auto it = last.find({job.name, frame});
+      if (it == last.end()) {
+        if (missing++ < 10) missing_names += (missing_names.empty() ? "" : ", ") + job.name + "/" + std::to_string(frame);
+        continue;
+      }
+      failed += it->second.value("status", "") == "failed";
+      merged += it->second.dump() + "\n";
+    }
+  try {
+    write_text_file(plan.log_path, merged);
+  } catch (const std::exception& e) {
+    message(describe_error(e).text);
+    return BatchOutcome::Stopped;
+  }
+  message("algray: merged " + std::to_string(shard_logs.size()) + " shard logs into " + plan.log_path + ": " +
+          std::to_string(total) + " frames, " + std::to_string(failed) + " failed, " + std::to_string(missing) +
+          " in no log" + (missing ? " (" + missing_names + (missing > 10 ? ", ..." : "") + ")" : "") + "\n");
+  return missing || failed ? BatchOutcome::FramesFailed : BatchOutcome::Done;
 }
 
 }  // namespace algray

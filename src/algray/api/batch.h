@@ -54,6 +54,21 @@ std::vector<Override> frame_overrides(const BatchJob& job, int frame);
 // Turns the scene's camera (and with it, optionally, its lights) for frame `frame` of the orbit.
 void apply_orbit(Scene& scene, const Orbit& orbit, int frame, int frames);
 
+// A deterministic share of a batch's frames, for Slurm job arrays: numbering every frame of every job in order
+// from 0, shard `index` of `count` renders the frames whose number is index modulo count.
+struct BatchShard {
+  int index = 0, count = 1;
+};
+
+// "K/N" with 0 <= K < N; false with a message otherwise.
+bool parse_shard(const std::string& text, BatchShard& out, std::string& error);
+// The shard of a Slurm array task: SLURM_ARRAY_TASK_ID with SLURM_ARRAY_TASK_COUNT, or with
+// SLURM_ARRAY_TASK_MIN and _MAX (an array 1-4 is shards 0/4 to 3/4). Unset outside an array job; throws
+// SceneError on values that make no shard.
+std::optional<BatchShard> shard_from_slurm_environment();
+// A shard's own file beside `path`: "jobs.log.jsonl" -> "jobs.log.shard-2-of-4.jsonl".
+std::string shard_file(const std::string& path, const BatchShard& shard);
+
 struct BatchRequest {
   std::string jobs_path;            // "-" for standard input
   std::vector<Override> overrides;  // --set and flags, applied to every job after its own
@@ -62,6 +77,8 @@ struct BatchRequest {
   bool resume = false;                    // skip frames whose outputs all exist
   std::optional<std::string> log_path;    // default: beside the jobs file, <stem>.log.jsonl
   std::optional<std::string> stats_path;  // a summary of the whole batch
+  // Only this share of the frames; the log and the stats become the shard's own (shard_file).
+  std::optional<BatchShard> shard;
 };
 
 // One frame finished (rendered, failed or skipped), for a progress display.
@@ -83,6 +100,10 @@ struct BatchCallbacks {
 // rendered), the jobs file or its outputs were bad input (nothing rendered), or it stopped early (the device or
 // the log failed).
 enum class BatchOutcome { Done, FramesFailed, BadInput, Stopped };
+
+// Joins the shard logs of a batch (shard_file of its log, any shard count) into its log: each frame's last entry,
+// in job and frame order. Frames no shard rendered or skipped are reported (FramesFailed), as is a bad jobs file.
+BatchOutcome merge_shard_logs(const BatchRequest& request, const BatchCallbacks& callbacks);
 
 // Runs every frame of every job, in order, on one device with one program cache. A failing frame is reported
 // and logged, and the rest still run.
