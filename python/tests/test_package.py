@@ -160,3 +160,10 @@ def test_the_gil_is_released_while_rendering(renderer):
     worker.join()
     elapsed = time.perf_counter() - start
     assert ticks >= min(10, elapsed / 0.004), (ticks, elapsed)
+
+
+def test_the_renderers_precision_and_a_missing_device():
+    image = algray.Renderer(precision="float").render(algray.Scene.load(TORUS), width=16, height=12, preview=True)
+    assert image.stats["solver"]["precision"] == "float"
+    with pytest.raises(algray.DeviceError):
+        algray.Renderer(device="no such device 12345").device
