@@ -192,10 +192,12 @@ PYBIND11_MODULE(_algray, m) {
       .def(
           "batch",
           [](api::Renderer& r, const std::string& jobs, bool resume, const std::function<void(py::dict)>& progress,
-             const std::function<void(const std::string&)>& message) {
+             const std::function<void(const std::string&)>& message, std::pair<int, int> shard) {
             api::BatchSettings settings;
             settings.jobs_path = jobs;
             settings.resume = resume;
+            settings.shard_index = shard.first;
+            settings.shard_count = shard.second;
             if (progress)
               settings.on_frame = [&](const api::BatchFrame& f) {
                 call_python([&] {
@@ -221,5 +223,6 @@ PYBIND11_MODULE(_algray, m) {
             }
             return std::string("stopped");
           },
-          py::arg("jobs"), py::arg("resume") = false, py::arg("progress") = nullptr, py::arg("message") = nullptr);
+          py::arg("jobs"), py::arg("resume") = false, py::arg("progress") = nullptr, py::arg("message") = nullptr,
+          py::arg("shard") = std::pair<int, int>{0, 1});
 }

@@ -157,6 +157,9 @@ struct BatchSettings {
   bool resume = false;                                       // skip frames whose outputs all exist
   std::optional<std::string> log_path;                       // default: beside the jobs file
   std::optional<std::string> stats_path;
+  // Only frames shard_index, shard_index + shard_count, ... of all (algray batch --shard K/N); the log and stats
+  // become the shard's own. shard_count 1 renders them all.
+  int shard_index = 0, shard_count = 1;
   std::function<void(const BatchFrame&)> on_frame;
   std::function<void(const std::string&)> on_message;  // warnings and failures, one or more lines each
 };

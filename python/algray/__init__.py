@@ -108,12 +108,13 @@ class Renderer:
         origin, direction = ray
         return json.loads(self._renderer.probe_ray(scene, list(origin), list(direction), all_solvers))
 
-    def batch(self, jobs, progress=None, message=None, resume=False, **render_options):
+    def batch(self, jobs, progress=None, message=None, resume=False, shard=(0, 1), **render_options):
         """A jobs file (a path, as `algray batch` takes) run on this device: returns "done", "frames failed",
         "bad input" or "stopped"; progress(frame_dict) after each frame, message(text) for warnings and
-        failures. Or an iterable of scenes: returns their images, calling progress(index, image) after each."""
+        failures; shard=(k, n) renders frames k, k+n, ... as `--shard k/n` does. Or an iterable of scenes:
+        returns their images, calling progress(index, image) after each."""
         if isinstance(jobs, (str, os.PathLike)):
-            return self._renderer.batch(os.fspath(jobs), resume, progress, message)
+            return self._renderer.batch(os.fspath(jobs), resume, progress, message, tuple(shard))
         images = []
         for index, scene in enumerate(jobs):
             images.append(self.render(scene, **render_options))

@@ -139,6 +139,15 @@ def test_a_batch_of_scenes_and_a_jobs_file(renderer, tmp_path):
     frames = []
     assert renderer.batch(str(tmp_path / "jobs.toml"), progress=frames.append) == "done"
     assert frames[0]["status"] == "ok" and (tmp_path / "one.png").exists()
+    (tmp_path / "sweep.toml").write_text('[defaults]\nset = { image = { width = 16, height = 12 } }\n[[job]]\n'
+                                         'name = "s"\nscene = "ball.toml"\noutput = "s_{frame}.png"\n'
+                                         "frames = 5\norbit = { degrees = 90 }\n")
+    shard = []
+    assert renderer.batch(str(tmp_path / "sweep.toml"), progress=shard.append, shard=(1, 2)) == "done"
+    assert [f["frame"] for f in shard] == [1, 3]
+    assert (tmp_path / "sweep.log.shard-1-of-2.jsonl").exists()
+    with pytest.raises(algray.SceneError):
+        renderer.batch(str(tmp_path / "sweep.toml"), shard=(2, 2))
 
 
 def test_the_gil_is_released_while_rendering(renderer):

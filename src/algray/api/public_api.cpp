@@ -239,6 +239,13 @@ BatchResult Renderer::batch(const BatchSettings& settings) {
   request.resume = settings.resume;
   request.log_path = settings.log_path;
   request.stats_path = settings.stats_path;
+  if (settings.shard_count != 1 || settings.shard_index != 0) {
+    BatchShard shard;
+    std::string error;
+    const std::string text = std::to_string(settings.shard_index) + "/" + std::to_string(settings.shard_count);
+    if (!parse_shard(text, shard, error)) throw SceneError("shard " + text + ": " + error, "shard", 0, 0, error, "");
+    request.shard = shard;
+  }
   BatchCallbacks callbacks;
   callbacks.on_message = settings.on_message;
   if (settings.on_frame)
