@@ -36,6 +36,15 @@ py::dict solver_channels(const api::Image& image) {
   return out;
 }
 
+// A device as algray.devices() lists it and Renderer.device describes it.
+py::dict device_dict(const api::Device& d) {
+  return py::dict(py::arg("index") = d.index, py::arg("platform") = d.platform,
+                  py::arg("platform_version") = d.platform_version, py::arg("name") = d.name,
+                  py::arg("vendor") = d.vendor, py::arg("version") = d.version, py::arg("driver") = d.driver,
+                  py::arg("type") = d.type, py::arg("compute_units") = d.compute_units, py::arg("fp64") = d.fp64,
+                  py::arg("global_mem_bytes") = d.global_mem_bytes, py::arg("max_alloc_bytes") = d.max_alloc_bytes);
+}
+
 // Whether to stop: a signal Python must handle (Ctrl-C), or an exception a callback raised. Asked between tiles,
 // with the GIL held only for the question; the Python error stays set, and is raised once the render has stopped.
 bool python_interrupted() {
@@ -86,13 +95,7 @@ PYBIND11_MODULE(_algray, m) {
 
   m.def("devices", [] {
     py::list out;
-    for (const api::Device& d : api::devices())
-      out.append(py::dict(py::arg("index") = d.index, py::arg("platform") = d.platform,
-                          py::arg("platform_version") = d.platform_version, py::arg("name") = d.name,
-                          py::arg("vendor") = d.vendor, py::arg("version") = d.version, py::arg("driver") = d.driver,
-                          py::arg("type") = d.type, py::arg("compute_units") = d.compute_units,
-                          py::arg("fp64") = d.fp64, py::arg("global_mem_bytes") = d.global_mem_bytes,
-                          py::arg("max_alloc_bytes") = d.max_alloc_bytes));
+    for (const api::Device& d : api::devices()) out.append(device_dict(d));
     return out;
   });
 
@@ -142,12 +145,7 @@ PYBIND11_MODULE(_algray, m) {
 
   py::class_<api::Renderer>(m, "_Renderer")
       .def(py::init<const std::string&, bool>(), py::arg("device") = "", py::arg("cache") = true)
-      .def("device",
-           [](api::Renderer& r) {
-             const api::Device d = r.device();
-             return py::dict(py::arg("index") = d.index, py::arg("name") = d.name, py::arg("platform") = d.platform,
-                             py::arg("type") = d.type, py::arg("fp64") = d.fp64);
-           })
+      .def("device", [](api::Renderer& r) { return device_dict(r.device()); })
       .def(
           "render",
           [](api::Renderer& r, const api::Scene& scene, int width, int height, bool preview,

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -16,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
+#include <string_view>
 #include <system_error>
 
 #include "algray/io/image_io.h"
@@ -346,19 +346,48 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks)
   return run_batch(req, callbacks, context);
 }
 
+namespace {
+
+// The whole of `text` as a decimal int: no sign but '-', no spaces, no trailing characters.
+bool whole_number(std::string_view text, int& value) {
+  const char* end = text.data() + text.size();
+  return !text.empty() && std::from_chars(text.data(), end, value).ptr == end;
+}
+
+// Lines for the person running the batch, through its callback; a refusal before any frame, as its outcome.
+struct BatchReporter {
+  const BatchCallbacks& callbacks;
+  void operator()(const std::string& text) const {
+    if (callbacks.on_message) callbacks.on_message(text);
+  }
+  BatchOutcome refused(const std::exception& e) const {
+    const ErrorReport report = describe_error(e);
+    (*this)(report.text);
+    return report.bad_input ? BatchOutcome::BadInput : BatchOutcome::Stopped;
+  }
+};
+
+constexpr const char* kShardExpected = "expected K/N with 0 <= K < N, such as 0/4 for the first of four shards";
+
+}  // namespace
+
+bool check_shard(const BatchShard& shard, std::string& error) {
+  if (shard.count >= 1 && shard.index >= 0 && shard.index < shard.count) return true;
+  error = kShardExpected;
+  return false;
+}
+
 bool parse_shard(const std::string& text, BatchShard& out, std::string& error) {
   const std::size_t slash = text.find('/');
-  int index = -1, count = 0;
-  const auto number = [](const std::string& digits, int& value) {
-    const char* end = digits.data() + digits.size();
-    return !digits.empty() && std::from_chars(digits.data(), end, value).ptr == end;
-  };
-  if (slash == std::string::npos || !number(text.substr(0, slash), index) || !number(text.substr(slash + 1), count) ||
-      count < 1 || index < 0 || index >= count) {
-    error = "expected K/N with 0 <= K < N, such as 0/4 for the first of four shards";
+  BatchShard shard{-1, 0};
+  const std::string_view view(text);
+  if (slash == std::string::npos || !whole_number(view.substr(0, slash), shard.index) ||
+      !whole_number(view.substr(slash + 1), shard.count)) {
+    error = kShardExpected;
     return false;
   }
-  out = {index, count};
+  if (!check_shard(shard, error)) return false;
+  out = shard;
   return true;
 }
 
@@ -367,9 +396,7 @@ std::optional<BatchShard> shard_from_slurm_environment() {
     const char* text = std::getenv(name);
     if (!text || !*text) return std::nullopt;
     int value = 0;
-    const char* end = text + std::strlen(text);
-    if (std::from_chars(text, end, value).ptr != end)
-      throw SceneError(name, std::string("not a whole number: '") + text + "'");
+    if (!whole_number(text, value)) throw SceneError(name, std::string("not a whole number: '") + text + "'");
     return value;
   };
   const std::optional<int> id = variable("SLURM_ARRAY_TASK_ID");
@@ -493,8 +520,7 @@ struct DeviceLost {
 // failing frame is reported through `message`; a DeviceError is thrown on as DeviceLost after logging it.
 class FrameRunner {
  public:
-  FrameRunner(const BatchRequest& req, RenderContext& context, JsonLinesLog& log,
-              const std::function<void(const std::string&)>& message)
+  FrameRunner(const BatchRequest& req, RenderContext& context, JsonLinesLog& log, const BatchReporter& message)
       : req_(req), context_(context), log_(log), message_(message) {}
 
   std::string run(const BatchJob& job, int frame, bool& warned, nlohmann::json& entry) {
@@ -559,27 +585,20 @@ class FrameRunner {
   const BatchRequest& req_;
   RenderContext& context_;
   JsonLinesLog& log_;
-  const std::function<void(const std::string&)>& message_;
+  const BatchReporter& message_;
 };
 
 }  // namespace
 
 BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks, RenderContext& context) {
-  const std::function<void(const std::string&)> message = [&](const std::string& text) {
-    if (callbacks.on_message) callbacks.on_message(text);
-  };
-  const auto refused = [&](const std::exception& e) {
-    const ErrorReport report = describe_error(e);
-    message(report.text);
-    return report.bad_input ? BatchOutcome::BadInput : BatchOutcome::Stopped;
-  };
+  const BatchReporter message{callbacks};
   BatchPlan plan;
   std::optional<JsonLinesLog> log;
   try {
     plan = plan_batch(req);
     log.emplace(plan.log_path, req.resume);
   } catch (const std::exception& e) {
-    return refused(e);
+    return message.refused(e);
   }
 
   const int total = plan.total_frames;
@@ -649,18 +668,14 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks,
 }
 
 BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& callbacks) {
-  const auto message = [&](const std::string& text) {
-    if (callbacks.on_message) callbacks.on_message(text);
-  };
+  const BatchReporter message{callbacks};
   BatchRequest whole = req;
   whole.shard.reset();
   BatchPlan plan;
   try {
     plan = plan_batch(whole);
   } catch (const std::exception& e) {
-    const ErrorReport report = describe_error(e);
-    message(report.text);
-    return report.bad_input ? BatchOutcome::BadInput : BatchOutcome::Stopped;
+    return message.refused(e);
   }
   // The shard logs beside the batch's log: <stem>.shard-K-of-N<extension>, whatever the shard count.
   const fs::path log(plan.log_path);

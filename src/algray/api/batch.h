@@ -60,6 +60,8 @@ struct BatchShard {
   int index = 0, count = 1;
 };
 
+// Whether 0 <= index < count; false with a message otherwise.
+bool check_shard(const BatchShard& shard, std::string& error);
 // "K/N" with 0 <= K < N; false with a message otherwise.
 bool parse_shard(const std::string& text, BatchShard& out, std::string& error);
 // The shard of a Slurm array task: SLURM_ARRAY_TASK_ID with SLURM_ARRAY_TASK_COUNT, or with

@@ -174,13 +174,15 @@ Device Renderer::device() {
 
 Image Renderer::render(const Scene& scene, const RenderSettings& settings) {
   return translated([&] {
-    // The settings are overrides like the command line's flags, applied after the scene's own keys.
+    // The settings are overrides like the command line's flags, applied after the scene's own keys; without any
+    // the scene as read already is the one to render.
     std::vector<Override> overrides = scene.state_->overrides;
     if (settings.width > 0) overrides.push_back({"image.width", std::to_string(settings.width)});
     if (settings.height > 0) overrides.push_back({"image.height", std::to_string(settings.height)});
     if (settings.preview) overrides.push_back({"render.preview", "true"});
     if (!settings.precision.empty()) overrides.push_back({"render.precision", "\"" + settings.precision + "\""});
-    const algray::Scene s = read_scene(*scene.state_, overrides);
+    const bool as_read = overrides.size() == scene.state_->overrides.size();
+    const algray::Scene s = as_read ? scene.state_->scene : read_scene(*scene.state_, overrides);
     FrameRequest request;
     request.reference = settings.reference;
     request.depth_and_normal = settings.depth_and_normal;
@@ -240,10 +242,11 @@ BatchResult Renderer::batch(const BatchSettings& settings) {
   request.log_path = settings.log_path;
   request.stats_path = settings.stats_path;
   if (settings.shard_count != 1 || settings.shard_index != 0) {
-    BatchShard shard;
+    const BatchShard shard{settings.shard_index, settings.shard_count};
     std::string error;
-    const std::string text = std::to_string(settings.shard_index) + "/" + std::to_string(settings.shard_count);
-    if (!parse_shard(text, shard, error)) throw SceneError("shard " + text + ": " + error, "shard", 0, 0, error, "");
+    if (!check_shard(shard, error))
+      throw SceneError("shard " + std::to_string(shard.index) + "/" + std::to_string(shard.count) + ": " + error,
+                       "shard", 0, 0, error, "");
     request.shard = shard;
   }
   BatchCallbacks callbacks;
