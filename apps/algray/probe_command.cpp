@@ -9,7 +9,7 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
   Scene scene;
   try {
     scene = SceneLoader().load(req.scene_path, req.overrides);
-    print_warnings(scene, err);
+    err << warning_text(scene);
     check_probe_target(scene, req.target);
     if (req.plot_path) {
       check_probe_plot_path(*req.plot_path);

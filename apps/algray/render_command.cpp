@@ -38,7 +38,7 @@ int run_render(const RenderRequest& req, std::ostream& err) {
   Scene scene;
   try {
     scene = SceneLoader().load(req.scene_path, req.overrides);
-    print_warnings(scene, err);
+    err << warning_text(scene);
     check_outputs(scene, req.outputs, req.scene_path.value_or(""));
   } catch (const std::exception& e) {
     return report_error(e, err);

@@ -549,7 +549,7 @@ class FrameRunner {
       }
       Scene scene = load_scene_file(job.scene, overrides);
       if (!warned) {
-        for (const std::string& w : scene.warnings) message_("algray: warning: job " + job.name + ": " + w + "\n");
+        if (!scene.warnings.empty()) message_(warning_text(scene, "job " + job.name + ": "));
         warned = true;
       }
       if (job.orbit) {

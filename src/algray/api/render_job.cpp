@@ -282,8 +282,10 @@ Scene SceneLoader::load(const std::optional<std::string>& path, const std::vecto
   return load_scene_file(*path, overrides);
 }
 
-void print_warnings(const Scene& scene, std::ostream& err, const std::string& prefix) {
-  for (const std::string& w : scene.warnings) err << "algray: warning: " << prefix << w << "\n";
+std::string warning_text(const Scene& scene, const std::string& prefix) {
+  std::string text;
+  for (const std::string& w : scene.warnings) text += "algray: warning: " + prefix + w + "\n";
+  return text;
 }
 
 namespace {

@@ -6,7 +6,6 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <ostream>
 #include <string>
 #include <vector>
 
@@ -101,8 +100,8 @@ class SceneLoader {
   bool stdin_read_ = false;
 };
 
-// The scene's warnings, one "algray: warning: ..." line each.
-void print_warnings(const Scene& scene, std::ostream& err, const std::string& prefix = "");
+// The scene's warnings as the command line prints them: one "algray: warning: PREFIX..." line each.
+std::string warning_text(const Scene& scene, const std::string& prefix = "");
 
 // Bad input in the outputs (unknown format, missing or unwritable directory, an output that is the scene file
 // `scene_path` or another output), found before any work: throws OutputError or SceneError.
