@@ -11,9 +11,14 @@
 #include "algray/scene/scene.h"
 #include "algray/render/shade.h"
 #include "algray/render/solver_aov.h"
+#include "film_compare.h"
+#include "scene_fixtures.h"
 #include "test_support.h"
 
 using namespace algray;
+using testing::ball_and_ring;
+using testing::first_difference;
+using testing::same_bits;
 
 namespace {
 
@@ -128,34 +133,6 @@ TEST_CASE("a transparent side without a transmission pass shows opaque, not dark
   }
 }
 
-namespace {
-
-// Bit for bit: the same floats, NaNs and signed zeros included.
-template <typename T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
-
-// The first pixel where two films differ, for the failure message.
-std::string first_difference(const FrameImage& a, const FrameImage& b) {
-  for (std::size_t i = 0; i < a.depth.size() && i < b.depth.size(); ++i) {
-    const bool differs = std::memcmp(&a.rgba[4 * i], &b.rgba[4 * i], 4 * sizeof(float)) != 0 ||
-                         std::memcmp(&a.depth[i], &b.depth[i], sizeof(float)) != 0 ||
-                         std::memcmp(&a.normal[3 * i], &b.normal[3 * i], 3 * sizeof(float)) != 0;
-    if (differs)
-      return "pixel " + std::to_string(i % a.width) + "," + std::to_string(i / a.width) + ": red " +
-             std::to_string(a.rgba[4 * i]) + " against " + std::to_string(b.rgba[4 * i]);
-  }
-  return "none";
-}
-
-Scene ball_and_ring(const std::vector<Override>& overrides) {
-  std::vector<Override> all = {{"image.width", "72"}, {"image.height", "54"}};
-  all.insert(all.end(), overrides.begin(), overrides.end());
-  return load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/examples/ball_and_ring.toml", all);
-}
-
-}  // namespace
 
 TEST_CASE("tiles and batches change no pixel: small ones render the one-tile image bit for bit", "[secondary][tiles]") {
   ClSession& session = testing::device_session();

@@ -36,7 +36,9 @@ void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = t
                     "scene file (.toml or .jsurf), or - for standard input; default: the built-in Barth sextic");
   cmd->add_option("--width", o.width, "image width in pixels (overrides image.width)");
   cmd->add_option("--height", o.height, "image height in pixels (overrides image.height)");
-  cmd->add_option("--device", o.device_spec, "device index or name substring (see `algray devices`)");
+  cmd->add_option("--device", o.device_spec,
+                  "device index or name substring (see `algray devices`); a comma-separated list of them, or all, "
+                  "renders each image on those devices together");
   cmd->add_option("--precision", o.precision, precision_choices("or") + " (overrides render.precision)");
   cmd->add_option("--isolation", o.isolation,
                   "root isolation: " + isolation_choices("or") + " (overrides render.isolation)");
@@ -124,9 +126,8 @@ struct RenderCommand {
     cmd->add_option("-o,--output", request.outputs.images, "output image; .exr or .png by extension; may be repeated")
         ->default_str("algray.exr");
     cmd->add_option("--stats", stats_path, "write render statistics as JSON");
-    cmd->add_flag(
-        "--reference", request.outputs.reference,
-        "solve every pixel exactly on the CPU (solver_ref, all cores, slow); adds a reference.class channel");
+    cmd->add_flag("--reference", request.outputs.reference,
+                  "solve every pixel exactly on the CPU (solver_ref, all cores, slow); adds a reference.class channel");
     cmd->add_option("--aov", aov_text, "solver channels for EXR outputs, comma-separated: " + aov_choices());
     cmd->add_option("--heatmap", request.outputs.heatmap_path,
                     "write a heat map of solver work per pixel (isolation steps + refinement iterations), .png");

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "algray/device/kernel_config.h"
+#include "algray/scene/scene.h"
 
 namespace algray::testing {
 
@@ -57,6 +58,14 @@ inline std::string random_scene(int degree, unsigned seed, Precision precision) 
     << "fov_y = 45\n[image]\nwidth = 64\nheight = 48\n[render]\nprecision = \"" << to_string(precision) << "\"\npreview = true\n"
     << "ray_origin = \"auto\"\n";
   return s.str();
+}
+
+// The example scene with everything that crosses a tile's border or fills a batch: two surfaces, a reflective
+// ball and a transparent ring, an area light; small.
+inline Scene ball_and_ring(const std::vector<Override>& overrides) {
+  std::vector<Override> all = {{"image.width", "72"}, {"image.height", "54"}};
+  all.insert(all.end(), overrides.begin(), overrides.end());
+  return load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/examples/ball_and_ring.toml", all);
 }
 
 }  // namespace algray::testing

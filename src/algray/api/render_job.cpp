@@ -19,12 +19,12 @@
 #include <sstream>
 
 #include "algray/device/cl_runtime.h"
-#include "algray/io/heatmap.h"
-#include "algray/scene/jsurf.h"
 #include "algray/device/program_cache.h"
+#include "algray/io/heatmap.h"
 #include "algray/render/reference_render.h"
 #include "algray/render/renderer.h"
 #include "algray/render/shade.h"
+#include "algray/scene/jsurf.h"
 #include "algray/util/version.h"
 
 namespace algray {
@@ -45,6 +45,9 @@ std::string vec_text(const glm::dvec3& v) {
 // Metadata that lets anyone rebuild any pixel's ray from the file and the README's camera convention.
 void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, const DeviceInfo& device) {
   const RayBasis& b = r.basis;
+  std::string devices = device.name + " (" + device.platform_name + ", " + device.driver_version + ")";
+  for (std::size_t d = 1; d < r.devices.size(); ++d)
+    devices += " + [" + std::to_string(r.devices[d].index) + "] " + r.devices[d].name;
   const CameraSpec& cam = scene.camera;
   img.string_attributes = {
       {"algray/scene", scene.source},
@@ -55,7 +58,7 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
       {"algray/refinement", to_string(r.config.refinement)},
       {"algray/rayOrigin", to_string(r.config.ray_origin)},
       {"algray/precision", to_string(r.config.precision)},
-      {"algray/device", device.name + " (" + device.platform_name + ", " + device.driver_version + ")"},
+      {"algray/device", devices},
       {"algray/camera/projection", cam.projection == Projection::Perspective ? "perspective" : "orthographic"},
       {"algray/camera/eye", vec_text(cam.eye)},
       {"algray/camera/lookAt", vec_text(cam.look_at)},
@@ -110,7 +113,6 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
   img.world_to_camera = world_to_camera_matrix(b, cam.eye);
   img.world_to_ndc = world_to_ndc_matrix(cam, b, scene.image.width, scene.image.height);
 }
-
 
 }  // namespace
 
@@ -183,6 +185,14 @@ nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const
     passes_ms += pass.wall_ms;
   }
   j["render_ms"] = {{"kernel", kernel_ms}, {"passes_wall", passes_ms}, {"host_shading", r.shade_ms}};
+  // Each device's share of the tiles, of the rays of every pass, and of the device time.
+  for (const DeviceShare& d : r.devices)
+    j["devices"].push_back({{"index", d.index},
+                            {"name", d.name},
+                            {"tiles", d.tiles},
+                            {"rays", d.rays},
+                            {"kernel_ms", d.kernel_ms},
+                            {"programs_ms", d.programs_ms}});
   j["phases_ms"] = frame.timer.json();
   j["total_ms"] = frame.timer.total_ms();
   return j;
@@ -196,8 +206,7 @@ namespace {
 // Two names of one file give one identity: its device and inode when it exists, else its normalised absolute path.
 std::string file_identity(const std::string& path) {
   struct stat st {};
-  if (::stat(path.c_str(), &st) == 0)
-    return "inode " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+  if (::stat(path.c_str(), &st) == 0) return "inode " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
   std::error_code ec;
   const std::filesystem::path canonical = std::filesystem::weakly_canonical(std::filesystem::absolute(path, ec), ec);
   return "path " + (ec ? std::filesystem::path(path).lexically_normal().string() : canonical.string());
@@ -246,9 +255,14 @@ RenderContext::RenderContext(std::string device_spec, bool use_cache)
 
 RenderContext::~RenderContext() = default;
 
-ClSession& RenderContext::session() {
-  if (!session_) session_ = std::make_unique<ClSession>(select_device(device_spec_));
-  return *session_;
+ClSession& RenderContext::session() { return *sessions().front(); }
+
+std::vector<ClSession*> RenderContext::sessions() {
+  if (sessions_.empty())
+    for (DeviceInfo& device : select_devices(device_spec_)) sessions_.push_back(std::make_unique<ClSession>(device));
+  std::vector<ClSession*> out;
+  for (const auto& session : sessions_) out.push_back(session.get());
+  return out;
 }
 
 ProgramCache& RenderContext::cache() {
@@ -358,10 +372,10 @@ RenderedFrame render_frame(const Scene& scene, const FrameRequest& request, Rend
         if (png) srgb_byte(0.5f);
         return make_film(film_width, film_height, depth_and_normal);
       });
-    ClSession& session = context.session();
-    device = session.info;
+    const std::vector<ClSession*> sessions = context.sessions();
+    device = sessions.front()->info;
     timer.mark("device");
-    Renderer renderer(session, context.cache());
+    Renderer renderer(sessions, context.cache());
     RenderOptions options;
     if (ahead) options.film = [&film] { return film.get(); };
     options.on_progress = callbacks.on_progress;

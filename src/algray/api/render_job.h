@@ -11,9 +11,9 @@
 
 #include "algray/device/cl_runtime.h"
 #include "algray/device/program_cache.h"
-#include "algray/scene/scene.h"
 #include "algray/render/renderer.h"
 #include "algray/render/solver_aov.h"
+#include "algray/scene/scene.h"
 
 namespace algray {
 
@@ -72,20 +72,23 @@ class OutputWriter {
 // input, found before any work.
 void check_output_writable(const std::string& path);
 
-// The device session and program cache, opened on first use and then shared by every render of the process:
-// a batch compiles each kernel once and opens the device once.
+// The device sessions and program cache, opened on first use and then shared by every render of the process:
+// a batch compiles each kernel once and opens each device once. The spec is select_devices': one device, a
+// list, or "all", which then render every image together.
 class RenderContext {
  public:
   RenderContext(std::string device_spec, bool use_cache);
   ~RenderContext();
-  ClSession& session();  // throws DeviceError when the device cannot be opened
+  // Throw DeviceError when a device cannot be opened.
+  ClSession& session();  // the first device: the probe's, and the one an API user is told of
+  std::vector<ClSession*> sessions();
   ProgramCache& cache();
   bool uses_cache() const { return use_cache_; }
 
  private:
   std::string device_spec_;
   bool use_cache_;
-  std::unique_ptr<ClSession> session_;
+  std::vector<std::unique_ptr<ClSession>> sessions_;
   std::unique_ptr<ProgramCache> cache_;
 };
 
@@ -146,8 +149,8 @@ struct RenderedFrame {
   FrameImage image;
   std::optional<FrameImage> heatmap;
   RenderResult result;  // its image moved into `image`
-  DeviceInfo device;
-  PhaseTimer timer;  // the steps so far, from the command's start; the caller marks its own after
+  DeviceInfo device;    // the first of the devices (result.devices lists them all)
+  PhaseTimer timer;     // the steps so far, from the command's start; the caller marks its own after
 };
 
 // What render_frame makes besides the colour: whether EXR's depth and normal channels are wanted (a PNG holds

@@ -79,29 +79,72 @@ std::string describe_devices(const std::vector<DeviceInfo>& devices) {
   return s.str();
 }
 
-DeviceInfo select_device(const std::string& spec) {
-  const std::vector<DeviceInfo> devices = enumerate_devices();
+namespace {
+
+// One item of a device spec among `devices`: digits are an index, anything else the first device or platform
+// name containing it that `taken` does not already hold (so "pthread,pthread" names two PoCL devices).
+const DeviceInfo& find_device(const std::vector<DeviceInfo>& devices, const std::string& item,
+                              const std::vector<DeviceInfo>& taken) {
+  auto is_taken = [&](const DeviceInfo& d) {
+    return std::any_of(taken.begin(), taken.end(), [&](const DeviceInfo& t) { return t.index == d.index; });
+  };
+  if (!item.empty() && std::all_of(item.begin(), item.end(), [](unsigned char c) { return std::isdigit(c); })) {
+    const unsigned long index = item.size() > 9 ? devices.size() : std::stoul(item);
+    if (index >= devices.size())
+      throw DeviceError("--device " + item + ": there are only " + std::to_string(devices.size()) + " devices:\n" +
+                        describe_devices(devices));
+    if (is_taken(devices[index])) throw DeviceError("--device: device " + item + " is named twice");
+    return devices[index];
+  }
+  const std::string needle = lower(item);
+  bool matched = false;
+  for (const DeviceInfo& d : devices)
+    if (lower(d.name).find(needle) != std::string::npos || lower(d.platform_name).find(needle) != std::string::npos) {
+      matched = true;
+      if (!is_taken(d)) return d;
+    }
+  throw DeviceError("--device " + item +
+                    (matched ? ": every device whose name contains it is already named; the devices are:\n"
+                             : ": no device or platform name contains it; the devices are:\n") +
+                    describe_devices(devices));
+}
+
+std::vector<DeviceInfo> devices_or_error() {
+  std::vector<DeviceInfo> devices = enumerate_devices();
   if (devices.empty())
     throw DeviceError(
         "no OpenCL device found: install an OpenCL driver (for the CPU on Debian: apt-get install "
         "pocl-opencl-icd) and check with `algray devices`");
+  return devices;
+}
+
+}  // namespace
+
+DeviceInfo select_device(const std::string& spec) {
+  const std::vector<DeviceInfo> devices = devices_or_error();
   if (spec.empty()) {
     for (const DeviceInfo& d : devices)
       if (d.type == "GPU") return d;
     return devices.front();
   }
-  if (std::all_of(spec.begin(), spec.end(), [](unsigned char c) { return std::isdigit(c); })) {
-    const unsigned long index = std::stoul(spec);
-    if (index < devices.size()) return devices[index];
-    throw DeviceError("--device " + spec + ": there are only " + std::to_string(devices.size()) + " devices:\n" +
-                      describe_devices(devices));
+  return find_device(devices, spec, {});
+}
+
+std::vector<DeviceInfo> select_devices(const std::string& spec) {
+  if (lower(spec) == "all") return devices_or_error();
+  if (spec.find(',') == std::string::npos) return {select_device(spec)};
+  const std::vector<DeviceInfo> devices = devices_or_error();
+  std::vector<DeviceInfo> chosen;
+  std::size_t begin = 0;
+  while (begin <= spec.size()) {
+    const std::size_t comma = std::min(spec.find(',', begin), spec.size());
+    std::string item = trimmed(spec.substr(begin, comma - begin));
+    item.erase(0, std::min(item.size(), item.find_first_not_of(' ')));
+    if (item.empty()) throw DeviceError("--device " + spec + ": an empty item in the list");
+    chosen.push_back(find_device(devices, item, chosen));
+    begin = comma + 1;
   }
-  const std::string needle = lower(spec);
-  for (const DeviceInfo& d : devices)
-    if (lower(d.name).find(needle) != std::string::npos || lower(d.platform_name).find(needle) != std::string::npos)
-      return d;
-  throw DeviceError("--device " + spec + ": no device or platform name contains it; the devices are:\n" +
-                    describe_devices(devices));
+  return chosen;
 }
 
 ClSession::ClSession(DeviceInfo chosen)

@@ -31,6 +31,10 @@ std::vector<DeviceInfo> enumerate_devices();
 // spec "": the first GPU, else the first device. Digits: that index. Otherwise a case-insensitive substring of
 // the device or platform name. Throws DeviceError naming the devices that exist.
 DeviceInfo select_device(const std::string& spec);
+// Several devices for one render: "all", or a comma-separated list of indices and name substrings ("0,2",
+// "pthread,pthread": a repeated substring takes the next device it matches). One item is select_device's.
+// Throws DeviceError naming the devices that exist, or a device named twice.
+std::vector<DeviceInfo> select_devices(const std::string& spec);
 
 std::string describe_devices(const std::vector<DeviceInfo>& devices);
 

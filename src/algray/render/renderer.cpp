@@ -8,10 +8,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <future>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <new>
+#include <thread>
 #include <utility>
 
 #include "algray/render/ray_tracer.h"
@@ -188,15 +191,26 @@ struct Renderer::Bounce {
   std::uint8_t surface;  // which of the scene's surfaces it hit
 };
 
-// What every tile's passes share while a render runs: kernels, tracers, the stats, and one tile's buffers,
-// which the next tile reuses.
+// What the devices of one render share: the tile queue, and a lock around the caller's callbacks and the kept
+// records. Each device's thread writes its own tiles' pixels into the film, so the film itself needs no lock.
+struct Renderer::Shared {
+  std::mutex lock;
+  std::atomic<std::size_t> next_tile{0};
+  std::atomic<bool> stop{false};  // a device failed, or the render was cancelled: the others take no more tiles
+  int tiles_done = 0, tiles_total = 0;
+};
+
+// What every tile's passes on one device share while a render runs: kernels, tracers, the device's stats, and
+// one tile's buffers, which the device's next tile reuses.
 struct Renderer::Passes {
-  Passes(const Scene& s, const RenderOptions& o, Precision p, RenderResult& r)
-      : scene(s), options(o), precision(p), result(r), stats(r.plan.passes.size()) {}
+  Passes(ClSession& se, Shared& sh, const Scene& s, const RenderOptions& o, Precision p, RenderResult& r)
+      : session(se), shared(sh), scene(s), options(o), precision(p), result(r), stats(r.plan.passes.size()) {}
+  ClSession& session;
+  Shared& shared;
   const Scene& scene;
   const RenderOptions& options;
   Precision precision;
-  RenderResult& result;
+  RenderResult& result;  // its plan, basis and film are the render's; the tallies below are this device's
   std::vector<std::unique_ptr<DeviceSurface>> surfaces;  // one per scene surface
   std::vector<PassStats> stats;                          // one per planned pass, in plan order
   std::vector<cl::Kernel> primary;                       // one per surface
@@ -209,8 +223,15 @@ struct Renderer::Passes {
   std::unique_ptr<ShadowPoints> shadow_points;           // a batch's surface points on the device
   std::vector<std::vector<glm::dvec3>> light_points;     // per shadow-casting light of the plan
   std::vector<std::unique_ptr<RayTracer>> rays;          // one per surface, when it has a secondary pass
-  std::unique_ptr<Shader> shader;
-  RayBasis fine;  // adaptive antialiasing: the rays of the n-times finer grid
+  const Shader* shader = nullptr;                        // the render's: shading is const, so the devices share one
+  RayBasis fine;                                         // adaptive antialiasing: the rays of the n-times finer grid
+
+  // This device's share, added into the result when every device is done.
+  PrimarySummary primary_summary;
+  double shade_ms = 0;
+  std::vector<ProgramRecord> programs;
+  int tiles = 0;
+  int band_y0 = -1;  // the band (row of tiles) whose arguments the primary kernels hold
 
   // One tile's work.
   HitRecord* hits = nullptr;              // camera rays, row-major in the tile: primary_out mapped
@@ -220,23 +241,23 @@ struct Renderer::Passes {
   std::vector<glm::dvec3> refined_colour;  // adaptive antialiasing: per pixel of the tile
   std::vector<double> refined_alpha;
 
-  int tiles_done = 0, tiles_total = 0;
-
   PassStats* stats_of(PassKind kind) {
     for (std::size_t i = 0; i < stats.size(); ++i)
       if (result.plan.passes[i].kind == kind) return &stats[i];
     return nullptr;
   }
   bool single() const { return precision != Precision::Double; }
-  // One more tile done; then, before the next, whether to go on.
+  // One more tile done; then, before the next, whether to go on. The caller's callbacks are called by one
+  // device at a time.
   void progress() {
-    ++tiles_done;
-    if (options.on_progress) options.on_progress({tiles_done, tiles_total});
+    const std::lock_guard<std::mutex> hold(shared.lock);
+    ++shared.tiles_done;
+    if (options.on_progress) options.on_progress({shared.tiles_done, shared.tiles_total});
   }
   void check_cancelled() const {
+    const std::lock_guard<std::mutex> hold(shared.lock);
     if (options.cancelled && options.cancelled()) throw RenderCancelled("the render was cancelled");
   }
-
 };
 
 namespace {
@@ -318,21 +339,91 @@ RenderResult Renderer::render_with_records(const Scene& scene) {
   return render(scene, options);
 }
 
+Renderer::Renderer(std::vector<ClSession*> sessions, ProgramCache& cache)
+    : sessions_(std::move(sessions)), cache_(cache) {
+  if (sessions_.empty()) throw DeviceError("a render needs at least one device");
+}
+
+Precision Renderer::precision_of(const Scene& scene) const {
+  Precision precision = resolve_precision(scene, sessions_.front()->info);
+  // Left to the devices, the render is in double only where every device has it: the devices' tiles must match.
+  for (const ClSession* session : sessions_)
+    if (resolve_precision(scene, session->info) != precision) precision = Precision::Float;
+  return precision;
+}
+
+RenderPlan Renderer::plan_of(const Scene& scene, Precision precision) const {
+  const DeviceInfo& first = sessions_.front()->info;
+  const int lanes = default_lanes(first.type);
+  if (scene.render.tile_size > 0) return make_render_plan(scene, precision, scene.render.tile_size, lanes);
+  int side = default_tile_size(first);
+  for (const ClSession* session : sessions_) side = std::min(side, default_tile_size(session->info));
+  RenderPlan plan = make_render_plan(scene, precision, side, lanes);
+  // Several devices take tiles from one queue: with about 8 tiles each, a device that finds its tiles cheaper
+  // takes more of them, and none idles long at the end. The tile size changes no pixel (test_multi_device).
+  const std::size_t wanted = sessions_.size() > 1 ? 8 * sessions_.size() : 1;
+  auto tiles = [](const RenderPlan& p) {
+    const std::size_t side_pixels = static_cast<std::size_t>(p.tile_pixels());
+    return ((static_cast<std::size_t>(p.width) + side_pixels - 1) / side_pixels) *
+           ((static_cast<std::size_t>(p.height) + side_pixels - 1) / side_pixels);
+  };
+  while (tiles(plan) < wanted && plan.tile_size / 2 >= 16 * plan.samples)
+    plan = make_render_plan(scene, precision, plan.tile_size / 2, lanes);
+  return plan;
+}
+
+void Renderer::sweep(std::vector<std::unique_ptr<Passes>>& devices, const std::vector<Tile>& tiles,
+                     const std::function<void(Passes&, const Tile&)>& work) {
+  Shared& shared = devices.front()->shared;
+  shared.next_tile = 0;
+  auto take_tiles = [&](Passes& passes) {
+    while (!shared.stop) {
+      const std::size_t t = shared.next_tile++;
+      if (t >= tiles.size()) return;
+      passes.check_cancelled();
+      work(passes, tiles[t]);
+      passes.progress();
+    }
+  };
+  if (devices.size() == 1) return take_tiles(*devices.front());
+  // One thread per device, each waiting on its own queue and shading its own tiles on the host.
+  std::vector<std::exception_ptr> failures(devices.size());
+  std::vector<std::thread> threads;
+  for (std::size_t d = 0; d < devices.size(); ++d)
+    threads.emplace_back([&, d] {
+      try {
+        take_tiles(*devices[d]);
+      } catch (...) {
+        failures[d] = std::current_exception();
+        shared.stop = true;
+      }
+    });
+  for (std::thread& t : threads) t.join();
+  for (const std::exception_ptr& failure : failures)
+    if (failure) std::rethrow_exception(failure);
+}
+
 RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) {
   RenderResult result;
-  const Precision precision = resolve_precision(scene, session_.info);
-  const int tile_side = scene.render.tile_size > 0 ? scene.render.tile_size : default_tile_size(session_.info);
-  result.plan = make_render_plan(scene, precision, tile_side, default_lanes(session_.info.type));
-  check_plan_fits(result.plan, session_.info);
+  const Precision precision = precision_of(scene);
+  result.plan = plan_of(scene, precision);
+  for (const ClSession* session : sessions_) check_plan_fits(result.plan, session->info);
   result.config = primary_config(scene, precision);
   const RenderPlan& plan = result.plan;
   const int trace_width = plan.trace_width(), trace_height = plan.trace_height();
   result.basis = make_ray_basis(scene.camera, trace_width, trace_height);
-  Passes passes(scene, options, precision, result);
-  for (std::size_t i = 0; i < scene.surfaces.size(); ++i)
-    passes.surfaces.push_back(std::make_unique<DeviceSurface>(session_.context, scene, precision, i));
-  prepare_passes(passes);
-  passes.shader = std::make_unique<Shader>(scene, plan, result.basis, precision);
+  Shared shared;
+  const Shader shader(scene, plan, result.basis, precision);
+  // The devices' kernels are loaded one device after another: the program cache serves one caller at a time.
+  std::vector<std::unique_ptr<Passes>> devices;
+  for (ClSession* session : sessions_) {
+    devices.push_back(std::make_unique<Passes>(*session, shared, scene, options, precision, result));
+    Passes& passes = *devices.back();
+    for (std::size_t i = 0; i < scene.surfaces.size(); ++i)
+      passes.surfaces.push_back(std::make_unique<DeviceSurface>(session->context, scene, precision, i));
+    prepare_passes(passes);
+    passes.shader = &shader;
+  }
   if (options.film) result.image = options.film();
   if (result.image.width != plan.width || result.image.height != plan.height ||
       result.image.rgba.size() != 4 * static_cast<std::size_t>(plan.width) * plan.height)
@@ -354,33 +445,64 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
       tiles.push_back({x0, y0, w, h, x0 * s, y0 * s, w * s, h * s});
     }
   const bool adaptive = plan.refine_samples > 1;
-  passes.tiles_total = static_cast<int>(tiles.size()) * (adaptive ? 2 : 1);
-  for (std::size_t t = 0; t < tiles.size(); ++t) {
-    const Tile& tile = tiles[t];
-    passes.check_cancelled();
-    if (t == 0 || tile.y0 != tiles[t - 1].y0) set_band_args(passes, tile);
+  shared.tiles_total = static_cast<int>(tiles.size()) * (adaptive ? 2 : 1);
+  sweep(devices, tiles, [this](Passes& passes, const Tile& tile) {
+    if (tile.y0 != passes.band_y0) {
+      set_band_args(passes, tile);
+      passes.band_y0 = tile.y0;
+    }
     trace_primary(passes, tile);
     finish_tile(passes, tile);
-    passes.progress();
-  }
+    ++passes.tiles;
+  });
   if (adaptive) {
+    // Every device's first colours are in the film before any pixel is chosen: a tile's choice at its border
+    // sees its neighbours', whichever device traced them.
     const auto start = std::chrono::steady_clock::now();
-    passes.fine = make_ray_basis(scene.camera, plan.width * plan.refine_samples, plan.height * plan.refine_samples);
+    const RayBasis fine =
+        make_ray_basis(scene.camera, plan.width * plan.refine_samples, plan.height * plan.refine_samples);
+    for (auto& passes : devices) passes->fine = fine;
     const std::vector<std::uint8_t> refine = pixels_to_refine(result.image, plan.refine_threshold);
-    result.shade_ms += ms_since(start);
-    for (const Tile& tile : tiles) {
-      passes.check_cancelled();
-      refine_tile(passes, tile, refine);
-      passes.progress();
-    }
+    devices.front()->shade_ms += ms_since(start);
+    sweep(devices, tiles, [this, &refine](Passes& passes, const Tile& tile) { refine_tile(passes, tile, refine); });
     if (options.keep_records) result.refined = refine;
   }
-
-  for (std::size_t i = 0; i < passes.stats.size(); ++i) {
-    passes.stats[i].name = to_string(plan.passes[i].kind);
-    result.passes.push_back(passes.stats[i]);
-  }
+  add_device_tallies(devices, result);
   return result;
+}
+
+void Renderer::add_device_tallies(const std::vector<std::unique_ptr<Passes>>& devices, RenderResult& result) {
+  const RenderPlan& plan = result.plan;
+  for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+    PassStats total = devices.front()->stats[i];
+    for (std::size_t d = 1; d < devices.size(); ++d) {
+      const PassStats& more = devices[d]->stats[i];
+      total.rays += more.rays;
+      total.launches += more.launches;
+      total.kernel_ms += more.kernel_ms;
+      total.wall_ms += more.wall_ms;  // device threads' times added, as one device's passes' are
+      for (std::size_t k = 0; k < total.program_ms.size(); ++k) total.program_ms[k] += more.program_ms[k];
+    }
+    total.name = to_string(plan.passes[i].kind);
+    result.passes.push_back(total);
+  }
+  // Every device loads the same programs; the first device's records stand for them, each device's load time
+  // is in its share.
+  result.programs = devices.front()->programs;
+  for (const auto& passes : devices) {
+    result.primary += passes->primary_summary;
+    result.shade_ms += passes->shade_ms;
+    DeviceShare share;
+    share.index = passes->session.info.index;
+    share.name = passes->session.info.name;
+    share.tiles = passes->tiles;
+    for (const PassStats& pass : passes->stats) {
+      share.rays += pass.rays;
+      share.kernel_ms += pass.kernel_ms;
+    }
+    for (const ProgramRecord& program : passes->programs) share.programs_ms += program.build_ms;
+    result.devices.push_back(share);
+  }
 }
 
 void Renderer::prepare_passes(Passes& passes) {
@@ -396,29 +518,30 @@ void Renderer::prepare_passes(Passes& passes) {
       std::async(std::launch::async, [tile_rays] { return PopulatedPages(tile_rays * sizeof(HitRecord)); });
   for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
     ProgramRecord record;
-    passes.primary.push_back(cache_.kernel(session_, plan.find(PassKind::Primary)->kernels[s], &record));
+    passes.primary.push_back(cache_.kernel(passes.session, plan.find(PassKind::Primary)->kernels[s], &record));
     passes.primary_tile_arg.push_back(0);
     passes.primary_lanes.push_back(plan.find(PassKind::Primary)->kernels[s].lanes);
     passes.screen_rows.emplace_back();
-    result.programs.push_back(record);
+    passes.programs.push_back(record);
     primary.program_keys.push_back(record.key);
     primary.program_ms.push_back(0);
   }
-  passes.primary_out = std::make_unique<TileHits>(session_.context, session_.queue, tile_rays, hit_memory.get());
+  passes.primary_out =
+      std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays, hit_memory.get());
   if (scene.surfaces.size() > 1)
-    passes.other_out = std::make_unique<TileHits>(session_.context, session_.queue, tile_rays,
+    passes.other_out = std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays,
                                                   PopulatedPages(tile_rays * sizeof(HitRecord)));
 
   if (PassStats* stats = passes.stats_of(PassKind::Shadow)) {
     const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
     for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-      passes.shadows.push_back(std::make_unique<ShadowTracer>(session_, cache_, plan.find(PassKind::Shadow)->kernels[i],
-                                                              *passes.surfaces[i], offset));
-      result.programs.push_back(passes.shadows.back()->program());
+      passes.shadows.push_back(std::make_unique<ShadowTracer>(
+          passes.session, cache_, plan.find(PassKind::Shadow)->kernels[i], *passes.surfaces[i], offset));
+      passes.programs.push_back(passes.shadows.back()->program());
       stats->program_keys.push_back(passes.shadows.back()->program().key);
       stats->program_ms.push_back(0);
     }
-    passes.shadow_points = std::make_unique<ShadowPoints>(session_, passes.precision);
+    passes.shadow_points = std::make_unique<ShadowPoints>(passes.session, passes.precision);
     for (int light : plan.shadow_lights)
       passes.light_points.push_back(scene.lights[static_cast<std::size_t>(light)].sample_points());
   }
@@ -428,8 +551,8 @@ void Renderer::prepare_passes(Passes& passes) {
       if (passes.rays.empty())
         for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
           passes.rays.push_back(
-              std::make_unique<RayTracer>(session_, cache_, plan.find(kind)->kernels[i], *passes.surfaces[i]));
-          result.programs.push_back(passes.rays.back()->program());
+              std::make_unique<RayTracer>(passes.session, cache_, plan.find(kind)->kernels[i], *passes.surfaces[i]));
+          passes.programs.push_back(passes.rays.back()->program());
         }
       for (const auto& tracer : passes.rays) {
         stats->program_keys.push_back(tracer->program().key);
@@ -451,7 +574,7 @@ void Renderer::set_band_args(Passes& passes, const Tile& first) {
     // The screen form's polynomials of the band's rows; the kernel must answer each camera ray alike whatever
     // tile and band it is in (test_secondary_rays compares renders in small and large tiles bit for bit).
     passes.screen_rows[s] =
-        surface.set_screen_args(args, session_.context, plan.find(PassKind::Primary)->kernels[s], result.basis,
+        surface.set_screen_args(args, passes.session.context, plan.find(PassKind::Primary)->kernels[s], result.basis,
                                 plan.trace_width(), plan.trace_height(), first.trace_y0, first.trace_h);
     passes.primary_tile_arg[s] = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
     args.skip(4);
@@ -474,9 +597,9 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
     kernel.setArg(tile_arg + 2, static_cast<cl_uint>(tile.trace_w));
     kernel.setArg(tile_arg + 3, static_cast<cl_uint>(tile.trace_h));
     cl::Event done;
-    session_.queue.enqueueNDRangeKernel(kernel, cl::NullRange,
-                                        primary_global_size(passes.primary_lanes[s], tile.trace_w, tile.trace_h),
-                                        primary_local_size(passes.primary_lanes[s]), nullptr, &done);
+    passes.session.queue.enqueueNDRangeKernel(kernel, cl::NullRange,
+                                              primary_global_size(passes.primary_lanes[s], tile.trace_w, tile.trace_h),
+                                              primary_local_size(passes.primary_lanes[s]), nullptr, &done);
     // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
     done.wait();
     pass.kernel_ms += ms_between(done);
@@ -525,10 +648,12 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
     return pixel_ray(result.basis, single, tile.trace_x0 + static_cast<int>(k % tile.trace_w),
                      tile.trace_y0 + static_cast<int>(k / tile.trace_w));
   };
-  result.primary.add(passes.hits, tile.trace_w, tile.trace_h, plan.samples);
-  if (passes.options.on_primary_tile)
+  passes.primary_summary.add(passes.hits, tile.trace_w, tile.trace_h, plan.samples);
+  if (passes.options.on_primary_tile) {
+    const std::lock_guard<std::mutex> hold(passes.shared.lock);
     passes.options.on_primary_tile(
         {tile.trace_x0, tile.trace_y0, tile.trace_w, tile.trace_h, plan.samples, passes.hits});
+  }
   if (passes.options.keep_records)
     for (std::size_t k = 0; k < rays; ++k) {
       const std::uint32_t at = tile.ray_in_image(k, grid_width);
@@ -540,6 +665,7 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
   if (!passes.shadows.empty()) {
     shadows = trace_shadows(passes, passes.hits, rays, camera_ray);
     if (passes.options.keep_records) {
+      const std::lock_guard<std::mutex> hold(passes.shared.lock);
       for (std::uint32_t k : shadows.points) result.shadows.points.push_back(tile.ray_in_image(k, grid_width));
       for (std::size_t l = 0; l < shadows.occlusion.size(); ++l) {
         std::vector<std::uint64_t>& all = result.shadows.occlusion[l].masks;
@@ -578,7 +704,7 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
   block.shadows = &lookup;
   block.secondary = passes.any_secondary ? passes.secondary.data() : nullptr;
   passes.shader->resolve(block, result.image);
-  result.shade_ms += ms_since(start);
+  passes.shade_ms += ms_since(start);
 }
 
 void Renderer::run_bounces(Passes& passes, const Tile& tile, std::vector<Bounce> current, int depth, bool refinement) {
@@ -626,12 +752,13 @@ void Renderer::run_bounces(Passes& passes, const Tile& tile, std::vector<Bounce>
     const auto start = std::chrono::steady_clock::now();
     passes.shader->add_batch(batch, refinement ? passes.refined_colour : passes.secondary, passes.refined_alpha);
     passes.any_secondary = true;
-    result.shade_ms += ms_since(start);
+    passes.shade_ms += ms_since(start);
     for (std::size_t i = 0; i < batch.rays.size(); ++i)
       if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
         next.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i],
                         batch.hit_surface.empty() ? std::uint8_t{0} : batch.hit_surface[i]});
     if (passes.options.keep_records) {
+      const std::lock_guard<std::mutex> hold(passes.shared.lock);
       for (std::uint32_t& sample : batch.sample)
         sample = refinement ? static_cast<std::uint32_t>(tile.pixel_in_image(sample, result.plan.width))
                             : tile.ray_in_image(sample, result.plan.trace_width());
@@ -676,13 +803,14 @@ void Renderer::refine_tile(Passes& passes, const Tile& tile, const std::vector<s
     trace_batch(passes, batch);
     const auto start = std::chrono::steady_clock::now();
     passes.shader->add_batch(batch, passes.refined_colour, passes.refined_alpha);
-    result.shade_ms += ms_since(start);
+    passes.shade_ms += ms_since(start);
     std::vector<Bounce> first;
     for (std::size_t i = 0; i < batch.rays.size(); ++i)
       if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
         first.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i],
                          batch.hit_surface.empty() ? std::uint8_t{0} : batch.hit_surface[i]});
     if (passes.options.keep_records) {
+      const std::lock_guard<std::mutex> hold(passes.shared.lock);
       for (std::uint32_t& sample : batch.sample)
         sample = static_cast<std::uint32_t>(tile.pixel_in_image(sample, plan.width));
       result.secondary.push_back(std::move(batch));
@@ -693,7 +821,7 @@ void Renderer::refine_tile(Passes& passes, const Tile& tile, const std::vector<s
   for (std::uint32_t k : pixels)
     passes.shader->resolve_refined(tile.pixel_in_image(k, plan.width), passes.refined_colour[k],
                                    passes.refined_alpha[k], result.image);
-  result.shade_ms += ms_since(start);
+  passes.shade_ms += ms_since(start);
 }
 
 FrameImage shade_frame(const Scene& scene, const RenderResult& result) {

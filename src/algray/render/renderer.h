@@ -3,19 +3,20 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "kernels/algray_shared.h"
-#include "algray/scene/camera.h"
 #include "algray/device/cl_runtime.h"
-#include "algray/render/device_surface.h"
-#include "algray/io/image_io.h"
 #include "algray/device/program_cache.h"
+#include "algray/io/image_io.h"
+#include "algray/render/device_surface.h"
 #include "algray/render/render_plan.h"
 #include "algray/render/trace_records.h"
+#include "algray/scene/camera.h"
 #include "algray/scene/scene.h"
+#include "kernels/algray_shared.h"
 
 namespace algray {
 
@@ -48,7 +49,8 @@ struct RenderCancelled : std::runtime_error {
 };
 
 struct RenderOptions {
-  // Called after each tile, on the rendering thread; the command line draws its progress line from it.
+  // Called after each tile, on the rendering thread; the command line draws its progress line from it. With
+  // several devices, each callback is called from their threads, one call at a time.
   std::function<void(const RenderProgress&)> on_progress;
   // Asked before each tile; true stops the render with RenderCancelled (Ctrl-C in a notebook, a closed viewer).
   std::function<bool()> cancelled;
@@ -66,12 +68,24 @@ struct RenderOptions {
   std::function<FrameImage()> film;
 };
 
+// One device's share of a render of several: the tiles it took from the queue (the first sweep's, when
+// adaptive antialiasing sweeps twice), its rays and device time over every pass, and its programs' load time.
+struct DeviceShare {
+  int index = 0;  // in enumerate_devices()
+  std::string name;
+  int tiles = 0;
+  std::uint64_t rays = 0;
+  double kernel_ms = 0;
+  double programs_ms = 0;
+};
+
 struct RenderResult {
   RenderPlan plan;
   KernelConfig config;  // of the first surface's primary pass, with precision and tolerance as used
   RayBasis basis;       // of the traced rays (per antialiasing sample, not per pixel)
   std::vector<ProgramRecord> programs;
-  std::vector<PassStats> passes;
+  std::vector<PassStats> passes;     // summed over the devices
+  std::vector<DeviceShare> devices;  // in the order the renderer was given them
   // The film: RGBA, depth and normal per output pixel, as shade_frame would make them from the records.
   FrameImage image;
   PrimarySummary primary;
@@ -100,18 +114,31 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result);
 
 class Renderer {
  public:
-  Renderer(ClSession& session, ProgramCache& cache) : session_(session), cache_(cache) {}
+  Renderer(ClSession& session, ProgramCache& cache) : sessions_{&session}, cache_(cache) {}
+  // Several devices render each image together. They take tiles from one queue, so a faster device takes more,
+  // and the image is the one a single device of their kind renders, bit for bit. Precision left to the devices
+  // is double only where every device has it; the tile size left to them gives each device about 8 tiles.
+  Renderer(std::vector<ClSession*> sessions, ProgramCache& cache);
   // Runs every pass of the scene's plan, tile by tile, into the film. Each tile's camera rays, shadow rays and
-  // bounces are traced and shaded before the next tile starts, so memory holds the film and one tile's work.
+  // bounces are traced and shaded before the device's next tile starts, so memory holds the film and one tile's
+  // work per device.
   RenderResult render(const Scene& scene, const RenderOptions& options);
   // The same render keeping every ray's record (tests and tools).
   RenderResult render_with_records(const Scene& scene);
 
  private:
+  struct Shared;
   struct Passes;
   struct Bounce;
   struct Tile;
   class TileHits;
+  Precision precision_of(const Scene& scene) const;
+  RenderPlan plan_of(const Scene& scene, Precision precision) const;
+  // Deals `tiles` to the devices from one queue, each device's on its own thread, until every tile is done or one
+  // fails; the first failure is thrown on.
+  void sweep(std::vector<std::unique_ptr<Passes>>& devices, const std::vector<Tile>& tiles,
+             const std::function<void(Passes&, const Tile&)>& work);
+  static void add_device_tallies(const std::vector<std::unique_ptr<Passes>>& devices, RenderResult& result);
   void prepare_passes(Passes& passes);
   // The primary kernels' arguments for a band of tiles (a row of them), but the tile's own.
   void set_band_args(Passes& passes, const Tile& first);
@@ -124,7 +151,7 @@ class Renderer {
   // Adaptive antialiasing in one tile: n x n more camera rays in the pixels `refine` marks.
   void refine_tile(Passes& passes, const Tile& tile, const std::vector<std::uint8_t>& refine);
 
-  ClSession& session_;
+  std::vector<ClSession*> sessions_;
   ProgramCache& cache_;
 };
 

@@ -39,6 +39,17 @@ void PrimarySummary::add(const HitRecord* records, int width, int height, int sa
     }
 }
 
+PrimarySummary& PrimarySummary::operator+=(const PrimarySummary& other) {
+  rays += other.rays;
+  hits += other.hits;
+  depth_limited += other.depth_limited;
+  isolation_steps += other.isolation_steps;
+  refine_iterations += other.refine_iterations;
+  pixels += other.pixels;
+  pixels_hit += other.pixels_hit;
+  return *this;
+}
+
 PrimarySummary summarise_hits(const HitBuffer& hits, int samples) {
   PrimarySummary s;
   s.add(hits.records.data(), hits.width, hits.height, std::max(samples, 1));

@@ -51,6 +51,7 @@ struct PrimarySummary {
   std::uint64_t pixels = 0, pixels_hit = 0;  // output pixels, and those some antialiasing sample hit
   // A block of whole pixels: width x height records, row-major, `samples` x `samples` per pixel.
   void add(const HitRecord* records, int width, int height, int samples);
+  PrimarySummary& operator+=(const PrimarySummary& other);
 };
 PrimarySummary summarise_hits(const HitBuffer& hits, int samples);
 

@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""One image on two devices against one: `algray render --device 0,1` against `--device 0`, on two PoCL devices
+of one thread each (POCL_DEVICES="pthread pthread", POCL_MAX_PTHREAD_COUNT=1), whole process, runs interleaved
+after one warm-up each. Reports medians, the speed-up per pair (one device's time over two devices') with its
+spread, each device's share of the tiles, and whether the two images are bit-identical."""
+import argparse
+import os
+import statistics
+import subprocess
+import tempfile
+from pathlib import Path
+
+from bench_common import ROOT, machine, run_render
+
+
+def identical(exr_compare, a, b):
+    out = subprocess.run([str(exr_compare), str(a), str(b)], capture_output=True, text=True).stdout
+    return "channels bit-identical: all" in out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--algray", default=str(ROOT / "build/apps/algray/algray"))
+    ap.add_argument("--exr-compare", default=str(ROOT / "build/bench/exr_compare"))
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--scenes", nargs="*", default=["barth_decic"])
+    ap.add_argument("--width", type=int, default=1024)
+    ap.add_argument("--height", type=int, default=768)
+    ap.add_argument("--preview", action="store_true", help="preview mode instead of the scene as shipped")
+    a = ap.parse_args()
+    env = dict(os.environ, POCL_DEVICES="pthread pthread", POCL_MAX_PTHREAD_COUNT="1")
+    args = ["--width", str(a.width), "--height", str(a.height)] + (["--preview"] if a.preview else [])
+    specs = ["0", "0,1"]
+    print(f"Machine: {machine()}. `POCL_DEVICES=\"pthread pthread\" POCL_MAX_PTHREAD_COUNT=1 algray render SCENE "
+          f"{' '.join(args)} --device D` to EXR, wall ms of the whole process, median of {a.repeat} interleaved "
+          f"runs each after one warm-up; speed-up = ms(--device 0) / ms(--device 0,1) per pair (median, min-max).\n")
+    print("| scene | 1 device ms | 2 devices ms | speed-up (median) | min-max | tiles per device | image |")
+    print("|---|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        work = [Path(tmp) / "one", Path(tmp) / "two"]
+        for w in work:
+            w.mkdir()
+        for name in a.scenes:
+            scene = ROOT / "scenes" / f"{name}.toml"
+            for spec, w in zip(specs, work):
+                run_render(a.algray, scene, args + ["--device", spec], env, w)
+            times = [[], []]
+            stats = None
+            for _ in range(a.repeat):
+                for k, (spec, w) in enumerate(zip(specs, work)):
+                    ms, s = run_render(a.algray, scene, args + ["--device", spec], env, w)
+                    times[k].append(ms)
+                    if k == 1:
+                        stats = s
+            speedups = [one / two for one, two in zip(times[0], times[1])]
+            tiles = "/".join(str(d["tiles"]) for d in stats["devices"])
+            same = "bit-identical" if identical(a.exr_compare, work[0] / "out.exr", work[1] / "out.exr") else "DIFFERS"
+            print(f"| {name} | {statistics.median(times[0]):.0f} | {statistics.median(times[1]):.0f} | "
+                  f"{statistics.median(speedups):.2f} | {min(speedups):.2f}-{max(speedups):.2f} | {tiles} | {same} |",
+                  flush=True)
+
+
+if __name__ == "__main__":
+    main()
