@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """One image on two devices against one: `algray render --device 0,1` against `--device 0`, on two PoCL devices
-of one thread each (POCL_DEVICES="pthread pthread", POCL_MAX_PTHREAD_COUNT=1), whole process, runs interleaved
-after one warm-up each. Reports medians, the speed-up per pair (one device's time over two devices') with its
+of one thread each, whole process, runs interleaved after one warm-up each. PoCL's "basic" devices run each
+kernel on the thread that enqueues it, so each device has a core of its own. Its "pthread" devices would not
+do: PoCL 3.1 has one worker pool per process, sized by the first pthread device, which all of them share
+(POCL_DEVICES="pthread pthread" with POCL_MAX_PTHREAD_COUNT=1 is two devices on one thread). Reports medians, the speed-up per pair (one device's time over two devices') with its
 spread, each device's share of the tiles, and whether the two images are bit-identical."""
 import argparse
 import os
@@ -28,10 +30,10 @@ def main():
     ap.add_argument("--height", type=int, default=768)
     ap.add_argument("--preview", action="store_true", help="preview mode instead of the scene as shipped")
     a = ap.parse_args()
-    env = dict(os.environ, POCL_DEVICES="pthread pthread", POCL_MAX_PTHREAD_COUNT="1")
+    env = dict(os.environ, POCL_DEVICES="basic basic")
     args = ["--width", str(a.width), "--height", str(a.height)] + (["--preview"] if a.preview else [])
     specs = ["0", "0,1"]
-    print(f"Machine: {machine()}. `POCL_DEVICES=\"pthread pthread\" POCL_MAX_PTHREAD_COUNT=1 algray render SCENE "
+    print(f"Machine: {machine()}. `POCL_DEVICES=\"basic basic\" algray render SCENE "
           f"{' '.join(args)} --device D` to EXR, wall ms of the whole process, median of {a.repeat} interleaved "
           f"runs each after one warm-up; speed-up = ms(--device 0) / ms(--device 0,1) per pair (median, min-max).\n")
     print("| scene | 1 device ms | 2 devices ms | speed-up (median) | min-max | tiles per device | image |")

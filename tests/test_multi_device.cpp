@@ -1,5 +1,6 @@
-// Several devices rendering one image from one tile queue: the devices chosen, the image bit for bit against one
-// device, each device's share, the callbacks, and cancellation. CTest runs it with two 1-thread PoCL devices.
+// One image split: several devices from one tile queue (the devices chosen, the image bit for bit against one
+// device, each device's share, the callbacks, cancellation), and bands of rows put together. CTest runs it with
+// two PoCL "basic" devices.
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <memory>
@@ -11,6 +12,7 @@
 #include "algray/api/render_job.h"
 #include "algray/device/program_cache.h"
 #include "algray/render/renderer.h"
+#include "algray/render/shade.h"
 #include "algray/render/solver_aov.h"
 #include "film_compare.h"
 #include "scene_fixtures.h"
@@ -23,15 +25,15 @@ using testing::same_film;
 
 namespace {
 
-// Two devices of one kind, as the test's environment makes them (POCL_DEVICES="pthread pthread"); without them
-// the test fails, since it could check nothing.
+// Two devices of one kind, as the test's environment makes them (POCL_DEVICES="basic basic"); without them the
+// test fails, since it could check nothing.
 std::vector<ClSession*> two_devices() {
   static std::vector<std::unique_ptr<ClSession>> owned;
   if (owned.empty()) {
     testing::device_session();  // fails loudly without any device
     const std::vector<DeviceInfo> devices = enumerate_devices();
     if (devices.size() < 2)
-      FAIL("test_multi_device needs two OpenCL devices; CTest runs it with POCL_DEVICES=\"pthread pthread\", found "
+      FAIL("test_multi_device needs two OpenCL devices; CTest runs it with POCL_DEVICES=\"basic basic\", found "
            << devices.size() << ":\n"
            << describe_devices(devices));
     for (const DeviceInfo& d : select_devices("0,1")) owned.push_back(std::make_unique<ClSession>(d));
@@ -66,7 +68,7 @@ TEST_CASE("device lists: all, indices, repeated name substrings, and the errors"
   CHECK(listed[0].index == 1);
   CHECK(listed[1].index == 0);
   // The two PoCL devices share a name: the substring, given twice, names both.
-  const std::vector<DeviceInfo> by_name = select_devices("pthread,pthread");
+  const std::vector<DeviceInfo> by_name = select_devices("basic,basic");
   REQUIRE(by_name.size() == 2);
   CHECK(by_name[0].index == 0);
   CHECK(by_name[1].index == 1);
@@ -75,7 +77,7 @@ TEST_CASE("device lists: all, indices, repeated name substrings, and the errors"
   CHECK_THROWS_WITH(select_devices("0,,1"), Catch::Contains("empty item"));
   CHECK_THROWS_WITH(select_devices("0,99"), Catch::Contains("there are only"));
   CHECK_THROWS_WITH(select_devices("0,no-such-device"), Catch::Contains("no device or platform name contains it"));
-  const std::string three = "pthread,pthread,pthread";
+  const std::string three = "basic,basic,basic";
   if (all.size() == 2) CHECK_THROWS_WITH(select_devices(three), Catch::Contains("already named"));
 }
 
@@ -90,17 +92,17 @@ TEST_CASE("two devices render the one-device image bit for bit, sharing the tile
   std::vector<Case> cases;
   // Everything that crosses a tile's border: two surfaces, bounces, an area light's shadows, and adaptive
   // antialiasing, whose choice at a tile's edge needs the neighbouring tiles' first colours from either device.
-  cases.push_back({"ball and ring, adaptive 3x3", testing::ball_and_ring({{"antialias.adaptive", "true"},
-                                                                         {"antialias.samples", "3"}})});
+  cases.push_back({"ball and ring, adaptive 3x3",
+                   testing::ball_and_ring({{"antialias.adaptive", "true"}, {"antialias.samples", "3"}})});
   cases.push_back({"ball and ring, 2x2", testing::ball_and_ring({{"antialias.samples", "2"}})});
   for (const char* precision : {"double", "float"})
-    cases.push_back({std::string("Barth sextic, full mode, ") + precision,
-                     load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_sextic.toml",
-                                     {{"image.width", "80"}, {"image.height", "60"}, {"render.precision", precision}})});
-  cases.push_back({"Barth decic, preview", load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_decic.toml",
-                                                           {{"image.width", "96"},
-                                                            {"image.height", "72"},
-                                                            {"render.preview", "true"}})});
+    cases.push_back(
+        {std::string("Barth sextic, full mode, ") + precision,
+         load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_sextic.toml",
+                         {{"image.width", "80"}, {"image.height", "60"}, {"render.precision", precision}})});
+  cases.push_back({"Barth decic, preview",
+                   load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_decic.toml",
+                                   {{"image.width", "96"}, {"image.height", "72"}, {"render.preview", "true"}})});
   for (const Case& c : cases) {
     INFO(c.what);
     RenderOptions records;
@@ -176,7 +178,7 @@ TEST_CASE("with two devices the callbacks come one at a time, and cancelling sto
   CHECK(total == static_cast<int>(tile_count(shared.plan)) * (shared.plan.refine_samples > 1 ? 2 : 1));
   CHECK(static_cast<int>(done.size()) == total);
   for (std::size_t i = 0; i < done.size(); ++i) CHECK(done[i] == static_cast<int>(i + 1));
-  CHECK(threads.size() == 2);  // each device's own thread reported its tiles
+  CHECK(threads.size() >= 2);  // each device's own thread reported its tiles (one pair of threads per sweep)
   Renderer one(*both[0], test_cache());
   const SolverWork whole = solver_work(one.render_with_records(scene));
   CHECK(work.isolation_steps == whole.isolation_steps);
@@ -218,4 +220,62 @@ TEST_CASE("a render context of several devices renders with all of them and repo
   for (const auto& [key, value] : together.image.string_attributes)
     if (key == "algray/device") device_attribute = value;
   CHECK_THAT(device_attribute, Catch::Contains(" + [1] "));
+}
+
+TEST_CASE("bands of rows, on one device or two, put together are the whole image bit for bit", "[devices][bands]") {
+  const std::vector<ClSession*> both = two_devices();
+  Renderer one(*both[0], test_cache());
+  Renderer two(both, test_cache());
+  struct Case {
+    std::string what;
+    Scene scene;
+  };
+  // Adaptive antialiasing chooses at a band's edge from the rows beyond it; bounces, shadows and two surfaces
+  // cross every edge too.
+  const std::vector<Case> cases = {
+      {"ball and ring, adaptive 3x3",
+       testing::ball_and_ring({{"antialias.adaptive", "true"}, {"antialias.samples", "3"}})},
+      {"ball and ring, 2x2", testing::ball_and_ring({{"antialias.samples", "2"}})},
+      {"Barth sextic, full mode", load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_sextic.toml",
+                                                  {{"image.width", "80"}, {"image.height", "60"}})}};
+  for (const Case& c : cases) {
+    const RenderResult whole = one.render(c.scene, {});
+    const int height = c.scene.image.height, width = c.scene.image.width;
+    // Bands of 1 row, at both ends, and of sizes that split tiles.
+    const std::vector<int> edges = {0, 1, 8, 21, 22, height - 1, height};
+    for (Renderer* renderer : {&one, &two}) {
+      INFO(c.what << (renderer == &two ? ", two devices" : ", one device"));
+      FrameImage stitched = make_film(width, height, true);
+      PrimarySummary summed;
+      for (std::size_t b = 0; b + 1 < edges.size(); ++b) {
+        RenderOptions options;
+        options.rows = RenderOptions::RowBand{edges[b], edges[b + 1]};
+        const RenderResult band = renderer->render(c.scene, options);
+        REQUIRE(band.image.height == edges[b + 1] - edges[b]);
+        REQUIRE(band.image.width == width);
+        const std::size_t at = static_cast<std::size_t>(edges[b]) * width;
+        std::copy(band.image.rgba.begin(), band.image.rgba.end(), stitched.rgba.begin() + 4 * at);
+        std::copy(band.image.depth.begin(), band.image.depth.end(), stitched.depth.begin() + at);
+        std::copy(band.image.normal.begin(), band.image.normal.end(), stitched.normal.begin() + 3 * at);
+        summed += band.primary;
+      }
+      INFO("first difference: " << testing::first_difference(whole.image, stitched));
+      CHECK(same_film(whole.image, stitched));
+      CHECK(summed.pixels == whole.primary.pixels);
+      CHECK(summed.pixels_hit == whole.primary.pixels_hit);
+      CHECK(summed.rays == whole.primary.rays);
+      CHECK(summed.hits == whole.primary.hits);
+      CHECK(summed.isolation_steps == whole.primary.isolation_steps);
+    }
+  }
+  const Scene scene = testing::ball_and_ring({});
+  RenderOptions bad;
+  for (const RenderOptions::RowBand& rows : {RenderOptions::RowBand{5, 5}, RenderOptions::RowBand{-1, 3},
+                                             RenderOptions::RowBand{0, scene.image.height + 1}}) {
+    bad.rows = rows;
+    CHECK_THROWS_AS(one.render(scene, bad), std::invalid_argument);
+  }
+  bad.rows = RenderOptions::RowBand{0, 4};
+  bad.keep_records = true;
+  CHECK_THROWS_AS(one.render(scene, bad), std::invalid_argument);
 }

@@ -26,6 +26,18 @@ std::vector<double> binomial_table(int degree) {
 
 }  // namespace
 
+RayLaunch ray_launch(std::size_t count, std::size_t largest_group) {
+  // 64 fills a wavefront on AMD and two warps on NVIDIA, and is a multiple of PoCL's vector widths; a kernel
+  // too large for it on some device gets the largest power of two that device allows.
+  std::size_t group = 64;
+  while (group > 1 && group > largest_group) group /= 2;
+  return {cl::NDRange((count + group - 1) / group * group), cl::NDRange(group)};
+}
+
+std::size_t largest_group(const cl::Kernel& kernel, const cl::Device& device) {
+  return kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device);
+}
+
 double ms_between(const cl::Event& e) {
   const auto start = e.getProfilingInfo<CL_PROFILING_COMMAND_START>();
   const auto end = e.getProfilingInfo<CL_PROFILING_COMMAND_END>();

@@ -22,6 +22,16 @@ SurfaceData prepare_surface(const Scene& scene, std::size_t surface = 0);
 // Device time of a finished command, in milliseconds (the queue has profiling on).
 double ms_between(const cl::Event& e);
 
+// A launch of one work-item per ray for `count` rays, in work-groups of a fixed size; the kernels skip the items
+// past `count`. The driver's own choice would follow each count, and PoCL compiles a work-group function for
+// every group size it meets: a render's batches come in many sizes, and each new one cost a second or more.
+// `largest_group` is the kernel's CL_KERNEL_WORK_GROUP_SIZE on the device.
+struct RayLaunch {
+  cl::NDRange global, local;
+};
+RayLaunch ray_launch(std::size_t count, std::size_t largest_group);
+std::size_t largest_group(const cl::Kernel& kernel, const cl::Device& device);
+
 // Sets kernel arguments in declaration order; REAL-typed ones follow the build's precision.
 class KernelArgs {
  public:

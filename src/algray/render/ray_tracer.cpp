@@ -7,6 +7,7 @@ RayTracer::RayTracer(ClSession& session, ProgramCache& cache, const KernelConfig
                      const DeviceSurface& surface)
     : session_(session), surface_(surface) {
   kernel_ = cache.kernel(session, config, &record_);
+  largest_group_ = largest_group(kernel_, session.info.device);
 }
 
 TracedBatch RayTracer::trace(const std::vector<PixelRay>& rays) {
@@ -58,7 +59,8 @@ TracedBatch RayTracer::trace(const std::vector<PixelRay>& rays) {
   surface_.set_surface_args(args);
   args.plain(out_);
   cl::Event done;
-  queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(count), cl::NullRange, nullptr, &done);
+  const RayLaunch launch = ray_launch(count, largest_group_);
+  queue.enqueueNDRangeKernel(kernel_, cl::NullRange, launch.global, launch.local, nullptr, &done);
   done.wait();
   batch.kernel_ms = ms_between(done);
   queue.enqueueReadBuffer(out_, CL_TRUE, 0, count * sizeof(HitRecord), batch.hits.data());

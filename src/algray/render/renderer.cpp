@@ -96,6 +96,21 @@ std::vector<std::uint8_t> pixels_to_refine(const FrameImage& coarse, double thre
   return refine;
 }
 
+// Keeps `rows` rows of the film from row `first` on.
+void crop_rows(FrameImage& film, int first, int rows) {
+  if (first == 0 && rows == film.height) return;
+  const std::size_t width = static_cast<std::size_t>(film.width);
+  auto crop = [&](auto& channel, std::size_t per_pixel) {
+    if (channel.empty()) return;
+    channel.erase(channel.begin(), channel.begin() + static_cast<std::ptrdiff_t>(first * width * per_pixel));
+    channel.resize(static_cast<std::size_t>(rows) * width * per_pixel);
+  };
+  crop(film.rgba, 4);
+  crop(film.depth, 1);
+  crop(film.normal, 3);
+  film.height = rows;
+}
+
 }  // namespace
 
 // Page-aligned anonymous memory with every page faulted in as it is made (MAP_POPULATE: one system call rather
@@ -232,6 +247,12 @@ struct Renderer::Passes {
   std::vector<ProgramRecord> programs;
   int tiles = 0;
   int band_y0 = -1;  // the band (row of tiles) whose arguments the primary kernels hold
+  int film_y0 = 0;   // the image row of the film's row 0, and the output rows [first_row, end_row) kept
+  int first_row = 0, end_row = 0;
+  // A pixel of the image (its index in the whole image) in the film.
+  std::size_t film_pixel(std::size_t image_pixel) const {
+    return image_pixel - static_cast<std::size_t>(film_y0) * static_cast<std::size_t>(result.plan.width);
+  }
 
   // One tile's work.
   HitRecord* hits = nullptr;              // camera rays, row-major in the tile: primary_out mapped
@@ -412,6 +433,16 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   const RenderPlan& plan = result.plan;
   const int trace_width = plan.trace_width(), trace_height = plan.trace_height();
   result.basis = make_ray_basis(scene.camera, trace_width, trace_height);
+  const bool adaptive = plan.refine_samples > 1;
+  // The rows kept, and those traced: adaptive antialiasing's choice at a band's edge needs the row beyond it.
+  const int first_row = options.rows ? options.rows->first : 0,
+            end_row = options.rows ? options.rows->end : plan.height;
+  if (first_row < 0 || end_row > plan.height || first_row >= end_row)
+    throw std::invalid_argument("rows " + std::to_string(first_row) + " to " + std::to_string(end_row) +
+                                " are not a band of the image's " + std::to_string(plan.height));
+  if (options.rows && options.keep_records) throw std::invalid_argument("a band of rows keeps no records");
+  const int margin = adaptive ? 1 : 0;
+  const int traced_first = std::max(0, first_row - margin), traced_end = std::min(plan.height, end_row + margin);
   Shared shared;
   const Shader shader(scene, plan, result.basis, precision);
   // The devices' kernels are loaded one device after another: the program cache serves one caller at a time.
@@ -423,11 +454,15 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
       passes.surfaces.push_back(std::make_unique<DeviceSurface>(session->context, scene, precision, i));
     prepare_passes(passes);
     passes.shader = &shader;
+    passes.film_y0 = traced_first;
+    passes.first_row = first_row;
+    passes.end_row = end_row;
   }
+  const int film_height = traced_end - traced_first;
   if (options.film) result.image = options.film();
-  if (result.image.width != plan.width || result.image.height != plan.height ||
-      result.image.rgba.size() != 4 * static_cast<std::size_t>(plan.width) * plan.height)
-    result.image = make_film(plan);
+  if (result.image.width != plan.width || result.image.height != film_height ||
+      result.image.rgba.size() != 4 * static_cast<std::size_t>(plan.width) * film_height)
+    result.image = make_film(plan.width, film_height, true);
   if (options.keep_records) {
     result.hits.width = trace_width;
     result.hits.height = trace_height;
@@ -439,12 +474,11 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   // Row by row of tiles, as the film's lines are laid out.
   std::vector<Tile> tiles;
   const int side = plan.tile_pixels(), s = plan.samples;
-  for (int y0 = 0; y0 < plan.height; y0 += side)
+  for (int y0 = traced_first; y0 < traced_end; y0 += side)
     for (int x0 = 0; x0 < plan.width; x0 += side) {
-      const int w = std::min(side, plan.width - x0), h = std::min(side, plan.height - y0);
+      const int w = std::min(side, plan.width - x0), h = std::min(side, traced_end - y0);
       tiles.push_back({x0, y0, w, h, x0 * s, y0 * s, w * s, h * s});
     }
-  const bool adaptive = plan.refine_samples > 1;
   shared.tiles_total = static_cast<int>(tiles.size()) * (adaptive ? 2 : 1);
   sweep(devices, tiles, [this](Passes& passes, const Tile& tile) {
     if (tile.y0 != passes.band_y0) {
@@ -462,12 +496,17 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
     const RayBasis fine =
         make_ray_basis(scene.camera, plan.width * plan.refine_samples, plan.height * plan.refine_samples);
     for (auto& passes : devices) passes->fine = fine;
-    const std::vector<std::uint8_t> refine = pixels_to_refine(result.image, plan.refine_threshold);
+    std::vector<std::uint8_t> refine = pixels_to_refine(result.image, plan.refine_threshold);
+    // The rows beyond the band were traced for their first colours only.
+    const std::size_t width = static_cast<std::size_t>(plan.width);
+    std::fill(refine.begin(), refine.begin() + static_cast<std::ptrdiff_t>((first_row - traced_first) * width), 0);
+    std::fill(refine.end() - static_cast<std::ptrdiff_t>((traced_end - end_row) * width), refine.end(), 0);
     devices.front()->shade_ms += ms_since(start);
     sweep(devices, tiles, [this, &refine](Passes& passes, const Tile& tile) { refine_tile(passes, tile, refine); });
     if (options.keep_records) result.refined = refine;
   }
   add_device_tallies(devices, result);
+  crop_rows(result.image, first_row - traced_first, end_row - first_row);
   return result;
 }
 
@@ -648,7 +687,13 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
     return pixel_ray(result.basis, single, tile.trace_x0 + static_cast<int>(k % tile.trace_w),
                      tile.trace_y0 + static_cast<int>(k / tile.trace_w));
   };
-  passes.primary_summary.add(passes.hits, tile.trace_w, tile.trace_h, plan.samples);
+  {
+    // The rows of the tile the film keeps: a band's extra rows are counted by the band they belong to.
+    const int first = std::max(tile.y0, passes.first_row), end = std::min(tile.y0 + tile.height, passes.end_row);
+    if (end > first)
+      passes.primary_summary.add(passes.hits + static_cast<std::size_t>(first - tile.y0) * plan.samples * tile.trace_w,
+                                 tile.trace_w, (end - first) * plan.samples, plan.samples);
+  }
   if (passes.options.on_primary_tile) {
     const std::lock_guard<std::mutex> hold(passes.shared.lock);
     passes.options.on_primary_tile(
@@ -703,6 +748,7 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
   block.surface = passes.hit_surface.empty() ? nullptr : passes.hit_surface.data();
   block.shadows = &lookup;
   block.secondary = passes.any_secondary ? passes.secondary.data() : nullptr;
+  block.film_y0 = passes.film_y0;
   passes.shader->resolve(block, result.image);
   passes.shade_ms += ms_since(start);
 }
@@ -777,7 +823,7 @@ void Renderer::refine_tile(Passes& passes, const Tile& tile, const std::vector<s
   const int n = plan.refine_samples;
   std::vector<std::uint32_t> pixels;  // the tile's pixels to refine, row-major
   for (std::size_t k = 0; k < tile.pixels(); ++k)
-    if (refine[tile.pixel_in_image(k, plan.width)]) pixels.push_back(static_cast<std::uint32_t>(k));
+    if (refine[passes.film_pixel(tile.pixel_in_image(k, plan.width))]) pixels.push_back(static_cast<std::uint32_t>(k));
   if (pixels.empty()) return;
   passes.refined_colour.assign(tile.pixels(), glm::dvec3(0));
   passes.refined_alpha.assign(tile.pixels(), 0.0);
@@ -819,7 +865,7 @@ void Renderer::refine_tile(Passes& passes, const Tile& tile, const std::vector<s
   }
   const auto start = std::chrono::steady_clock::now();
   for (std::uint32_t k : pixels)
-    passes.shader->resolve_refined(tile.pixel_in_image(k, plan.width), passes.refined_colour[k],
+    passes.shader->resolve_refined(passes.film_pixel(tile.pixel_in_image(k, plan.width)), passes.refined_colour[k],
                                    passes.refined_alpha[k], result.image);
   passes.shade_ms += ms_since(start);
 }

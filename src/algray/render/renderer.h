@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -66,6 +67,14 @@ struct RenderOptions {
   // is used when its size is the plan's, and may then lack depth and normal (PNG outputs only); otherwise, or
   // without it, the render makes its own.
   std::function<FrameImage()> film;
+  // Only the output rows [first, end) of the image, into a film of the band's height whose row 0 is image row
+  // `first`: a band renders the pixels the whole image has there, bit for bit (MPI ranks render bands of one
+  // image). Adaptive antialiasing then traces one more row beyond each inner edge, first colours only, so that
+  // its choice there sees the neighbours the whole image has. Not with keep_records.
+  struct RowBand {
+    int first = 0, end = 0;
+  };
+  std::optional<RowBand> rows;
 };
 
 // One device's share of a render of several: the tiles it took from the queue (the first sweep's, when

@@ -70,8 +70,7 @@ const Material& Shader::material_of(const HitToShade& h) const {
   return (h.hit->flags & ALGRAY_HIT_BACK) ? sides.back : sides.front;
 }
 
-void Shader::shade_hits(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows,
-                        glm::dvec3* out) const {
+void Shader::shade_hits(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const {
   if (lights_.empty()) {
     // The headlight: no lights, nothing to hide, the colour by how squarely the surface faces the eye.
     for (std::size_t i = 0; i < count; ++i) {
@@ -232,7 +231,7 @@ void Shader::resolve(const TracedBlock& block, FrameImage& film) const {
       shaded.resize(found.size());
       shade_hits(found.data(), found.size(), *block.shadows, shaded.data());
       for (int x = 0; x < pixels_x; ++x) {
-        const std::size_t i = static_cast<std::size_t>(py0 + y) * film.width + px0 + x;
+        const std::size_t i = static_cast<std::size_t>(py0 + y - block.film_y0) * film.width + px0 + x;
         float depth = std::numeric_limits<float>::infinity();
         float normal[3] = {0, 0, 0};
         glm::dvec4 sum(0);

@@ -5,10 +5,10 @@
 #include <cstdint>
 #include <vector>
 
-#include "algray/scene/camera.h"
 #include "algray/io/image_io.h"
 #include "algray/render/render_plan.h"
 #include "algray/render/trace_records.h"
+#include "algray/scene/camera.h"
 #include "algray/scene/scene.h"
 
 namespace algray {
@@ -43,6 +43,7 @@ struct TracedBlock {
   const std::uint8_t* surface = nullptr;      // which surface each hit; null when the scene has one
   const ShadowLookup* shadows = nullptr;      // of these hits
   const glm::dvec3* secondary = nullptr;      // per ray, what its bounces brought back; null without bounces
+  int film_y0 = 0;                            // the image row of the film's first row (a band's film)
 };
 
 // The lights and materials of one render, shared by the film and by shade_frame, so both shade alike.

@@ -53,6 +53,7 @@ ShadowTracer::ShadowTracer(ClSession& session, ProgramCache& cache, const Kernel
                            const DeviceSurface& surface, double offset)
     : session_(session), surface_(surface), offset_(offset) {
   kernel_ = cache.kernel(session, config, &record_);
+  largest_group_ = largest_group(kernel_, session.info.device);
   traced_ = cl::Buffer(session.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
 }
 
@@ -96,7 +97,8 @@ ShadowAnswer ShadowTracer::trace(ShadowPoints& points, const std::vector<glm::dv
   args.plain(points.masks_);
   args.plain(traced_);
   cl::Event done;
-  queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(count), cl::NullRange, nullptr, &done);
+  const RayLaunch launch = ray_launch(count, largest_group_);
+  queue.enqueueNDRangeKernel(kernel_, cl::NullRange, launch.global, launch.local, nullptr, &done);
   done.wait();
   answer.kernel_ms = ms_between(done);
   queue.enqueueReadBuffer(points.masks_, CL_TRUE, 0, count * sizeof(cl_ulong), answer.masks.data());

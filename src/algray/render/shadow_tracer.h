@@ -56,6 +56,7 @@ class ShadowTracer {
   double offset_;
   ProgramRecord record_;
   cl::Kernel kernel_;
+  std::size_t largest_group_ = 1;  // the kernel's work-group limit on the device
   cl::Buffer traced_;  // the kernel's count of traced rays
 };
 
