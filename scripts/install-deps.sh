@@ -13,6 +13,7 @@ packages=(
   python3-numpy python3-pytest python3-ipywidgets  # its arrays, its tests, and algray.explore's sliders
   jupyter-nbconvert python3-ipykernel python3-matplotlib  # the notebook of docs/, run headless by the tests
   munge slurmctld slurmd slurm-client  # test_slurm_array: a single-node Slurm started by the test itself
+  libopenmpi-dev openmpi-bin  # `mpirun -n N algray batch` (the cluster layer) and test_mpi_batch
   clang-15                  # the sanitizer tree and libFuzzer targets of scripts/test.sh: the clang PoCL already
                             # depends on, with ASan, UBSan and libFuzzer in its libclang-common-15-dev
   ninja-build               # scripts/test.sh builds with Ninja

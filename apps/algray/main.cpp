@@ -6,7 +6,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <optional>
 
+#ifdef ALGRAY_WITH_MPI
+#include "algray/cluster/mpi_batch.h"
+#include "algray/cluster/mpi_world.h"
+#endif
 #include "algray/io/image_io.h"
 #include "algray/render/solver_aov.h"
 #include "algray/scene/solver_options.h"
@@ -277,7 +282,23 @@ struct BatchCommand {
     } catch (const std::exception& e) {
       return report_error(e, std::cerr);
     }
-    return run_batch_command(request, ::isatty(STDERR_FILENO) != 0, std::cerr);
+    bool progress = ::isatty(STDERR_FILENO) != 0;
+#ifdef ALGRAY_WITH_MPI
+    // Started by an MPI launcher, the ranks share the batch's frames; started alone, MPI is never initialised.
+    std::optional<MpiWorld> world;
+    if (MpiWorld::launched()) {
+      try {
+        world.emplace();
+      } catch (const std::exception& e) {
+        return report_error(e, std::cerr);
+      }
+      request.distribute = [&world](const BatchRequest& r, const BatchCallbacks& c) {
+        return run_mpi_batch(r, c, *world);
+      };
+      progress = progress && world->rank() == 0;
+    }
+#endif
+    return run_batch_command(request, progress, std::cerr);
   }
 };
 

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
+#include <stdexcept>
 #include <string_view>
 #include <system_error>
 
@@ -342,6 +343,7 @@ void apply_orbit(Scene& scene, const Orbit& orbit, int frame, int frames) {
 }
 
 BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks) {
+  if (req.distribute) return req.distribute(req, callbacks);
   RenderContext context(req.device_spec, req.use_cache);
   return run_batch(req, callbacks, context);
 }
@@ -426,14 +428,6 @@ std::string shard_file(const std::string& path, const BatchShard& shard) {
 
 namespace {
 
-// The jobs file read and every path the batch will touch checked, before anything renders.
-struct BatchPlan {
-  std::vector<BatchJob> jobs;
-  std::string log_path;
-  std::optional<std::string> stats_path;
-  int total_frames = 0;  // of this shard
-};
-
 // Whether frame `number` of the whole batch (every job's frames in order) is this request's to render.
 bool in_shard(const BatchRequest& req, int number) {
   return !req.shard || number % req.shard->count == req.shard->index;
@@ -450,8 +444,8 @@ std::string shard_text(const BatchShard& shard) {
   return std::to_string(shard.index) + "/" + std::to_string(shard.count);
 }
 
-// Throws SceneError or OutputError on bad input: a bad jobs file, or an output that cannot be written or is
-// another input or output by some other name.
+}  // namespace
+
 BatchPlan plan_batch(const BatchRequest& req) {
   BatchPlan plan;
   std::string text, base_dir;
@@ -481,12 +475,15 @@ BatchPlan plan_batch(const BatchRequest& req) {
       ++plan.total_frames;
     }
   }
+  plan.numbered_frames = number;
   check_distinct_files(inputs, outputs);
   // Every frame's paths are checked now, as render checks its own, so that a bad one is bad input (exit 2)
   // before anything renders rather than a failure of each frame.
   for (const RoleAndPath& o : outputs) check_output_writable(o.path);
   return plan;
 }
+
+namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -511,20 +508,26 @@ struct JobTally {
   }
 };
 
-// Thrown when no frame can run without the device: the batch stops rather than fail every remaining frame alike.
-struct DeviceLost {
-  std::string message;
-};
+// Which job frame `number` of the whole batch belongs to, and its frame within the job.
+std::pair<std::size_t, int> place_of(const BatchPlan& plan, int number) {
+  for (std::size_t j = 0; j < plan.jobs.size(); ++j) {
+    if (number < plan.jobs[j].frames) return {j, number};
+    number -= plan.jobs[j].frames;
+  }
+  throw std::out_of_range("frame number beyond the batch's frames");
+}
 
-// Renders (or, with --resume, skips) one frame, filling its log entry; returns "ok", "failed" or "skipped". A
-// failing frame is reported through `message`; a DeviceError is thrown on as DeviceLost after logging it.
-class FrameRunner {
+// Renders (or, with --resume, skips) one frame into its report. Nothing is written but the frame's own files:
+// the log and the messages are the recorder's, perhaps in another process.
+class FrameRenderer {
  public:
-  FrameRunner(const BatchRequest& req, RenderContext& context, JsonLinesLog& log, const BatchReporter& message)
-      : req_(req), context_(context), log_(log), message_(message) {}
+  FrameRenderer(const BatchRequest& req, RenderContext& context) : req_(req), context_(context) {}
 
-  std::string run(const BatchJob& job, int frame, bool& warned, nlohmann::json& entry) {
+  FrameReport render(const BatchJob& job, int frame, int number) {
     const auto start = std::chrono::steady_clock::now();
+    FrameReport report;
+    report.number = number;
+    nlohmann::json& entry = report.entry;
     entry = {{"version", version_string()}, {"job", job.name}, {"frame", frame}, {"frames", job.frames},
              {"scene", job.scene}};
     if (req_.shard) entry["shard"] = shard_text(*req_.shard);
@@ -544,14 +547,10 @@ class FrameRunner {
       if (req_.resume && complete) {
         entry["status"] = "skipped";
         entry["reason"] = "--resume: every output exists";
-        log_.write(entry);
-        return "skipped";
+        return report;
       }
       Scene scene = load_scene_file(job.scene, overrides);
-      if (!warned) {
-        if (!scene.warnings.empty()) message_(warning_text(scene, "job " + job.name + ": "));
-        warned = true;
-      }
+      report.warnings = warning_text(scene, "job " + job.name + ": ");
       if (job.orbit) {
         apply_orbit(scene, *job.orbit, frame, job.frames);
         entry["camera"] = {{"eye", {scene.camera.eye.x, scene.camera.eye.y, scene.camera.eye.z}},
@@ -565,106 +564,179 @@ class FrameRunner {
       entry["stats"] = render_scene(scene, render, context_, {}, start);
       entry["status"] = "ok";
     } catch (const DeviceError& e) {
-      message_(std::string("algray: ") + e.what() + "\n");
+      report.message = std::string("algray: ") + e.what() + "\n";
       entry["status"] = "failed";
       entry["error"] = e.what();
-      log_.write(entry);
-      throw DeviceLost{e.what()};
+      report.device_lost = true;
+      return report;
     } catch (const std::exception& e) {
       const std::string why = describe_error(e).text;
-      message_("algray: job " + job.name + " frame " + std::to_string(frame) + " failed:\n" + why);
+      report.message = "algray: job " + job.name + " frame " + std::to_string(frame) + " failed:\n" + why;
       entry["status"] = "failed";
       entry["error"] = why;
     }
     entry["ms"] = ms_since(start);
-    log_.write(entry);
-    return entry["status"].get<std::string>();
+    return report;
   }
 
  private:
   const BatchRequest& req_;
   RenderContext& context_;
-  JsonLinesLog& log_;
-  const BatchReporter& message_;
 };
 
 }  // namespace
 
-BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks, RenderContext& context) {
-  const BatchReporter message{callbacks};
-  BatchPlan plan;
-  std::optional<JsonLinesLog> log;
-  try {
-    plan = plan_batch(req);
-    log.emplace(plan.log_path, req.resume);
-  } catch (const std::exception& e) {
-    return message.refused(e);
+void render_dealt_frames(const BatchRequest& req, const BatchPlan& plan, RenderContext& context,
+                         FrameDealer& dealer) {
+  FrameRenderer renderer(req, context);
+  while (const std::optional<int> number = dealer.next_frame()) {
+    const auto [job, frame] = place_of(plan, *number);
+    FrameReport report = renderer.render(plan.jobs[job], frame, *number);
+    // No frame can run without the device: this renderer stops rather than fail every frame it would get alike.
+    const bool device_lost = report.device_lost;
+    dealer.finished(std::move(report));
+    if (device_lost) return;
   }
+}
 
-  const int total = plan.total_frames;
-  const auto batch_start = std::chrono::steady_clock::now();
-  int done = 0, ok = 0, failed = 0, skipped = 0;
-  nlohmann::json summary_jobs = nlohmann::json::array();
-  FrameRunner runner(req, context, *log, message);
-  try {
-    int number = 0;
-    for (const BatchJob& job : plan.jobs) {
-      JobTally tally;
-      bool warned = false;
-      for (int frame = 0; frame < job.frames; ++frame) {
-        if (!in_shard(req, number++)) continue;
-        nlohmann::json entry;
-        const std::string status = runner.run(job, frame, warned, entry);
-        ++done;
-        if (status == "skipped") {
-          ++skipped;
-          ++tally.skipped;
-          continue;
-        }
-        if (status == "ok") {
-          ++ok;
-          ++tally.ok;
-        } else {
-          ++failed;
-          ++tally.failed;
-        }
-        const double ms = entry["ms"].get<double>();
-        tally.frame_ms.push_back(ms);
-        if (callbacks.on_frame) {
-          const double elapsed = ms_since(batch_start);
-          callbacks.on_frame({done, total, &job, frame, status, ms, elapsed, elapsed / done * (total - done)});
-        }
-      }
-      summary_jobs.push_back(tally.json(job));
-    }
-  } catch (const DeviceLost&) {
-    return BatchOutcome::BadInput;
-  } catch (const JsonLinesLog::WriteFailed& e) {
-    message(std::string("algray: ") + e.what() + "\nalgray: stopped after " + std::to_string(done) + " of " +
-            std::to_string(total) + " frames (" + std::to_string(ok) + " rendered, " + std::to_string(failed) +
-            " failed); --resume continues where the images end\n");
-    return BatchOutcome::Stopped;
+struct BatchRecorder::State {
+  const BatchRequest& req;
+  const BatchPlan& plan;
+  const BatchCallbacks& callbacks;
+  BatchReporter message{callbacks};
+  JsonLinesLog log;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  int done = 0, ok = 0, failed = 0, skipped = 0, devices_lost = 0;
+  bool stopped = false;
+  std::vector<JobTally> tallies;
+  // A job's warnings are shown once, from the first of its frames that read the scene.
+  std::vector<bool> warned;
+
+  State(const BatchRequest& r, const BatchPlan& p, const BatchCallbacks& c)
+      : req(r), plan(p), callbacks(c), log(p.log_path, r.resume), tallies(p.jobs.size()), warned(p.jobs.size()) {}
+};
+
+BatchRecorder::BatchRecorder(const BatchRequest& request, const BatchPlan& plan, const BatchCallbacks& callbacks)
+    : state_(std::make_unique<State>(request, plan, callbacks)) {}
+
+BatchRecorder::~BatchRecorder() = default;
+
+bool BatchRecorder::stopped() const { return state_->stopped; }
+
+void BatchRecorder::record(const FrameReport& report) {
+  State& s = *state_;
+  if (s.stopped) return;
+  const auto [job_index, frame] = place_of(s.plan, report.number);
+  const BatchJob& job = s.plan.jobs[job_index];
+  if (report.warnings && !s.warned[job_index]) {
+    s.warned[job_index] = true;
+    if (!report.warnings->empty()) s.message(*report.warnings);
   }
-  const nlohmann::json summary = {{"version", version_string()},
-                                  {"jobs_file", req.jobs_path},
-                                  {"log", plan.log_path},
-                                  {"shard", req.shard ? nlohmann::json(shard_text(*req.shard)) : nlohmann::json()},
-                                  {"frames", {{"total", total}, {"ok", ok}, {"failed", failed}, {"skipped", skipped}}},
-                                  {"jobs", summary_jobs},
-                                  {"total_ms", ms_since(batch_start)}};
-  if (plan.stats_path) {
+  if (!report.message.empty()) s.message(report.message);
+  try {
+    s.log.write(report.entry);
+  } catch (const JsonLinesLog::WriteFailed& e) {
+    s.message(std::string("algray: ") + e.what() + "\nalgray: stopped after " + std::to_string(s.done) + " of " +
+              std::to_string(s.plan.total_frames) + " frames (" + std::to_string(s.ok) + " rendered, " +
+              std::to_string(s.failed) + " failed); --resume continues where the images end\n");
+    s.stopped = true;
+    return;
+  }
+  ++s.done;
+  JobTally& tally = s.tallies[job_index];
+  const std::string status = report.entry.value("status", "");
+  if (report.device_lost) {
+    ++s.devices_lost;
+    ++s.failed;
+    ++tally.failed;
+    return;
+  }
+  if (status == "skipped") {
+    ++s.skipped;
+    ++tally.skipped;
+    return;
+  }
+  if (status == "ok") {
+    ++s.ok;
+    ++tally.ok;
+  } else {
+    ++s.failed;
+    ++tally.failed;
+  }
+  const double ms = report.entry.value("ms", 0.0);
+  tally.frame_ms.push_back(ms);
+  if (s.callbacks.on_frame) {
+    const int total = s.plan.total_frames;
+    const double elapsed = ms_since(s.start);
+    s.callbacks.on_frame({s.done, total, &job, frame, status, ms, elapsed, elapsed / s.done * (total - s.done)});
+  }
+}
+
+BatchOutcome BatchRecorder::finish(int renderers) {
+  State& s = *state_;
+  if (s.stopped) return BatchOutcome::Stopped;
+  // The device's message is out already; as in one process, where the first failure of the device ends the batch.
+  if (s.devices_lost >= renderers) return BatchOutcome::BadInput;
+  const int total = s.plan.total_frames;
+  nlohmann::json summary_jobs = nlohmann::json::array();
+  for (std::size_t j = 0; j < s.plan.jobs.size(); ++j) summary_jobs.push_back(s.tallies[j].json(s.plan.jobs[j]));
+  const nlohmann::json summary = {
+      {"version", version_string()},
+      {"jobs_file", s.req.jobs_path},
+      {"log", s.plan.log_path},
+      {"shard", s.req.shard ? nlohmann::json(shard_text(*s.req.shard)) : nlohmann::json()},
+      {"frames", {{"total", total}, {"ok", s.ok}, {"failed", s.failed}, {"skipped", s.skipped}}},
+      {"jobs", summary_jobs},
+      {"total_ms", ms_since(s.start)}};
+  if (s.plan.stats_path) {
     try {
-      write_text_file(*plan.stats_path, summary.dump(2) + "\n");
+      write_text_file(*s.plan.stats_path, summary.dump(2) + "\n");
     } catch (const std::exception& e) {
       // After the frames: a failure to write, not bad input.
-      message(std::string("algray: the frames are done, but the batch stats were not written: ") + e.what() + "\n");
+      s.message(std::string("algray: the frames are done, but the batch stats were not written: ") + e.what() +
+                "\n");
       return BatchOutcome::Stopped;
     }
   }
-  if (failed)
-    message("algray: " + std::to_string(failed) + " of " + std::to_string(total) + " frames failed (see " +
-            plan.log_path + ")\n");
-  return failed ? BatchOutcome::FramesFailed : BatchOutcome::Done;
+  if (s.failed)
+    s.message("algray: " + std::to_string(s.failed) + " of " + std::to_string(total) + " frames failed (see " +
+              s.plan.log_path + ")\n");
+  return s.failed ? BatchOutcome::FramesFailed : BatchOutcome::Done;
+}
+
+BatchOutcome refuse_batch(const std::exception& error, const BatchCallbacks& callbacks) {
+  return BatchReporter{callbacks}.refused(error);
+}
+
+BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks, RenderContext& context) {
+  BatchPlan plan;
+  std::optional<BatchRecorder> recorder;
+  try {
+    plan = plan_batch(req);
+    recorder.emplace(req, plan, callbacks);
+  } catch (const std::exception& e) {
+    return refuse_batch(e, callbacks);
+  }
+  // One process deals itself its shard's frames in order, each recorded as soon as it is done.
+  class OwnFrames : public FrameDealer {
+   public:
+    OwnFrames(const BatchRequest& req, const BatchPlan& plan, BatchRecorder& recorder)
+        : req_(req), plan_(plan), recorder_(recorder) {}
+    std::optional<int> next_frame() override {
+      while (next_ < plan_.numbered_frames && !in_shard(req_, next_)) ++next_;
+      if (next_ >= plan_.numbered_frames || recorder_.stopped()) return std::nullopt;
+      return next_++;
+    }
+    void finished(FrameReport report) override { recorder_.record(report); }
+
+   private:
+    const BatchRequest& req_;
+    const BatchPlan& plan_;
+    BatchRecorder& recorder_;
+    int next_ = 0;
+  } own(req, plan, *recorder);
+  render_dealt_frames(req, plan, context, own);
+  return recorder->finish(1);
 }
 
 BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& callbacks) {

@@ -1,7 +1,10 @@
 // Batches: a TOML list of render jobs with parameter sweeps and camera orbits, run in one process.
 #pragma once
 
+#include <exception>
 #include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -10,6 +13,8 @@
 #include "algray/scene/scene.h"
 
 namespace algray {
+
+struct BatchCallbacks;
 
 // One value swept over the frames of a job: a parameter (bare name) or any dotted scene key, from `from` to
 // `to` in `steps` evenly spaced values, both ends included.
@@ -60,6 +65,11 @@ struct BatchShard {
   int index = 0, count = 1;
 };
 
+// How a batch ended: every frame done (or skipped), some frames failed (each reported and logged, the rest
+// rendered), the jobs file or its outputs were bad input (nothing rendered), or it stopped early (the device or
+// the log failed).
+enum class BatchOutcome { Done, FramesFailed, BadInput, Stopped };
+
 // Whether 0 <= index < count; false with a message otherwise.
 bool check_shard(const BatchShard& shard, std::string& error);
 // "K/N" with 0 <= K < N; false with a message otherwise.
@@ -81,6 +91,9 @@ struct BatchRequest {
   std::optional<std::string> stats_path;  // a summary of the whole batch
   // Only this share of the frames; the log and the stats become the shard's own (shard_file).
   std::optional<BatchShard> shard;
+  // Runs the batch in place of this process alone, from the same request and callbacks: set by the command line
+  // under an MPI launcher (cluster/mpi_batch.h), which sits above this layer. run_batch calls it when set.
+  std::function<BatchOutcome(const BatchRequest&, const BatchCallbacks&)> distribute;
 };
 
 // One frame finished (rendered, failed or skipped), for a progress display.
@@ -98,19 +111,77 @@ struct BatchCallbacks {
   std::function<void(const std::string&)> on_message;
 };
 
-// How a batch ended: every frame done (or skipped), some frames failed (each reported and logged, the rest
-// rendered), the jobs file or its outputs were bad input (nothing rendered), or it stopped early (the device or
-// the log failed).
-enum class BatchOutcome { Done, FramesFailed, BadInput, Stopped };
-
 // Joins the shard logs of a batch (shard_file of its log, any shard count) into its log: each frame's last entry,
 // in job and frame order. Frames no shard rendered or skipped are reported (FramesFailed), as is a bad jobs file.
 BatchOutcome merge_shard_logs(const BatchRequest& request, const BatchCallbacks& callbacks);
 
 // Runs every frame of every job, in order, on one device with one program cache. A failing frame is reported
-// and logged, and the rest still run.
+// and logged, and the rest still run. With request.distribute set, that runs the batch instead.
 BatchOutcome run_batch(const BatchRequest& request, const BatchCallbacks& callbacks);
-// The same on a device already open (its device_spec and use_cache are then the context's).
+// The same in this process, on a device already open (its device_spec and use_cache are then the context's).
 BatchOutcome run_batch(const BatchRequest& request, const BatchCallbacks& callbacks, RenderContext& context);
+
+// The pieces run_batch is made of, for a batch whose frames are rendered by several processes (cluster/): one
+// plans and records, every one renders the frames a FrameDealer hands it.
+
+// The jobs file read and every path the batch will write checked, before anything renders.
+struct BatchPlan {
+  std::vector<BatchJob> jobs;
+  std::string log_path;
+  std::optional<std::string> stats_path;
+  int total_frames = 0;     // of this shard
+  int numbered_frames = 0;  // of every job: frame numbers run from 0 to this, shard or not
+};
+// Throws SceneError or OutputError on bad input: a bad jobs file, or an output that cannot be written or is
+// another input or output by some other name.
+BatchPlan plan_batch(const BatchRequest& request);
+
+// A frame finished (rendered, failed or skipped) by whichever process rendered it.
+struct FrameReport {
+  int number = 0;        // in the numbering of the whole batch that shards use
+  nlohmann::json entry;  // its log line
+  std::string message;   // why it failed, for the person running the batch; empty when it did not
+  std::optional<std::string> warnings;  // the scene's warning lines, once the frame has read its scene
+  bool device_lost = false;             // the device failed: the process that rendered it renders no more
+};
+
+// Where a renderer's frames come from and where what became of them goes.
+class FrameDealer {
+ public:
+  virtual ~FrameDealer() = default;
+  // The number of the next frame to render, or none when there are no more for this renderer.
+  virtual std::optional<int> next_frame() = 0;
+  virtual void finished(FrameReport report) = 0;
+};
+
+// Renders (or, with --resume, skips) the frames `dealer` deals, one at a time, until it deals no more or the
+// device fails. Writes nothing but the frames' own files.
+void render_dealt_frames(const BatchRequest& request, const BatchPlan& plan, RenderContext& context,
+                         FrameDealer& dealer);
+
+// The log, the messages, the progress and the summary of a batch, from its frames' reports in the order they
+// finish. One thread at a time.
+class BatchRecorder {
+ public:
+  // Opens the log (throws OutputError).
+  BatchRecorder(const BatchRequest& request, const BatchPlan& plan, const BatchCallbacks& callbacks);
+  ~BatchRecorder();
+  BatchRecorder(const BatchRecorder&) = delete;
+  BatchRecorder& operator=(const BatchRecorder&) = delete;
+
+  void record(const FrameReport& report);
+  // The log could not be written: the batch stops, and no later report is recorded.
+  bool stopped() const;
+  // The outcome once every renderer is done, the summary written and the failures counted. `renderers` of them
+  // rendered: when every one lost its device, the batch ends as a device that cannot be opened does.
+  BatchOutcome finish(int renderers);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// A batch refused before any frame (its plan or its log failed): the reason through the callbacks, and the outcome.
+BatchOutcome refuse_batch(const std::exception& error, const BatchCallbacks& callbacks);
 
 }  // namespace algray

@@ -1,0 +1,32 @@
+// MPI's start and end for the process, and the launchers' variables that say whether to start it at all.
+#include "algray/cluster/mpi_world.h"
+
+#include <mpi.h>
+
+#include <cstdlib>
+#include <stdexcept>
+
+namespace algray {
+
+bool MpiWorld::launched() {
+  // Open MPI's mpirun; PMIx launchers (Open MPI 5, srun --mpi=pmix); PMI-1/2 launchers (MPICH's hydra, srun
+  // --mpi=pmi2).
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
+    if (const char* value = std::getenv(name); value && *value) return true;
+  return false;
+}
+
+MpiWorld::MpiWorld() {
+  int provided = MPI_THREAD_SINGLE;
+  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+  if (provided < MPI_THREAD_FUNNELED) {
+    MPI_Finalize();
+    throw std::runtime_error("the MPI library gives no MPI_THREAD_FUNNELED, which a batch across ranks needs");
+  }
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+}
+
+MpiWorld::~MpiWorld() { MPI_Finalize(); }
+
+}  // namespace algray

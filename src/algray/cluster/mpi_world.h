@@ -1,0 +1,26 @@
+// The MPI job a process belongs to: MPI initialised while a MpiWorld lives, and this process's rank in it.
+#pragma once
+
+namespace algray {
+
+class MpiWorld {
+ public:
+  // Whether an MPI launcher (mpirun, mpiexec, srun with PMI or PMIx) started this process, read from the
+  // variables launchers set. A process started alone never initialises MPI, so it starts as fast as before.
+  static bool launched();
+
+  // MPI_Init_thread with MPI_THREAD_FUNNELED: MPI calls come from the main thread only, while other threads
+  // render. Throws std::runtime_error when the library cannot give that.
+  MpiWorld();
+  ~MpiWorld();
+  MpiWorld(const MpiWorld&) = delete;
+  MpiWorld& operator=(const MpiWorld&) = delete;
+
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+
+ private:
+  int rank_ = 0, size_ = 1;
+};
+
+}  // namespace algray

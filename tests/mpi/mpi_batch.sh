@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# test_mpi_batch: `mpirun -n 2 algray batch` on this machine. A 16-frame sweep must have every frame rendered
+# exactly once, by both ranks between them, byte-identical to a single-process batch; a batch with one failing
+# frame must report and log it and render the rest (exit 1); a bad jobs file must end every rank with exit 2 and
+# nothing written. Without mpirun it fails, saying what to install.
+#   mpi_batch.sh ALGRAY_BINARY WORK_DIR
+set -uo pipefail
+algray=$1
+work=$2
+rm -rf "$work"
+mkdir -p "$work"/{single,mpi,failing,bad}
+
+fail() {
+  echo "test_mpi_batch: $*" >&2
+  exit 1
+}
+command -v mpirun >/dev/null || fail "mpirun not found: install openmpi-bin and libopenmpi-dev (scripts/install-deps.sh does)"
+command -v python3 >/dev/null || fail "python3 not found (it reads the JSON-lines logs)"
+# CI runs as root; the timeout turns a deadlock into a failure.
+mpirun_2=(timeout 120 mpirun --oversubscribe --allow-run-as-root -n 2 -x POCL_MAX_PTHREAD_COUNT=1)
+
+scene='[surface]
+equation = "x^2+y^2+z^2-r^2"
+[parameters]
+r = 1
+[extent]
+radius = 2
+[camera]
+eye = [0, 0, 5]
+look_at = [0, 0, 0]
+up = [0, 1, 0]
+fov_y = 45
+[[light]]
+position = [3, 4, 5]'
+sweep='[defaults]
+set = { image = { width = 160, height = 120 } }
+[[job]]
+name = "grow"
+scene = "ball.toml"
+output = "grow_{frame:02}.png"
+sweep.r = { from = 0.4, to = 1.5, steps = 16 }'
+for dir in single mpi failing bad; do echo "$scene" > "$work/$dir/ball.toml"; done
+echo "$sweep" > "$work/single/jobs.toml"
+echo "$sweep" > "$work/mpi/jobs.toml"
+
+# The single process first: it also fills the program cache, so that both ranks start alike.
+(cd "$work/single" && POCL_MAX_PTHREAD_COUNT=1 "$algray" batch jobs.toml) || fail "the single-process batch failed"
+(cd "$work/mpi" && "${mpirun_2[@]}" "$algray" batch jobs.toml --stats summary.json) ||
+  fail "the 2-rank batch failed (exit $?)"
+status=0
+python3 - "$work/mpi/jobs.log.jsonl" <<'PY' || status=1
+import json, sys
+entries = [json.loads(line) for line in open(sys.argv[1])]
+frames = sorted(e["frame"] for e in entries)
+ranks = {e["rank"] for e in entries}
+problems = []
+if frames != list(range(16)): problems.append(f"frames in the log: {frames}, not 0..15 once each")
+if any(e["status"] != "ok" for e in entries): problems.append("a frame is not ok")
+if any(e.get("ranks") != 2 for e in entries): problems.append("an entry without \"ranks\": 2")
+if ranks != {0, 1}: problems.append(f"frames rendered by ranks {sorted(ranks)}, not by both 0 and 1")
+for p in problems: print("test_mpi_batch:", p, file=sys.stderr)
+sys.exit(1 if problems else 0)
+PY
+for f in $(seq -f %02g 0 15); do
+  cmp -s "$work/single/grow_$f.png" "$work/mpi/grow_$f.png" || { echo "frame $f differs or is missing" >&2; status=1; }
+done
+grep -q '"ok": 16' "$work/mpi/summary.json" || { echo "the summary does not count 16 frames ok" >&2; status=1; }
+[ $status = 0 ] || fail "the 2-rank sweep is wrong (above)"
+
+# One failing frame among six: reported on rank 0's stderr, logged with its error, the rest rendered.
+cat > "$work/failing/jobs.toml" <<'JOBS'
+[defaults]
+set = { image = { width = 64, height = 48 } }
+[[job]]
+name = "grow"
+scene = "ball.toml"
+output = "grow_{frame}.png"
+sweep.r = { from = 0.5, to = 1, steps = 5 }
+[[job]]
+name = "bad"
+scene = "ball.toml"
+set = { r = "huge" }
+output = "bad.png"
+JOBS
+(cd "$work/failing" && "${mpirun_2[@]}" "$algray" batch jobs.toml 2> stderr.txt)
+code=$?
+[ $code = 1 ] || fail "a batch with a failing frame exited $code, not 1: $(cat "$work/failing/stderr.txt")"
+grep -q "job bad frame 0 failed" "$work/failing/stderr.txt" || fail "the failing frame was not reported: $(cat "$work/failing/stderr.txt")"
+[ "$(grep -c "job bad frame 0 failed" "$work/failing/stderr.txt")" = 1 ] || fail "the failure was reported more than once"
+python3 - "$work/failing/jobs.log.jsonl" <<'PY' || fail "the failing batch's log is wrong (above)"
+import json, sys
+entries = {(e["job"], e["frame"]): e for e in map(json.loads, open(sys.argv[1]))}
+problems = []
+if len(entries) != 6: problems.append(f"{len(entries)} frames in the log, not 6")
+bad = entries.get(("bad", 0), {})
+if bad.get("status") != "failed" or "must be a number" not in bad.get("error", ""): problems.append(f"bad frame: {bad}")
+if bad.get("rank") not in (0, 1): problems.append("the failed frame does not say which rank tried it")
+if any(entries.get(("grow", f), {}).get("status") != "ok" for f in range(5)): problems.append("a good frame is not ok")
+for p in problems: print("test_mpi_batch:", p, file=sys.stderr)
+sys.exit(1 if problems else 0)
+PY
+for f in 0 1 2 3 4; do [ -f "$work/failing/grow_$f.png" ] || fail "grow_$f.png was not rendered"; done
+[ ! -e "$work/failing/bad.png" ] || fail "the failing frame left bad.png"
+
+# Bad input: every rank finds it and exits 2 before anything renders, without waiting for the others forever.
+printf '[[job]]\nscene = 3\noutput = "x.png"\n' > "$work/bad/jobs.toml"
+(cd "$work/bad" && "${mpirun_2[@]}" "$algray" batch jobs.toml 2> stderr.txt)
+code=$?
+[ $code = 2 ] || fail "a bad jobs file exited $code, not 2: $(cat "$work/bad/stderr.txt")"
+grep -q "jobs.toml:2:9" "$work/bad/stderr.txt" || fail "the jobs file's error does not say where: $(cat "$work/bad/stderr.txt")"
+[ ! -e "$work/bad/jobs.log.jsonl" ] || fail "a refused batch wrote its log"
+(cd "$work/mpi" && "${mpirun_2[@]}" "$algray" batch jobs.toml --shard 0/2 2> shard.txt)
+code=$?
+[ $code = 2 ] || fail "--shard under MPI exited $code, not 2"
+grep -q "does not combine with MPI" "$work/mpi/shard.txt" || fail "--shard under MPI was not refused: $(cat "$work/mpi/shard.txt")"
+echo "test_mpi_batch: 2 ranks, 16 frames each once and identical to one process; a failing frame logged; bad input exit 2"
