@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
@@ -36,7 +37,8 @@ std::vector<ClSession*> two_devices() {
       FAIL("test_multi_device needs two OpenCL devices; CTest runs it with POCL_DEVICES=\"basic basic\", found "
            << devices.size() << ":\n"
            << describe_devices(devices));
-    for (const DeviceInfo& d : select_devices("0,1")) owned.push_back(std::make_unique<ClSession>(d));
+    owned = open_sessions(select_devices("0,1"));
+    REQUIRE(owned[1]->copy == 1);  // the same device kind: its programs are built apart (ClSession::copy)
   }
   return {owned[0].get(), owned[1].get()};
 }
@@ -261,6 +263,30 @@ TEST_CASE("bands of rows, on one device or two, put together are the whole image
       }
       INFO("first difference: " << testing::first_difference(whole.image, stitched));
       CHECK(same_film(whole.image, stitched));
+      // The same bands in another order from one render (next_band), its kernels and buffers set up once.
+      FrameImage handed = make_film(width, height, true);
+      std::vector<std::size_t> order(edges.size() - 1);
+      for (std::size_t b = 0; b < order.size(); ++b) order[b] = order.size() - 1 - b;
+      std::size_t next = 0;
+      RenderOptions in_turn;
+      in_turn.next_band = [&]() -> std::optional<RenderOptions::RowBand> {
+        if (next == order.size()) return std::nullopt;
+        const std::size_t b = order[next++];
+        return RenderOptions::RowBand{edges[b], edges[b + 1]};
+      };
+      in_turn.on_band = [&](const RenderOptions::RowBand& band, FrameImage& film) {
+        REQUIRE(film.height == band.end - band.first);
+        const std::size_t at = static_cast<std::size_t>(band.first) * width;
+        std::copy(film.rgba.begin(), film.rgba.end(), handed.rgba.begin() + 4 * at);
+        std::copy(film.depth.begin(), film.depth.end(), handed.depth.begin() + at);
+        std::copy(film.normal.begin(), film.normal.end(), handed.normal.begin() + 3 * at);
+      };
+      const RenderResult bands = renderer->render(c.scene, in_turn);
+      CHECK(next == order.size());
+      CHECK(same_film(whole.image, handed));
+      CHECK(bands.primary.pixels == whole.primary.pixels);
+      CHECK(bands.primary.hits == whole.primary.hits);
+      CHECK(bands.image.rgba.empty());
       CHECK(summed.pixels == whole.primary.pixels);
       CHECK(summed.pixels_hit == whole.primary.pixels_hit);
       CHECK(summed.rays == whole.primary.rays);
@@ -278,4 +304,7 @@ TEST_CASE("bands of rows, on one device or two, put together are the whole image
   bad.rows = RenderOptions::RowBand{0, 4};
   bad.keep_records = true;
   CHECK_THROWS_AS(one.render(scene, bad), std::invalid_argument);
+  RenderOptions no_hand_over;
+  no_hand_over.next_band = [] { return std::optional<RenderOptions::RowBand>(); };
+  CHECK_THROWS_AS(one.render(scene, no_hand_over), std::invalid_argument);
 }

@@ -10,6 +10,9 @@
 #include "algray/api/probe_report.h"
 #include "algray/api/render_job.h"
 #include "algray/scene/scene.h"
+#ifdef ALGRAY_WITH_MPI
+#include "algray/cluster/mpi_world.h"
+#endif
 
 namespace algray::cli {
 
@@ -37,6 +40,11 @@ struct ProbeRequest {
 
 // Each prints errors (and nothing else on success, unless progress) to `err`; probe's report goes to `out`.
 int run_render(const RenderRequest& request, std::ostream& err);
+#ifdef ALGRAY_WITH_MPI
+// `algray render` under an MPI launcher: every rank renders bands of the image, rank 0 writes the files. Every
+// rank returns the same exit code.
+int run_render_across_ranks(const RenderRequest& request, MpiWorld& world, std::ostream& err);
+#endif
 int run_probe(const ProbeRequest& request, std::ostream& out, std::ostream& err);
 int run_batch_command(const BatchRequest& request, bool progress, std::ostream& err);
 // `algray batch --merge-logs`: the shard logs joined into the batch's log.

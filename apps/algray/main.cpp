@@ -153,6 +153,19 @@ struct RenderCommand {
     request.use_cache = !scene.no_cache;
     if (!stats_path.empty()) request.outputs.stats_path = stats_path;
     request.progress = ::isatty(STDERR_FILENO) != 0;
+#ifdef ALGRAY_WITH_MPI
+    // Started by an MPI launcher, the ranks share the image's rows; started alone, MPI is never initialised.
+    if (MpiWorld::launched()) {
+      std::optional<MpiWorld> world;
+      try {
+        world.emplace();
+      } catch (const std::exception& e) {
+        return report_error(e, std::cerr);
+      }
+      request.progress = request.progress && world->rank() == 0;
+      return run_render_across_ranks(request, *world, std::cerr);
+    }
+#endif
     return run_render(request, std::cerr);
   }
 };

@@ -34,8 +34,7 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
     if (req.json || req.stats_path) {
       const nlohmann::json j = probe_json(scene, req.target, probes);
       if (req.json) out << j.dump(2) << "\n";
-      if (req.stats_path)
-        writer.write(*req.stats_path, [&] { write_text_file(*req.stats_path, j.dump(2) + "\n"); });
+      if (req.stats_path) writer.write(*req.stats_path, [&] { write_text_file(*req.stats_path, j.dump(2) + "\n"); });
     }
     if (!req.json) print_probe(out, scene, req.target, probes);
     if (req.plot_path) {

@@ -6,6 +6,9 @@
 #include "algray/device/cl_runtime.h"
 #include "algray/io/image_io.h"
 #include "algray/util/version.h"
+#ifdef ALGRAY_WITH_MPI
+#include "algray/cluster/mpi_render.h"
+#endif
 #include "commands.h"
 #include "exit_codes.h"
 #include "progress_line.h"
@@ -22,10 +25,13 @@ namespace {
 
 int exit_code(BatchOutcome outcome) {
   switch (outcome) {
-    case BatchOutcome::Done: return kExitOk;
-    case BatchOutcome::BadInput: return kExitBadInput;
+    case BatchOutcome::Done:
+      return kExitOk;
+    case BatchOutcome::BadInput:
+      return kExitBadInput;
     case BatchOutcome::FramesFailed:
-    case BatchOutcome::Stopped: break;
+    case BatchOutcome::Stopped:
+      break;
   }
   return kExitFailure;
 }
@@ -62,6 +68,72 @@ int run_render(const RenderRequest& req, std::ostream& err) {
   return kExitOk;
 }
 
+#ifdef ALGRAY_WITH_MPI
+int run_render_across_ranks(const RenderRequest& req, MpiWorld& world, std::ostream& err) {
+  const auto started = std::chrono::steady_clock::now();
+  const bool lead = world.rank() == 0;
+  // Every rank reads the scene; rank 0 alone checks the outputs and speaks for the job. Any rank's bad input
+  // ends every rank with it, before any device work.
+  Scene scene;
+  int code = kExitOk;
+  try {
+    if (req.scene_path && *req.scene_path == "-")
+      throw SceneError("scene -", "a scene on standard input cannot be shared among MPI ranks; give its file");
+    if (req.outputs.reference || !req.outputs.aovs.empty() || req.outputs.heatmap_path)
+      throw SceneError("mpirun",
+                       "--reference, --aov and --heatmap are not available across MPI ranks yet; render "
+                       "them in one process");
+    scene = SceneLoader().load(req.scene_path, req.overrides);
+    if (lead) {
+      err << warning_text(scene);
+      check_outputs(scene, req.outputs, req.scene_path.value_or(""));
+    }
+  } catch (const std::exception& e) {
+    code = report_error(e, err);
+  }
+  if (!every_rank_agrees(code == kExitOk)) {
+    if (code == kExitOk && lead) err << "algray: another MPI rank refused the scene (see its message)\n";
+    return kExitBadInput;
+  }
+  if (!lead) {
+    std::unique_ptr<RenderContext> context;
+    std::unique_ptr<Renderer> renderer;
+    std::string cannot_render;
+    try {
+      context = std::make_unique<RenderContext>(req.device_spec, req.use_cache);
+      renderer = std::make_unique<Renderer>(context->sessions(), context->cache());
+    } catch (const std::exception& e) {
+      cannot_render = describe_error(e).text;
+    }
+    render_bands_as_worker(renderer.get(), scene, cannot_render);
+    return share_exit_code(kExitOk, world);
+  }
+  ProgressLine progress(req.progress);
+  RenderCallbacks callbacks;
+  if (progress.enabled())
+    callbacks.on_progress = [&](const RenderProgress& p) {
+      char line[256];
+      std::snprintf(line, sizeof line, "rendering %s on %d ranks: %3d%% (%d/%d bands)", scene.name.c_str(),
+                    world.size(), 100 * p.tiles_done / p.tiles_total, p.tiles_done, p.tiles_total);
+      progress.show(line);
+    };
+  bool dealt = false;
+  callbacks.render_pixels = [&](Renderer& renderer, const Scene& s, const RenderOptions& options) {
+    dealt = true;
+    return render_bands_as_rank0(renderer, s, options, outputs_hold_depth(req.outputs), world);
+  };
+  try {
+    RenderContext context(req.device_spec, req.use_cache);
+    render_scene(scene, req.outputs, context, callbacks, started);
+  } catch (const std::exception& e) {
+    progress.finish();
+    code = report_error(e, err);
+  }
+  if (!dealt) release_workers(world);
+  return share_exit_code(code, world);
+}
+#endif
+
 int run_batch_command(const BatchRequest& request, bool show_progress, std::ostream& err) {
   ProgressLine progress(show_progress);
   BatchCallbacks callbacks;
@@ -70,8 +142,8 @@ int run_batch_command(const BatchRequest& request, bool show_progress, std::ostr
     callbacks.on_frame = [&](const BatchProgress& p) {
       char line[512];
       std::snprintf(line, sizeof line, "[%*d/%d] %s frame %d/%d: %s %s | elapsed %s, eta %s   ",
-                    static_cast<int>(std::to_string(p.total).size()), p.done, p.total, p.job->name.c_str(),
-                    p.frame + 1, p.job->frames, p.status.c_str(), seconds_text(p.frame_ms).c_str(),
+                    static_cast<int>(std::to_string(p.total).size()), p.done, p.total, p.job->name.c_str(), p.frame + 1,
+                    p.job->frames, p.status.c_str(), seconds_text(p.frame_ms).c_str(),
                     seconds_text(p.elapsed_ms).c_str(), seconds_text(p.eta_ms).c_str());
       progress.show(line);
     };

@@ -187,7 +187,8 @@ nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const
   j["render_ms"] = {{"kernel", kernel_ms}, {"passes_wall", passes_ms}, {"host_shading", r.shade_ms}};
   // Each device's share of the tiles, of the rays of every pass, and of the device time.
   for (const DeviceShare& d : r.devices)
-    j["devices"].push_back({{"index", d.index},
+    j["devices"].push_back({{"rank", d.rank},
+                            {"index", d.index},
                             {"name", d.name},
                             {"tiles", d.tiles},
                             {"rays", d.rays},
@@ -258,8 +259,7 @@ RenderContext::~RenderContext() = default;
 ClSession& RenderContext::session() { return *sessions().front(); }
 
 std::vector<ClSession*> RenderContext::sessions() {
-  if (sessions_.empty())
-    for (DeviceInfo& device : select_devices(device_spec_)) sessions_.push_back(std::make_unique<ClSession>(device));
+  if (sessions_.empty()) sessions_ = open_sessions(select_devices(device_spec_));
   std::vector<ClSession*> out;
   for (const auto& session : sessions_) out.push_back(session.get());
   return out;
@@ -377,7 +377,11 @@ RenderedFrame render_frame(const Scene& scene, const FrameRequest& request, Rend
     timer.mark("device");
     Renderer renderer(sessions, context.cache());
     RenderOptions options;
-    if (ahead) options.film = [&film] { return film.get(); };
+    // A larger film is made when the render has checked that it fits, with only the channels the outputs hold.
+    if (ahead)
+      options.film = [&film] { return film.get(); };
+    else
+      options.film = [=] { return make_film(film_width, film_height, depth_and_normal); };
     options.on_progress = callbacks.on_progress;
     options.cancelled = callbacks.cancelled;
     if (diagnostics) {
@@ -386,7 +390,8 @@ RenderedFrame render_frame(const Scene& scene, const FrameRequest& request, Rend
         add_tile_work(work, tile);
       };
     }
-    result = renderer.render(scene, options);
+    result =
+        callbacks.render_pixels ? callbacks.render_pixels(renderer, scene, options) : renderer.render(scene, options);
     timer.mark("render");
     timer.move("render", "shade", result.shade_ms);
     image = std::move(result.image);
@@ -408,14 +413,16 @@ RenderedFrame render_frame(const Scene& scene, const FrameRequest& request, Rend
   return frame;
 }
 
+bool outputs_hold_depth(const RenderOutputs& outputs) {
+  return std::any_of(outputs.images.begin(), outputs.images.end(),
+                     [](const std::string& out) { return format_from_extension(out) == ImageFormat::Exr; });
+}
+
 nlohmann::json render_scene(const Scene& scene, const RenderOutputs& outputs, RenderContext& context,
                             const RenderCallbacks& callbacks, std::chrono::steady_clock::time_point started) {
   FrameRequest request;
-  request.depth_and_normal = false;
-  for (const std::string& out : outputs.images) {
-    request.depth_and_normal |= format_from_extension(out) == ImageFormat::Exr;
-    request.png |= format_from_extension(out) == ImageFormat::Png;
-  }
+  request.depth_and_normal = outputs_hold_depth(outputs);
+  for (const std::string& out : outputs.images) request.png |= format_from_extension(out) == ImageFormat::Png;
   request.reference = outputs.reference;
   request.aovs = outputs.aovs;
   request.heatmap = outputs.heatmap_path.has_value();

@@ -30,6 +30,9 @@ struct RenderOutputs {
 struct RenderCallbacks {
   std::function<void(const RenderProgress&)> on_progress;
   std::function<bool()> cancelled;
+  // Where the film's pixels come from when not from renderer.render(scene, options) alone: the bands of other
+  // processes too (an MPI job, cluster/mpi_render.h). It returns what render() would, film and stats.
+  std::function<RenderResult(Renderer& renderer, const Scene& scene, const RenderOptions& options)> render_pixels;
 };
 
 // A failure as a person reads it, and whether the input was at fault (a scene, an output path, a device: the
@@ -172,6 +175,9 @@ RenderedFrame render_frame(const Scene& scene, const FrameRequest& request, Rend
 // The --stats JSON of a frame: version, scene, device, solver, plan, passes, rays and timings.
 nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const std::vector<std::string>& images,
                            bool cache_used);
+
+// Whether the outputs keep depth and normal (an EXR among them), so that the film needs them.
+bool outputs_hold_depth(const RenderOutputs& outputs);
 
 // Renders `scene` and writes the images, heat map and stats file; returns the stats. Throws on failure; outputs
 // already written stay complete (each is replaced atomically).

@@ -23,18 +23,8 @@ constexpr int kOutcomeTag = 3;
 constexpr int kNoMoreFrames = -1;
 constexpr int kPlanned = -1;  // in the exchange of plans: this rank's plan is good
 
-// Open MPI's blocking calls spin on a core while they wait. A rank waiting for a message sleeps instead, so that
-// its core stays with the renderers beside it: rank 0's render thread, or other ranks on the node.
+// Waiting for a request, rank 0 sleeps between probes (wait_sleeping's reason).
 constexpr auto kPollInterval = std::chrono::microseconds(500);
-
-void wait_sleeping(MPI_Request& request) {
-  for (;;) {
-    int done = 0;
-    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
-    if (done) return;
-    std::this_thread::sleep_for(kPollInterval);
-  }
-}
 
 void say(const BatchCallbacks& callbacks, const std::string& text) {
   if (callbacks.on_message) callbacks.on_message(text);

@@ -3,8 +3,10 @@
 
 #include <mpi.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <stdexcept>
+#include <thread>
 
 namespace algray {
 
@@ -28,5 +30,23 @@ MpiWorld::MpiWorld() {
 }
 
 MpiWorld::~MpiWorld() { MPI_Finalize(); }
+
+void wait_sleeping(MPI_Request& request) {
+  constexpr auto kPollInterval = std::chrono::microseconds(500);
+  for (;;) {
+    int done = 0;
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    std::this_thread::sleep_for(kPollInterval);
+  }
+}
+
+bool every_rank_agrees(bool ok) {
+  int mine = ok ? 1 : 0, all = 0;
+  MPI_Request request;
+  MPI_Iallreduce(&mine, &all, 1, MPI_INT, MPI_LAND, MPI_COMM_WORLD, &request);
+  wait_sleeping(request);
+  return all != 0;
+}
 
 }  // namespace algray

@@ -1,6 +1,8 @@
 // The MPI job a process belongs to: MPI initialised while a MpiWorld lives, and this process's rank in it.
 #pragma once
 
+#include <mpi.h>
+
 namespace algray {
 
 class MpiWorld {
@@ -22,5 +24,12 @@ class MpiWorld {
  private:
   int rank_ = 0, size_ = 1;
 };
+
+// Waits for a request to complete, sleeping between tests. Open MPI's blocking calls spin on a core while they
+// wait; a rank waiting for a message sleeps instead, so that its core stays with the renderers beside it.
+void wait_sleeping(MPI_Request& request);
+
+// Collective: whether every rank says `ok`, without spinning.
+bool every_rank_agrees(bool ok);
 
 }  // namespace algray

@@ -147,7 +147,21 @@ std::vector<DeviceInfo> select_devices(const std::string& spec) {
   return chosen;
 }
 
-ClSession::ClSession(DeviceInfo chosen)
-    : info(std::move(chosen)), context(info.device), queue(context, info.device, CL_QUEUE_PROFILING_ENABLE) {}
+ClSession::ClSession(DeviceInfo chosen, int copy_number)
+    : info(std::move(chosen)),
+      copy(copy_number),
+      context(info.device),
+      queue(context, info.device, CL_QUEUE_PROFILING_ENABLE) {}
+
+std::vector<std::unique_ptr<ClSession>> open_sessions(const std::vector<DeviceInfo>& devices) {
+  std::vector<std::unique_ptr<ClSession>> sessions;
+  for (const DeviceInfo& d : devices) {
+    int copy = 0;
+    for (const auto& s : sessions)
+      if (s->info.name == d.name && s->info.driver_version == d.driver_version) ++copy;
+    sessions.push_back(std::make_unique<ClSession>(d, copy));
+  }
+  return sessions;
+}
 
 }  // namespace algray

@@ -3,6 +3,7 @@
 
 #include <CL/opencl.hpp>
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -39,10 +40,18 @@ std::vector<DeviceInfo> select_devices(const std::string& spec);
 std::string describe_devices(const std::vector<DeviceInfo>& devices);
 
 struct ClSession {
-  explicit ClSession(DeviceInfo chosen);
+  explicit ClSession(DeviceInfo chosen, int copy = 0);
   DeviceInfo info;
+  // 0, or n for the n-th other device of one process with this device's name and driver. Its programs are built
+  // with -DALGRAY_DEVICE_COPY=n, so that they differ from the first device's: PoCL 3.1 keeps one table of loaded
+  // kernels for all its devices, matched by the program's hash and work-group size only, and two such devices
+  // running the same kernel at once broke its reference counts (an assertion in pocl_release_dlhandle_cache).
+  int copy = 0;
   cl::Context context;
   cl::CommandQueue queue;
 };
+
+// A session on each device, with `copy` numbered among devices of one name and driver.
+std::vector<std::unique_ptr<ClSession>> open_sessions(const std::vector<DeviceInfo>& devices);
 
 }  // namespace algray

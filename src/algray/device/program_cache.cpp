@@ -64,7 +64,8 @@ std::filesystem::path ProgramCache::default_directory() {
 cl::Kernel ProgramCache::kernel(ClSession& session, const KernelConfig& config, ProgramRecord* record) {
   const auto start = std::chrono::steady_clock::now();
   const std::string source = assemble_kernel_source(config.source_file());
-  const std::string options = config.build_options();
+  const std::string options =
+      config.build_options() + (session.copy ? " -DALGRAY_DEVICE_COPY=" + std::to_string(session.copy) : "");
   // Everything the binary depends on: a change to any of it must miss.
   const std::string identity = "source-hash=" + hex64(fnv1a(source)) + "\noptions=" + options +
                                "\ndevice=" + session.info.name + "\ndriver=" + session.info.driver_version +

@@ -433,16 +433,9 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   const RenderPlan& plan = result.plan;
   const int trace_width = plan.trace_width(), trace_height = plan.trace_height();
   result.basis = make_ray_basis(scene.camera, trace_width, trace_height);
-  const bool adaptive = plan.refine_samples > 1;
-  // The rows kept, and those traced: adaptive antialiasing's choice at a band's edge needs the row beyond it.
-  const int first_row = options.rows ? options.rows->first : 0,
-            end_row = options.rows ? options.rows->end : plan.height;
-  if (first_row < 0 || end_row > plan.height || first_row >= end_row)
-    throw std::invalid_argument("rows " + std::to_string(first_row) + " to " + std::to_string(end_row) +
-                                " are not a band of the image's " + std::to_string(plan.height));
-  if (options.rows && options.keep_records) throw std::invalid_argument("a band of rows keeps no records");
-  const int margin = adaptive ? 1 : 0;
-  const int traced_first = std::max(0, first_row - margin), traced_end = std::min(plan.height, end_row + margin);
+  if ((options.rows || options.next_band) && options.keep_records)
+    throw std::invalid_argument("a band of rows keeps no records");
+  if (options.next_band && !options.on_band) throw std::invalid_argument("bands of rows need on_band");
   Shared shared;
   const Shader shader(scene, plan, result.basis, precision);
   // The devices' kernels are loaded one device after another: the program cache serves one caller at a time.
@@ -454,15 +447,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
       passes.surfaces.push_back(std::make_unique<DeviceSurface>(session->context, scene, precision, i));
     prepare_passes(passes);
     passes.shader = &shader;
-    passes.film_y0 = traced_first;
-    passes.first_row = first_row;
-    passes.end_row = end_row;
   }
-  const int film_height = traced_end - traced_first;
-  if (options.film) result.image = options.film();
-  if (result.image.width != plan.width || result.image.height != film_height ||
-      result.image.rgba.size() != 4 * static_cast<std::size_t>(plan.width) * film_height)
-    result.image = make_film(plan.width, film_height, true);
   if (options.keep_records) {
     result.hits.width = trace_width;
     result.hits.height = trace_height;
@@ -470,6 +455,46 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
     if (scene.surfaces.size() > 1) result.hits.surface.assign(result.hits.records.size(), 0);
     for (int light : plan.shadow_lights) result.shadows.occlusion.push_back({light, {}});
   }
+  if (options.next_band) {
+    // Band after band with the same kernels and buffers: only the tiles change.
+    while (const std::optional<RenderOptions::RowBand> band = options.next_band()) {
+      FrameImage film = render_rows(devices, *band, nullptr);
+      options.on_band(*band, film);
+    }
+  } else {
+    result.image = render_rows(devices, options.rows.value_or(RenderOptions::RowBand{0, plan.height}), &options);
+  }
+  add_device_tallies(devices, result);
+  return result;
+}
+
+FrameImage Renderer::render_rows(std::vector<std::unique_ptr<Passes>>& devices, const RenderOptions::RowBand& rows,
+                                 const RenderOptions* film_from) {
+  Passes& any = *devices.front();
+  const Scene& scene = any.scene;
+  RenderResult& result = any.result;
+  const RenderPlan& plan = result.plan;
+  const bool adaptive = plan.refine_samples > 1;
+  const int first_row = rows.first, end_row = rows.end;
+  if (first_row < 0 || end_row > plan.height || first_row >= end_row)
+    throw std::invalid_argument("rows " + std::to_string(first_row) + " to " + std::to_string(end_row) +
+                                " are not a band of the image's " + std::to_string(plan.height));
+  // The rows kept, and those traced: adaptive antialiasing's choice at a band's edge needs the row beyond it.
+  const int margin = adaptive ? 1 : 0;
+  const int traced_first = std::max(0, first_row - margin), traced_end = std::min(plan.height, end_row + margin);
+  for (auto& passes : devices) {
+    passes->film_y0 = traced_first;
+    passes->first_row = first_row;
+    passes->end_row = end_row;
+    passes->band_y0 = -1;  // a band's first tile row may start where the last band's did, but be shorter
+  }
+  const int film_height = traced_end - traced_first;
+  FrameImage film;
+  if (film_from && film_from->film) film = film_from->film();
+  if (film.width != plan.width || film.height != film_height ||
+      film.rgba.size() != 4 * static_cast<std::size_t>(plan.width) * film_height)
+    film = make_film(plan.width, film_height, true);
+  std::swap(result.image, film);  // the devices' tiles go into result.image
 
   // Row by row of tiles, as the film's lines are laid out.
   std::vector<Tile> tiles;
@@ -479,6 +504,8 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
       const int w = std::min(side, plan.width - x0), h = std::min(side, traced_end - y0);
       tiles.push_back({x0, y0, w, h, x0 * s, y0 * s, w * s, h * s});
     }
+  Shared& shared = any.shared;
+  shared.tiles_done = 0;
   shared.tiles_total = static_cast<int>(tiles.size()) * (adaptive ? 2 : 1);
   sweep(devices, tiles, [this](Passes& passes, const Tile& tile) {
     if (tile.y0 != passes.band_y0) {
@@ -503,11 +530,11 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
     std::fill(refine.end() - static_cast<std::ptrdiff_t>((traced_end - end_row) * width), refine.end(), 0);
     devices.front()->shade_ms += ms_since(start);
     sweep(devices, tiles, [this, &refine](Passes& passes, const Tile& tile) { refine_tile(passes, tile, refine); });
-    if (options.keep_records) result.refined = refine;
+    if (any.options.keep_records) result.refined = refine;
   }
-  add_device_tallies(devices, result);
-  crop_rows(result.image, first_row - traced_first, end_row - first_row);
-  return result;
+  std::swap(result.image, film);
+  crop_rows(film, first_row - traced_first, end_row - first_row);
+  return film;
 }
 
 void Renderer::add_device_tallies(const std::vector<std::unique_ptr<Passes>>& devices, RenderResult& result) {

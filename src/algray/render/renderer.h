@@ -75,12 +75,18 @@ struct RenderOptions {
     int first = 0, end = 0;
   };
   std::optional<RowBand> rows;
+  // Bands one after another, as next_band gives them until it gives none, each handed to on_band in a film of
+  // its own rows (row 0 is the band's first), with the kernels, buffers and screen form set up once for all
+  // (MPI ranks take bands so). The result then holds no film, and its counts are the bands' together.
+  std::function<std::optional<RowBand>()> next_band;
+  std::function<void(const RowBand&, FrameImage&)> on_band;
 };
 
 // One device's share of a render of several: the tiles it took from the queue (the first sweep's, when
 // adaptive antialiasing sweeps twice), its rays and device time over every pass, and its programs' load time.
 struct DeviceShare {
-  int index = 0;  // in enumerate_devices()
+  int rank = 0;   // the MPI rank whose device it is, when ranks share an image (0 otherwise)
+  int index = 0;  // in enumerate_devices() of its process
   std::string name;
   int tiles = 0;
   std::uint64_t rays = 0;
@@ -147,6 +153,10 @@ class Renderer {
   // fails; the first failure is thrown on.
   void sweep(std::vector<std::unique_ptr<Passes>>& devices, const std::vector<Tile>& tiles,
              const std::function<void(Passes&, const Tile&)>& work);
+  // The output rows `rows` through every pass into a film of their own; the film from film_from->film when its
+  // size is the band's.
+  FrameImage render_rows(std::vector<std::unique_ptr<Passes>>& devices, const RenderOptions::RowBand& rows,
+                         const RenderOptions* film_from);
   static void add_device_tallies(const std::vector<std::unique_ptr<Passes>>& devices, RenderResult& result);
   void prepare_passes(Passes& passes);
   // The primary kernels' arguments for a band of tiles (a row of them), but the tile's own.
