@@ -54,6 +54,12 @@ ProgramCache& test_cache() {
   return cache;
 }
 
+// A scene the renders are compared on, and what it is for the failure message.
+struct Case {
+  std::string what;
+  Scene scene;
+};
+
 std::size_t tile_count(const RenderPlan& plan) {
   const std::size_t side = static_cast<std::size_t>(plan.tile_pixels());
   return ((plan.width + side - 1) / side) * ((plan.height + side - 1) / side);
@@ -87,10 +93,6 @@ TEST_CASE("two devices render the one-device image bit for bit, sharing the tile
   const std::vector<ClSession*> both = two_devices();
   Renderer one(*both[0], test_cache());
   Renderer two(both, test_cache());
-  struct Case {
-    std::string what;
-    Scene scene;
-  };
   std::vector<Case> cases;
   // Everything that crosses a tile's border: two surfaces, bounces, an area light's shadows, and adaptive
   // antialiasing, whose choice at a tile's edge needs the neighbouring tiles' first colours from either device.
@@ -228,10 +230,6 @@ TEST_CASE("bands of rows, on one device or two, put together are the whole image
   const std::vector<ClSession*> both = two_devices();
   Renderer one(*both[0], test_cache());
   Renderer two(both, test_cache());
-  struct Case {
-    std::string what;
-    Scene scene;
-  };
   // Adaptive antialiasing chooses at a band's edge from the rows beyond it; bounces, shadows and two surfaces
   // cross every edge too.
   const std::vector<Case> cases = {

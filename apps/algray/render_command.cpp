@@ -38,6 +38,23 @@ int exit_code(BatchOutcome outcome) {
 
 }  // namespace
 
+namespace {
+
+// The progress line of one render: "rendering NAME[ on N ranks]: P% (D/T tiles|bands)".
+RenderCallbacks progress_callbacks(ProgressLine& progress, const std::string& what, const char* unit) {
+  RenderCallbacks callbacks;
+  if (progress.enabled())
+    callbacks.on_progress = [&progress, what, unit](const RenderProgress& p) {
+      char line[256];
+      std::snprintf(line, sizeof line, "rendering %s: %3d%% (%d/%d %s)", what.c_str(),
+                    100 * p.tiles_done / p.tiles_total, p.tiles_done, p.tiles_total, unit);
+      progress.show(line);
+    };
+  return callbacks;
+}
+
+}  // namespace
+
 int run_render(const RenderRequest& req, std::ostream& err) {
   const auto started = std::chrono::steady_clock::now();
   // Everything the user gave is checked before any device work, so bad input costs nothing and writes nothing.
@@ -50,14 +67,7 @@ int run_render(const RenderRequest& req, std::ostream& err) {
     return report_error(e, err);
   }
   ProgressLine progress(req.progress);
-  RenderCallbacks callbacks;
-  if (progress.enabled())
-    callbacks.on_progress = [&](const RenderProgress& p) {
-      char line[256];
-      std::snprintf(line, sizeof line, "rendering %s: %3d%% (%d/%d tiles)", scene.name.c_str(),
-                    100 * p.tiles_done / p.tiles_total, p.tiles_done, p.tiles_total);
-      progress.show(line);
-    };
+  const RenderCallbacks callbacks = progress_callbacks(progress, scene.name, "tiles");
   try {
     RenderContext context(req.device_spec, req.use_cache);
     render_scene(scene, req.outputs, context, callbacks, started);
@@ -109,14 +119,8 @@ int run_render_across_ranks(const RenderRequest& req, MpiWorld& world, std::ostr
     return share_exit_code(kExitOk, world);
   }
   ProgressLine progress(req.progress);
-  RenderCallbacks callbacks;
-  if (progress.enabled())
-    callbacks.on_progress = [&](const RenderProgress& p) {
-      char line[256];
-      std::snprintf(line, sizeof line, "rendering %s on %d ranks: %3d%% (%d/%d bands)", scene.name.c_str(),
-                    world.size(), 100 * p.tiles_done / p.tiles_total, p.tiles_done, p.tiles_total);
-      progress.show(line);
-    };
+  RenderCallbacks callbacks =
+      progress_callbacks(progress, scene.name + " on " + std::to_string(world.size()) + " ranks", "rows");
   bool dealt = false;
   callbacks.render_pixels = [&](Renderer& renderer, const Scene& s, const RenderOptions& options) {
     dealt = true;

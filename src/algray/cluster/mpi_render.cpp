@@ -41,28 +41,33 @@ struct Band {
   int first = 0, end = 0;
 };
 
-// The bands still to deal, shared by rank 0's gathering loop and its render thread.
+// The rows still to deal, shared by rank 0's gathering loop and its render thread. Each band is cut as it is
+// dealt (band_rows), numbered in the order dealt.
 class BandQueue {
  public:
-  BandQueue(int height, int ranks) : height_(height), rows_(rows_per_band(height, ranks)) {
-    count_ = (height + rows_ - 1) / rows_;
+  BandQueue(int height, int ranks) : height_(height), ranks_(ranks) {}
+  Band band(int b) const {
+    const std::lock_guard<std::mutex> hold(lock_);
+    return dealt_.at(static_cast<std::size_t>(b));
   }
-  int count() const { return count_; }
-  Band band(int b) const { return {b * rows_, std::min(height_, (b + 1) * rows_)}; }
   std::optional<int> take() {
     const std::lock_guard<std::mutex> hold(lock_);
-    if (next_ >= count_) return std::nullopt;
-    return next_++;
+    if (next_row_ >= height_) return std::nullopt;
+    const int rows = band_rows(height_ - next_row_, height_, ranks_);
+    dealt_.push_back({next_row_, next_row_ + rows});
+    next_row_ += rows;
+    return static_cast<int>(dealt_.size()) - 1;
   }
   // No band is dealt any more: every rank stops after the band it has in hand.
   void stop() {
     const std::lock_guard<std::mutex> hold(lock_);
-    next_ = count_;
+    next_row_ = height_;
   }
 
  private:
-  std::mutex lock_;
-  int height_, rows_, count_ = 0, next_ = 0;
+  mutable std::mutex lock_;
+  int height_, ranks_, next_row_ = 0;
+  std::vector<Band> dealt_;
 };
 
 // What one band's render counted, as text for the message to rank 0 and as rank 0 adds it up.
@@ -194,7 +199,7 @@ class Gatherer {
   // `film_ready` is waited for before the first band is put in; `film` is null when there is none to fill.
   // `failed(why)` is told each worker's failure; `band_done` each finished band; `idle` runs between polls.
   void serve(int workers, const std::shared_future<void>& film_ready, FrameImage* const& film, int width,
-             const std::function<void(const std::string&)>& failed, const std::function<void()>& band_done,
+             const std::function<void(const std::string&)>& failed, const std::function<void(int rows)>& band_done,
              const std::function<void()>& idle) {
     std::vector<float> dropped;
     for (int active = workers; active > 0;) {
@@ -235,7 +240,7 @@ class Gatherer {
           MPI_Recv(to.normal, message_count(3 * pixels), MPI_FLOAT, source, kPixelsTag, MPI_COMM_WORLD,
                    MPI_STATUS_IGNORE);
         }
-        band_done();
+        band_done(band.end - band.first);
       }
       const int next = queue_.take().value_or(kNoBand);
       const Band band = next == kNoBand ? Band{} : queue_.band(next);
@@ -252,9 +257,10 @@ class Gatherer {
 
 }  // namespace
 
-int rows_per_band(int image_height, int ranks) {
-  const int bands = 8 * std::max(1, ranks);
-  return std::max(1, (image_height + bands - 1) / bands);
+int band_rows(int rows_left, int image_height, int ranks) {
+  ranks = std::max(1, ranks);
+  const int smallest = std::max(1, (image_height + 64 * ranks - 1) / (64 * ranks));
+  return std::min(rows_left, std::max(smallest, (rows_left + 2 * ranks - 1) / (2 * ranks)));
 }
 
 RenderResult render_bands_as_rank0(Renderer& renderer, const Scene& scene, const RenderOptions& options,
@@ -262,7 +268,7 @@ RenderResult render_bands_as_rank0(Renderer& renderer, const Scene& scene, const
   const int width = scene.image.width, height = scene.image.height;
   BandQueue queue(height, world.size());
   ImageTally tally;
-  std::atomic<int> bands_done{0};
+  std::atomic<int> rows_done{0};
   std::mutex failure_lock;
   std::string failure;  // the first failure, on whichever rank
   auto fail = [&](const std::string& why) {
@@ -303,7 +309,7 @@ RenderResult render_bands_as_rank0(Renderer& renderer, const Scene& scene, const
         std::copy(pixels.rgba.begin(), pixels.rgba.end(), to.rgba);
         if (to.depth) std::copy(pixels.depth.begin(), pixels.depth.end(), to.depth);
         if (to.normal) std::copy(pixels.normal.begin(), pixels.normal.end(), to.normal);
-        ++bands_done;
+        rows_done += pixels.height;
       };
       result = renderer.render(scene, bands);
       tally.add(band_tally(result), 0);
@@ -315,14 +321,14 @@ RenderResult render_bands_as_rank0(Renderer& renderer, const Scene& scene, const
 
   int reported = 0;
   auto report = [&] {
-    if (options.on_progress && bands_done > reported) {
-      reported = bands_done;
-      options.on_progress({reported, queue.count()});
+    if (options.on_progress && rows_done > reported) {
+      reported = rows_done;
+      options.on_progress({reported, height});
     }
   };
   Gatherer(queue, tally, depth_and_normal)
       .serve(
-          world.size() - 1, film_ready, film_made, width, fail, [&] { ++bands_done; }, report);
+          world.size() - 1, film_ready, film_made, width, fail, [&](int rows) { rows_done += rows; }, report);
   own.join();
   report();
   if (!failure.empty())
@@ -388,7 +394,7 @@ void release_workers(MpiWorld& world) {
   FrameImage* film = nullptr;
   Gatherer(none, ignored, false)
       .serve(
-          world.size() - 1, no_film.get_future().share(), film, 0, [](const std::string&) {}, [] {}, [] {});
+          world.size() - 1, no_film.get_future().share(), film, 0, [](const std::string&) {}, [](int) {}, [] {});
 }
 
 int share_exit_code(int code, MpiWorld& world) {

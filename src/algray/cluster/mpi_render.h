@@ -8,11 +8,12 @@
 
 namespace algray {
 
-// The image's rows cut into bands of whole rows, about 8 a rank, so that a rank whose bands are cheap takes
-// more of them.
-int rows_per_band(int image_height, int ranks);
+// The rows of the next band dealt, with `rows_left` of the image's still to deal: a share of what is left, so
+// that bands shrink towards the end (guided scheduling) and the ranks finish together, but never below 1/64 of
+// the image's height a rank.
+int band_rows(int rows_left, int image_height, int ranks);
 
-// Rank 0: deals the bands on request, renders its own on a thread of its own (RenderOptions::rows), and puts
+// Rank 0: deals the bands on request (its progress counts rows), renders its own on a thread of its own (RenderOptions::rows), and puts
 // every rank's band into its film as it arrives, straight from the message. The film has depth and normal
 // channels when `depth_and_normal` (outputs_hold_depth), and the other ranks send them then. Returns what
 // renderer.render() would for the whole image, bit for bit the same film; the passes, rays and primary counts are the
