@@ -23,8 +23,6 @@ constexpr int kOutcomeTag = 3;
 constexpr int kNoMoreFrames = -1;
 constexpr int kPlanned = -1;  // in the exchange of plans: this rank's plan is good
 
-// Waiting for a request, rank 0 sleeps between probes (wait_sleeping's reason).
-constexpr auto kPollInterval = std::chrono::microseconds(500);
 
 void say(const BatchCallbacks& callbacks, const std::string& text) {
   if (callbacks.on_message) callbacks.on_message(text);
@@ -136,7 +134,7 @@ BatchOutcome lead(const BatchRequest& req, const BatchPlan& plan, const BatchCal
     int arrived = 0;
     MPI_Iprobe(MPI_ANY_SOURCE, kRequestTag, MPI_COMM_WORLD, &arrived, &status);
     if (!arrived) {
-      std::this_thread::sleep_for(kPollInterval);
+      std::this_thread::sleep_for(kMpiPollInterval);
       continue;
     }
     int length = 0;

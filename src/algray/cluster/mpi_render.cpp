@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <climits>
+#include <cstdint>
 #include <cstring>
 #include <functional>
 #include <future>
@@ -45,7 +46,7 @@ struct Band {
 // dealt (band_rows), numbered in the order dealt.
 class BandQueue {
  public:
-  BandQueue(int height, int ranks) : height_(height), ranks_(ranks) {}
+  BandQueue(int width, int height, int ranks) : width_(width), height_(height), ranks_(ranks) {}
   Band band(int b) const {
     const std::lock_guard<std::mutex> hold(lock_);
     return dealt_.at(static_cast<std::size_t>(b));
@@ -53,7 +54,7 @@ class BandQueue {
   std::optional<int> take() {
     const std::lock_guard<std::mutex> hold(lock_);
     if (next_row_ >= height_) return std::nullopt;
-    const int rows = band_rows(height_ - next_row_, height_, ranks_);
+    const int rows = band_rows(height_ - next_row_, height_, width_, ranks_);
     dealt_.push_back({next_row_, next_row_ + rows});
     next_row_ += rows;
     return static_cast<int>(dealt_.size()) - 1;
@@ -66,7 +67,7 @@ class BandQueue {
 
  private:
   mutable std::mutex lock_;
-  int height_, ranks_, next_row_ = 0;
+  int width_, height_, ranks_, next_row_ = 0;
   std::vector<Band> dealt_;
 };
 
@@ -208,7 +209,7 @@ class Gatherer {
       MPI_Iprobe(MPI_ANY_SOURCE, kRequestTag, MPI_COMM_WORLD, &arrived, &status);
       idle();
       if (!arrived) {
-        std::this_thread::sleep_for(std::chrono::microseconds(500));
+        std::this_thread::sleep_for(kMpiPollInterval);
         continue;
       }
       const int source = status.MPI_SOURCE;
@@ -257,16 +258,20 @@ class Gatherer {
 
 }  // namespace
 
-int band_rows(int rows_left, int image_height, int ranks) {
+int band_rows(int rows_left, int image_height, int image_width, int ranks) {
   ranks = std::max(1, ranks);
   const int smallest = std::max(1, (image_height + 64 * ranks - 1) / (64 * ranks));
-  return std::min(rows_left, std::max(smallest, (rows_left + 2 * ranks - 1) / (2 * ranks)));
+  // A band's film is 32 bytes a pixel on the rank that renders it; 8 M pixels keep it within 256 MB.
+  constexpr std::int64_t kLargestBandPixels = 8 << 20;
+  const int largest = static_cast<int>(std::max<std::int64_t>(1, kLargestBandPixels / std::max(1, image_width)));
+  const int share = std::max(smallest, (rows_left + 2 * ranks - 1) / (2 * ranks));
+  return std::min({rows_left, share, std::max(largest, 1)});
 }
 
 RenderResult render_bands_as_rank0(Renderer& renderer, const Scene& scene, const RenderOptions& options,
                                    bool depth_and_normal, MpiWorld& world) {
   const int width = scene.image.width, height = scene.image.height;
-  BandQueue queue(height, world.size());
+  BandQueue queue(width, height, world.size());
   ImageTally tally;
   std::atomic<int> rows_done{0};
   std::mutex failure_lock;
@@ -386,7 +391,7 @@ void render_bands_as_worker(Renderer* renderer, const Scene& scene, const std::s
 }
 
 void release_workers(MpiWorld& world) {
-  BandQueue none(1, 1);
+  BandQueue none(1, 1, 1);
   none.stop();
   ImageTally ignored;
   std::promise<void> no_film;

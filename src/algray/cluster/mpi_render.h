@@ -10,8 +10,8 @@ namespace algray {
 
 // The rows of the next band dealt, with `rows_left` of the image's still to deal: a share of what is left, so
 // that bands shrink towards the end (guided scheduling) and the ranks finish together, but never below 1/64 of
-// the image's height a rank.
-int band_rows(int rows_left, int image_height, int ranks);
+// the image's height a rank, and never above 8 M pixels (a 256 MB film on the rank that renders it).
+int band_rows(int rows_left, int image_height, int image_width, int ranks);
 
 // Rank 0: deals the bands on request (its progress counts rows), renders its own on a thread of its own (RenderOptions::rows), and puts
 // every rank's band into its film as it arrives, straight from the message. The film has depth and normal

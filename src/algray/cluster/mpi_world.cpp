@@ -32,12 +32,11 @@ MpiWorld::MpiWorld() {
 MpiWorld::~MpiWorld() { MPI_Finalize(); }
 
 void wait_sleeping(MPI_Request& request) {
-  constexpr auto kPollInterval = std::chrono::microseconds(500);
   for (;;) {
     int done = 0;
     MPI_Test(&request, &done, MPI_STATUS_IGNORE);
     if (done) return;
-    std::this_thread::sleep_for(kPollInterval);
+    std::this_thread::sleep_for(kMpiPollInterval);
   }
 }
 

@@ -3,6 +3,8 @@
 
 #include <mpi.h>
 
+#include <chrono>
+
 namespace algray {
 
 class MpiWorld {
@@ -25,7 +27,11 @@ class MpiWorld {
   int rank_ = 0, size_ = 1;
 };
 
-// Waits for a request to complete, sleeping between tests. Open MPI's blocking calls spin on a core while they
+// How long a waiting rank sleeps between two looks at MPI. Each look wakes a thread on a core that a renderer
+// uses (Open MPI binds a rank to one core), so not too often; a frame or a band takes far longer than this.
+inline constexpr std::chrono::milliseconds kMpiPollInterval{2};
+
+// Waits for a request to complete, sleeping kMpiPollInterval between tests. Open MPI's blocking calls spin on a core while they
 // wait; a rank waiting for a message sleeps instead, so that its core stays with the renderers beside it.
 void wait_sleeping(MPI_Request& request);
 
