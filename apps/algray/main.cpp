@@ -34,6 +34,15 @@ struct SceneOptions {
   bool no_cache = false, preview = false;
 };
 
+// --no-fp64: every device counts as having no double precision (ALGRAY_NO_FP64, set as the flag is parsed, before
+// any device is opened), so that the float-only path can be tried anywhere.
+void add_no_fp64_flag(CLI::App* cmd) {
+  cmd->add_flag_callback(
+      "--no-fp64", [] { ::setenv("ALGRAY_NO_FP64", "1", 1); },
+      "act as if no device had double precision (as ALGRAY_NO_FP64=1 does): auto precision picks float, and "
+      "double is refused");
+}
+
 // Batch takes a jobs file where the others take a scene, and no scene positional.
 void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = true) {
   if (scene_positional)
@@ -56,6 +65,7 @@ void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = t
   cmd->add_flag("--preview", o.preview,
                 "the paper's preview mode: primary rays only (no shadows); sets render.preview");
   cmd->add_flag("--no-cache", o.no_cache, "compile kernels from source; neither read nor write the program cache");
+  add_no_fp64_flag(cmd);
 }
 
 // --set first, then the flags, which are overrides like any --set applied last so that they win. Returns false
@@ -322,6 +332,7 @@ struct DevicesCommand {
   void add_to(CLI::App& app) {
     cmd = app.add_subcommand("devices", "list OpenCL platforms and devices");
     cmd->add_option("--stats", stats_path, "write the list as JSON too");
+    add_no_fp64_flag(cmd);
   }
 
   int run() { return run_devices(stats_path, std::cout, std::cerr); }

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "algray/device/cl_runtime.h"
+#include "algray/device/fp64_speed.h"
 #include "algray/io/image_io.h"
 #include "algray/util/version.h"
 #ifdef ALGRAY_WITH_MPI
@@ -166,22 +167,40 @@ int run_devices(const std::string& stats_path, std::ostream& out, std::ostream& 
     err << "algray: no OpenCL device found (on Debian: apt-get install pocl-opencl-icd)\n";
     return kExitFailure;
   }
-  out << describe_devices(list);
+  // Each device with fp64 is timed once in float and double (device/fp64_speed.h); the program cache keeps it.
+  std::vector<std::optional<double>> slowdown(list.size());
+  ProgramCache cache(true);
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    if (!list[i].fp64) continue;
+    try {
+      ClSession session(list[i]);
+      slowdown[i] = fp64_slowdown(session, cache);
+    } catch (const std::exception& e) {
+      err << "algray: device [" << list[i].index << "] " << list[i].name << ": double precision not timed: " << e.what()
+          << "\n";
+    }
+  }
+  out << describe_devices(list, slowdown);
   if (stats_path.empty()) return kExitOk;
   nlohmann::json j = {{"version", version_string()}, {"devices", nlohmann::json::array()}};
   for (const DeviceInfo& d : list)
-    j["devices"].push_back({{"index", d.index},
-                            {"platform", d.platform_name},
-                            {"platform_version", d.platform_version},
-                            {"name", d.name},
-                            {"vendor", d.vendor},
-                            {"version", d.version},
-                            {"driver", d.driver_version},
-                            {"type", d.type},
-                            {"compute_units", d.compute_units},
-                            {"fp64", d.fp64},
-                            {"global_mem_bytes", d.global_mem_bytes},
-                            {"max_alloc_bytes", d.max_alloc_bytes}});
+    j["devices"].push_back(
+        {{"index", d.index},
+         {"platform", d.platform_name},
+         {"platform_version", d.platform_version},
+         {"name", d.name},
+         {"vendor", d.vendor},
+         {"version", d.version},
+         {"driver", d.driver_version},
+         {"type", d.type},
+         {"compute_units", d.compute_units},
+         {"fp64", d.fp64},
+         {"fp64_hidden", d.fp64_hidden},
+         {"fp64_slowdown", slowdown[static_cast<std::size_t>(&d - list.data())]
+                               ? nlohmann::json(*slowdown[static_cast<std::size_t>(&d - list.data())])
+                               : nlohmann::json()},
+         {"global_mem_bytes", d.global_mem_bytes},
+         {"max_alloc_bytes", d.max_alloc_bytes}});
   try {
     check_output_writable(stats_path);
     write_text_file(stats_path, j.dump(2) + "\n");

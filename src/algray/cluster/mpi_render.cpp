@@ -284,7 +284,8 @@ RenderResult render_bands_as_rank0(Renderer& renderer, const Scene& scene, const
 
   // Rank 0's own bands, on a thread of their own: MPI is called from the main thread only (FUNNELED). They are
   // one render, so its kernels and buffers are set up once, and its check that the image fits the device comes
-  // before the film is made, in its first band's hand-over. Band 0 is its first, taken before any is dealt.
+  // before the film is made, when it asks for its first band; the other ranks' bands wait for the film. Band 0
+  // is its first, taken before any is dealt.
   RenderResult result;
   FrameImage film;
   FrameImage* film_made = nullptr;  // set before film_ready is
@@ -297,11 +298,6 @@ RenderResult render_bands_as_rank0(Renderer& renderer, const Scene& scene, const
       RenderOptions bands;
       bands.batch_rays = options.batch_rays;
       bands.next_band = [&]() -> std::optional<RenderOptions::RowBand> {
-        const std::optional<int> b = band_in_hand ? std::exchange(band_in_hand, std::nullopt) : queue.take();
-        if (!b) return std::nullopt;
-        return RenderOptions::RowBand{queue.band(*b).first, queue.band(*b).end};
-      };
-      bands.on_band = [&](const RenderOptions::RowBand& band, FrameImage& pixels) {
         if (!promised) {
           film = options.film ? options.film() : make_film(width, height, depth_and_normal);
           if (film.width != width || film.height != height || film.depth.empty() == depth_and_normal)
@@ -310,6 +306,11 @@ RenderResult render_bands_as_rank0(Renderer& renderer, const Scene& scene, const
           promised = true;
           film_promise.set_value();
         }
+        const std::optional<int> b = band_in_hand ? std::exchange(band_in_hand, std::nullopt) : queue.take();
+        if (!b) return std::nullopt;
+        return RenderOptions::RowBand{queue.band(*b).first, queue.band(*b).end};
+      };
+      bands.on_band = [&](const RenderOptions::RowBand& band, FrameImage& pixels) {
         const BandChannels to = channels_of(film, band.first, pixels.height);
         std::copy(pixels.rgba.begin(), pixels.rgba.end(), to.rgba);
         if (to.depth) std::copy(pixels.depth.begin(), pixels.depth.end(), to.depth);

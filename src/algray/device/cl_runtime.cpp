@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 namespace algray {
@@ -26,6 +28,11 @@ std::string type_name(cl_device_type t) {
 }
 
 }  // namespace
+
+bool fp64_hidden_by_environment() {
+  const char* value = std::getenv("ALGRAY_NO_FP64");
+  return value && *value && std::string(value) != "0";
+}
 
 std::vector<DeviceInfo> enumerate_devices() {
   std::vector<DeviceInfo> out;
@@ -54,7 +61,9 @@ std::vector<DeviceInfo> enumerate_devices() {
       info.driver_version = trimmed(d.getInfo<CL_DRIVER_VERSION>());
       info.type = type_name(d.getInfo<CL_DEVICE_TYPE>());
       info.compute_units = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
-      info.fp64 = d.getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>() != 0;
+      const bool fp64 = d.getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>() != 0;
+      info.fp64_hidden = fp64 && fp64_hidden_by_environment();
+      info.fp64 = fp64 && !info.fp64_hidden;
       info.global_mem_bytes = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
       info.max_alloc_bytes = d.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
       info.device = d;
@@ -64,7 +73,8 @@ std::vector<DeviceInfo> enumerate_devices() {
   return out;
 }
 
-std::string describe_devices(const std::vector<DeviceInfo>& devices) {
+std::string describe_devices(const std::vector<DeviceInfo>& devices,
+                             const std::vector<std::optional<double>>& fp64_slowdown) {
   std::ostringstream s;
   std::string platform;
   for (const DeviceInfo& d : devices) {
@@ -73,8 +83,17 @@ std::string describe_devices(const std::vector<DeviceInfo>& devices) {
       s << "platform: " << d.platform_name << " (" << d.platform_version << ")\n";
     }
     s << "  [" << d.index << "] " << d.name << "\n"
-      << "      type " << d.type << ", " << d.compute_units << " compute units, fp64 " << (d.fp64 ? "yes" : "no")
-      << ", " << d.version << ", driver " << d.driver_version << "\n";
+      << "      type " << d.type << ", " << d.compute_units << " compute units, fp64 "
+      << (d.fp64          ? "yes"
+          : d.fp64_hidden ? "hidden (ALGRAY_NO_FP64)"
+                          : "no");
+    const std::size_t k = static_cast<std::size_t>(&d - devices.data());
+    if (k < fp64_slowdown.size() && fp64_slowdown[k]) {
+      char ratio[64];
+      std::snprintf(ratio, sizeof ratio, " (double takes %.2fx float's time)", *fp64_slowdown[k]);
+      s << ratio;
+    }
+    s << ", " << d.version << ", driver " << d.driver_version << "\n";
   }
   return s.str();
 }

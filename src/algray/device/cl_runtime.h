@@ -4,6 +4,7 @@
 #include <CL/opencl.hpp>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,11 +21,16 @@ struct DeviceInfo {
   std::string name, vendor, version, driver_version;
   std::string type;  // "GPU", "CPU", "accelerator", ...
   unsigned compute_units = 0;
-  bool fp64 = false;
+  bool fp64 = false;                   // double precision usable: the device has cl_khr_fp64 and fp64_hidden is false
+  bool fp64_hidden = false;            // the device has it, but ALGRAY_NO_FP64 (--no-fp64) makes algray act as if not
   std::uint64_t global_mem_bytes = 0;  // CL_DEVICE_GLOBAL_MEM_SIZE
   std::uint64_t max_alloc_bytes = 0;   // CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest single buffer
   cl::Device device;
 };
+
+// Whether ALGRAY_NO_FP64 is set (to anything but "" or "0"): every device then counts as having no double
+// precision, so that the float-only path can be tried on any machine. `--no-fp64` sets it.
+bool fp64_hidden_by_environment();
 
 // Every device of every platform, in platform order. Empty when no ICD is installed.
 std::vector<DeviceInfo> enumerate_devices();
@@ -37,7 +43,10 @@ DeviceInfo select_device(const std::string& spec);
 // Throws DeviceError naming the devices that exist, or a device named twice.
 std::vector<DeviceInfo> select_devices(const std::string& spec);
 
-std::string describe_devices(const std::vector<DeviceInfo>& devices);
+// The list as `algray devices` prints it; `fp64_slowdown` (one per device, where measured) adds how much longer
+// each takes for double arithmetic than for float.
+std::string describe_devices(const std::vector<DeviceInfo>& devices,
+                             const std::vector<std::optional<double>>& fp64_slowdown = {});
 
 struct ClSession {
   explicit ClSession(DeviceInfo chosen, int copy = 0);

@@ -28,7 +28,9 @@ int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 
 Precision resolve_precision(const Scene& scene, const DeviceInfo& device) {
   if (!scene.render.precision) return device.fp64 ? Precision::Double : Precision::Float;
   if (*scene.render.precision == Precision::Double && !device.fp64)
-    throw DeviceError("device '" + device.name + "' has no double precision (cl_khr_fp64); use --precision float");
+    throw DeviceError("device '" + device.name + "' has no double precision (" +
+                      (device.fp64_hidden ? "cl_khr_fp64 is hidden by --no-fp64 or ALGRAY_NO_FP64" : "cl_khr_fp64") +
+                      "); use --precision float");
   return *scene.render.precision;
 }
 

@@ -1,0 +1,17 @@
+// How much longer a device takes for double arithmetic than for float, measured once and kept with the programs.
+#pragma once
+
+#include <optional>
+
+#include "algray/device/cl_runtime.h"
+#include "algray/device/program_cache.h"
+
+namespace algray {
+
+// The time of a chain of double multiply-adds over the same chain in float (kernels/fp_speed.cl), on the
+// session's device: about 1-2 on CPUs and datacenter GPUs, 16-64 on most others. Measured the first time and
+// then read from the program cache (ProgramCache::remembered), as CLBlast keeps its tuning results; a device
+// without fp64 (or with it hidden) has none.
+std::optional<double> fp64_slowdown(ClSession& session, ProgramCache& cache);
+
+}  // namespace algray
