@@ -10,28 +10,11 @@ work=$2
 rm -rf "$work"
 mkdir -p "$work"/{single,mpi,failing,bad}
 
-fail() {
-  echo "test_mpi_batch: $*" >&2
-  exit 1
-}
-command -v mpirun >/dev/null || fail "mpirun not found: install openmpi-bin and libopenmpi-dev (scripts/install-deps.sh does)"
-command -v python3 >/dev/null || fail "python3 not found (it reads the JSON-lines logs)"
-# CI runs as root; the timeout turns a deadlock into a failure.
-mpirun_2=(timeout 120 mpirun --oversubscribe --allow-run-as-root -n 2 -x POCL_MAX_PTHREAD_COUNT=1)
+test_name=test_mpi_batch
+source "$(dirname "$0")/../support/script_test.sh"
+mpi_ready
 
-scene='[surface]
-equation = "x^2+y^2+z^2-r^2"
-[parameters]
-r = 1
-[extent]
-radius = 2
-[camera]
-eye = [0, 0, 5]
-look_at = [0, 0, 0]
-up = [0, 1, 0]
-fov_y = 45
-[[light]]
-position = [3, 4, 5]'
+scene=$(growing_ball_scene)
 sweep='[defaults]
 set = { image = { width = 160, height = 120 } }
 [[job]]

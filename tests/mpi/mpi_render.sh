@@ -12,14 +12,9 @@ work=$4
 rm -rf "$work"
 mkdir -p "$work"
 
-fail() {
-  echo "test_mpi_render: $*" >&2
-  exit 1
-}
-command -v mpirun >/dev/null || fail "mpirun not found: install openmpi-bin and libopenmpi-dev (scripts/install-deps.sh does)"
-command -v python3 >/dev/null || fail "python3 not found (it reads the stats)"
-# CI runs as root; the timeout turns a deadlock into a failure.
-mpirun_2=(timeout 120 mpirun --oversubscribe --allow-run-as-root -n 2 -x POCL_MAX_PTHREAD_COUNT=1)
+test_name=test_mpi_render
+source "$(dirname "$0")/../support/script_test.sh"
+mpi_ready
 cd "$work" || fail "no work directory"
 
 # Everything that crosses a band's edge: adaptive antialiasing (its choice there needs the row beyond), two

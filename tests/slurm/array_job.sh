@@ -5,6 +5,9 @@
 # with their logs.
 #   array_job.sh ALGRAY_BINARY WORK_DIR
 set -uo pipefail
+test_name=test_slurm_array
+# Its own fail(), below, also prints the daemons' logs.
+source "$(dirname "$0")/../support/script_test.sh"
 algray=$1
 work=$2
 rm -rf "$work"
@@ -78,17 +81,7 @@ done
 [ "$state" = idle ] || fail "the node did not become idle (sinfo: '$state')"
 
 # The sweep: 12 frames of a growing ball, once in one process, once as a 4-task array.
-scene='[surface]
-equation = "x^2+y^2+z^2-r^2"
-[parameters]
-r = 1
-[extent]
-radius = 2
-[camera]
-eye = [0, 0, 5]
-look_at = [0, 0, 0]
-up = [0, 1, 0]
-fov_y = 45'
+scene=$(growing_ball_scene)
 jobs='[defaults]
 set = { image = { width = 32, height = 24 } }
 [[job]]
