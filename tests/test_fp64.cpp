@@ -80,30 +80,29 @@ TEST_CASE("double's speed against float is measured once a device and then read 
   const testing::TempDir dir("fp64-cache");
   ProgramCache cache(true, dir.path());
   int measured = 0;
-  const double first = cache.remembered(session, "test-measurement", [&] { return ++measured, 2.5; });
-  const double again = cache.remembered(session, "test-measurement", [&] { return ++measured, 7.0; });
+  const double first = cache.remembered(session.info, "test-measurement", [&] { return ++measured, 2.5; });
+  const double again = cache.remembered(session.info, "test-measurement", [&] { return ++measured, 7.0; });
   CHECK(first == 2.5);
   CHECK(again == 2.5);  // from the file, not measured again
   CHECK(measured == 1);
   // A damaged entry is measured again, never read.
   for (const auto& e : std::filesystem::directory_iterator(dir.path()))
     if (e.path().extension() == ".measured") testing::write_text(e.path(), "algray-program-binary-v2\ngarbage");
-  CHECK(cache.remembered(session, "test-measurement", [&] { return ++measured, 3.0; }) == 3.0);
+  CHECK(cache.remembered(session.info, "test-measurement", [&] { return ++measured, 3.0; }) == 3.0);
   CHECK(measured == 2);
   ProgramCache off(false, dir.path());
-  CHECK(off.remembered(session, "test-measurement", [&] { return ++measured, 4.0; }) == 4.0);
+  CHECK(off.remembered(session.info, "test-measurement", [&] { return ++measured, 4.0; }) == 4.0);
 
-  const std::optional<double> slowdown = fp64_slowdown(session, cache);
+  const std::optional<double> slowdown = fp64_slowdown(session.info, cache);
   REQUIRE(slowdown.has_value());
   INFO("double takes " << *slowdown << "x float's time");
   CHECK(std::isfinite(*slowdown));
   CHECK(*slowdown > 0.2);  // a CPU does double at about float's speed per element; anything is within 0.2-100
   CHECK(*slowdown < 100);
-  CHECK(fp64_slowdown(session, cache) == slowdown);  // the second time from the cache, so the same number
+  CHECK(fp64_slowdown(session.info, cache) == slowdown);  // the second time from the cache, so the same number
 
   const HiddenFp64 hidden;
-  ClSession without(enumerate_devices().at(static_cast<std::size_t>(session.info.index)));
-  CHECK_FALSE(fp64_slowdown(without, cache).has_value());
+  CHECK_FALSE(fp64_slowdown(enumerate_devices().at(static_cast<std::size_t>(session.info.index)), cache).has_value());
 }
 
 TEST_CASE("--no-fp64 on the command line: devices say so, auto renders in float, double is bad input", "[fp64][cli]") {

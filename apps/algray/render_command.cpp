@@ -173,8 +173,7 @@ int run_devices(const std::string& stats_path, std::ostream& out, std::ostream& 
   for (std::size_t i = 0; i < list.size(); ++i) {
     if (!list[i].fp64) continue;
     try {
-      ClSession session(list[i]);
-      slowdown[i] = fp64_slowdown(session, cache);
+      slowdown[i] = fp64_slowdown(list[i], cache);
     } catch (const std::exception& e) {
       err << "algray: device [" << list[i].index << "] " << list[i].name << ": double precision not timed: " << e.what()
           << "\n";

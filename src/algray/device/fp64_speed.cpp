@@ -41,10 +41,11 @@ double best_launch_ms(ClSession& session, bool in_double) {
 
 }  // namespace
 
-std::optional<double> fp64_slowdown(ClSession& session, ProgramCache& cache) {
-  if (!session.info.fp64) return std::nullopt;
+std::optional<double> fp64_slowdown(const DeviceInfo& device, ProgramCache& cache) {
+  if (!device.fp64) return std::nullopt;
   // v1: the kernel and its sizes; a change to either must measure again.
-  return cache.remembered(session, "fp64-slowdown-v1", [&] {
+  return cache.remembered(device, "fp64-slowdown-v1", [&] {
+    ClSession session(device);
     const double in_float = best_launch_ms(session, false);
     return best_launch_ms(session, true) / std::max(in_float, 1e-6);
   });

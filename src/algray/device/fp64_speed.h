@@ -12,6 +12,7 @@ namespace algray {
 // session's device: about 1-2 on CPUs and datacenter GPUs, 16-64 on most others. Measured the first time and
 // then read from the program cache (ProgramCache::remembered), as CLBlast keeps its tuning results; a device
 // without fp64 (or with it hidden) has none.
-std::optional<double> fp64_slowdown(ClSession& session, ProgramCache& cache);
+// The device is opened only to measure.
+std::optional<double> fp64_slowdown(const DeviceInfo& device, ProgramCache& cache);
 
 }  // namespace algray

@@ -44,6 +44,12 @@ double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
+// The device and driver a cache entry was made on: any change to them must miss.
+std::string device_identity(const DeviceInfo& d) {
+  return "device=" + d.name + "\ndriver=" + d.driver_version + "\nplatform=" + d.platform_name + " " +
+         d.platform_version + "\n";
+}
+
 std::string build_log(const cl::Program& program, const cl::Device& device) {
   try {
     return program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device);
@@ -69,9 +75,8 @@ cl::Kernel ProgramCache::kernel(ClSession& session, const KernelConfig& config, 
   const std::string options =
       config.build_options() + (session.copy ? " -DALGRAY_DEVICE_COPY=" + std::to_string(session.copy) : "");
   // Everything the binary depends on: a change to any of it must miss.
-  const std::string identity = "source-hash=" + hex64(fnv1a(source)) + "\noptions=" + options +
-                               "\ndevice=" + session.info.name + "\ndriver=" + session.info.driver_version +
-                               "\nplatform=" + session.info.platform_name + " " + session.info.platform_version + "\n";
+  const std::string identity =
+      "source-hash=" + hex64(fnv1a(source)) + "\noptions=" + options + "\n" + device_identity(session.info);
   ProgramRecord rec{config.key(), options, "built", 0};
 
   cl::Program program;
@@ -95,10 +100,9 @@ cl::Kernel ProgramCache::kernel(ClSession& session, const KernelConfig& config, 
   return k;
 }
 
-double ProgramCache::remembered(ClSession& session, const std::string& name, const std::function<double()>& measure) {
-  const std::string identity = "measurement=" + name + "\ndevice=" + session.info.name +
-                               "\ndriver=" + session.info.driver_version + "\nplatform=" + session.info.platform_name +
-                               " " + session.info.platform_version + "\n";
+double ProgramCache::remembered(const DeviceInfo& device, const std::string& name,
+                                const std::function<double()>& measure) {
+  const std::string identity = "measurement=" + name + "\n" + device_identity(device);
   const std::filesystem::path file = dir_ / (hex64(fnv1a(identity)) + ".measured");
   std::string payload;
   if (enabled_ && read_entry(file, identity, payload)) {

@@ -32,10 +32,10 @@ class ProgramCache {
   // The kernel named config.entry, from the cheapest place that has a valid program.
   cl::Kernel kernel(ClSession& session, const KernelConfig& config, ProgramRecord* record = nullptr);
 
-  // A number measured on the session's device, such as its double arithmetic's speed: read from the cache
-  // directory when it was measured before on this device and driver, otherwise measured now and kept there.
-  // With the cache off it is measured every time.
-  double remembered(ClSession& session, const std::string& name, const std::function<double()>& measure);
+  // A number measured on a device, such as its double arithmetic's speed: read from the cache directory when it
+  // was measured before on this device and driver, otherwise measured now (`measure` opens the device only
+  // then) and kept there. With the cache off it is measured every time.
+  double remembered(const DeviceInfo& device, const std::string& name, const std::function<double()>& measure);
 
   // $ALGRAY_CACHE_DIR, else $XDG_CACHE_HOME/algray, else ~/.cache/algray.
   static std::filesystem::path default_directory();

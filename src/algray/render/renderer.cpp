@@ -460,18 +460,18 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   if (options.next_band) {
     // Band after band with the same kernels and buffers: only the tiles change.
     while (const std::optional<RenderOptions::RowBand> band = options.next_band()) {
-      FrameImage film = render_rows(devices, *band, nullptr);
+      FrameImage film = render_rows(devices, *band, {});
       options.on_band(*band, film);
     }
   } else {
-    result.image = render_rows(devices, options.rows.value_or(RenderOptions::RowBand{0, plan.height}), &options);
+    result.image = render_rows(devices, options.rows.value_or(RenderOptions::RowBand{0, plan.height}), options.film);
   }
   add_device_tallies(devices, result);
   return result;
 }
 
 FrameImage Renderer::render_rows(std::vector<std::unique_ptr<Passes>>& devices, const RenderOptions::RowBand& rows,
-                                 const RenderOptions* film_from) {
+                                 const std::function<FrameImage()>& film_source) {
   Passes& any = *devices.front();
   const Scene& scene = any.scene;
   RenderResult& result = any.result;
@@ -492,7 +492,7 @@ FrameImage Renderer::render_rows(std::vector<std::unique_ptr<Passes>>& devices, 
   }
   const int film_height = traced_end - traced_first;
   FrameImage film;
-  if (film_from && film_from->film) film = film_from->film();
+  if (film_source) film = film_source();
   if (film.width != plan.width || film.height != film_height ||
       film.rgba.size() != 4 * static_cast<std::size_t>(plan.width) * film_height)
     film = make_film(plan.width, film_height, true);

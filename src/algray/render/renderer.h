@@ -153,10 +153,10 @@ class Renderer {
   // fails; the first failure is thrown on.
   void sweep(std::vector<std::unique_ptr<Passes>>& devices, const std::vector<Tile>& tiles,
              const std::function<void(Passes&, const Tile&)>& work);
-  // The output rows `rows` through every pass into a film of their own; the film from film_from->film when its
-  // size is the band's.
+  // The output rows `rows` through every pass into a film of their own; the one `film` makes when its size is
+  // the band's.
   FrameImage render_rows(std::vector<std::unique_ptr<Passes>>& devices, const RenderOptions::RowBand& rows,
-                         const RenderOptions* film_from);
+                         const std::function<FrameImage()>& film);
   static void add_device_tallies(const std::vector<std::unique_ptr<Passes>>& devices, RenderResult& result);
   void prepare_passes(Passes& passes);
   // The primary kernels' arguments for a band of tiles (a row of them), but the tile's own.
