@@ -104,27 +104,26 @@ class ImageTally {
     const nlohmann::json& passes = band.at("passes");
     if (passes_.empty()) passes_.resize(passes.size());
     for (std::size_t i = 0; i < passes.size() && i < passes_.size(); ++i) {
-      PassStats& p = passes_[i];
-      p.rays += passes[i].at("rays").get<std::uint64_t>();
-      p.launches += passes[i].at("launches").get<int>();
-      p.kernel_ms += passes[i].at("kernel_ms").get<double>();
-      p.wall_ms += passes[i].at("wall_ms").get<double>();
-      const std::vector<double> program_ms = passes[i].at("program_ms").get<std::vector<double>>();
-      p.program_ms.resize(std::max(p.program_ms.size(), program_ms.size()));
-      for (std::size_t k = 0; k < program_ms.size(); ++k) p.program_ms[k] += program_ms[k];
+      PassStats more;
+      more.rays = passes[i].at("rays").get<std::uint64_t>();
+      more.launches = passes[i].at("launches").get<int>();
+      more.kernel_ms = passes[i].at("kernel_ms").get<double>();
+      more.wall_ms = passes[i].at("wall_ms").get<double>();
+      more.program_ms = passes[i].at("program_ms").get<std::vector<double>>();
+      add_counts(passes_[i], more);
     }
     for (const nlohmann::json& d : band.at("devices")) {
-      const int index = d.at("index").get<int>();
+      DeviceShare more{rank, d.at("index").get<int>(), d.at("name").get<std::string>()};
+      more.tiles = d.at("tiles").get<int>();
+      more.rays = d.at("rays").get<std::uint64_t>();
+      more.kernel_ms = d.at("kernel_ms").get<double>();
+      more.programs_ms = d.at("programs_ms").get<double>();
       auto it = std::find_if(devices_.begin(), devices_.end(),
-                             [&](const DeviceShare& s) { return s.rank == rank && s.index == index; });
-      if (it == devices_.end()) {
-        devices_.push_back({rank, index, d.at("name").get<std::string>()});
-        it = devices_.end() - 1;
-      }
-      it->tiles += d.at("tiles").get<int>();
-      it->rays += d.at("rays").get<std::uint64_t>();
-      it->kernel_ms += d.at("kernel_ms").get<double>();
-      it->programs_ms += d.at("programs_ms").get<double>();
+                             [&](const DeviceShare& s) { return s.rank == rank && s.index == more.index; });
+      if (it == devices_.end())
+        devices_.push_back(more);
+      else
+        add_counts(*it, more);
     }
     shade_ms_ += band.at("shade_ms").get<double>();
     const std::vector<std::uint64_t> p = band.at("primary").get<std::vector<std::uint64_t>>();
@@ -136,12 +135,10 @@ class ImageTally {
   // Into `result`, whose passes carry their names and program keys (a band's, rank 0's first).
   void finish(RenderResult& result) const {
     for (std::size_t i = 0; i < result.passes.size() && i < passes_.size(); ++i) {
-      PassStats& p = result.passes[i];
-      p.rays = passes_[i].rays;
-      p.launches = passes_[i].launches;
-      p.kernel_ms = passes_[i].kernel_ms;
-      p.wall_ms = passes_[i].wall_ms;
-      p.program_ms = passes_[i].program_ms;
+      PassStats counted = passes_[i];
+      counted.name = result.passes[i].name;
+      counted.program_keys = result.passes[i].program_keys;
+      result.passes[i] = counted;
     }
     result.devices = devices_;
     std::sort(result.devices.begin(), result.devices.end(), [](const DeviceShare& a, const DeviceShare& b) {

@@ -539,18 +539,27 @@ FrameImage Renderer::render_rows(std::vector<std::unique_ptr<Passes>>& devices, 
   return film;
 }
 
+void add_counts(PassStats& into, const PassStats& more) {
+  into.rays += more.rays;
+  into.launches += more.launches;
+  into.kernel_ms += more.kernel_ms;
+  into.wall_ms += more.wall_ms;
+  into.program_ms.resize(std::max(into.program_ms.size(), more.program_ms.size()));
+  for (std::size_t k = 0; k < more.program_ms.size(); ++k) into.program_ms[k] += more.program_ms[k];
+}
+
+void add_counts(DeviceShare& into, const DeviceShare& more) {
+  into.tiles += more.tiles;
+  into.rays += more.rays;
+  into.kernel_ms += more.kernel_ms;
+  into.programs_ms += more.programs_ms;
+}
+
 void Renderer::add_device_tallies(const std::vector<std::unique_ptr<Passes>>& devices, RenderResult& result) {
   const RenderPlan& plan = result.plan;
   for (std::size_t i = 0; i < plan.passes.size(); ++i) {
     PassStats total = devices.front()->stats[i];
-    for (std::size_t d = 1; d < devices.size(); ++d) {
-      const PassStats& more = devices[d]->stats[i];
-      total.rays += more.rays;
-      total.launches += more.launches;
-      total.kernel_ms += more.kernel_ms;
-      total.wall_ms += more.wall_ms;  // device threads' times added, as one device's passes' are
-      for (std::size_t k = 0; k < total.program_ms.size(); ++k) total.program_ms[k] += more.program_ms[k];
-    }
+    for (std::size_t d = 1; d < devices.size(); ++d) add_counts(total, devices[d]->stats[i]);
     total.name = to_string(plan.passes[i].kind);
     result.passes.push_back(total);
   }

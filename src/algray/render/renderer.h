@@ -94,6 +94,11 @@ struct DeviceShare {
   double programs_ms = 0;
 };
 
+// Adds the counts of the same pass, or of the same device, from another device, band or rank: rays, launches,
+// tiles and times (wall times too, so with several devices they are the devices' threads' added up).
+void add_counts(PassStats& into, const PassStats& more);
+void add_counts(DeviceShare& into, const DeviceShare& more);
+
 struct RenderResult {
   RenderPlan plan;
   KernelConfig config;  // of the first surface's primary pass, with precision and tolerance as used
