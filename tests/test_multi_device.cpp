@@ -15,6 +15,7 @@
 #include "algray/render/renderer.h"
 #include "algray/render/shade.h"
 #include "algray/render/solver_aov.h"
+#include "cli_sandbox.h"
 #include "film_compare.h"
 #include "scene_fixtures.h"
 #include "temp_dir.h"
@@ -305,4 +306,43 @@ TEST_CASE("bands of rows, on one device or two, put together are the whole image
   RenderOptions no_hand_over;
   no_hand_over.next_band = [] { return std::optional<RenderOptions::RowBand>(); };
   CHECK_THROWS_AS(one.render(scene, no_hand_over), std::invalid_argument);
+}
+
+TEST_CASE("algray batch --device all renders every frame on both devices, as one device does", "[devices][batch]") {
+  two_devices();
+  const testing::Sandbox box;
+  const std::string jobs =
+      "[defaults]\nset = { image = { width = 64, height = 48 } }\n[[job]]\nname = \"turn\"\nscene = \"" +
+      std::string(ALGRAY_SOURCE_DIR) +
+      "/scenes/examples/ball_and_ring.toml\"\noutput = \"{dir}/turn_{frame}.png\"\nframes = 3\norbit = { degrees = 90 "
+      "}\n";
+  for (const char* dir : {"one", "all"}) {
+    std::filesystem::create_directories(box.work / dir);
+    std::string text = jobs;
+    text.replace(text.find("{dir}"), 5, dir);
+    testing::write_text(box.work / (std::string(dir) + ".toml"), text);
+  }
+  const testing::Result one = box.run("batch one.toml --device 0 --log one.jsonl");
+  INFO(one.err);
+  REQUIRE(one.exit_code == 0);
+  const testing::Result all = box.run("batch all.toml --device all --log all.jsonl");
+  INFO(all.err);
+  REQUIRE(all.exit_code == 0);
+  std::istringstream log(testing::read_text(box.work / "all.jsonl"));
+  int frames = 0;
+  for (std::string line; std::getline(log, line); ++frames) {
+    const nlohmann::json entry = nlohmann::json::parse(line);
+    INFO("frame " << entry["frame"]);
+    REQUIRE(entry["status"] == "ok");
+    const nlohmann::json& devices = entry["stats"]["devices"];
+    REQUIRE(devices.size() == 2);
+    CHECK(devices[0]["tiles"].get<int>() > 0);
+    CHECK(devices[1]["tiles"].get<int>() > 0);
+  }
+  CHECK(frames == 3);
+  for (int f = 0; f < 3; ++f) {
+    const std::string name = "turn_" + std::to_string(f) + ".png";
+    INFO(name);
+    CHECK(testing::read_text(box.work / "one" / name) == testing::read_text(box.work / "all" / name));
+  }
 }
