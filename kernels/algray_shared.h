@@ -22,6 +22,9 @@ typedef cl_int algray_i32;
 #define ALGRAY_HIT_IN_EXTENT 16u   /* the ray met the extent at all */
 #define ALGRAY_HIT_EXACT 32u       /* the root is where P* came out exactly 0, or changed sign between two intervals */
 #define ALGRAY_HIT_CLUSTER 64u     /* the root is a sign change across an interval that still held several roots */
+#define ALGRAY_HIT_DOUBT 128u      /* adaptive precision: the float kernel could not decide this ray (ALGRAY_DOUBT_*) and
+                                      left it for the float-float pass; its other fields mean nothing */
+#define ALGRAY_HIT_ESCALATED 256u  /* adaptive precision: this record is the float-float answer to a doubted ray */
 
 /* Extent kinds (kernel argument extent_kind). */
 #define ALGRAY_EXTENT_SPHERE 0
@@ -75,6 +78,9 @@ typedef struct {
                                        halving limit; values: lo, hi, P(lo), P(hi) */
 #define ALGRAY_EVENT_ITERATE 6      /* a refinement iterate. count: its number; values: y, P(y), and the bracket
                                        (y in [0, 1] across the isolating interval) */
+#define ALGRAY_EVENT_DOUBT 7        /* adaptive precision: a decision within the coefficients' rounding noise, which
+                                       ends the float search. decision: ALGRAY_DOUBT_*; level: halving level;
+                                       values: the interval's lo, hi, the value in question, the noise bound */
 
 /* What an isolation found (kernels/isolation.h's Isolation.status) */
 #define ALGRAY_ISOLATED_NONE 0    /* certified: no root in [t_in, t_out] (up to the tolerance) */
@@ -84,6 +90,13 @@ typedef struct {
 #define ALGRAY_BASIS_BERNSTEIN 1     /* Bernstein basis of s in [0, 1] over [t_in, t_out] */
 #define ALGRAY_BASIS_POWER_SEGMENT 2 /* power basis of s in [0, 1] over [t_in, t_out] */
 #define ALGRAY_BASIS_POWER_EYE 3     /* power basis of t itself, around the ray origin (the paper's RAY_ORIGIN=eye) */
+
+/* Why an adaptive float kernel doubted a ray (ALGRAY_EVENT_DOUBT; the host's names in render/escalation.h) */
+#define ALGRAY_DOUBT_DISCARD 1 /* an interval looked root-free, but one of its coefficients was within noise of 0 */
+#define ALGRAY_DOUBT_ACCEPT 2  /* a root looked isolated or crossed, but P at an end was within noise of 0 */
+#define ALGRAY_DOUBT_CLUSTER 3 /* the search reached the stopping width or the halving limit with several roots */
+#define ALGRAY_DOUBT_FLAT 4    /* a root was isolated where P is so flat that the noise could move it (camera and
+                                  secondary rays: ALGRAY_DOUBT_POSITION) */
 
 /* ALGRAY_EVENT_STEP decisions */
 #define ALGRAY_STEP_EXACT_ZERO 1   /* P is exactly 0 at the interval's left end: the root is there */

@@ -160,6 +160,14 @@ int refinable_in_float(const REAL* c) {
  * (level, idx), so no stack is kept. The right half of the latest split is cached, as the left half is usually
  * rejected at once. On return `cur` holds the Bernstein coefficients on [iso.lo, iso.hi] (rounded to float in
  * mixed precision, where they are accurate relative to their own size). */
+#if ALGRAY_ESCALATE
+/* What the noise must stay below for an isolated root's position to hold to ALGRAY_DOUBT_POSITION of its t: the
+ * secant slope of P over the interval (its end coefficients' difference per unit t) times that share of t. */
+REAL position_margin(const REAL* c, REAL width, REAL t_in, REAL lo, REAL len) {
+  return fabs(c[DEGREE] - c[0]) * ALGRAY_DOUBT_POSITION * fabs(t_in + lo * len) / (width * len);
+}
+#endif
+
 Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out, REAL* cur PROBE_PARAM) {
   Isolation iso = isolation_none();
   REAL cur_lo[NCOEF], sib[NCOEF], sib_lo[NCOEF];
@@ -170,6 +178,11 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
   const REAL len = t_out - t_in;
   const int start_sign = (root[0] > 0) - (root[0] < 0);
   coefs_copy(cur, cur_lo, root, root_lo);
+#if ALGRAY_ESCALATE
+  const REAL noise = doubt_noise(root);
+#else
+  const REAL noise = 0;
+#endif
 
   for (;;) {
     ++iso.steps;
@@ -178,14 +191,31 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
     iso.hi = iso.lo + width;
     iso.f_lo = cur[0];
     iso.f_hi = cur[DEGREE];
-    if (settled_at_left_end(&iso, start_sign, level PROBE_ARG)) return iso;
+    if (settled_at_left_end(&iso, start_sign, level PROBE_ARG)) {
+      doubted(&iso, ALGRAY_DOUBT_ACCEPT, iso.f_lo, noise, level PROBE_ARG);
+      return iso;
+    }
     const int v = sign_variations(cur);
     if (v == 1 && cur[DEGREE] != 0 && refinable_in_float(cur)) {
       PROBE_STEP(iso, v, ALGRAY_STEP_ISOLATED, level);
       iso.status = ISOLATION_BRACKET;
+      if (!doubted(&iso, ALGRAY_DOUBT_ACCEPT, smaller_end(cur, iso.lo), noise, level PROBE_ARG) &&
+          !ALGRAY_SHADOW_RAYS)
+        doubted(&iso, ALGRAY_DOUBT_FLAT, position_margin(cur, width, t_in, iso.lo, len), noise, level PROBE_ARG);
       return iso;
     }
-    if (v >= 1) {
+#if ALGRAY_ESCALATE
+    /* No sign variation, but a coefficient within the noise of zero: the interval is not yet shown root-free.
+     * Its end coefficients are P's values: near zero there, float cannot tell; an inner one is halved until it
+     * stands clear, as de Casteljau's coefficients close in on P's values (fewer rays doubted: on the Barth
+     * decic's shadow rays, 10% of them doubted without this). */
+    const int near_zero = v == 0 && smallest_magnitude(cur, iso.lo) <= noise;
+    if (near_zero && doubted(&iso, ALGRAY_DOUBT_DISCARD, smaller_end(cur, iso.lo), noise, level PROBE_ARG))
+      return iso;
+#else
+    const int near_zero = 0;
+#endif
+    if (v >= 1 || near_zero) {
       const int next = halve_or_settle(&iso, v, level, width, t_in, len PROBE_ARG);
       if (next == INTERVAL_HALVE) {
         casteljau_halve(cur, cur_lo, sib, sib_lo);
@@ -195,6 +225,8 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
         sib_idx = idx + 1;
         continue;
       }
+      /* A cluster is always in doubt: float cannot tell a close pair from a complex one there. */
+      if (doubted(&iso, ALGRAY_DOUBT_CLUSTER, 0, noise, level PROBE_ARG)) return iso;
       if (next == INTERVAL_SETTLED) return iso;
     } else {
       PROBE_STEP(iso, v, ALGRAY_STEP_NO_ROOT, level);
@@ -275,6 +307,22 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
   LREAL level = 0, idx = 0, width = 1, sib_level = -1, sib_idx = 0;
   LREAL status = ISOLATION_NONE, steps = 0, lo = 0, hi = 1, f_lo = 0, f_hi = 0;
   LMASK budget = 0, cluster = 0, done = !running;
+#if ALGRAY_ESCALATE
+  /* doubt_noise and doubted per lane: a doubted lane stops with status NONE and its ALGRAY_DOUBT_* */
+  LREAL noise = 0, doubt = 0;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) noise = fmax(noise, fabs(root[k]));
+  noise *= (REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * REAL_EPS;
+#define DOUBT_LANES(mask, reason)                           \
+  do {                                                      \
+    const LMASK doubted_ = (mask);                          \
+    doubt = LANE_SEL(doubt, (LREAL)(reason), doubted_);     \
+    status = LANE_SEL(status, (LREAL)ISOLATION_NONE, doubted_); \
+    done = done || doubted_;                                \
+  } while (0)
+#else
+#define DOUBT_LANES(mask, reason) ((void)0)
+#endif
   for (;;) {
     const LMASK active = !done;
     steps += LANE_SEL((LREAL)0, (LREAL)1, active);
@@ -287,12 +335,28 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     const LMASK exact = active && (f_lo == 0 || (s != 0 && s != start_sign));
     status = LANE_SEL(status, (LREAL)ISOLATION_EXACT, exact);
     done = done || exact;
+    DOUBT_LANES(exact && fabs(f_lo) <= noise, ALGRAY_DOUBT_ACCEPT);
     const LREAL v = sign_variations_lanes(cur);
     const LMASK isolated = !done && v == 1 && cur[DEGREE] != 0;
     status = LANE_SEL(status, (LREAL)ISOLATION_BRACKET, isolated);
     done = done || isolated;
+    DOUBT_LANES(isolated && fmin(fabs(cur[0]), fabs(cur[DEGREE])) <= noise, ALGRAY_DOUBT_ACCEPT);
+    DOUBT_LANES(isolated && doubt == 0 &&
+                    fabs(cur[DEGREE] - cur[0]) * ALGRAY_DOUBT_POSITION * fabs(t_in + lo * len) / (width * len) <= noise,
+                ALGRAY_DOUBT_FLAT);
+#if ALGRAY_ESCALATE
+    /* isolate_bernstein's near_zero: doubted at an end, halved inside */
+    LREAL smallest = fabs(cur[0]);
+    ALGRAY_UNROLL
+    for (int k = 1; k <= DEGREE; ++k) smallest = fmin(smallest, fabs(cur[k]));
+    const LMASK near_zero = !done && v == 0 && smallest <= noise;
+    DOUBT_LANES(near_zero && fmin(fabs(cur[0]), fabs(cur[DEGREE])) <= noise, ALGRAY_DOUBT_DISCARD);
+    /* halve_or_settle for the lanes that may hold several roots */
+    const LMASK several = !done && (v >= 1 || near_zero);
+#else
     /* halve_or_settle for the lanes that may hold several roots */
     const LMASK several = !done && v >= 1;
+#endif
     const LMASK located = width * len <= (REAL)4 * (REAL)TOLERANCE * fmax(fabs(t_in + lo * len), (LREAL)1);
     const LMASK halve = several && !located && level < (REAL)REAL_MAX_HALVINGS;
     const LMASK settle = several && !halve;
@@ -301,6 +365,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     status = LANE_SEL(status, (LREAL)ISOLATION_BRACKET, cluster_root);
     cluster = cluster || cluster_root;
     done = done || cluster_root;
+    DOUBT_LANES(settle, ALGRAY_DOUBT_CLUSTER);
     if (LANE_ALL(done)) break;
     if (LANE_ANY(halve)) {
       /* casteljau_halve: the same rows of the triangle */
@@ -359,6 +424,11 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     iso[j].budget = lane_get_mask(budget, j) != 0;
     iso[j].cluster = lane_get_mask(cluster, j) != 0;
     iso[j].steps = (uint)lane_get(steps, j);
+#if ALGRAY_ESCALATE
+    iso[j].doubt = (uint)lane_get(doubt, j);
+#else
+    iso[j].doubt = 0;
+#endif
     iso[j].lo = lane_get(lo, j);
     iso[j].hi = lane_get(hi, j);
     iso[j].f_lo = lane_get(f_lo, j);
@@ -367,6 +437,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) cur_out[k] = cur[k];
 }
+#undef DOUBT_LANES
 #endif
 
 /* Whether isolate_bernstein would find a root at all, read off the signs of the scaled coefficients c (as the

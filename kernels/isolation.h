@@ -16,6 +16,7 @@ typedef struct {
   int budget;  /* 1 when some interval hit the halving limit before reaching the tolerance */
   int cluster; /* 1 when the bracket is an interval that still held several roots (settle_cluster) */
   uint steps;  /* intervals examined */
+  uint doubt;  /* adaptive builds: the ALGRAY_DOUBT_* that ended the search undecided (status NONE), else 0 */
   REAL lo, hi;
   REAL f_lo, f_hi;
 } Isolation;
@@ -26,12 +27,69 @@ Isolation isolation_none(void) {
   iso.budget = 0;
   iso.cluster = 0;
   iso.steps = 0;
+  iso.doubt = 0;
   iso.lo = 0;
   iso.hi = 1;
   iso.f_lo = 0;
   iso.f_hi = 0;
   return iso;
 }
+
+/* Adaptive precision (ALGRAY_ESCALATE): the float search stops where a decision rests on values within the
+ * rounding noise of the coefficients it started from, and the host redoes the ray in float-float. The noise is
+ * ALGRAY_DOUBT_FACTOR * DEGREE * REAL_EPS * max |b_k| over the segment's coefficients: de Casteljau's convex
+ * combinations add no more than that to it, so it bounds every subinterval's coefficients too. Measured on the
+ * scenes' wrong float pixels (bench/RESULTS.md, "Adaptive precision"). */
+#ifndef ALGRAY_DOUBT_FACTOR
+#define ALGRAY_DOUBT_FACTOR 1
+#endif
+REAL doubt_noise(const REAL* c) {
+  REAL scale = 0;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(c[k]));
+  return (REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * REAL_EPS * scale;
+}
+
+/* Shadow kernels define ALGRAY_SHADOW_RAYS. Their rays start off the surface on purpose (the shadow offset), so
+ * P's value at their start, however small, is no sign of a root: the coefficient c_0 of an interval starting
+ * there (lo == 0) does not count. And they ask only whether there is a root, not where. */
+#ifndef ALGRAY_SHADOW_RAYS
+#define ALGRAY_SHADOW_RAYS 0
+#endif
+ALGRAY_INLINE int first_counted(REAL lo) { return ALGRAY_SHADOW_RAYS && lo == 0; }
+
+/* The smallest |c_k| that counts: an interval whose coefficients all stand clear of the noise keeps its sign
+ * variations. */
+REAL smallest_magnitude(const REAL* c, REAL lo) {
+  REAL m = fabs(c[DEGREE]);
+  ALGRAY_UNROLL
+  for (int k = 0; k < DEGREE; ++k) m = k < first_counted(lo) ? m : fmin(m, fabs(c[k]));
+  return m;
+}
+
+/* The smaller |P| at the interval's ends that counts (c_0 and c_n are P's values there). */
+REAL smaller_end(const REAL* c, REAL lo) {
+  return first_counted(lo) ? fabs(c[DEGREE]) : fmin(fabs(c[0]), fabs(c[DEGREE]));
+}
+
+/* Rays that need their root's position doubt an isolated root whose position the noise could move by more than
+ * this fraction of its t: the noise over the isolating interval's secant slope, times its width (measured: an
+ * Endrass octic ray whose ends stood just clear of the noise had its root 1.2e-3 off, with this ratio 8e-3). */
+#define ALGRAY_DOUBT_POSITION 1e-4f
+
+/* Ends the search undecided for `reason` when |value| is within the noise; returns 1 then. Other builds
+ * compute none of its arguments. */
+#if ALGRAY_ESCALATE
+int doubted(Isolation* iso, uint reason, REAL value, REAL noise, int level PROBE_PARAM) {
+  if (!(fabs(value) <= noise)) return 0;
+  PROBE(ALGRAY_EVENT_DOUBT, 0, reason, (uint)level, iso->lo, iso->hi, value, noise);
+  iso->doubt = reason;
+  iso->status = ISOLATION_NONE;
+  return 1;
+}
+#else
+#define doubted(...) 0
+#endif
 
 /* Whether an interval `width` (a fraction of [t_in, t_out], starting at fraction lo) is down to the stopping
  * width: then it is located, however many roots Descartes' rule still allows in it. */

@@ -2,6 +2,13 @@
 #ifndef ALGRAY_REAL_H
 #define ALGRAY_REAL_H
 
+#ifndef ALGRAY_ESCALATE
+#define ALGRAY_ESCALATE 0 /* 1: float that marks the rays it cannot decide (adaptive precision; isolation.h) */
+#endif
+#if ALGRAY_ESCALATE && (ALGRAY_DOUBLE || ALGRAY_COMPENSATED)
+#error "ALGRAY_ESCALATE is a plain float build"
+#endif
+
 #ifndef ALGRAY_COMPENSATED
 #define ALGRAY_COMPENSATED 0 /* 1: float, but P*(t) built in compensated (float-float) arithmetic */
 #endif

@@ -1,5 +1,7 @@
 /* The shadow-ray kernel: for each lit surface point, which sample points of one light the surface hides. */
 #include "algray_shared.h"
+/* Shadow rays start off the surface and ask only whether there is a root: what adaptive builds doubt (isolation.h). */
+#define ALGRAY_SHADOW_RAYS 1
 
 /* Shadow rays restrict P in batches (see RESTRICT_RAYS in restrict.h); the width that measured fastest for the
  * vector width the degree takes. */
@@ -21,14 +23,19 @@
 #endif
 
 /* Whether the segment, restricted to root (and root_lo, both consumed), holds a root: what isolate_restricted
- * reports, without the search when the coefficients' signs already settle it (Bernstein builds). */
-int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials) {
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+ * reports, without the search when the coefficients' signs already settle it (Bernstein builds other than
+ * adaptive ones, whose search must see every coefficient's distance from the noise). *doubt gets the search's. */
+int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
+                     uint* doubt) {
+  *doubt = 0;
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN && !ALGRAY_ESCALATE
   const int by_signs = bernstein_root_by_signs(root);
   if (by_signs >= 0) return by_signs != ISOLATION_NONE;
 #endif
   REAL iso_c[NCOEF];
-  return isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c).status != ISOLATION_NONE;
+  const Isolation iso = isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c);
+  *doubt = iso.doubt;
+  return iso.status != ISOLATION_NONE;
 }
 
 /* One work-item per surface point. points[i].xyz is the point (world), normals[i].xyz its unit normal on the
@@ -38,6 +45,7 @@ int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constan
  * not traced again. The shadow ray stops at the first evidence of a root, an isolating interval, and never
  * refines it. offset: how far the origin moves along the normal, in world units. rays_traced counts the
  * shadow rays that reached the root isolation, for the render statistics.
+ * Adaptive builds also set bit s of undecided[i] where the float search doubted sample s (SHADOW_UNDECIDED).
  * The answers are shadow_serial's, bit for bit: the segments are restricted RESTRICT_RAYS at a time, each
  * with the operations it would get alone, and the shortcuts return what the search would. */
 __kernel void shadow(SHADOW_KERNEL_PARAMS) {
@@ -45,7 +53,7 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) {
   if (i >= point_count) return;
   REAL3 p, n, o, o_unit;
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
-  ulong mask = occluded[i];
+  ulong mask = occluded[i], unsure = 0;
   uint traced = 0;
   /* The batch waiting for its restriction: ray r is light sample sample[r] on [t_in[r], t_out[r]]. */
   AxisFactor fx[RESTRICT_RAYS], fy[RESTRICT_RAYS], fz[RESTRICT_RAYS];
@@ -77,10 +85,14 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) {
     }
     REAL root[RESTRICT_RAYS][NCOEF], root_lo[RESTRICT_RAYS][NCOEF];
     restrict_to_rays(mono_exps, mono_coefs, mono_count, binomials, fx, fy, fz, root, root_lo);
-    for (int r = 0; r < pending; ++r)
-      if (segment_has_root(root[r], root_lo[r], t_in[r], t_out[r], binomials)) mask |= (ulong)1 << sample[r];
+    for (int r = 0; r < pending; ++r) {
+      uint doubt;
+      if (segment_has_root(root[r], root_lo[r], t_in[r], t_out[r], binomials, &doubt)) mask |= (ulong)1 << sample[r];
+      if (doubt) unsure |= (ulong)1 << sample[r];
+    }
     pending = 0;
   }
   occluded[i] = mask;
+  SHADOW_UNDECIDED(i, unsure);
   if (traced) atomic_add(rays_traced, traced);
 }

@@ -40,6 +40,17 @@ void shadow_origin(__global const REAL4* points, __global const float4* normals,
   __global const REAL4 *points, __global const float4 *normals, uint point_count, __global const REAL4 *light_points, \
       uint light_count, REAL offset, REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half,              \
       int extent_kind, __global const uint *mono_exps, __global const REAL *mono_coefs, uint mono_count,             \
-      __constant const REAL *binomials, uint even_axes, __global ulong *occluded, __global uint *rays_traced
+      __constant const REAL *binomials, uint even_axes, __global ulong *occluded,                                \
+      __global uint *rays_traced SHADOW_UNDECIDED_PARAM
+
+/* Adaptive builds take one more argument, undecided: per surface point, the samples whose shadow rays the
+ * float search doubted, which the host traces again in float-float. Other builds take nothing more. */
+#if ALGRAY_ESCALATE
+#define SHADOW_UNDECIDED_PARAM , __global ulong *undecided
+#define SHADOW_UNDECIDED(i, mask) (undecided[i] = (mask))
+#else
+#define SHADOW_UNDECIDED_PARAM
+#define SHADOW_UNDECIDED(i, mask) ((void)(mask))
+#endif
 
 #endif /* ALGRAY_SHADOW_H */

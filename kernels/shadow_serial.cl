@@ -1,5 +1,7 @@
 /* The shadow kernel's answers the plain way, one segment at a time through isolate_on_segment: what the tests hold shadow.cl to. */
 #include "algray_shared.h"
+/* Shadow rays start off the surface and ask only whether there is a root: what adaptive builds doubt (isolation.h). */
+#define ALGRAY_SHADOW_RAYS 1
 #include "isolate.h"
 #include "ray.h"
 #include "real.h"
@@ -17,7 +19,7 @@ __kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
   if (i >= point_count) return;
   REAL3 p, n, o, o_unit;
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
-  ulong mask = occluded[i];
+  ulong mask = occluded[i], unsure = 0;
   uint traced = 0;
   for (uint s = 0; s < light_count; ++s) {
     const ulong bit = (ulong)1 << s;
@@ -33,7 +35,9 @@ __kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
     const Isolation iso = isolate_on_segment(o_unit, d_unit, t_in, t_out, mono_exps, mono_coefs, mono_count,
                                              binomials, even_axes, iso_c);
     if (iso.status != ISOLATION_NONE) mask |= bit;
+    if (iso.doubt) unsure |= bit;
   }
   occluded[i] = mask;
+  SHADOW_UNDECIDED(i, unsure);
   if (traced) atomic_add(rays_traced, traced);
 }

@@ -13,6 +13,9 @@
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EYE && ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
 #error "RAY_ORIGIN=eye needs a power-basis isolation method"
 #endif
+#if ALGRAY_ESCALATE && ISOLATION != ALGRAY_ISOLATION_BERNSTEIN
+#error "adaptive precision doubts rays in the Bernstein isolation only"
+#endif
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && ALGRAY_COMPENSATED
 #error "RAY_ORIGIN=screen is built in plain float or double"
 #endif
@@ -82,6 +85,7 @@ SegmentRoot isolated_root(Isolation iso, REAL t_in, REAL t_out, RefineSetup* set
   setup->refine = 0;
   setup->tol_y = 0;
   PROBE(ALGRAY_EVENT_ISOLATED, iso.budget, (uint)iso.status, 0u, iso.lo, iso.hi, iso.f_lo, iso.f_hi);
+  if (iso.doubt) r.flags |= ALGRAY_HIT_DOUBT;
   if (iso.status == ISOLATION_NONE) return r;
   if (iso.status == ISOLATION_EXACT) r.flags |= ALGRAY_HIT_EXACT;
   if (iso.cluster) r.flags |= ALGRAY_HIT_CLUSTER;

@@ -4,11 +4,11 @@
 #include <random>
 #include <set>
 
-#include "algray/scene/camera.h"
-#include "algray/scene/expression.h"
 #include "algray/device/kernel_config.h"
 #include "algray/device/kernel_sources.h"
 #include "algray/render/renderer.h"
+#include "algray/scene/camera.h"
+#include "algray/scene/expression.h"
 #include "algray/scene/scene.h"
 
 using namespace algray;
@@ -79,7 +79,7 @@ TEST_CASE("solver names round-trip and unknown names are refused", "[config]") {
   }
   Precision p{};
   CHECK_FALSE(parse_precision("quad", p));
-  CHECK(precision_choices() == "float, double, mixed");
+  CHECK(precision_choices() == "float, double, mixed, adaptive");
   // Mixed precision stops at degree 15, with the scene's position in the message.
   CHECK_THROWS_WITH(
       load_scene_text(kSphereScene, "t.toml", {{"surface.equation", "\"x^16 - 1\""}, {"render.precision", "mixed"}}),
@@ -89,18 +89,42 @@ TEST_CASE("solver names round-trip and unknown names are refused", "[config]") {
   CHECK(mixed.build_options().find("-D ALGRAY_DOUBLE=0 -D ALGRAY_COMPENSATED=1") != std::string::npos);
 }
 
-TEST_CASE("precision follows the device: double refused without fp64, auto falls back to float", "[config]") {
+TEST_CASE("precision follows the device: double refused without fp64, auto takes fast fp64 or adaptive float",
+          "[config]") {
   Scene scene = load_scene_text(kSphereScene, "t.toml");
   DeviceInfo no_fp64;
   no_fp64.name = "toy device";
   no_fp64.fp64 = false;
   DeviceInfo with_fp64 = no_fp64;
   with_fp64.fp64 = true;
-  CHECK(resolve_precision(scene, no_fp64) == Precision::Float);
-  CHECK(resolve_precision(scene, with_fp64) == Precision::Double);
+  CHECK(resolve_precision(scene, no_fp64, std::nullopt) == Precision::Adaptive);
+  CHECK(resolve_precision(scene, with_fp64, 1.02) == Precision::Double);
+  CHECK(resolve_precision(scene, with_fp64, kFastFp64Slowdown) == Precision::Double);
+  CHECK(resolve_precision(scene, with_fp64, 32.0) == Precision::Adaptive);  // a consumer GPU's fp64
+  // Where adaptive cannot go (mixed precision's degree limit, another isolation), float.
+  scene.render.isolation = Isolation::Sturm;
+  CHECK(resolve_precision(scene, no_fp64, std::nullopt) == Precision::Float);
+  CHECK(resolve_precision(scene, with_fp64, 32.0) == Precision::Float);
+  scene.render.isolation = Isolation::Bernstein;
   scene.render.precision = Precision::Double;
-  CHECK_THROWS_WITH(resolve_precision(scene, no_fp64), Catch::Contains("has no double precision"));
-  CHECK(resolve_precision(scene, with_fp64) == Precision::Double);
+  CHECK_THROWS_WITH(resolve_precision(scene, no_fp64, std::nullopt), Catch::Contains("has no double precision"));
+  CHECK(resolve_precision(scene, with_fp64, 32.0) == Precision::Double);  // asked for: slow or not
+  scene.render.precision = Precision::Adaptive;
+  CHECK(resolve_precision(scene, with_fp64, 1.0) == Precision::Adaptive);
+}
+
+TEST_CASE("adaptive precision is refused, naming the line, where it cannot escalate", "[config]") {
+  CHECK_THROWS_WITH(
+      load_scene_text(kSphereScene, "t.toml", {{"render.precision", "adaptive"}, {"render.isolation", "sturm"}}),
+      Catch::Contains("adaptive precision needs render.isolation = \"bernstein\"") &&
+          Catch::Contains("--set render.precision=adaptive"));  // where the choice was made
+  CHECK_THROWS_WITH(
+      load_scene_text(kSphereScene, "t.toml", {{"surface.equation", "\"x^16 - 1\""}, {"render.precision", "adaptive"}}),
+      Catch::Contains("escalates to mixed, which supports degrees up to 15"));
+  KernelConfig adaptive;
+  adaptive.precision = Precision::Adaptive;
+  CHECK(adaptive.build_options().find("-D ALGRAY_DOUBLE=0 -D ALGRAY_COMPENSATED=0 -D ALGRAY_ESCALATE=1") !=
+        std::string::npos);
 }
 
 TEST_CASE("tolerances below the working precision are raised to it", "[config]") {

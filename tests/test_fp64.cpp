@@ -66,11 +66,12 @@ TEST_CASE("ALGRAY_NO_FP64 hides double precision: auto picks float and double is
   CHECK_THAT(describe_devices(devices), Catch::Contains("fp64 hidden (ALGRAY_NO_FP64)"));
   Scene scene = load_scene_text(testing::sphere_with({}), "sphere.toml");
   const DeviceInfo& device = devices.front();
-  CHECK(resolve_precision(scene, device) == Precision::Float);
+  ProgramCache cache(false);
+  CHECK(resolve_precision(scene, device, cache) == Precision::Adaptive);
   scene.render.precision = Precision::Double;
-  CHECK_THROWS_WITH(resolve_precision(scene, device), Catch::Contains("hidden by --no-fp64 or ALGRAY_NO_FP64"));
+  CHECK_THROWS_WITH(resolve_precision(scene, device, cache), Catch::Contains("hidden by --no-fp64 or ALGRAY_NO_FP64"));
   scene.render.precision = Precision::Mixed;  // compensated float: no fp64 needed
-  CHECK(resolve_precision(scene, device) == Precision::Mixed);
+  CHECK(resolve_precision(scene, device, cache) == Precision::Mixed);
 }
 
 TEST_CASE("double's speed against float is measured once a device and then read from the cache", "[fp64]") {
@@ -105,7 +106,8 @@ TEST_CASE("double's speed against float is measured once a device and then read 
   CHECK_FALSE(fp64_slowdown(enumerate_devices().at(static_cast<std::size_t>(session.info.index)), cache).has_value());
 }
 
-TEST_CASE("--no-fp64 on the command line: devices say so, auto renders in float, double is bad input", "[fp64][cli]") {
+TEST_CASE("--no-fp64 on the command line: devices say so, auto renders adaptive float, double is bad input",
+          "[fp64][cli]") {
   ::unsetenv("ALGRAY_NO_FP64");
   const testing::Sandbox box;
   const testing::Result listed = box.run("devices --stats d.json");
@@ -123,7 +125,18 @@ TEST_CASE("--no-fp64 on the command line: devices say so, auto renders in float,
   const testing::Result as_float =
       box.run("render " + scene + " --no-fp64 --width 32 --height 24 -o a.png --stats s.json");
   REQUIRE(as_float.exit_code == 0);
-  CHECK(box.stats("s.json")["solver"]["precision"] == "float");
+  const nlohmann::json stats = box.stats("s.json");
+  CHECK(stats["solver"]["precision"] == "adaptive");
+  // Without fp64 the doubted rays go to mixed precision; with this CPU's fast fp64, to double.
+  const nlohmann::json& primary = stats["plan"]["passes"][0];
+  REQUIRE(primary["escalation"].size() == 1);
+  CHECK_THAT(primary["escalation"][0].get<std::string>(),
+             Catch::Contains("trace") && Catch::Contains("precision=mixed"));
+  const testing::Result with_fp64 =
+      box.run("render " + scene + " --precision adaptive --width 32 --height 24 -o c.png --stats c.json");
+  REQUIRE(with_fp64.exit_code == 0);
+  CHECK_THAT(box.stats("c.json")["plan"]["passes"][0]["escalation"][0].get<std::string>(),
+             Catch::Contains("precision=double"));
   const testing::Result refused =
       box.run("render " + scene + " --no-fp64 --precision double --width 32 --height 24 -o b.png");
   CHECK(refused.exit_code == 2);

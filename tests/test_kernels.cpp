@@ -73,15 +73,17 @@ TEST_CASE("every DEGREE from 1 to 32 builds and finds the smallest root, in floa
   for (const NamedChoice<Precision>& choice : kPrecisions) {
     const char* const precision = choice.name;
     if (std::string(precision) == "double" && !session.info.fp64) FAIL("the test device lacks fp64");
-    // Mixed precision exists up to degree 15 (kMaxMixedDegree); the scene layer refuses it above.
-    const int max_degree = std::string(precision) == "mixed" ? kMaxMixedDegree : 32;
+    // Mixed precision, and adaptive, which escalates to it, exist up to degree 15 (kMaxMixedDegree); the scene
+    // layer refuses them above.
+    const bool compensated = choice.value == Precision::Mixed || choice.value == Precision::Adaptive;
+    const int max_degree = compensated ? kMaxMixedDegree : 32;
     for (int degree = 1; degree <= max_degree; ++degree) {
       INFO("DEGREE=" << degree << " precision=" << precision);
       const Scene scene = degree_scene(degree, precision);
       REQUIRE(scene.surface().polynomial.degree() == degree);
       RenderResult result;
       REQUIRE_NOTHROW(result = renderer.render_with_records(scene));  // a BuildError prints the options and the log
-      REQUIRE(result.programs.size() == 1);
+      REQUIRE(result.programs.size() == (choice.value == Precision::Adaptive ? 2u : 1u));  // with its escalation
       CHECK(result.programs[0].origin == "built");
       check_known_root(result, degree, precision);
     }

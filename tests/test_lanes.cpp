@@ -93,8 +93,8 @@ TEST_CASE("lanes give the one-ray kernel's hit records where groups settle witho
       const Precision precision = choice.value;
       const std::string quoted_precision = '"' + std::string(to_string(precision)) + '"';
       const auto render = [&](int lanes) {
-        return renderer.render_with_records(
-            load_scene_text(text, "plane", {{"render.precision", quoted_precision}, {"render.lanes", std::to_string(lanes)}}));
+        return renderer.render_with_records(load_scene_text(
+            text, "plane", {{"render.precision", quoted_precision}, {"render.lanes", std::to_string(lanes)}}));
       };
       const RenderResult one = render(1), many = render(8);
       REQUIRE(many.plan.find(PassKind::Primary)->kernels.at(0).lanes == 8);
@@ -103,7 +103,10 @@ TEST_CASE("lanes give the one-ray kernel's hit records where groups settle witho
       const long at = first_difference(one.hits.records, many.hits.records);
       INFO(equation << ", " << to_string(precision) << ": first differing record " << at << " of "
                     << one.hits.records.size() << ", " << found << " hits");
-      CHECK(found >= least_hits);
+      // Adaptive precision doubts the double plane's float hits and escalates them: none need be left, as on the
+      // surface itself; every other surface keeps its hits.
+      const bool double_plane = equation == "(z-0.1)^2";
+      CHECK(found >= (precision == Precision::Adaptive && double_plane ? std::size_t{0} : least_hits));
       CHECK(at == -1);
     }
   }

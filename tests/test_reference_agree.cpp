@@ -12,9 +12,9 @@
 
 #include "algray/device/program_cache.h"
 #include "algray/render/reference_render.h"
-#include "scene_fixtures.h"
 #include "algray/render/renderer.h"
 #include "algray/scene/scene.h"
+#include "scene_fixtures.h"
 #include "test_support.h"
 #include "tolerances.h"
 
@@ -111,6 +111,7 @@ TEST_CASE("every scene agrees with the certified reference within issue 3's thre
   for (const auto& file : files) {
     check_scene(renderer, file, "double");
     check_scene(renderer, file, "mixed");
+    check_scene(renderer, file, "adaptive");
     if (!kFloatNotYet.count(file.stem().string())) check_scene(renderer, file, "float");
   }
 }

@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "algray/render/device_surface.h"
 #include "algray/device/program_cache.h"
+#include "algray/render/device_surface.h"
 #include "algray/render/render_plan.h"
-#include "algray/scene/scene.h"
 #include "algray/render/shadow_tracer.h"
+#include "algray/scene/scene.h"
 #include "test_support.h"
 
 using namespace algray;
@@ -38,8 +38,7 @@ Scene random_scene(std::mt19937& rng, int degree, bool even, Precision precision
   toml << "[surface]\nequation = \"" << eq.str() << "\"\n"
        << "[extent]\nradius = 1\n"
        << "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n"
-       << "[render]\nprecision = \"" << to_string(precision) << "\"\nisolation = \"" << to_string(isolation)
-       << "\"\n";
+       << "[render]\nprecision = \"" << to_string(precision) << "\"\nisolation = \"" << to_string(isolation) << "\"\n";
   return load_scene_text(toml.str(), "random.toml");
 }
 
@@ -88,7 +87,8 @@ Counts check_same_masks(const Scene& scene, Precision precision, Isolation isola
     }
     const int light_count = std::uniform_int_distribution<int>(1, 64)(rng);
     std::vector<glm::dvec3> lights;
-    for (int s = 0; s < light_count; ++s) lights.push_back(in_ball(std::uniform_real_distribution<double>(0.3, 4)(rng)));
+    for (int s = 0; s < light_count; ++s)
+      lights.push_back(in_ball(std::uniform_real_distribution<double>(0.3, 4)(rng)));
     const ShadowAnswer a = batched.trace(points, normals, lights, hidden);
     const ShadowAnswer b = serial.trace(points, normals, lights, hidden);
     REQUIRE(a.masks.size() == b.masks.size());
@@ -97,13 +97,16 @@ Counts check_same_masks(const Scene& scene, Precision precision, Isolation isola
       if (a.masks[i] == b.masks[i]) continue;
       if (mismatches++ == 0)
         UNSCOPED_INFO(what << ", seed " << kSeed << ", round " << round << ", point " << i << " of " << point_count
-                           << " (" << points[i].x << ", " << points[i].y << ", " << points[i].z << "), "
-                           << light_count << " lights: batched mask " << std::hex << a.masks[i] << ", serial "
-                           << b.masks[i] << std::dec);
+                           << " (" << points[i].x << ", " << points[i].y << ", " << points[i].z << "), " << light_count
+                           << " lights: batched mask " << std::hex << a.masks[i] << ", serial " << b.masks[i]
+                           << std::dec);
     }
     INFO(what << ", seed " << kSeed << ", round " << round << ": " << mismatches << " masks differ");
     CHECK(mismatches == 0);
     CHECK(a.rays_traced == b.rays_traced);
+    // Adaptive builds also name the samples they doubted, alike.
+    CHECK(a.undecided.size() == (precision == Precision::Adaptive ? a.masks.size() : 0u));
+    CHECK(a.undecided == b.undecided);
     counts.traced += a.rays_traced;
     const std::uint64_t all = light_count == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << light_count) - 1;
     for (std::size_t i = 0; i < a.masks.size(); ++i)
@@ -124,13 +127,13 @@ TEST_CASE("batched shadow rays answer as the serial ones, bit for bit, at every 
     int degree;
     bool even;
   };
-  const Case cases[] = {{1, false}, {2, true}, {5, false}, {6, true}, {7, false},
+  const Case cases[] = {{1, false}, {2, true},   {5, false},  {6, true},  {7, false},
                         {10, true}, {13, false}, {15, false}, {18, true}, {21, false}};
   std::mt19937 rng(kSeed);
-  for (Precision precision : {Precision::Double, Precision::Float, Precision::Mixed}) {
+  for (Precision precision : {Precision::Double, Precision::Float, Precision::Mixed, Precision::Adaptive}) {
     for (std::size_t c = 0; c < std::size(cases); ++c) {
       const Case& k = cases[c];
-      if (precision == Precision::Mixed && k.degree > kMaxMixedDegree) continue;
+      if (precision != Precision::Double && precision != Precision::Float && k.degree > kMaxMixedDegree) continue;
       const Scene scene = random_scene(rng, k.degree, k.even, precision, Isolation::Bernstein);
       std::ostringstream what;
       what << to_string(precision) << " case " << c << " (degree " << k.degree << (k.even ? ", even" : "") << ")";

@@ -39,7 +39,7 @@ struct SceneOptions {
 void add_no_fp64_flag(CLI::App* cmd) {
   cmd->add_flag_callback(
       "--no-fp64", [] { ::setenv("ALGRAY_NO_FP64", "1", 1); },
-      "act as if no device had double precision (as ALGRAY_NO_FP64=1 does): auto precision picks float, and "
+      "act as if no device had double precision (as ALGRAY_NO_FP64=1 does): auto precision picks adaptive float, and "
       "double is refused");
 }
 

@@ -10,12 +10,12 @@
 #include <initializer_list>
 #include <sstream>
 
-#include "algray/io/probe_plot.h"
-#include "algray/util/version.h"
-#include "algray/io/image_io.h"
 #include "algray/api/render_job.h"
+#include "algray/io/image_io.h"
+#include "algray/io/probe_plot.h"
 #include "algray/render/render_plan.h"
 #include "algray/render/renderer.h"
+#include "algray/util/version.h"
 #include "solver_ref/solver_ref.h"
 
 namespace algray {
@@ -385,8 +385,8 @@ nlohmann::json probe_json(const Scene& scene, const ProbeTarget& target, const s
 }
 
 void check_probe_target(const Scene& scene, const ProbeTarget& target) {
-  if (!target.given_ray && (target.px < 0 || target.py < 0 || target.px >= scene.image.width ||
-                            target.py >= scene.image.height))
+  if (!target.given_ray &&
+      (target.px < 0 || target.py < 0 || target.px >= scene.image.width || target.py >= scene.image.height))
     throw SceneError("--pixel", "pixel (" + std::to_string(target.px) + ", " + std::to_string(target.py) +
                                     ") is outside the " + std::to_string(scene.image.width) + "x" +
                                     std::to_string(scene.image.height) + " image");
@@ -398,7 +398,7 @@ void check_probe_target(const Scene& scene, const ProbeTarget& target) {
 std::vector<SurfaceProbe> probe_scene(const Scene& scene, const ProbeTarget& target, bool all_solvers,
                                       RenderContext& context) {
   ClSession& session = context.session();
-  const Precision precision = resolve_precision(scene, session.info);
+  const Precision precision = resolve_precision(scene, session.info, context.cache());
   std::vector<SurfaceProbe> probes;
   for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
     SurfaceProbe p;

@@ -167,7 +167,9 @@ nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const
                            {"rays", p.rays},
                            {"launches", p.launches},
                            {"kernel_ms", p.kernel_ms},
-                           {"wall_ms", p.wall_ms}});
+                           {"wall_ms", p.wall_ms},
+                           {"escalated", p.escalated},
+                           {"escalation_ms", p.escalation_ms}});
   }
   const PrimarySummary& p = r.primary;
   j["primary_rays"] = {{"count", p.rays},

@@ -31,9 +31,9 @@ double best_launch_ms(ClSession& session, bool in_double) {
     cl::Event done;
     session.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(items), cl::NullRange, nullptr, &done);
     done.wait();
-    const double ms =
-        (done.getProfilingInfo<CL_PROFILING_COMMAND_END>() - done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
-        1e-6;
+    const double ms = static_cast<double>(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                                          done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
+                      1e-6;
     best = std::min(best, ms);
   }
   return best;

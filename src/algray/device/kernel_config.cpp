@@ -59,6 +59,7 @@ std::string KernelConfig::build_options() const {
   return "-cl-std=CL1.2 -D DEGREE=" + std::to_string(degree) +
          " -D ALGRAY_DOUBLE=" + (precision == Precision::Double ? "1" : "0") +
          " -D ALGRAY_COMPENSATED=" + (precision == Precision::Mixed ? "1" : "0") +
+         " -D ALGRAY_ESCALATE=" + (precision == Precision::Adaptive ? "1" : "0") +
          " -D ISOLATION=" + std::to_string(isolation_id) + " -D REFINEMENT=" + std::to_string(refinement_id) +
          " -D RAY_ORIGIN=" + std::to_string(origin_id) + " -D TOLERANCE=" + tolerance_literal +
          " -D MAX_ITERATIONS=" + std::to_string(max_iterations) + " -D LANES=" + std::to_string(lanes) +

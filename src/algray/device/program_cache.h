@@ -34,7 +34,8 @@ class ProgramCache {
 
   // A number measured on a device, such as its double arithmetic's speed: read from the cache directory when it
   // was measured before on this device and driver, otherwise measured now (`measure` opens the device only
-  // then) and kept there. With the cache off it is measured every time.
+  // then) and kept there. With the cache off it is measured once for this object's life (a render asks on
+  // every frame), and never stored.
   double remembered(const DeviceInfo& device, const std::string& name, const std::function<double()>& measure);
 
   // $ALGRAY_CACHE_DIR, else $XDG_CACHE_HOME/algray, else ~/.cache/algray.
@@ -56,6 +57,7 @@ class ProgramCache {
   bool enabled_;
   std::filesystem::path dir_;
   std::map<std::string, cl::Program> memory_;  // keyed by device identity + options + source hash
+  std::map<std::string, double> measured_;     // the cache off: remembered()'s numbers, by identity
 };
 
 }  // namespace algray

@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <limits>
 
-#include "kernels/algray_shared.h"
 #include "algray/render/screen_form.h"
+#include "kernels/algray_shared.h"
 
 namespace algray {
 
@@ -33,6 +33,11 @@ KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t
   config.max_iterations =
       scene.render.max_iterations > 0 ? scene.render.max_iterations : default_max_iterations(scene.render.refinement);
   return config;
+}
+
+void escalate_in(RenderPlan& plan, Precision precision) {
+  for (PlannedPass& pass : plan.passes)
+    for (KernelConfig& c : pass.escalation) c.precision = precision;
 }
 
 double shadow_offset_unit(Precision precision) { return precision == Precision::Double ? 1e-6 : 1e-3; }
@@ -95,7 +100,8 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
                          plan.samples > 1 ? "camera rays, " + std::to_string(plan.samples) + "x" +
                                                 std::to_string(plan.samples) + " per pixel"
                                           : "camera rays, one per pixel",
-                         primary});
+                         primary,
+                         {}});
   plan.buffers.push_back({"primary hits", rays * sizeof(HitRecord)});
 
   for (std::size_t i = 0; i < scene.lights.size(); ++i)
@@ -120,7 +126,8 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
     plan.passes.push_back({PassKind::Shadow,
                            std::to_string(plan.shadow_lights.size()) + " shadow-casting light(s), " +
                                std::to_string(points) + " sample point(s) per lit surface point",
-                           shadow});
+                           shadow,
+                           {}});
     // A batch of surface points at a time, asked about each light in turn.
     const std::size_t batch = std::min(rays, kBatchRays);
     plan.buffers.push_back({"shading points (per batch)", batch * 4 * real_size});
@@ -152,8 +159,10 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
     else if (scene.render.max_depth == 0)
       plan.skipped.push_back(name + ": render.max_depth is 0");
     else {
-      plan.passes.push_back(
-          {effect.kind, std::string(effect.why) + ", up to depth " + std::to_string(scene.render.max_depth), trace});
+      plan.passes.push_back({effect.kind,
+                             std::string(effect.why) + ", up to depth " + std::to_string(scene.render.max_depth),
+                             trace,
+                             {}});
       // Each bounce can double a tile's rays; they are traced in batches of at most kBatchRays.
       const std::size_t batch = rays << std::min(scene.render.max_depth - 1, 8) < kBatchRays
                                     ? rays << std::min(scene.render.max_depth - 1, 8)
@@ -164,17 +173,32 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
   }
   if (adaptive) {
     const std::string n = std::to_string(plan.refine_samples);
-    plan.passes.push_back(
-        {PassKind::Antialias, n + "x" + n + " camera rays in pixels whose colour differs from a neighbour's", trace});
+    plan.passes.push_back({PassKind::Antialias,
+                           n + "x" + n + " camera rays in pixels whose colour differs from a neighbour's",
+                           trace,
+                           {}});
     const std::size_t batch =
         std::min(rays * static_cast<std::size_t>(plan.refine_samples * plan.refine_samples), kBatchRays);
     plan.buffers.push_back({"antialias rays (per batch)", batch * 8 * real_size});
     plan.buffers.push_back({"antialias hits (per batch)", batch * sizeof(HitRecord)});
   } else {
     plan.skipped.push_back("antialias: " + std::string(scene.render.preview && scene.antialias.samples > 1
-                                                          ? "preview mode traces one camera ray per pixel"
-                                                          : scene.antialias.samples > 1 ? "uniform supersampling"
+                                                           ? "preview mode traces one camera ray per pixel"
+                                                       : scene.antialias.samples > 1 ? "uniform supersampling"
                                                                                      : "off (one ray per pixel)"));
+  }
+  if (precision == Precision::Adaptive) {
+    // Rays the float kernels doubt go again through mixed precision's own kernels (or double's: escalate_in), a
+    // batch at a time.
+    for (PlannedPass& pass : plan.passes) {
+      pass.escalation = pass.kind == PassKind::Primary ? with_entry("trace") : pass.kernels;
+      for (KernelConfig& c : pass.escalation) c.precision = Precision::Mixed;
+    }
+    const std::size_t batch = std::min(rays, kBatchRays);
+    // Sized for double, which escalate_in may choose.
+    plan.buffers.push_back({"escalated rays (per batch)", batch * (8 * sizeof(double) + sizeof(HitRecord))});
+  } else {
+    plan.skipped.push_back("escalation: only adaptive precision traces doubted rays again in float-float");
   }
   // The host's share of one tile's work, per camera ray of the tile: its hit record (twice, and which surface,
   // with several), the shadow answers (an index each way, a mask per light), what its bounces bring back; and
@@ -207,7 +231,12 @@ nlohmann::json RenderPlan::json() const {
   for (const PlannedPass& p : passes) {
     nlohmann::json kernels = nlohmann::json::array();
     for (const KernelConfig& k : p.kernels) kernels.push_back(k.key());
-    j["passes"].push_back({{"name", to_string(p.kind)}, {"purpose", p.purpose}, {"kernels", kernels}});
+    nlohmann::json pass = {{"name", to_string(p.kind)}, {"purpose", p.purpose}, {"kernels", kernels}};
+    if (!p.escalation.empty()) {
+      pass["escalation"] = nlohmann::json::array();
+      for (const KernelConfig& k : p.escalation) pass["escalation"].push_back(k.key());
+    }
+    j["passes"].push_back(pass);
   }
   for (const PlannedBuffer& b : buffers) j["buffers"].push_back({{"name", b.name}, {"bytes", b.bytes}});
   j["shadow_lights"] = shadow_lights;
@@ -229,7 +258,7 @@ std::uint64_t RenderPlan::film_bytes() const {
 }
 
 std::uint64_t RenderPlan::estimated_memory_bytes() const {
-  constexpr std::uint64_t kBase = 128ull << 20;  // the process, the OpenCL runtime and its compiler
+  constexpr std::uint64_t kBase = 128ull << 20;    // the process, the OpenCL runtime and its compiler
   constexpr std::uint64_t kWriters = 32ull << 20;  // the image writers convert and compress a strip of lines at a time
   return kBase + kWriters + film_bytes() + tile_host_bytes + buffer_bytes();
 }

@@ -25,8 +25,12 @@ std::string to_string(PassKind kind);
 // One pass: the rays it traces and the kernel it launches. Nothing outside the plan is built or launched.
 struct PlannedPass {
   PassKind kind = PassKind::Primary;
-  std::string purpose;  // why the scene needs it, for --stats
+  std::string purpose;                // why the scene needs it, for --stats
   std::vector<KernelConfig> kernels;  // one per surface of the scene, in scene order
+  // Adaptive precision: per surface, the kernel, in mixed precision or double (escalate_in), that traces again
+  // the rays `kernels` doubted (the trace kernel for ray passes, the shadow kernel for the shadow pass); empty in
+  // other precisions.
+  std::vector<KernelConfig> escalation;
 };
 
 struct PlannedBuffer {
@@ -55,8 +59,8 @@ struct RenderPlan {
     return static_cast<std::size_t>(std::min(tile_pixels(), width)) * samples * std::min(tile_pixels(), height) *
            samples;
   }
-  int samples = 1;            // antialiasing: samples x samples camera rays per pixel, traced as one grid
-  int refine_samples = 0;     // adaptive antialiasing: n x n rays later, in pixels that differ (0: off)
+  int samples = 1;         // antialiasing: samples x samples camera rays per pixel, traced as one grid
+  int refine_samples = 0;  // adaptive antialiasing: n x n rays later, in pixels that differ (0: off)
   double refine_threshold = 0;
   int trace_width() const { return width * samples; }
   int trace_height() const { return height * samples; }
@@ -97,6 +101,10 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
 // Chebyshev nonic and the Roman surface (depth errors 0.15 and 0.08), so float keeps the extent construction
 // (bench/RESULTS.md, "The screen form").
 bool screen_form_applies(const Scene& scene, Precision precision);
+
+// Adaptive precision's escalation kernels in `precision` instead: double where every device's fp64 is fast (the
+// doubted rays then cost about what float does), mixed otherwise (what make_render_plan plans).
+void escalate_in(RenderPlan& plan, Precision precision);
 
 // The kernel of the primary pass for one surface of `scene`.
 KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t surface = 0);

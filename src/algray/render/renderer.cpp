@@ -17,6 +17,8 @@
 #include <thread>
 #include <utility>
 
+#include "algray/device/fp64_speed.h"
+#include "algray/render/escalation.h"
 #include "algray/render/ray_tracer.h"
 #include "algray/render/shade.h"
 #include "algray/render/shadow_tracer.h"
@@ -25,13 +27,25 @@ namespace algray {
 
 int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 256 : 1024; }
 
-Precision resolve_precision(const Scene& scene, const DeviceInfo& device) {
-  if (!scene.render.precision) return device.fp64 ? Precision::Double : Precision::Float;
+Precision float_precision_for(const Scene& scene) {
+  for (const SceneSurface& surface : scene.surfaces)
+    if (!adaptive_unsupported(surface.polynomial.degree(), scene.render.isolation).empty()) return Precision::Float;
+  return Precision::Adaptive;
+}
+
+Precision resolve_precision(const Scene& scene, const DeviceInfo& device, std::optional<double> fp64_slowdown) {
+  if (!scene.render.precision)
+    return device.fp64 && fp64_slowdown && *fp64_slowdown <= kFastFp64Slowdown ? Precision::Double
+                                                                               : float_precision_for(scene);
   if (*scene.render.precision == Precision::Double && !device.fp64)
     throw DeviceError("device '" + device.name + "' has no double precision (" +
                       (device.fp64_hidden ? "cl_khr_fp64 is hidden by --no-fp64 or ALGRAY_NO_FP64" : "cl_khr_fp64") +
                       "); use --precision float");
   return *scene.render.precision;
+}
+
+Precision resolve_precision(const Scene& scene, const DeviceInfo& device, ProgramCache& cache) {
+  return resolve_precision(scene, device, scene.render.precision ? std::nullopt : fp64_slowdown(device, cache));
 }
 
 namespace {
@@ -240,8 +254,12 @@ struct Renderer::Passes {
   std::unique_ptr<ShadowPoints> shadow_points;           // a batch's surface points on the device
   std::vector<std::vector<glm::dvec3>> light_points;     // per shadow-casting light of the plan
   std::vector<std::unique_ptr<RayTracer>> rays;          // one per surface, when it has a secondary pass
-  const Shader* shader = nullptr;                        // the render's: shading is const, so the devices share one
-  RayBasis fine;                                         // adaptive antialiasing: the rays of the n-times finer grid
+  // Adaptive precision: per surface, mixed precision's trace kernel for doubted camera and secondary rays, and
+  // its shadow kernel for doubted shadow rays (when the plan has a shadow pass).
+  std::vector<std::unique_ptr<RayEscalation>> escalate_rays;
+  std::vector<std::unique_ptr<ShadowEscalation>> escalate_shadows;
+  const Shader* shader = nullptr;  // the render's: shading is const, so the devices share one
+  RayBasis fine;                   // adaptive antialiasing: the rays of the n-times finer grid
 
   // This device's share, added into the result when every device is done.
   PrimarySummary primary_summary;
@@ -285,6 +303,25 @@ struct Renderer::Passes {
 
 namespace {
 
+// Adds an escalation's rays and time to its pass's stats; `program` indexes its kernel in the pass's programs,
+// after those of the pass's own kernels.
+void count_escalation(PassStats& stats, std::size_t program, const EscalationCount& done) {
+  stats.escalated += done.rays;
+  stats.escalation_ms += done.kernel_ms;
+  stats.kernel_ms += done.kernel_ms;
+  stats.program_ms[program] += done.kernel_ms;
+}
+
+// Adaptive precision: traces again, in mixed precision, the records among `records` (of `surface`) that the
+// float kernel doubted, ray_of(i) being record i's ray, and counts them in the pass's stats.
+template <typename Passes, typename RayOf>
+void escalate_doubted(Passes& p, PassStats& stats, std::size_t surface, HitRecord* records, std::size_t count,
+                      RayOf ray_of) {
+  if (p.escalate_rays.empty()) return;
+  const EscalationCount done = p.escalate_rays[surface]->redo(records, count, ray_of, p.options.batch_rays);
+  count_escalation(stats, p.surfaces.size() + surface, done);
+}
+
 // Shadow rays from every hit of one batch, in groups of at most batch_rays surface points; ray(i) is the ray of hit i
 // (camera rays rebuilt exactly as the kernel traced them; secondary rays in double, which a float kernel traced
 // rounded).
@@ -320,6 +357,11 @@ ShadowData trace_shadows(Passes& p, const HitRecord* hits, std::size_t count, Ra
         stats.program_ms[s] += answer.kernel_ms;
         ++stats.launches;
         if (s == 0) stats.rays += answer.rays_traced;
+        if (!p.escalate_shadows.empty()) {
+          count_escalation(
+              stats, p.shadows.size() + s,
+              p.escalate_shadows[s]->redo(points, normals, p.light_points[l], answer.undecided, answer.masks));
+        }
         hidden = std::move(answer.masks);
       }
       std::copy(hidden.begin(), hidden.end(), data.occlusion[l].masks.begin() + static_cast<std::ptrdiff_t>(begin));
@@ -368,11 +410,20 @@ Renderer::Renderer(std::vector<ClSession*> sessions, ProgramCache& cache)
 }
 
 Precision Renderer::precision_of(const Scene& scene) const {
-  Precision precision = resolve_precision(scene, sessions_.front()->info);
-  // Left to the devices, the render is in double only where every device has it: the devices' tiles must match.
+  auto on = [&](const ClSession* session) { return resolve_precision(scene, session->info, cache_); };
+  Precision precision = on(sessions_.front());
+  // Left to the devices, the render is in double only where every device's fp64 is fast: their tiles must match.
   for (const ClSession* session : sessions_)
-    if (resolve_precision(scene, session->info) != precision) precision = Precision::Float;
+    if (on(session) != precision) precision = float_precision_for(scene);
   return precision;
+}
+
+Precision Renderer::escalation_precision() const {
+  for (const ClSession* session : sessions_) {
+    const std::optional<double> slowdown = fp64_slowdown(session->info, cache_);
+    if (!slowdown || *slowdown > kFastFp64Slowdown) return Precision::Mixed;
+  }
+  return Precision::Double;
 }
 
 RenderPlan Renderer::plan_of(const Scene& scene, Precision precision) const {
@@ -430,6 +481,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   RenderResult result;
   const Precision precision = precision_of(scene);
   result.plan = plan_of(scene, precision);
+  if (precision == Precision::Adaptive) escalate_in(result.plan, escalation_precision());
   for (const ClSession* session : sessions_) check_plan_fits(result.plan, session->info);
   result.config = primary_config(scene, precision);
   const RenderPlan& plan = result.plan;
@@ -544,6 +596,8 @@ void add_counts(PassStats& into, const PassStats& more) {
   into.launches += more.launches;
   into.kernel_ms += more.kernel_ms;
   into.wall_ms += more.wall_ms;
+  into.escalated += more.escalated;
+  into.escalation_ms += more.escalation_ms;
   into.program_ms.resize(std::max(into.program_ms.size(), more.program_ms.size()));
   for (std::size_t k = 0; k < more.program_ms.size(); ++k) into.program_ms[k] += more.program_ms[k];
 }
@@ -622,6 +676,22 @@ void Renderer::prepare_passes(Passes& passes) {
     for (int light : plan.shadow_lights)
       passes.light_points.push_back(scene.lights[static_cast<std::size_t>(light)].sample_points());
   }
+  // Adaptive precision: every ray pass escalates to the same mixed trace kernels.
+  if (const PlannedPass* primary_pass = plan.find(PassKind::Primary); !primary_pass->escalation.empty()) {
+    for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+      passes.escalate_rays.push_back(
+          std::make_unique<RayEscalation>(passes.session, cache_, primary_pass->escalation[i], scene, i));
+      passes.programs.push_back(passes.escalate_rays.back()->program());
+    }
+    if (const PlannedPass* shadow_pass = plan.find(PassKind::Shadow)) {
+      const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
+      for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+        passes.escalate_shadows.push_back(
+            std::make_unique<ShadowEscalation>(passes.session, cache_, shadow_pass->escalation[i], scene, i, offset));
+        passes.programs.push_back(passes.escalate_shadows.back()->program());
+      }
+    }
+  }
   // Every secondary pass launches the same trace kernels.
   for (PassKind kind : {PassKind::Reflection, PassKind::Transmission, PassKind::Antialias})
     if (PassStats* stats = passes.stats_of(kind)) {
@@ -635,6 +705,12 @@ void Renderer::prepare_passes(Passes& passes) {
         stats->program_keys.push_back(tracer->program().key);
         stats->program_ms.push_back(0);
       }
+    }
+  // The pass's stats list its escalation kernels after its own.
+  for (std::size_t i = 0; i < plan.passes.size(); ++i)
+    for (const KernelConfig& config : plan.passes[i].escalation) {
+      passes.stats[i].program_keys.push_back(config.key());
+      passes.stats[i].program_ms.push_back(0);
     }
 }
 
@@ -683,10 +759,18 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
     pass.program_ms[s] += ms_between(done);
     ++pass.launches;
     if (s == 0) pass.rays += rays;  // each camera ray once, however many surfaces it is tested against
+    const bool single = passes.single();
+    auto camera_ray = [&](std::size_t k) {
+      return pixel_ray(passes.result.basis, single, tile.trace_x0 + static_cast<int>(k % tile.trace_w),
+                       tile.trace_y0 + static_cast<int>(k / tile.trace_w));
+    };
     if (s == 0) {
       passes.hits = passes.primary_out->map(rays);
+      escalate_doubted(passes, pass, s, passes.hits, rays, camera_ray);
     } else {
-      keep_nearest(passes.hits, rays, passes.hit_surface, passes.other_out->map(rays), static_cast<std::uint8_t>(s));
+      HitRecord* other = passes.other_out->map(rays);
+      escalate_doubted(passes, pass, s, other, rays, camera_ray);
+      keep_nearest(passes.hits, rays, passes.hit_surface, other, static_cast<std::uint8_t>(s));
       passes.other_out->release();
     }
     pass.wall_ms += ms_since(start);
@@ -699,6 +783,8 @@ void Renderer::trace_batch(Passes& passes, SecondaryBatch& batch) {
   PassStats& stats = *passes.stats_of(batch.pass);
   for (std::size_t s = 0; s < passes.rays.size(); ++s) {
     TracedBatch traced = passes.rays[s]->trace(batch.rays);
+    escalate_doubted(passes, stats, s, traced.hits.data(), traced.hits.size(),
+                     [&](std::size_t i) { return batch.rays[i]; });
     if (s == 0)
       batch.hits = std::move(traced.hits);
     else

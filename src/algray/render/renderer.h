@@ -27,8 +27,12 @@ struct PassStats {
   std::vector<double> program_ms;         // device time of each of those kernels
   std::uint64_t rays = 0;                 // rays traced, each once however many surfaces it was tested against
   int launches = 0;
-  double kernel_ms = 0;  // device time summed over launches (profiling events)
+  double kernel_ms = 0;  // device time summed over launches (profiling events), escalations' included
   double wall_ms = 0;
+  // Adaptive precision: the pass's rays the float kernel doubted and mixed precision traced again, and that
+  // second pass's device time (also in kernel_ms).
+  std::uint64_t escalated = 0;
+  double escalation_ms = 0;
 };
 
 // One tile's camera rays as the primary pass left them, whole pixels of the traced grid, handed to
@@ -119,9 +123,18 @@ struct RenderResult {
   std::vector<std::uint8_t> refined;
 };
 
-// Precision a scene renders in on a device: as asked, or double where fp64 exists. Throws DeviceError when
-// double is asked of a device without fp64.
-Precision resolve_precision(const Scene& scene, const DeviceInfo& device);
+// fp64 counts as fast where double takes at most this many times float's time (device/fp64_speed.h): CPUs and
+// datacenter GPUs measure 1-2, most other GPUs 16-64, where adaptive float costs about 1.1-1.3x plain float.
+inline constexpr double kFastFp64Slowdown = 2.0;
+
+// Precision a scene renders in on a device: as asked; left open, double where the device's fp64 is fast
+// (fp64_slowdown: fp64_slowdown()'s measure for it), else adaptive where the scene's surfaces allow it
+// (adaptive_unsupported), else float. Throws DeviceError when double is asked of a device without fp64.
+Precision resolve_precision(const Scene& scene, const DeviceInfo& device, std::optional<double> fp64_slowdown);
+// The same, with the device's fp64 measured (once, then kept by the cache) where the scene leaves precision open.
+Precision resolve_precision(const Scene& scene, const DeviceInfo& device, ProgramCache& cache);
+// The precision left open resolves to on a device without fast fp64.
+Precision float_precision_for(const Scene& scene);
 
 // Tile side, in traced rays, for a device when the scene leaves it open. GPUs get launches short enough for
 // display watchdogs; CPUs (PoCL) lose ~2 ms per launch and idle cores at each launch's tail, so they get few,
@@ -137,7 +150,7 @@ class Renderer {
   Renderer(ClSession& session, ProgramCache& cache) : sessions_{&session}, cache_(cache) {}
   // Several devices render each image together. They take tiles from one queue, so a faster device takes more,
   // and the image is the one a single device of their kind renders, bit for bit. Precision left to the devices
-  // is double only where every device has it; the tile size left to them gives each device about 8 tiles.
+  // is double only where every device has fast fp64; the tile size left to them gives each device about 8 tiles.
   Renderer(std::vector<ClSession*> sessions, ProgramCache& cache);
   // Runs every pass of the scene's plan, tile by tile, into the film. Each tile's camera rays, shadow rays and
   // bounces are traced and shaded before the device's next tile starts, so memory holds the film and one tile's
@@ -154,6 +167,8 @@ class Renderer {
   class TileHits;
   Precision precision_of(const Scene& scene) const;
   RenderPlan plan_of(const Scene& scene, Precision precision) const;
+  // Adaptive precision's second pass: double where every device's fp64 is fast, mixed elsewhere.
+  Precision escalation_precision() const;
   // Deals `tiles` to the devices from one queue, each device's on its own thread, until every tile is done or one
   // fails; the first failure is thrown on.
   void sweep(std::vector<std::unique_ptr<Passes>>& devices, const std::vector<Tile>& tiles,

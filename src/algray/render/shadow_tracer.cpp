@@ -17,6 +17,8 @@ void ShadowPoints::upload(const std::vector<glm::dvec3>& points, const std::vect
     points_ = cl::Buffer(ctx, CL_MEM_READ_ONLY, capacity_ * 4 * real_size);
     normals_ = cl::Buffer(ctx, CL_MEM_READ_ONLY, capacity_ * 4 * sizeof(float));
     masks_ = cl::Buffer(ctx, CL_MEM_READ_WRITE, capacity_ * sizeof(cl_ulong));
+    if (precision_ == Precision::Adaptive)
+      undecided_ = cl::Buffer(ctx, CL_MEM_WRITE_ONLY, capacity_ * sizeof(cl_ulong));
   }
   // As real4_buffer converts: each component rounded to the kernel's REAL on its own.
   cl::CommandQueue& queue = session_.queue;
@@ -96,6 +98,7 @@ ShadowAnswer ShadowTracer::trace(ShadowPoints& points, const std::vector<glm::dv
   surface_.set_surface_args(args);
   args.plain(points.masks_);
   args.plain(traced_);
+  if (precision == Precision::Adaptive) args.plain(points.undecided_);
   cl::Event done;
   const RayLaunch launch = ray_launch(count, largest_group_);
   queue.enqueueNDRangeKernel(kernel_, cl::NullRange, launch.global, launch.local, nullptr, &done);
@@ -103,6 +106,10 @@ ShadowAnswer ShadowTracer::trace(ShadowPoints& points, const std::vector<glm::dv
   answer.kernel_ms = ms_between(done);
   queue.enqueueReadBuffer(points.masks_, CL_TRUE, 0, count * sizeof(cl_ulong), answer.masks.data());
   queue.enqueueReadBuffer(traced_, CL_TRUE, 0, sizeof(cl_uint), &traced);
+  if (precision == Precision::Adaptive) {
+    answer.undecided.resize(count);
+    queue.enqueueReadBuffer(points.undecided_, CL_TRUE, 0, count * sizeof(cl_ulong), answer.undecided.data());
+  }
   answer.rays_traced = traced;
   return answer;
 }

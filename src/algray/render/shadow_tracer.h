@@ -4,14 +4,17 @@
 #include <cstdint>
 #include <vector>
 
-#include "algray/render/device_surface.h"
 #include "algray/device/program_cache.h"
+#include "algray/render/device_surface.h"
 
 namespace algray {
 
 struct ShadowAnswer {
   std::vector<std::uint64_t> masks;  // per surface point: bit s set when light point s is hidden
-  std::uint64_t rays_traced = 0;     // shadow rays that reached root isolation
+  // Adaptive precision: per surface point, the light points whose answers the float search doubted (their bits
+  // in masks mean nothing); empty in other precisions.
+  std::vector<std::uint64_t> undecided;
+  std::uint64_t rays_traced = 0;  // shadow rays that reached root isolation
   double kernel_ms = 0;
 };
 
@@ -29,8 +32,8 @@ class ShadowPoints {
   ClSession& session_;
   Precision precision_;
   std::size_t count_ = 0, capacity_ = 0;
-  cl::Buffer points_, normals_, masks_;
-  std::vector<double> staging_;  // REAL4 values in double, converted to the precision on upload
+  cl::Buffer points_, normals_, masks_, undecided_;  // undecided_: adaptive precision only
+  std::vector<double> staging_;                      // REAL4 values in double, converted to the precision on upload
   std::vector<float> staging_float_;
 };
 
@@ -48,7 +51,8 @@ class ShadowTracer {
                      const std::vector<std::uint64_t>& already_hidden = {});
   // The same for points given here (uploaded for this one question).
   ShadowAnswer trace(const std::vector<glm::dvec3>& points, const std::vector<glm::vec3>& normals,
-                     const std::vector<glm::dvec3>& light_points, const std::vector<std::uint64_t>& already_hidden = {});
+                     const std::vector<glm::dvec3>& light_points,
+                     const std::vector<std::uint64_t>& already_hidden = {});
 
  private:
   ClSession& session_;
@@ -57,7 +61,7 @@ class ShadowTracer {
   ProgramRecord record_;
   cl::Kernel kernel_;
   std::size_t largest_group_ = 1;  // the kernel's work-group limit on the device
-  cl::Buffer traced_;  // the kernel's count of traced rays
+  cl::Buffer traced_;              // the kernel's count of traced rays
 };
 
 }  // namespace algray

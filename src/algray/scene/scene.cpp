@@ -12,11 +12,11 @@
 #include <set>
 #include <sstream>
 
-#include "algray/util/embedded_files.h"
 #include "algray/scene/expression.h"
-#include "algray/util/file_names.h"
 #include "algray/scene/jsurf.h"
 #include "algray/scene/toml_reader.h"
+#include "algray/util/embedded_files.h"
+#include "algray/util/file_names.h"
 
 namespace algray {
 namespace {
@@ -459,6 +459,9 @@ void read_render(const TomlReader& r, const toml::table& root, int degree, Rende
   if (const toml::node* n = render->get("refinement"))
     if (!parse_refinement(r.string(*n, "render.refinement"), rs.refinement))
       r.fail(n->source(), "render.refinement must be one of " + refinement_choices());
+  if (rs.precision == Precision::Adaptive)
+    if (const std::string why = adaptive_unsupported(degree, rs.isolation); !why.empty())
+      r.fail(render->get("precision")->source(), why + "; use mixed or double");
   if (const toml::node* n = render->get("ray_origin")) {
     if (!parse_ray_origin(r.string(*n, "render.ray_origin"), rs.ray_origin))
       r.fail(n->source(), "render.ray_origin must be one of " + ray_origin_choices());
@@ -654,10 +657,10 @@ std::string scene_to_toml(const Scene& scene) {
     out << "\n[extent]\ntype = \"box\"\nmin = " << toml_vector(e.min) << "\nmax = " << toml_vector(e.max) << "\n";
   const CameraSpec& c = scene.camera;
   const bool perspective = c.projection == Projection::Perspective;
-  out << "\n[camera]\nprojection = \"" << (perspective ? "perspective" : "orthographic") << "\"\neye = "
-      << toml_vector(c.eye) << "\nlook_at = " << toml_vector(c.look_at) << "\nup = " << toml_vector(c.up) << "\n"
-      << (perspective ? "fov_y = " + toml_number(c.fov_y_degrees) : "height = " + toml_number(c.ortho_height))
-      << "\n";
+  out << "\n[camera]\nprojection = \"" << (perspective ? "perspective" : "orthographic")
+      << "\"\neye = " << toml_vector(c.eye) << "\nlook_at = " << toml_vector(c.look_at)
+      << "\nup = " << toml_vector(c.up) << "\n"
+      << (perspective ? "fov_y = " + toml_number(c.fov_y_degrees) : "height = " + toml_number(c.ortho_height)) << "\n";
   const glm::dvec4& bg = scene.image.background;
   out << "\n[image]\nwidth = " << scene.image.width << "\nheight = " << scene.image.height << "\nbackground = ["
       << toml_number(bg.r) << ", " << toml_number(bg.g) << ", " << toml_number(bg.b) << ", " << toml_number(bg.a)
@@ -693,8 +696,8 @@ std::string read_input_stream(std::istream& in, const std::string& source, const
     in.read(buf, sizeof buf);
     text.append(buf, static_cast<std::size_t>(in.gcount()));
     if (text.size() > kMaxInputBytes)
-      throw SceneError(source, "the " + what + " is larger than " + std::to_string(kMaxInputBytes >> 20) +
-                                   " MiB; " + what + "s are small text files");
+      throw SceneError(source, "the " + what + " is larger than " + std::to_string(kMaxInputBytes >> 20) + " MiB; " +
+                                   what + "s are small text files");
   }
   if (in.bad()) throw SceneError(source, "cannot read the " + what);
   return text;

@@ -77,4 +77,13 @@ std::string lanes_choices() {
 
 int default_max_iterations(Refinement r) { return r == Refinement::RegulaFalsi ? 1000 : 100; }
 
+std::string adaptive_unsupported(int degree, Isolation isolation) {
+  if (isolation != Isolation::Bernstein)
+    return "adaptive precision needs render.isolation = \"bernstein\", whose search it checks against rounding noise";
+  if (degree > kMaxMixedDegree)
+    return "adaptive precision escalates to mixed, which supports degrees up to " + std::to_string(kMaxMixedDegree) +
+           "; this surface has degree " + std::to_string(degree);
+  return "";
+}
+
 }  // namespace algray

@@ -9,7 +9,9 @@ namespace algray {
 inline constexpr int kMaxDegree = 32;
 
 // Mixed: float, except that P*(t) is built in compensated float-float arithmetic (degrees up to 15).
-enum class Precision { Float, Double, Mixed };
+// Adaptive: float, and the rays whose float search rests on rounding noise are traced again in mixed precision
+// (render/escalation.h); Bernstein isolation only, degrees up to 15.
+enum class Precision { Float, Double, Mixed, Adaptive };
 inline constexpr int kMaxMixedDegree = 15;
 enum class Isolation { Bernstein, PowerDescartes, Sturm, DerivativeChain };
 enum class Refinement { Brent, Bisection, RegulaFalsi, Illinois, Newton };
@@ -26,21 +28,21 @@ struct NamedChoice {
 
 // Every choice of each kind, in the order help text, the probe's --all-solvers, benchmarks and tests list them.
 // Adding a method here (and its kernel id in device/kernel_config.cpp) makes every one of them offer it.
-inline constexpr std::array<NamedChoice<Precision>, 3> kPrecisions{
-    {{Precision::Float, "float"}, {Precision::Double, "double"}, {Precision::Mixed, "mixed"}}};
+inline constexpr std::array<NamedChoice<Precision>, 4> kPrecisions{{{Precision::Float, "float"},
+                                                                    {Precision::Double, "double"},
+                                                                    {Precision::Mixed, "mixed"},
+                                                                    {Precision::Adaptive, "adaptive"}}};
 inline constexpr std::array<NamedChoice<Isolation>, 4> kIsolations{{{Isolation::Bernstein, "bernstein"},
                                                                     {Isolation::PowerDescartes, "descartes"},
                                                                     {Isolation::Sturm, "sturm"},
                                                                     {Isolation::DerivativeChain, "derivative-chain"}}};
 inline constexpr std::array<NamedChoice<Refinement>, 5> kRefinements{{{Refinement::Brent, "brent"},
-                                                                     {Refinement::Bisection, "bisection"},
-                                                                     {Refinement::RegulaFalsi, "regula-falsi"},
-                                                                     {Refinement::Illinois, "illinois"},
-                                                                     {Refinement::Newton, "newton"}}};
-inline constexpr std::array<NamedChoice<RayOrigin>, 4> kRayOrigins{{{RayOrigin::Auto, "auto"},
-                                                                   {RayOrigin::Extent, "extent"},
-                                                                   {RayOrigin::Eye, "eye"},
-                                                                   {RayOrigin::Screen, "screen"}}};
+                                                                      {Refinement::Bisection, "bisection"},
+                                                                      {Refinement::RegulaFalsi, "regula-falsi"},
+                                                                      {Refinement::Illinois, "illinois"},
+                                                                      {Refinement::Newton, "newton"}}};
+inline constexpr std::array<NamedChoice<RayOrigin>, 4> kRayOrigins{
+    {{RayOrigin::Auto, "auto"}, {RayOrigin::Extent, "extent"}, {RayOrigin::Eye, "eye"}, {RayOrigin::Screen, "screen"}}};
 
 std::string to_string(Precision p);
 std::string to_string(Isolation i);
@@ -61,6 +63,11 @@ std::string ray_origin_choices();
 bool isolates_in_power_basis(Isolation i);
 // As isolation_choices, of those alone.
 std::string power_basis_isolation_choices(const char* last = nullptr);
+
+// Whether a precision runs its rays in float (every one but double).
+inline constexpr bool in_float(Precision p) { return p != Precision::Double; }
+// Why adaptive precision cannot render a surface of `degree` with `isolation`, or "" when it can.
+std::string adaptive_unsupported(int degree, Isolation isolation);
 
 // The lane counts a kernel can be built with (render.lanes; kernels/lanes.h).
 bool valid_lanes(int lanes);
