@@ -95,8 +95,8 @@ typedef struct {
 #define ALGRAY_DOUBT_DISCARD 1 /* an interval looked root-free, but one of its coefficients was within noise of 0 */
 #define ALGRAY_DOUBT_ACCEPT 2  /* a root looked isolated or crossed, but P at an end was within noise of 0 */
 #define ALGRAY_DOUBT_CLUSTER 3 /* the search reached the stopping width or the halving limit with several roots */
-#define ALGRAY_DOUBT_FLAT 4    /* a root was isolated where P is so flat that the noise could move it (camera and
-                                  secondary rays: ALGRAY_DOUBT_POSITION) */
+#define ALGRAY_DOUBT_FLAT 4    /* the refined root lies where P is so flat that the noise could move it by more
+                                  than ALGRAY_DOUBT_POSITION of its t (rays that need the position) */
 
 /* ALGRAY_EVENT_STEP decisions */
 #define ALGRAY_STEP_EXACT_ZERO 1   /* P is exactly 0 at the interval's left end: the root is there */

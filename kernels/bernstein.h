@@ -160,15 +160,8 @@ int refinable_in_float(const REAL* c) {
  * (level, idx), so no stack is kept. The right half of the latest split is cached, as the left half is usually
  * rejected at once. On return `cur` holds the Bernstein coefficients on [iso.lo, iso.hi] (rounded to float in
  * mixed precision, where they are accurate relative to their own size). */
-#if ALGRAY_ESCALATE
-/* What the noise must stay below for an isolated root's position to hold to ALGRAY_DOUBT_POSITION of its t: the
- * secant slope of P over the interval (its end coefficients' difference per unit t) times that share of t. */
-REAL position_margin(const REAL* c, REAL width, REAL t_in, REAL lo, REAL len) {
-  return fabs(c[DEGREE] - c[0]) * ALGRAY_DOUBT_POSITION * fabs(t_in + lo * len) / (width * len);
-}
-#endif
-
-Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out, REAL* cur PROBE_PARAM) {
+Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out, REAL* cur TERMS_PARAM
+                            PROBE_PARAM) {
   Isolation iso = isolation_none();
   REAL cur_lo[NCOEF], sib[NCOEF], sib_lo[NCOEF];
   int sib_level = -1;
@@ -179,7 +172,8 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
   const int start_sign = (root[0] > 0) - (root[0] < 0);
   coefs_copy(cur, cur_lo, root, root_lo);
 #if ALGRAY_ESCALATE
-  const REAL noise = doubt_noise(root);
+  const REAL noise = doubt_noise(root, terms);
+  iso.noise = noise;
 #else
   const REAL noise = 0;
 #endif
@@ -199,9 +193,7 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
     if (v == 1 && cur[DEGREE] != 0 && refinable_in_float(cur)) {
       PROBE_STEP(iso, v, ALGRAY_STEP_ISOLATED, level);
       iso.status = ISOLATION_BRACKET;
-      if (!doubted(&iso, ALGRAY_DOUBT_ACCEPT, smaller_end(cur, iso.lo), noise, level PROBE_ARG) &&
-          !ALGRAY_SHADOW_RAYS)
-        doubted(&iso, ALGRAY_DOUBT_FLAT, position_margin(cur, width, t_in, iso.lo, len), noise, level PROBE_ARG);
+      doubted(&iso, ALGRAY_DOUBT_ACCEPT, smaller_end(cur, iso.lo), noise, level PROBE_ARG);
       return iso;
     }
 #if ALGRAY_ESCALATE
@@ -240,6 +232,11 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
 }
 
 #if LANES > 1 && !ALGRAY_COMPENSATED
+#if ALGRAY_ESCALATE
+#define LANE_TERMS_PARAM , LREAL terms
+#else
+#define LANE_TERMS_PARAM
+#endif
 /* isolate_bernstein for LANES polynomials at once (lanes.h), lanes where `running` is clear left alone: each
  * lane takes the scalar search's decisions in its order, with the same arithmetic, so it ends with the scalar
  * result bit for bit (tests/test_lanes). The search's position (level, idx) and the interval's width are kept
@@ -298,7 +295,7 @@ void bernstein_restrict_lanes(const LREAL* root, LREAL width, LREAL idx, LMASK t
 /* root: each lane's Bernstein coefficients on [t_in, t_out]. On return iso[j] is lane j's Isolation for every
  * running lane j < count, and cur_out holds each lane's coefficients on its isolating interval. */
 void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL t_in, LREAL t_out,
-                             Isolation* iso, LREAL* cur_out) {
+                             Isolation* iso, LREAL* cur_out LANE_TERMS_PARAM) {
   LREAL cur[NCOEF], sib[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) cur[k] = sib[k] = root[k];
@@ -312,7 +309,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
   LREAL noise = 0, doubt = 0;
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) noise = fmax(noise, fabs(root[k]));
-  noise *= (REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * REAL_EPS;
+  noise = REAL_EPS * fmax((REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * noise, (REAL)ALGRAY_TERMS_FACTOR * terms);
 #define DOUBT_LANES(mask, reason)                           \
   do {                                                      \
     const LMASK doubted_ = (mask);                          \
@@ -341,9 +338,6 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     status = LANE_SEL(status, (LREAL)ISOLATION_BRACKET, isolated);
     done = done || isolated;
     DOUBT_LANES(isolated && fmin(fabs(cur[0]), fabs(cur[DEGREE])) <= noise, ALGRAY_DOUBT_ACCEPT);
-    DOUBT_LANES(isolated && doubt == 0 &&
-                    fabs(cur[DEGREE] - cur[0]) * ALGRAY_DOUBT_POSITION * fabs(t_in + lo * len) / (width * len) <= noise,
-                ALGRAY_DOUBT_FLAT);
 #if ALGRAY_ESCALATE
     /* isolate_bernstein's near_zero: doubted at an end, halved inside */
     LREAL smallest = fabs(cur[0]);
@@ -426,6 +420,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     iso[j].steps = (uint)lane_get(steps, j);
 #if ALGRAY_ESCALATE
     iso[j].doubt = (uint)lane_get(doubt, j);
+    iso[j].noise = lane_get(noise, j);
 #else
     iso[j].doubt = 0;
 #endif

@@ -17,6 +17,7 @@ typedef struct {
   int cluster; /* 1 when the bracket is an interval that still held several roots (settle_cluster) */
   uint steps;  /* intervals examined */
   uint doubt;  /* adaptive builds: the ALGRAY_DOUBT_* that ended the search undecided (status NONE), else 0 */
+  REAL noise;  /* adaptive builds: doubt_noise of the coefficients searched, for the refined root's check */
   REAL lo, hi;
   REAL f_lo, f_hi;
 } Isolation;
@@ -28,6 +29,7 @@ Isolation isolation_none(void) {
   iso.cluster = 0;
   iso.steps = 0;
   iso.doubt = 0;
+  iso.noise = 0;
   iso.lo = 0;
   iso.hi = 1;
   iso.f_lo = 0;
@@ -36,19 +38,46 @@ Isolation isolation_none(void) {
 }
 
 /* Adaptive precision (ALGRAY_ESCALATE): the float search stops where a decision rests on values within the
- * rounding noise of the coefficients it started from, and the host redoes the ray in float-float. The noise is
- * ALGRAY_DOUBT_FACTOR * DEGREE * REAL_EPS * max |b_k| over the segment's coefficients: de Casteljau's convex
- * combinations add no more than that to it, so it bounds every subinterval's coefficients too. Measured on the
- * scenes' wrong float pixels (bench/RESULTS.md, "Adaptive precision"). */
+ * rounding noise of the coefficients it started from, and the host redoes the ray in float-float or double. The
+ * noise is REAL_EPS * max(ALGRAY_DOUBT_FACTOR * DEGREE * max |b_k|, ALGRAY_TERMS_FACTOR * terms), b the segment's
+ * coefficients and terms the size of the terms they were summed from (term_bound in restrict.h): de Casteljau's
+ * convex combinations add no more than that, so it bounds every subinterval's coefficients too. The factors were
+ * measured on the scenes and tests/data/hard_surfaces at 160x120 against solver_ref (bench/RESULTS.md, "Adaptive
+ * precision"): at 1 and 1 the worst depth error was 7e-6 and the Barth decic doubted 17% of its camera rays; at
+ * 0.5 and 0.25, 4e-5 and 10%; without the terms (max |b_k| alone) a Kummer shell ray's root was 1e-3 off. */
 #ifndef ALGRAY_DOUBT_FACTOR
-#define ALGRAY_DOUBT_FACTOR 1
+#define ALGRAY_DOUBT_FACTOR 0.5f
 #endif
-REAL doubt_noise(const REAL* c) {
+#ifndef ALGRAY_TERMS_FACTOR
+#define ALGRAY_TERMS_FACTOR 0.25f
+#endif
+REAL doubt_noise(const REAL* c, REAL terms) {
   REAL scale = 0;
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(c[k]));
-  return (REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * REAL_EPS * scale;
+  return REAL_EPS * fmax((REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * scale, (REAL)ALGRAY_TERMS_FACTOR * terms);
 }
+
+#if ALGRAY_ESCALATE
+/* An upper bound on doubt_noise for any coefficients summed from terms of size at most `terms`. */
+REAL noise_bound(REAL terms) {
+  return REAL_EPS * fmax((REAL)(ALGRAY_DOUBT_FACTOR * DEGREE), (REAL)ALGRAY_TERMS_FACTOR) * terms;
+}
+#endif
+
+/* Adaptive builds hand the isolation the size of the terms its coefficients were summed from (term_bound in
+ * restrict.h); other builds hand it nothing. */
+#if ALGRAY_ESCALATE
+#define TERMS_PARAM , REAL terms
+#define TERMS_ARG , terms
+#define TERMS_OUT_PARAM , REAL *terms
+#define TERMS_OUT(p) , p
+#else
+#define TERMS_PARAM
+#define TERMS_ARG
+#define TERMS_OUT_PARAM
+#define TERMS_OUT(p)
+#endif
 
 /* Shadow kernels define ALGRAY_SHADOW_RAYS. Their rays start off the surface on purpose (the shadow offset), so
  * P's value at their start, however small, is no sign of a root: the coefficient c_0 of an interval starting
@@ -72,9 +101,9 @@ REAL smaller_end(const REAL* c, REAL lo) {
   return first_counted(lo) ? fabs(c[DEGREE]) : fmin(fabs(c[0]), fabs(c[DEGREE]));
 }
 
-/* Rays that need their root's position doubt an isolated root whose position the noise could move by more than
- * this fraction of its t: the noise over the isolating interval's secant slope, times its width (measured: an
- * Endrass octic ray whose ends stood just clear of the noise had its root 1.2e-3 off, with this ratio 8e-3). */
+/* Rays that need their root's position doubt a refined root whose position the noise could move by more than
+ * this fraction of its t: the noise over P's slope there (surface.h, flat_root). Measured: an Endrass octic ray
+ * whose interval's ends stood just clear of the noise had its root 1.2e-3 off. */
 #define ALGRAY_DOUBT_POSITION 1e-4f
 
 /* Ends the search undecided for `reason` when |value| is within the noise; returns 1 then. Other builds

@@ -47,7 +47,7 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
   REAL t_in[LANES], t_out[LANES];
   LREAL iso_c[NCOEF];
   int in_extent[LANES];
-  REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
+  REAL root[LANES][NCOEF], root_lo[LANES][NCOEF], terms[LANES];
   for (uint j = 0; j < count; ++j) {
     const uint px = tile_x0 + x0 + j;
     rays[j] = camera_ray(px, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
@@ -59,9 +59,9 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
     const REAL taylor_t = screen_ray_taylor(px, py, SCREEN_ROWS_ARG, taylor);
 #endif
     segment_coefficients(hits[j].u, hits[j].d_unit, t_in[j], t_out[j], mono_exps, mono_coefs, mono_count,
-                         binomials, even_axes, root[j], root_lo[j] SCREEN_ARG);
+                         binomials, even_axes, root[j], root_lo[j] TERMS_OUT(&terms[j]) SCREEN_ARG);
   }
-  isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, iso, iso_c);
+  isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, terms, iso, iso_c);
   refine_lanes(count, in_extent, iso, iso_c, t_in, t_out, binomials, roots);
   for (uint j = 0; j < count; ++j)
     if (in_extent[j]) finish_surface(&hits[j], roots[j]);

@@ -54,6 +54,46 @@ AxisFactor axis_factor(REAL l0, REAL l1, int even) {
   return f;
 }
 
+#if ALGRAY_ESCALATE
+/* The size of the terms P*(s)'s coefficients are sums of, for the coordinates' factors fx, fy, fz (their l0, l1:
+ * the coordinate at the segment's ends, Bernstein form): sum_m |a_m| X^i Y^j Z^k, X = max(|l0|, |l1|) of x and so
+ * on. It bounds each monomial's Bernstein coefficients on the segment, so every coefficient of P* is computed to a
+ * small multiple of REAL_EPS times it. Cancelling monomials make it far larger than P* itself (a Kummer shell
+ * ray: 30 times its largest coefficient). Adaptive builds measure their noise by it (isolation.h). Measured
+ * against a nested Horner scheme in scalars (like restrict_to_rays'): these power tables were faster. */
+REAL term_bound(__global const uint* exps, __global const REAL* coefs, uint count, AxisFactor fx, AxisFactor fy,
+                AxisFactor fz) {
+  const REAL x = fmax(fabs(fx.l0), fabs(fx.l1)), y = fmax(fabs(fy.l0), fabs(fy.l1)),
+             z = fmax(fabs(fz.l0), fabs(fz.l1));
+  REAL px[NCOEF], py[NCOEF], pz[NCOEF];
+  px[0] = py[0] = pz[0] = 1;
+  ALGRAY_UNROLL
+  for (int n = 1; n <= DEGREE; ++n) {
+    px[n] = px[n - 1] * x;
+    py[n] = py[n - 1] * y;
+    pz[n] = pz[n - 1] * z;
+  }
+  REAL sum = 0;
+  for (uint m = 0; m < count; ++m) {
+    const uint e = exps[m];
+    sum += fabs(coefs[m]) * px[e & 0xffu] * py[(e >> 8) & 0xffu] * pz[(e >> 16) & 0xffu];
+  }
+  return sum;
+}
+
+/* A cheaper bound on term_bound, from the largest |coordinate| R at the segment's ends alone: sum_d A_d R^d, with
+ * A_d = sum |a_m| over the monomials of degree d, which adaptive builds' coefficient buffer holds after the
+ * coefficients (coefs[count + d]). D + 1 multiply-adds: shadow rays that stand clear of its noise need no more. */
+REAL term_bound_by_radius(__global const REAL* coefs, uint count, AxisFactor fx, AxisFactor fy, AxisFactor fz) {
+  const REAL r = fmax(fmax(fmax(fabs(fx.l0), fabs(fx.l1)), fmax(fabs(fy.l0), fabs(fy.l1))),
+                      fmax(fabs(fz.l0), fabs(fz.l1)));
+  REAL sum = 0;
+  ALGRAY_UNROLL
+  for (int d = DEGREE; d >= 0; --d) sum = sum * r + coefs[count + (uint)d];
+  return sum;
+}
+#endif
+
 /* c (degree n) plus a * one^n. binomials[n * NCOEF + k] = C(n, k), zero for k > n. */
 ALGRAY_INLINE void poly_add_constant(REAL* c, int n, REAL a, __constant const REAL* binomials) {
 #if RESTRICT_BERNSTEIN

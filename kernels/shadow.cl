@@ -22,18 +22,46 @@
 #error "the screen form is for camera rays; the host builds this kernel with RAY_ORIGIN=extent"
 #endif
 
+#if ALGRAY_ESCALATE
+/* Whether the scaled coefficients c (before bernstein_from_scaled) settle bernstein_root_by_signs' answer with
+ * every coefficient it reads further from zero than `noise` (scaled alike): then no rounding could change it. */
+int signs_clear_of(const REAL* c, int by_signs, REAL noise, __constant const REAL* binomials) {
+  if (by_signs == ISOLATION_BRACKET) return fmin(fabs(c[0]), fabs(c[DEGREE])) > noise;
+  __constant const REAL* row = binomials + DEGREE * NCOEF;
+  int clear = 1;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) clear &= fabs(c[k]) > noise * row[k];
+  return clear;
+}
+#endif
+
 /* Whether the segment, restricted to root (and root_lo, both consumed), holds a root: what isolate_restricted
- * reports, without the search when the coefficients' signs already settle it (Bernstein builds other than
- * adaptive ones, whose search must see every coefficient's distance from the noise). *doubt gets the search's. */
+ * reports, without the search when the coefficients' signs already settle it (Bernstein builds; adaptive ones
+ * only when the signs stand clear of the noise that term_bound_by_radius allows). *doubt gets the search's.
+ * f: the ray's coordinates' factors, for adaptive builds' term bounds. */
 int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
-                     uint* doubt) {
+                     uint* doubt, __global const uint* exps, __global const REAL* coefs, uint count, AxisFactor fx,
+                     AxisFactor fy, AxisFactor fz) {
   *doubt = 0;
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN && !ALGRAY_ESCALATE
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   const int by_signs = bernstein_root_by_signs(root);
+#if ALGRAY_ESCALATE
+  if (by_signs >= 0 &&
+      signs_clear_of(root, by_signs, noise_bound(term_bound_by_radius(coefs, count, fx, fy, fz)), binomials))
+    return by_signs != ISOLATION_NONE;
+#else
   if (by_signs >= 0) return by_signs != ISOLATION_NONE;
 #endif
+#endif
+  (void)exps;
+  (void)coefs;
+  (void)count;
+  (void)fx;
+  (void)fy;
+  (void)fz;
   REAL iso_c[NCOEF];
-  const Isolation iso = isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c);
+  const Isolation iso =
+      isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(term_bound(exps, coefs, count, fx, fy, fz)));
   *doubt = iso.doubt;
   return iso.status != ISOLATION_NONE;
 }
@@ -87,7 +115,9 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) {
     restrict_to_rays(mono_exps, mono_coefs, mono_count, binomials, fx, fy, fz, root, root_lo);
     for (int r = 0; r < pending; ++r) {
       uint doubt;
-      if (segment_has_root(root[r], root_lo[r], t_in[r], t_out[r], binomials, &doubt)) mask |= (ulong)1 << sample[r];
+      if (segment_has_root(root[r], root_lo[r], t_in[r], t_out[r], binomials, &doubt, mono_exps, mono_coefs,
+                           mono_count, fx[r], fy[r], fz[r]))
+        mask |= (ulong)1 << sample[r];
       if (doubt) unsure |= (ulong)1 << sample[r];
     }
     pending = 0;

@@ -16,6 +16,9 @@
 #if ALGRAY_ESCALATE && ISOLATION != ALGRAY_ISOLATION_BERNSTEIN
 #error "adaptive precision doubts rays in the Bernstein isolation only"
 #endif
+#if RAY_ORIGIN != ALGRAY_ORIGIN_EXTENT && ALGRAY_ESCALATE
+#error "adaptive precision builds P*(t) on the segment (RAY_ORIGIN=extent), whose terms it measures its noise by"
+#endif
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && ALGRAY_COMPENSATED
 #error "RAY_ORIGIN=screen is built in plain float or double"
 #endif
@@ -112,6 +115,29 @@ void place_root(SegmentRoot* r, Isolation iso, REAL y, REAL t_in, REAL t_out) {
   r->flags |= ALGRAY_HIT_FOUND;
 }
 
+/* Adaptive builds: whether the root at y of the isolating interval (prepared coefficients c) could move by more
+ * than ALGRAY_DOUBT_POSITION of its t under the coefficients' noise, read off P's slope there: the secant of the
+ * isolating interval can be many times steeper than P at the root (a Kummer shell ray: 60 times, with the root
+ * 1e-3 off). Then r is marked doubted. */
+void doubt_flat_root(SegmentRoot* r, Isolation iso, const REAL* c, REAL y, REAL t_in, REAL t_out PROBE_PARAM) {
+#if ALGRAY_ESCALATE
+  REAL slope;
+  (void)isolated_value_slope(c, y, &slope);
+  const REAL width_t = (iso.hi - iso.lo) * (t_out - t_in);
+  const REAL margin = fabs(slope) * ALGRAY_DOUBT_POSITION * fabs(r->t) / width_t;
+  if (!(margin <= iso.noise)) return;
+  PROBE(ALGRAY_EVENT_DOUBT, 0, ALGRAY_DOUBT_FLAT, 0u, iso.lo, iso.hi, margin, iso.noise);
+  r->flags |= ALGRAY_HIT_DOUBT;
+#else
+  (void)r;
+  (void)iso;
+  (void)c;
+  (void)y;
+  (void)t_in;
+  (void)t_out;
+#endif
+}
+
 #if LANES == 1
 /* Refines what the isolation found; iso_c holds the polynomial on the isolating interval (consumed). */
 SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
@@ -126,6 +152,7 @@ SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
     y = refine_root(iso_c, iso.f_lo, iso.f_hi, setup.tol_y, scale, &r.iterations PROBE_ARG);
   }
   place_root(&r, iso, y, t_in, t_out);
+  if (setup.refine) doubt_flat_root(&r, iso, iso_c, y, t_in, t_out PROBE_ARG);
   return r;
 }
 #else
@@ -158,6 +185,13 @@ void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL*
     const int refined = lane_get_mask(running, j) != 0;
     roots[j].iterations = refined ? (uint)lane_get_mask(iterations, j) : 0u;
     place_root(&roots[j], iso[j], refined ? lane_get(y, j) : (REAL)0, t_in[j], t_out[j]);
+#if ALGRAY_ESCALATE
+    if (refined) {
+      REAL lane_c[NCOEF];
+      for (int k = 0; k <= DEGREE; ++k) lane_c[k] = lane_get(c[k], j);
+      doubt_flat_root(&roots[j], iso[j], lane_c, lane_get(y, j), t_in[j], t_out[j]);
+    }
+#endif
   }
 }
 #endif
@@ -198,7 +232,7 @@ void restricted_to_isolation_basis(REAL* root, REAL* root_lo, __constant const R
  * coefficients on the segment, or the power basis of the segment (of the whole ray, for RAY_ORIGIN=eye). */
 void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
                           __global const REAL* coefs, uint count, __constant const REAL* binomials, uint even_axes,
-                          REAL* root, REAL* root_lo SCREEN_PARAM PROBE_PARAM) {
+                          REAL* root, REAL* root_lo TERMS_OUT_PARAM SCREEN_PARAM PROBE_PARAM) {
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
   /* The same coefficients the extent construction computes from the monomials, from D + 1 numbers instead. */
   (void)o;
@@ -218,15 +252,19 @@ void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global cons
   AxisFactor fx, fy, fz;
   segment_factors(o, d, t_in, t_out, even_axes, &fx, &fy, &fz);
   restrict_to_ray(exps, coefs, count, binomials, fx, fy, fz, root, root_lo);
+#if ALGRAY_ESCALATE
+  *terms = term_bound(exps, coefs, count, fx, fy, fz);
+#endif
 #endif
   restricted_to_isolation_basis(root, root_lo, binomials PROBE_ARG);
 }
 
 /* The smallest root of segment_coefficients' polynomial (root, root_lo are consumed); iso_c gets the polynomial
  * on the isolating interval. */
-Isolation isolate_coefficients(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c PROBE_PARAM) {
+Isolation isolate_coefficients(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c TERMS_PARAM
+                               PROBE_PARAM) {
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
+  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c TERMS_ARG PROBE_ARG);
 #elif RAY_ORIGIN == ALGRAY_ORIGIN_EYE
   (void)root_lo;
   return isolate_power_basis(root, t_in, t_out - t_in, t_in, t_out, iso_c PROBE_ARG);
@@ -242,9 +280,11 @@ Isolation isolate_coefficients(REAL* root, REAL* root_lo, REAL t_in, REAL t_out,
 Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
                              __global const REAL* coefs, uint count, __constant const REAL* binomials,
                              uint even_axes, REAL* iso_c SCREEN_PARAM PROBE_PARAM) {
-  REAL root[NCOEF], root_lo[NCOEF];
-  segment_coefficients(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, root, root_lo SCREEN_ARG PROBE_ARG);
-  return isolate_coefficients(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
+  REAL root[NCOEF], root_lo[NCOEF], terms = 0;
+  segment_coefficients(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, root,
+                       root_lo TERMS_OUT(&terms) SCREEN_ARG PROBE_ARG);
+  (void)terms;
+  return isolate_coefficients(root, root_lo, t_in, t_out, iso_c TERMS_ARG PROBE_ARG);
 }
 
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EXTENT
@@ -252,9 +292,9 @@ Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global c
  * factors (root, root_lo are consumed), as isolate_on_segment would; iso_c gets the polynomial on the isolating
  * interval. */
 Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
-                             REAL* iso_c PROBE_PARAM) {
+                             REAL* iso_c TERMS_PARAM PROBE_PARAM) {
   restricted_to_isolation_basis(root, root_lo, binomials PROBE_ARG);
-  return isolate_coefficients(root, root_lo, t_in, t_out, iso_c PROBE_ARG);
+  return isolate_coefficients(root, root_lo, t_in, t_out, iso_c TERMS_ARG PROBE_ARG);
 }
 #endif
 
@@ -293,18 +333,19 @@ int isolate_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int e
  * isolating interval, for refine_lanes. Lanes from `count` on, and those whose ray missed the extent
  * (in_extent[j] == 0), are left alone. */
 void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (*root_lo)[NCOEF], const REAL* t_in,
-                   const REAL* t_out, Isolation* iso, LREAL* c) {
+                   const REAL* t_out, const REAL* terms, Isolation* iso, LREAL* c) {
   for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
+  (void)terms;
 #if ALGRAY_COMPENSATED
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j]) continue;
     REAL iso_c[NCOEF];
-    iso[j] = isolate_coefficients(root[j], root_lo[j], t_in[j], t_out[j], iso_c);
+    iso[j] = isolate_coefficients(root[j], root_lo[j], t_in[j], t_out[j], iso_c TERMS_OUT(terms[j]));
     for (int k = 0; k <= DEGREE; ++k) lane_set(&c[k], j, iso_c[k]);
   }
 #else
   (void)root_lo;
-  LREAL lane_root[NCOEF], lane_t_in = 0, lane_t_out = 1;
+  LREAL lane_root[NCOEF], lane_t_in = 0, lane_t_out = 1, lane_terms = 0;
   for (int k = 0; k <= DEGREE; ++k) lane_root[k] = 0;
   LMASK running = 0;
   for (uint j = 0; j < count; ++j) {
@@ -313,8 +354,11 @@ void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (
     for (int k = 0; k <= DEGREE; ++k) lane_set(&lane_root[k], j, root[j][k]);
     lane_set(&lane_t_in, j, t_in[j]);
     lane_set(&lane_t_out, j, t_out[j]);
+    lane_set(&lane_terms, j, terms[j]);
   }
-  if (LANE_ANY(running)) isolate_bernstein_lanes(count, running, lane_root, lane_t_in, lane_t_out, iso, c);
+  (void)lane_terms;
+  if (LANE_ANY(running))
+    isolate_bernstein_lanes(count, running, lane_root, lane_t_in, lane_t_out, iso, c TERMS_OUT(lane_terms));
 #endif
 }
 #endif

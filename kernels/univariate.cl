@@ -23,7 +23,8 @@ __kernel void univariate(__global const REAL* polys, uint count, __constant cons
 #endif
   }
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  const Isolation iso = isolate_bernstein(root, root_lo, (REAL)0, (REAL)1, iso_c);
+  /* The coefficients are given, rounded once: their own size is their noise's. */
+  const Isolation iso = isolate_bernstein(root, root_lo, (REAL)0, (REAL)1, iso_c TERMS_OUT((REAL)0));
 #else
   const Isolation iso = isolate_power_basis(root, (REAL)0, (REAL)1, (REAL)0, (REAL)1, iso_c);
 #endif

@@ -3,9 +3,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
-#include "kernels/algray_shared.h"
 #include "algray/render/screen_form.h"
+#include "kernels/algray_shared.h"
 
 namespace algray {
 namespace {
@@ -111,6 +112,16 @@ DeviceSurface::DeviceSurface(const cl::Context& ctx, const Scene& scene, Precisi
   std::vector<double> coefficient_data = data_.coefficients;
   if (precision == Precision::Mixed)
     for (double c : data_.coefficients) coefficient_data.push_back(c - static_cast<double>(static_cast<float>(c)));
+  // Adaptive precision's float kernels take, after the coefficients, the sum of |a_m| over the monomials of each
+  // degree 0..n, for a quick bound on the size of the terms they measure their noise by (kernels/restrict.h).
+  if (precision == Precision::Adaptive) {
+    std::vector<double> by_degree(static_cast<std::size_t>(data_.degree) + 1, 0.0);
+    for (std::size_t m = 0; m < data_.coefficients.size(); ++m) {
+      const cl_uint e = data_.exponents[m];
+      by_degree[(e & 0xffu) + ((e >> 8) & 0xffu) + ((e >> 16) & 0xffu)] += std::fabs(data_.coefficients[m]);
+    }
+    coefficient_data.insert(coefficient_data.end(), by_degree.begin(), by_degree.end());
+  }
   coefs_ = real_buffer(ctx, coefficient_data, precision);
   binomials_ = real_buffer(ctx, binomial_table(data_.degree), precision);
 }

@@ -468,8 +468,9 @@ void read_render(const TomlReader& r, const toml::table& root, int degree, Rende
     if (rs.ray_origin == RayOrigin::Eye && !isolates_in_power_basis(rs.isolation))
       r.fail(n->source(),
              "render.ray_origin = \"eye\" needs a power-basis isolation (" + power_basis_isolation_choices("or") + ")");
-    if (rs.ray_origin == RayOrigin::Screen && rs.precision == Precision::Mixed)
-      r.fail(n->source(), "render.ray_origin = \"screen\" is built in float or double, not mixed precision");
+    if (rs.ray_origin == RayOrigin::Screen && (rs.precision == Precision::Mixed || rs.precision == Precision::Adaptive))
+      r.fail(n->source(), "render.ray_origin = \"screen\" is built in float or double, not " +
+                              to_string(*rs.precision) + " precision");
   }
   if (const toml::node* n = render->get("max_iterations"))
     rs.max_iterations = static_cast<int>(r.integer(*n, "render.max_iterations", 1, 1000000));
