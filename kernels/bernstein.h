@@ -309,7 +309,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
   LREAL noise = 0, doubt = 0;
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) noise = fmax(noise, fabs(root[k]));
-  noise = REAL_EPS * fmax((REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * noise, (REAL)ALGRAY_TERMS_FACTOR * terms);
+  noise = DOUBT_NOISE(noise, terms);
 #define DOUBT_LANES(mask, reason)                           \
   do {                                                      \
     const LMASK doubted_ = (mask);                          \

@@ -51,11 +51,14 @@ Isolation isolation_none(void) {
 #ifndef ALGRAY_TERMS_FACTOR
 #define ALGRAY_TERMS_FACTOR 0.25f
 #endif
+/* The noise for coefficients of largest size `scale` summed from terms of size `terms`: for REALs and lanes alike. */
+#define DOUBT_NOISE(scale, terms) \
+  (REAL_EPS * fmax((REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * (scale), (REAL)ALGRAY_TERMS_FACTOR * (terms)))
 REAL doubt_noise(const REAL* c, REAL terms) {
   REAL scale = 0;
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(c[k]));
-  return REAL_EPS * fmax((REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * scale, (REAL)ALGRAY_TERMS_FACTOR * terms);
+  return DOUBT_NOISE(scale, terms);
 }
 
 #if ALGRAY_ESCALATE

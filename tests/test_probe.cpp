@@ -5,12 +5,13 @@
 #include <map>
 #include <sstream>
 
-#include "cli_sandbox.h"
-#include "algray/io/image_io.h"
-#include "algray/device/kernel_sources.h"
 #include "algray/api/probe_report.h"
+#include "algray/device/kernel_sources.h"
+#include "algray/io/image_io.h"
+#include "algray/render/escalation.h"
 #include "algray/render/render_plan.h"
 #include "algray/render/renderer.h"
+#include "cli_sandbox.h"
 #include "temp_dir.h"
 #include "test_support.h"
 
@@ -392,4 +393,46 @@ TEST_CASE("render builds contain no probe code: the hooks compile to nothing unl
       CHECK(render.find("probe_log") == std::string::npos);
     }
   }
+}
+
+TEST_CASE("a ray adaptive precision doubts: the probe says why, and the second pass's trace is the render's answer",
+          "[probe]") {
+  RenderContext context("", true);
+  const Scene scene =
+      load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/tests/data/hard_surfaces/kummer_shell.toml",
+                      {{"image.width", "64"}, {"image.height", "48"}, {"render.precision", "\"adaptive\""}});
+  Renderer renderer(context.session(), context.cache());
+  const RenderResult render = renderer.render_with_records(scene);
+  int probed = 0, plain = 0;
+  for (int py = 0; py < 48 && probed < 12; ++py)
+    for (int px = 0; px < 64 && probed < 12; ++px) {
+      const HitRecord& rendered = render.hits.at(px, py);
+      if (!(rendered.flags & ALGRAY_HIT_ESCALATED)) {
+        // A ray the float kernel decided: one trace, no doubt.
+        if (plain++ % 97 != 0) continue;
+        ProbeTarget target{false, px, py, {}, {}};
+        const std::vector<SurfaceProbe> probes = probe_scene(scene, target, false, context);
+        REQUIRE(probes.at(0).traces.size() == 1);
+        CHECK_FALSE(probes[0].traces[0].doubt.has_value());
+        continue;
+      }
+      ++probed;
+      ProbeTarget target{false, px, py, {}, {}};
+      const std::vector<SurfaceProbe> probes = probe_scene(scene, target, false, context);
+      INFO("pixel (" << px << ", " << py << ")");
+      REQUIRE(probes.at(0).traces.size() == 2);
+      const SolverTrace& first = probes[0].traces[0];
+      const SolverTrace& again = probes[0].traces[1];
+      CHECK(first.config.precision == Precision::Adaptive);
+      REQUIRE(first.doubt.has_value());
+      CHECK(doubt_reason(static_cast<unsigned>(first.doubt->reason)) != nullptr);
+      CHECK(std::fabs(first.doubt->value) <= first.doubt->noise);
+      CHECK((first.hit.flags & ALGRAY_HIT_DOUBT) != 0);
+      CHECK(again.config.precision == escalation_precision(context.session().info, context.cache()));
+      CHECK_FALSE(again.doubt.has_value());
+      // The render kept the second pass's answer.
+      CHECK(again.found() == ((rendered.flags & ALGRAY_HIT_FOUND) != 0));
+      if (again.found()) CHECK(std::memcmp(&again.hit, &rendered, offsetof(HitRecord, flags)) == 0);
+    }
+  CHECK(probed == 12);
 }

@@ -13,6 +13,7 @@
 #include "algray/api/render_job.h"
 #include "algray/io/image_io.h"
 #include "algray/io/probe_plot.h"
+#include "algray/render/escalation.h"
 #include "algray/render/render_plan.h"
 #include "algray/render/renderer.h"
 #include "algray/util/version.h"
@@ -137,7 +138,10 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
     }
   }
   out << "result: ";
-  if (tr.found()) {
+  const bool doubted = (tr.hit.flags & ALGRAY_HIT_DOUBT) != 0;
+  if (doubted) {
+    out << "undecided, left to the second pass";
+  } else if (tr.found()) {
     out << "root t = " << num(tr.t) << " (" << ((tr.hit.flags & ALGRAY_HIT_BACK) ? "back" : "front") << " side";
     if (tr.hit.flags & ALGRAY_HIT_EXACT) out << ", exact zero";
     if (tr.hit.flags & ALGRAY_HIT_CLUSTER) out << ", cluster";
@@ -149,7 +153,9 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
   if (tr.hit.flags & ALGRAY_HIT_BUDGET) out << "; halving limit reached";
   out << "\n";
   const RayCertificate& cert = ref.certificate;
-  if (tr.found() && cert.answer.kind != ref::Classification::Miss && cert.cls != PixelClass::OutsideExtent) {
+  if (doubted) {
+    // The next trace is the answer the render keeps; this one stopped undecided.
+  } else if (tr.found() && cert.answer.kind != ref::Classification::Miss && cert.cls != PixelClass::OutsideExtent) {
     const double error = std::fabs(tr.t - cert.answer.t_nearest);
     out << "vs solver_ref: |t - t_ref| = " << num(error, 3);
     if (cert.answer.t_nearest != 0) out << " (relative " << num(error / std::fabs(cert.answer.t_nearest), 3) << ")";
@@ -159,6 +165,13 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
   } else if (tr.found() != (cert.answer.kind != ref::Classification::Miss)) {
     out << "vs solver_ref: DISAGREES (" << (tr.found() ? "kernel hit, reference miss" : "kernel miss, reference root")
         << ")\n";
+  }
+  if (tr.doubt) {
+    const DoubtReason* why = doubt_reason(static_cast<unsigned>(tr.doubt->reason));
+    out << "doubted (" << (why ? why->name : "?") << ": " << (why ? why->meaning : "unknown reason")
+        << "): " << num(tr.doubt->value, 4) << " within the noise " << num(tr.doubt->noise, 4) << " on ["
+        << num(tr.t_at(tr.doubt->lo)) << ", " << num(tr.t_at(tr.doubt->hi)) << "]; the render traces the ray again in "
+        << "the next trace's precision, whose answer it keeps\n";
   }
   if (tr.events_offered > tr.events_recorded)
     out << "note: the log kept the first " << tr.events_recorded << " of " << tr.events_offered << " events\n";
@@ -222,6 +235,11 @@ nlohmann::json trace_json(const SolverTrace& tr) {
                     {"f_hi", tr.iso_f_hi},
                     {"halving_limit", tr.halving_limit}};
   j["iterates"] = iterates(tr.iterates);
+  if (tr.doubt) {
+    const DoubtReason* why = doubt_reason(static_cast<unsigned>(tr.doubt->reason));
+    j["doubt"] = {{"reason", why ? why->name : "?"}, {"level", tr.doubt->level}, {"t_lo", tr.t_at(tr.doubt->lo)},
+                  {"t_hi", tr.t_at(tr.doubt->hi)},   {"value", tr.doubt->value}, {"noise", tr.doubt->noise}};
+  }
   j["found"] = tr.found();
   if (tr.found()) j["t"] = tr.t;
   j["back_side"] = (tr.hit.flags & ALGRAY_HIT_BACK) != 0;
@@ -403,8 +421,20 @@ std::vector<SurfaceProbe> probe_scene(const Scene& scene, const ProbeTarget& tar
   for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
     SurfaceProbe p;
     p.surface = s;
-    for (const KernelConfig& c : solver_configs(scene, precision, s, all_solvers))
+    for (const KernelConfig& c : solver_configs(scene, precision, s, all_solvers)) {
       p.traces.push_back(trace_probe(session, context.cache(), scene, s, c, target));
+      // A ray adaptive precision doubts is traced again as the render does, the float ray as it was traced, in
+      // the precision of the second pass: that trace follows it.
+      if (p.traces.back().hit.flags & ALGRAY_HIT_DOUBT) {
+        KernelConfig again = c;
+        again.precision = escalation_precision(session.info, context.cache());
+        ProbeTarget same_ray;
+        same_ray.given_ray = true;
+        same_ray.origin = p.traces.back().ray.origin;
+        same_ray.direction = p.traces.back().ray.direction;
+        p.traces.push_back(trace_probe(session, context.cache(), scene, s, again, same_ray));
+      }
+    }
     p.reference = probe_reference(scene, s, p.traces.front().ray, precision);
     probes.push_back(std::move(p));
   }

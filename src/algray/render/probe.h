@@ -3,15 +3,16 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include "kernels/algray_shared.h"
-#include "algray/scene/camera.h"
 #include "algray/device/cl_runtime.h"
 #include "algray/device/kernel_config.h"
 #include "algray/device/program_cache.h"
+#include "algray/scene/camera.h"
 #include "algray/scene/scene.h"
+#include "kernels/algray_shared.h"
 
 namespace algray {
 
@@ -41,6 +42,15 @@ struct ProbeIterate {
   double t = 0;             // y as a ray parameter
 };
 
+// Why adaptive precision's float kernel doubted the ray (ALGRAY_EVENT_DOUBT), which ends its search.
+struct ProbeDoubt {
+  int reason = 0;         // ALGRAY_DOUBT_* (doubt_reason() in render/escalation.h names it)
+  int level = 0;          // halving level of the interval
+  double lo = 0, hi = 0;  // the interval, as fractions of [t_in, t_out]
+  double value = 0;       // what stood within the noise: a coefficient, P at an end, or the slope's margin
+  double noise = 0;       // the noise bound it was held to
+};
+
 // Everything the kernel recorded for one ray and one solver configuration.
 struct SolverTrace {
   KernelConfig config;
@@ -59,7 +69,8 @@ struct SolverTrace {
   bool halving_limit = false;
   double iso_lo = 0, iso_hi = 0, iso_f_lo = 0, iso_f_hi = 0;
   std::vector<ProbeIterate> iterates;
-  HitRecord hit{};                                        // exactly what the render writes for this ray
+  std::optional<ProbeDoubt> doubt;  // adaptive precision: the decision that sent the ray to the second pass
+  HitRecord hit{};                  // exactly what the render writes for this ray
   double t = std::numeric_limits<double>::infinity();     // hit.t_hi + hit.t_lo; +inf without a root
   std::uint32_t events_offered = 0, events_recorded = 0;  // the log overflowed if they differ
 

@@ -418,11 +418,14 @@ Precision Renderer::precision_of(const Scene& scene) const {
   return precision;
 }
 
+Precision escalation_precision(const DeviceInfo& device, ProgramCache& cache) {
+  const std::optional<double> slowdown = fp64_slowdown(device, cache);
+  return slowdown && *slowdown <= kFastFp64Slowdown ? Precision::Double : Precision::Mixed;
+}
+
 Precision Renderer::escalation_precision() const {
-  for (const ClSession* session : sessions_) {
-    const std::optional<double> slowdown = fp64_slowdown(session->info, cache_);
-    if (!slowdown || *slowdown > kFastFp64Slowdown) return Precision::Mixed;
-  }
+  for (const ClSession* session : sessions_)
+    if (algray::escalation_precision(session->info, cache_) == Precision::Mixed) return Precision::Mixed;
   return Precision::Double;
 }
 

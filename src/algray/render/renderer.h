@@ -133,6 +133,10 @@ inline constexpr double kFastFp64Slowdown = 2.0;
 Precision resolve_precision(const Scene& scene, const DeviceInfo& device, std::optional<double> fp64_slowdown);
 // The same, with the device's fp64 measured (once, then kept by the cache) where the scene leaves precision open.
 Precision resolve_precision(const Scene& scene, const DeviceInfo& device, ProgramCache& cache);
+// The precision adaptive precision traces doubted rays again in on a device: double where its fp64 is fast
+// (resolve_precision's measure), else mixed. A render on several devices takes mixed unless all are fast.
+Precision escalation_precision(const DeviceInfo& device, ProgramCache& cache);
+
 // The precision left open resolves to on a device without fast fp64.
 Precision float_precision_for(const Scene& scene);
 
