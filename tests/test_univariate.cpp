@@ -10,8 +10,8 @@
 #include <random>
 #include <vector>
 
-#include "kernels/algray_shared.h"
 #include "algray/device/program_cache.h"
+#include "kernels/algray_shared.h"
 #include "solver_ref/solver_ref.h"
 #include "test_seed.h"
 #include "test_support.h"
@@ -138,7 +138,8 @@ void check_solver(const KernelConfig& solver, int max_degree) {
   {
     const Precision precision = solver.precision;
     const bool is_double = precision == Precision::Double, is_mixed = precision == Precision::Mixed;
-    const char* const name = is_double ? "double" : is_mixed ? "mixed" : "float";
+    const bool is_adaptive = precision == Precision::Adaptive;
+    const char* const name = is_double ? "double" : is_mixed ? "mixed" : is_adaptive ? "adaptive" : "float";
     const double float_eps = std::numeric_limits<float>::epsilon();
     // Mixed precision takes its coefficients as float pairs and isolates in float-float, whose roundoff is about
     // 2^-46 after a few operations: hit or miss is held to that. Its refinement runs in float, so the root's
@@ -201,6 +202,39 @@ void check_solver(const KernelConfig& solver, int max_degree) {
       session.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(kCases));
       std::vector<HitRecord> results(kCases);
       session.queue.enqueueReadBuffer(out, CL_TRUE, 0, kCases * sizeof(HitRecord), results.data());
+      // Adaptive precision: the cases the float kernel doubted go again through mixed precision's kernel, as a
+      // render's rays do on a device without fast fp64. The coefficients are floats: their low parts are zero.
+      if (is_adaptive) {
+        std::vector<int> again;
+        for (int c = 0; c < kCases; ++c)
+          if (results[static_cast<std::size_t>(c)].flags & ALGRAY_HIT_DOUBT) again.push_back(c);
+        std::printf("adaptive degree %d: %zu of %d cases doubted and solved again in mixed precision\n", degree,
+                    again.size(), kCases);
+        if (!again.empty()) {
+          KernelConfig mixed = config;
+          mixed.precision = Precision::Mixed;
+          cl::Kernel second = cache.kernel(session, mixed);
+          const std::size_t n = static_cast<std::size_t>(degree) + 1;
+          std::vector<float> values(2 * again.size() * n, 0.0f);
+          for (std::size_t i = 0; i < again.size(); ++i)
+            for (std::size_t k = 0; k < n; ++k)
+              values[i * n + k] = as_float[static_cast<std::size_t>(again[i]) * n + k];
+          cl::Buffer again_polys(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
+                                 values.data());
+          cl::Buffer again_out(ctx, CL_MEM_WRITE_ONLY, again.size() * sizeof(HitRecord));
+          second.setArg(0, again_polys);
+          second.setArg(1, static_cast<cl_uint>(again.size()));
+          second.setArg(2, binomials);
+          second.setArg(3, again_out);
+          session.queue.enqueueNDRangeKernel(second, cl::NullRange, cl::NDRange(again.size()));
+          std::vector<HitRecord> answers(again.size());
+          session.queue.enqueueReadBuffer(again_out, CL_TRUE, 0, answers.size() * sizeof(HitRecord), answers.data());
+          for (std::size_t i = 0; i < again.size(); ++i) {
+            CHECK_FALSE(answers[i].flags & ALGRAY_HIT_DOUBT);
+            results[static_cast<std::size_t>(again[i])] = answers[i];
+          }
+        }
+      }
 
       const mpq_class width(1, 1000000000000000L);
       int stuck_at_cap = 0;
@@ -287,6 +321,7 @@ TEST_CASE("random polynomials: the kernels' smallest root matches the certified 
   check_solver(solver(Precision::Double), kMaxTestedDegree);
   check_solver(solver(Precision::Float), kMaxTestedDegree);
   check_solver(solver(Precision::Mixed), std::min(kMaxTestedDegree, kMaxMixedDegree));
+  check_solver(solver(Precision::Adaptive), std::min(kMaxTestedDegree, kMaxMixedDegree));
 }
 
 // Every method but the default (Bernstein with Brent), which the test case above checks in every precision.
