@@ -3,14 +3,16 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "algray/device/program_cache.h"
 #include "algray/render/renderer.h"
-#include "algray/scene/scene.h"
 #include "algray/render/shade.h"
 #include "algray/render/solver_aov.h"
+#include "algray/scene/scene.h"
 #include "film_compare.h"
 #include "scene_fixtures.h"
 #include "test_support.h"
@@ -88,9 +90,9 @@ TEST_CASE("transmission rays continue to the next root: nested spheres", "[secon
   ProgramCache cache(false);
   Renderer renderer(session, cache);
   // Radii 1 and 2 around the origin; both sides of both transparent, so rays pass through up to four sheets.
-  const Scene scene = sphere_scene("(x^2+y^2+z^2-1)*(x^2+y^2+z^2-4)",
-                                   {"[material.front]", "transparency = 0.5", "[material.back]", "transparency = 0.5",
-                                    "[render]", "precision = \"double\""});
+  const Scene scene =
+      sphere_scene("(x^2+y^2+z^2-1)*(x^2+y^2+z^2-4)", {"[material.front]", "transparency = 0.5", "[material.back]",
+                                                       "transparency = 0.5", "[render]", "precision = \"double\""});
   const RenderResult r = renderer.render_with_records(scene);
   std::size_t checked = 0;
   check_batches(r, {{{0, 0, 0}, 1}, {{0, 0, 0}, 2}}, PassKind::Transmission, checked);
@@ -132,7 +134,6 @@ TEST_CASE("a transparent side without a transmission pass shows opaque, not dark
     CHECK(a.rgba[centre] == b.rgba[centre]);
   }
 }
-
 
 TEST_CASE("tiles and batches change no pixel: small ones render the one-tile image bit for bit", "[secondary][tiles]") {
   ClSession& session = testing::device_session();
@@ -235,4 +236,57 @@ TEST_CASE("without records a render keeps the film and the totals, not every ray
   CHECK(work.refine_iterations == whole.refine_iterations);
   CHECK(work.flags == whole.flags);
   CHECK(work.classification == whole.classification);
+}
+
+TEST_CASE("adaptive precision escalates camera, shadow, reflected and transmitted rays alike, counted per pass",
+          "[secondary][adaptive]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  std::ifstream in(std::string(ALGRAY_SOURCE_DIR) + "/tests/data/hard_surfaces/kummer_shell.toml");
+  std::stringstream text;
+  text << in.rdbuf() << "\n[[light]]\nposition = [4, 5, 6]\n";
+  const Scene scene = load_scene_text(text.str(), "kummer_shell.toml",
+                                      {{"image.width", "48"},
+                                       {"image.height", "36"},
+                                       {"render.preview", "false"},
+                                       {"render.precision", "\"adaptive\""},
+                                       {"render.max_depth", "2"},
+                                       {"material.front.reflectivity", "0.4"},
+                                       {"material.front.transparency", "0.4"}});
+  const RenderResult r = renderer.render_with_records(scene);
+  for (const PassKind kind : {PassKind::Primary, PassKind::Shadow, PassKind::Reflection, PassKind::Transmission}) {
+    const PlannedPass* planned = r.plan.find(kind);
+    REQUIRE(planned != nullptr);
+    REQUIRE(planned->escalation.size() == 1);
+    const PassStats* stats = nullptr;
+    for (const PassStats& p : r.passes)
+      if (p.name == to_string(kind)) stats = &p;
+    REQUIRE(stats != nullptr);
+    INFO(stats->name << ": " << stats->escalated << " of " << stats->rays << " rays escalated");
+    CHECK(stats->escalated > 0);
+    CHECK(stats->escalated < stats->rays);
+    CHECK(stats->escalation_ms > 0);
+    CHECK(stats->escalation_ms <= stats->kernel_ms);
+    // The pass lists its escalation kernel after its own, with its device time.
+    REQUIRE(stats->program_keys.size() == 2);
+    CHECK(stats->program_keys[1] == planned->escalation[0].key());
+    CHECK(stats->program_ms[1] == Approx(stats->escalation_ms));
+  }
+  // No record keeps the float kernel's doubt: each doubted ray's answer is the second pass's.
+  std::size_t escalated_camera = 0;
+  for (const HitRecord& h : r.hits.records) {
+    CHECK_FALSE(h.flags & ALGRAY_HIT_DOUBT);
+    escalated_camera += (h.flags & ALGRAY_HIT_ESCALATED) != 0;
+  }
+  std::size_t escalated_secondary = 0, secondary = 0;
+  for (const SecondaryBatch& b : r.secondary)
+    for (const HitRecord& h : b.hits) {
+      CHECK_FALSE(h.flags & ALGRAY_HIT_DOUBT);
+      escalated_secondary += (h.flags & ALGRAY_HIT_ESCALATED) != 0;
+      ++secondary;
+    }
+  CHECK(escalated_camera == r.passes.at(0).escalated);
+  CHECK(escalated_secondary > 0);
+  CHECK(escalated_secondary < secondary);
 }
