@@ -1,0 +1,167 @@
+#!/usr/bin/env python3
+"""Issue 18's table: what each precision costs and what it gets right, on every scene (and, with --hard, on
+tests/data/hard_surfaces).
+
+Speed: `algray render` at 1024x768, one camera ray per pixel, the scene's lights and shadows, in float, adaptive,
+adaptive with fp64 hidden (its second pass then in mixed precision, as on a GPU without fast fp64), mixed and
+double; --runs rounds, the modes interleaved in a rotating order, median kernel time (device time of every pass,
+escalations included). The share of escalated rays is per pass, of the rays the pass traced.
+
+Accuracy: camera rays only (preview) at 320x240 through the Python module, against solver_ref on the same rays:
+hit/miss disagreements among the pixels the reference certifies, and the worst relative depth error where both
+hit. The float line: at most 0.1% disagreements, depth error at most 1e-3.
+
+Writes bench/results/precision_modes.json and its section of bench/RESULTS.md.
+"""
+import argparse
+import datetime
+import json
+import os
+import statistics
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from bench_common import ROOT, machine, replace_section, run_render
+
+sys.path.insert(0, str(ROOT / "build/python"))
+import algray  # noqa: E402
+
+HEADING = "## Precision modes: float, adaptive, mixed, double (issue 18)"
+# (column name, --precision, extra environment)
+SPEED_MODES = [("float", "float", {}), ("adaptive", "adaptive", {}),
+               ("adaptive, no fp64", "adaptive", {"ALGRAY_NO_FP64": "1"}), ("mixed", "mixed", {}),
+               ("double", "double", {})]
+ACCURACY_MODES = ["float", "adaptive", "mixed", "double"]
+FLOAT_LINE = (0.001, 1e-3)
+
+
+def pass_sum(stats, key, name=None):
+    return sum(p[key] for p in stats["passes"] if name is None or p["name"] == name)
+
+
+def speed(binary, scene, runs, work):
+    size = ["--width", "1024", "--height", "768", "--set", "antialias.samples=1"]
+    times = {m[0]: [] for m in SPEED_MODES}
+    shares = {}
+    for r in range(runs):
+        order = SPEED_MODES[r % len(SPEED_MODES):] + SPEED_MODES[:r % len(SPEED_MODES)]
+        for name, precision, extra in order:
+            env = dict(os.environ, **extra)
+            _, stats = run_render(binary, scene, size + ["--precision", precision], env, work)
+            times[name].append(pass_sum(stats, "kernel_ms"))
+            shares[name] = {p["name"]: p["escalated"] / max(p["rays"], 1) for p in stats["passes"]}
+    return {m: statistics.median(t) for m, t in times.items()}, shares
+
+
+def accuracy(path, width, height):
+    renderer = algray.Renderer()
+    out = {}
+    refs = {}
+    for mode in ACCURACY_MODES:
+        scene = algray.Scene.load(str(path))
+        scene.set("antialias.samples", 1)
+        scene.set("render.precision", mode)
+        size = dict(width=width, height=height, preview=True)
+        rays = "double" if mode == "double" else "float"  # float, adaptive and mixed trace the same float rays
+        if rays not in refs:
+            refs[rays] = renderer.render(scene, reference=True, **size)
+        ref = refs[rays]
+        img = renderer.render(scene, aov=["flags"], **size)
+        cls = ref.aov["reference.class"]
+        certified = (cls == 1) | (cls == 2)
+        ref_hit, hit = np.isfinite(ref.depth), np.isfinite(img.depth)
+        both = certified & ref_hit & hit
+        rel = np.zeros(ref.depth.shape)
+        rel[both] = np.abs(img.depth[both] - ref.depth[both]) / np.maximum(np.abs(ref.depth[both]), 1e-30)
+        disagree = int((certified & (ref_hit != hit)).sum())
+        flags = img.aov["flags"].astype(np.uint32)
+        in_extent = (flags & 16) != 0
+        escalated = int(((flags & 256) != 0).sum())
+        out[mode] = {"certified": int(certified.sum()), "disagree": disagree,
+                     "worst_depth": float(rel.max()) if both.any() else 0.0,
+                     "escalated_share": escalated / max(int(in_extent.sum()), 1)}
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--binary", default=ROOT / "build/apps/algray/algray")
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--scenes", nargs="*", default=None, help="scene names in scenes/ (default: all)")
+    ap.add_argument("--hard", action="store_true", help="also tests/data/hard_surfaces")
+    ap.add_argument("--no-speed", action="store_true")
+    ap.add_argument("--no-accuracy", action="store_true")
+    ap.add_argument("--output", default=ROOT / "bench/RESULTS.md")
+    args = ap.parse_args()
+    names = args.scenes or sorted(p.stem for p in (ROOT / "scenes").glob("*.toml"))
+    paths = [ROOT / "scenes" / f"{n}.toml" for n in names]
+    if args.hard:
+        paths += sorted((ROOT / "tests/data/hard_surfaces").glob("*.toml"))
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for path in paths:
+            row = {"scene": path.stem, "hard": "hard_surfaces" in str(path)}
+            if not args.no_speed and not row["hard"]:
+                row["kernel_ms"], row["escalated"] = speed(args.binary, path, args.runs, Path(tmp))
+            if not args.no_accuracy:
+                row["accuracy"] = accuracy(path, 320, 240)
+            rows.append(row)
+            print(json.dumps(row), file=sys.stderr, flush=True)
+
+    command = "python3 bench/precision_modes.py " + " ".join(sys.argv[1:])
+    results = {"date": datetime.date.today().isoformat(), "machine": machine(), "command": command.strip(),
+               "runs": args.runs, "rows": rows}
+    (ROOT / "bench/results/precision_modes.json").write_text(json.dumps(results, indent=1) + "\n")
+
+    lines = [HEADING, "", f"- Date: {results['date']}", f"- Machine: {results['machine']}",
+             f"- Command: `{results['command']}` (after `cmake --build build`); raw figures in "
+             "`bench/results/precision_modes.json`", ""]
+    speed_rows = [r for r in rows if "kernel_ms" in r]
+    if speed_rows:
+        lines += [
+            "Kernel time at 1024x768, one camera ray per pixel, shadows as the scene casts them (median of "
+            f"{args.runs} interleaved rounds; device time of all passes, the second pass included). Escalated: "
+            "the share of each pass's rays the float kernel doubted. \"no fp64\" runs with ALGRAY_NO_FP64=1, so "
+            "the doubted rays go to mixed precision, as on a GPU without fast fp64; otherwise this CPU's fp64 is "
+            "fast and they go to double. Target: adaptive within 1.25x float.",
+            "",
+            "| scene | float ms | adaptive ms | (x float) | adaptive, no fp64 ms | (x float) | mixed ms | double ms "
+            "| escalated: camera | escalated: shadow |",
+            "|---|---|---|---|---|---|---|---|---|---|"]
+        for r in speed_rows:
+            t, e = r["kernel_ms"], r["escalated"]["adaptive"]
+            f = t["float"]
+            lines.append(f"| {r['scene']} | {f:.0f} | {t['adaptive']:.0f} | {t['adaptive'] / f:.2f} | "
+                         f"{t['adaptive, no fp64']:.0f} | {t['adaptive, no fp64'] / f:.2f} | {t['mixed']:.0f} | "
+                         f"{t['double']:.0f} | {100 * e.get('primary', 0):.1f}% | {100 * e.get('shadow', 0):.1f}% |")
+        lines.append("")
+    acc_rows = [r for r in rows if "accuracy" in r]
+    if acc_rows:
+        lines += [
+            "Accuracy of camera rays at 320x240 against solver_ref on the same rays: hit/miss disagreements among "
+            "certified pixels, worst relative depth error (the float line: 0.1% and 1e-3; **bold** where missed), "
+            "and for adaptive the share of rays in the extent that were escalated. Scenes marked (hard) are "
+            "tests/data/hard_surfaces.",
+            "",
+            "| scene | float | adaptive | adaptive escalated | mixed | double |", "|---|---|---|---|---|---|"]
+        for r in acc_rows:
+            cells = []
+            for mode in ACCURACY_MODES:
+                a = r["accuracy"][mode]
+                text = f"{a['disagree']} / {a['worst_depth']:.1e}"
+                missed = a["disagree"] > FLOAT_LINE[0] * a["certified"] or a["worst_depth"] > FLOAT_LINE[1]
+                cells.append(f"**{text}**" if missed and mode != "double" else text)
+                if mode == "adaptive":
+                    cells.append(f"{100 * a['escalated_share']:.1f}%")
+            name = r["scene"] + (" (hard)" if r["hard"] else "")
+            lines.append(f"| {name} | " + " | ".join(cells) + " |")
+        lines.append("")
+    replace_section(args.output, HEADING, "\n".join(lines))
+    print(f"wrote {args.output}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
