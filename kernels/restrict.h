@@ -81,17 +81,6 @@ REAL term_bound(__global const uint* exps, __global const REAL* coefs, uint coun
   return sum;
 }
 
-/* A cheaper bound on term_bound, from the largest |coordinate| R at the segment's ends alone: sum_d A_d R^d, with
- * A_d = sum |a_m| over the monomials of degree d, which adaptive builds' coefficient buffer holds after the
- * coefficients (coefs[count + d]). D + 1 multiply-adds: shadow rays that stand clear of its noise need no more. */
-REAL term_bound_by_radius(__global const REAL* coefs, uint count, AxisFactor fx, AxisFactor fy, AxisFactor fz) {
-  const REAL r = fmax(fmax(fmax(fabs(fx.l0), fabs(fx.l1)), fmax(fabs(fy.l0), fabs(fy.l1))),
-                      fmax(fabs(fz.l0), fabs(fz.l1)));
-  REAL sum = 0;
-  ALGRAY_UNROLL
-  for (int d = DEGREE; d >= 0; --d) sum = sum * r + coefs[count + (uint)d];
-  return sum;
-}
 #endif
 
 /* c (degree n) plus a * one^n. binomials[n * NCOEF + k] = C(n, k), zero for k > n. */
