@@ -159,7 +159,7 @@ def main():
             name = r["scene"] + (" (hard)" if r["hard"] else "")
             lines.append(f"| {name} | " + " | ".join(cells) + " |")
         lines.append("")
-    replace_section(args.output, HEADING, "\n".join(lines))
+    replace_section(args.output, HEADING, "\n".join(lines) + "\n")
     print(f"wrote {args.output}", file=sys.stderr)
 
 
