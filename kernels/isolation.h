@@ -63,9 +63,7 @@ REAL doubt_noise(const REAL* c, REAL terms) {
 
 #if ALGRAY_ESCALATE
 /* An upper bound on doubt_noise for any coefficients summed from terms of size at most `terms`. */
-REAL noise_bound(REAL terms) {
-  return REAL_EPS * fmax((REAL)(ALGRAY_DOUBT_FACTOR * DEGREE), (REAL)ALGRAY_TERMS_FACTOR) * terms;
-}
+REAL noise_bound(REAL terms) { return DOUBT_NOISE(terms, terms); }
 #endif
 
 /* Adaptive builds hand the isolation the size of the terms its coefficients were summed from (term_bound in
@@ -94,8 +92,7 @@ ALGRAY_INLINE int first_counted(REAL lo) { return ALGRAY_SHADOW_RAYS && lo == 0;
  * variations. */
 REAL smallest_magnitude(const REAL* c, REAL lo) {
   REAL m = fabs(c[DEGREE]);
-  ALGRAY_UNROLL
-  for (int k = 0; k < DEGREE; ++k) m = k < first_counted(lo) ? m : fmin(m, fabs(c[k]));
+  for (int k = first_counted(lo); k < DEGREE; ++k) m = fmin(m, fabs(c[k]));
   return m;
 }
 

@@ -288,6 +288,11 @@ struct Renderer::Passes {
     return nullptr;
   }
   bool single() const { return precision != Precision::Double; }
+  // Camera ray k of the tile's traced block, rebuilt exactly as the primary kernel traced it.
+  PixelRay camera_ray(const Tile& tile, std::size_t k) const {
+    return pixel_ray(result.basis, single(), tile.trace_x0 + static_cast<int>(k % tile.trace_w),
+                     tile.trace_y0 + static_cast<int>(k / tile.trace_w));
+  }
   // One more tile done; then, before the next, whether to go on. The caller's callbacks are called by one
   // device at a time.
   void progress() {
@@ -762,11 +767,7 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
     pass.program_ms[s] += ms_between(done);
     ++pass.launches;
     if (s == 0) pass.rays += rays;  // each camera ray once, however many surfaces it is tested against
-    const bool single = passes.single();
-    auto camera_ray = [&](std::size_t k) {
-      return pixel_ray(passes.result.basis, single, tile.trace_x0 + static_cast<int>(k % tile.trace_w),
-                       tile.trace_y0 + static_cast<int>(k / tile.trace_w));
-    };
+    auto camera_ray = [&](std::size_t k) { return passes.camera_ray(tile, k); };
     if (s == 0) {
       passes.hits = passes.primary_out->map(rays);
       escalate_doubted(passes, pass, s, passes.hits, rays, camera_ray);
@@ -809,11 +810,7 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
   const RenderPlan& plan = result.plan;
   const std::size_t rays = tile.rays();
   const int grid_width = plan.trace_width();
-  const bool single = passes.single();
-  auto camera_ray = [&](std::size_t k) {
-    return pixel_ray(result.basis, single, tile.trace_x0 + static_cast<int>(k % tile.trace_w),
-                     tile.trace_y0 + static_cast<int>(k / tile.trace_w));
-  };
+  auto camera_ray = [&](std::size_t k) { return passes.camera_ray(tile, k); };
   {
     // The rows of the tile the film keeps: a band's extra rows are counted by the band they belong to.
     const int first = std::max(tile.y0, passes.first_row), end = std::min(tile.y0 + tile.height, passes.end_row);
