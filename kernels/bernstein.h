@@ -160,8 +160,8 @@ int refinable_in_float(const REAL* c) {
  * (level, idx), so no stack is kept. The right half of the latest split is cached, as the left half is usually
  * rejected at once. On return `cur` holds the Bernstein coefficients on [iso.lo, iso.hi] (rounded to float in
  * mixed precision, where they are accurate relative to their own size). */
-Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out, REAL* cur TERMS_PARAM
-                            PROBE_PARAM) {
+Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out,
+                            REAL* cur TERMS_PARAM PROBE_PARAM) {
   Isolation iso = isolation_none();
   REAL cur_lo[NCOEF], sib[NCOEF], sib_lo[NCOEF];
   int sib_level = -1;
@@ -172,10 +172,8 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
   const int start_sign = (root[0] > 0) - (root[0] < 0);
   coefs_copy(cur, cur_lo, root, root_lo);
 #if ALGRAY_ESCALATE
-  const REAL noise = doubt_noise(root, terms);
-  iso.noise = noise;
-#else
-  const REAL noise = 0;
+  SearchNoise noise_of_search = search_noise(root, terms);
+  SearchNoise* noise = &noise_of_search;
 #endif
 
   for (;;) {
@@ -187,23 +185,22 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
     iso.f_hi = cur[DEGREE];
     if (settled_at_left_end(&iso, start_sign, level PROBE_ARG)) {
       doubted(&iso, ALGRAY_DOUBT_ACCEPT, iso.f_lo, noise, level PROBE_ARG);
-      return iso;
+      return isolation_found(iso, noise);
     }
     const int v = sign_variations(cur);
     if (v == 1 && cur[DEGREE] != 0 && refinable_in_float(cur)) {
       PROBE_STEP(iso, v, ALGRAY_STEP_ISOLATED, level);
       iso.status = ISOLATION_BRACKET;
       doubted(&iso, ALGRAY_DOUBT_ACCEPT, smaller_end(cur, iso.lo), noise, level PROBE_ARG);
-      return iso;
+      return isolation_found(iso, noise);
     }
 #if ALGRAY_ESCALATE
     /* No sign variation, but a coefficient within the noise of zero: the interval is not yet shown root-free.
      * Its end coefficients are P's values: near zero there, float cannot tell; an inner one is halved until it
      * stands clear, as de Casteljau's coefficients close in on P's values (fewer rays doubted: on the Barth
      * decic's shadow rays, 10% of them doubted without this). */
-    const int near_zero = v == 0 && smallest_magnitude(cur, iso.lo) <= noise;
-    if (near_zero && doubted(&iso, ALGRAY_DOUBT_DISCARD, smaller_end(cur, iso.lo), noise, level PROBE_ARG))
-      return iso;
+    const int near_zero = v == 0 && within_noise(noise, smallest_magnitude(cur, iso.lo));
+    if (near_zero && doubted(&iso, ALGRAY_DOUBT_DISCARD, smaller_end(cur, iso.lo), noise, level PROBE_ARG)) return iso;
 #else
     const int near_zero = 0;
 #endif
@@ -219,7 +216,7 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
       }
       /* A cluster is always in doubt: float cannot tell a close pair from a complex one there. */
       if (doubted(&iso, ALGRAY_DOUBT_CLUSTER, 0, noise, level PROBE_ARG)) return iso;
-      if (next == INTERVAL_SETTLED) return iso;
+      if (next == INTERVAL_SETTLED) return isolation_found(iso, noise);
     } else {
       PROBE_STEP(iso, v, ALGRAY_STEP_NO_ROOT, level);
     }
@@ -294,8 +291,8 @@ void bernstein_restrict_lanes(const LREAL* root, LREAL width, LREAL idx, LMASK t
 
 /* root: each lane's Bernstein coefficients on [t_in, t_out]. On return iso[j] is lane j's Isolation for every
  * running lane j < count, and cur_out holds each lane's coefficients on its isolating interval. */
-void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL t_in, LREAL t_out,
-                             Isolation* iso, LREAL* cur_out LANE_TERMS_PARAM) {
+void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL t_in, LREAL t_out, Isolation* iso,
+                             LREAL* cur_out LANE_TERMS_PARAM) {
   LREAL cur[NCOEF], sib[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) cur[k] = sib[k] = root[k];
@@ -310,12 +307,12 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) noise = fmax(noise, fabs(root[k]));
   noise = DOUBT_NOISE(noise, terms);
-#define DOUBT_LANES(mask, reason)                           \
-  do {                                                      \
-    const LMASK doubted_ = (mask);                          \
-    doubt = LANE_SEL(doubt, (LREAL)(reason), doubted_);     \
+#define DOUBT_LANES(mask, reason)                               \
+  do {                                                          \
+    const LMASK doubted_ = (mask);                              \
+    doubt = LANE_SEL(doubt, (LREAL)(reason), doubted_);         \
     status = LANE_SEL(status, (LREAL)ISOLATION_NONE, doubted_); \
-    done = done || doubted_;                                \
+    done = done || doubted_;                                    \
   } while (0)
 #else
 #define DOUBT_LANES(mask, reason) ((void)0)

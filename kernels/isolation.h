@@ -17,7 +17,7 @@ typedef struct {
   int cluster; /* 1 when the bracket is an interval that still held several roots (settle_cluster) */
   uint steps;  /* intervals examined */
   uint doubt;  /* adaptive builds: the ALGRAY_DOUBT_* that ended the search undecided (status NONE), else 0 */
-  REAL noise;  /* adaptive builds: doubt_noise of the coefficients searched, for the refined root's check */
+  REAL noise;  /* adaptive builds: the search's noise where it found a root to refine (isolation_found) */
   REAL lo, hi;
   REAL f_lo, f_hi;
 } Isolation;
@@ -40,7 +40,7 @@ Isolation isolation_none(void) {
 /* Adaptive precision (ALGRAY_ESCALATE): the float search stops where a decision rests on values within the
  * rounding noise of the coefficients it started from, and the host redoes the ray in float-float or double. The
  * noise is REAL_EPS * max(ALGRAY_DOUBT_FACTOR * DEGREE * max |b_k|, ALGRAY_TERMS_FACTOR * terms), b the segment's
- * coefficients and terms the size of the terms they were summed from (term_bound in restrict.h): de Casteljau's
+ * coefficients and terms the size of the terms they were summed from (RayTerms in restrict.h): de Casteljau's
  * convex combinations add no more than that, so it bounds every subinterval's coefficients too. The factors were
  * measured on the scenes and tests/data/hard_surfaces at 160x120 against solver_ref (bench/RESULTS.md, "Adaptive
  * precision"): at 1 and 1 the worst depth error was 7e-6 and the Barth decic doubted 17% of its camera rays; at
@@ -54,24 +54,49 @@ Isolation isolation_none(void) {
 /* The noise for coefficients of largest size `scale` summed from terms of size `terms`: for REALs and lanes alike. */
 #define DOUBT_NOISE(scale, terms) \
   (REAL_EPS * fmax((REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * (scale), (REAL)ALGRAY_TERMS_FACTOR * (terms)))
-REAL doubt_noise(const REAL* c, REAL terms) {
-  REAL scale = 0;
+
+#if ALGRAY_ESCALATE
+/* The noise of one scalar search: DOUBT_NOISE of its coefficients' size and its ray's terms, on the terms' upper
+ * bound until a value falls within it (RayTerms in restrict.h). */
+typedef struct {
+  REAL scale; /* max |b_k| of the coefficients the search starts from */
+  REAL noise;
+  RayTerms* terms;
+} SearchNoise;
+
+SearchNoise search_noise(const REAL* c, RayTerms* terms) {
+  SearchNoise n;
+  n.scale = 0;
   ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(c[k]));
-  return DOUBT_NOISE(scale, terms);
+  for (int k = 0; k <= DEGREE; ++k) n.scale = fmax(n.scale, fabs(c[k]));
+  n.terms = terms;
+  n.noise = DOUBT_NOISE(n.scale, terms->value);
+  return n;
 }
 
-#if ALGRAY_ESCALATE
-/* An upper bound on doubt_noise for any coefficients summed from terms of size at most `terms`. */
+/* An upper bound on the noise of any coefficients summed from terms of size at most `terms`. */
 REAL noise_bound(REAL terms) { return DOUBT_NOISE(terms, terms); }
+
+/* Whether |value| is within the noise (a NaN is not). */
+int within_noise(SearchNoise* n, REAL value) {
+  if (!(fabs(value) <= n->noise)) return 0;
+  if (!n->terms->exact) n->noise = DOUBT_NOISE(n->scale, ray_terms_exact(n->terms));
+  return fabs(value) <= n->noise;
+}
+
+/* The noise with the ray's terms summed: what the refined root's check (doubt_flat_root) compares against. */
+REAL exact_noise(SearchNoise* n) {
+  if (!n->terms->exact) n->noise = DOUBT_NOISE(n->scale, ray_terms_exact(n->terms));
+  return n->noise;
+}
 #endif
 
-/* Adaptive builds hand the isolation the size of the terms its coefficients were summed from (term_bound in
- * restrict.h); other builds hand it nothing. */
+/* The scalar isolation is handed the ray's terms (RayTerms in restrict.h) in adaptive builds, nothing in others;
+ * TERMS_OUT passes segment_coefficients where to put them. */
 #if ALGRAY_ESCALATE
-#define TERMS_PARAM , REAL terms
+#define TERMS_PARAM , RayTerms* terms
 #define TERMS_ARG , terms
-#define TERMS_OUT_PARAM , REAL *terms
+#define TERMS_OUT_PARAM , RayTerms* terms
 #define TERMS_OUT(p) , p
 #else
 #define TERMS_PARAM
@@ -109,15 +134,23 @@ REAL smaller_end(const REAL* c, REAL lo) {
 /* Ends the search undecided for `reason` when |value| is within the noise; returns 1 then. Other builds
  * compute none of its arguments. */
 #if ALGRAY_ESCALATE
-int doubted(Isolation* iso, uint reason, REAL value, REAL noise, int level PROBE_PARAM) {
-  if (!(fabs(value) <= noise)) return 0;
-  PROBE(ALGRAY_EVENT_DOUBT, 0, reason, (uint)level, iso->lo, iso->hi, value, noise);
+int doubted(Isolation* iso, uint reason, REAL value, SearchNoise* noise, int level PROBE_PARAM) {
+  if (!within_noise(noise, value)) return 0;
+  PROBE(ALGRAY_EVENT_DOUBT, 0, reason, (uint)level, iso->lo, iso->hi, value, noise->noise);
   iso->doubt = reason;
   iso->status = ISOLATION_NONE;
   return 1;
 }
+
+/* A root to refine takes the search's noise with the terms summed, for the refined root's check
+ * (doubt_flat_root); shadow rays refine nothing. */
+Isolation isolation_found(Isolation iso, SearchNoise* noise) {
+  if (!ALGRAY_SHADOW_RAYS && iso.status == ISOLATION_BRACKET) iso.noise = exact_noise(noise);
+  return iso;
+}
 #else
 #define doubted(...) 0
+#define isolation_found(iso, noise) (iso)
 #endif
 
 /* Whether an interval `width` (a fraction of [t_in, t_out], starting at fraction lo) is down to the stopping

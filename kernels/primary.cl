@@ -17,8 +17,7 @@
 __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, REAL4 ray_du, REAL4 ray_dv,
                       REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
                       __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
-                      __constant const REAL* binomials, uint even_axes SCREEN_ROWS_PARAM,
-                      uint tile_x0, uint tile_y0,
+                      __constant const REAL* binomials, uint even_axes SCREEN_ROWS_PARAM, uint tile_x0, uint tile_y0,
                       uint tile_w, uint tile_h, __global HitRecord* out) {
 #if LANES == 1
   const uint gx = get_global_id(0), gy = get_global_id(1);
@@ -35,7 +34,8 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
   out[(size_t)gy * tile_w + gx] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
 #else
   /* LANES pixels of a row per work-item: each is clipped and restricted on its own, then all are isolated,
-   * refined, and their normals taken, together in vector lanes (lanes.h). Global size (ceil(tile_w / LANES), tile_h); the pixels are the same as above. */
+   * refined, and their normals taken, together in vector lanes (lanes.h). Global size (ceil(tile_w / LANES), tile_h);
+   * the pixels are the same as above. */
   const uint gx = get_global_id(0), gy = get_global_id(1);
   const uint x0 = gx * LANES;
   if (x0 >= tile_w || gy >= tile_h) return;
@@ -47,7 +47,10 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
   REAL t_in[LANES], t_out[LANES];
   LREAL iso_c[NCOEF];
   int in_extent[LANES];
-  REAL root[LANES][NCOEF], root_lo[LANES][NCOEF], terms[LANES];
+  REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
+#if ALGRAY_ESCALATE
+  RayTerms terms[LANES];
+#endif
   for (uint j = 0; j < count; ++j) {
     const uint px = tile_x0 + x0 + j;
     rays[j] = camera_ray(px, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
@@ -58,10 +61,10 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
     REAL taylor[NCOEF];
     const REAL taylor_t = screen_ray_taylor(px, py, SCREEN_ROWS_ARG, taylor);
 #endif
-    segment_coefficients(hits[j].u, hits[j].d_unit, t_in[j], t_out[j], mono_exps, mono_coefs, mono_count,
-                         binomials, even_axes, root[j], root_lo[j] TERMS_OUT(&terms[j]) SCREEN_ARG);
+    segment_coefficients(hits[j].u, hits[j].d_unit, t_in[j], t_out[j], mono_exps, mono_coefs, mono_count, binomials,
+                         even_axes, root[j], root_lo[j] TERMS_OUT(&terms[j]) SCREEN_ARG);
   }
-  isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, terms, iso, iso_c);
+  isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, iso, iso_c TERMS_OUT(terms));
   refine_lanes(count, in_extent, iso, iso_c, t_in, t_out, binomials, roots);
   for (uint j = 0; j < count; ++j)
     if (in_extent[j]) finish_surface(&hits[j], roots[j]);

@@ -24,56 +24,49 @@
 
 #if ALGRAY_ESCALATE
 /* Whether the scaled coefficients c (before bernstein_from_scaled) settle bernstein_root_by_signs' answer with
- * every coefficient it reads further from zero than noise[k], the noise scaled alike: then no rounding could
- * change it. */
-int signs_clear_of(const REAL* c, int by_signs, const REAL* noise) {
-  if (by_signs == ISOLATION_BRACKET) return fmin(fabs(c[0]), fabs(c[DEGREE])) > noise[0];
+ * every coefficient it reads further from zero than noise_bound(terms) scaled alike: then no rounding could
+ * change it. c_0, P at the ray's start, does not count (first_counted): the isolation takes its sign as it is. */
+int signs_clear_of(const REAL* c, int by_signs, REAL terms, __constant const REAL* binomials) {
+  const REAL noise = noise_bound(terms);
+  if (by_signs == ISOLATION_BRACKET) return fabs(c[DEGREE]) > noise;
+  __constant const REAL* row = binomials + DEGREE * NCOEF;
   int clear = 1;
   ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) clear &= fabs(c[k]) > noise[k];
+  for (int k = 1; k <= DEGREE; ++k) clear &= fabs(c[k]) > noise * row[k];
   return clear;
-}
-
-/* The noise the sign shortcut holds every shadow ray of a work-item to, per scaled coefficient: noise_bound of
- * the terms anywhere in the extent, where every unit coordinate is at most 1: the sum of all |a_m|, which the
- * coefficient buffer holds by degree after the coefficients.
- * Once per work-item: per ray, its cost showed on the cheapest shadow kernels (the Whitney umbrella's: 25%). */
-void shortcut_noise_of(__global const REAL* coefs, uint count, __constant const REAL* binomials, REAL* noise) {
-  REAL terms = 0;
-  for (int d = 0; d <= DEGREE; ++d) terms += coefs[count + (uint)d];
-  const REAL n = noise_bound(terms);
-  __constant const REAL* row = binomials + DEGREE * NCOEF;
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) noise[k] = n * row[k];
 }
 #endif
 
 /* Whether the segment, restricted to root (and root_lo, both consumed), holds a root: what isolate_restricted
  * reports, without the search when the coefficients' signs already settle it (Bernstein builds; adaptive ones
- * only when the signs stand clear of shortcut_noise, shortcut_noise_of's). *doubt gets the search's.
- * f: the ray's coordinates' factors, for adaptive builds' term bounds. */
-int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
-                     uint* doubt, __global const uint* exps, __global const REAL* coefs, uint count, AxisFactor fx,
-                     AxisFactor fy, AxisFactor fz, const REAL* shortcut_noise) {
+ * only when the signs stand clear of the noise, first of the ray's terms' upper bound, then of their sum).
+ * *doubt gets the search's. f: the ray's coordinates' factors, for adaptive builds' terms. */
+int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials, uint* doubt,
+                     __global const uint* exps, __global const REAL* coefs, uint count, AxisFactor fx, AxisFactor fy,
+                     AxisFactor fz) {
   *doubt = 0;
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  const int by_signs = bernstein_root_by_signs(root);
 #if ALGRAY_ESCALATE
-  if (by_signs >= 0 && signs_clear_of(root, by_signs, shortcut_noise)) return by_signs != ISOLATION_NONE;
+  RayTerms terms = ray_terms(exps, coefs, count, fx, fy, fz);
 #else
-  if (by_signs >= 0) return by_signs != ISOLATION_NONE;
-#endif
-#endif
-  (void)shortcut_noise;
   (void)exps;
   (void)coefs;
   (void)count;
   (void)fx;
   (void)fy;
   (void)fz;
+#endif
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+  const int by_signs = bernstein_root_by_signs(root);
+#if ALGRAY_ESCALATE
+  if (by_signs >= 0 && (signs_clear_of(root, by_signs, terms.value, binomials) ||
+                        signs_clear_of(root, by_signs, ray_terms_exact(&terms), binomials)))
+    return by_signs != ISOLATION_NONE;
+#else
+  if (by_signs >= 0) return by_signs != ISOLATION_NONE;
+#endif
+#endif
   REAL iso_c[NCOEF];
-  const Isolation iso =
-      isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(term_bound(exps, coefs, count, fx, fy, fz)));
+  const Isolation iso = isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(&terms));
   *doubt = iso.doubt;
   return iso.status != ISOLATION_NONE;
 }
@@ -95,10 +88,6 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) {
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
   ulong mask = occluded[i], unsure = 0;
   uint traced = 0;
-  REAL shortcut_noise[NCOEF];
-#if ALGRAY_ESCALATE
-  shortcut_noise_of(mono_coefs, mono_count, binomials, shortcut_noise);
-#endif
   /* The batch waiting for its restriction: ray r is light sample sample[r] on [t_in[r], t_out[r]]. */
   AxisFactor fx[RESTRICT_RAYS], fy[RESTRICT_RAYS], fz[RESTRICT_RAYS];
   REAL t_in[RESTRICT_RAYS], t_out[RESTRICT_RAYS];
@@ -131,8 +120,8 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) {
     restrict_to_rays(mono_exps, mono_coefs, mono_count, binomials, fx, fy, fz, root, root_lo);
     for (int r = 0; r < pending; ++r) {
       uint doubt;
-      if (segment_has_root(root[r], root_lo[r], t_in[r], t_out[r], binomials, &doubt, mono_exps, mono_coefs,
-                           mono_count, fx[r], fy[r], fz[r], shortcut_noise))
+      if (segment_has_root(root[r], root_lo[r], t_in[r], t_out[r], binomials, &doubt, mono_exps, mono_coefs, mono_count,
+                           fx[r], fy[r], fz[r]))
         mask |= (ulong)1 << sample[r];
       if (doubt) unsure |= (ulong)1 << sample[r];
     }

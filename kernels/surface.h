@@ -30,12 +30,13 @@
 #define SCREEN_ARG , taylor, taylor_t
 /* The kernel arguments of the screen form: rows[(py - row0) * NCOEF * NCOEF + j * NCOEF + k] is the xi^j
  * coefficient of row py's taylor[k], expanded about t = taylor_t; a pixel's xi = (px + 1/2) * xi_scale + xi_offset. */
-#define SCREEN_ROWS_PARAM , __global const REAL *screen_rows, uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset
+#define SCREEN_ROWS_PARAM \
+  , __global const REAL *screen_rows, uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset
 #define SCREEN_ROWS_ARG screen_rows, screen_row0, screen_t, xi_scale, xi_offset
 
 /* Pixel (px, py)'s Taylor coefficients; returns the t they are expanded about. */
-REAL screen_ray_taylor(uint px, uint py, __global const REAL* rows, uint row0, REAL t0, REAL xi_scale,
-                       REAL xi_offset, REAL* taylor) {
+REAL screen_ray_taylor(uint px, uint py, __global const REAL* rows, uint row0, REAL t0, REAL xi_scale, REAL xi_offset,
+                       REAL* taylor) {
   const REAL xi = ((REAL)px + (REAL)0.5) * xi_scale + xi_offset;
   screen_taylor(rows + (size_t)(py - row0) * (NCOEF * NCOEF), xi, taylor);
   return t0;
@@ -159,8 +160,8 @@ SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
 /* The roots of LANES rays' isolations, refined together in lanes (lanes.h); c holds each lane's polynomial on its
  * isolating interval (consumed). Lanes from `count` on, and those whose ray missed the extent (in_extent[j] ==
  * 0), are left alone. */
-void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL* c, const REAL* t_in,
-                  const REAL* t_out, __constant const REAL* binomials, SegmentRoot* roots) {
+void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL* c, const REAL* t_in, const REAL* t_out,
+                  __constant const REAL* binomials, SegmentRoot* roots) {
   LREAL f0 = 0, f1 = 0, tol_y = 0;
   LMASK running = 0;
   for (uint j = 0; j < count; ++j) {
@@ -253,7 +254,7 @@ void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global cons
   segment_factors(o, d, t_in, t_out, even_axes, &fx, &fy, &fz);
   restrict_to_ray(exps, coefs, count, binomials, fx, fy, fz, root, root_lo);
 #if ALGRAY_ESCALATE
-  *terms = term_bound(exps, coefs, count, fx, fy, fz);
+  *terms = ray_terms(exps, coefs, count, fx, fy, fz);
 #endif
 #endif
   restricted_to_isolation_basis(root, root_lo, binomials PROBE_ARG);
@@ -261,8 +262,7 @@ void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global cons
 
 /* The smallest root of segment_coefficients' polynomial (root, root_lo are consumed); iso_c gets the polynomial
  * on the isolating interval. */
-Isolation isolate_coefficients(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c TERMS_PARAM
-                               PROBE_PARAM) {
+Isolation isolate_coefficients(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c TERMS_PARAM PROBE_PARAM) {
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   return isolate_bernstein(root, root_lo, t_in, t_out, iso_c TERMS_ARG PROBE_ARG);
 #elif RAY_ORIGIN == ALGRAY_ORIGIN_EYE
@@ -278,13 +278,15 @@ Isolation isolate_coefficients(REAL* root, REAL* root_lo, REAL t_in, REAL t_out,
  * the polynomial on the isolating interval. The primary and shadow kernels share this: one refines what it
  * returns, the other only asks whether there is anything to refine. */
 Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
-                             __global const REAL* coefs, uint count, __constant const REAL* binomials,
-                             uint even_axes, REAL* iso_c SCREEN_PARAM PROBE_PARAM) {
-  REAL root[NCOEF], root_lo[NCOEF], terms = 0;
+                             __global const REAL* coefs, uint count, __constant const REAL* binomials, uint even_axes,
+                             REAL* iso_c SCREEN_PARAM PROBE_PARAM) {
+  REAL root[NCOEF], root_lo[NCOEF];
+#if ALGRAY_ESCALATE
+  RayTerms terms;
+#endif
   segment_coefficients(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, root,
                        root_lo TERMS_OUT(&terms) SCREEN_ARG PROBE_ARG);
-  (void)terms;
-  return isolate_coefficients(root, root_lo, t_in, t_out, iso_c TERMS_ARG PROBE_ARG);
+  return isolate_coefficients(root, root_lo, t_in, t_out, iso_c TERMS_OUT(&terms) PROBE_ARG);
 }
 
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EXTENT
@@ -300,8 +302,8 @@ Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, _
 
 /* The start of trace_surface: the ray in unit coordinates (h->u, h->d_unit), clipped to the extent. Returns 0
  * when the ray misses the extent; *h is then the whole answer. */
-int enter_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, SurfaceHit* h,
-                  REAL* t_in, REAL* t_out PROBE_PARAM) {
+int enter_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, SurfaceHit* h, REAL* t_in,
+                  REAL* t_out PROBE_PARAM) {
   h->root.t = INFINITY;
   h->root.f_before = 0;
   h->root.flags = 0;
@@ -333,14 +335,13 @@ int isolate_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int e
  * isolating interval, for refine_lanes. Lanes from `count` on, and those whose ray missed the extent
  * (in_extent[j] == 0), are left alone. */
 void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (*root_lo)[NCOEF], const REAL* t_in,
-                   const REAL* t_out, const REAL* terms, Isolation* iso, LREAL* c) {
+                   const REAL* t_out, Isolation* iso, LREAL* c TERMS_OUT_PARAM) {
   for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
-  (void)terms;
 #if ALGRAY_COMPENSATED
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j]) continue;
     REAL iso_c[NCOEF];
-    iso[j] = isolate_coefficients(root[j], root_lo[j], t_in[j], t_out[j], iso_c TERMS_OUT(terms[j]));
+    iso[j] = isolate_coefficients(root[j], root_lo[j], t_in[j], t_out[j], iso_c TERMS_OUT(&terms[j]));
     for (int k = 0; k <= DEGREE; ++k) lane_set(&c[k], j, iso_c[k]);
   }
 #else
@@ -354,7 +355,9 @@ void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (
     for (int k = 0; k <= DEGREE; ++k) lane_set(&lane_root[k], j, root[j][k]);
     lane_set(&lane_t_in, j, t_in[j]);
     lane_set(&lane_t_out, j, t_out[j]);
-    lane_set(&lane_terms, j, terms[j]);
+#if ALGRAY_ESCALATE
+    lane_set(&lane_terms, j, ray_terms_exact(&terms[j]));
+#endif
   }
   (void)lane_terms;
   if (LANE_ANY(running))
@@ -377,8 +380,8 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   SurfaceHit h;
   Isolation iso;
   REAL t_in, t_out, iso_c[NCOEF];
-  if (isolate_surface(ray, centre, inv_scale, box_half, extent_kind, exps, coefs, count, binomials, even_axes, &h,
-                      &iso, &t_in, &t_out, iso_c SCREEN_ARG PROBE_ARG))
+  if (isolate_surface(ray, centre, inv_scale, box_half, extent_kind, exps, coefs, count, binomials, even_axes, &h, &iso,
+                      &t_in, &t_out, iso_c SCREEN_ARG PROBE_ARG))
     finish_surface(&h, refine_isolated(iso, iso_c, t_in, t_out, binomials PROBE_ARG));
   return h;
 }

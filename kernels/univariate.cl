@@ -24,7 +24,10 @@ __kernel void univariate(__global const REAL* polys, uint count, __constant cons
   }
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   /* The coefficients are given, rounded once: their own size is their noise's. */
-  const Isolation iso = isolate_bernstein(root, root_lo, (REAL)0, (REAL)1, iso_c TERMS_OUT((REAL)0));
+#if ALGRAY_ESCALATE
+  RayTerms terms = known_terms(0);
+#endif
+  const Isolation iso = isolate_bernstein(root, root_lo, (REAL)0, (REAL)1, iso_c TERMS_OUT(&terms));
 #else
   const Isolation iso = isolate_power_basis(root, (REAL)0, (REAL)1, (REAL)0, (REAL)1, iso_c);
 #endif

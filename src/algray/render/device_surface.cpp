@@ -113,7 +113,8 @@ DeviceSurface::DeviceSurface(const cl::Context& ctx, const Scene& scene, Precisi
   if (precision == Precision::Mixed)
     for (double c : data_.coefficients) coefficient_data.push_back(c - static_cast<double>(static_cast<float>(c)));
   // Adaptive precision's float kernels take, after the coefficients, the sum of |a_m| over the monomials of each
-  // degree 0..n: their sum bounds the terms anywhere in the extent (shortcut_noise_of in kernels/shadow.cl).
+  // degree 0..n: a ray whose coordinates are at most R has terms of size at most sum_d S_d R^d (ray_terms in
+  // kernels/restrict.h), the cheap bound it decides by before it sums its own.
   if (precision == Precision::Adaptive) {
     std::vector<double> by_degree(static_cast<std::size_t>(data_.degree) + 1, 0.0);
     for (std::size_t m = 0; m < data_.coefficients.size(); ++m) {
