@@ -87,8 +87,16 @@ RayTerms known_terms(REAL value) {
   return t;
 }
 
-/* A ray's terms, with the upper bound from the per-degree sums. Its rounding could put it a few ulps of count
- * below the sum's (both are sums of positive products): 2^-10 more covers every degree up to 32. */
+/* An upper bound on the terms of any ray whose coordinates are all at most r: the per-degree sums at r. Its
+ * rounding could put it a few ulps of count below the exact sum's (both are sums of positive products): 2^-10
+ * more covers every degree up to 32. */
+REAL terms_within(__global const REAL* coefs, uint count, REAL r) {
+  REAL bound = coefs[count + DEGREE];
+  for (int d = DEGREE - 1; d >= 0; --d) bound = bound * r + coefs[count + (uint)d];
+  return bound * (REAL)(1 + 1.0 / 1024);
+}
+
+/* A ray's terms, with the upper bound of terms_within its largest coordinate. */
 RayTerms ray_terms(__global const uint* exps, __global const REAL* coefs, uint count, AxisFactor fx, AxisFactor fy,
                    AxisFactor fz) {
   RayTerms t;
@@ -99,10 +107,7 @@ RayTerms ray_terms(__global const uint* exps, __global const REAL* coefs, uint c
   t.x = fmax(fabs(fx.l0), fabs(fx.l1));
   t.y = fmax(fabs(fy.l0), fabs(fy.l1));
   t.z = fmax(fabs(fz.l0), fabs(fz.l1));
-  const REAL r = fmax(t.x, fmax(t.y, t.z));
-  REAL bound = coefs[count + DEGREE];
-  for (int d = DEGREE - 1; d >= 0; --d) bound = bound * r + coefs[count + (uint)d];
-  t.value = bound * (REAL)(1 + 1.0 / 1024);
+  t.value = terms_within(coefs, count, fmax(t.x, fmax(t.y, t.z)));
   return t;
 }
 

@@ -39,14 +39,26 @@ int signs_clear_of(const REAL* c, int by_signs, REAL terms, __constant const REA
 
 /* Whether the segment, restricted to root (and root_lo, both consumed), holds a root: what isolate_restricted
  * reports, without the search when the coefficients' signs already settle it (Bernstein builds; adaptive ones
- * only when the signs stand clear of the noise, first of the ray's terms' upper bound, then of their sum).
+ * only when the signs stand clear of the noise: of extent_terms, the bound on every ray's terms in the extent,
+ * then of the ray's terms' upper bound, then of their sum; each check costs more and passes more rays).
  * *doubt gets the search's. f: the ray's coordinates' factors, for adaptive builds' terms. */
 int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials, uint* doubt,
                      __global const uint* exps, __global const REAL* coefs, uint count, AxisFactor fx, AxisFactor fy,
-                     AxisFactor fz) {
+                     AxisFactor fz, REAL extent_terms) {
   *doubt = 0;
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+  const int by_signs = bernstein_root_by_signs(root);
+#if ALGRAY_ESCALATE
+  if (by_signs >= 0 && signs_clear_of(root, by_signs, extent_terms, binomials)) return by_signs != ISOLATION_NONE;
+#else
+  if (by_signs >= 0) return by_signs != ISOLATION_NONE;
+#endif
+#endif
 #if ALGRAY_ESCALATE
   RayTerms terms = ray_terms(exps, coefs, count, fx, fy, fz);
+  if (by_signs >= 0 && (signs_clear_of(root, by_signs, terms.value, binomials) ||
+                        signs_clear_of(root, by_signs, ray_terms_exact(&terms), binomials)))
+    return by_signs != ISOLATION_NONE;
 #else
   (void)exps;
   (void)coefs;
@@ -54,16 +66,7 @@ int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constan
   (void)fx;
   (void)fy;
   (void)fz;
-#endif
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  const int by_signs = bernstein_root_by_signs(root);
-#if ALGRAY_ESCALATE
-  if (by_signs >= 0 && (signs_clear_of(root, by_signs, terms.value, binomials) ||
-                        signs_clear_of(root, by_signs, ray_terms_exact(&terms), binomials)))
-    return by_signs != ISOLATION_NONE;
-#else
-  if (by_signs >= 0) return by_signs != ISOLATION_NONE;
-#endif
+  (void)extent_terms;
 #endif
   REAL iso_c[NCOEF];
   const Isolation iso = isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(&terms));
@@ -88,6 +91,11 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) {
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
   ulong mask = occluded[i], unsure = 0;
   uint traced = 0;
+#if ALGRAY_ESCALATE
+  const REAL extent_terms = terms_within(mono_coefs, mono_count, 1); /* unit coordinates are at most 1 */
+#else
+  const REAL extent_terms = 0;
+#endif
   /* The batch waiting for its restriction: ray r is light sample sample[r] on [t_in[r], t_out[r]]. */
   AxisFactor fx[RESTRICT_RAYS], fy[RESTRICT_RAYS], fz[RESTRICT_RAYS];
   REAL t_in[RESTRICT_RAYS], t_out[RESTRICT_RAYS];
@@ -121,7 +129,7 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) {
     for (int r = 0; r < pending; ++r) {
       uint doubt;
       if (segment_has_root(root[r], root_lo[r], t_in[r], t_out[r], binomials, &doubt, mono_exps, mono_coefs, mono_count,
-                           fx[r], fy[r], fz[r]))
+                           fx[r], fy[r], fz[r], extent_terms))
         mask |= (ulong)1 << sample[r];
       if (doubt) unsure |= (ulong)1 << sample[r];
     }
