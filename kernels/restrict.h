@@ -61,8 +61,8 @@ AxisFactor axis_factor(REAL l0, REAL l1, int even) {
  * small multiple of REAL_EPS times it. Cancelling monomials make it far larger than P* itself (a Kummer shell
  * ray: 30 times its largest coefficient). Adaptive builds measure their noise by it (isolation.h).
  *
- * Its sum over the monomials costs about what a decision rarely needs (the Barth decic's shadow kernel: 12% of
- * float's time when every ray computed it), so a ray carries the cheap upper bound sum_d S_d R^d first, S_d the
+ * Its sum is a loop over every monomial that most decisions do not need (a third of the Barth decic's searched
+ * shadow rays need it), so a ray carries the cheap upper bound sum_d S_d R^d first, S_d the
  * sum of |a_m| of degree d (the host appends them to the coefficients) and R the largest of X, Y, Z, and computes
  * the sum only when a value falls within the noise of that bound (ray_terms_exact). The decisions are the same as
  * with the sum from the start. */

@@ -28,7 +28,8 @@
  * change it. c_0, P at the ray's start, does not count (first_counted): the isolation takes its sign as it is. */
 int signs_clear_of(const REAL* c, int by_signs, REAL terms, __constant const REAL* binomials) {
   const REAL noise = noise_bound(terms);
-  if (by_signs == ISOLATION_BRACKET) return fabs(c[DEGREE]) > noise;
+  /* c_0 exactly zero: the search doubts a root at the start, so the shortcut must not settle it */
+  if (by_signs == ISOLATION_BRACKET) return c[0] != 0 && fabs(c[DEGREE]) > noise;
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   int clear = 1;
   ALGRAY_UNROLL
