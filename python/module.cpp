@@ -1,11 +1,10 @@
 // The compiled module algray._algray: pybind11 bindings of the public C++ API (include/algray/algray.h).
 #include <Python.h>
+#include <algray/algray.h>
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
-
-#include <algray/algray.h>
 
 namespace py = pybind11;
 namespace api = algray::api;
@@ -141,7 +140,18 @@ PYBIND11_MODULE(_algray, m) {
                              })
       .def_property_readonly("aov", &solver_channels)
       .def_property_readonly("stats_json", &api::Image::stats_json)
-      .def("save", &api::Image::save, py::arg("path"), py::call_guard<py::gil_scoped_release>());
+      .def("save", &api::Image::save, py::arg("path"), py::call_guard<py::gil_scoped_release>())
+      .def(
+          "png",
+          [](const api::Image& i) {
+            std::string bytes;
+            {
+              py::gil_scoped_release released;
+              bytes = i.png();
+            }
+            return py::bytes(bytes);
+          },
+          "the bytes save(\"x.png\") writes, the scene included, without a file");
 
   py::class_<api::Renderer>(m, "_Renderer")
       .def(py::init<const std::string&, bool>(), py::arg("device") = "", py::arg("cache") = true)
@@ -204,8 +214,7 @@ PYBIND11_MODULE(_algray, m) {
                                     py::arg("status") = f.status, py::arg("frame_ms") = f.frame_ms));
                 });
               };
-            if (message)
-              settings.on_message = [&](const std::string& text) { call_python([&] { message(text); }); };
+            if (message) settings.on_message = [&](const std::string& text) { call_python([&] { message(text); }); };
             api::BatchResult result;
             {
               py::gil_scoped_release released;
@@ -214,10 +223,14 @@ PYBIND11_MODULE(_algray, m) {
             // A callback's exception ends nothing early in a batch (frames are not cancelled), but is raised now.
             if (PyErr_Occurred()) throw py::error_already_set();
             switch (result) {
-              case api::BatchResult::Done: return std::string("done");
-              case api::BatchResult::FramesFailed: return std::string("frames failed");
-              case api::BatchResult::BadInput: return std::string("bad input");
-              case api::BatchResult::Stopped: break;
+              case api::BatchResult::Done:
+                return std::string("done");
+              case api::BatchResult::FramesFailed:
+                return std::string("frames failed");
+              case api::BatchResult::BadInput:
+                return std::string("bad input");
+              case api::BatchResult::Stopped:
+                break;
             }
             return std::string("stopped");
           },

@@ -1,11 +1,11 @@
 // Tests for EXR/PNG output: round trips, header and text metadata, sRGB encoding, atomic replacement, the kinds
 // of failure, and cleanup after signals and of stale temporaries.
 #include "algray/io/image_io.h"
-#include "noisy_image.h"
 #include "algray/io/png_deflate.h"
+#include "algray/util/version.h"
+#include "noisy_image.h"
 #include "temp_dir.h"
 #include "test_seed.h"
-#include "algray/util/version.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wconversion"
@@ -209,7 +209,6 @@ std::optional<int> wait_child(pid_t child) {
   return status;
 }
 
-
 // PNG chunk surgery for the reader tests: a file as its chunks, and back with correct CRCs.
 struct PngChunk {
   std::string type, data;
@@ -261,7 +260,8 @@ std::string with_chunk_at_end(const std::string& png, const PngChunk& chunk) {
 // A scene as it will be embedded: several KB, with quotes, backslashes, blank lines, tabs and UTF-8.
 std::string multi_kb_scene() {
   std::string text =
-      "# Gr\xC3\xBC\xC3\x9F" "e aus K\xC3\xB6ln \xE2\x80\x94 \xCF\x80 \xE2\x89\x88 3.14159, \xF0\x9F\x8C\x80\n"
+      "# Gr\xC3\xBC\xC3\x9F"
+      "e aus K\xC3\xB6ln \xE2\x80\x94 \xCF\x80 \xE2\x89\x88 3.14159, \xF0\x9F\x8C\x80\n"
       "[surface]\nname = \"Barth \\\"sextic\\\"\"\nequation = '4*(t^2*x^2-y^2)*(t^2*y^2-z^2)'\n\n\t\n";
   for (int i = 0; text.size() < 6000; ++i)
     text += "[[light]]\nposition = [" + std::to_string(i) + ", -2.5, 1e3]\nintensity = 0." + std::to_string(i % 10) +
@@ -796,8 +796,7 @@ TEST_CASE("the version names the project version and a commit of this repository
   if (std::system("git -C '" ALGRAY_SOURCE_DIR "' rev-parse --verify -q HEAD >/dev/null 2>&1") == 0) {
     REQUIRE(revision != "unknown");
     const std::string hash = revision.substr(0, revision.find('-'));
-    const std::string command =
-        "git -C '" ALGRAY_SOURCE_DIR "' cat-file -e '" + hash + "^{commit}' 2>/dev/null";
+    const std::string command = "git -C '" ALGRAY_SOURCE_DIR "' cat-file -e '" + hash + "^{commit}' 2>/dev/null";
     CHECK(std::system(command.c_str()) == 0);
   }
 }
@@ -872,8 +871,11 @@ TEST_CASE("PNG text chunks round trip, the scene compressed", "[image_io][png]")
 
   const auto text = algray::read_png_text(out);
   const std::vector<std::pair<std::string, std::string>> expected = {
-      {"Software", algray::version_string()}, {"Comment", im.comments}, {algray::kPngSceneKey, scene},
-      {"Title", "Barth sextic"},              {"algray:short-utf8", "\xCF\x80 r\xC3\xA9sum\xC3\xA9"},
+      {"Software", algray::version_string()},
+      {"Comment", im.comments},
+      {algray::kPngSceneKey, scene},
+      {"Title", "Barth sextic"},
+      {"algray:short-utf8", "\xCF\x80 r\xC3\xA9sum\xC3\xA9"},
       {"Empty", ""}};
   REQUIRE(text.size() == expected.size());
   for (std::size_t i = 0; i < expected.size(); ++i) {
@@ -886,7 +888,8 @@ TEST_CASE("PNG text chunks round trip, the scene compressed", "[image_io][png]")
   const std::vector<PngChunk> chunks = split_png(read_bytes(out));
   auto chunk_for = [&](const std::string& key) -> const PngChunk* {
     for (const PngChunk& c : chunks)
-      if ((c.type == "tEXt" || c.type == "iTXt" || c.type == "zTXt") && c.data.compare(0, key.size() + 1, key + '\0') == 0)
+      if ((c.type == "tEXt" || c.type == "iTXt" || c.type == "zTXt") &&
+          c.data.compare(0, key.size() + 1, key + '\0') == 0)
         return &c;
     return nullptr;
   };
@@ -1093,9 +1096,9 @@ TEST_CASE("check_output_path finds path problems before anything is written", "[
   REQUIRE(name_max > 0);
   const std::string longest = std::string(static_cast<std::size_t>(name_max) - 4, 'n') + ".png";
   const std::string too_long = std::string(static_cast<std::size_t>(name_max) - 3, 'n') + ".png";
-  CHECK_THROWS_WITH(algray::check_output_path(dir / too_long),
-                    Contains("file name is " + std::to_string(too_long.size()) + " bytes") &&
-                        Contains(std::to_string(name_max)));
+  CHECK_THROWS_WITH(
+      algray::check_output_path(dir / too_long),
+      Contains("file name is " + std::to_string(too_long.size()) + " bytes") && Contains(std::to_string(name_max)));
   // The writers make the same check, as bad input, and leave nothing behind.
   CHECK_THROWS_AS(algray::write_png(dir / too_long, im), OutputError);
   CHECK_THROWS_AS(algray::write_text_file(dir / too_long, "x"), OutputError);
@@ -1123,10 +1126,14 @@ TEST_CASE("temporaries of dead writers are removed by the next write to that nam
   make_temp_like(dir / (".out.png.tmp-" + d + "-x"), old);    // kept: not a temporary's name
   make_temp_like(dir / (".out.png.tmp-" + d), old);           // kept: not a temporary's name
   make_temp_like(dir / ("out.png.tmp-" + d + "-1"), old);     // kept: not hidden, so not ours
-  const std::vector<std::string> kept = {
-      ".other.png.tmp-" + d + "-1", ".out.png.tmp-" + d,         ".out.png.tmp-" + d + "-2",
-      ".out.png.tmp-" + d + "-x",   ".out.png.tmp-" + l + "-1",  ".out.png.tmp-" + self + "-987654",
-      "out.png",                    "out.png.tmp-" + d + "-1"};
+  const std::vector<std::string> kept = {".other.png.tmp-" + d + "-1",
+                                         ".out.png.tmp-" + d,
+                                         ".out.png.tmp-" + d + "-2",
+                                         ".out.png.tmp-" + d + "-x",
+                                         ".out.png.tmp-" + l + "-1",
+                                         ".out.png.tmp-" + self + "-987654",
+                                         "out.png",
+                                         "out.png.tmp-" + d + "-1"};
 
   algray::write_png(dir / "out.png", im);
   std::vector<std::string> expected = kept;
@@ -1259,4 +1266,26 @@ TEST_CASE("EXR and PNG written in strips read back whole", "[image_io][exr][png]
   }
   INFO("first PNG pixel off: line " << png_wrong / width);
   CHECK(png_wrong == n);
+}
+
+TEST_CASE("png_bytes is what write_png puts in the file, opaque or not, text included", "[image_io][png]") {
+  TempDir dir;
+  for (const std::mt19937::result_type seed :
+       {std::mt19937::result_type{7}, std::mt19937::result_type{algray::testing::fresh_test_seed()}}) {
+    std::mt19937 rng(seed);
+    for (int c = 0; c < 4; ++c) {
+      INFO("seed " << seed << ", case " << c);
+      FrameImage im =
+          random_png_image(rng, 1 + static_cast<int>(rng() % 300), 1 + static_cast<int>(rng() % 200), c % 2 == 0);
+      im.comments = "case " + std::to_string(c);
+      im.png_text = {{algray::kPngSceneKey, multi_kb_scene()}};
+      const fs::path out = dir / "frame.png";
+      algray::write_png(out, im);
+      CHECK(algray::png_bytes(im) == read_bytes(out));
+    }
+  }
+  // A bad image is refused in memory as on disk.
+  FrameImage broken = make_image(4, 4);
+  broken.rgba.resize(3);
+  CHECK_THROWS_AS(algray::png_bytes(broken), algray::OutputError);
 }

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -90,10 +91,9 @@ TEST_CASE("a render through the API is the renderer's own film, bit for bit, wit
 
   algray::RenderContext context("", true);
   algray::Renderer internal(context.session(), context.cache());
-  const algray::RenderResult direct =
-      internal.render(algray::load_scene_file(kTorus, {{"image.width", "64"}, {"image.height", "48"},
-                                                       {"render.preview", "true"}}),
-                      algray::RenderOptions{});
+  const algray::RenderResult direct = internal.render(
+      algray::load_scene_file(kTorus, {{"image.width", "64"}, {"image.height", "48"}, {"render.preview", "true"}}),
+      algray::RenderOptions{});
   REQUIRE(image.width() == 64);
   REQUIRE(image.height() == 48);
   CHECK(image.rgba() == direct.image.rgba);
@@ -115,6 +115,10 @@ TEST_CASE("a render through the API is the renderer's own film, bit for bit, wit
   image.save((dir / "t.png").string());
   CHECK(algray::read_exr(dir / "t.exr").width == 64);
   CHECK(fs::file_size(dir / "t.png") > 0);
+  // In memory, the same bytes as the file: the scene included, so `algray render` can redo it from either.
+  std::ifstream saved(dir / "t.png", std::ios::binary);
+  const std::string file_bytes((std::istreambuf_iterator<char>(saved)), std::istreambuf_iterator<char>());
+  CHECK(image.png() == file_bytes);
   CHECK_THROWS_AS(image.save((dir / "t.bmp").string()), api::OutputError);
   CHECK_FALSE(fs::exists(dir / "t.bmp"));
 }
@@ -138,7 +142,8 @@ TEST_CASE("devices, probes and their errors through the API", "[api]") {
   api::Renderer renderer;
   CHECK_FALSE(renderer.device().name.empty());
   const api::Scene scene = api::Scene::load(kTorus);
-  const nlohmann::json pixel = nlohmann::json::parse(renderer.probe_pixel(scene, scene.width() / 2, scene.height() / 2));
+  const nlohmann::json pixel =
+      nlohmann::json::parse(renderer.probe_pixel(scene, scene.width() / 2, scene.height() / 2));
   REQUIRE(pixel["surfaces"].size() == 1);
   CHECK_FALSE(pixel["surfaces"][0]["solvers"].empty());
   const nlohmann::json ray = nlohmann::json::parse(renderer.probe_ray(scene, {-5, 0, 0.85}, {1, 0, 0}, true));

@@ -32,8 +32,7 @@ std::string version();
 // for a --set key or a missing file); `message` says what, `excerpt` shows the line with a caret under the
 // column. what() is the whole text the command line prints.
 struct SceneError : std::runtime_error {
-  SceneError(const std::string& what, std::string file, int line, int column, std::string message,
-             std::string excerpt);
+  SceneError(const std::string& what, std::string file, int line, int column, std::string message, std::string excerpt);
   std::string file;
   int line = 0, column = 0;
   std::string message, excerpt;
@@ -86,9 +85,9 @@ class Scene {
   std::string source() const;  // the file's path, or the name given with the text
   int width() const;
   int height() const;
-  std::vector<std::string> equations() const;                           // one per surface, as written
-  std::vector<std::pair<std::string, double>> parameters() const;       // name and value, sorted by name
-  std::vector<std::string> warnings() const;  // what the reader could not render as written
+  std::vector<std::string> equations() const;                      // one per surface, as written
+  std::vector<std::pair<std::string, double>> parameters() const;  // name and value, sorted by name
+  std::vector<std::string> warnings() const;                       // what the reader could not render as written
 
   struct State;  // the library's scene and how to read it again
 
@@ -133,6 +132,8 @@ class Image {
   const std::string& stats_json() const;
   // .exr (every channel, the metadata) or .png (colour, and the scene to render it again), atomically.
   void save(const std::string& path) const;
+  // The bytes save("x.png") writes, the scene included, without a file.
+  std::string png() const;
 
   struct State;
 
@@ -152,10 +153,10 @@ struct BatchFrame {
 };
 
 struct BatchSettings {
-  std::string jobs_path;                                     // a jobs file (.toml), as `algray batch` takes
+  std::string jobs_path;                                       // a jobs file (.toml), as `algray batch` takes
   std::vector<std::pair<std::string, std::string>> overrides;  // set on every job's scene, after its own
-  bool resume = false;                                       // skip frames whose outputs all exist
-  std::optional<std::string> log_path;                       // default: beside the jobs file
+  bool resume = false;                                         // skip frames whose outputs all exist
+  std::optional<std::string> log_path;                         // default: beside the jobs file
   std::optional<std::string> stats_path;
   // Only frames shard_index, shard_index + shard_count, ... of all (algray batch --shard K/N); the log and stats
   // become the shard's own. shard_count 1 renders them all.
@@ -182,8 +183,8 @@ class Renderer {
   // The probe report as JSON (`algray probe --json`): every step of the scene's solver (or of all of them) on
   // the pixel's centre ray or on the ray origin + t direction, beside solver_ref's certified answer.
   std::string probe_pixel(const Scene& scene, int x, int y, bool all_solvers = false);
-  std::string probe_ray(const Scene& scene, const std::array<double, 3>& origin,
-                        const std::array<double, 3>& direction, bool all_solvers = false);
+  std::string probe_ray(const Scene& scene, const std::array<double, 3>& origin, const std::array<double, 3>& direction,
+                        bool all_solvers = false);
   BatchResult batch(const BatchSettings& settings);
 
  private:

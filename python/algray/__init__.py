@@ -12,7 +12,6 @@ implementation. Errors raise SceneError (with .file, .line, .column), DeviceErro
 """
 import json
 import os
-import tempfile
 
 from . import _toml
 from ._algray import DeviceError, Image, OutputError, Scene, SceneError, _Renderer
@@ -64,11 +63,7 @@ def _image_stats(self):
 
 def _image_png(self):
     """The image as PNG bytes, as `save("x.png")` writes it (Jupyter shows an Image by this)."""
-    with tempfile.TemporaryDirectory() as tmp:
-        path = os.path.join(tmp, "image.png")
-        self.save(path)
-        with open(path, "rb") as f:
-            return f.read()
+    return self.png()
 
 
 Image.stats = property(_image_stats)

@@ -38,7 +38,7 @@ def test_a_render_from_python_is_the_command_lines_render_bit_for_bit(renderer, 
         assert "channels bit-identical: all" in compared.stdout, (name, compared.stdout)
 
 
-def test_the_arrays_have_the_image_shape_and_depth_is_inf_on_misses(renderer):
+def test_the_arrays_have_the_image_shape_and_depth_is_inf_on_misses(renderer, tmp_path):
     image = renderer.render(algray.Scene.load(TORUS), width=64, height=48, preview=True, aov=["classification"])
     assert image.rgba.shape == (48, 64, 4) and image.rgba.dtype == np.float32
     assert image.depth.shape == (48, 64) and image.depth.dtype == np.float32
@@ -53,6 +53,8 @@ def test_the_arrays_have_the_image_shape_and_depth_is_inf_on_misses(renderer):
     assert not image.rgba.flags.writeable  # a view of the render's own memory
     assert image.stats["image"] == {"width": 64, "height": 48}
     assert image._repr_png_().startswith(b"\x89PNG")
+    image.save(str(tmp_path / "image.png"))
+    assert image.png() == (tmp_path / "image.png").read_bytes()  # in memory, the file's bytes
     flat = renderer.render(algray.Scene.load(TORUS), width=64, height=48, preview=True, depth=False)
     assert flat.depth is None and flat.normal is None
     assert np.array_equal(flat.rgba, image.rgba)  # the same colours, without the channels a PNG cannot hold

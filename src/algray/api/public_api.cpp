@@ -66,10 +66,14 @@ auto translated(F&& f) -> decltype(f()) {
 
 algray::Scene read_scene(const Scene::State& s, const std::vector<Override>& overrides) {
   switch (s.kind) {
-    case Scene::State::Kind::File: return SceneLoader().load(s.text_or_path, overrides);
-    case Scene::State::Kind::Toml: return load_scene_text(s.text_or_path, s.name, overrides);
-    case Scene::State::Kind::Jsurf: return load_jsurf_text(s.text_or_path, s.name, overrides);
-    case Scene::State::Kind::Default: break;
+    case Scene::State::Kind::File:
+      return SceneLoader().load(s.text_or_path, overrides);
+    case Scene::State::Kind::Toml:
+      return load_scene_text(s.text_or_path, s.name, overrides);
+    case Scene::State::Kind::Jsurf:
+      return load_jsurf_text(s.text_or_path, s.name, overrides);
+    case Scene::State::Kind::Default:
+      break;
   }
   return algray::default_scene(overrides);
 }
@@ -82,8 +86,8 @@ std::shared_ptr<const Scene::State> read_state(Scene::State state) {
 }
 
 Device to_device(const DeviceInfo& d) {
-  return {d.index,  d.platform_name, d.platform_version, d.name,          d.vendor,           d.version,
-          d.driver_version, d.type,  d.compute_units,    d.fp64,          d.global_mem_bytes, d.max_alloc_bytes};
+  return {d.index,          d.platform_name, d.platform_version, d.name, d.vendor,           d.version,
+          d.driver_version, d.type,          d.compute_units,    d.fp64, d.global_mem_bytes, d.max_alloc_bytes};
 }
 
 }  // namespace
@@ -161,9 +165,11 @@ const std::string& Image::stats_json() const { return state_->stats; }
 void Image::save(const std::string& path) const {
   translated([&] { write_image(path, state_->image); });
 }
+std::string Image::png() const {
+  return translated([&] { return png_bytes(state_->image); });
+}
 
-Renderer::Renderer(const std::string& device, bool cache)
-    : state_(std::make_unique<State>(device, cache)) {}
+Renderer::Renderer(const std::string& device, bool cache) : state_(std::make_unique<State>(device, cache)) {}
 Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
@@ -253,14 +259,18 @@ BatchResult Renderer::batch(const BatchSettings& settings) {
   callbacks.on_message = settings.on_message;
   if (settings.on_frame)
     callbacks.on_frame = [&](const BatchProgress& p) {
-      settings.on_frame({p.done, p.total, p.job->name, p.frame, p.job->frames, p.status, p.frame_ms, p.elapsed_ms,
-                         p.eta_ms});
+      settings.on_frame(
+          {p.done, p.total, p.job->name, p.frame, p.job->frames, p.status, p.frame_ms, p.elapsed_ms, p.eta_ms});
     };
   switch (run_batch(request, callbacks, state_->context)) {
-    case BatchOutcome::Done: return BatchResult::Done;
-    case BatchOutcome::FramesFailed: return BatchResult::FramesFailed;
-    case BatchOutcome::BadInput: return BatchResult::BadInput;
-    case BatchOutcome::Stopped: break;
+    case BatchOutcome::Done:
+      return BatchResult::Done;
+    case BatchOutcome::FramesFailed:
+      return BatchResult::FramesFailed;
+    case BatchOutcome::BadInput:
+      return BatchResult::BadInput;
+    case BatchOutcome::Stopped:
+      break;
   }
   return BatchResult::Stopped;
 }

@@ -34,6 +34,7 @@
 #include <csetjmp>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -501,8 +502,8 @@ std::vector<std::pair<std::string, std::string>> png_text_entries(const FrameIma
   for (const auto& [key, value] : image.png_text) {
     check_png_key(key);
     if (key == "Software" || key == "Comment")
-      throw OutputError("PNG text '" + key + "' comes from FrameImage::" + (key == "Software" ? "software" : "comments") +
-                        ", not from png_text");
+      throw OutputError("PNG text '" + key + "' comes from FrameImage::" +
+                        (key == "Software" ? "software" : "comments") + ", not from png_text");
     if (!used.insert(key).second) throw OutputError("PNG text key '" + key + "' is given twice");
     entries.emplace_back(key, value);
   }
@@ -531,7 +532,8 @@ std::vector<png_text> png_text_chunks(const std::vector<std::pair<std::string, s
   return chunks;
 }
 
-void encode_png(const fs::path& file, const FrameImage& image) {
+// The PNG into an open stream: a file's, or memory's (png_bytes).
+void encode_png_to(std::FILE* fp, const FrameImage& image) {
   const std::size_t n = checked_pixel_count(image);
   const std::vector<std::pair<std::string, std::string>> entries = png_text_entries(image);
   std::vector<png_text> text = png_text_chunks(entries);
@@ -553,7 +555,7 @@ void encode_png(const fs::path& file, const FrameImage& image) {
   };
   const std::size_t row_bytes = static_cast<std::size_t>(image.width) * channels;
 
-  write_with_stdio(file, [&](std::FILE* fp) {
+  {
     PngErrorState error;
     if (!encode_png_head(fp, static_cast<png_uint_32>(image.width), static_cast<png_uint_32>(image.height),
                          opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGB_ALPHA, text.data(),
@@ -568,7 +570,11 @@ void encode_png(const fs::path& file, const FrameImage& image) {
       // The message a failed PNG write has always had (libpng's, from when libpng wrote the image data too).
       throw WriteError("libpng: Write Error");
     }
-  });
+  }
+}
+
+void encode_png(const fs::path& file, const FrameImage& image) {
+  write_with_stdio(file, [&](std::FILE* fp) { encode_png_to(fp, image); });
 }
 
 void encode_text(const fs::path& file, const std::string& text) {
@@ -688,6 +694,26 @@ void write_png(const fs::path& path, const FrameImage& image) {
   write_atomically(path, [&](const fs::path& temp) { encode_png(temp, image); });
 }
 
+std::string png_bytes(const FrameImage& image) {
+  // open_memstream: the same stdio stream the file path writes through, so the bytes are the file's.
+  char* data = nullptr;
+  std::size_t size = 0;
+  std::FILE* fp = ::open_memstream(&data, &size);
+  if (!fp) throw WriteError("cannot open a memory stream for the PNG: " + errno_text(errno));
+  try {
+    encode_png_to(fp, image);
+  } catch (...) {
+    std::fclose(fp);
+    std::free(data);
+    throw;
+  }
+  const bool flushed = std::fclose(fp) == 0;
+  std::string bytes = flushed ? std::string(data, size) : std::string();
+  std::free(data);
+  if (!flushed) throw WriteError("write failed: " + errno_text(errno));
+  return bytes;
+}
+
 void write_text_file(const fs::path& path, const std::string& text) {
   write_atomically(path, [&](const fs::path& temp) { encode_text(temp, text); });
 }
@@ -785,8 +811,8 @@ FrameImage read_exr(const fs::path& path) {
     if (Imf::hasWorldToNDC(header)) image.world_to_ndc = from_m44(Imf::worldToNDC(header));
     if (Imf::hasChromaticities(header)) {
       const Imf::Chromaticities& c = Imf::chromaticities(header);
-      image.chromaticities = std::array<float, 8>{c.red.x,  c.red.y,  c.green.x, c.green.y,
-                                                  c.blue.x, c.blue.y, c.white.x, c.white.y};
+      image.chromaticities =
+          std::array<float, 8>{c.red.x, c.red.y, c.green.x, c.green.y, c.blue.x, c.blue.y, c.white.x, c.white.y};
     }
     return image;
   } catch (const std::exception& e) {
@@ -798,7 +824,8 @@ bool is_png_file(const fs::path& path) {
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> fp(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!fp) return false;
   png_byte head[sizeof kPngSignature];
-  return std::fread(head, 1, sizeof head, fp.get()) == sizeof head && std::memcmp(head, kPngSignature, sizeof head) == 0;
+  return std::fread(head, 1, sizeof head, fp.get()) == sizeof head &&
+         std::memcmp(head, kPngSignature, sizeof head) == 0;
 }
 
 std::vector<std::pair<std::string, std::string>> read_png_text(const fs::path& path) {
@@ -820,7 +847,8 @@ std::vector<std::pair<std::string, std::string>> read_png_text(const fs::path& p
   if (!reader.png || !reader.info) throw OutputError(where + ": out of memory for libpng");
 
   int passes = 1;
-  if (!png_read_head(reader.png, reader.info, fp.get(), &passes)) throw OutputError(where + " as PNG: " + error.message);
+  if (!png_read_head(reader.png, reader.info, fp.get(), &passes))
+    throw OutputError(where + " as PNG: " + error.message);
   std::vector<png_byte> row(png_get_rowbytes(reader.png, reader.info));
   if (!png_read_rest(reader.png, reader.info, row.data(), passes))
     throw OutputError(where + " as PNG: " + error.message);

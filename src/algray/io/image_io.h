@@ -110,6 +110,8 @@ void write_exr(const std::filesystem::path& path, const FrameImage& image);
 // PNG: 8-bit sRGB-encoded RGB, or RGBA when some alpha does not round to 255; tagged with sRGB/gAMA/cHRM;
 // text chunks "Software", "Comment" (if any) and png_text. string_attributes are not written.
 void write_png(const std::filesystem::path& path, const FrameImage& image);
+// The bytes write_png would put in the file, in memory (for a frame served or shown, not saved).
+std::string png_bytes(const FrameImage& image);
 // Text (SVG, JSON, ...) byte for byte, through the same temporary file and rename as the images.
 void write_text_file(const std::filesystem::path& path, const std::string& text);
 
