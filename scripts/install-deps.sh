@@ -8,6 +8,7 @@ packages=(
   libglm-dev libopenexr-dev libpng-dev
   catch2 libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgmp-dev
+  libcpp-httplib-dev  # `algray view`'s local web server
   python3
   python3-dev pybind11-dev  # the Python package (python/)
   python3-numpy python3-pytest python3-ipywidgets  # its arrays, its tests, and algray.explore's sliders

@@ -38,6 +38,16 @@ struct ProbeRequest {
   bool use_cache = true;
 };
 
+struct ViewRequest {
+  std::optional<std::string> scene_path;  // unset: the built-in default scene
+  std::vector<Override> overrides;        // --set, --precision, in order
+  std::string device_spec;
+  std::string host = "127.0.0.1";  // another address (--host) is reachable from other machines: a warning says so
+  int port = 0;                    // 0: any free port
+  bool open = false;               // open the URL in a browser (xdg-open)
+  bool use_cache = true;
+};
+
 // Each prints errors (and nothing else on success, unless progress) to `err`; probe's report goes to `out`.
 int run_render(const RenderRequest& request, std::ostream& err);
 #ifdef ALGRAY_WITH_MPI
@@ -49,6 +59,8 @@ int run_probe(const ProbeRequest& request, std::ostream& out, std::ostream& err)
 int run_batch_command(const BatchRequest& request, bool progress, std::ostream& err);
 // `algray batch --merge-logs`: the shard logs joined into the batch's log.
 int run_merge_logs(const BatchRequest& request, std::ostream& err);
+// `algray view`: serves the page and its frames until killed; prints the URL on `out` once listening.
+int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err);
 // `algray devices`: the list on `out`, and as JSON in `stats_path` when given.
 int run_devices(const std::string& stats_path, std::ostream& out, std::ostream& err);
 

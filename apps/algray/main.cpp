@@ -1,4 +1,4 @@
-// The algray command line: `algray render`, `algray probe`, `algray batch` and `algray devices`.
+// The algray command line: `algray render`, `algray probe`, `algray batch`, `algray devices` and `algray view`.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -338,6 +338,46 @@ struct DevicesCommand {
   int run() { return run_devices(stats_path, std::cout, std::cerr); }
 };
 
+// `algray view`: the scene options that make sense live, and where to listen.
+struct ViewCommand {
+  CLI::App* cmd = nullptr;
+  ViewRequest request;
+  std::string scene_path, precision;
+  std::vector<std::string> sets;
+  bool no_cache = false;
+
+  void add_to(CLI::App& app) {
+    cmd = app.add_subcommand("view", "explore a scene live in the browser: a local web server for its page and frames");
+    cmd->add_option("scene", scene_path,
+                    "scene file (.toml, .jsurf or an algray PNG); default: the built-in Barth sextic");
+    cmd->add_option("--port", request.port, "port to listen on (default: any free port; the URL is printed)")
+        ->check(CLI::Range(0, 65535));
+    cmd->add_option("--host", request.host,
+                    "address to listen on (default 127.0.0.1; any other is reachable from other machines)");
+    cmd->add_option("--device", request.device_spec, "device index or name substring (see `algray devices`)");
+    cmd->add_option("--precision", precision, precision_choices("or") + " (overrides render.precision)");
+    cmd->add_option("--set", sets, "override a scene key: name=value (a bare name is a parameter)");
+    cmd->add_flag("--open", request.open, "open the page in the default browser (xdg-open)");
+    cmd->add_flag("--no-cache", no_cache, "compile kernels from source; neither read nor write the program cache");
+    add_no_fp64_flag(cmd);
+  }
+
+  int run() {
+    if (!scene_path.empty()) request.scene_path = scene_path;
+    for (const std::string& s : sets) {
+      const auto eq = s.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        std::cerr << "algray: --set " << s << ": expected name=value\n";
+        return kExitBadInput;
+      }
+      request.overrides.push_back({s.substr(0, eq), s.substr(eq + 1)});
+    }
+    if (!precision.empty()) request.overrides.push_back({"render.precision", "\"" + precision + "\""});
+    request.use_cache = !no_cache;
+    return run_view(request, std::cout, std::cerr);
+  }
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -350,10 +390,12 @@ int main(int argc, char** argv) {
   ProbeCommand probe;
   BatchCommand batch;
   DevicesCommand devices;
+  ViewCommand view;
   render.add_to(app);
   probe.add_to(app);
   batch.add_to(app);
   devices.add_to(app);
+  view.add_to(app);
 
   try {
     app.parse(argc, argv);
@@ -362,6 +404,7 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kExitBadInput;
   }
   if (devices.cmd->parsed()) return devices.run();
+  if (view.cmd->parsed()) return view.run();
   if (batch.cmd->parsed()) return batch.run();
   if (probe.cmd->parsed()) return probe.run();
   end_process(render.run());

@@ -1,0 +1,127 @@
+#!/usr/bin/env python3
+"""`algray view` without a browser: 200 concurrent valid and malformed requests to one server, the errors it
+answers, and a saved scene that `algray render` turns into the view's own frame.
+
+Usage: test_view_server.py ALGRAY_BINARY WORK_DIR. Fails (exit 1) on the first broken expectation, naming the
+seed and the request; needs an OpenCL device, as every render does."""
+import concurrent.futures
+import json
+import os
+import random
+import struct
+import subprocess
+import sys
+import urllib.error
+import urllib.parse
+import urllib.request
+import zlib
+
+BINARY, WORK = sys.argv[1], sys.argv[2]
+SEED = int(os.environ.get("ALGRAY_TEST_SEED", "20261204"))
+os.makedirs(WORK, exist_ok=True)
+
+
+def fail(message):
+    print(f"test_view_server: FAILED (seed {SEED}): {message}", file=sys.stderr)
+    sys.exit(1)
+
+
+def get(base, path, params=()):
+    url = base + path + ("?" + urllib.parse.urlencode(list(params)) if params else "")
+    try:
+        with urllib.request.urlopen(url, timeout=120) as r:
+            return r.status, r.headers, r.read()
+    except urllib.error.HTTPError as e:
+        return e.code, e.headers, e.read()
+
+
+def idat(png):
+    """The image data of a PNG: the same pixels from algray's one encoder give the same bytes."""
+    assert png[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    pos, data = 8, b""
+    while pos < len(png):
+        length, kind = struct.unpack(">I4s", png[pos:pos + 8])
+        if kind == b"IDAT":
+            data += png[pos + 8:pos + 8 + length]
+        pos += 12 + length
+    return zlib.decompress(data)
+
+
+server = subprocess.Popen([BINARY, "view", "--port", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+try:
+    url = server.stdout.readline().strip()
+    if not url.startswith("http://127.0.0.1:"):
+        fail(f"expected the URL on 127.0.0.1, got {url!r}; stderr: {server.stderr.read()}")
+    base = url.rstrip("/")
+
+    status, headers, page = get(base, "/")
+    if status != 200 or b"<title>algray view</title>" not in page:
+        fail(f"the page: {status}")
+    status, _, body = get(base, "/scene.json")
+    scene = json.loads(body)
+    if status != 200 or scene["camera"]["look_at"] != [0.0, 0.0, 0.0] or "phi" not in scene["parameters"]:
+        fail(f"scene.json: {status} {scene}")
+
+    # 200 requests at once, a third of them malformed in each way the page could be wrong.
+    rng = random.Random(SEED)
+    malformed = [
+        [("width", "abc")], [("width", "0")], [("height", "100000")], [("full", "2")],
+        [("set", "no equals sign")], [("set", "=3")], [("set", "camera.eye=[1, 2")],
+        [("set", "surface.equation=\"x^2+*y\"")], [("set", "render.precision=\"quadruple\"")],
+        [("set", "phi=abc")], [("set", "camera.nonsense=1")],
+    ]
+    cases = []
+    for k in range(200):
+        if k % 3 == 0:
+            cases.append(("bad", malformed[rng.randrange(len(malformed))]))
+        else:
+            eye = [round(rng.uniform(-6, 6), 3) for _ in range(3)]
+            eye[2] = abs(eye[2]) + 3
+            cases.append(("good", [("width", "24"), ("height", "16"), ("set", f"camera.eye={eye}"),
+                                   ("set", f"phi={rng.uniform(1.4, 1.8):.4f}")]))
+
+    def run(case):
+        return case, get(base, "/frame.png", case[1])
+
+    with concurrent.futures.ThreadPoolExecutor(max_workers=32) as pool:
+        for index, ((kind, params), (status, headers, body)) in enumerate(pool.map(run, cases)):
+            if kind == "good":
+                if status != 200 or headers["Content-Type"] != "image/png" or not body.startswith(b"\x89PNG"):
+                    fail(f"case {index}: a valid request {params} got {status}: {body[:200]!r}")
+                if headers["X-Algray-Degree"] != "6":
+                    fail(f"case {index}: degree {headers['X-Algray-Degree']}")
+            else:
+                error = json.loads(body) if status == 400 else None
+                if not error or not error.get("error"):
+                    fail(f"case {index}: a malformed request {params} got {status}: {body[:200]!r}")
+    if server.poll() is not None:
+        fail("the server stopped")
+
+    # A bad equation: the error names the column the command line reports, as "character N".
+    status, _, body = get(base, "/frame.png", [("set", 'surface.equation="x^2+*y"')])
+    error = json.loads(body)
+    cli = subprocess.run([BINARY, "render", "--set", 'surface.equation="x^2+*y"', "-o", f"{WORK}/never.png"],
+                         capture_output=True, text=True)
+    if status != 400 or error["key"] != "surface.equation" or error["column"] != 5 or cli.returncode != 2 \
+            or "at character 5 of the equation" not in cli.stderr or os.path.exists(f"{WORK}/never.png"):
+        fail(f"bad equation: {status} {error}; the CLI said {cli.returncode} {cli.stderr!r}")
+
+    # The saved scene renders to the view's frame: the same pixels, in preview and in full mode.
+    view = [("width", "64"), ("height", "48"), ("set", "camera.eye=[1.5, 4.0, 5.0]"), ("set", "phi=1.7"),
+            ("set", "extent.radius=2.0")]
+    for full in ("0", "1"):
+        status, _, frame = get(base, "/frame.png", view + [("full", full)])
+        status_toml, _, toml = get(base, "/scene.toml", view + [("full", full)])
+        if status != 200 or status_toml != 200:
+            fail(f"full={full}: frame {status}, scene.toml {status_toml}")
+        path = f"{WORK}/saved_{full}.toml"
+        with open(path, "wb") as f:
+            f.write(toml)
+        subprocess.run([BINARY, "render", path, "-o", f"{WORK}/saved_{full}.png"], check=True)
+        with open(f"{WORK}/saved_{full}.png", "rb") as f:
+            if idat(f.read()) != idat(frame):
+                fail(f"full={full}: `algray render` of the saved scene is not the view's frame")
+finally:
+    server.terminate()
+    server.wait(timeout=30)
+print("test_view_server: 200 concurrent requests answered, errors located, saved scenes render to the frames")
