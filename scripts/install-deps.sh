@@ -9,6 +9,7 @@ packages=(
   catch2 libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgmp-dev
   libcpp-httplib-dev  # `algray view`'s local web server
+  chromium chromium-driver python3-selenium  # test_view_browser drives the page in headless Chromium
   python3
   python3-dev pybind11-dev  # the Python package (python/)
   python3-numpy python3-pytest python3-ipywidgets  # its arrays, its tests, and algray.explore's sliders

@@ -1,0 +1,151 @@
+#!/usr/bin/env python3
+"""`algray view` in a real browser: headless Chromium driven by Selenium loads the page and its first frame, a drag
+turns the camera, a slider moves a parameter, a bad equation shows its error at the command line's column and
+keeps the image, and the saved scene renders to the view's last full-size frame.
+
+Usage: test_view_browser.py ALGRAY_BINARY WORK_DIR. Needs chromium, chromium-driver and python3-selenium
+(scripts/install-deps.sh installs them) and an OpenCL device; fails loudly without any of them."""
+import base64
+import os
+import struct
+import subprocess
+import sys
+import urllib.request
+import zlib
+
+BINARY, WORK = sys.argv[1], sys.argv[2]
+os.makedirs(WORK, exist_ok=True)
+
+try:
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import WebDriverWait
+except ImportError as e:
+    print(f"test_view_browser: FAILED: Selenium is missing ({e}); install python3-selenium", file=sys.stderr)
+    sys.exit(1)
+for tool in ("/usr/bin/chromium", "/usr/bin/chromedriver"):
+    if not os.path.exists(tool):
+        print(f"test_view_browser: FAILED: {tool} is missing; install chromium and chromium-driver", file=sys.stderr)
+        sys.exit(1)
+
+
+def fail(message):
+    print(f"test_view_browser: FAILED: {message}", file=sys.stderr)
+    sys.exit(1)
+
+
+def idat(png):
+    """The image data of a PNG: the same pixels from algray's one encoder give the same bytes."""
+    pos, data = 8, b""
+    while pos < len(png):
+        length, kind = struct.unpack(">I4s", png[pos:pos + 8])
+        if kind == b"IDAT":
+            data += png[pos + 8:pos + 8 + length]
+        pos += 12 + length
+    return zlib.decompress(data)
+
+
+# The frame the page shows, as PNG bytes, read back from its blob URL.
+SHOWN = """
+const done = arguments[arguments.length - 1];
+fetch(document.getElementById("frame").src).then(r => r.arrayBuffer()).then(b => {
+  let s = ""; for (const x of new Uint8Array(b)) s += String.fromCharCode(x); done(btoa(s));
+});"""
+
+server = subprocess.Popen([BINARY, "view", "--port", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+driver = None
+try:
+    url = server.stdout.readline().strip()
+    if not url.startswith("http://127.0.0.1:"):
+        fail(f"expected the URL, got {url!r}; stderr: {server.stderr.read()}")
+    options = webdriver.ChromeOptions()
+    options.binary_location = "/usr/bin/chromium"
+    for flag in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                 "--window-size=1200,800"):
+        options.add_argument(flag)
+    driver = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
+    driver.set_script_timeout(60)
+    wait = WebDriverWait(driver, 120)
+    driver.get(url)
+
+    def frames():
+        return int(driver.execute_script("return Number(document.getElementById('frame').dataset.frames || 0)"))
+
+    def settle(after):
+        """Waits for a full-size frame newer than frame number `after`, with nothing in flight or waiting."""
+        wait.until(lambda d: frames() > after and d.execute_script(
+            "return !inFlight && waiting === null && document.getElementById('frame').dataset.stage === 'still'"))
+        return base64.b64decode(driver.execute_async_script(SHOWN))
+
+    # The page loads and shows its first frame, with the info line.
+    first = settle(0)
+    if not first.startswith(b"\x89PNG"):
+        fail("the first frame is not a PNG")
+    info = driver.find_element(By.ID, "info").text
+    if "degree 6" not in info or "fps" not in info:
+        fail(f"info line: {info!r}")
+
+    original = driver.execute_script("return view.equation")
+    # A drag turns the camera about the look-at point, and the image changes.
+    eye = driver.execute_script("return view.camera.eye.slice()")
+    n = frames()
+    ActionChains(driver).move_to_element(driver.find_element(By.ID, "frame")).click_and_hold() \
+        .move_by_offset(40, 0).move_by_offset(40, 15).release().perform()
+    dragged = settle(n)
+    new_eye = driver.execute_script("return view.camera.eye")
+    dist = lambda e: sum(x * x for x in e) ** 0.5
+    if new_eye == eye or abs(dist(new_eye) - dist(eye)) > 1e-6 * dist(eye):
+        fail(f"the drag moved the eye from {eye} to {new_eye}, not about the look-at point")
+    if dragged == first:
+        fail("the image did not change with the drag")
+
+    # A slider moves the parameter, and the image changes.
+    n = frames()
+    driver.execute_script("""const s = document.getElementById('param-phi');
+                             s.value = String(Number(s.value) + 0.15); s.dispatchEvent(new Event('input'));""")
+    slid = settle(n)
+    phi = driver.execute_script("return view.parameters.phi")
+    if abs(phi - (1.618033988749895 + 0.15)) > 1e-9:
+        fail(f"phi is {phi} after the slider")
+    if slid == dragged:
+        fail("the image did not change with the slider")
+
+    # A bad equation: the error under the column the command line reports, and the last good image stays.
+    n = frames()
+    src = driver.execute_script("return document.getElementById('frame').src")
+    driver.execute_script("""const e = document.getElementById('equation');
+                             e.value = 'x^2+*y'; e.dispatchEvent(new Event('change'));""")
+    wait.until(lambda d: d.find_element(By.ID, "error").text != "")
+    box = driver.find_element(By.ID, "error")
+    lines = box.get_attribute("textContent").split("\n")
+    if box.get_attribute("data-column") != "5" or lines[0] != "x^2+*y" or lines[1] != " " * 4 + "^" \
+            or "at character 5 of the equation" not in lines[2]:
+        fail(f"error box: {lines!r}")
+    if frames() != n or driver.execute_script("return document.getElementById('frame').src") != src:
+        fail("the image changed with a bad equation")
+
+    # Back to the good equation; then the saved scene renders to the last full-size frame.
+    n = frames()
+    driver.execute_script("""const e = document.getElementById('equation');
+                             e.value = arguments[0]; e.dispatchEvent(new Event('change'));""", original)
+    last = settle(n)
+    if driver.find_element(By.ID, "error").text != "":
+        fail("the error stayed after a good equation")
+    toml_url = url.rstrip("/") + driver.execute_script("return '/scene.toml?' + query(view.width, view.height, false)")
+    with urllib.request.urlopen(toml_url, timeout=60) as r:
+        saved = r.read()
+    with open(os.path.join(WORK, "saved.toml"), "wb") as f:
+        f.write(saved)
+    out = os.path.join(WORK, "saved.png")
+    subprocess.run([BINARY, "render", os.path.join(WORK, "saved.toml"), "-o", out], check=True)
+    with open(out, "rb") as f:
+        if idat(f.read()) != idat(last):
+            fail("the saved scene does not render to the view's last full-size frame")
+finally:
+    if driver is not None:
+        driver.quit()
+    server.terminate()
+    server.wait(timeout=30)
+print("test_view_browser: first frame, drag, slider, located error and saved scene all hold in Chromium")
