@@ -1,6 +1,7 @@
 // `algray view`: a local web server that shows a scene live in the browser (its page, frames and saved scenes).
 #include <algray/algray.h>
 #include <httplib.h>
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <charconv>
@@ -9,7 +10,6 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <stdexcept>
-#include <toml++/toml.h>
 
 #include "algray/scene/solver_options.h"
 #include "algray/util/embedded_files.h"
@@ -100,6 +100,8 @@ json scene_summary(const api::Scene& scene, const std::string& device) {
   json precisions = json::array({"auto"}), isolations = json::array();
   for (const auto& c : kPrecisions) precisions.push_back(c.name);
   for (const auto& c : kIsolations) isolations.push_back(c.name);
+  json refinements = json::array();
+  for (const auto& c : kRefinements) refinements.push_back(c.name);
   const std::vector<std::string> equations = scene.equations();
   return {{"name", scene.name()},
           {"equation", equations.empty() ? "" : equations.front()},
@@ -111,10 +113,12 @@ json scene_summary(const api::Scene& scene, const std::string& device) {
           {"extent_radius", t["extent"]["radius"].value_or(1.0)},
           {"precision", t["render"]["precision"].value_or(std::string("auto"))},
           {"isolation", t["render"]["isolation"].value_or(std::string("bernstein"))},
+          {"refinement", t["render"]["refinement"].value_or(std::string("brent"))},
           {"width", scene.width()},
           {"height", scene.height()},
           {"precisions", precisions},
           {"isolations", isolations},
+          {"refinements", refinements},
           {"device", device}};
 }
 
@@ -193,6 +197,9 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
                const json s = json::parse(stats);
                double kernel_ms = 0;
                for (const json& p : s["passes"]) kernel_ms += p.value("kernel_ms", 0.0);
+               int new_programs = 0;  // built or loaded from disk for this frame, rather than kept in memory
+               for (const json& p : s["programs"]) new_programs += p.value("origin", "") != "memory";
+               res.set_header("X-Algray-New-Programs", std::to_string(new_programs));
                int degree = 0;
                for (const json& surface : s["surfaces"]) degree = std::max(degree, surface.value("degree", 0));
                res.set_header("X-Algray-Kernel-Ms", std::to_string(kernel_ms));
@@ -207,6 +214,17 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
                q.scene.set("render.preview", q.full ? "false" : "true");
                res.set_header("Content-Disposition", "attachment; filename=\"scene.toml\"");
                res.set_content(q.scene.to_toml(), "application/toml");
+             }));
+  server.Get("/orbit.toml", guarded([&](const httplib::Request& req, httplib::Response& res) {
+               const int frames = int_param(req, "frames", 36, 2, 3600);
+               (void)parse_query(base, req);  // the same settings as scene.toml, checked alike
+               res.set_header("Content-Disposition", "attachment; filename=\"orbit.toml\"");
+               res.set_content(
+                   "# An orbit about the look-at point of the scene as `algray view` showed it. With scene.toml "
+                   "beside this file\n# (the page saves both): algray batch orbit.toml\n[[job]]\nname = \"orbit\"\n"
+                   "scene = \"scene.toml\"\noutput = \"orbit_{frame:03}.png\"\norbit = { frames = " +
+                       std::to_string(frames) + ", degrees = 360 }\n",
+                   "application/toml");
              }));
   server.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
     res.status = 500;

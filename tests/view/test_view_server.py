@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """`algray view` without a browser: 200 concurrent valid and malformed requests to one server, the errors it
-answers, and a saved scene that `algray render` turns into the view's own frame.
+answers, saved scenes that `algray render` turns into the view's own frames, an orbit job that `algray batch`
+renders, and programs kept in memory across frames of one degree.
 
 Usage: test_view_server.py ALGRAY_BINARY WORK_DIR. Fails (exit 1) on the first broken expectation, naming the
 seed and the request; needs an OpenCL device, as every render does."""
@@ -121,7 +122,42 @@ try:
         with open(f"{WORK}/saved_{full}.png", "rb") as f:
             if idat(f.read()) != idat(frame):
                 fail(f"full={full}: `algray render` of the saved scene is not the view's frame")
+
+    # One context and program cache for the server's life: a parameter change builds nothing, a degree change does.
+    small = [("width", "24"), ("height", "16")]
+    get(base, "/frame.png", small + [("set", "phi=1.5")])
+    _, headers, _ = get(base, "/frame.png", small + [("set", "phi=1.55")])
+    if headers["X-Algray-New-Programs"] != "0":
+        fail(f"a parameter change took {headers['X-Algray-New-Programs']} programs not in memory")
+    _, headers, _ = get(base, "/frame.png", small + [("set", 'surface.equation="x^4+y^4+z^4-1"')])
+    if headers["X-Algray-Degree"] != "4" or headers["X-Algray-New-Programs"] == "0":
+        fail(f"a degree change: degree {headers['X-Algray-Degree']}, {headers['X-Algray-New-Programs']} new programs")
+
+    # The orbit job: scene.toml and orbit.toml side by side, which `algray batch` renders; frame 0 is the view's.
+    orbit_dir = os.path.join(WORK, "orbit")
+    os.makedirs(orbit_dir, exist_ok=True)
+    for name, params in (("scene.toml", view), ("orbit.toml", view + [("frames", "4")])):
+        status, _, body = get(base, "/" + name, params + [("full", "0")])
+        if status != 200:
+            fail(f"{name}: {status} {body[:200]!r}")
+        with open(os.path.join(orbit_dir, name), "wb") as f:
+            f.write(body)
+    subprocess.run([BINARY, "batch", os.path.join(orbit_dir, "orbit.toml")], check=True, capture_output=True)
+    made = sorted(n for n in os.listdir(orbit_dir) if n.startswith("orbit_") and n.endswith(".png"))
+    if made != [f"orbit_{k:03}.png" for k in range(4)]:
+        fail(f"the orbit job wrote {made}")
+    _, _, frame = get(base, "/frame.png", view + [("full", "0")])
+    with open(os.path.join(orbit_dir, "orbit_000.png"), "rb") as f:
+        first = f.read()
+    with open(os.path.join(orbit_dir, "orbit_001.png"), "rb") as f:
+        second = f.read()
+    if idat(first) != idat(frame) or idat(second) == idat(frame):
+        fail("the orbit's frame 0 is not the view's frame, or its frame 1 did not turn")
+    status, _, _ = get(base, "/orbit.toml", view + [("frames", "1")])
+    if status != 400:
+        fail(f"an orbit of 1 frame got {status}")
 finally:
     server.terminate()
     server.wait(timeout=30)
-print("test_view_server: 200 concurrent requests answered, errors located, saved scenes render to the frames")
+print("test_view_server: 200 concurrent requests answered, errors located, saved scenes and orbit jobs render, "
+      "programs kept")
