@@ -123,6 +123,14 @@ try:
             if idat(f.read()) != idat(frame):
                 fail(f"full={full}: `algray render` of the saved scene is not the view's frame")
 
+    # The frame's PNG embeds its scene: `algray render frame.png` renders it again.
+    with open(f"{WORK}/frame.png", "wb") as f:
+        f.write(frame)
+    subprocess.run([BINARY, "render", f"{WORK}/frame.png", "-o", f"{WORK}/again.png"], check=True)
+    with open(f"{WORK}/again.png", "rb") as f:
+        if idat(f.read()) != idat(frame):
+            fail("the frame's embedded scene does not render to the frame")
+
     # One context and program cache for the server's life: a parameter change builds nothing, a degree change does.
     small = [("width", "24"), ("height", "16")]
     get(base, "/frame.png", small + [("set", "phi=1.5")])
