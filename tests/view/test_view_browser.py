@@ -7,11 +7,11 @@ Usage: test_view_browser.py ALGRAY_BINARY WORK_DIR. Needs chromium, chromium-dri
 (scripts/install-deps.sh installs them) and an OpenCL device; fails loudly without any of them."""
 import base64
 import os
-import struct
 import subprocess
 import sys
 import urllib.request
-import zlib
+
+from png_data import idat
 
 BINARY, WORK = sys.argv[1], sys.argv[2]
 os.makedirs(WORK, exist_ok=True)
@@ -34,17 +34,6 @@ for tool in ("/usr/bin/chromium", "/usr/bin/chromedriver"):
 def fail(message):
     print(f"test_view_browser: FAILED: {message}", file=sys.stderr)
     sys.exit(1)
-
-
-def idat(png):
-    """The image data of a PNG: the same pixels from algray's one encoder give the same bytes."""
-    pos, data = 8, b""
-    while pos < len(png):
-        length, kind = struct.unpack(">I4s", png[pos:pos + 8])
-        if kind == b"IDAT":
-            data += png[pos + 8:pos + 8 + length]
-        pos += 12 + length
-    return zlib.decompress(data)
 
 
 # The frame the page shows, as PNG bytes, read back from its blob URL.

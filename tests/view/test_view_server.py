@@ -9,13 +9,13 @@ import concurrent.futures
 import json
 import os
 import random
-import struct
 import subprocess
 import sys
 import urllib.error
 import urllib.parse
 import urllib.request
-import zlib
+
+from png_data import idat
 
 BINARY, WORK = sys.argv[1], sys.argv[2]
 SEED = int(os.environ.get("ALGRAY_TEST_SEED", "20261204"))
@@ -34,18 +34,6 @@ def get(base, path, params=()):
             return r.status, r.headers, r.read()
     except urllib.error.HTTPError as e:
         return e.code, e.headers, e.read()
-
-
-def idat(png):
-    """The image data of a PNG: the same pixels from algray's one encoder give the same bytes."""
-    assert png[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
-    pos, data = 8, b""
-    while pos < len(png):
-        length, kind = struct.unpack(">I4s", png[pos:pos + 8])
-        if kind == b"IDAT":
-            data += png[pos + 8:pos + 8 + length]
-        pos += 12 + length
-    return zlib.decompress(data)
 
 
 server = subprocess.Popen([BINARY, "view", "--port", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
