@@ -101,6 +101,27 @@ try:
     if slid == dragged:
         fail("the image did not change with the slider")
 
+    # The wheel and a two-finger pinch zoom: the eye moves along its line to the look-at point.
+    def distance():
+        return driver.execute_script("return Math.hypot(...sub(view.camera.eye, view.camera.look_at))")
+    before = distance()
+    n = frames()
+    driver.execute_script("document.getElementById('frame').dispatchEvent("
+                          "new WheelEvent('wheel', {deltaY: 200, cancelable: true}))")
+    if abs(distance() / before - 2.718281828 ** 0.2) > 1e-9:
+        fail(f"the wheel scaled the distance by {distance() / before}")
+    before = distance()
+    driver.execute_script("""const f = document.getElementById('frame');
+      const p = (type, id, x) => f.dispatchEvent(new PointerEvent(type, {pointerId: id, clientX: x, clientY: 100,
+                                                                        bubbles: true, cancelable: true}));
+      p('pointerdown', 11, 100); p('pointerdown', 12, 200); p('pointermove', 12, 300);
+      p('pointerup', 12, 300); p('pointerup', 11, 100);""")
+    if abs(distance() / before - 0.5) > 1e-9:
+        fail(f"spreading two fingers from 100 to 200 px scaled the distance by {distance() / before}, not 0.5")
+    zoomed = settle(n)
+    if zoomed == slid:
+        fail("the image did not change with the zoom")
+
     # A bad equation: the error under the column the command line reports, and the last good image stays.
     n = frames()
     src = driver.execute_script("return document.getElementById('frame').src")
