@@ -77,18 +77,15 @@ SearchNoise search_noise(const REAL* c, RayTerms* terms) {
 /* An upper bound on the noise of any coefficients summed from terms of size at most `terms`. */
 REAL noise_bound(REAL terms) { return DOUBT_NOISE(terms, terms); }
 
-/* Whether |value| is within the noise (a NaN is not). */
-int within_noise(SearchNoise* n, REAL value) {
-  if (!(fabs(value) <= n->noise)) return 0;
-  if (!n->terms->exact) n->noise = DOUBT_NOISE(n->scale, ray_terms_exact(n->terms));
-  return fabs(value) <= n->noise;
-}
-
-/* The noise with the ray's terms summed: what the refined root's check (doubt_flat_root) compares against. */
+/* The noise with the ray's terms summed: what a value within the upper bound's noise, and the refined root's
+ * check (doubt_flat_root), compare against. */
 REAL exact_noise(SearchNoise* n) {
   if (!n->terms->exact) n->noise = DOUBT_NOISE(n->scale, ray_terms_exact(n->terms));
   return n->noise;
 }
+
+/* Whether |value| is within the noise (a NaN is not). */
+int within_noise(SearchNoise* n, REAL value) { return fabs(value) <= n->noise && fabs(value) <= exact_noise(n); }
 #endif
 
 /* The scalar isolation is handed the ray's terms (RayTerms in restrict.h) in adaptive builds, nothing in others;

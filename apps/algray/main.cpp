@@ -338,42 +338,27 @@ struct DevicesCommand {
   int run() { return run_devices(stats_path, std::cout, std::cerr); }
 };
 
-// `algray view`: the scene options that make sense live, and where to listen.
+// `algray view`: the scene options every scene command takes, and where to listen.
 struct ViewCommand {
   CLI::App* cmd = nullptr;
   ViewRequest request;
-  std::string scene_path, precision;
-  std::vector<std::string> sets;
-  bool no_cache = false;
+  SceneOptions scene;
 
   void add_to(CLI::App& app) {
     cmd = app.add_subcommand("view", "explore a scene live in the browser: a local web server for its page and frames");
-    cmd->add_option("scene", scene_path,
-                    "scene file (.toml, .jsurf or an algray PNG); default: the built-in Barth sextic");
+    add_scene_options(cmd, scene);
     cmd->add_option("--port", request.port, "port to listen on (default: any free port; the URL is printed)")
         ->check(CLI::Range(0, 65535));
     cmd->add_option("--host", request.host,
                     "address to listen on (default 127.0.0.1; any other is reachable from other machines)");
-    cmd->add_option("--device", request.device_spec, "device index or name substring (see `algray devices`)");
-    cmd->add_option("--precision", precision, precision_choices("or") + " (overrides render.precision)");
-    cmd->add_option("--set", sets, "override a scene key: name=value (a bare name is a parameter)");
     cmd->add_flag("--open", request.open, "open the page in the default browser (xdg-open)");
-    cmd->add_flag("--no-cache", no_cache, "compile kernels from source; neither read nor write the program cache");
-    add_no_fp64_flag(cmd);
   }
 
   int run() {
-    if (!scene_path.empty()) request.scene_path = scene_path;
-    for (const std::string& s : sets) {
-      const auto eq = s.find('=');
-      if (eq == std::string::npos || eq == 0) {
-        std::cerr << "algray: --set " << s << ": expected name=value\n";
-        return kExitBadInput;
-      }
-      request.overrides.push_back({s.substr(0, eq), s.substr(eq + 1)});
-    }
-    if (!precision.empty()) request.overrides.push_back({"render.precision", "\"" + precision + "\""});
-    request.use_cache = !no_cache;
+    if (!scene.scene_path.empty()) request.scene_path = scene.scene_path;
+    if (!collect_overrides(cmd, scene, request.overrides)) return kExitBadInput;
+    request.device_spec = scene.device_spec;
+    request.use_cache = !scene.no_cache;
     return run_view(request, std::cout, std::cerr);
   }
 };

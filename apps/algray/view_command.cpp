@@ -92,16 +92,21 @@ std::vector<double> numbers(const toml::node* node) {
   return out;
 }
 
+// The names of one list of solver choices (solver_options.h), as the page's selectors offer them.
+template <class Choices>
+json choice_names(const Choices& choices) {
+  json names = json::array();
+  for (const auto& c : choices) names.push_back(c.name);
+  return names;
+}
+
 // What the page starts from: the scene's equation, parameters, camera, extent and solver, and the choices.
 json scene_summary(const api::Scene& scene, const std::string& device) {
   const toml::table t = toml::parse(scene.to_toml());
   json parameters = json::object();
   for (const auto& [name, value] : scene.parameters()) parameters[name] = value;
-  json precisions = json::array({"auto"}), isolations = json::array();
-  for (const auto& c : kPrecisions) precisions.push_back(c.name);
-  for (const auto& c : kIsolations) isolations.push_back(c.name);
-  json refinements = json::array();
-  for (const auto& c : kRefinements) refinements.push_back(c.name);
+  json precisions = choice_names(kPrecisions);
+  precisions.insert(precisions.begin(), "auto");
   const std::vector<std::string> equations = scene.equations();
   return {{"name", scene.name()},
           {"equation", equations.empty() ? "" : equations.front()},
@@ -117,8 +122,8 @@ json scene_summary(const api::Scene& scene, const std::string& device) {
           {"width", scene.width()},
           {"height", scene.height()},
           {"precisions", precisions},
-          {"isolations", isolations},
-          {"refinements", refinements},
+          {"isolations", choice_names(kIsolations)},
+          {"refinements", choice_names(kRefinements)},
           {"device", device}};
 }
 
@@ -149,14 +154,15 @@ httplib::Server::Handler guarded(F handle) {
 }  // namespace
 
 int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
-  api::Scene base = api::Scene::default_scene();
+  std::optional<api::Scene> loaded;
   try {
-    base = request.scene_path ? api::Scene::load(*request.scene_path) : api::Scene::default_scene();
-    for (const Override& o : request.overrides) base.set(o.key, o.value);
+    loaded = request.scene_path ? api::Scene::load(*request.scene_path) : api::Scene::default_scene();
+    for (const Override& o : request.overrides) loaded->set(o.key, o.value);
   } catch (const api::SceneError& e) {
     err << e.what() << "\n";
     return kExitBadInput;
   }
+  const api::Scene& base = *loaded;
   // One context and program cache for as long as the server runs: only a new degree builds a kernel.
   std::optional<api::Renderer> renderer;
   std::string device;

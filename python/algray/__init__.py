@@ -61,13 +61,8 @@ def _image_stats(self):
     return json.loads(self.stats_json)
 
 
-def _image_png(self):
-    """The image as PNG bytes, as `save("x.png")` writes it (Jupyter shows an Image by this)."""
-    return self.png()
-
-
 Image.stats = property(_image_stats)
-Image._repr_png_ = _image_png
+Image._repr_png_ = Image.png  # Jupyter shows an Image by its PNG bytes
 Image.__repr__ = lambda self: f"<algray.Image {self.width}x{self.height}>"
 
 
