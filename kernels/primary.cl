@@ -33,43 +33,18 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
                                        mono_exps, mono_coefs, mono_count, binomials, even_axes SCREEN_ARG);
   out[(size_t)gy * tile_w + gx] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
 #else
-  /* LANES pixels of a row per work-item: each is clipped and restricted on its own, then all are isolated,
-   * refined, and their normals taken, together in vector lanes (lanes.h). Global size (ceil(tile_w / LANES), tile_h);
-   * the pixels are the same as above. */
+  /* LANES pixels of a row per work-item, traced together (trace_lanes). Global size (ceil(tile_w / LANES),
+   * tile_h); the pixels are the same as above. */
   const uint gx = get_global_id(0), gy = get_global_id(1);
   const uint x0 = gx * LANES;
   if (x0 >= tile_w || gy >= tile_h) return;
   const uint count = min((uint)LANES, tile_w - x0), py = tile_y0 + gy;
   Ray rays[LANES];
-  SurfaceHit hits[LANES];
-  Isolation iso[LANES];
-  SegmentRoot roots[LANES];
-  REAL t_in[LANES], t_out[LANES];
-  LREAL iso_c[NCOEF];
-  int in_extent[LANES];
-  REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
-#if ALGRAY_ESCALATE
-  RayTerms terms[LANES];
-#endif
-  for (uint j = 0; j < count; ++j) {
-    const uint px = tile_x0 + x0 + j;
-    rays[j] = camera_ray(px, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
-    in_extent[j] = enter_surface(rays[j], extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                 &hits[j], &t_in[j], &t_out[j]);
-    if (!in_extent[j]) continue;
-#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
-    REAL taylor[NCOEF];
-    const REAL taylor_t = screen_ray_taylor(px, py, SCREEN_ROWS_ARG, taylor);
-#endif
-    segment_coefficients(hits[j].u, hits[j].d_unit, t_in[j], t_out[j], mono_exps, mono_coefs, mono_count, binomials,
-                         even_axes, root[j], root_lo[j] TERMS_OUT(&terms[j]) SCREEN_ARG);
-  }
-  isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, iso, iso_c TERMS_OUT(terms));
-  refine_lanes(count, in_extent, iso, iso_c, t_in, t_out, binomials, roots);
   for (uint j = 0; j < count; ++j)
-    if (in_extent[j]) finish_surface(&hits[j], roots[j]);
+    rays[j] = camera_ray(tile_x0 + x0 + j, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
   HitRecord records[LANES];
-  hit_records_lanes(count, rays, hits, mono_exps, mono_coefs, mono_count, records);
+  trace_lanes(count, rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind, mono_exps, mono_coefs,
+              mono_count, binomials, even_axes, records SCREEN_LANES_ARG(tile_x0 + x0, py));
   for (uint j = 0; j < count; ++j) out[(size_t)gy * tile_w + x0 + j] = records[j];
 #endif
 }

@@ -33,6 +33,9 @@
 #define SCREEN_ROWS_PARAM \
   , __global const REAL *screen_rows, uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset
 #define SCREEN_ROWS_ARG screen_rows, screen_row0, screen_t, xi_scale, xi_offset
+/* A group of lanes (trace_lanes) is LANES pixels of one row from px0 on, whose Taylor coefficients it takes. */
+#define SCREEN_LANES_PARAM , uint px0, uint py SCREEN_ROWS_PARAM
+#define SCREEN_LANES_ARG(px0, py) , px0, py, SCREEN_ROWS_ARG
 
 /* Pixel (px, py)'s Taylor coefficients; returns the t they are expanded about. */
 REAL screen_ray_taylor(uint px, uint py, __global const REAL* rows, uint row0, REAL t0, REAL xi_scale, REAL xi_offset,
@@ -45,6 +48,8 @@ REAL screen_ray_taylor(uint px, uint py, __global const REAL* rows, uint row0, R
 #define SCREEN_PARAM
 #define SCREEN_ARG
 #define SCREEN_ROWS_PARAM
+#define SCREEN_LANES_PARAM
+#define SCREEN_LANES_ARG(px0, py)
 #endif
 
 /* The outcome of isolating and refining the smallest root of P*(t) on [t_in, t_out]. */
@@ -463,6 +468,41 @@ void hit_records_lanes(uint count, const Ray* rays, const SurfaceHit* hits, __gl
     if (hits[j].root.flags & ALGRAY_HIT_FOUND) g = (REAL3)(lane_get(gx, j), lane_get(gy, j), lane_get(gz, j));
     out[j] = hit_record_with_gradient(rays[j], hits[j], g);
   }
+}
+#endif
+
+#if LANES > 1
+/* trace_surface and hit_record for rays[0 .. count), count <= LANES: each ray is clipped and restricted on its
+ * own, then all are isolated, refined and their normals taken together in vector lanes (lanes.h), with the
+ * one-ray kernel's records bit for bit (tests/test_lanes). Camera and secondary rays share it. */
+void trace_lanes(uint count, const Ray* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
+                 __global const uint* exps, __global const REAL* coefs, uint mono_count,
+                 __constant const REAL* binomials, uint even_axes, HitRecord* records SCREEN_LANES_PARAM) {
+  SurfaceHit hits[LANES];
+  Isolation iso[LANES];
+  SegmentRoot roots[LANES];
+  REAL t_in[LANES], t_out[LANES];
+  LREAL iso_c[NCOEF];
+  int in_extent[LANES];
+  REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
+#if ALGRAY_ESCALATE
+  RayTerms terms[LANES];
+#endif
+  for (uint j = 0; j < count; ++j) {
+    in_extent[j] = enter_surface(rays[j], centre, inv_scale, box_half, extent_kind, &hits[j], &t_in[j], &t_out[j]);
+    if (!in_extent[j]) continue;
+#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
+    REAL taylor[NCOEF];
+    const REAL taylor_t = screen_ray_taylor(px0 + j, py, SCREEN_ROWS_ARG, taylor);
+#endif
+    segment_coefficients(hits[j].u, hits[j].d_unit, t_in[j], t_out[j], exps, coefs, mono_count, binomials, even_axes,
+                         root[j], root_lo[j] TERMS_OUT(&terms[j]) SCREEN_ARG);
+  }
+  isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, iso, iso_c TERMS_OUT(terms));
+  refine_lanes(count, in_extent, iso, iso_c, t_in, t_out, binomials, roots);
+  for (uint j = 0; j < count; ++j)
+    if (in_extent[j]) finish_surface(&hits[j], roots[j]);
+  hit_records_lanes(count, rays, hits, exps, coefs, mono_count, records);
 }
 #endif
 

@@ -1,6 +1,7 @@
 /* The secondary-ray kernel: given rays (reflection, transmission) against the surface, one work-item per ray. */
 #include "algray_shared.h"
 #include "isolate.h"
+#include "lanes.h"
 #include "ray.h"
 #include "real.h"
 #include "restrict.h"
@@ -11,11 +12,13 @@
 #endif
 
 /* Ray i is origins[i].xyz + t * directions[i].xyz, t >= 0, in world coordinates; its hit goes to out[i] as the
- * primary kernel writes it (t, depth, normal facing the ray, side, work). */
-__kernel void trace(__global const REAL4* origins, __global const REAL4* directions, uint count,
-                    REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
-                    __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
-                    __constant const REAL* binomials, uint even_axes, __global HitRecord* out) {
+ * primary kernel writes it (t, depth, normal facing the ray, side, work). With LANES > 1, global size
+ * ceil(count / LANES) and LANES consecutive rays per work-item (trace_lanes), with the same records. */
+__kernel void trace(__global const REAL4* origins, __global const REAL4* directions, uint count, REAL4 extent_centre,
+                    REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind, __global const uint* mono_exps,
+                    __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials, uint even_axes,
+                    __global HitRecord* out) {
+#if LANES == 1
   const uint i = get_global_id(0);
   if (i >= count) return;
   Ray ray;
@@ -24,4 +27,18 @@ __kernel void trace(__global const REAL4* origins, __global const REAL4* directi
   const SurfaceHit hit = trace_surface(ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
                                        mono_exps, mono_coefs, mono_count, binomials, even_axes);
   out[i] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
+#else
+  const uint first = get_global_id(0) * LANES;
+  if (first >= count) return;
+  const uint group = min((uint)LANES, count - first);
+  Ray rays[LANES];
+  for (uint j = 0; j < group; ++j) {
+    rays[j].o = origins[first + j].xyz;
+    rays[j].d = directions[first + j].xyz;
+  }
+  HitRecord records[LANES];
+  trace_lanes(group, rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind, mono_exps, mono_coefs,
+              mono_count, binomials, even_axes, records);
+  for (uint j = 0; j < group; ++j) out[first + j] = records[j];
+#endif
 }

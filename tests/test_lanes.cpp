@@ -1,4 +1,4 @@
-// The primary kernel traced in vector lanes (render.lanes, kernels/lanes.h) against one ray per work-item: the
+// The primary and trace kernels in vector lanes (render.lanes, kernels/lanes.h) against one ray per work-item: the
 // same hit records bit for bit, on seeded random surfaces, in every precision and with partial lane groups.
 #include <catch2/catch.hpp>
 #include <cstring>
@@ -112,16 +112,57 @@ TEST_CASE("lanes give the one-ray kernel's hit records where groups settle witho
   }
 }
 
-TEST_CASE("the plan gives lanes to the primary kernel alone, where they apply", "[lanes]") {
+// Reflection and transmission rays of a random surface, traced by the trace kernel: its lanes against one ray
+// per work-item, in every precision. In adaptive precision the camera rays' doubts go to the trace kernel too.
+TEST_CASE("secondary rays in lanes give the one-ray kernel's hit records bit for bit", "[lanes]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  std::size_t rays = 0, partial_groups = 0;
+  for (int degree : {2, 4, 7, 10}) {
+    const unsigned seed = 2100u + static_cast<unsigned>(degree);
+    for (const NamedChoice<Precision>& choice : kPrecisions) {
+      if (choice.value == Precision::Mixed && degree > kMaxMixedDegree) continue;
+      const auto render = [&](int lanes) {
+        return renderer.render_with_records(load_scene_text(
+            testing::random_scene(degree, seed, choice.value) + "[[light]]\nposition = [3, 3, 3]\n", "random",
+            {{"render.preview", "false"},
+             {"render.lanes", std::to_string(lanes)},
+             {"material.front.reflectivity", "0.5"},
+             {"material.back.transparency", "0.5"}}));
+      };
+      const RenderResult one = render(1), many = render(8);
+      REQUIRE(many.plan.find(PassKind::Reflection)->kernels.at(0).lanes == 8);
+      REQUIRE(one.secondary.size() == many.secondary.size());
+      INFO("degree " << degree << ", seed " << seed << ", " << choice.name);
+      CHECK(first_difference(one.hits.records, many.hits.records) == -1);
+      for (std::size_t b = 0; b < one.secondary.size(); ++b) {
+        const std::vector<HitRecord>& hits = one.secondary[b].hits;
+        INFO("batch " << b << " of " << one.secondary.size() << ", " << hits.size() << " rays");
+        CHECK(first_difference(hits, many.secondary[b].hits) == -1);
+        rays += hits.size();
+        partial_groups += hits.size() % 8 != 0;
+      }
+    }
+  }
+  CHECK(rays > 10000);        // the surfaces are in view and spawn secondary rays
+  CHECK(partial_groups > 0);  // and some batch ends in a partial group of lanes
+}
+
+TEST_CASE("the plan gives lanes to the camera and secondary rays' kernels, where they apply", "[lanes]") {
   const std::string text = testing::random_scene(6, 2006, Precision::Double);
   const Scene full = load_scene_text(text + "[[light]]\nposition = [3, 3, 3]\n", "random",
                                      {{"render.preview", "false"}, {"material.front.reflectivity", "0.5"}});
   const RenderPlan plan = make_render_plan(full, Precision::Double, 0, 8);
   CHECK(plan.find(PassKind::Primary)->kernels.at(0).lanes == 8);
   CHECK(plan.find(PassKind::Primary)->kernels.at(0).key().find(" lanes=8") != std::string::npos);
-  for (const PlannedPass& pass : plan.passes)
-    if (pass.kind != PassKind::Primary)
-      for (const KernelConfig& k : pass.kernels) CHECK(k.lanes == 1);
+  CHECK(plan.find(PassKind::Reflection)->kernels.at(0).lanes == 8);
+  CHECK(plan.find(PassKind::Shadow)->kernels.at(0).lanes == 1);  // the shadow kernel batches rays its own way
+  // Adaptive precision's second pass for camera rays is the trace kernel: in lanes too.
+  const RenderPlan adaptive = make_render_plan(full, Precision::Adaptive, 0, 8);
+  CHECK(adaptive.find(PassKind::Primary)->escalation.at(0).entry == "trace");
+  CHECK(adaptive.find(PassKind::Primary)->escalation.at(0).lanes == 8);
+  CHECK(adaptive.find(PassKind::Shadow)->escalation.at(0).lanes == 1);
   // A refinement without a lane version keeps one ray per work-item; the scene's setting overrides the device's.
   const Scene bisection = load_scene_text(text, "random", {{"render.refinement", "\"bisection\""}});
   CHECK(make_render_plan(bisection, Precision::Double, 0, 8).find(PassKind::Primary)->kernels.at(0).lanes == 1);

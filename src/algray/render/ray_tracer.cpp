@@ -5,7 +5,7 @@ namespace algray {
 
 RayTracer::RayTracer(ClSession& session, ProgramCache& cache, const KernelConfig& config,
                      const DeviceSurface& surface)
-    : session_(session), surface_(surface) {
+    : session_(session), surface_(surface), lanes_(static_cast<std::size_t>(config.lanes)) {
   kernel_ = cache.kernel(session, config, &record_);
   largest_group_ = largest_group(kernel_, session.info.device);
 }
@@ -59,7 +59,7 @@ TracedBatch RayTracer::trace(const std::vector<PixelRay>& rays) {
   surface_.set_surface_args(args);
   args.plain(out_);
   cl::Event done;
-  const RayLaunch launch = ray_launch(count, largest_group_);
+  const RayLaunch launch = ray_launch((count + lanes_ - 1) / lanes_, largest_group_);
   queue.enqueueNDRangeKernel(kernel_, cl::NullRange, launch.global, launch.local, nullptr, &done);
   done.wait();
   batch.kernel_ms = ms_between(done);

@@ -29,6 +29,7 @@ class RayTracer {
   ProgramRecord record_;
   cl::Kernel kernel_;
   std::size_t largest_group_ = 1;  // the kernel's work-group limit on the device
+  std::size_t lanes_ = 1;          // rays per work-item (KernelConfig::lanes)
   std::size_t capacity_ = 0;
   cl::Buffer origins_, directions_, out_;
   std::vector<double> staging_;  // REAL4 values before the upload, in double or (staging_float_) float

@@ -91,7 +91,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
     std::vector<KernelConfig> configs = primary;
     for (KernelConfig& c : configs) {
       c.entry = entry;
-      c.lanes = 1;  // lanes are the camera rays' (kernels/primary.cl)
+      if (!lanes_apply(c)) c.lanes = 1;  // the shadow kernel batches its rays its own way (kernels/shadow.cl)
       if (c.ray_origin == RayOrigin::Screen) c.ray_origin = RayOrigin::Extent;  // the screen form is camera rays'
     }
     return configs;

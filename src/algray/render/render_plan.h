@@ -92,8 +92,8 @@ void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device);
 // The passes and buffers `scene` calls for in `precision`. The primary pass is always there; the shadow pass
 // only when a light casts shadows and the scene is not a preview.
 // tile_size: the tile side in traced rays; 0 takes the scene's render.tile_size, or 1024 when it has none.
-// lanes: camera rays per primary work-item where lanes_apply (kernel_config.h); the scene's render.lanes, when
-// set, comes first.
+// lanes: rays per work-item of the primary and trace kernels where lanes_apply (kernel_config.h); the scene's
+// render.lanes, when set, comes first.
 RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size = 0, int lanes = 1);
 
 // Whether RayOrigin::Auto means the screen form for camera rays: in double, with the camera outside the extent,

@@ -103,7 +103,7 @@ struct RenderSettings {
   RayOrigin ray_origin = RayOrigin::Auto;
   int max_iterations = 0;  // 0: the refinement's default (default_max_iterations)
   int tile_size = 0;       // pixels per side of a dispatched tile; 0 chooses by device type
-  int lanes = 0;           // camera rays per primary work-item (kernels/lanes.h); 0 chooses by device type
+  int lanes = 0;           // rays per work-item of camera and secondary rays (kernels/lanes.h); 0: by device type
   bool preview = false;    // primary rays only: lights shade, but cast no shadows (the paper's preview mode)
   // Secondary bounces after the camera ray: reflection and transmission rays stop after this many.
   int max_depth = 5;
