@@ -64,7 +64,7 @@ typedef struct {
   RayTerms* terms;
 } SearchNoise;
 
-SearchNoise search_noise(const REAL* c, RayTerms* terms) {
+ALGRAY_INLINE SearchNoise search_noise(const REAL* c, RayTerms* terms) {
   SearchNoise n;
   n.scale = 0;
   ALGRAY_UNROLL

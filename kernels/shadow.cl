@@ -26,7 +26,7 @@
 /* Whether the scaled coefficients c (before bernstein_from_scaled) settle bernstein_root_by_signs' answer with
  * every coefficient it reads further from zero than noise_bound(terms) scaled alike: then no rounding could
  * change it. c_0, P at the ray's start, does not count (first_counted): the isolation takes its sign as it is. */
-int signs_clear_of(const REAL* c, int by_signs, REAL terms, __constant const REAL* binomials) {
+ALGRAY_INLINE int signs_clear_of(const REAL* c, int by_signs, REAL terms, __constant const REAL* binomials) {
   const REAL noise = noise_bound(terms);
   /* c_0 exactly zero: the search doubts a root at the start, so the shortcut must not settle it */
   if (by_signs == ISOLATION_BRACKET) return c[0] != 0 && fabs(c[DEGREE]) > noise;
@@ -43,9 +43,9 @@ int signs_clear_of(const REAL* c, int by_signs, REAL terms, __constant const REA
  * only when the signs stand clear of the noise: of extent_terms, the bound on every ray's terms in the extent,
  * then of the ray's terms' upper bound, then of their sum; each check costs more and passes more rays).
  * *doubt gets the search's. f: the ray's coordinates' factors, for adaptive builds' terms. */
-int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials, uint* doubt,
-                     __global const uint* exps, __global const REAL* coefs, uint count, AxisFactor fx, AxisFactor fy,
-                     AxisFactor fz, REAL extent_terms) {
+ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
+                                   uint* doubt, __global const uint* exps, __global const REAL* coefs, uint count,
+                                   AxisFactor fx, AxisFactor fy, AxisFactor fz, REAL extent_terms) {
   *doubt = 0;
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   const int by_signs = bernstein_root_by_signs(root);

@@ -236,9 +236,10 @@ void restricted_to_isolation_basis(REAL* root, REAL* root_lo, __constant const R
 
 /* P*(t) on [t_in, t_out] for the ray o + t*d in unit coordinates, in the isolation method's basis: Bernstein
  * coefficients on the segment, or the power basis of the segment (of the whole ray, for RAY_ORIGIN=eye). */
-void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
-                          __global const REAL* coefs, uint count, __constant const REAL* binomials, uint even_axes,
-                          REAL* root, REAL* root_lo TERMS_OUT_PARAM SCREEN_PARAM PROBE_PARAM) {
+ALGRAY_INLINE void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
+                                        __global const REAL* coefs, uint count, __constant const REAL* binomials,
+                                        uint even_axes, REAL* root,
+                                        REAL* root_lo TERMS_OUT_PARAM SCREEN_PARAM PROBE_PARAM) {
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
   /* The same coefficients the extent construction computes from the monomials, from D + 1 numbers instead. */
   (void)o;
