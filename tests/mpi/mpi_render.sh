@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # test_mpi_render: `mpirun -n 2 algray render` on this machine. The image must be the single process's, bit for
 # bit in every EXR channel and byte for byte as a PNG, with both ranks' devices in its stats; a rank whose device
-# does not open must fail the render on every rank with nothing written; bad input must end every rank with
-# exit 2 and nothing written. Without mpirun it fails, saying what to install.
+# does not open must fail the render on every rank with nothing written; a rank that starts late must still render
+# a band; bad input must end every rank with exit 2 and nothing written. Without mpirun it fails, saying what to
+# install.
 #   mpi_render.sh ALGRAY_BINARY EXR_COMPARE SOURCE_DIR WORK_DIR
 set -uo pipefail
 algray=$1
@@ -41,6 +42,22 @@ if sum(d["rays"] for d in devices) != sum(p["rays"] for p in stats["passes"]):
 for p in problems: print("test_mpi_render:", p, file=sys.stderr)
 sys.exit(1 if problems else 0)
 PY
+
+# A rank that starts late (its programs built from source while rank 0's come from the cache the single render
+# filled) still renders the band kept for it: rank 0 used to render the whole image before it asked.
+timeout 120 mpirun --oversubscribe --allow-run-as-root -x POCL_MAX_PTHREAD_COUNT=1 \
+  -n 1 "$algray" render "$scene" "${size[@]}" -o late.exr --stats late.json : \
+  -n 1 "$algray" render "$scene" "${size[@]}" -o late.exr --no-cache || fail "the render with a late rank failed"
+python3 - late.json <<'PY' || fail "the late rank rendered nothing (above)"
+import json, sys
+devices = json.load(open(sys.argv[1]))["devices"]
+late = [d for d in devices if d["rank"] == 1]
+if not late or late[0]["tiles"] <= 0:
+    print("test_mpi_render: the late rank traced nothing:", devices, file=sys.stderr)
+    sys.exit(1)
+PY
+compared=$("$exr_compare" single.exr late.exr) || fail "exr_compare failed: $compared"
+grep -q "channels bit-identical: all" <<<"$compared" || fail "the late-rank EXR differs from the single process's: $compared"
 
 # Rank 1 cannot open its device: the render fails on both ranks (exit 1), naming the rank, and writes nothing.
 timeout 120 mpirun --oversubscribe --allow-run-as-root -x POCL_MAX_PTHREAD_COUNT=1 \

@@ -43,31 +43,50 @@ struct Band {
 };
 
 // The rows still to deal, shared by rank 0's gathering loop and its render thread. Each band is cut as it is
-// dealt (band_rows), numbered in the order dealt.
+// dealt (band_rows), numbered in the order dealt. Band 0 is rank 0's and bands 1 .. ranks - 1 are kept for the
+// other ranks' first requests, so that every rank renders a band however late its device is ready (a rank that
+// started late used to find rank 0 had rendered the whole image).
 class BandQueue {
  public:
-  BandQueue(int width, int height, int ranks) : width_(width), height_(height), ranks_(ranks) {}
+  BandQueue(int width, int height, int ranks) : width_(width), height_(height), ranks_(ranks) {
+    for (int r = 0; r < ranks; ++r) deal();
+  }
+  // Band 0, rank 0's first.
+  int first_of_rank0() const { return 0; }
+  // A worker's first band: the one kept for it, unless dealing has stopped.
+  std::optional<int> first_of(int rank) {
+    const std::lock_guard<std::mutex> hold(lock_);
+    if (stopped_ || rank <= 0 || rank >= static_cast<int>(dealt_.size())) return std::nullopt;
+    return rank;
+  }
   Band band(int b) const {
     const std::lock_guard<std::mutex> hold(lock_);
     return dealt_.at(static_cast<std::size_t>(b));
   }
+  // The next band for whichever rank asks, after its first.
   std::optional<int> take() {
     const std::lock_guard<std::mutex> hold(lock_);
+    if (stopped_) return std::nullopt;
+    return deal();
+  }
+  // No band is dealt any more, kept ones included: every rank stops after the band it has in hand.
+  void stop() {
+    const std::lock_guard<std::mutex> hold(lock_);
+    stopped_ = true;
+  }
+
+ private:
+  std::optional<int> deal() {
     if (next_row_ >= height_) return std::nullopt;
     const int rows = band_rows(height_ - next_row_, height_, width_, ranks_);
     dealt_.push_back({next_row_, next_row_ + rows});
     next_row_ += rows;
     return static_cast<int>(dealt_.size()) - 1;
   }
-  // No band is dealt any more: every rank stops after the band it has in hand.
-  void stop() {
-    const std::lock_guard<std::mutex> hold(lock_);
-    next_row_ = height_;
-  }
 
- private:
   mutable std::mutex lock_;
   int width_, height_, ranks_, next_row_ = 0;
+  bool stopped_ = false;
   std::vector<Band> dealt_;
 };
 
@@ -240,7 +259,7 @@ class Gatherer {
         }
         band_done(band.end - band.first);
       }
-      const int next = queue_.take().value_or(kNoBand);
+      const int next = (header[1] == kFirstRequest ? queue_.first_of(source) : queue_.take()).value_or(kNoBand);
       const Band band = next == kNoBand ? Band{} : queue_.band(next);
       const int reply[4] = {next, band.first, band.end, depth_and_normal_ ? 1 : 0};
       MPI_Send(reply, 4, MPI_INT, source, kReplyTag, MPI_COMM_WORLD);
@@ -282,13 +301,13 @@ RenderResult render_bands_as_rank0(Renderer& renderer, const Scene& scene, const
   // Rank 0's own bands, on a thread of their own: MPI is called from the main thread only (FUNNELED). They are
   // one render, so its kernels and buffers are set up once, and its check that the image fits the device comes
   // before the film is made, when it asks for its first band; the other ranks' bands wait for the film. Band 0
-  // is its first, taken before any is dealt.
+  // is its first (BandQueue).
   RenderResult result;
   FrameImage film;
   FrameImage* film_made = nullptr;  // set before film_ready is
   std::promise<void> film_promise;
   const std::shared_future<void> film_ready = film_promise.get_future().share();
-  std::optional<int> band_in_hand = queue.take();
+  std::optional<int> band_in_hand = queue.first_of_rank0();
   std::thread own([&] {
     bool promised = false;
     try {
