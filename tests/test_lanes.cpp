@@ -119,7 +119,7 @@ TEST_CASE("secondary rays in lanes give the one-ray kernel's hit records bit for
   ProgramCache cache(false);
   Renderer renderer(session, cache);
   std::size_t rays = 0, partial_groups = 0;
-  for (int degree : {2, 4, 7, 10}) {
+  for (int degree : {3, 10}) {  // coefficients filling a float4, and 11 of a float16
     const unsigned seed = 2100u + static_cast<unsigned>(degree);
     for (const NamedChoice<Precision>& choice : kPrecisions) {
       if (choice.value == Precision::Mixed && degree > kMaxMixedDegree) continue;
@@ -127,6 +127,8 @@ TEST_CASE("secondary rays in lanes give the one-ray kernel's hit records bit for
         return renderer.render_with_records(load_scene_text(
             testing::random_scene(degree, seed, choice.value) + "[[light]]\nposition = [3, 3, 3]\n", "random",
             {{"render.preview", "false"},
+             {"image.width", "96"},
+             {"image.height", "72"},
              {"render.lanes", std::to_string(lanes)},
              {"material.front.reflectivity", "0.5"},
              {"material.back.transparency", "0.5"}}));
@@ -145,7 +147,7 @@ TEST_CASE("secondary rays in lanes give the one-ray kernel's hit records bit for
       }
     }
   }
-  CHECK(rays > 10000);        // the surfaces are in view and spawn secondary rays
+  CHECK(rays > 5000);         // the surfaces are in view and spawn secondary rays
   CHECK(partial_groups > 0);  // and some batch ends in a partial group of lanes
 }
 
