@@ -51,12 +51,10 @@ class BandQueue {
   BandQueue(int width, int height, int ranks) : width_(width), height_(height), ranks_(ranks) {
     for (int r = 0; r < ranks; ++r) deal();
   }
-  // Band 0, rank 0's first.
-  int first_of_rank0() const { return 0; }
-  // A worker's first band: the one kept for it, unless dealing has stopped.
+  // A rank's first band: the one kept for it (band r for rank r), unless dealing has stopped.
   std::optional<int> first_of(int rank) {
     const std::lock_guard<std::mutex> hold(lock_);
-    if (stopped_ || rank <= 0 || rank >= static_cast<int>(dealt_.size())) return std::nullopt;
+    if (stopped_ || rank < 0 || rank >= static_cast<int>(dealt_.size())) return std::nullopt;
     return rank;
   }
   Band band(int b) const {
@@ -307,7 +305,7 @@ RenderResult render_bands_as_rank0(Renderer& renderer, const Scene& scene, const
   FrameImage* film_made = nullptr;  // set before film_ready is
   std::promise<void> film_promise;
   const std::shared_future<void> film_ready = film_promise.get_future().share();
-  std::optional<int> band_in_hand = queue.first_of_rank0();
+  std::optional<int> band_in_hand = queue.first_of(0);
   std::thread own([&] {
     bool promised = false;
     try {

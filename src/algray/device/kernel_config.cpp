@@ -45,7 +45,8 @@ std::string hex_double(double v) {
 
 int default_lanes(const std::string& device_type) { return device_type == "CPU" ? 8 : 1; }
 bool lanes_apply(const KernelConfig& c) {
-  return (c.entry == "primary" || c.entry == "trace") && c.isolation == Isolation::Bernstein && c.refinement == Refinement::Brent;
+  return (c.entry == "primary" || c.entry == "trace") && c.isolation == Isolation::Bernstein &&
+         c.refinement == Refinement::Brent;
 }
 
 std::string KernelConfig::build_options() const {

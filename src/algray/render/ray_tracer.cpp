@@ -3,8 +3,7 @@
 
 namespace algray {
 
-RayTracer::RayTracer(ClSession& session, ProgramCache& cache, const KernelConfig& config,
-                     const DeviceSurface& surface)
+RayTracer::RayTracer(ClSession& session, ProgramCache& cache, const KernelConfig& config, const DeviceSurface& surface)
     : session_(session), surface_(surface), lanes_(static_cast<std::size_t>(config.lanes)) {
   kernel_ = cache.kernel(session, config, &record_);
   largest_group_ = largest_group(kernel_, session.info.device);

@@ -3,10 +3,10 @@
 
 #include <vector>
 
-#include "kernels/algray_shared.h"
-#include "algray/scene/camera.h"
-#include "algray/render/device_surface.h"
 #include "algray/device/program_cache.h"
+#include "algray/render/device_surface.h"
+#include "algray/scene/camera.h"
+#include "kernels/algray_shared.h"
 
 namespace algray {
 
