@@ -44,6 +44,8 @@ typedef cl_int algray_i32;
 #define ALGRAY_ORIGIN_EYE 2            /* P*(t) built around the ray origin, as the paper does */
 #define ALGRAY_ORIGIN_SCREEN 3         /* camera rays: P*(t) from its Taylor coefficients where the ray crosses the
                                           extent's middle, given per image row as polynomials in the column */
+#define ALGRAY_ORIGIN_POINT 4          /* shadow rays: P expanded once about their shared origin (point_form.h);
+                                          other rays as ALGRAY_ORIGIN_EXTENT */
 
 /* Per-pixel result of the primary kernel; 32 bytes. */
 typedef struct {

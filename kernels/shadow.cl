@@ -19,8 +19,22 @@
 #include "surface.h"
 
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
-#error "the screen form is for camera rays; the host builds this kernel with RAY_ORIGIN=extent"
+#error "the screen form is for camera rays; the host builds this kernel with RAY_ORIGIN=extent or point"
 #endif
+
+#if RAY_ORIGIN == ALGRAY_ORIGIN_POINT
+/* The point form (point_form.h): the arguments and the result are the extent form's below. */
+__kernel void shadow(SHADOW_KERNEL_PARAMS) {
+  const uint i = get_global_id(0);
+  if (i >= point_count) return;
+  (void)even_axes;
+  uint traced = 0;
+  occluded[i] = shadow_mask_point_form(points, normals, i, light_points, light_count, offset, extent_centre,
+                                       extent_inv_scale, extent_box_half, extent_kind, mono_exps, mono_coefs,
+                                       mono_count, binomials, occluded[i], &traced);
+  if (traced) atomic_add(rays_traced, traced);
+}
+#else
 
 #if ALGRAY_ESCALATE
 /* Whether the scaled coefficients c (before bernstein_from_scaled) settle bernstein_root_by_signs' answer with
@@ -140,3 +154,4 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) {
   SHADOW_UNDECIDED(i, unsure);
   if (traced) atomic_add(rays_traced, traced);
 }
+#endif /* RAY_ORIGIN == ALGRAY_ORIGIN_POINT */

@@ -15,6 +15,20 @@
 
 /* The arguments and the result are shadow's (shadow.cl). */
 __kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
+#if RAY_ORIGIN == ALGRAY_ORIGIN_POINT
+  /* The point form one ray at a time: shadow.cl's code built with one lane. */
+#if LANES != 1
+#error "shadow_serial is built with one lane"
+#endif
+  const uint i = get_global_id(0);
+  if (i >= point_count) return;
+  (void)even_axes;
+  uint traced = 0;
+  occluded[i] = shadow_mask_point_form(points, normals, i, light_points, light_count, offset, extent_centre,
+                                       extent_inv_scale, extent_box_half, extent_kind, mono_exps, mono_coefs,
+                                       mono_count, binomials, occluded[i], &traced);
+  if (traced) atomic_add(rays_traced, traced);
+#else
   const uint i = get_global_id(0);
   if (i >= point_count) return;
   REAL3 p, n, o, o_unit;
@@ -40,4 +54,5 @@ __kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
   occluded[i] = mask;
   SHADOW_UNDECIDED(i, unsure);
   if (traced) atomic_add(rays_traced, traced);
+#endif
 }

@@ -202,7 +202,7 @@ void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL*
 }
 #endif
 
-#if RAY_ORIGIN == ALGRAY_ORIGIN_EXTENT
+#if RAY_ORIGIN == ALGRAY_ORIGIN_EXTENT || RAY_ORIGIN == ALGRAY_ORIGIN_POINT
 /* The coordinates' factors of the ray o + t*d restricted to [t_in, t_out] as s in [0, 1], in the isolation's
  * basis: entry and exit points for the Bernstein form, entry point and chord for the power basis. */
 void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, AxisFactor* fx, AxisFactor* fy,

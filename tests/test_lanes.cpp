@@ -159,7 +159,12 @@ TEST_CASE("the plan gives lanes to the camera and secondary rays' kernels, where
   CHECK(plan.find(PassKind::Primary)->kernels.at(0).lanes == 8);
   CHECK(plan.find(PassKind::Primary)->kernels.at(0).key().find(" lanes=8") != std::string::npos);
   CHECK(plan.find(PassKind::Reflection)->kernels.at(0).lanes == 8);
-  CHECK(plan.find(PassKind::Shadow)->kernels.at(0).lanes == 1);  // the shadow kernel batches rays its own way
+  // The shadow kernel's point form (double) runs lanes too; the extent form batches rays its own way.
+  CHECK(plan.find(PassKind::Shadow)->kernels.at(0).ray_origin == RayOrigin::Point);
+  CHECK(plan.find(PassKind::Shadow)->kernels.at(0).lanes == 8);
+  const RenderPlan float_plan = make_render_plan(full, Precision::Float, 0, 8);
+  CHECK(float_plan.find(PassKind::Shadow)->kernels.at(0).ray_origin == RayOrigin::Extent);
+  CHECK(float_plan.find(PassKind::Shadow)->kernels.at(0).lanes == 1);
   // Adaptive precision's second pass for camera rays is the trace kernel: in lanes too.
   const RenderPlan adaptive = make_render_plan(full, Precision::Adaptive, 0, 8);
   CHECK(adaptive.find(PassKind::Primary)->escalation.at(0).entry == "trace");

@@ -111,7 +111,8 @@ TEST_CASE("the screen form meets the double line on seeded random surfaces of ev
     }
 }
 
-TEST_CASE("auto builds camera rays in the screen form in double only, and never the other kernels", "[reference]") {
+TEST_CASE("auto builds camera rays in the screen form and shadow rays in the point form, in double only",
+          "[reference]") {
   const Scene base = load_scene_text(random_scene(6, 1006, Precision::Double), "random");
   const RenderPlan plan = make_render_plan(base, Precision::Double);
   CHECK(plan.find(PassKind::Primary)->kernels.at(0).ray_origin == RayOrigin::Screen);
@@ -128,7 +129,16 @@ TEST_CASE("auto builds camera rays in the screen form in double only, and never 
   const RenderPlan full_plan = make_render_plan(full, Precision::Double);
   REQUIRE(full_plan.passes.size() == 3);  // primary, shadow, antialias
   for (const PlannedPass& pass : full_plan.passes)
-    CHECK(pass.kernels.at(0).ray_origin == (pass.kind == PassKind::Primary ? RayOrigin::Screen : RayOrigin::Extent));
+    CHECK(pass.kernels.at(0).ray_origin == (pass.kind == PassKind::Primary  ? RayOrigin::Screen
+                                            : pass.kind == PassKind::Shadow ? RayOrigin::Point
+                                                                            : RayOrigin::Extent));
+  for (Precision p : {Precision::Float, Precision::Mixed, Precision::Adaptive})
+    CHECK(make_render_plan(full, p).find(PassKind::Shadow)->kernels.at(0).ray_origin == RayOrigin::Extent);
+  // A scene that asks for the extent construction gets it for every kernel.
+  const Scene extent = load_scene_text(random_scene(6, 1006, Precision::Double) + "[[light]]\nposition = [3, 3, 3]\n",
+                                       "random", {{"render.preview", "false"}, {"render.ray_origin", "\"extent\""}});
+  for (const PlannedPass& pass : make_render_plan(extent, Precision::Double).passes)
+    CHECK(pass.kernels.at(0).ray_origin == RayOrigin::Extent);
 }
 
 TEST_CASE("every scene agrees with the certified reference within issue 3's thresholds", "[reference]") {

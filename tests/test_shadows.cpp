@@ -110,6 +110,11 @@ glm::dvec3 light_at(std::mt19937& rng, const SurfacePoint& sp, double elevation,
   return sp.point + distance * (std::cos(elevation) * tangent + std::sin(elevation) * n);
 }
 
+// The shadow kernels the render plan builds: double around each segment or from the point form, float around
+// each segment.
+const std::pair<Precision, RayOrigin> kConstructions[] = {
+    {Precision::Double, RayOrigin::Extent}, {Precision::Double, RayOrigin::Point}, {Precision::Float, RayOrigin::Extent}};
+
 struct Tally {
   int certified = 0, ambiguous = 0, failures = 0;
 };
@@ -117,7 +122,7 @@ struct Tally {
 // Traces each (surface point, light point) pair with the shadow kernel and checks it against the reference.
 // `make_light` picks the light point of ray `index`.
 template <typename MakeLight>
-Tally check_shadow_rays(Precision precision, int rays_per_scene, MakeLight make_light) {
+Tally check_shadow_rays(Precision precision, RayOrigin origin, int rays_per_scene, MakeLight make_light) {
   ClSession& session = testing::device_session();
   ProgramCache cache(false);
   Renderer renderer(session, cache);
@@ -140,8 +145,10 @@ Tally check_shadow_rays(Precision precision, int rays_per_scene, MakeLight make_
     const RenderPlan plan = make_render_plan(scene, precision);
     KernelConfig config = primary_config(scene, precision);
     config.entry = "shadow";
-    // As the render plan builds it: the screen form is the camera rays' alone.
-    if (config.ray_origin == RayOrigin::Screen) config.ray_origin = RayOrigin::Extent;
+    // The render plan's two constructions of shadow rays: around each segment, or from P expanded about their
+    // origin (in lanes, as on a CPU).
+    config.ray_origin = origin;
+    if (origin == RayOrigin::Point) config.lanes = 8;
     config.refinement = Refinement::Brent;
     config.max_iterations = default_max_iterations(Refinement::Brent);
     const DeviceSurface surface(session.context, scene, precision);
@@ -153,8 +160,8 @@ Tally check_shadow_rays(Precision precision, int rays_per_scene, MakeLight make_
       PixelRay ray;
       const Verdict verdict = reference_verdict(scene, precision, sp, light, ray);
       const bool hidden = tracer.trace({sp.point}, {sp.normal}, {light}).masks[0] & 1u;
-      INFO(file << " " << to_string(precision) << " seed " << kSeed << " ray " << index << ": from "
-                << sp.point.x << "," << sp.point.y << "," << sp.point.z << " to " << light.x << "," << light.y
+      INFO(file << " " << to_string(precision) << " " << to_string(origin) << " seed " << kSeed << " ray " << index
+                << ": from " << sp.point.x << "," << sp.point.y << "," << sp.point.z << " to " << light.x << "," << light.y
                 << "," << light.z << "; reference " << name(verdict) << ", kernel "
                 << (hidden ? "hidden" : "visible"));
       CHECK(verdict != Verdict::OriginOnSurface);  // the offset must take the origin clearly off the surface
@@ -174,17 +181,18 @@ Tally check_shadow_rays(Precision precision, int rays_per_scene, MakeLight make_
 }  // namespace
 
 TEST_CASE("shadow rays never hit the surface they leave, at any angle, in double and float", "[shadows]") {
-  // 1000 rays per precision (200 per surface): a fifth of them grazing, 0.5 to 5 degrees above the tangent
+  // 1000 rays per construction (200 per surface): a fifth of them grazing, 0.5 to 5 degrees above the tangent
   // plane, the rest up to the normal; lights 1% to 2.5 extent radii away, so that short rays are tried too.
-  for (Precision precision : {Precision::Double, Precision::Float}) {
-    const Tally t = check_shadow_rays(precision, 200, [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
+  for (const auto& [precision, origin] : kConstructions) {
+    const Tally t = check_shadow_rays(precision, origin, 200, [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
       const bool grazing = std::uniform_int_distribution<int>(0, 4)(rng) == 0;
       const double degrees = grazing ? std::uniform_real_distribution<double>(0.5, 5)(rng)
                                      : std::uniform_real_distribution<double>(5, 90)(rng);
       const double distance = std::uniform_real_distribution<double>(0.01, 2.5)(rng) * scene.extent.unit_scale();
       return light_at(rng, sp, degrees * 3.141592653589793 / 180, distance);
     });
-    INFO(to_string(precision) << ": " << t.certified << " certified, " << t.ambiguous << " ambiguous");
+    INFO(to_string(precision) << " " << to_string(origin) << ": " << t.certified << " certified, " << t.ambiguous
+                              << " ambiguous");
     CHECK(t.failures == 0);
     CHECK(t.certified >= 900);  // the reference certifies almost all of them, so the check means something
   }
@@ -193,8 +201,8 @@ TEST_CASE("shadow rays never hit the surface they leave, at any angle, in double
 TEST_CASE("shadow answers agree with the reference towards the lights of a scene", "[shadows]") {
   // Light points where a scene puts its lights: on a sphere of 3 extent radii around the extent, on the side
   // of the surface point's normal (behind the tangent plane the kernel answers "hidden" without tracing).
-  for (Precision precision : {Precision::Double, Precision::Float}) {
-    const Tally t = check_shadow_rays(precision, 200, [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
+  for (const auto& [precision, origin] : kConstructions) {
+    const Tally t = check_shadow_rays(precision, origin, 200, [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
       std::normal_distribution<double> g;
       for (;;) {
         const glm::dvec3 dir = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
@@ -202,7 +210,8 @@ TEST_CASE("shadow answers agree with the reference towards the lights of a scene
         if (glm::dot(light - sp.point, glm::dvec3(sp.normal)) > 0) return light;
       }
     });
-    INFO(to_string(precision) << ": " << t.certified << " certified, " << t.ambiguous << " ambiguous");
+    INFO(to_string(precision) << " " << to_string(origin) << ": " << t.certified << " certified, " << t.ambiguous
+                              << " ambiguous");
     CHECK(t.failures == 0);
     CHECK(t.certified >= 900);
   }

@@ -46,10 +46,13 @@ struct Counts {
   long hidden = 0, visible = 0, traced = 0;
 };
 
-// The config both kernels are built with; entry names the kernel.
-KernelConfig shadow_config(const Scene& scene, Precision precision, Isolation isolation, const std::string& entry) {
+// The config both kernels are built with; entry names the kernel. The point form's shadow kernel runs 8 lanes,
+// and shadow_serial the same code in one.
+KernelConfig shadow_config(const Scene& scene, Precision precision, Isolation isolation, const std::string& entry,
+                           RayOrigin origin) {
   KernelConfig config = primary_config(scene, precision);
-  config.ray_origin = RayOrigin::Extent;
+  config.ray_origin = origin;
+  config.lanes = origin == RayOrigin::Point && entry == "shadow" ? 8 : 1;
   config.isolation = isolation;
   config.refinement = Refinement::Brent;
   config.max_iterations = default_max_iterations(Refinement::Brent);
@@ -59,13 +62,13 @@ KernelConfig shadow_config(const Scene& scene, Precision precision, Isolation is
 
 // The shadow kernel and shadow_serial for one scene, with the renderer's shadow offset.
 struct TracerPair {
-  TracerPair(const Scene& scene, Precision precision, Isolation isolation)
+  TracerPair(const Scene& scene, Precision precision, Isolation isolation, RayOrigin origin = RayOrigin::Extent)
       : surface(testing::device_session().context, scene, precision),
         offset(shadow_offset_unit(precision) * scene.extent.unit_scale()),
-        batched(testing::device_session(), cache(), shadow_config(scene, precision, isolation, "shadow"), surface,
-                offset),
-        serial(testing::device_session(), cache(), shadow_config(scene, precision, isolation, "shadow_serial"), surface,
-               offset) {}
+        batched(testing::device_session(), cache(), shadow_config(scene, precision, isolation, "shadow", origin),
+                surface, offset),
+        serial(testing::device_session(), cache(), shadow_config(scene, precision, isolation, "shadow_serial", origin),
+               surface, offset) {}
   static ProgramCache& cache() {
     static ProgramCache c(false);
     return c;
@@ -78,8 +81,8 @@ struct TracerPair {
 // Traces `points` random surface points towards up to 64 random light points with both kernels and requires the
 // same masks and the same count of traced rays. Some bits start set, as when another surface hid the sample.
 Counts check_same_masks(const Scene& scene, Precision precision, Isolation isolation, std::mt19937& rng,
-                        const std::string& what) {
-  TracerPair tracers(scene, precision, isolation);
+                        const std::string& what, RayOrigin origin = RayOrigin::Extent) {
+  TracerPair tracers(scene, precision, isolation, origin);
   ShadowTracer& batched = tracers.batched;
   ShadowTracer& serial = tracers.serial;
 
@@ -165,6 +168,28 @@ TEST_CASE("batched shadow rays answer as the serial ones, bit for bit, at every 
       CHECK(n.visible >= 100);
     }
   }
+}
+
+TEST_CASE("the point form's shadow rays in lanes answer as one at a time, bit for bit, at every degree it takes",
+          "[shadows]") {
+  // Random points (some outside the extent) and up to 64 lights: blocks of 8 lanes that end mid-way, rays the
+  // signs settle, rays a sampled sign change settles, and rays only the search in lanes settles.
+  std::mt19937 rng(kSeed + 3);
+  for (int degree = 1; degree <= kMaxPointFormDegree; ++degree) {
+    const bool even = degree % 2 == 0 && degree % 4 != 0;
+    const Scene scene = random_scene(rng, degree, even, Precision::Double, Isolation::Bernstein);
+    std::ostringstream what;
+    what << "point form (seed " << kSeed + 3 << "), degree " << degree << (even ? ", even" : "");
+    const Counts n = check_same_masks(scene, Precision::Double, Isolation::Bernstein, rng, what.str(), RayOrigin::Point);
+    INFO(what.str() << ": " << n.traced << " rays traced, " << n.hidden << " samples hidden, " << n.visible
+                    << " visible");
+    CHECK(n.traced >= 1000);
+    CHECK(n.hidden >= 100);
+    CHECK(n.visible >= 100);
+  }
+  const Scene barth = load_scene_file(ALGRAY_SOURCE_DIR "/scenes/barth_sextic.toml");
+  check_same_masks(barth, Precision::Double, Isolation::Bernstein, rng, "point form (seed 20261205), Barth sextic",
+                   RayOrigin::Point);
 }
 
 TEST_CASE("batched shadow rays answer as the serial ones with a power-basis isolation and on the Barth sextic",

@@ -31,9 +31,10 @@ int kernel_id(const std::array<std::pair<Enum, int>, N>& table, Enum value) {
   return 0;
 }
 // Auto never reaches a kernel: primary_config resolves it.
-constexpr std::array<std::pair<RayOrigin, int>, 3> kOriginIds{{{RayOrigin::Extent, ALGRAY_ORIGIN_EXTENT},
+constexpr std::array<std::pair<RayOrigin, int>, 4> kOriginIds{{{RayOrigin::Extent, ALGRAY_ORIGIN_EXTENT},
                                                                {RayOrigin::Eye, ALGRAY_ORIGIN_EYE},
-                                                               {RayOrigin::Screen, ALGRAY_ORIGIN_SCREEN}}};
+                                                               {RayOrigin::Screen, ALGRAY_ORIGIN_SCREEN},
+                                                               {RayOrigin::Point, ALGRAY_ORIGIN_POINT}}};
 
 std::string hex_double(double v) {
   char buf[64];
@@ -45,6 +46,7 @@ std::string hex_double(double v) {
 
 int default_lanes(const std::string& device_type) { return device_type == "CPU" ? 8 : 1; }
 bool lanes_apply(const KernelConfig& c) {
+  if (c.entry == "shadow") return c.ray_origin == RayOrigin::Point;  // the extent form batches its own way
   return (c.entry == "primary" || c.entry == "trace") && c.isolation == Isolation::Bernstein &&
          c.refinement == Refinement::Brent;
 }

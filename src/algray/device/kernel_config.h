@@ -25,7 +25,8 @@ struct KernelConfig {
   double tolerance = 1e-9;   // the paper's eps: stop when the bracket is <= 4*eps*max(|t|,1)
   int max_iterations = 100;  // see default_max_iterations
   // Rays per work-item, side by side in vector lanes (kernels/lanes.h): more than 1 only for the primary and
-  // trace kernels with Bernstein isolation and Brent refinement (lanes_apply), where the plan asks for it.
+  // trace kernels with Bernstein isolation and Brent refinement, and the shadow kernel's point form
+  // (lanes_apply), where the plan asks for it.
   int lanes = 1;
 
   // "-D DEGREE=6 -D ALGRAY_DOUBLE=1 ..." with the tolerance as an exact hexadecimal literal.

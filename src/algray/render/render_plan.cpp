@@ -16,6 +16,11 @@ bool screen_form_applies(const Scene& scene, Precision precision) {
   return screen_geometry(basis, scene.image.width, scene.image.height, scene.extent).well_placed;
 }
 
+bool point_form_applies(const KernelConfig& shadow) {
+  return shadow.precision == Precision::Double && shadow.isolation == Isolation::Bernstein &&
+         shadow.degree <= kMaxPointFormDegree;
+}
+
 KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t surface) {
   KernelConfig config;
   config.entry = "primary";
@@ -117,9 +122,14 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
   if (!plan.shadow_lights.empty()) {
     // The shadow kernel isolates roots and never refines them: the refinement is not part of its code.
     std::vector<KernelConfig> shadow = with_entry("shadow");
-    for (KernelConfig& c : shadow) {
+    for (std::size_t i = 0; i < shadow.size(); ++i) {
+      KernelConfig& c = shadow[i];
       c.refinement = Refinement::Brent;
       c.max_iterations = default_max_iterations(Refinement::Brent);
+      if (scene.render.ray_origin == RayOrigin::Auto && point_form_applies(c)) {
+        c.ray_origin = RayOrigin::Point;
+        c.lanes = primary[i].lanes;
+      }
     }
     std::size_t points = 0;
     for (int i : plan.shadow_lights) points += scene.lights[static_cast<std::size_t>(i)].sample_points().size();

@@ -102,6 +102,14 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
 // (bench/RESULTS.md, "The screen form").
 bool screen_form_applies(const Scene& scene, Precision precision);
 
+// Whether RayOrigin::Auto means the point form for a shadow kernel (kernels/point_form.h: P expanded once about
+// each surface point, restricted to its shadow rays in lanes): in double with Bernstein isolation, up to the degree
+// its vectors hold. Measured bit for bit against the extent construction's images on the shipped scenes, and
+// against the certified reference in test_shadows; float keeps the extent construction, whose digits adaptive
+// precision's noise is measured on.
+inline constexpr int kMaxPointFormDegree = 15;
+bool point_form_applies(const KernelConfig& shadow);
+
 // Adaptive precision's escalation kernels in `precision` instead: double where every device's fp64 is fast (the
 // doubted rays then cost about what float does), mixed otherwise (what make_render_plan plans).
 void escalate_in(RenderPlan& plan, Precision precision);

@@ -51,7 +51,7 @@ std::string enum_choices(const std::array<NamedChoice<E>, N>& choices, const cha
 std::string to_string(Precision p) { return enum_name(kPrecisions, p); }
 std::string to_string(Isolation i) { return enum_name(kIsolations, i); }
 std::string to_string(Refinement r) { return enum_name(kRefinements, r); }
-std::string to_string(RayOrigin o) { return enum_name(kRayOrigins, o); }
+std::string to_string(RayOrigin o) { return o == RayOrigin::Point ? "point" : enum_name(kRayOrigins, o); }
 bool parse_precision(const std::string& n, Precision& out) { return parse_enum(kPrecisions, n, out); }
 bool parse_isolation(const std::string& n, Isolation& out) { return parse_enum(kIsolations, n, out); }
 bool parse_refinement(const std::string& n, Refinement& out) { return parse_enum(kRefinements, n, out); }

@@ -16,8 +16,9 @@ inline constexpr int kMaxMixedDegree = 15;
 enum class Isolation { Bernstein, PowerDescartes, Sturm, DerivativeChain };
 enum class Refinement { Brent, Bisection, RegulaFalsi, Illinois, Newton };
 // Where P*(t) is built around: Auto (scenes only) is Screen for camera rays where it applies (screen_form_applies
-// in render_plan.h), else Extent.
-enum class RayOrigin { Auto, Extent, Eye, Screen };
+// in render_plan.h), else Extent; for shadow rays it is Point where that applies (point_form_applies), else Extent.
+// Point is the plan's choice for shadow rays, never a scene's: it is not in kRayOrigins.
+enum class RayOrigin { Auto, Extent, Eye, Screen, Point };
 
 // One choice: its value and its name in scenes, on the command line, in stats and in the probe.
 template <typename E>

@@ -1,0 +1,131 @@
+/* The point form (RAY_ORIGIN=point): P expanded once about a shadow rays' shared origin, then restricted to each. */
+#ifndef ALGRAY_POINT_FORM_H
+#define ALGRAY_POINT_FORM_H
+
+#include "lanes.h"
+#include "real.h"
+#include "restrict.h"
+
+/* Every shadow ray of a surface point starts at the same origin o. Expanding P about o once,
+ *   Q(v) = P(o + v) = sum q_abg x^a y^b z^g,
+ * turns each ray's restriction into sums of Q's terms: P(o + t d) = sum_k t^k sum_(a+b+g=k) q_abg dx^a dy^b dz^g,
+ * two vector operations per term over LANES rays, in place of a Horner scheme over every monomial of P per ray
+ * (measured on the Barth decic's shadow rays: restriction 2.3 s -> 0.9 s, bench/RESULTS.md "Shadow rays from a
+ * shared expansion"). The origin lies on the surface, inside the extent, and the segment to the extent's edge is
+ * at most its diameter long, so the power basis about o keeps the extent construction's digits: every term is
+ * bounded by the same sums of |a_m| times powers of coordinates within the extent (up to the binomial weights
+ * of the shift, at most 2^DEGREE in the worst case, which double precision absorbs; float is not offered). */
+#if DEGREE > 15
+#error "the point form keeps its expansion in vectors of up to 16 coefficients (degree 15)"
+#endif
+
+/* The expansion's columns: column (a, b), a + b <= DEGREE, holds the coefficients of x^a y^b z^g,
+ * g = 0 .. DEGREE - a - b, in one PolyVec (the lanes above are zero). */
+#define POINT_FORM_COLUMNS ((DEGREE + 1) * (DEGREE + 2) / 2)
+#define POINT_FORM_COLUMN(a, b) ((a) * (2 * DEGREE + 3 - (a)) / 2 + (b))
+
+/* rows[k] = (s + v)^k as a vector of coefficients in v: C(k, g) s^(k - g) in lane g. */
+ALGRAY_INLINE void shift_rows(REAL s, PolyVec* rows) {
+  rows[0] = vec_constant(1);
+  ALGRAY_UNROLL
+  for (int k = 1; k <= DEGREE; ++k) rows[k] = s * rows[k - 1] + VEC_SHIFT(rows[k - 1]);
+}
+
+/* q: P(o + v) by columns, from P's monomials (exponents packed i | j<<8 | k<<16) in unit coordinates. The shift
+ * is separable: along z while each monomial is added to its column (one vector operation per monomial), then
+ * along y and along x, each a sum of vector products with independent accumulators (the nested Taylor shift
+ * of one coefficient at a time was a chain of dependent operations, 3x slower). The y and x sums run in place,
+ * in ascending order, so each reads only columns it has not yet overwritten. */
+void taylor_at_point(__global const uint* exps, __global const REAL* coefs, uint count, REAL3 o, PolyVec* q) {
+  PolyVec rows[NCOEF];
+  shift_rows(o.z, rows);
+  ALGRAY_UNROLL
+  for (int c = 0; c < POINT_FORM_COLUMNS; ++c) q[c] = (PolyVec)((REAL)0);
+  for (uint m = 0; m < count; ++m) {
+    const uint e = exps[m];
+    const int i = (int)(e & 0xffu), j = (int)((e >> 8) & 0xffu), k = (int)((e >> 16) & 0xffu);
+    q[POINT_FORM_COLUMN(i, j)] += coefs[m] * rows[k];
+  }
+  REAL weight[NCOEF][ACC_WIDTH]; /* weight[b][b0] = C(b, b0) s^(b - b0) */
+  shift_rows(o.y, rows);
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) VEC_STORE(rows[k], weight[k]);
+  ALGRAY_UNROLL
+  for (int a = 0; a <= DEGREE; ++a) ALGRAY_UNROLL
+  for (int b0 = 0; a + b0 <= DEGREE; ++b0) {
+    PolyVec sum = q[POINT_FORM_COLUMN(a, b0)];
+    ALGRAY_UNROLL
+    for (int b = b0 + 1; a + b <= DEGREE; ++b) sum += weight[b][b0] * q[POINT_FORM_COLUMN(a, b)];
+    q[POINT_FORM_COLUMN(a, b0)] = sum;
+  }
+  shift_rows(o.x, rows);
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) VEC_STORE(rows[k], weight[k]);
+  ALGRAY_UNROLL
+  for (int a0 = 0; a0 <= DEGREE; ++a0) ALGRAY_UNROLL
+  for (int b = 0; a0 + b <= DEGREE; ++b) {
+    PolyVec sum = q[POINT_FORM_COLUMN(a0, b)];
+    ALGRAY_UNROLL
+    for (int a = a0 + 1; a + b <= DEGREE; ++a) sum += weight[a][a0] * q[POINT_FORM_COLUMN(a, b)];
+    q[POINT_FORM_COLUMN(a0, b)] = sum;
+  }
+}
+
+/* P(o + t d) = sum_k c[k] t^k for LANES directions d (unit coordinates), from taylor_at_point's q. */
+void point_form_restrict(const PolyVec* columns, LREAL dx, LREAL dy, LREAL dz, LREAL* c) {
+  const REAL* q = (const REAL*)columns;
+  LREAL pz[NCOEF];
+  pz[0] = 1;
+  ALGRAY_UNROLL
+  for (int g = 1; g <= DEGREE; ++g) pz[g] = pz[g - 1] * dz;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
+  LREAL px = 1;
+  ALGRAY_UNROLL
+  for (int a = 0; a <= DEGREE; ++a) {
+    LREAL pxy = px;
+    ALGRAY_UNROLL
+    for (int b = 0; a + b <= DEGREE; ++b) {
+      ALGRAY_UNROLL
+      for (int g = 0; a + b + g <= DEGREE; ++g) c[a + b + g] += q[POINT_FORM_COLUMN(a, b) * ACC_WIDTH + g] * (pxy * pz[g]);
+      pxy *= dy;
+    }
+    px *= dx;
+  }
+}
+
+/* The power basis c of P*(t) turned into scaled Bernstein coefficients on [t_in, t_out] (C(n,k) b_k, as
+ * restrict_to_rays leaves them): the homogeneous Horner scheme of restrict_from_taylor, lane by lane. */
+void point_form_segment(const LREAL* c, LREAL t_in, LREAL t_out, __constant const REAL* binomials, LREAL* out) {
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) out[k] = 0;
+  out[0] = c[DEGREE];
+  ALGRAY_UNROLL
+  for (int n = 1; n <= DEGREE; ++n) {
+    ALGRAY_UNROLL
+    for (int j = n; j > 0; --j) out[j] = t_in * out[j] + t_out * out[j - 1];
+    out[0] = t_in * out[0];
+    __constant const REAL* row = binomials + n * NCOEF;
+    ALGRAY_UNROLL
+    for (int j = 0; j <= n; ++j) out[j] += c[DEGREE - n] * row[j];
+  }
+}
+
+/* Whether P*(t), power basis c, changes sign within [t_in, t_out]: its value at seven evenly spaced points
+ * against start, its value at t_in. A sign opposite to start's is a crossing, by the intermediate value theorem;
+ * most shadow rays that meet the surface pass through it, so this settles them without the search (Barth
+ * decic: the search took 55% of the shadow kernel, most of it on such rays). */
+LMASK sign_change_sampled(const LREAL* c, LREAL t_in, LREAL t_out, LREAL start, LMASK open) {
+  LMASK crossed = open && !open; /* all lanes false, of the mask type */
+  ALGRAY_UNROLL
+  for (int j = 1; j < 8; ++j) {
+    const LREAL t = t_in + (t_out - t_in) * ((REAL)j / 8);
+    LREAL v = c[DEGREE];
+    ALGRAY_UNROLL
+    for (int k = DEGREE - 1; k >= 0; --k) v = v * t + c[k];
+    crossed = crossed || (start > 0 && v < 0) || (start < 0 && v > 0);
+  }
+  return open && crossed;
+}
+
+#endif /* ALGRAY_POINT_FORM_H */
