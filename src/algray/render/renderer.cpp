@@ -252,7 +252,7 @@ struct Renderer::Passes {
   std::unique_ptr<TileHits> other_out;                   // several surfaces: those of the next ones
   std::vector<std::unique_ptr<ShadowTracer>> shadows;    // one per surface, when the plan has a shadow pass
   std::unique_ptr<ShadowPoints> shadow_points;           // a batch's surface points on the device
-  std::vector<std::vector<glm::dvec3>> light_points;     // per shadow-casting light of the plan
+  std::vector<LightGroup> light_groups;                  // the plan's shadow-casting lights, a launch per group
   std::vector<std::unique_ptr<RayTracer>> rays;          // one per surface, when it has a secondary pass
   // Adaptive precision: per surface, mixed precision's trace kernel for doubted camera and secondary rays, and
   // its shadow kernel for doubted shadow rays (when the plan has a shadow pass).
@@ -352,24 +352,26 @@ ShadowData trace_shadows(Passes& p, const HitRecord* hits, std::size_t count, Ra
       normals.emplace_back(h.normal_x, h.normal_y, h.normal_z);
     }
     p.shadow_points->upload(points, normals);
-    for (std::size_t l = 0; l < lights.size(); ++l) {
+    for (const LightGroup& group : p.light_groups) {
       // Each surface's kernel in turn; a light point one surface hides is not traced against the next. A ray
       // counts once, from the first surface's kernel, which traces every light point in front of the surface.
       std::vector<std::uint64_t> hidden;
       for (std::size_t s = 0; s < p.shadows.size(); ++s) {
-        ShadowAnswer answer = p.shadows[s]->trace(*p.shadow_points, p.light_points[l], hidden);
+        ShadowAnswer answer = p.shadows[s]->trace(*p.shadow_points, group.points, hidden);
         stats.kernel_ms += answer.kernel_ms;
         stats.program_ms[s] += answer.kernel_ms;
         ++stats.launches;
         if (s == 0) stats.rays += answer.rays_traced;
         if (!p.escalate_shadows.empty()) {
-          count_escalation(
-              stats, p.shadows.size() + s,
-              p.escalate_shadows[s]->redo(points, normals, p.light_points[l], answer.undecided, answer.masks));
+          count_escalation(stats, p.shadows.size() + s,
+                           p.escalate_shadows[s]->redo(points, normals, group.points, answer.undecided, answer.masks));
         }
         hidden = std::move(answer.masks);
       }
-      std::copy(hidden.begin(), hidden.end(), data.occlusion[l].masks.begin() + static_cast<std::ptrdiff_t>(begin));
+      for (const LightGroup::Member& m : group.members) {
+        std::vector<std::uint64_t>& masks = data.occlusion[m.light].masks;
+        for (std::size_t k = 0; k < hidden.size(); ++k) masks[begin + k] = group.mask_of(m, hidden[k]);
+      }
     }
   }
   stats.wall_ms += ms_since(start);
@@ -681,8 +683,10 @@ void Renderer::prepare_passes(Passes& passes) {
       stats->program_ms.push_back(0);
     }
     passes.shadow_points = std::make_unique<ShadowPoints>(passes.session, passes.precision);
+    std::vector<std::vector<glm::dvec3>> light_points;  // per shadow-casting light of the plan
     for (int light : plan.shadow_lights)
-      passes.light_points.push_back(scene.lights[static_cast<std::size_t>(light)].sample_points());
+      light_points.push_back(scene.lights[static_cast<std::size_t>(light)].sample_points());
+    passes.light_groups = group_lights(light_points);
   }
   // Adaptive precision: every ray pass escalates to the same mixed trace kernels.
   if (const PlannedPass* primary_pass = plan.find(PassKind::Primary); !primary_pass->escalation.empty()) {

@@ -5,6 +5,24 @@
 
 namespace algray {
 
+std::uint64_t LightGroup::mask_of(const Member& m, std::uint64_t group_mask) const {
+  const std::uint64_t low = m.count == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << m.count) - 1;
+  return (group_mask >> m.first_bit) & low;
+}
+
+std::vector<LightGroup> group_lights(const std::vector<std::vector<glm::dvec3>>& light_points) {
+  std::vector<LightGroup> groups;
+  for (std::size_t l = 0; l < light_points.size(); ++l) {
+    const std::vector<glm::dvec3>& points = light_points[l];
+    if (points.empty() || points.size() > 64) throw std::invalid_argument("a light has 1 to 64 sample points");
+    if (groups.empty() || groups.back().points.size() + points.size() > 64) groups.emplace_back();
+    LightGroup& g = groups.back();
+    g.members.push_back({l, static_cast<int>(g.points.size()), static_cast<int>(points.size())});
+    g.points.insert(g.points.end(), points.begin(), points.end());
+  }
+  return groups;
+}
+
 void ShadowPoints::upload(const std::vector<glm::dvec3>& points, const std::vector<glm::vec3>& normals) {
   if (normals.size() != points.size()) throw std::invalid_argument("one normal per surface point");
   count_ = points.size();

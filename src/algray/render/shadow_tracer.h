@@ -18,6 +18,22 @@ struct ShadowAnswer {
   double kernel_ms = 0;
 };
 
+// Shadow-casting lights whose sample points share one launch of the shadow kernel: at most 64 points in all, each
+// light's a run of bits in the occlusion masks. One launch per group rather than per light lets the kernel's point
+// form expand P once per surface point for every light, and fill its lanes across the lights' samples.
+struct LightGroup {
+  std::vector<glm::dvec3> points;  // the members' sample points, one after another
+  struct Member {
+    std::size_t light;  // index into the list given to group_lights
+    int first_bit, count;
+  };
+  std::vector<Member> members;
+  // Member m's part of a group mask, as its own light's mask.
+  std::uint64_t mask_of(const Member& m, std::uint64_t group_mask) const;
+};
+// Consecutive lights packed greedily; each light has 1 to 64 sample points.
+std::vector<LightGroup> group_lights(const std::vector<std::vector<glm::dvec3>>& light_points);
+
 // One batch of surface points and their normals on the device, asked about any number of lights and surfaces.
 // Its buffers grow to the largest batch and are then reused, batch after batch.
 class ShadowPoints {
