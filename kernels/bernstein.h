@@ -64,13 +64,17 @@ ALGRAY_INLINE void coefs_copy(REAL* dst, REAL* dst_lo, const REAL* src, const RE
 #endif
 }
 
+/* The triangles below run every inner loop to a constant bound and test the row's end inside: a bound that
+ * depends on the outer index kept LLVM from unrolling fully, and the rows then went through memory (measured in
+ * PoCL's compiled kernels). The operations and their order are the same. */
+
 /* Keeps the part of the curve on [0, x], x dyadic (so 1 - x is exact). In place: after pass r, c[r] is the
  * r-th left coefficient. */
 void casteljau_keep_left(REAL* c, REAL* c_lo, REAL x) {
   const REAL x1 = (REAL)1 - x;
   ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-  for (int k = DEGREE; k >= r; --k) casteljau_step(c, c_lo, k, k - 1, k, x1, 0, x, 0);
+  for (int k = DEGREE; k >= 1; --k) if (k >= r) casteljau_step(c, c_lo, k, k - 1, k, x1, 0, x, 0);
 }
 
 /* Keeps the part on [x + x_lo, 1], for x >= 1/2 (so 1 - x is exact). */
@@ -78,7 +82,7 @@ void casteljau_keep_right(REAL* c, REAL* c_lo, REAL x, REAL x_lo) {
   const REAL x1 = (REAL)1 - x;
   ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE - r; ++k) casteljau_step(c, c_lo, k, k, k + 1, x1, -x_lo, x, x_lo);
+  for (int k = 0; k < DEGREE; ++k) if (k <= DEGREE - r) casteljau_step(c, c_lo, k, k, k + 1, x1, -x_lo, x, x_lo);
 }
 
 /* Halves c at 1/2 in one de Casteljau triangle: c becomes the left half, right the right half. */
@@ -113,7 +117,7 @@ void casteljau_halve(REAL* c, REAL* c_lo, REAL* right, REAL* right_lo) {
   ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r) {
     ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE - r; ++k) casteljau_step(t, t_lo, k, k, k + 1, (REAL)0.5, 0, (REAL)0.5, 0);
+    for (int k = 0; k < DEGREE; ++k) if (k <= DEGREE - r) casteljau_step(t, t_lo, k, k, k + 1, (REAL)0.5, 0, (REAL)0.5, 0);
     c[r] = t[0];
     right[DEGREE - r] = t[DEGREE - r];
 #if ALGRAY_COMPENSATED
@@ -269,7 +273,7 @@ void bernstein_restrict_lanes(const LREAL* root, LREAL width, LREAL idx, LMASK t
     for (int k = 0; k <= DEGREE; ++k) t[k] = o[k];
     ALGRAY_UNROLL
     for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-    for (int k = DEGREE; k >= r; --k) t[k] = CASTELJAU_COMBINE(x1, t[k - 1], hi, t[k]);
+    for (int k = DEGREE; k >= 1; --k) if (k >= r) t[k] = CASTELJAU_COMBINE(x1, t[k - 1], hi, t[k]);
     ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE; ++k) o[k] = LANE_SEL(o[k], t[k], left);
   }
@@ -281,7 +285,7 @@ void bernstein_restrict_lanes(const LREAL* root, LREAL width, LREAL idx, LMASK t
     for (int k = 0; k <= DEGREE; ++k) t[k] = o[k];
     ALGRAY_UNROLL
     for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE - r; ++k) t[k] = CASTELJAU_COMBINE(x1, t[k], x, t[k + 1]);
+    for (int k = 0; k < DEGREE; ++k) if (k <= DEGREE - r) t[k] = CASTELJAU_COMBINE(x1, t[k], x, t[k + 1]);
     ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE; ++k) o[k] = LANE_SEL(o[k], t[k], right);
   }
@@ -368,7 +372,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
       ALGRAY_UNROLL
       for (int r = 1; r <= DEGREE; ++r) {
         ALGRAY_UNROLL
-        for (int k = 0; k <= DEGREE - r; ++k) t[k] = CASTELJAU_COMBINE((REAL)0.5, t[k], (REAL)0.5, t[k + 1]);
+        for (int k = 0; k < DEGREE; ++k) if (k <= DEGREE - r) t[k] = CASTELJAU_COMBINE((REAL)0.5, t[k], (REAL)0.5, t[k + 1]);
         left[r] = t[0];
         right[DEGREE - r] = t[DEGREE - r];
       }

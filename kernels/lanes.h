@@ -29,18 +29,73 @@ typedef int LMASK;
 #define LANE_VEC(type, n) LANE_CAT(type, n)
 typedef LANE_VEC(REAL, LANES) LREAL; /* REAL8 for LANES = 8 (real.h) */
 #if ALGRAY_DOUBLE
-typedef long LANE_INT; /* one lane of a mask: as wide as a REAL */
-typedef LANE_VEC(long, LANES) LMASK;
+#define LANE_INT_NAME long /* one lane of a mask: as wide as a REAL */
 #else
-typedef int LANE_INT;
-typedef LANE_VEC(int, LANES) LMASK;
+#define LANE_INT_NAME int
 #endif
+typedef LANE_INT_NAME LANE_INT;
+typedef LANE_VEC(LANE_INT_NAME, LANES) LMASK;
 #define LANE_SEL(a, b, m) select((a), (b), (m))
 #define LANE_ANY(m) any(m)
 #define LANE_ALL(m) all(m)
 #else
 #error "LANES must be 1, 2, 4, 8 or 16"
 #endif
+
+/* The vector of type T holding f(0), f(1), ..., f(LANES - 1), built in registers (lane_set goes through memory,
+ * and a vector read after scalar stores stalls on them). */
+#if LANES == 1
+#define LANES_OF(T, f) ((T)(f(0)))
+#elif LANES == 2
+#define LANES_OF(T, f) ((T)(f(0), f(1)))
+#elif LANES == 4
+#define LANES_OF(T, f) ((T)(f(0), f(1), f(2), f(3)))
+#elif LANES == 8
+#define LANES_OF(T, f) ((T)(f(0), f(1), f(2), f(3), f(4), f(5), f(6), f(7)))
+#else
+#define LANES_OF(T, f) \
+  ((T)(f(0), f(1), f(2), f(3), f(4), f(5), f(6), f(7), f(8), f(9), f(10), f(11), f(12), f(13), f(14), f(15)))
+#endif
+
+/* Bit j set for each lane j of m that is set, without a trip through memory: each lane keeps its own bit,
+ * then the halves are summed. */
+ALGRAY_INLINE uint lane_mask_bits(LMASK m) {
+#if LANES == 1
+  return m != 0;
+#else
+#define LANE_BIT(j) (1 << (j))
+  LANE_VEC(LANE_INT_NAME, LANES) b = m & LANES_OF(LANE_VEC(LANE_INT_NAME, LANES), LANE_BIT);
+#undef LANE_BIT
+#if LANES == 16
+  LANE_VEC(LANE_INT_NAME, 8) b8 = b.lo + b.hi;
+#elif LANES == 8
+  LANE_VEC(LANE_INT_NAME, 8) b8 = b;
+#endif
+#if LANES >= 8
+  LANE_VEC(LANE_INT_NAME, 4) b4 = b8.lo + b8.hi;
+#elif LANES == 4
+  LANE_VEC(LANE_INT_NAME, 4) b4 = b;
+#endif
+#if LANES >= 4
+  LANE_VEC(LANE_INT_NAME, 2) b2 = b4.lo + b4.hi;
+#else
+  LANE_VEC(LANE_INT_NAME, 2) b2 = b;
+#endif
+  return (uint)(b2.s0 + b2.s1);
+#endif
+}
+
+/* Lane j set where bit j of bits is. */
+ALGRAY_INLINE LMASK lanes_of_bits(uint bits) {
+#if LANES == 1
+  return (bits & 1u) != 0;
+#else
+#define LANE_BIT(j) (1 << (j))
+  const LANE_VEC(LANE_INT_NAME, LANES) each = LANES_OF(LANE_VEC(LANE_INT_NAME, LANES), LANE_BIT);
+#undef LANE_BIT
+  return ((LANE_VEC(LANE_INT_NAME, LANES))((LANE_INT)bits) & each) != 0;
+#endif
+}
 
 /* Lane j of a vector (j < LANES), read and written through its private storage. */
 ALGRAY_INLINE REAL lane_get(LREAL v, uint j) { return ((REAL*)&v)[j]; }

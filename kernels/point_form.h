@@ -52,10 +52,12 @@ void taylor_at_point(__global const uint* exps, __global const REAL* coefs, uint
   for (int k = 0; k <= DEGREE; ++k) VEC_STORE(rows[k], weight[k]);
   ALGRAY_UNROLL
   for (int a = 0; a <= DEGREE; ++a) ALGRAY_UNROLL
-  for (int b0 = 0; a + b0 <= DEGREE; ++b0) {
+  for (int b0 = 0; b0 <= DEGREE; ++b0) {
+    if (a + b0 > DEGREE) continue;
     PolyVec sum = q[POINT_FORM_COLUMN(a, b0)];
     ALGRAY_UNROLL
-    for (int b = b0 + 1; a + b <= DEGREE; ++b) sum += weight[b][b0] * q[POINT_FORM_COLUMN(a, b)];
+    for (int b = 1; b <= DEGREE; ++b)
+      if (b > b0 && a + b <= DEGREE) sum += weight[b][b0] * q[POINT_FORM_COLUMN(a, b)];
     q[POINT_FORM_COLUMN(a, b0)] = sum;
   }
   shift_rows(o.x, rows);
@@ -63,35 +65,43 @@ void taylor_at_point(__global const uint* exps, __global const REAL* coefs, uint
   for (int k = 0; k <= DEGREE; ++k) VEC_STORE(rows[k], weight[k]);
   ALGRAY_UNROLL
   for (int a0 = 0; a0 <= DEGREE; ++a0) ALGRAY_UNROLL
-  for (int b = 0; a0 + b <= DEGREE; ++b) {
+  for (int b = 0; b <= DEGREE; ++b) {
+    if (a0 + b > DEGREE) continue;
     PolyVec sum = q[POINT_FORM_COLUMN(a0, b)];
     ALGRAY_UNROLL
-    for (int a = a0 + 1; a + b <= DEGREE; ++a) sum += weight[a][a0] * q[POINT_FORM_COLUMN(a, b)];
+    for (int a = 1; a <= DEGREE; ++a)
+      if (a > a0 && a + b <= DEGREE) sum += weight[a][a0] * q[POINT_FORM_COLUMN(a, b)];
     q[POINT_FORM_COLUMN(a0, b)] = sum;
   }
 }
 
-/* P(o + t d) = sum_k c[k] t^k for LANES directions d (unit coordinates), from taylor_at_point's q. */
+/* P(o + t d) = sum_k c[k] t^k for LANES directions d (unit coordinates), from taylor_at_point's q. Every loop runs
+ * to DEGREE and tests its bound inside: with bounds that depend on the outer indices, LLVM unrolled the inner loops
+ * only partly and kept the sums in memory (four loads and stores per term, measured in PoCL's compiled kernel). */
 void point_form_restrict(const PolyVec* columns, LREAL dx, LREAL dy, LREAL dz, LREAL* c) {
   const REAL* q = (const REAL*)columns;
-  LREAL pz[NCOEF];
+  LREAL pz[NCOEF], sum[NCOEF];
   pz[0] = 1;
   ALGRAY_UNROLL
   for (int g = 1; g <= DEGREE; ++g) pz[g] = pz[g - 1] * dz;
   ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
+  for (int k = 0; k <= DEGREE; ++k) sum[k] = 0;
   LREAL px = 1;
   ALGRAY_UNROLL
   for (int a = 0; a <= DEGREE; ++a) {
     LREAL pxy = px;
     ALGRAY_UNROLL
-    for (int b = 0; a + b <= DEGREE; ++b) {
+    for (int b = 0; b <= DEGREE; ++b) {
+      if (a + b > DEGREE) continue;
       ALGRAY_UNROLL
-      for (int g = 0; a + b + g <= DEGREE; ++g) c[a + b + g] += q[POINT_FORM_COLUMN(a, b) * ACC_WIDTH + g] * (pxy * pz[g]);
+      for (int g = 0; g <= DEGREE; ++g)
+        if (a + b + g <= DEGREE) sum[a + b + g] += q[POINT_FORM_COLUMN(a, b) * ACC_WIDTH + g] * (pxy * pz[g]);
       pxy *= dy;
     }
     px *= dx;
   }
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) c[k] = sum[k];
 }
 
 /* The power basis c of P*(t) turned into scaled Bernstein coefficients on [t_in, t_out] (C(n,k) b_k, as
@@ -103,11 +113,13 @@ void point_form_segment(const LREAL* c, LREAL t_in, LREAL t_out, __constant cons
   ALGRAY_UNROLL
   for (int n = 1; n <= DEGREE; ++n) {
     ALGRAY_UNROLL
-    for (int j = n; j > 0; --j) out[j] = t_in * out[j] + t_out * out[j - 1];
+    for (int j = DEGREE; j > 0; --j)
+      if (j <= n) out[j] = t_in * out[j] + t_out * out[j - 1];
     out[0] = t_in * out[0];
     __constant const REAL* row = binomials + n * NCOEF;
     ALGRAY_UNROLL
-    for (int j = 0; j <= n; ++j) out[j] += c[DEGREE - n] * row[j];
+    for (int j = 0; j <= DEGREE; ++j)
+      if (j <= n) out[j] += c[DEGREE - n] * row[j];
   }
 }
 

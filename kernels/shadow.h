@@ -98,20 +98,66 @@ LMASK shadow_segments(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, LREAL lx, LREAL l
   return !*self && hit && hi > lo && *t_out > *t_in;
 }
 
-/* Bit s0 + j of a mask for each lane j of m. */
-ALGRAY_INLINE ulong lane_bits(LMASK m, uint s0) {
-  ulong bits = 0;
-  for (uint j = 0; j < LANES; ++j)
-    if (lane_get_mask(m, j)) bits |= (ulong)1 << (s0 + j);
-  return bits;
+/* Measured on the Barth sextic and decic (full mode, 1024x768): 3 levels saved the most at degree 6, 2 at degree
+ * 10, where 3 cost more than they saved. */
+#if DEGREE <= 7
+#define SHADOW_PIECE_LEVELS 3
+#else
+#define SHADOW_PIECE_LEVELS 2
+#endif
+/* Whether every one of the 2^SHADOW_PIECE_LEVELS equal pieces of the segment has Bernstein coefficients of one
+ * strict sign (c: scaled coefficients on the whole segment): then no piece, and so no part of the segment, holds
+ * a root. De Casteljau's halving keeps a piece of one sign so, so this is what the search concludes after as many
+ * halvings, without its bookkeeping: most segments the search excludes are settled by one or two halvings. */
+LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials) {
+  __constant const REAL* row = binomials + DEGREE * NCOEF;
+  LREAL piece[1 << SHADOW_PIECE_LEVELS][NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) piece[0][k] = c[k] / row[k]; /* bernstein_from_scaled */
+  ALGRAY_UNROLL
+  for (int level = 0; level < SHADOW_PIECE_LEVELS; ++level) {
+    /* Pieces 0 .. 2^level - 1 become 0 .. 2^(level + 1) - 1, from the right so none is overwritten unread. */
+    ALGRAY_UNROLL
+    for (int p = (1 << level) - 1; p >= 0; --p) {
+      LREAL t[NCOEF], left[NCOEF], right[NCOEF];
+      ALGRAY_UNROLL
+      for (int k = 0; k <= DEGREE; ++k) t[k] = piece[p][k];
+      left[0] = t[0];
+      right[DEGREE] = t[DEGREE];
+      ALGRAY_UNROLL
+      for (int r = 1; r <= DEGREE; ++r) {
+        ALGRAY_UNROLL
+        for (int k = 0; k < DEGREE; ++k) if (k <= DEGREE - r) t[k] = CASTELJAU_COMBINE((REAL)0.5, t[k], (REAL)0.5, t[k + 1]);
+        left[r] = t[0];
+        right[DEGREE - r] = t[DEGREE - r];
+      }
+      ALGRAY_UNROLL
+      for (int k = 0; k <= DEGREE; ++k) {
+        piece[2 * p][k] = left[k];
+        piece[2 * p + 1][k] = right[k];
+      }
+    }
+  }
+  LMASK all_clear = c[0] == c[0]; /* every lane set (the coefficients are finite) */
+  ALGRAY_UNROLL
+  for (int p = 0; p < (1 << SHADOW_PIECE_LEVELS); ++p) {
+    LMASK positive = piece[p][0] > 0, negative = piece[p][0] < 0;
+    ALGRAY_UNROLL
+    for (int k = 1; k <= DEGREE; ++k) {
+      positive = positive && piece[p][k] > 0;
+      negative = negative && piece[p][k] < 0;
+    }
+    all_clear = all_clear && (positive || negative);
+  }
+  return all_clear;
 }
 
-/* Which of the traced lanes' segments hold a root: what isolate_bernstein reports for each, from the scaled
- * Bernstein coefficients c on [t_in, t_out] (power basis power, the same polynomial). The signs of c settle most
- * (bernstein_root_by_signs), a sign change at seven points of the segment most of the rest, and the search the
- * remainder: in lanes (isolate_bernstein_lanes), or alone in a one-lane build. */
-LMASK segment_roots(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced,
-                    __constant const REAL* binomials) {
+/* Which of the traced lanes' segments a cheap test shows to hold a root, from the scaled Bernstein coefficients c
+ * on [t_in, t_out] (power basis power, the same polynomial); *open gets the lanes only the search can settle. The
+ * signs of c settle most (bernstein_root_by_signs' answers), and a sign change at seven points of the segment
+ * most of the rest. */
+LMASK segment_roots_settled(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced, LMASK* open,
+                            __constant const REAL* binomials) {
   LMASK positive = c[0] > 0, negative = c[0] < 0;
   ALGRAY_UNROLL
   for (int k = 1; k <= DEGREE; ++k) {
@@ -121,26 +167,61 @@ LMASK segment_roots(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out,
   const LREAL start = c[0], end = c[DEGREE];
   const LMASK none = positive || negative;
   LMASK root = traced && !none && (start == 0 || end == 0 || (start < 0 && end > 0) || (start > 0 && end < 0));
-  LMASK open = traced && !none && !root;
-  if (!LANE_ANY(open)) return root;
-  const LMASK crossed = sign_change_sampled(power, t_in, t_out, start, open);
-  root = root || crossed;
-  open = open && !crossed;
-  if (!LANE_ANY(open)) return root;
+  *open = traced && !none && !root;
+  if (!LANE_ANY(*open)) return root;
+  const LMASK crossed = sign_change_sampled(power, t_in, t_out, start, *open);
+  *open = *open && !crossed;
+  if (LANE_ANY(*open)) *open = *open && !no_root_in_pieces(c, binomials);
+  return root || crossed;
+}
+
+/* Segments waiting for the search, gathered from the blocks of lanes of one surface point until they fill a block:
+ * the search in lanes costs every lane while any runs, and a block holds two open segments on average. */
+typedef struct {
+  LREAL b[NCOEF]; /* Bernstein coefficients (bernstein_from_scaled's) */
+  LREAL t_in, t_out;
+  uint sample[LANES];
+  uint count;
+} SearchQueue;
+
+/* The samples whose queued segments hold a root, by isolate_bernstein's search; the queue is emptied. */
+ulong search_queued(SearchQueue* queue) {
+  ulong found = 0;
+  LREAL cur[NCOEF];
+#if LANES > 1
+  LMASK running = lanes_of_bits((1u << queue->count) - 1);
+  Isolation iso[LANES];
+  isolate_bernstein_lanes(queue->count, running, queue->b, queue->t_in, queue->t_out, iso, cur);
+  for (uint j = 0; j < queue->count; ++j)
+    if (iso[j].status != ISOLATION_NONE) found |= (ulong)1 << queue->sample[j];
+#else
+  if (isolate_bernstein(queue->b, queue->b, queue->t_in, queue->t_out, cur).status != ISOLATION_NONE)
+    found = (ulong)1 << queue->sample[0];
+#endif
+  queue->count = 0;
+  return found;
+}
+
+/* Queues the open lanes of the block of samples s0 ..; searches whenever the queue fills. Returns the samples
+ * found hidden. */
+ulong queue_for_search(SearchQueue* queue, const LREAL* c, LREAL t_in, LREAL t_out, uint open_bits, uint s0,
+                       __constant const REAL* binomials) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
-  LREAL b[NCOEF], cur[NCOEF];
+  LREAL b[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) b[k] = c[k] / row[k]; /* bernstein_from_scaled */
-#if LANES > 1
-  Isolation iso[LANES];
-  isolate_bernstein_lanes(LANES, open, b, t_in, t_out, iso, cur);
-  for (uint j = 0; j < LANES; ++j)
-    if (lane_get_mask(open, j) && iso[j].status != ISOLATION_NONE) lane_set_mask(&root, j, 1);
-  return root;
-#else
-  const Isolation iso = isolate_bernstein(b, b, t_in, t_out, cur);
-  return iso.status != ISOLATION_NONE;
-#endif
+  ulong found = 0;
+  for (uint j = 0; j < LANES; ++j) {
+    if (!((open_bits >> j) & 1)) continue;
+    const uint at = queue->count;
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) lane_set(&queue->b[k], at, lane_get(b[k], j));
+    lane_set(&queue->t_in, at, lane_get(t_in, j));
+    lane_set(&queue->t_out, at, lane_get(t_out, j));
+    queue->sample[at] = s0 + j;
+    if (++queue->count == LANES) found |= search_queued(queue);
+  }
+  return found;
 }
 
 /* The shadow kernels' answer for surface point i in the point form: its occlusion mask, with the number of rays
@@ -155,30 +236,32 @@ ulong shadow_mask_point_form(__global const REAL4* points, __global const float4
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
   PolyVec q[POINT_FORM_COLUMNS];
   int expanded = 0;
+  SearchQueue queue;
+  queue.count = 0;
+  /* Lanes the queue leaves empty are never read, but keep them defined: copies of a harmless segment. */
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) queue.b[k] = 1;
+  queue.t_in = 0;
+  queue.t_out = 1;
   for (uint s0 = 0; s0 < light_count; s0 += LANES) {
-    REAL lx[LANES], ly[LANES], lz[LANES];
-    LMASK wanted;
-    for (uint j = 0; j < LANES; ++j) {
-      const uint s = min(s0 + j, light_count - 1);
-      lx[j] = light_points[s].x;
-      ly[j] = light_points[s].y;
-      lz[j] = light_points[s].z;
-      lane_set_mask(&wanted, j, s0 + j < light_count && !((mask >> s) & 1));
-    }
-#if LANES > 1
-    const LREAL Lx = LANE_VEC(vload, LANES)(0, lx), Ly = LANE_VEC(vload, LANES)(0, ly),
-                Lz = LANE_VEC(vload, LANES)(0, lz);
-#else
-    const LREAL Lx = lx[0], Ly = ly[0], Lz = lz[0];
-#endif
+    /* The host pads the light points to a multiple of 16, so a block may read past light_count. */
+#define LIGHT_X(j) light_points[s0 + (j)].x
+#define LIGHT_Y(j) light_points[s0 + (j)].y
+#define LIGHT_Z(j) light_points[s0 + (j)].z
+    const LREAL Lx = LANES_OF(LREAL, LIGHT_X), Ly = LANES_OF(LREAL, LIGHT_Y), Lz = LANES_OF(LREAL, LIGHT_Z);
+#undef LIGHT_X
+#undef LIGHT_Y
+#undef LIGHT_Z
+    const uint in_block = light_count - s0 >= LANES ? (1u << LANES) - 1 : (1u << (light_count - s0)) - 1;
+    const LMASK wanted = lanes_of_bits(~(uint)(mask >> s0) & in_block);
     LMASK self;
     LREAL dx, dy, dz, t_in, t_out;
     LMASK trace = shadow_segments(p, n, o, o_unit, Lx, Ly, Lz, extent_inv_scale, extent_kind, extent_box_half.xyz,
                                   &self, &dx, &dy, &dz, &t_in, &t_out);
-    mask |= lane_bits(wanted && self, s0);
+    mask |= (ulong)lane_mask_bits(wanted && self) << s0;
     trace = trace && wanted;
     if (!LANE_ANY(trace)) continue;
-    *traced += (uint)popcount(lane_bits(trace, 0));
+    *traced += popcount(lane_mask_bits(trace));
     if (!expanded) {
       taylor_at_point(mono_exps, mono_coefs, mono_count, o_unit, q);
       expanded = 1;
@@ -186,8 +269,11 @@ ulong shadow_mask_point_form(__global const REAL4* points, __global const float4
     LREAL power[NCOEF], c[NCOEF];
     point_form_restrict(q, dx, dy, dz, power);
     point_form_segment(power, t_in, t_out, binomials, c);
-    mask |= lane_bits(segment_roots(c, power, t_in, t_out, trace, binomials), s0);
+    LMASK open;
+    mask |= (ulong)lane_mask_bits(segment_roots_settled(c, power, t_in, t_out, trace, &open, binomials)) << s0;
+    if (LANE_ANY(open)) mask |= queue_for_search(&queue, c, t_in, t_out, lane_mask_bits(open), s0, binomials);
   }
+  if (queue.count) mask |= search_queued(&queue);
   return mask;
 }
 #endif

@@ -101,7 +101,11 @@ ShadowAnswer ShadowTracer::trace(ShadowPoints& points, const std::vector<glm::dv
   const Precision precision = surface_.precision();
   cl::CommandQueue& queue = session_.queue;
   queue.enqueueWriteBuffer(points.masks_, CL_TRUE, 0, count * sizeof(cl_ulong), answer.masks.data());
-  const cl::Buffer light_buffer = real4_buffer(session_.context, light_points, precision);
+  // Padded to a multiple of 16 with the last point: the point form reads the light points a block of lanes at a
+  // time (kernels/shadow.h), past light_count in the last block.
+  std::vector<glm::dvec3> padded = light_points;
+  padded.resize((light_points.size() + 15) / 16 * 16, light_points.back());
+  const cl::Buffer light_buffer = real4_buffer(session_.context, padded, precision);
   cl_uint traced = 0;
   queue.enqueueWriteBuffer(traced_, CL_TRUE, 0, sizeof(cl_uint), &traced);
 
