@@ -232,6 +232,38 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
   }
 }
 
+#if !ALGRAY_COMPENSATED
+/* casteljau_halve over lanes: c's halves at 1/2 into left and right, by the same rows of the triangle (the same
+ * products and sums per lane). */
+ALGRAY_INLINE void casteljau_halve_lanes(const LREAL* c, LREAL* left, LREAL* right) {
+  LREAL t[NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) t[k] = c[k];
+  left[0] = t[0];
+  right[DEGREE] = t[DEGREE];
+  ALGRAY_UNROLL
+  for (int r = 1; r <= DEGREE; ++r) {
+    ALGRAY_UNROLL
+    for (int k = 0; k < DEGREE; ++k)
+      if (k <= DEGREE - r) t[k] = CASTELJAU_COMBINE((REAL)0.5, t[k], (REAL)0.5, t[k + 1]);
+    left[r] = t[0];
+    right[DEGREE - r] = t[DEGREE - r];
+  }
+}
+
+/* Whether every coefficient of c has one strict sign, lane by lane: then the polynomial has no root on the
+ * interval (and de Casteljau's pieces of it keep the sign). */
+ALGRAY_INLINE LMASK one_strict_sign(const LREAL* c) {
+  LMASK positive = c[0] > 0, negative = c[0] < 0;
+  ALGRAY_UNROLL
+  for (int k = 1; k <= DEGREE; ++k) {
+    positive = positive && c[k] > 0;
+    negative = negative && c[k] < 0;
+  }
+  return positive || negative;
+}
+#endif
+
 #if LANES > 1 && !ALGRAY_COMPENSATED
 #if ALGRAY_ESCALATE
 #define LANE_TERMS_PARAM , LREAL terms
@@ -363,19 +395,8 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     DOUBT_LANES(settle, ALGRAY_DOUBT_CLUSTER);
     if (LANE_ALL(done)) break;
     if (LANE_ANY(halve)) {
-      /* casteljau_halve: the same rows of the triangle */
-      LREAL t[NCOEF], left[NCOEF], right[NCOEF];
-      ALGRAY_UNROLL
-      for (int k = 0; k <= DEGREE; ++k) t[k] = cur[k];
-      left[0] = t[0];
-      right[DEGREE] = t[DEGREE];
-      ALGRAY_UNROLL
-      for (int r = 1; r <= DEGREE; ++r) {
-        ALGRAY_UNROLL
-        for (int k = 0; k < DEGREE; ++k) if (k <= DEGREE - r) t[k] = CASTELJAU_COMBINE((REAL)0.5, t[k], (REAL)0.5, t[k + 1]);
-        left[r] = t[0];
-        right[DEGREE - r] = t[DEGREE - r];
-      }
+      LREAL left[NCOEF], right[NCOEF];
+      casteljau_halve_lanes(cur, left, right);
       ALGRAY_UNROLL
       for (int k = 0; k <= DEGREE; ++k) {
         cur[k] = LANE_SEL(cur[k], left[k], halve);

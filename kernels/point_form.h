@@ -10,8 +10,8 @@
  *   Q(v) = P(o + v) = sum q_abg x^a y^b z^g,
  * turns each ray's restriction into sums of Q's terms: P(o + t d) = sum_k t^k sum_(a+b+g=k) q_abg dx^a dy^b dz^g,
  * two vector operations per term over LANES rays, in place of a Horner scheme over every monomial of P per ray
- * (measured on the Barth decic's shadow rays: restriction 2.3 s -> 0.9 s, bench/RESULTS.md "Shadow rays from a
- * shared expansion"). The origin lies on the surface, inside the extent, and the segment to the extent's edge is
+ * (the Barth decic's shadow rays: about 2.3 s -> 0.5 s of restriction in full mode, bench/RESULTS.md "Shadow rays
+ * from a shared expansion"). The origin lies on the surface, inside the extent, and the segment to the extent's edge is
  * at most its diameter long, so the power basis about o keeps the extent construction's digits: every term is
  * bounded by the same sums of |a_m| times powers of coordinates within the extent (up to the binomial weights
  * of the shift, at most 2^DEGREE in the worst case, which double precision absorbs; float is not offered). */
@@ -31,11 +31,35 @@ ALGRAY_INLINE void shift_rows(REAL s, PolyVec* rows) {
   for (int k = 1; k <= DEGREE; ++k) rows[k] = s * rows[k - 1] + VEC_SHIFT(rows[k - 1]);
 }
 
+/* One of taylor_at_point's shifts by s, in place: along y, column (a, b0) gains C(b, b0) s^(b - b0) times each
+ * column (a, b > b0); along x, column (a0, b) gains C(a, a0) s^(a - a0) times each column (a > a0, b). Each sum
+ * reads only columns it has not yet overwritten, as `to` ascends. */
+ALGRAY_INLINE void shift_columns(PolyVec* q, REAL s, int along_x) {
+  PolyVec rows[NCOEF];
+  shift_rows(s, rows);
+  REAL weight[NCOEF][ACC_WIDTH]; /* weight[from][to] = C(from, to) s^(from - to) */
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) VEC_STORE(rows[k], weight[k]);
+#define SHIFTED_COLUMN(outer, i) (along_x ? POINT_FORM_COLUMN(i, outer) : POINT_FORM_COLUMN(outer, i))
+  ALGRAY_UNROLL
+  for (int outer = 0; outer <= DEGREE; ++outer) ALGRAY_UNROLL
+  for (int to = 0; to <= DEGREE; ++to) {
+    if (outer + to > DEGREE) continue;
+    PolyVec sum = q[SHIFTED_COLUMN(outer, to)];
+    ALGRAY_UNROLL
+    for (int from = 1; from <= DEGREE; ++from)
+      if (from > to && outer + from <= DEGREE) sum += weight[from][to] * q[SHIFTED_COLUMN(outer, from)];
+    q[SHIFTED_COLUMN(outer, to)] = sum;
+  }
+#undef SHIFTED_COLUMN
+}
+
 /* q: P(o + v) by columns, from P's monomials (exponents packed i | j<<8 | k<<16) in unit coordinates. The shift
  * is separable: along z while each monomial is added to its column (one vector operation per monomial), then
  * along y and along x, each a sum of vector products with independent accumulators (the nested Taylor shift
- * of one coefficient at a time was a chain of dependent operations, 3x slower). The y and x sums run in place,
- * in ascending order, so each reads only columns it has not yet overwritten. */
+ * of one coefficient at a time was a chain of dependent operations, 3x slower). Every loop runs to DEGREE and
+ * tests its bound inside: with bounds that depend on the outer indices LLVM unrolled the inner loops only partly
+ * and kept the sums in memory (measured in PoCL's compiled kernel). */
 void taylor_at_point(__global const uint* exps, __global const REAL* coefs, uint count, REAL3 o, PolyVec* q) {
   PolyVec rows[NCOEF];
   shift_rows(o.z, rows);
@@ -46,38 +70,12 @@ void taylor_at_point(__global const uint* exps, __global const REAL* coefs, uint
     const int i = (int)(e & 0xffu), j = (int)((e >> 8) & 0xffu), k = (int)((e >> 16) & 0xffu);
     q[POINT_FORM_COLUMN(i, j)] += coefs[m] * rows[k];
   }
-  REAL weight[NCOEF][ACC_WIDTH]; /* weight[b][b0] = C(b, b0) s^(b - b0) */
-  shift_rows(o.y, rows);
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) VEC_STORE(rows[k], weight[k]);
-  ALGRAY_UNROLL
-  for (int a = 0; a <= DEGREE; ++a) ALGRAY_UNROLL
-  for (int b0 = 0; b0 <= DEGREE; ++b0) {
-    if (a + b0 > DEGREE) continue;
-    PolyVec sum = q[POINT_FORM_COLUMN(a, b0)];
-    ALGRAY_UNROLL
-    for (int b = 1; b <= DEGREE; ++b)
-      if (b > b0 && a + b <= DEGREE) sum += weight[b][b0] * q[POINT_FORM_COLUMN(a, b)];
-    q[POINT_FORM_COLUMN(a, b0)] = sum;
-  }
-  shift_rows(o.x, rows);
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) VEC_STORE(rows[k], weight[k]);
-  ALGRAY_UNROLL
-  for (int a0 = 0; a0 <= DEGREE; ++a0) ALGRAY_UNROLL
-  for (int b = 0; b <= DEGREE; ++b) {
-    if (a0 + b > DEGREE) continue;
-    PolyVec sum = q[POINT_FORM_COLUMN(a0, b)];
-    ALGRAY_UNROLL
-    for (int a = 1; a <= DEGREE; ++a)
-      if (a > a0 && a + b <= DEGREE) sum += weight[a][a0] * q[POINT_FORM_COLUMN(a, b)];
-    q[POINT_FORM_COLUMN(a0, b)] = sum;
-  }
+  shift_columns(q, o.y, 0);
+  shift_columns(q, o.x, 1);
 }
 
-/* P(o + t d) = sum_k c[k] t^k for LANES directions d (unit coordinates), from taylor_at_point's q. Every loop runs
- * to DEGREE and tests its bound inside: with bounds that depend on the outer indices, LLVM unrolled the inner loops
- * only partly and kept the sums in memory (four loads and stores per term, measured in PoCL's compiled kernel). */
+/* P(o + t d) = sum_k c[k] t^k for LANES directions d (unit coordinates), from taylor_at_point's q; its loops are
+ * bounded as taylor_at_point's (left partly unrolled, the sums went through memory: four loads and stores a term). */
 void point_form_restrict(const PolyVec* columns, LREAL dx, LREAL dy, LREAL dz, LREAL* c) {
   const REAL* q = (const REAL*)columns;
   LREAL pz[NCOEF], sum[NCOEF];

@@ -24,16 +24,7 @@
 
 #if RAY_ORIGIN == ALGRAY_ORIGIN_POINT
 /* The point form (point_form.h): the arguments and the result are the extent form's below. */
-__kernel void shadow(SHADOW_KERNEL_PARAMS) {
-  const uint i = get_global_id(0);
-  if (i >= point_count) return;
-  (void)even_axes;
-  uint traced = 0;
-  occluded[i] = shadow_mask_point_form(points, normals, i, light_points, light_count, offset, extent_centre,
-                                       extent_inv_scale, extent_box_half, extent_kind, mono_exps, mono_coefs,
-                                       mono_count, binomials, occluded[i], &traced);
-  if (traced) atomic_add(rays_traced, traced);
-}
+__kernel void shadow(SHADOW_KERNEL_PARAMS) { shadow_point_form_item(SHADOW_KERNEL_ARGS); }
 #else
 
 #if ALGRAY_ESCALATE

@@ -43,13 +43,20 @@ void shadow_origin(__global const REAL4* points, __global const float4* normals,
       __constant const REAL *binomials, uint even_axes, __global ulong *occluded,                                \
       __global uint *rays_traced SHADOW_UNDECIDED_PARAM
 
+/* The same arguments, passed on. */
+#define SHADOW_KERNEL_ARGS                                                                                          \
+  points, normals, point_count, light_points, light_count, offset, extent_centre, extent_inv_scale, extent_box_half, \
+      extent_kind, mono_exps, mono_coefs, mono_count, binomials, even_axes, occluded, rays_traced SHADOW_UNDECIDED_ARG
+
 /* Adaptive builds take one more argument, undecided: per surface point, the samples whose shadow rays the
  * float search doubted, which the host traces again in float-float. Other builds take nothing more. */
 #if ALGRAY_ESCALATE
 #define SHADOW_UNDECIDED_PARAM , __global ulong *undecided
+#define SHADOW_UNDECIDED_ARG , undecided
 #define SHADOW_UNDECIDED(i, mask) (undecided[i] = (mask))
 #else
 #define SHADOW_UNDECIDED_PARAM
+#define SHADOW_UNDECIDED_ARG
 #define SHADOW_UNDECIDED(i, mask) ((void)(mask))
 #endif
 
@@ -119,18 +126,8 @@ LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials) {
     /* Pieces 0 .. 2^level - 1 become 0 .. 2^(level + 1) - 1, from the right so none is overwritten unread. */
     ALGRAY_UNROLL
     for (int p = (1 << level) - 1; p >= 0; --p) {
-      LREAL t[NCOEF], left[NCOEF], right[NCOEF];
-      ALGRAY_UNROLL
-      for (int k = 0; k <= DEGREE; ++k) t[k] = piece[p][k];
-      left[0] = t[0];
-      right[DEGREE] = t[DEGREE];
-      ALGRAY_UNROLL
-      for (int r = 1; r <= DEGREE; ++r) {
-        ALGRAY_UNROLL
-        for (int k = 0; k < DEGREE; ++k) if (k <= DEGREE - r) t[k] = CASTELJAU_COMBINE((REAL)0.5, t[k], (REAL)0.5, t[k + 1]);
-        left[r] = t[0];
-        right[DEGREE - r] = t[DEGREE - r];
-      }
+      LREAL left[NCOEF], right[NCOEF];
+      casteljau_halve_lanes(piece[p], left, right);
       ALGRAY_UNROLL
       for (int k = 0; k <= DEGREE; ++k) {
         piece[2 * p][k] = left[k];
@@ -140,15 +137,7 @@ LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials) {
   }
   LMASK all_clear = c[0] == c[0]; /* every lane set (the coefficients are finite) */
   ALGRAY_UNROLL
-  for (int p = 0; p < (1 << SHADOW_PIECE_LEVELS); ++p) {
-    LMASK positive = piece[p][0] > 0, negative = piece[p][0] < 0;
-    ALGRAY_UNROLL
-    for (int k = 1; k <= DEGREE; ++k) {
-      positive = positive && piece[p][k] > 0;
-      negative = negative && piece[p][k] < 0;
-    }
-    all_clear = all_clear && (positive || negative);
-  }
+  for (int p = 0; p < (1 << SHADOW_PIECE_LEVELS); ++p) all_clear = all_clear && one_strict_sign(piece[p]);
   return all_clear;
 }
 
@@ -158,14 +147,8 @@ LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials) {
  * most of the rest. */
 LMASK segment_roots_settled(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced, LMASK* open,
                             __constant const REAL* binomials) {
-  LMASK positive = c[0] > 0, negative = c[0] < 0;
-  ALGRAY_UNROLL
-  for (int k = 1; k <= DEGREE; ++k) {
-    positive = positive && c[k] > 0;
-    negative = negative && c[k] < 0;
-  }
   const LREAL start = c[0], end = c[DEGREE];
-  const LMASK none = positive || negative;
+  const LMASK none = one_strict_sign(c);
   LMASK root = traced && !none && (start == 0 || end == 0 || (start < 0 && end > 0) || (start > 0 && end < 0));
   *open = traced && !none && !root;
   if (!LANE_ANY(*open)) return root;
@@ -275,6 +258,19 @@ ulong shadow_mask_point_form(__global const REAL4* points, __global const float4
   }
   if (queue.count) mask |= search_queued(&queue);
   return mask;
+}
+
+/* One work-item of the point form's kernels (shadow.cl, and shadow_serial.cl with one lane): surface point i's
+ * mask, and its traced rays counted. */
+void shadow_point_form_item(SHADOW_KERNEL_PARAMS) {
+  const uint i = get_global_id(0);
+  if (i >= point_count) return;
+  (void)even_axes;
+  uint traced = 0;
+  occluded[i] = shadow_mask_point_form(points, normals, i, light_points, light_count, offset, extent_centre,
+                                       extent_inv_scale, extent_box_half, extent_kind, mono_exps, mono_coefs,
+                                       mono_count, binomials, occluded[i], &traced);
+  if (traced) atomic_add(rays_traced, traced);
 }
 #endif
 

@@ -20,14 +20,7 @@ __kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
 #if LANES != 1
 #error "shadow_serial is built with one lane"
 #endif
-  const uint i = get_global_id(0);
-  if (i >= point_count) return;
-  (void)even_axes;
-  uint traced = 0;
-  occluded[i] = shadow_mask_point_form(points, normals, i, light_points, light_count, offset, extent_centre,
-                                       extent_inv_scale, extent_box_half, extent_kind, mono_exps, mono_coefs,
-                                       mono_count, binomials, occluded[i], &traced);
-  if (traced) atomic_add(rays_traced, traced);
+  shadow_point_form_item(SHADOW_KERNEL_ARGS);
 #else
   const uint i = get_global_id(0);
   if (i >= point_count) return;
