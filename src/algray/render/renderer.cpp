@@ -3,6 +3,7 @@
 #include "algray/render/renderer.h"
 
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -129,17 +130,24 @@ void crop_rows(FrameImage& film, int first, int rows) {
 
 }  // namespace
 
-// Page-aligned anonymous memory with every page faulted in as it is made (MAP_POPULATE: one system call rather
-// than a fault per page, which the kernel's threads would otherwise take on the render's path). 4 KB pages on
-// purpose: transparent huge pages populate 4x faster back to back, but on a VM that hands free memory back to
-// its host (Firecracker here) a fresh process's 2 MB pages are often host-faulted, and a 1024^2 preview at a
-// user's pace took 242 ms against 167 (bench/RESULTS.md, "Transparent huge pages: tried").
+// Page-aligned anonymous memory with every page faulted in as it is made, one write a page, on the thread that makes
+// it (another than the render's: see prepare_passes). Not MAP_POPULATE: its one system call holds the process's
+// memory-map lock while it faults 32 MB in (a 1024^2 preview), and the thread loading the programs meanwhile,
+// whose allocations need that lock, waited for it: 8 ms of the 15 ms a program took to load from the disk cache
+// (1024^2 preview; faulting page by page takes 11 ms against 7, so the kernel now waits for the pages instead, about
+// 4 ms less in all). 4 KB pages on purpose (MADV_NOHUGEPAGE, whatever the system's default):
+// transparent huge pages populate 4x faster back to back, but on a VM that hands free memory back to its host
+// (Firecracker here) a fresh process's 2 MB pages are often host-faulted, and a 1024^2 preview at a user's pace
+// took 242 ms against 167 (bench/RESULTS.md, "Transparent huge pages: tried").
 class PopulatedPages {
  public:
   explicit PopulatedPages(std::size_t bytes) : bytes_(std::max<std::size_t>(bytes, 1)) {
-    void* p = ::mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+    void* p = ::mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (p == MAP_FAILED) throw std::bad_alloc();
     data_ = p;
+    ::madvise(p, bytes_, MADV_NOHUGEPAGE);  // advice only: a kernel without transparent huge pages refuses it
+    const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
+    for (std::size_t at = 0; at < bytes_; at += page) static_cast<volatile char*>(p)[at] = 0;
   }
   PopulatedPages(PopulatedPages&& other) noexcept
       : data_(std::exchange(other.data_, nullptr)), bytes_(std::exchange(other.bytes_, 0)) {}
