@@ -369,19 +369,34 @@ RenderedFrame render_frame(const Scene& scene, const FrameRequest& request, Rend
                            (depth_and_normal ? 8 : 4) * sizeof(float) <=
                        (std::uint64_t{256} << 20);
     std::future<FrameImage> film;
-    if (ahead)
+    // The camera rays' hit records of the largest tile on a CPU (the plan's default tile; a GPU's is smaller and
+    // makes its own), after the film on the same thread: both overlap the device's start, which needs no memory.
+    std::future<PopulatedPages> tile_memory;
+    if (ahead) {
+      const std::size_t tile_bytes = tile_memory_bytes(make_render_plan(scene, Precision::Double));
+      auto pages = std::make_shared<std::promise<PopulatedPages>>();
+      tile_memory = pages->get_future();
       film = std::async(std::launch::async, [=] {
+        // The tile first: the render needs it when its programs are loaded, the film only after the first tile.
+        try {
+          pages->set_value(PopulatedPages(tile_bytes));
+        } catch (...) {
+          pages->set_exception(std::current_exception());
+        }
         if (png) srgb_byte(0.5f);
         return make_film(film_width, film_height, depth_and_normal);
       });
+    }
     const std::vector<ClSession*> sessions = context.sessions();
     device = sessions.front()->info;
     timer.mark("device");
     Renderer renderer(sessions, context.cache());
     RenderOptions options;
     // A larger film is made when the render has checked that it fits, with only the channels the outputs hold.
-    if (ahead)
+    if (ahead) {
       options.film = [&film] { return film.get(); };
+      options.tile_memory = [&tile_memory] { return tile_memory.get(); };
+    }
     else
       options.film = [=] { return make_film(film_width, film_height, depth_and_normal); };
     options.on_progress = callbacks.on_progress;

@@ -2,9 +2,6 @@
 // film, before the next tile; adaptive antialiasing then refines tile by tile from the film's first colours.
 #include "algray/render/renderer.h"
 
-#include <sys/mman.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,6 +17,7 @@
 
 #include "algray/device/fp64_speed.h"
 #include "algray/render/escalation.h"
+#include "algray/render/populated_pages.h"
 #include "algray/render/ray_tracer.h"
 #include "algray/render/shade.h"
 #include "algray/render/shadow_tracer.h"
@@ -27,6 +25,8 @@
 namespace algray {
 
 int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 256 : 1024; }
+
+std::size_t tile_memory_bytes(const RenderPlan& plan) { return plan.tile_rays() * sizeof(HitRecord); }
 
 Precision float_precision_for(const Scene& scene) {
   for (const SceneSurface& surface : scene.surfaces)
@@ -129,39 +129,6 @@ void crop_rows(FrameImage& film, int first, int rows) {
 }
 
 }  // namespace
-
-// Page-aligned anonymous memory with every page faulted in as it is made, one write a page, on the thread that makes
-// it (another than the render's: see prepare_passes). Not MAP_POPULATE: its one system call holds the process's
-// memory-map lock while it faults 32 MB in (a 1024^2 preview), and the thread loading the programs meanwhile,
-// whose allocations need that lock, waited for it: 8 ms of the 15 ms a program took to load from the disk cache
-// (1024^2 preview; faulting page by page takes 11 ms against 7, so the kernel now waits for the pages instead, about
-// 4 ms less in all). 4 KB pages on purpose (MADV_NOHUGEPAGE, whatever the system's default):
-// transparent huge pages populate 4x faster back to back, but on a VM that hands free memory back to its host
-// (Firecracker here) a fresh process's 2 MB pages are often host-faulted, and a 1024^2 preview at a user's pace
-// took 242 ms against 167 (bench/RESULTS.md, "Transparent huge pages: tried").
-class PopulatedPages {
- public:
-  explicit PopulatedPages(std::size_t bytes) : bytes_(std::max<std::size_t>(bytes, 1)) {
-    void* p = ::mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (p == MAP_FAILED) throw std::bad_alloc();
-    data_ = p;
-    ::madvise(p, bytes_, MADV_NOHUGEPAGE);  // advice only: a kernel without transparent huge pages refuses it
-    const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
-    for (std::size_t at = 0; at < bytes_; at += page) static_cast<volatile char*>(p)[at] = 0;
-  }
-  PopulatedPages(PopulatedPages&& other) noexcept
-      : data_(std::exchange(other.data_, nullptr)), bytes_(std::exchange(other.bytes_, 0)) {}
-  PopulatedPages& operator=(PopulatedPages&&) = delete;
-  PopulatedPages(const PopulatedPages&) = delete;
-  ~PopulatedPages() {
-    if (data_) ::munmap(data_, bytes_);
-  }
-  void* data() const { return data_; }
-
- private:
-  void* data_ = nullptr;
-  std::size_t bytes_;
-};
 
 // Host memory for one tile's hit records, which the primary kernel writes through a CL_MEM_USE_HOST_PTR buffer.
 // On a CPU device the kernel writes this memory itself and mapping it copies nothing; on a GPU the map copies
@@ -517,7 +484,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
     Passes& passes = *devices.back();
     for (std::size_t i = 0; i < scene.surfaces.size(); ++i)
       passes.surfaces.push_back(std::make_unique<DeviceSurface>(session->context, scene, precision, i));
-    prepare_passes(passes);
+    prepare_passes(passes, devices.size() == 1);
     passes.shader = &shader;
   }
   if (options.keep_records) {
@@ -654,17 +621,27 @@ void Renderer::add_device_tallies(const std::vector<std::unique_ptr<Passes>>& de
   }
 }
 
-void Renderer::prepare_passes(Passes& passes) {
+void Renderer::prepare_passes(Passes& passes, bool first_device) {
   const Scene& scene = passes.scene;
   RenderResult& result = passes.result;
   const RenderPlan& plan = result.plan;
   PassStats& primary = *passes.stats_of(PassKind::Primary);
   // The largest tile: a tile's hit records are all the device holds for the camera rays. Their memory (32 MB
   // at 1024^2) is populated on another thread while this one loads the programs, a core's work either way.
-  const std::size_t tile_rays = static_cast<std::size_t>(std::min(plan.tile_pixels(), plan.width)) * plan.samples *
-                                std::min(plan.tile_pixels(), plan.height) * plan.samples;
+  const std::size_t tile_rays = plan.tile_rays(), bytes = tile_memory_bytes(plan);
+  // The caller's memory, made while the device started, when it fits the tile (the first device only).
   std::future<PopulatedPages> hit_memory =
-      std::async(std::launch::async, [tile_rays] { return PopulatedPages(tile_rays * sizeof(HitRecord)); });
+      std::async(std::launch::async, [bytes, made = first_device ? passes.options.tile_memory : nullptr] {
+        if (made) {
+          try {
+            PopulatedPages pages = made();
+            if (pages.size() >= bytes && pages.size() <= 2 * bytes) return pages;
+          } catch (...) {
+            // the caller's could not be made (its memory, or the film before it): make ours below
+          }
+        }
+        return PopulatedPages(bytes);
+      });
   for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
     ProgramRecord record;
     passes.primary.push_back(cache_.kernel(passes.session, plan.find(PassKind::Primary)->kernels[s], &record));
@@ -679,7 +656,7 @@ void Renderer::prepare_passes(Passes& passes) {
       std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays, hit_memory.get());
   if (scene.surfaces.size() > 1)
     passes.other_out = std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays,
-                                                  PopulatedPages(tile_rays * sizeof(HitRecord)));
+                                                  PopulatedPages(bytes));
 
   if (PassStats* stats = passes.stats_of(PassKind::Shadow)) {
     const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();

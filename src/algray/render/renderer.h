@@ -13,6 +13,7 @@
 #include "algray/device/program_cache.h"
 #include "algray/io/image_io.h"
 #include "algray/render/device_surface.h"
+#include "algray/render/populated_pages.h"
 #include "algray/render/render_plan.h"
 #include "algray/render/trace_records.h"
 #include "algray/scene/camera.h"
@@ -53,6 +54,9 @@ struct RenderCancelled : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The host memory one tile's camera-ray records take under `plan`.
+std::size_t tile_memory_bytes(const RenderPlan& plan);
+
 struct RenderOptions {
   // Called after each tile, on the rendering thread; the command line draws its progress line from it. With
   // several devices, each callback is called from their threads, one call at a time.
@@ -71,6 +75,10 @@ struct RenderOptions {
   // is used when its size is the plan's, and may then lack depth and normal (PNG outputs only); otherwise, or
   // without it, the render makes its own.
   std::function<FrameImage()> film;
+  // Gives host memory for one tile's camera-ray records, made ahead by the caller as the film is (page faults
+  // overlapping the device's start, render_scene). Called once, by the first device; used when it holds the
+  // plan's tile (tile_memory_bytes) and no more than twice that, else the render makes its own.
+  std::function<PopulatedPages()> tile_memory;
   // Only the output rows [first, end) of the image, into a film of the band's height whose row 0 is image row
   // `first`: a band renders the pixels the whole image has there, bit for bit (MPI ranks render bands of one
   // image). Adaptive antialiasing then traces one more row beyond each inner edge, first colours only, so that
@@ -182,7 +190,7 @@ class Renderer {
   FrameImage render_rows(std::vector<std::unique_ptr<Passes>>& devices, const RenderOptions::RowBand& rows,
                          const std::function<FrameImage()>& film);
   static void add_device_tallies(const std::vector<std::unique_ptr<Passes>>& devices, RenderResult& result);
-  void prepare_passes(Passes& passes);
+  void prepare_passes(Passes& passes, bool first_device);
   // The primary kernels' arguments for a band of tiles (a row of them), but the tile's own.
   void set_band_args(Passes& passes, const Tile& first);
   void trace_primary(Passes& passes, const Tile& tile);
