@@ -74,7 +74,8 @@ void casteljau_keep_left(REAL* c, REAL* c_lo, REAL x) {
   const REAL x1 = (REAL)1 - x;
   ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-  for (int k = DEGREE; k >= 1; --k) if (k >= r) casteljau_step(c, c_lo, k, k - 1, k, x1, 0, x, 0);
+  for (int k = DEGREE; k >= 1; --k)
+    if (k >= r) casteljau_step(c, c_lo, k, k - 1, k, x1, 0, x, 0);
 }
 
 /* Keeps the part on [x + x_lo, 1], for x >= 1/2 (so 1 - x is exact). */
@@ -82,7 +83,8 @@ void casteljau_keep_right(REAL* c, REAL* c_lo, REAL x, REAL x_lo) {
   const REAL x1 = (REAL)1 - x;
   ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-  for (int k = 0; k < DEGREE; ++k) if (k <= DEGREE - r) casteljau_step(c, c_lo, k, k, k + 1, x1, -x_lo, x, x_lo);
+  for (int k = 0; k < DEGREE; ++k)
+    if (k <= DEGREE - r) casteljau_step(c, c_lo, k, k, k + 1, x1, -x_lo, x, x_lo);
 }
 
 /* Halves c at 1/2 in one de Casteljau triangle: c becomes the left half, right the right half. */
@@ -117,7 +119,8 @@ void casteljau_halve(REAL* c, REAL* c_lo, REAL* right, REAL* right_lo) {
   ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r) {
     ALGRAY_UNROLL
-    for (int k = 0; k < DEGREE; ++k) if (k <= DEGREE - r) casteljau_step(t, t_lo, k, k, k + 1, (REAL)0.5, 0, (REAL)0.5, 0);
+    for (int k = 0; k < DEGREE; ++k)
+      if (k <= DEGREE - r) casteljau_step(t, t_lo, k, k, k + 1, (REAL)0.5, 0, (REAL)0.5, 0);
     c[r] = t[0];
     right[DEGREE - r] = t[DEGREE - r];
 #if ALGRAY_COMPENSATED
@@ -305,7 +308,8 @@ void bernstein_restrict_lanes(const LREAL* root, LREAL width, LREAL idx, LMASK t
     for (int k = 0; k <= DEGREE; ++k) t[k] = o[k];
     ALGRAY_UNROLL
     for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-    for (int k = DEGREE; k >= 1; --k) if (k >= r) t[k] = CASTELJAU_COMBINE(x1, t[k - 1], hi, t[k]);
+    for (int k = DEGREE; k >= 1; --k)
+      if (k >= r) t[k] = CASTELJAU_COMBINE(x1, t[k - 1], hi, t[k]);
     ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE; ++k) o[k] = LANE_SEL(o[k], t[k], left);
   }
@@ -317,7 +321,8 @@ void bernstein_restrict_lanes(const LREAL* root, LREAL width, LREAL idx, LMASK t
     for (int k = 0; k <= DEGREE; ++k) t[k] = o[k];
     ALGRAY_UNROLL
     for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-    for (int k = 0; k < DEGREE; ++k) if (k <= DEGREE - r) t[k] = CASTELJAU_COMBINE(x1, t[k], x, t[k + 1]);
+    for (int k = 0; k < DEGREE; ++k)
+      if (k <= DEGREE - r) t[k] = CASTELJAU_COMBINE(x1, t[k], x, t[k + 1]);
     ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE; ++k) o[k] = LANE_SEL(o[k], t[k], right);
   }

@@ -180,7 +180,8 @@ TEST_CASE("the point form's shadow rays in lanes answer as one at a time, bit fo
     const Scene scene = random_scene(rng, degree, even, Precision::Double, Isolation::Bernstein);
     std::ostringstream what;
     what << "point form (seed " << kSeed + 3 << "), degree " << degree << (even ? ", even" : "");
-    const Counts n = check_same_masks(scene, Precision::Double, Isolation::Bernstein, rng, what.str(), RayOrigin::Point);
+    const Counts n =
+        check_same_masks(scene, Precision::Double, Isolation::Bernstein, rng, what.str(), RayOrigin::Point);
     INFO(what.str() << ": " << n.traced << " rays traced, " << n.hidden << " samples hidden, " << n.visible
                     << " visible");
     CHECK(n.traced >= 1000);

@@ -396,8 +396,7 @@ RenderedFrame render_frame(const Scene& scene, const FrameRequest& request, Rend
     if (ahead) {
       options.film = [&film] { return film.get(); };
       options.tile_memory = [&tile_memory] { return tile_memory.get(); };
-    }
-    else
+    } else
       options.film = [=] { return make_film(film_width, film_height, depth_and_normal); };
     options.on_progress = callbacks.on_progress;
     options.cancelled = callbacks.cancelled;

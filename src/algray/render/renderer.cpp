@@ -655,8 +655,8 @@ void Renderer::prepare_passes(Passes& passes, bool first_device) {
   passes.primary_out =
       std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays, hit_memory.get());
   if (scene.surfaces.size() > 1)
-    passes.other_out = std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays,
-                                                  PopulatedPages(bytes));
+    passes.other_out =
+        std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays, PopulatedPages(bytes));
 
   if (PassStats* stats = passes.stats_of(PassKind::Shadow)) {
     const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
