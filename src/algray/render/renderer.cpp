@@ -434,24 +434,24 @@ RenderPlan Renderer::plan_of(const Scene& scene, Precision precision) const {
 void Renderer::sweep(std::vector<std::unique_ptr<Passes>>& devices, const std::vector<Tile>& tiles,
                      const std::function<void(Passes&, const Tile&)>& work) {
   Shared& shared = devices.front()->shared;
-  shared.next_tile = 0;
-  auto take_tiles = [&](Passes& passes) {
-    while (!shared.stop) {
-      const std::size_t t = shared.next_tile++;
-      if (t >= tiles.size()) return;
+  // Tile d is device d's own, the queue hands out the rest: a device whose thread starts late still renders a
+  // tile (under load, one device once took every tile of a small frame before the other's thread began).
+  shared.next_tile = devices.size();
+  auto take_tiles = [&](Passes& passes, std::size_t first) {
+    for (std::size_t t = first; !shared.stop && t < tiles.size(); t = shared.next_tile++) {
       passes.check_cancelled();
       work(passes, tiles[t]);
       passes.progress();
     }
   };
-  if (devices.size() == 1) return take_tiles(*devices.front());
+  if (devices.size() == 1) return take_tiles(*devices.front(), 0);
   // One thread per device, each waiting on its own queue and shading its own tiles on the host.
   std::vector<std::exception_ptr> failures(devices.size());
   std::vector<std::thread> threads;
   for (std::size_t d = 0; d < devices.size(); ++d)
     threads.emplace_back([&, d] {
       try {
-        take_tiles(*devices[d]);
+        take_tiles(*devices[d], d);
       } catch (...) {
         failures[d] = std::current_exception();
         shared.stop = true;
