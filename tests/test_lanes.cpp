@@ -170,6 +170,16 @@ TEST_CASE("the plan gives lanes to the camera and secondary rays' kernels, where
   CHECK(adaptive.find(PassKind::Primary)->escalation.at(0).entry == "trace");
   CHECK(adaptive.find(PassKind::Primary)->escalation.at(0).lanes == 8);
   CHECK(adaptive.find(PassKind::Shadow)->escalation.at(0).lanes == 1);
+  // Where double's fp64 is fast the doubted shadow rays go again in double, in the point form and its lanes; in
+  // mixed precision through the extent form.
+  RenderPlan in_double = adaptive;
+  escalate_in(in_double, Precision::Double);
+  CHECK(in_double.find(PassKind::Shadow)->escalation.at(0).ray_origin == RayOrigin::Point);
+  CHECK(in_double.find(PassKind::Shadow)->escalation.at(0).lanes == 8);
+  CHECK(in_double.find(PassKind::Primary)->escalation.at(0).ray_origin == RayOrigin::Extent);
+  RenderPlan in_mixed = adaptive;
+  escalate_in(in_mixed, Precision::Mixed);
+  CHECK(in_mixed.find(PassKind::Shadow)->escalation.at(0).ray_origin == RayOrigin::Extent);
   // A refinement without a lane version keeps one ray per work-item; the scene's setting overrides the device's.
   const Scene bisection = load_scene_text(text, "random", {{"render.refinement", "\"bisection\""}});
   CHECK(make_render_plan(bisection, Precision::Double, 0, 8).find(PassKind::Primary)->kernels.at(0).lanes == 1);

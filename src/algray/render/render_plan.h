@@ -113,7 +113,8 @@ inline constexpr int kMaxPointFormDegree = 15;
 bool point_form_applies(const KernelConfig& shadow);
 
 // Adaptive precision's escalation kernels in `precision` instead: double where every device's fp64 is fast (the
-// doubted rays then cost about what float does), mixed otherwise (what make_render_plan plans).
+// doubted rays then cost about what float does; shadow rays in the point form where it applies), mixed otherwise
+// (what make_render_plan plans).
 void escalate_in(RenderPlan& plan, Precision precision);
 
 // The kernel of the primary pass for one surface of `scene`.
