@@ -146,7 +146,9 @@ Isolation isolation_found(Isolation iso, SearchNoise* noise) {
   return iso;
 }
 #else
-#define doubted(...) 0
+/* Named parameters: OpenCL C before 3.0 has no variadic macros (NVIDIA's compiler refuses them). The probe's
+ * extra argument rides inside `level`, as the call sites write `level PROBE_ARG`. */
+#define doubted(iso, reason, value, noise, level) 0
 #define isolation_found(iso, noise) (iso)
 #endif
 
