@@ -17,7 +17,8 @@ packages=(
   munge slurmctld slurmd slurm-client  # test_slurm_array: a single-node Slurm started by the test itself
   libopenmpi-dev openmpi-bin  # `mpirun -n N algray batch` (the cluster layer) and test_mpi_batch
   clang-15                  # the sanitizer tree and libFuzzer targets of scripts/test.sh: the clang PoCL already
-                            # depends on, with ASan, UBSan and libFuzzer in its libclang-common-15-dev
+                            # depends on, with ASan, UBSan and libFuzzer in its libclang-common-15-dev; and
+                            # test_kernel_portability's strict OpenCL C 1.2 front end
   ninja-build               # scripts/test.sh builds with Ninja
   help2man                  # the man page
 )

@@ -2,9 +2,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <catch2/catch.hpp>
+#include <cctype>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -14,14 +16,16 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "cli_sandbox.h"
+#include "algray/device/cl_runtime.h"
 #include "algray/io/image_io.h"
 #include "algray/scene/scene.h"
 #include "algray/scene/solver_options.h"
-#include "scene_fixtures.h"
 #include "algray/util/version.h"
+#include "cli_sandbox.h"
+#include "scene_fixtures.h"
 
 namespace fs = std::filesystem;
 
@@ -31,7 +35,12 @@ namespace {
 
 const std::string kTiny = "--width 32 --height 24";
 
-std::string scene_file(const char* name) { return quoted(std::string(ALGRAY_SOURCE_DIR) + "/scenes/" + name); }
+std::string scene_file(const char* name) {
+  // Appended, not added: GCC 12 misreads operator+ on this temporary (a false -Warray-bounds).
+  std::string path = ALGRAY_SOURCE_DIR "/scenes/";
+  path += name;
+  return quoted(std::as_const(path));  // the sandbox's quoted, not std::quoted (which a non-const string picks)
+}
 
 std::string sphere_with(int line, const std::string& replacement) {
   return algray::testing::sphere_with({{line, replacement}});
@@ -286,12 +295,18 @@ TEST_CASE("--device picks by index or name substring and lists the devices when 
     CHECK_THAT(r.err, Catch::Contains("[0] ") && Catch::Contains("compute units"));
     CHECK(box.work_files().empty());
   }
-  SECTION("a substring of the PoCL device name") {
-    const Result r = box.run("render -o out.exr --device pthread --stats s.json " + kTiny);
+  SECTION("a substring of the device's name, in another case") {
+    const auto devices = algray::enumerate_devices();
+    REQUIRE_FALSE(devices.empty());
+    // The first word of the first device's name, upper-cased: "PTHREAD" on PoCL, "NVIDIA" on an NVIDIA GPU.
+    const std::string word = devices.front().name.substr(0, devices.front().name.find_first_of(" -"));
+    std::string upper = word;
+    std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char c) { return std::toupper(c); });
+    const Result r = box.run("render -o out.exr --device " + upper + " --stats s.json " + kTiny);
     INFO(r.err);
     REQUIRE(r.exit_code == 0);
     const std::string name = box.stats()["device"]["name"];
-    CHECK_THAT(name, Catch::Contains("pthread"));
+    CHECK_THAT(name, Catch::Contains(word));
   }
 }
 
@@ -340,7 +355,8 @@ TEST_CASE("a kernel that fails to build exits 1 with the build log and the optio
   CHECK(message.find("OpenCL build failed") != std::string::npos);
   CHECK(message.find("options: -cl-std=CL1.2 -D DEGREE=6") != std::string::npos);
   CHECK(message.find("build log:") != std::string::npos);
-  CHECK(message.find("primary.cl") != std::string::npos);  // the log names the file and line of the error
+  // The log names the file and line of the error, on every device (locate_in_kernel_files).
+  CHECK(message.find("primary.cl:") != std::string::npos);
   CHECK_FALSE(fs::exists(box.work / "out.png"));
 }
 
@@ -360,7 +376,7 @@ TEST_CASE("--version prints the version and git revision; stats, logs and images
   CHECK(exr.software == version);
   CHECK_THAT(exr.comments, Catch::Contains("Barth sextic") && Catch::Contains("= 0"));
   REQUIRE(exr.chromaticities);
-  CHECK((*exr.chromaticities)[0] == Approx(0.64));  // Rec.709 red x
+  CHECK((*exr.chromaticities)[0] == Approx(0.64));    // Rec.709 red x
   CHECK((*exr.chromaticities)[6] == Approx(0.3127));  // D65 white x
   std::map<std::string, std::string> png;
   for (const auto& [key, text] : algray::read_png_text(box.work / "out.png")) png[key] = text;

@@ -19,13 +19,14 @@ struct SpeedKernel {
 
 SpeedKernel speed_kernel(ClSession& session, bool in_double) {
   SpeedKernel k;
-  k.program = cl::Program(session.context, assemble_kernel_source("fp_speed.cl"));
-  const std::string options = in_double ? "-D ALGRAY_FP_DOUBLE=1" : "";
+  const std::string source = assemble_kernel_source("fp_speed.cl");
+  k.program = cl::Program(session.context, source);
+  const std::string options = fp_speed_build_options(in_double);
   try {
     k.program.build({session.info.device}, options.c_str());
   } catch (const cl::Error&) {
     throw BuildError("fp_speed.cl did not build on '" + session.info.name + "' with options '" + options + "':\n" +
-                     k.program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(session.info.device));
+                     locate_in_kernel_files(k.program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(session.info.device), source));
   }
   k.kernel = cl::Kernel(k.program, "fp_speed");
   // Enough work-items for every compute unit's lanes, and enough rounds that a launch's overhead is noise.
@@ -48,6 +49,8 @@ double launch_ms(ClSession& session, SpeedKernel& k) {
 }
 
 }  // namespace
+
+std::string fp_speed_build_options(bool in_double) { return in_double ? "-D ALGRAY_FP_DOUBLE=1" : ""; }
 
 std::optional<double> fp64_slowdown(const DeviceInfo& device, ProgramCache& cache) {
   if (!device.fp64) return std::nullopt;

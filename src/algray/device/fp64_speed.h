@@ -2,6 +2,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 
 #include "algray/device/cl_runtime.h"
 #include "algray/device/program_cache.h"
@@ -14,5 +15,8 @@ namespace algray {
 // without fp64 (or with it hidden) has none.
 // The device is opened only to measure.
 std::optional<double> fp64_slowdown(const DeviceInfo& device, ProgramCache& cache);
+
+// kernels/fp_speed.cl's build options in float or in double (the portability test compiles both).
+std::string fp_speed_build_options(bool in_double);
 
 }  // namespace algray

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -58,6 +59,63 @@ std::string assemble_kernel_source(const std::string& main_file) {
   std::vector<std::string> stack;
   std::string out;
   append_with_includes(main_file, stack, out);
+  return out;
+}
+
+namespace {
+
+struct SourceLine {
+  std::string file;
+  int line = 0;
+};
+
+// Where each line of an assembled program came from, by its #line directives (index 0 is the text's line 1).
+std::vector<SourceLine> line_origins(const std::string& source) {
+  std::vector<SourceLine> origins;
+  std::istringstream lines(source);
+  std::string line, file = "?";
+  int next = 1;
+  while (std::getline(lines, line)) {
+    origins.push_back({file, next});
+    std::istringstream directive(line);
+    std::string word, name;
+    int number = 0;
+    if (directive >> word && word == "#line" && directive >> number >> name && name.size() >= 2) {
+      file = name.substr(1, name.size() - 2);
+      next = number;
+    } else {
+      ++next;
+    }
+  }
+  return origins;
+}
+
+bool is_kernel_file(const std::string& name) {
+  for (const EmbeddedFile& f : embedded_kernel_files())
+    if (name == f.name) return true;
+  return false;
+}
+
+}  // namespace
+
+std::string locate_in_kernel_files(const std::string& log, const std::string& source) {
+  const std::vector<SourceLine> origins = line_origins(source);
+  static const std::regex location(R"(([^\s:]+):(\d+):(\d+):)");
+  std::string out;
+  auto rest = log.cbegin();
+  for (std::sregex_iterator it(log.begin(), log.end(), location), end; it != end; ++it) {
+    const std::smatch& m = *it;
+    const long line = std::stol(m[2].str());
+    out.append(rest, m[0].first);
+    if (!is_kernel_file(m[1].str()) && line >= 1 && line <= static_cast<long>(origins.size())) {
+      const SourceLine& from = origins[static_cast<std::size_t>(line - 1)];
+      out += from.file + ":" + std::to_string(from.line) + ":" + m[3].str() + ":";
+    } else {
+      out += m[0].str();
+    }
+    rest = m[0].second;
+  }
+  out.append(rest, log.cend());
   return out;
 }
 

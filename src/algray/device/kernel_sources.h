@@ -12,4 +12,9 @@ namespace algray {
 // can be edited without rebuilding the host.
 std::string assemble_kernel_source(const std::string& main_file);
 
+// A compiler's build log with each location it gives in the assembled program text (NVIDIA's compiler writes
+// "<kernel>:9756:1:", ignoring #line) rewritten as the kernel file and line it came from, so that every
+// device's errors point into kernels/; locations that already name a kernel file (PoCL honours #line) stay.
+std::string locate_in_kernel_files(const std::string& log, const std::string& source);
+
 }  // namespace algray

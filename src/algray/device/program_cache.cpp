@@ -135,7 +135,7 @@ cl::Program ProgramCache::build_from_source(ClSession& session, const std::strin
         << "  device: " << session.info.name << " (" << session.info.platform_name << ")\n"
         << "  options: " << options << "\n"
         << "build log:\n"
-        << build_log(program, session.info.device);
+        << locate_in_kernel_files(build_log(program, session.info.device), source);
     throw BuildError(msg.str());
   }
   return program;
