@@ -1,4 +1,5 @@
 // Hostile input, full disks, damaged caches: each a failure once found in algray, now an error or a render.
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,9 +14,10 @@
 #include <vector>
 
 #include "algray/api/batch.h"
-#include "cli_sandbox.h"
-#include "algray/scene/expression.h"
 #include "algray/io/image_io.h"
+#include "algray/scene/expression.h"
+#include "algray/util/host_memory.h"
+#include "cli_sandbox.h"
 #include "scene_fixtures.h"
 
 namespace fs = std::filesystem;
@@ -377,14 +379,50 @@ TEST_CASE("an error in what a .jsurf file translates to points into the .jsurf",
 TEST_CASE("a render too large for the memory is refused up front, naming the estimate", "[reliability][errors]") {
   require_device();
   Sandbox box;
+  // The film alone takes tens of GB, more than a 4 GB data size limit allows on any machine (a machine of 128 GB
+  // would otherwise start the render: seen on a lent GPU machine).
+  box.limits = "ulimit -d 4194304";
   const auto start = std::chrono::steady_clock::now();
   const Result r = box.run("render -o out.exr --width 32768 --height 32768 --set antialias.samples=2");
   INFO(r.err);
   CHECK(r.exit_code == 2);
   CHECK_THAT(r.err, Catch::Contains("needs about") && Catch::Contains(" GB of memory") &&
-                        Catch::Contains("32768x32768 render with 2x2 samples"));
+                        Catch::Contains("32768x32768 render with 2x2 samples") &&
+                        Catch::Contains("available to this process (its data size limit, ulimit -d)"));
   CHECK(seconds_since(start) < 30);
   CHECK(box.work_files().empty());
+}
+
+TEST_CASE("the memory a process may take is the least of the machine's, its cgroup's and its limits'",
+          "[reliability][memory]") {
+  const algray::HostMemory unlimited = algray::available_host_memory();
+  REQUIRE(unlimited.bytes > 0);  // every Linux has MemAvailable
+  // In a child, so that the limit stays there: a data size limit below what the machine offers becomes the answer.
+  int pipe_fds[2];
+  REQUIRE(pipe(pipe_fds) == 0);
+  const pid_t child = fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    const rlimit data{256ull << 20, 256ull << 20};
+    const algray::HostMemory limited =
+        setrlimit(RLIMIT_DATA, &data) == 0 ? algray::available_host_memory() : algray::HostMemory{};
+    const std::string answer = std::to_string(limited.bytes) + " " + limited.limited_by;
+    const ssize_t written = write(pipe_fds[1], answer.data(), answer.size());
+    _exit(written == static_cast<ssize_t>(answer.size()) ? 0 : 1);
+  }
+  close(pipe_fds[1]);
+  std::string answer;
+  char buf[256];
+  for (ssize_t n; (n = read(pipe_fds[0], buf, sizeof buf)) > 0;) answer.append(buf, static_cast<std::size_t>(n));
+  close(pipe_fds[0]);
+  int status = 0;
+  REQUIRE(waitpid(child, &status, 0) == child);
+  INFO(answer);
+  REQUIRE(answer.find(' ') != std::string::npos);
+  const std::uint64_t bytes = std::stoull(answer.substr(0, answer.find(' ')));
+  CHECK(bytes > 0);
+  CHECK(bytes <= (256ull << 20));
+  CHECK_THAT(answer, Catch::Contains("ulimit -d"));
 }
 
 TEST_CASE("what the one-hour fuzz runs found is refused with a located error", "[reliability][errors][fuzz]") {

@@ -65,6 +65,7 @@ struct Sandbox {
   fs::path work = root / "work";
   fs::path in = root / "in";
   fs::path cache = shared_cache_dir();
+  std::string limits;  // shell commands run before the binary, such as "ulimit -d 4194304"
 
   Sandbox() {
     fs::create_directories(work);
@@ -78,9 +79,10 @@ struct Sandbox {
   // Standard input is `stdin_path`, /dev/null unless a test pipes a scene in.
   Result run(const std::string& args, const fs::path& stdin_path = "/dev/null") const {
     const fs::path out = in / "stdout.txt", err = in / "stderr.txt";
-    const std::string cmd = "cd " + quoted(work.string()) + " && ALGRAY_CACHE_DIR=" + quoted(cache.string()) + " " +
-                            quoted(ALGRAY_BINARY) + " " + args + " >" + quoted(out.string()) + " 2>" +
-                            quoted(err.string()) + " <" + quoted(stdin_path.string());
+    const std::string cmd = "cd " + quoted(work.string()) + " && " + (limits.empty() ? "" : limits + " && ") +
+                            "ALGRAY_CACHE_DIR=" + quoted(cache.string()) + " " + quoted(ALGRAY_BINARY) + " " + args +
+                            " >" + quoted(out.string()) + " 2>" + quoted(err.string()) + " <" +
+                            quoted(stdin_path.string());
     const int status = std::system(cmd.c_str());
     REQUIRE(status != -1);
     REQUIRE(WIFEXITED(status));

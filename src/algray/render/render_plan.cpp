@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "algray/render/screen_form.h"
+#include "algray/util/host_memory.h"
 #include "kernels/algray_shared.h"
 
 namespace algray {
@@ -286,18 +287,6 @@ std::uint64_t RenderPlan::estimated_memory_bytes() const {
 
 namespace {
 
-// MemAvailable from /proc/meminfo: what can be allocated without swapping; 0 when unknown.
-std::uint64_t available_host_memory() {
-  std::FILE* f = std::fopen("/proc/meminfo", "r");
-  if (!f) return 0;
-  char line[256];
-  unsigned long long kb = 0;
-  while (std::fgets(line, sizeof line, f))
-    if (std::sscanf(line, "MemAvailable: %llu kB", &kb) == 1) break;
-  std::fclose(f);
-  return static_cast<std::uint64_t>(kb) * 1024;
-}
-
 std::string gigabytes(std::uint64_t bytes) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.2f GB", static_cast<double>(bytes) / 1e9);
@@ -312,9 +301,9 @@ void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device) {
                            " samples per pixel needs about ";
   const std::string advice = ": render a smaller image (or with a smaller render.tile_size)";
   const std::uint64_t need = plan.estimated_memory_bytes();
-  if (const std::uint64_t available = available_host_memory(); available && need > available)
-    throw DeviceError(what + gigabytes(need) + " of memory, and this machine has " + gigabytes(available) +
-                      " available" + advice);
+  if (const HostMemory available = available_host_memory(); available.bytes && need > available.bytes)
+    throw DeviceError(what + gigabytes(need) + " of memory, and " + gigabytes(available.bytes) +
+                      " are available to this process (" + available.limited_by + ")" + advice);
   if (device.type == "CPU") return;  // its buffers are in the memory counted above
   if (device.global_mem_bytes && plan.buffer_bytes() > device.global_mem_bytes)
     throw DeviceError(what + gigabytes(plan.buffer_bytes()) + " of device memory, and " + device.name + " has " +
