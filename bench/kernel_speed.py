@@ -44,9 +44,42 @@ def compare(binaries, scene, args, repeat, workdir):
     return [statistics.median(t) for t in times], statistics.median(ratios), min(ratios), max(ratios)
 
 
+def timed(binary, scene, args, repeat, workdir):
+    """Kernel ms of one binary: (median, min, max) of `repeat` runs after one warm-up."""
+    run_render(binary, scene, args, None, workdir)
+    times = [kernel_ms(run_render(binary, scene, args, None, workdir)[1]) for _ in range(repeat)]
+    return statistics.median(times), min(times), max(times)
+
+
+def time_alone(a, degrees):
+    """One binary's figures without a baseline (a device where no earlier build is at hand, a lent GPU)."""
+    print(f"Machine: {machine()}. `{a.algray}`; kernel ms of the primary pass, median of {a.repeat} runs after "
+          f"one warm-up. Precision {a.precision}.\n")
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        if a.only != "surfaces":
+            print(f"| degree | Mrays/s ({a.side}x{a.side}) | min-max |")
+            print("|---|---|---|")
+            for d in degrees:
+                scene = work / f"random{d}.toml"
+                scene.write_text(random_surface(d, 1000 + d, a.side))
+                ms, lo, hi = timed(a.algray, scene, ["--set", f"render.precision={a.precision}"], a.repeat, work)
+                rays = a.side * a.side
+                print(f"| {d} | {rays / ms / 1e3:.2f} | {rays / hi / 1e3:.2f}-{rays / lo / 1e3:.2f} |", flush=True)
+            print()
+        if a.only != "degrees":
+            print("| surface (1024x768 preview, one ray per pixel) | kernel ms | min-max |")
+            print("|---|---|---|")
+            for name in PAPER_SURFACES:
+                args = ["--preview", "--width", "1024", "--height", "768", "--set", f"render.precision={a.precision}",
+                        "--set", "antialias.samples=1"]
+                ms, lo, hi = timed(a.algray, ROOT / "scenes" / f"{name}.toml", args, a.repeat, work)
+                print(f"| {name} | {ms:.2f} | {lo:.2f}-{hi:.2f} |", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--baseline", required=True, help="the algray binary to compare against")
+    ap.add_argument("--baseline", help="the algray binary to compare against (none: time --algray alone)")
     ap.add_argument("--algray", default=str(ROOT / "build/apps/algray/algray"))
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--side", type=int, default=512, help="random surfaces: side x side rays")
@@ -59,6 +92,8 @@ def main():
         degrees = list(range(lo, hi + 1))
     else:
         degrees = [int(x) for x in a.degrees.split(",")]
+    if a.baseline is None:
+        return time_alone(a, degrees)
     binaries = [a.baseline, a.algray]
     print(f"Machine: {machine()}. Baseline `{a.baseline}`, current `{a.algray}`; kernel ms of the primary pass, "
           f"median of {a.repeat} interleaved runs each after one warm-up; ratio = current/baseline time per pair "

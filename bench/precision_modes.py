@@ -22,12 +22,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-import numpy as np
-
 from bench_common import ROOT, machine, replace_section, run_render
-
-sys.path.insert(0, str(ROOT / "build/python"))
-import algray  # noqa: E402
 
 HEADING = "## Precision modes: float, adaptive, mixed, double (issue 18)"
 # (column name, --precision, extra environment)
@@ -57,6 +52,11 @@ def speed(binary, scene, runs, work):
 
 
 def accuracy(path, width, height):
+    # Imported here so that the speed part runs where the module is not built (a lent GPU's other Python).
+    import numpy as np
+    sys.path.insert(0, str(ROOT / "build/python"))
+    import algray
+
     renderer = algray.Renderer()
     out = {}
     refs = {}
@@ -95,6 +95,8 @@ def main():
     ap.add_argument("--no-speed", action="store_true")
     ap.add_argument("--no-accuracy", action="store_true")
     ap.add_argument("--output", default=ROOT / "bench/RESULTS.md")
+    ap.add_argument("--json", default=ROOT / "bench/results/precision_modes.json", help="where the raw figures go")
+    ap.add_argument("--heading", default=HEADING, help="the RESULTS.md section to write (another device's, say)")
     args = ap.parse_args()
     names = args.scenes or sorted(p.stem for p in (ROOT / "scenes").glob("*.toml"))
     paths = [ROOT / "scenes" / f"{n}.toml" for n in names]
@@ -114,11 +116,11 @@ def main():
     command = "python3 bench/precision_modes.py " + " ".join(sys.argv[1:])
     results = {"date": datetime.date.today().isoformat(), "machine": machine(), "command": command.strip(),
                "runs": args.runs, "rows": rows}
-    (ROOT / "bench/results/precision_modes.json").write_text(json.dumps(results, indent=1) + "\n")
+    Path(args.json).write_text(json.dumps(results, indent=1) + "\n")
 
-    lines = [HEADING, "", f"- Date: {results['date']}", f"- Machine: {results['machine']}",
+    lines = [args.heading, "", f"- Date: {results['date']}", f"- Machine: {results['machine']}",
              f"- Command: `{results['command']}` (after `cmake --build build`); raw figures in "
-             "`bench/results/precision_modes.json`", ""]
+             f"`{Path(args.json).name}`", ""]
     speed_rows = [r for r in rows if "kernel_ms" in r]
     if speed_rows:
         lines += [
@@ -159,7 +161,7 @@ def main():
             name = r["scene"] + (" (hard)" if r["hard"] else "")
             lines.append(f"| {name} | " + " | ".join(cells) + " |")
         lines.append("")
-    replace_section(args.output, HEADING, "\n".join(lines) + "\n")
+    replace_section(args.output, args.heading, "\n".join(lines) + "\n")
     print(f"wrote {args.output}", file=sys.stderr)
 
 
