@@ -54,12 +54,19 @@ std::vector<RayOrigin> origins_of(const std::string& entry, Precision precision,
   return origins;
 }
 
+// Float, mixed and adaptive builds are what devices without fp64 run: they compile with cl_khr_fp64 switched
+// off, so that no double type creeps into them (double constants cast to float stay allowed, as OpenCL C 1.2
+// lets such devices do).
+std::string device_options(const KernelConfig& config) {
+  return strict_options(config.build_options()) +
+         (config.precision == Precision::Double ? "" : " -Xclang -cl-ext=-cl_khr_fp64");
+}
+
 void add(std::vector<Compile>& jobs, KernelConfig config) {
   const std::string kind = config.entry + " " + to_string(config.precision);
-  jobs.push_back({kind, config.key(), config.source_file(), strict_options(config.build_options())});
+  jobs.push_back({kind, config.key(), config.source_file(), device_options(config)});
   config.lanes = 8;
-  if (lanes_apply(config))
-    jobs.push_back({kind, config.key(), config.source_file(), strict_options(config.build_options())});
+  if (lanes_apply(config)) jobs.push_back({kind, config.key(), config.source_file(), device_options(config)});
 }
 
 // Every entry in every precision and ray origin, at the degrees where the kernels switch code paths, with the
@@ -93,8 +100,9 @@ std::vector<Compile> every_configuration() {
         }
     }
   for (bool in_double : {false, true})
-    jobs.push_back({std::string("fp_speed ") + (in_double ? "double" : "float"), "fp_speed", "fp_speed.cl",
-                    strict_options(fp_speed_build_options(in_double))});
+    jobs.push_back(
+        {std::string("fp_speed ") + (in_double ? "double" : "float"), "fp_speed", "fp_speed.cl",
+         strict_options(fp_speed_build_options(in_double)) + (in_double ? "" : " -Xclang -cl-ext=-cl_khr_fp64")});
   return jobs;
 }
 
