@@ -51,30 +51,27 @@ def timed(binary, scene, args, repeat, workdir):
     return statistics.median(times), min(times), max(times)
 
 
-def time_alone(a, degrees):
-    """One binary's figures without a baseline (a device where no earlier build is at hand, a lent GPU)."""
-    print(f"Machine: {machine()}. `{a.algray}`; kernel ms of the primary pass, median of {a.repeat} runs after "
-          f"one warm-up. Precision {a.precision}.\n")
-    with tempfile.TemporaryDirectory() as tmp:
-        work = Path(tmp)
-        if a.only != "surfaces":
-            print(f"| degree | Mrays/s ({a.side}x{a.side}) | min-max |")
-            print("|---|---|---|")
-            for d in degrees:
-                scene = work / f"random{d}.toml"
-                scene.write_text(random_surface(d, 1000 + d, a.side))
-                ms, lo, hi = timed(a.algray, scene, ["--set", f"render.precision={a.precision}"], a.repeat, work)
-                rays = a.side * a.side
-                print(f"| {d} | {rays / ms / 1e3:.2f} | {rays / hi / 1e3:.2f}-{rays / lo / 1e3:.2f} |", flush=True)
-            print()
-        if a.only != "degrees":
-            print("| surface (1024x768 preview, one ray per pixel) | kernel ms | min-max |")
-            print("|---|---|---|")
-            for name in PAPER_SURFACES:
-                args = ["--preview", "--width", "1024", "--height", "768", "--set", f"render.precision={a.precision}",
-                        "--set", "antialias.samples=1"]
-                ms, lo, hi = timed(a.algray, ROOT / "scenes" / f"{name}.toml", args, a.repeat, work)
-                print(f"| {name} | {ms:.2f} | {lo:.2f}-{hi:.2f} |", flush=True)
+def degree_row(binaries, d, scene, a, work):
+    """One row of the per-degree table: Mrays/s of one binary, or of both and the speed-up."""
+    args = ["--set", f"render.precision={a.precision}"]
+    rays = a.side * a.side / 1e3
+    if len(binaries) == 1:
+        ms, lo, hi = timed(binaries[0], scene, args, a.repeat, work)
+        return f"| {d} | {rays / ms:.2f} | {rays / hi:.2f}-{rays / lo:.2f} |"
+    (old, new), ratio, lo, hi = compare(binaries, scene, args, a.repeat, work)
+    return f"| {d} | {rays / old:.2f} | {rays / new:.2f} | {1 / ratio:.2f}x | {1 / hi:.2f}-{1 / lo:.2f} |"
+
+
+def surface_row(binaries, name, a, work):
+    # One ray per pixel in both: a baseline from before preview dropped antialiasing traced 2x2.
+    args = ["--preview", "--width", "1024", "--height", "768", "--set", f"render.precision={a.precision}",
+            "--set", "antialias.samples=1"]
+    scene = ROOT / "scenes" / f"{name}.toml"
+    if len(binaries) == 1:
+        ms, lo, hi = timed(binaries[0], scene, args, a.repeat, work)
+        return f"| {name} | {ms:.2f} | {lo:.2f}-{hi:.2f} |"
+    (old, new), ratio, lo, hi = compare(binaries, scene, args, a.repeat, work)
+    return f"| {name} | {old:.1f} | {new:.1f} | {1 / ratio:.2f}x | {1 / hi:.2f}-{1 / lo:.2f} |"
 
 
 def main():
@@ -92,35 +89,33 @@ def main():
         degrees = list(range(lo, hi + 1))
     else:
         degrees = [int(x) for x in a.degrees.split(",")]
-    if a.baseline is None:
-        return time_alone(a, degrees)
-    binaries = [a.baseline, a.algray]
-    print(f"Machine: {machine()}. Baseline `{a.baseline}`, current `{a.algray}`; kernel ms of the primary pass, "
-          f"median of {a.repeat} interleaved runs each after one warm-up; ratio = current/baseline time per pair "
-          f"(median, min-max). Precision {a.precision}.\n")
+    if a.baseline is None:  # a device where no earlier build is at hand (a lent GPU)
+        binaries = [a.algray]
+        print(f"Machine: {machine()}. `{a.algray}`; kernel ms of the primary pass, median of {a.repeat} runs after "
+              f"one warm-up. Precision {a.precision}.\n")
+        heads = [f"| degree | Mrays/s ({a.side}x{a.side}) | min-max |\n|---|---|---|",
+                 "| surface (1024x768 preview, one ray per pixel) | kernel ms | min-max |\n|---|---|---|"]
+    else:
+        binaries = [a.baseline, a.algray]
+        print(f"Machine: {machine()}. Baseline `{a.baseline}`, current `{a.algray}`; kernel ms of the primary pass, "
+              f"median of {a.repeat} interleaved runs each after one warm-up; ratio = current/baseline time per pair "
+              f"(median, min-max). Precision {a.precision}.\n")
+        heads = ["| degree | baseline Mrays/s | current Mrays/s | speed-up (median) | min-max |\n|---|---|---|---|---|",
+                 "| surface (1024x768 preview, one ray per pixel) | baseline kernel ms | current kernel ms | "
+                 "speed-up (median) | min-max |\n|---|---|---|---|---|"]
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         if a.only != "surfaces":
-            print("| degree | baseline Mrays/s | current Mrays/s | speed-up (median) | min-max |")
-            print("|---|---|---|---|---|")
-            rays = a.side * a.side
+            print(heads[0])
             for d in degrees:
                 scene = work / f"random{d}.toml"
                 scene.write_text(random_surface(d, 1000 + d, a.side))
-                (old, new), ratio, lo, hi = compare(binaries, scene, ["--set", f"render.precision={a.precision}"],
-                                                    a.repeat, work)
-                print(f"| {d} | {rays / old / 1e3:.2f} | {rays / new / 1e3:.2f} | {1 / ratio:.2f}x | "
-                      f"{1 / hi:.2f}-{1 / lo:.2f} |", flush=True)
+                print(degree_row(binaries, d, scene, a, work), flush=True)
             print()
         if a.only != "degrees":
-            print("| surface (1024x768 preview, one ray per pixel) | baseline kernel ms | current kernel ms | speed-up (median) | min-max |")
-            print("|---|---|---|---|---|")
+            print(heads[1])
             for name in PAPER_SURFACES:
-                # One ray per pixel in both: a baseline from before preview dropped antialiasing traced 2x2.
-                args = ["--preview", "--width", "1024", "--height", "768", "--set", f"render.precision={a.precision}",
-                        "--set", "antialias.samples=1"]
-                (old, new), ratio, lo, hi = compare(binaries, ROOT / "scenes" / f"{name}.toml", args, a.repeat, work)
-                print(f"| {name} | {old:.1f} | {new:.1f} | {1 / ratio:.2f}x | {1 / hi:.2f}-{1 / lo:.2f} |", flush=True)
+                print(surface_row(binaries, name, a, work), flush=True)
 
 
 if __name__ == "__main__":
