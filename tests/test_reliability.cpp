@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <string>
@@ -379,18 +380,32 @@ TEST_CASE("an error in what a .jsurf file translates to points into the .jsurf",
 TEST_CASE("a render too large for the memory is refused up front, naming the estimate", "[reliability][errors]") {
   require_device();
   Sandbox box;
-  // The film alone takes tens of GB, more than a 4 GB data size limit allows on any machine (a machine of 128 GB
-  // would otherwise start the render: seen on a lent GPU machine).
-  box.limits = "ulimit -d 4194304";
+  // The film alone takes tens of GB, more than a cap of 4 GB allows on any machine (a machine of 128 GB would
+  // otherwise start the render: seen on a lent GPU machine). The cap is ALGRAY_MEMORY_LIMIT rather than ulimit -d,
+  // under which AddressSanitizer cannot reserve its shadow memory.
+  box.limits = "export ALGRAY_MEMORY_LIMIT=4G";
   const auto start = std::chrono::steady_clock::now();
   const Result r = box.run("render -o out.exr --width 32768 --height 32768 --set antialias.samples=2");
   INFO(r.err);
   CHECK(r.exit_code == 2);
   CHECK_THAT(r.err, Catch::Contains("needs about") && Catch::Contains(" GB of memory") &&
                         Catch::Contains("32768x32768 render with 2x2 samples") &&
-                        Catch::Contains("available to this process (its data size limit, ulimit -d)"));
+                        Catch::Contains("available to this process (ALGRAY_MEMORY_LIMIT)"));
   CHECK(seconds_since(start) < 30);
   CHECK(box.work_files().empty());
+}
+
+TEST_CASE("an ALGRAY_MEMORY_LIMIT that is not a size exits 2 naming it, writing nothing", "[reliability][errors]") {
+  require_device();
+  Sandbox box;
+  for (const char* bad : {"lots", "4X", "-1G", "0"}) {
+    box.limits = std::string("export ALGRAY_MEMORY_LIMIT='") + bad + "'";
+    const Result r = box.run("render -o out.exr " + kTiny);
+    INFO(bad << ": " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains(std::string("ALGRAY_MEMORY_LIMIT='") + bad + "' is not a size"));
+    CHECK(box.work_files().empty());
+  }
 }
 
 TEST_CASE("the memory a process may take is the least of the machine's, its cgroup's and its limits'",
@@ -403,7 +418,13 @@ TEST_CASE("the memory a process may take is the least of the machine's, its cgro
   const pid_t child = fork();
   REQUIRE(child >= 0);
   if (child == 0) {
-    const rlimit data{256ull << 20, 256ull << 20};
+    // 256 MB beyond the data it has now (which, under AddressSanitizer, holds terabytes of reserved shadow).
+    std::ifstream status("/proc/self/status");
+    std::uint64_t data_kb = 0;
+    for (std::string line; std::getline(status, line);)
+      if (line.rfind("VmData:", 0) == 0) data_kb = std::stoull(line.substr(7));
+    const rlim_t cap = static_cast<rlim_t>((data_kb << 10) + (256ull << 20));
+    const rlimit data{cap, cap};
     const algray::HostMemory limited =
         setrlimit(RLIMIT_DATA, &data) == 0 ? algray::available_host_memory() : algray::HostMemory{};
     const std::string answer = std::to_string(limited.bytes) + " " + limited.limited_by;

@@ -65,7 +65,7 @@ struct Sandbox {
   fs::path work = root / "work";
   fs::path in = root / "in";
   fs::path cache = shared_cache_dir();
-  std::string limits;  // shell commands run before the binary, such as "ulimit -d 4194304"
+  std::string limits;  // shell commands run before the binary, such as "export ALGRAY_MEMORY_LIMIT=4G"
 
   Sandbox() {
     fs::create_directories(work);

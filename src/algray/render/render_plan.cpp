@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 
 #include "algray/render/screen_form.h"
 #include "algray/util/host_memory.h"
@@ -301,7 +302,13 @@ void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device) {
                            " samples per pixel needs about ";
   const std::string advice = ": render a smaller image (or with a smaller render.tile_size)";
   const std::uint64_t need = plan.estimated_memory_bytes();
-  if (const HostMemory available = available_host_memory(); available.bytes && need > available.bytes)
+  HostMemory available;
+  try {
+    available = available_host_memory();
+  } catch (const std::invalid_argument& e) {
+    throw DeviceError(e.what());
+  }
+  if (available.bytes && need > available.bytes)
     throw DeviceError(what + gigabytes(need) + " of memory, and " + gigabytes(available.bytes) +
                       " are available to this process (" + available.limited_by + ")" + advice);
   if (device.type == "CPU") return;  // its buffers are in the memory counted above

@@ -3,9 +3,11 @@
 
 #include <sys/resource.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 namespace algray {
 namespace {
@@ -68,6 +70,25 @@ void rlimit_left(HostMemory& best, int resource, const char* status_key, const c
     take_least(best, left_under(r.rlim_cur, proc_kb("/proc/self/status", status_key)), why);
 }
 
+// ALGRAY_MEMORY_LIMIT: bytes, or a number with K, M, G or T (powers of 1024); 0 when unset.
+std::uint64_t environment_limit() {
+  const char* text = std::getenv("ALGRAY_MEMORY_LIMIT");
+  if (!text || !*text) return 0;
+  char* end = nullptr;
+  const double number = std::strtod(text, &end);
+  const std::string unit(end);
+  const std::string units = "KMGT";
+  double scale = 1;
+  if (unit.size() == 1 && units.find(unit[0]) != std::string::npos)
+    for (std::size_t i = 0; i <= units.find(unit[0]); ++i) scale *= 1024;
+  else if (!unit.empty())
+    end = const_cast<char*>(text);  // not a size
+  if (end == text || !(number > 0) || number * scale > 1e19)
+    throw std::invalid_argument("ALGRAY_MEMORY_LIMIT='" + std::string(text) +
+                                "' is not a size: give bytes, or a number with K, M, G or T");
+  return static_cast<std::uint64_t>(number * scale);
+}
+
 }  // namespace
 
 HostMemory available_host_memory() {
@@ -76,6 +97,7 @@ HostMemory available_host_memory() {
   cgroup_limits(best);
   rlimit_left(best, RLIMIT_DATA, "VmData:", "its data size limit, ulimit -d");
   rlimit_left(best, RLIMIT_AS, "VmSize:", "its address space limit, ulimit -v");
+  take_least(best, environment_limit(), "ALGRAY_MEMORY_LIMIT");
   return best;
 }
 

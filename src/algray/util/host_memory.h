@@ -13,8 +13,9 @@ struct HostMemory {
 };
 
 // The least of: MemAvailable; each enclosing cgroup's limit less its use (a Slurm job's --mem, a container's
-// limit, where a node's free memory would promise far more than the job may take); and RLIMIT_DATA and RLIMIT_AS
-// less this process's data and address space.
+// limit, where a node's free memory would promise far more than the job may take); RLIMIT_DATA and RLIMIT_AS
+// less this process's data and address space; and ALGRAY_MEMORY_LIMIT (bytes, or with K, M, G or T), a cap a
+// user sets by hand. Throws std::invalid_argument when ALGRAY_MEMORY_LIMIT is not a size.
 HostMemory available_host_memory();
 
 }  // namespace algray
