@@ -39,8 +39,21 @@ __kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
     if (kind != SHADOW_TRACE) continue;
     ++traced;
     REAL iso_c[NCOEF];
+#if ALGRAY_ESCALATE && ALGRAY_SETTLE_BY_SIGNS
+    /* isolate_on_segment's two steps, keeping the segment's coefficients for certain_sign_change (shadow.h). */
+    REAL root[NCOEF], root_lo[NCOEF];
+    RayTerms terms;
+    segment_coefficients(o_unit, d_unit, t_in, t_out, mono_exps, mono_coefs, mono_count, binomials, even_axes, root,
+                         root_lo, &terms);
+    Isolation iso = isolate_coefficients(root, root_lo, t_in, t_out, iso_c, &terms);
+    if (iso.doubt && certain_sign_change(root, &terms)) {
+      iso.doubt = 0;
+      iso.status = ISOLATION_BRACKET;
+    }
+#else
     const Isolation iso = isolate_on_segment(o_unit, d_unit, t_in, t_out, mono_exps, mono_coefs, mono_count,
                                              binomials, even_axes, iso_c);
+#endif
     if (iso.status != ISOLATION_NONE) mask |= bit;
     if (iso.doubt) unsure |= bit;
   }

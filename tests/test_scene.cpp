@@ -142,7 +142,9 @@ TEST_CASE("equation errors point at the character inside the string", "[scene][e
     CHECK(e.where == "t.toml:3:17");
     CHECK_THAT(e.message, Catch::Contains("unexpected"));
     CHECK_THAT(e.message, Catch::Contains("at character 5 of the equation"));
-    CHECK(e.excerpt == "  equation = \"x^2+*y\"\n" + std::string(2 + 16, ' ') + "^");
+    std::string caret(2 + 16, ' ');  // built apart: GCC 12 misreads the temporaries of a + chain (-Warray-bounds)
+    caret += '^';
+    CHECK(e.excerpt == "  equation = \"x^2+*y\"\n" + caret);
     // what() carries the location and the excerpt, since that is all the CLI prints.
     CHECK_THAT(std::string(e.what()), Catch::StartsWith("t.toml:3:17: error: "));
     CHECK_THAT(std::string(e.what()), Catch::Contains(e.excerpt));
@@ -338,23 +340,42 @@ TEST_CASE("scene_to_toml reads back to the same scene, for every shipped scene a
     if (entry.path().extension() == ".toml")
       scenes.emplace_back(entry.path().string(), algray::load_scene_file(entry.path().string()));
   // What the shipped scenes may not use: a box, an orthographic camera, area lights, terms, odd settings.
-  scenes.emplace_back("variants", algray::load_scene_text(
-                                      sphere_with({{3, "terms = [[2, 0, 0, 0.1], [0, 2, 0, 1.0], [0, 0, 2, 1e-3], "
-                                                       "[0, 0, 0, -1.0]]\nname = \"odd \\\"name\\\"\\t\""},
-                                                   {5, "type = \"box\"\nmin = [-1.5, -2, -0.30000000000000004]\n"
-                                                       "max = [1, 2, 3]"},
-                                                   {10, "projection = \"orthographic\"\nheight = 3.25"}},
-                                                  {"[[light]]", "type = \"disc\"", "position = [1, 2, 3]",
-                                                   "radius = 0.5", "normal = [0, 1, 1]", "samples = 3",
-                                                   "[[light]]", "type = \"rectangle\"", "position = [-1, 2, 3]",
-                                                   "edge_u = [1, 0, 0]", "edge_v = [0, 0.5, 0]",
-                                                   "shadows = false", "colour = [0.1, 0.2, 0.3]", "[render]",
-                                                   "precision = \"float\"", "tolerance = 1e-7",
-                                                   "isolation = \"sturm\"", "refinement = \"illinois\"",
-                                                   "max_iterations = 77", "tile_size = 64", "max_depth = 2",
-                                                   "[antialias]", "samples = 3", "adaptive = true",
-                                                   "threshold = 0.05", "[image]", "background = [0, 0, 0, 0.5]"}),
-                                      "variants.toml", {{"image.width", "123"}}));
+  scenes.emplace_back("variants",
+                      algray::load_scene_text(sphere_with({{3,
+                                                            "terms = [[2, 0, 0, 0.1], [0, 2, 0, 1.0], [0, 0, 2, 1e-3], "
+                                                            "[0, 0, 0, -1.0]]\nname = \"odd \\\"name\\\"\\t\""},
+                                                           {5,
+                                                            "type = \"box\"\nmin = [-1.5, -2, -0.30000000000000004]\n"
+                                                            "max = [1, 2, 3]"},
+                                                           {10, "projection = \"orthographic\"\nheight = 3.25"}},
+                                                          {"[[light]]",
+                                                           "type = \"disc\"",
+                                                           "position = [1, 2, 3]",
+                                                           "radius = 0.5",
+                                                           "normal = [0, 1, 1]",
+                                                           "samples = 3",
+                                                           "[[light]]",
+                                                           "type = \"rectangle\"",
+                                                           "position = [-1, 2, 3]",
+                                                           "edge_u = [1, 0, 0]",
+                                                           "edge_v = [0, 0.5, 0]",
+                                                           "shadows = false",
+                                                           "colour = [0.1, 0.2, 0.3]",
+                                                           "[render]",
+                                                           "precision = \"float\"",
+                                                           "tolerance = 1e-7",
+                                                           "isolation = \"sturm\"",
+                                                           "refinement = \"illinois\"",
+                                                           "max_iterations = 77",
+                                                           "tile_size = 64",
+                                                           "max_depth = 2",
+                                                           "[antialias]",
+                                                           "samples = 3",
+                                                           "adaptive = true",
+                                                           "threshold = 0.05",
+                                                           "[image]",
+                                                           "background = [0, 0, 0, 0.5]"}),
+                                              "variants.toml", {{"image.width", "123"}}));
   REQUIRE(scenes.size() >= 12);
   const auto body = [](const std::string& toml) { return toml.substr(toml.find('\n') + 1); };  // past the comment
   for (const auto& [name, scene] : scenes) {

@@ -10,8 +10,8 @@
 #include "algray/render/reference_render.h"
 #include "algray/render/render_plan.h"
 #include "algray/render/renderer.h"
-#include "algray/scene/scene.h"
 #include "algray/render/shadow_tracer.h"
+#include "algray/scene/scene.h"
 #include "solver_ref/solver_ref.h"
 #include "test_support.h"
 
@@ -75,13 +75,14 @@ Verdict reference_verdict(const Scene& scene, Precision precision, const Surface
   const mpq_class width = exact_rational(1e-13);
   const ref::Answer a = ref::smallest_root(restricted, lo, hi, width);
   if (a.kind == ref::Classification::Miss)
-    return flips_under_ray_rounding(restricted, scene.surface().polynomial.monomials(), ray, lo, hi, eps) ? Verdict::Ambiguous
-                                                                                                 : Verdict::Visible;
+    return flips_under_ray_rounding(restricted, scene.surface().polynomial.monomials(), ray, lo, hi, eps)
+               ? Verdict::Ambiguous
+               : Verdict::Visible;
   const long double t = a.t_nearest;
   if (std::fabs(t) <= margin) return Verdict::OriginOnSurface;
   if (t < t_in + margin || t > t_out - margin) return Verdict::Ambiguous;
-  const bool crosses = a.kind == ref::Classification::SimpleRoot ||
-                       a.kind == ref::Classification::MultipleRootOddSignChange;
+  const bool crosses =
+      a.kind == ref::Classification::SimpleRoot || a.kind == ref::Classification::MultipleRootOddSignChange;
   return crosses ? Verdict::Hidden : Verdict::Ambiguous;
 }
 
@@ -112,8 +113,9 @@ glm::dvec3 light_at(std::mt19937& rng, const SurfacePoint& sp, double elevation,
 
 // The shadow kernels the render plan builds: double around each segment or from the point form, float around
 // each segment.
-const std::pair<Precision, RayOrigin> kConstructions[] = {
-    {Precision::Double, RayOrigin::Extent}, {Precision::Double, RayOrigin::Point}, {Precision::Float, RayOrigin::Extent}};
+const std::pair<Precision, RayOrigin> kConstructions[] = {{Precision::Double, RayOrigin::Extent},
+                                                          {Precision::Double, RayOrigin::Point},
+                                                          {Precision::Float, RayOrigin::Extent}};
 
 struct Tally {
   int certified = 0, ambiguous = 0, failures = 0;
@@ -134,12 +136,11 @@ Tally check_shadow_rays(Precision precision, RayOrigin origin, int rays_per_scen
   for (const char* file : kScenes) {
     std::string path = ALGRAY_SOURCE_DIR "/scenes/";  // appended, not added: the same false warning otherwise
     path += file;
-    const Scene scene = load_scene_file(path,
-                                        {{"image.width", "48"},
-                                         {"image.height", "36"},
-                                         {"antialias.samples", "1"},
-                                         {"render.preview", "true"},
-                                         {"render.precision", precision_value}});
+    const Scene scene = load_scene_file(path, {{"image.width", "48"},
+                                               {"image.height", "36"},
+                                               {"antialias.samples", "1"},
+                                               {"render.preview", "true"},
+                                               {"render.precision", precision_value}});
     const std::vector<SurfacePoint> points = surface_points(renderer, scene);
     REQUIRE(points.size() > 100);
     const RenderPlan plan = make_render_plan(scene, precision);
@@ -161,8 +162,8 @@ Tally check_shadow_rays(Precision precision, RayOrigin origin, int rays_per_scen
       const Verdict verdict = reference_verdict(scene, precision, sp, light, ray);
       const bool hidden = tracer.trace({sp.point}, {sp.normal}, {light}).masks[0] & 1u;
       INFO(file << " " << to_string(precision) << " " << to_string(origin) << " seed " << kSeed << " ray " << index
-                << ": from " << sp.point.x << "," << sp.point.y << "," << sp.point.z << " to " << light.x << "," << light.y
-                << "," << light.z << "; reference " << name(verdict) << ", kernel "
+                << ": from " << sp.point.x << "," << sp.point.y << "," << sp.point.z << " to " << light.x << ","
+                << light.y << "," << light.z << "; reference " << name(verdict) << ", kernel "
                 << (hidden ? "hidden" : "visible"));
       CHECK(verdict != Verdict::OriginOnSurface);  // the offset must take the origin clearly off the surface
       if (verdict == Verdict::Ambiguous || verdict == Verdict::OriginOnSurface) {
@@ -184,13 +185,14 @@ TEST_CASE("shadow rays never hit the surface they leave, at any angle, in double
   // 1000 rays per construction (200 per surface): a fifth of them grazing, 0.5 to 5 degrees above the tangent
   // plane, the rest up to the normal; lights 1% to 2.5 extent radii away, so that short rays are tried too.
   for (const auto& [precision, origin] : kConstructions) {
-    const Tally t = check_shadow_rays(precision, origin, 200, [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
-      const bool grazing = std::uniform_int_distribution<int>(0, 4)(rng) == 0;
-      const double degrees = grazing ? std::uniform_real_distribution<double>(0.5, 5)(rng)
-                                     : std::uniform_real_distribution<double>(5, 90)(rng);
-      const double distance = std::uniform_real_distribution<double>(0.01, 2.5)(rng) * scene.extent.unit_scale();
-      return light_at(rng, sp, degrees * 3.141592653589793 / 180, distance);
-    });
+    const Tally t =
+        check_shadow_rays(precision, origin, 200, [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
+          const bool grazing = std::uniform_int_distribution<int>(0, 4)(rng) == 0;
+          const double degrees = grazing ? std::uniform_real_distribution<double>(0.5, 5)(rng)
+                                         : std::uniform_real_distribution<double>(5, 90)(rng);
+          const double distance = std::uniform_real_distribution<double>(0.01, 2.5)(rng) * scene.extent.unit_scale();
+          return light_at(rng, sp, degrees * 3.141592653589793 / 180, distance);
+        });
     INFO(to_string(precision) << " " << to_string(origin) << ": " << t.certified << " certified, " << t.ambiguous
                               << " ambiguous");
     CHECK(t.failures == 0);
@@ -202,17 +204,88 @@ TEST_CASE("shadow answers agree with the reference towards the lights of a scene
   // Light points where a scene puts its lights: on a sphere of 3 extent radii around the extent, on the side
   // of the surface point's normal (behind the tangent plane the kernel answers "hidden" without tracing).
   for (const auto& [precision, origin] : kConstructions) {
-    const Tally t = check_shadow_rays(precision, origin, 200, [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
-      std::normal_distribution<double> g;
-      for (;;) {
-        const glm::dvec3 dir = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
-        const glm::dvec3 light = scene.extent.unit_centre() + 3 * scene.extent.unit_scale() * dir;
-        if (glm::dot(light - sp.point, glm::dvec3(sp.normal)) > 0) return light;
-      }
-    });
+    const Tally t =
+        check_shadow_rays(precision, origin, 200, [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
+          std::normal_distribution<double> g;
+          for (;;) {
+            const glm::dvec3 dir = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
+            const glm::dvec3 light = scene.extent.unit_centre() + 3 * scene.extent.unit_scale() * dir;
+            if (glm::dot(light - sp.point, glm::dvec3(sp.normal)) > 0) return light;
+          }
+        });
     INFO(to_string(precision) << " " << to_string(origin) << ": " << t.certified << " certified, " << t.ambiguous
                               << " ambiguous");
     CHECK(t.failures == 0);
     CHECK(t.certified >= 900);
   }
+}
+
+TEST_CASE("adaptive shadow rays a certain sign change settles are only doubted ones, and hidden by the reference",
+          "[shadows]") {
+  // The float shadow kernel as the plan builds it where the second pass runs in float-float (settle_by_signs):
+  // against the same kernel without it, on the scenes whose shadow rays it doubts most. Surface points from a
+  // small render, 64 light points on a sphere of 3 extent radii: every pair is one ray.
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  int settled_total = 0;
+  for (const char* file : {"barth_decic.toml", "endrass_octic.toml"}) {
+    std::string path = ALGRAY_SOURCE_DIR "/scenes/";
+    path += file;
+    const Scene scene = load_scene_file(path, {{"image.width", "64"},
+                                               {"image.height", "48"},
+                                               {"antialias.samples", "1"},
+                                               {"render.preview", "true"},
+                                               {"render.precision", "\"adaptive\""}});
+    const std::vector<SurfacePoint> sps = surface_points(renderer, scene);
+    REQUIRE(sps.size() > 100);
+    std::vector<glm::dvec3> points;
+    std::vector<glm::vec3> normals;
+    for (const SurfacePoint& sp : sps) {
+      points.push_back(sp.point);
+      normals.push_back(sp.normal);
+    }
+    std::mt19937 rng(kSeed + 7);
+    std::normal_distribution<double> g;
+    std::vector<glm::dvec3> lights;
+    for (int s = 0; s < 64; ++s)
+      lights.push_back(scene.extent.unit_centre() +
+                       3 * scene.extent.unit_scale() * glm::normalize(glm::dvec3(g(rng), g(rng), g(rng))));
+
+    KernelConfig config = primary_config(scene, Precision::Adaptive);
+    config.entry = "shadow";
+    config.lanes = 1;
+    const DeviceSurface surface(session.context, scene, Precision::Adaptive);
+    const double offset = shadow_offset_unit(Precision::Adaptive) * scene.extent.unit_scale();
+    ShadowTracer plain(session, cache, config, surface, offset);
+    config.settle_by_signs = true;
+    ShadowTracer settling(session, cache, config, surface, offset);
+    const ShadowAnswer a = plain.trace(points, normals, lights);
+    const ShadowAnswer b = settling.trace(points, normals, lights);
+    REQUIRE(a.undecided.size() == points.size());
+    REQUIRE(b.undecided.size() == points.size());
+    int doubted = 0, settled = 0, wrong = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      INFO(file << ", seed " << kSeed + 7 << ", point " << i);
+      CHECK((b.undecided[i] & ~a.undecided[i]) == 0);             // it doubts no ray the plain one did not
+      CHECK(((a.masks[i] ^ b.masks[i]) & ~a.undecided[i]) == 0);  // nor changes a decided answer
+      doubted += __builtin_popcountll(a.undecided[i]);
+      for (std::uint64_t cleared = a.undecided[i] & ~b.undecided[i]; cleared; cleared &= cleared - 1) {
+        const int s = __builtin_ctzll(cleared);
+        ++settled;
+        CHECK(((b.masks[i] >> s) & 1) == 1);  // settled means hidden
+        PixelRay ray;
+        const Verdict v = reference_verdict(scene, Precision::Adaptive, sps[i], lights[s], ray);
+        if (v == Verdict::Visible) {
+          ++wrong;
+          UNSCOPED_INFO(file << " point " << i << " light " << s << ": settled hidden, the reference says visible");
+        }
+      }
+    }
+    INFO(file << ": " << doubted << " doubted rays, " << settled << " of them settled by signs");
+    CHECK(wrong == 0);
+    CHECK(settled > 0);
+    settled_total += settled;
+  }
+  CHECK(settled_total >= 20);  // enough settled rays for the reference's answers to mean something
 }
