@@ -75,15 +75,12 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
   (void)extent_terms;
 #endif
   REAL iso_c[NCOEF];
-  const Isolation iso = isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(&terms));
-  *doubt = iso.doubt;
+  Isolation iso = isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(&terms));
 #if ALGRAY_ESCALATE && ALGRAY_SETTLE_BY_SIGNS
   /* root now holds the segment's Bernstein coefficients (isolate_restricted converted them in place). */
-  if (*doubt && certain_sign_change(root, &terms)) {
-    *doubt = 0;
-    return 1;
-  }
+  iso = settled_by_signs(iso, root, &terms);
 #endif
+  *doubt = iso.doubt;
   return iso.status != ISOLATION_NONE;
 }
 

@@ -81,13 +81,26 @@ int certain_sign_change(const REAL* b, RayTerms* terms) {
   SearchNoise noise = search_noise(b, terms);
   int seen = 0;
   for (int j = 0; j <= SHADOW_DOUBT_PIECES; ++j) {
-    const REAL v = j == SHADOW_DOUBT_PIECES ? b[DEGREE] : bernstein_value_at(b, (REAL)j / SHADOW_DOUBT_PIECES);
+    /* The ends are coefficients already: P's values there. */
+    const REAL v = j == 0                     ? b[0]
+                   : j == SHADOW_DOUBT_PIECES ? b[DEGREE]
+                                              : bernstein_value_at(b, (REAL)j / SHADOW_DOUBT_PIECES);
     if (within_noise(&noise, v)) continue;
     const int sign = v > 0 ? 1 : -1;
     if (seen && sign != seen) return 1;
     seen = sign;
   }
   return 0;
+}
+
+/* A shadow ray's search result on the segment's Bernstein coefficients b, a doubt settled as a root where
+ * certain_sign_change finds one: what shadow and shadow_serial both answer. */
+Isolation settled_by_signs(Isolation iso, const REAL* b, RayTerms* terms) {
+  if (iso.doubt && certain_sign_change(b, terms)) {
+    iso.doubt = 0;
+    iso.status = ISOLATION_BRACKET;
+  }
+  return iso;
 }
 #endif
 

@@ -40,16 +40,13 @@ __kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
     ++traced;
     REAL iso_c[NCOEF];
 #if ALGRAY_ESCALATE && ALGRAY_SETTLE_BY_SIGNS
-    /* isolate_on_segment's two steps, keeping the segment's coefficients for certain_sign_change (shadow.h). */
+    /* isolate_on_segment's two steps, keeping the segment's coefficients for settled_by_signs (shadow.h). */
     REAL root[NCOEF], root_lo[NCOEF];
     RayTerms terms;
     segment_coefficients(o_unit, d_unit, t_in, t_out, mono_exps, mono_coefs, mono_count, binomials, even_axes, root,
                          root_lo, &terms);
-    Isolation iso = isolate_coefficients(root, root_lo, t_in, t_out, iso_c, &terms);
-    if (iso.doubt && certain_sign_change(root, &terms)) {
-      iso.doubt = 0;
-      iso.status = ISOLATION_BRACKET;
-    }
+    const Isolation iso =
+        settled_by_signs(isolate_coefficients(root, root_lo, t_in, t_out, iso_c, &terms), root, &terms);
 #else
     const Isolation iso = isolate_on_segment(o_unit, d_unit, t_in, t_out, mono_exps, mono_coefs, mono_count,
                                              binomials, even_axes, iso_c);

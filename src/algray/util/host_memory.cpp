@@ -77,13 +77,11 @@ std::uint64_t environment_limit() {
   char* end = nullptr;
   const double number = std::strtod(text, &end);
   const std::string unit(end);
-  const std::string units = "KMGT";
+  const std::size_t power = unit.empty() ? 0 : unit.size() == 1 ? std::string("KMGT").find(unit[0]) + 1 : 0;
+  const bool known_unit = unit.empty() || power != 0;  // find's npos + 1 is 0
   double scale = 1;
-  if (unit.size() == 1 && units.find(unit[0]) != std::string::npos)
-    for (std::size_t i = 0; i <= units.find(unit[0]); ++i) scale *= 1024;
-  else if (!unit.empty())
-    end = const_cast<char*>(text);  // not a size
-  if (end == text || !(number > 0) || number * scale > 1e19)
+  for (std::size_t i = 0; i < power; ++i) scale *= 1024;
+  if (end == text || !known_unit || !(number > 0) || number * scale > 1e19)
     throw std::invalid_argument("ALGRAY_MEMORY_LIMIT='" + std::string(text) +
                                 "' is not a size: give bytes, or a number with K, M, G or T");
   return static_cast<std::uint64_t>(number * scale);
