@@ -114,8 +114,9 @@ ALGRAY_INLINE int first_counted(REAL lo) { return ALGRAY_SHADOW_RAYS && lo == 0;
  * variations. */
 REAL smallest_magnitude(const REAL* c, REAL lo) {
   REAL m = fabs(c[DEGREE]);
-  for (int k = first_counted(lo); k < DEGREE; ++k) m = fmin(m, fabs(c[k]));
-  return m;
+  ALGRAY_UNROLL
+  for (int k = 1; k < DEGREE; ++k) m = fmin(m, fabs(c[k]));
+  return first_counted(lo) ? m : fmin(m, fabs(c[0])); /* a fixed loop, unrolled */
 }
 
 /* The smaller |P| at the interval's ends that counts (c_0 and c_n are P's values there). */
