@@ -43,8 +43,8 @@ ALGRAY_INLINE int signs_clear_of(const REAL* c, int by_signs, REAL terms, __cons
 }
 #endif
 
-/* Whether the segment, restricted to root (and root_lo, both consumed), holds a root: what isolate_restricted
- * reports, without the search when the coefficients' signs already settle it (Bernstein builds; adaptive ones
+/* Whether the segment, restricted to root (and root_lo, both consumed), holds a root: what shadow_isolation
+ * (or, where it is not built, isolate_restricted) reports, without it when the coefficients' signs already settle it (Bernstein builds; adaptive ones
  * only when the signs stand clear of the noise: of extent_terms, the bound on every ray's terms in the extent,
  * then of the ray's terms' upper bound, then of their sum; each check costs more and passes more rays).
  * *doubt gets the search's. f: the ray's coordinates' factors, for adaptive builds' terms. */
@@ -75,10 +75,11 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
   (void)extent_terms;
 #endif
   REAL iso_c[NCOEF];
-  Isolation iso = isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(&terms));
-#if ALGRAY_ESCALATE && ALGRAY_SETTLE_BY_SIGNS
-  /* root now holds the segment's Bernstein coefficients (isolate_restricted converted them in place). */
-  iso = settled_by_signs(iso, root, &terms);
+#if SHADOW_SAMPLED
+  restricted_to_isolation_basis(root, root_lo, binomials);
+  const Isolation iso = shadow_isolation(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(&terms));
+#else
+  const Isolation iso = isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(&terms));
 #endif
   *doubt = iso.doubt;
   return iso.status != ISOLATION_NONE;

@@ -60,46 +60,104 @@ void shadow_origin(__global const REAL4* points, __global const float4* normals,
 #define SHADOW_UNDECIDED(i, mask) ((void)(mask))
 #endif
 
-/* Adaptive builds with -D ALGRAY_SETTLE_BY_SIGNS=1 settle doubted rays by certain_sign_change (KernelConfig). */
+/* Adaptive builds with -D ALGRAY_SETTLE_BY_SIGNS=1 settle doubted rays by sampled_sign_change (KernelConfig). */
 #ifndef ALGRAY_SETTLE_BY_SIGNS
 #define ALGRAY_SETTLE_BY_SIGNS 0
 #endif
 
-#if ALGRAY_ESCALATE && ALGRAY_SETTLE_BY_SIGNS
+/* The extent form's shadow rays with Bernstein isolation, in plain float, adaptive or double, look for a certain
+ * sign change at a few points of the segment before the search (shadow_isolation). Mixed precision's answers
+ * stay its float-float search's. */
+#if RAY_ORIGIN != ALGRAY_ORIGIN_POINT && ISOLATION == ALGRAY_ISOLATION_BERNSTEIN && !ALGRAY_COMPENSATED
+#define SHADOW_SAMPLED 1
+#else
+#define SHADOW_SAMPLED 0
+#endif
+
+#if SHADOW_SAMPLED
 #include "bernstein.h"
 #include "isolation.h"
 
-/* How many pieces a doubted shadow ray's segment is sampled in: values at 0, 1/n, ..., 1. Of the Barth decic's
- * doubted shadow rays (512x384, one ray per pixel), 8 pieces settled 33%, 16 settled 45%, 32 settled 53%; 16
- * measured a little faster than 8 at 1024x768 with a float-float second pass. */
+/* How many pieces a shadow ray's segment is sampled in before its search: values at 0, 1/n, ..., 1. Measured on
+ * the Barth decic (1024x768, one ray per pixel): 8 settled a third of the searched rays in float, and took the
+ * float shadow pass from 887 to 823 ms, adaptive's from 1042 to 1004. */
+#define SHADOW_SAMPLE_PIECES 8
+/* How many a doubted one is sampled in (ALGRAY_SETTLE_BY_SIGNS). Of the Barth decic's doubted shadow rays
+ * (512x384, one ray per pixel), 8 pieces settled 33%, 16 settled 45%, 32 settled 53%; 16 measured a little faster
+ * than 8 at 1024x768 with a float-float second pass. */
 #define SHADOW_DOUBT_PIECES 16
 
-/* Whether two of P*'s values on the segment (Bernstein coefficients b), each beyond the noise, have opposite
- * signs: then P* has a root between them whatever the rounding, and the shadow ray is hidden however the interval
- * its search doubted would be settled; it need not be traced again. */
-int certain_sign_change(const REAL* b, RayTerms* terms) {
+/* Whether two of P*'s values at the points j / pieces of the segment (Bernstein coefficients b), each beyond its
+ * evaluation's rounding and, in adaptive builds, beyond the search's noise (isolation.h), have opposite signs:
+ * then P* has a root between them whatever the rounding, and the shadow ray is hidden however a search would
+ * go. Inside, the value is Horner's on sum_k C(n,k) b_k u^k, u = s / (1 - s): P*(s) / (1 - s)^n, of P*'s sign,
+ * which an error e in every b_k moves by at most e (1 + u)^n. pieces: at most SHADOW_DOUBT_PIECES. */
+ALGRAY_INLINE int sampled_sign_change(const REAL* b, int pieces, __constant const REAL* binomials TERMS_PARAM) {
+  __constant const REAL* row = binomials + DEGREE * NCOEF;
+  /* sure[j]: the part of value j's magnitude that its rounding cannot take away, with its sign; scale[j] turns a
+   * coefficient's error into the value's */
+  REAL sure[SHADOW_DOUBT_PIECES + 1], scale[SHADOW_DOUBT_PIECES + 1];
+  int positive = 0, negative = 0;
+  ALGRAY_UNROLL
+  for (int j = 0; j <= pieces; ++j) {
+    REAL value, rounding = 0;
+    scale[j] = 1;
+    if (j == 0 || j == pieces) {
+      value = j == 0 ? b[0] : b[DEGREE]; /* the ends are P's values, unrounded */
+    } else {
+      const REAL u = (REAL)j / (REAL)(pieces - j);
+      REAL size = fabs(b[DEGREE]);
+      value = b[DEGREE];
+      ALGRAY_UNROLL
+      for (int k = DEGREE - 1; k >= 0; --k) {
+        const REAL term = b[k] * row[k];
+        value = value * u + term;
+        size = size * u + fabs(term);
+        scale[j] *= 1 + u;
+      }
+      /* Horner's error bound, 2n + 1 roundings of at most REAL_EPS / 2 each over the sum of |terms|, with room */
+      rounding = size * (REAL)(2 * DEGREE + 2) * REAL_EPS;
+      scale[j] *= (REAL)1.01f;
+    }
+    sure[j] = copysign(fmax(fabs(value) - rounding, (REAL)0), value);
+    positive |= sure[j] > 0;
+    negative |= sure[j] < 0;
+  }
+  if (!(positive && negative)) return 0;
+#if ALGRAY_ESCALATE
+  /* The noise only where the signs change at all: it may need the ray's terms summed. */
   SearchNoise noise = search_noise(b, terms);
   int seen = 0;
-  for (int j = 0; j <= SHADOW_DOUBT_PIECES; ++j) {
-    /* The ends are coefficients already: P's values there. */
-    const REAL v = j == 0                     ? b[0]
-                   : j == SHADOW_DOUBT_PIECES ? b[DEGREE]
-                                              : bernstein_value_at(b, (REAL)j / SHADOW_DOUBT_PIECES);
-    if (within_noise(&noise, v)) continue;
-    const int sign = v > 0 ? 1 : -1;
+  ALGRAY_UNROLL
+  for (int j = 0; j <= pieces; ++j) {
+    if (sure[j] == 0 || within_noise(&noise, sure[j] / scale[j])) continue;
+    const int sign = sure[j] > 0 ? 1 : -1;
     if (seen && sign != seen) return 1;
     seen = sign;
   }
   return 0;
+#else
+  return 1;
+#endif
 }
 
-/* A shadow ray's search result on the segment's Bernstein coefficients b, a doubt settled as a root where
- * certain_sign_change finds one: what shadow and shadow_serial both answer. */
-Isolation settled_by_signs(Isolation iso, const REAL* b, RayTerms* terms) {
-  if (iso.doubt && certain_sign_change(b, terms)) {
+/* A shadow ray's answer from its segment's Bernstein coefficients b (and b_lo): a root where
+ * sampled_sign_change finds one, else the search's; in builds that settle doubts by signs, a doubt settled as a
+ * root where a finer sampling finds one. What shadow and shadow_serial both answer. */
+Isolation shadow_isolation(const REAL* b, const REAL* b_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
+                           REAL* iso_c TERMS_PARAM) {
+  Isolation iso = isolation_none();
+  if (sampled_sign_change(b, SHADOW_SAMPLE_PIECES, binomials TERMS_ARG)) {
+    iso.status = ISOLATION_BRACKET;
+    return iso;
+  }
+  iso = isolate_bernstein(b, b_lo, t_in, t_out, iso_c TERMS_ARG); /* leaves b as it was */
+#if ALGRAY_ESCALATE && ALGRAY_SETTLE_BY_SIGNS
+  if (iso.doubt && sampled_sign_change(b, SHADOW_DOUBT_PIECES, binomials TERMS_ARG)) {
     iso.doubt = 0;
     iso.status = ISOLATION_BRACKET;
   }
+#endif
   return iso;
 }
 #endif

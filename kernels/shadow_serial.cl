@@ -1,4 +1,4 @@
-/* The shadow kernel's answers the plain way, one segment at a time through isolate_on_segment: what the tests hold shadow.cl to. */
+/* The shadow kernel's answers the plain way, one segment at a time without its batches and shortcuts: what the tests hold shadow.cl to. */
 #include "algray_shared.h"
 /* Shadow rays start off the surface and ask only whether there is a root: what adaptive builds doubt (isolation.h). */
 #define ALGRAY_SHADOW_RAYS 1
@@ -39,14 +39,15 @@ __kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
     if (kind != SHADOW_TRACE) continue;
     ++traced;
     REAL iso_c[NCOEF];
-#if ALGRAY_ESCALATE && ALGRAY_SETTLE_BY_SIGNS
-    /* isolate_on_segment's two steps, keeping the segment's coefficients for settled_by_signs (shadow.h). */
+#if SHADOW_SAMPLED
+    /* isolate_on_segment's two steps, the search's through shadow_isolation (shadow.h) */
     REAL root[NCOEF], root_lo[NCOEF];
+#if ALGRAY_ESCALATE
     RayTerms terms;
+#endif
     segment_coefficients(o_unit, d_unit, t_in, t_out, mono_exps, mono_coefs, mono_count, binomials, even_axes, root,
-                         root_lo, &terms);
-    const Isolation iso =
-        settled_by_signs(isolate_coefficients(root, root_lo, t_in, t_out, iso_c, &terms), root, &terms);
+                         root_lo TERMS_OUT(&terms));
+    const Isolation iso = shadow_isolation(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(&terms));
 #else
     const Isolation iso = isolate_on_segment(o_unit, d_unit, t_in, t_out, mono_exps, mono_coefs, mono_count,
                                              binomials, even_axes, iso_c);
