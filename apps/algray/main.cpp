@@ -1,4 +1,6 @@
 // The algray command line: `algray render`, `algray probe`, `algray batch`, `algray devices` and `algray view`.
+// Built twice: algray-full (ALGRAY_FULL) runs every command; algray, without the web server and Open MPI, hands
+// `algray view` and runs under an MPI launcher to it (hand_off.h).
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -18,6 +20,7 @@
 #include "algray/util/version.h"
 #include "commands.h"
 #include "exit_codes.h"
+#include "hand_off.h"
 
 namespace {
 
@@ -165,7 +168,7 @@ struct RenderCommand {
     request.progress = ::isatty(STDERR_FILENO) != 0;
 #ifdef ALGRAY_WITH_MPI
     // Started by an MPI launcher, the ranks share the image's rows; started alone, MPI is never initialised.
-    if (MpiWorld::launched()) {
+    if (started_by_mpi_launcher()) {
       std::optional<MpiWorld> world;
       try {
         world.emplace();
@@ -309,7 +312,7 @@ struct BatchCommand {
 #ifdef ALGRAY_WITH_MPI
     // Started by an MPI launcher, the ranks share the batch's frames; started alone, MPI is never initialised.
     std::optional<MpiWorld> world;
-    if (MpiWorld::launched()) {
+    if (started_by_mpi_launcher()) {
       try {
         world.emplace();
       } catch (const std::exception& e) {
@@ -354,6 +357,7 @@ struct ViewCommand {
     cmd->add_flag("--open", request.open, "open the page in the default browser (xdg-open)");
   }
 
+#ifdef ALGRAY_FULL
   int run() {
     if (!scene.scene_path.empty()) request.scene_path = scene.scene_path;
     if (!collect_overrides(cmd, scene, request.overrides)) return kExitBadInput;
@@ -361,6 +365,7 @@ struct ViewCommand {
     request.use_cache = !scene.no_cache;
     return run_view(request, std::cout, std::cerr);
   }
+#endif
 };
 
 }  // namespace
@@ -389,7 +394,15 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kExitBadInput;
   }
   if (devices.cmd->parsed()) return devices.run();
+#ifdef ALGRAY_FULL
   if (view.cmd->parsed()) return view.run();
+#else
+  // The arguments were checked here (bad input is 2 without starting the other binary); algray-full parses them
+  // again. ALGRAY_FULL_HAS_MPI: algray-full was built with the cluster layer.
+  if (view.cmd->parsed() ||
+      (ALGRAY_FULL_HAS_MPI && started_by_mpi_launcher() && (render.cmd->parsed() || batch.cmd->parsed())))
+    return hand_off_to_full(argv, std::cerr);
+#endif
   if (batch.cmd->parsed()) return batch.run();
   if (probe.cmd->parsed()) return probe.run();
   end_process(render.run());

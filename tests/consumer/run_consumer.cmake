@@ -1,5 +1,5 @@
 # Script mode (test_installed_package): installs the build tree into a fresh prefix, builds tests/consumer against
-# it with find_package(algray), and runs the program.
+# it with find_package(algray), and runs the program; then checks that the installed command line finds algray-full.
 #   cmake -DBINARY_DIR=<build> -DSOURCE_DIR=<consumer> -DWORK=<dir> -DGENERATOR=<gen> -P run_consumer.cmake
 file(REMOVE_RECURSE ${WORK})
 function(run)
@@ -14,3 +14,12 @@ run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK}/build -G ${GENERATOR} -DCMAKE_B
     -DCMAKE_PREFIX_PATH=${WORK}/prefix)
 run(${CMAKE_COMMAND} --build ${WORK}/build)
 run(${WORK}/build/algray_consumer)
+
+# The installed command line hands `algray view` to the installed algray-full (apps/algray/hand_off.h): the error
+# must be algray-full's own about the address, not that algray-full was not found.
+execute_process(COMMAND ${WORK}/prefix/bin/algray view --host 256.0.0.1 RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                ERROR_VARIABLE err)
+if(NOT err MATCHES "cannot listen on 256.0.0.1" OR err MATCHES "needs algray-full")
+  message(FATAL_ERROR "the installed algray did not hand `view` to algray-full (exit ${rc}):\n${out}\n${err}")
+endif()
+message(STATUS "the installed algray handed `algray view` to algray-full")

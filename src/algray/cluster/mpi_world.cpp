@@ -1,4 +1,4 @@
-// MPI's start and end for the process, and the launchers' variables that say whether to start it at all.
+// MPI's start and end for the process.
 #include "algray/cluster/mpi_world.h"
 
 #include <mpi.h>
@@ -9,14 +9,6 @@
 #include <thread>
 
 namespace algray {
-
-bool MpiWorld::launched() {
-  // Open MPI's mpirun; PMIx launchers (Open MPI 5, srun --mpi=pmix); PMI-1/2 launchers (MPICH's hydra, srun
-  // --mpi=pmi2).
-  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
-    if (const char* value = std::getenv(name); value && *value) return true;
-  return false;
-}
 
 MpiWorld::MpiWorld() {
   int provided = MPI_THREAD_SINGLE;

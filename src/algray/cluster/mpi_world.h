@@ -9,10 +9,6 @@ namespace algray {
 
 class MpiWorld {
  public:
-  // Whether an MPI launcher (mpirun, mpiexec, srun with PMI or PMIx) started this process, read from the
-  // variables launchers set. A process started alone never initialises MPI, so it starts as fast as before.
-  static bool launched();
-
   // MPI_Init_thread with MPI_THREAD_FUNNELED: MPI calls come from the main thread only, while other threads
   // render. Throws std::runtime_error when the library cannot give that.
   MpiWorld();
