@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "algray/io/image_io.h"
@@ -44,6 +45,9 @@ struct TracedBlock {
   const ShadowLookup* shadows = nullptr;      // of these hits
   const glm::dvec3* secondary = nullptr;      // per ray, what its bounces brought back; null without bounces
   int film_y0 = 0;                            // the image row of the film's first row (a band's film)
+  // Called on the shading thread with each range [first, end) of the block's pixel rows once they are shaded,
+  // while their records are still in that core's cache (the renderer's statistics); may be empty.
+  std::function<void(int first, int end)> after_rows;
 };
 
 // The lights and materials of one render, shared by the film and by shade_frame, so both shade alike.
