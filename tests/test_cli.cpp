@@ -434,3 +434,42 @@ TEST_CASE("the expansion budget is the whole equation's, not each power's", "[cl
   CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 15);
   CHECK(box.work_files().empty());
 }
+
+TEST_CASE("algray links neither Open MPI nor the web server, and hands `view` to algray-full", "[cli]") {
+  Sandbox box;
+  // Their libraries would load at every start (apps/algray/hand_off.cpp); readelf lists what the binary needs.
+  const fs::path needed = box.in / "needed.txt";
+  REQUIRE(std::system(("readelf -d " + quoted(ALGRAY_BINARY) + " > " + quoted(needed.string())).c_str()) == 0);
+  const std::string libraries = read_text(needed);
+  INFO(libraries);
+  CHECK(libraries.find("libOpenCL") != std::string::npos);  // the listing is the one we think it is
+  CHECK(libraries.find("libmpi") == std::string::npos);
+  CHECK(libraries.find("httplib") == std::string::npos);
+  CHECK(libraries.find("libssl") == std::string::npos);
+
+  SECTION("beside algray-full, `view` reaches it: the error about the address is algray-full's") {
+    const Result r = box.run("view --host 256.0.0.1");
+    INFO(r.err);
+    CHECK(r.exit_code != 0);
+    CHECK(r.err.find("cannot listen on 256.0.0.1") != std::string::npos);
+  }
+  SECTION("alone, `view` says what it needs and where it looked, and exits 1") {
+    const fs::path alone = box.in / "alone";
+    fs::create_directories(alone);
+    fs::copy_file(ALGRAY_BINARY, alone / "algray");
+    const fs::path err = box.in / "err.txt";
+    const int status = std::system((quoted((alone / "algray").string()) + " view --host 256.0.0.1 2> " +
+                                    quoted(err.string()) + " < /dev/null")
+                                       .c_str());
+    REQUIRE(WIFEXITED(status));
+    const std::string text = read_text(err);
+    INFO(text);
+    CHECK(WEXITSTATUS(status) == 1);
+    CHECK(text.find("needs algray-full") != std::string::npos);
+    CHECK(text.find((alone / "algray-full").string()) != std::string::npos);
+  }
+  SECTION("bad arguments are refused before the hand-off, with exit 2") {
+    const Result r = box.run("view --port 70000");
+    CHECK(r.exit_code == 2);
+  }
+}
