@@ -13,7 +13,8 @@ tests=(test_batch test_cli test_config test_diagnostic_images test_expression te
 stage=$(mktemp -d)
 trap 'rm -rf "$stage"' EXIT
 mkdir -p "$stage/build/apps/algray" "$stage/build/tests" "$stage/build/bench" "$stage/lib"
-install -s build/apps/algray/algray "$stage/build/apps/algray/"
+# algray-full: test_cli checks that `algray view` reaches it.
+install -s build/apps/algray/algray build/apps/algray/algray-full "$stage/build/apps/algray/"
 install -s build/bench/exr_compare "$stage/build/bench/"
 for t in "${tests[@]}" image_writer_tool; do install -s "build/tests/$t" "$stage/build/tests/"; done
 printf '%s\n' "${tests[@]}" > "$stage/tests.txt"
@@ -21,7 +22,7 @@ printf '%s\n' "${tests[@]}" > "$stage/tests.txt"
 pwd > "$stage/source_dir"
 
 # Every library the binaries load except the C and C++ runtimes, which the target has in a newer version.
-for f in "$stage"/build/*/*/algray "$stage"/build/tests/* "$stage"/build/bench/*; do ldd "$f"; done |
+for f in "$stage"/build/*/*/algray* "$stage"/build/tests/* "$stage"/build/bench/*; do ldd "$f"; done |
   awk '$3 ~ /^\// {print $3}' | sort -u |
   grep -Ev '/(libc|libm|libstdc\+\+|libgcc_s|libpthread|libdl|librt)\.so' |
   while read -r lib; do cp -L "$lib" "$stage/lib/"; done
