@@ -408,12 +408,12 @@ TEST_CASE("a ray adaptive precision doubts: the probe says why, and the second p
     for (int px = 0; px < 64 && probed < 12; ++px) {
       const HitRecord& rendered = render.hits.at(px, py);
       if (!(rendered.flags & ALGRAY_HIT_ESCALATED)) {
-        // A ray the float kernel decided: one trace, no doubt.
+        // A ray the float kernel decided: one trace, and no doubt but a flat one it confirmed.
         if (plain++ % 97 != 0) continue;
         ProbeTarget target{false, px, py, {}, {}};
         const std::vector<SurfaceProbe> probes = probe_scene(scene, target, false, context);
         REQUIRE(probes.at(0).traces.size() == 1);
-        CHECK_FALSE(probes[0].traces[0].doubt.has_value());
+        CHECK(probes[0].traces[0].doubt.has_value() == probes[0].traces[0].confirmed.has_value());
         continue;
       }
       ++probed;
@@ -435,4 +435,36 @@ TEST_CASE("a ray adaptive precision doubts: the probe says why, and the second p
       if (again.found()) CHECK(std::memcmp(&again.hit, &rendered, offsetof(HitRecord, flags)) == 0);
     }
   CHECK(probed == 12);
+}
+
+TEST_CASE("a flat-doubted root that P's values confirm is kept: one trace, the render's record", "[probe]") {
+  RenderContext context("", true);
+  const Scene scene = load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_decic.toml",
+                                      {{"image.width", "96"}, {"image.height", "72"},
+                                       {"render.precision", "\"adaptive\""}, {"render.preview", "true"}});
+  Renderer renderer(context.session(), context.cache());
+  const RenderResult render = renderer.render_with_records(scene);
+  int confirmed = 0;
+  for (int py = 0; py < 72 && confirmed < 4; py += 2)
+    for (int px = 0; px < 96 && confirmed < 4; px += 2) {
+      const HitRecord& rendered = render.hits.at(px, py);
+      if (!(rendered.flags & ALGRAY_HIT_FOUND) || (rendered.flags & ALGRAY_HIT_ESCALATED)) continue;
+      ProbeTarget target{false, px, py, {}, {}};
+      const std::vector<SurfaceProbe> probes = probe_scene(scene, target, false, context);
+      const SolverTrace& trace = probes.at(0).traces.at(0);
+      if (!trace.confirmed) continue;
+      ++confirmed;
+      INFO("pixel (" << px << ", " << py << ")");
+      REQUIRE(trace.doubt.has_value());
+      CHECK(doubt_reason(static_cast<unsigned>(trace.doubt->reason))->id == ALGRAY_DOUBT_FLAT);
+      CHECK(probes[0].traces.size() == 1);
+      CHECK((trace.hit.flags & ALGRAY_HIT_DOUBT) == 0);
+      // P changes sign across the root, each value beyond its rounding.
+      CHECK(std::fabs(trace.confirmed->before) > trace.confirmed->before_rounding);
+      CHECK(std::fabs(trace.confirmed->after) > trace.confirmed->after_rounding);
+      CHECK((trace.confirmed->before > 0) != (trace.confirmed->after > 0));
+      // The render kept this very root.
+      CHECK(std::memcmp(&trace.hit, &rendered, offsetof(HitRecord, flags)) == 0);
+    }
+  CHECK(confirmed == 4);
 }

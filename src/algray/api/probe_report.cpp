@@ -170,8 +170,14 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
     const DoubtReason* why = doubt_reason(static_cast<unsigned>(tr.doubt->reason));
     out << "doubted (" << (why ? why->name : "?") << ": " << (why ? why->meaning : "unknown reason")
         << "): " << num(tr.doubt->value, 4) << " within the noise " << num(tr.doubt->noise, 4) << " on ["
-        << num(tr.t_at(tr.doubt->lo)) << ", " << num(tr.t_at(tr.doubt->hi)) << "]; the render traces the ray again in "
-        << "the next trace's precision, whose answer it keeps\n";
+        << num(tr.t_at(tr.doubt->lo)) << ", " << num(tr.t_at(tr.doubt->hi)) << "]";
+    if (tr.confirmed)
+      out << "; confirmed: P from the monomials is " << num(tr.confirmed->before, 4) << " (rounding "
+          << num(tr.confirmed->before_rounding, 3) << ") before the root and " << num(tr.confirmed->after, 4)
+          << " (rounding " << num(tr.confirmed->after_rounding, 3)
+          << ") after it, within 1e-4 of its t: the render keeps this root\n";
+    else
+      out << "; the render traces the ray again in the next trace's precision, whose answer it keeps\n";
   }
   if (tr.events_offered > tr.events_recorded)
     out << "note: the log kept the first " << tr.events_recorded << " of " << tr.events_offered << " events\n";
@@ -239,6 +245,11 @@ nlohmann::json trace_json(const SolverTrace& tr) {
     const DoubtReason* why = doubt_reason(static_cast<unsigned>(tr.doubt->reason));
     j["doubt"] = {{"reason", why ? why->name : "?"}, {"level", tr.doubt->level}, {"t_lo", tr.t_at(tr.doubt->lo)},
                   {"t_hi", tr.t_at(tr.doubt->hi)},   {"value", tr.doubt->value}, {"noise", tr.doubt->noise}};
+    if (tr.confirmed)
+      j["doubt"]["confirmed"] = {{"before", tr.confirmed->before},
+                                 {"before_rounding", tr.confirmed->before_rounding},
+                                 {"after", tr.confirmed->after},
+                                 {"after_rounding", tr.confirmed->after_rounding}};
   }
   j["found"] = tr.found();
   if (tr.found()) j["t"] = tr.t;

@@ -61,6 +61,9 @@ void decode_events(const std::vector<ProbeEvent>& events, const std::vector<doub
       case ALGRAY_EVENT_DOUBT:
         trace.doubt = ProbeDoubt{static_cast<int>(e.decision), static_cast<int>(e.level), v[0], v[1], v[2], v[3]};
         break;
+      case ALGRAY_EVENT_CONFIRMED:
+        trace.confirmed = ProbeConfirmed{v[0], v[1], v[2], v[3]};
+        break;
       default:
         break;
     }

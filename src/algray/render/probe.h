@@ -51,6 +51,13 @@ struct ProbeDoubt {
   double noise = 0;       // the noise bound it was held to
 };
 
+// A flat-doubted root kept after all (ALGRAY_EVENT_CONFIRMED, kernels/surface.h confirm_flat_root): P from the
+// monomials at t - delta and t + delta, delta = ALGRAY_DOUBT_POSITION |t|, each beyond its rounding bound.
+struct ProbeConfirmed {
+  double before = 0, before_rounding = 0;
+  double after = 0, after_rounding = 0;
+};
+
 // Everything the kernel recorded for one ray and one solver configuration.
 struct SolverTrace {
   KernelConfig config;
@@ -70,6 +77,7 @@ struct SolverTrace {
   double iso_lo = 0, iso_hi = 0, iso_f_lo = 0, iso_f_hi = 0;
   std::vector<ProbeIterate> iterates;
   std::optional<ProbeDoubt> doubt;  // adaptive precision: the decision that sent the ray to the second pass
+  std::optional<ProbeConfirmed> confirmed;  // adaptive precision: a flat doubt withdrawn; no second pass then
   HitRecord hit{};                  // exactly what the render writes for this ray
   double t = std::numeric_limits<double>::infinity();     // hit.t_hi + hit.t_lo; +inf without a root
   std::uint32_t events_offered = 0, events_recorded = 0;  // the log overflowed if they differ
