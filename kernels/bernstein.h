@@ -254,22 +254,6 @@ ALGRAY_INLINE void casteljau_halve_lanes(const LREAL* c, LREAL* left, LREAL* rig
   }
 }
 
-/* P's value at t in [0, 1] from its Bernstein coefficients b, by de Casteljau's convex combinations: a search's
- * noise (isolation.h) bounds its error as it bounds every subinterval's coefficients. */
-ALGRAY_INLINE REAL bernstein_value_at(const REAL* b, REAL t) {
-  REAL w[NCOEF];
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) w[k] = b[k];
-  const REAL s = 1 - t;
-  ALGRAY_UNROLL
-  for (int r = 1; r <= DEGREE; ++r) {
-    ALGRAY_UNROLL
-    for (int k = 0; k < DEGREE; ++k)
-      if (k <= DEGREE - r) w[k] = s * w[k] + t * w[k + 1];
-  }
-  return w[0];
-}
-
 /* Whether every coefficient of c has one strict sign, lane by lane: then the polynomial has no root on the
  * interval (and de Casteljau's pieces of it keep the sign). */
 ALGRAY_INLINE LMASK one_strict_sign(const LREAL* c) {

@@ -111,18 +111,23 @@ RayTerms ray_terms(__global const uint* exps, __global const REAL* coefs, uint c
   return t;
 }
 
+/* The powers 0 .. DEGREE of q's coordinates, for sums over the monomials (exponents packed as i | j<<8 | k<<16). */
+ALGRAY_INLINE void axis_powers(REAL3 q, REAL* px, REAL* py, REAL* pz) {
+  px[0] = py[0] = pz[0] = 1;
+  ALGRAY_UNROLL
+  for (int n = 1; n <= DEGREE; ++n) {
+    px[n] = px[n - 1] * q.x;
+    py[n] = py[n - 1] * q.y;
+    pz[n] = pz[n - 1] * q.z;
+  }
+}
+
 /* term_bound's sum for the ray, computed once. Measured against a nested Horner scheme in scalars (like
  * restrict_to_rays'): these power tables were faster. */
 REAL ray_terms_exact(RayTerms* t) {
   if (t->exact) return t->value;
   REAL px[NCOEF], py[NCOEF], pz[NCOEF];
-  px[0] = py[0] = pz[0] = 1;
-  ALGRAY_UNROLL
-  for (int n = 1; n <= DEGREE; ++n) {
-    px[n] = px[n - 1] * t->x;
-    py[n] = py[n - 1] * t->y;
-    pz[n] = pz[n - 1] * t->z;
-  }
+  axis_powers((REAL3)(t->x, t->y, t->z), px, py, pz);
   /* Four partial sums: one would be a chain of dependent additions, each waiting for the last (measured on the
    * Barth decic's adaptive render: 1.5% of its kernel time less). */
   REAL sum[4] = {0, 0, 0, 0};

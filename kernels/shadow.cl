@@ -43,10 +43,11 @@ ALGRAY_INLINE int signs_clear_of(const REAL* c, int by_signs, REAL terms, __cons
 }
 #endif
 
-/* Whether the segment, restricted to root (and root_lo, both consumed), holds a root: what shadow_isolation
- * (or, where it is not built, isolate_restricted) reports, without it when the coefficients' signs already settle it (Bernstein builds; adaptive ones
- * only when the signs stand clear of the noise: of extent_terms, the bound on every ray's terms in the extent,
- * then of the ray's terms' upper bound, then of their sum; each check costs more and passes more rays).
+/* Whether the segment, restricted to root (and root_lo, both consumed), holds a root: what shadow_isolation (or,
+ * where it is not built, isolate_restricted) reports, without it when the coefficients' signs already settle it
+ * (Bernstein builds; adaptive ones only when the signs stand clear of the noise: of extent_terms, the bound on
+ * every ray's terms in the extent, then of the ray's terms' upper bound, then of their sum; each check costs more
+ * and passes more rays).
  * *doubt gets the search's. f: the ray's coordinates' factors, for adaptive builds' terms. */
 ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
                                    uint* doubt, __global const uint* exps, __global const REAL* coefs, uint count,

@@ -1,4 +1,4 @@
-/* The shadow kernel's answers the plain way, one segment at a time without its batches and shortcuts: what the tests hold shadow.cl to. */
+/* The shadow kernel's answers one segment at a time, without batches or sign shortcuts: what tests hold it to. */
 #include "algray_shared.h"
 /* Shadow rays start off the surface and ask only whether there is a root: what adaptive builds doubt (isolation.h). */
 #define ALGRAY_SHADOW_RAYS 1

@@ -379,7 +379,6 @@ void finish_surface(SurfaceHit* h, SegmentRoot root) {
   if (h->root.flags & ALGRAY_HIT_FOUND) h->u = h->u + h->root.t * h->d_unit;
 }
 
-
 /* Adaptive builds: a root doubted as flat (doubt_flat_root) is kept after all where P, evaluated from the
  * monomials at t -+ ALGRAY_DOUBT_POSITION |t| on the ray, has opposite signs beyond that evaluation's rounding:
  * then a root lies within what the flat check allows. The check held the root to the coefficients' noise, which
@@ -387,16 +386,12 @@ void finish_surface(SurfaceHit* h, SegmentRoot root) {
  * (the Barth decic's flat-doubted roots: 1e-4 to 2e-3 of the segment's), and so is P's rounding there.
  * Measured on the decic at 1024x768: 61% fewer camera rays traced again (bench/RESULTS.md). */
 #if ALGRAY_ESCALATE
-/* P at q from the monomials, and a bound on its rounding: the products, the sum, and the rounding of q's
- * coordinates and of the coefficients, each of at most REAL_EPS / 2 per operation to first order, with room. */
+/* P at q from the monomials (the power tables of axis_powers, restrict.h), and a bound on its rounding: the
+ * products, the sum, and the rounding of q's coordinates and of the coefficients, each of at most REAL_EPS / 2
+ * per operation to first order, with room. */
 REAL direct_value(REAL3 q, __global const uint* exps, __global const REAL* coefs, uint count, REAL* rounding) {
   REAL px[NCOEF], py[NCOEF], pz[NCOEF];
-  px[0] = py[0] = pz[0] = 1;
-  for (int n = 1; n <= DEGREE; ++n) {
-    px[n] = px[n - 1] * q.x;
-    py[n] = py[n - 1] * q.y;
-    pz[n] = pz[n - 1] * q.z;
-  }
+  axis_powers(q, px, py, pz);
   REAL value = 0, size = 0;
   for (uint m = 0; m < count; ++m) {
     const uint e = exps[m];

@@ -29,8 +29,8 @@ struct KernelConfig {
   // (lanes_apply), where the plan asks for it.
   int lanes = 1;
   // Adaptive shadow kernels only: before a doubted ray goes to the second pass, two values of P* of opposite signs
-  // beyond the noise at 16 points settle it as hidden (shadow.h, sampled_sign_change). It pays where that pass runs in
-  // float-float, not where it runs in double (bench/RESULTS.md), so the plan sets it for the former only.
+  // beyond the noise at 16 points settle it as hidden (shadow.h, sampled_sign_change). It pays where that pass
+  // runs in float-float, not where it runs in double (bench/RESULTS.md), so the plan sets it for the former only.
   bool settle_by_signs = false;
 
   // "-D DEGREE=6 -D ALGRAY_DOUBLE=1 ..." with the tolerance as an exact hexadecimal literal.
