@@ -22,10 +22,16 @@ int main(int argc, char** argv) {
     }
     long hit_miss = 0, both = 0, off_1e3 = 0, off_1e6 = 0;
     double worst = 0;
+    std::string where;  // the first few hit/miss disagreements, as x,y: which pixels to probe
     for (std::size_t i = 0; i < ref.depth.size(); ++i) {
       const bool ht = std::isfinite(test.depth[i]), hr = std::isfinite(ref.depth[i]);
       if (ht != hr) {
-        ++hit_miss;
+        if (++hit_miss <= 8) {
+          char pixel[64];
+          const auto width = static_cast<std::size_t>(ref.width);
+          std::snprintf(pixel, sizeof pixel, " %zu,%zu (test %s)", i % width, i / width, ht ? "hits" : "misses");
+          where += pixel;
+        }
       } else if (hr) {
         ++both;
         const double rel = std::fabs(double(test.depth[i]) - ref.depth[i]) / std::fabs(double(ref.depth[i]));
@@ -39,6 +45,7 @@ int main(int argc, char** argv) {
         "(%.2f%% of common hits), worst relative depth difference %.2g\n",
         ref.depth.size(), hit_miss, 100.0 * static_cast<double>(hit_miss) / static_cast<double>(ref.depth.size()), both,
         off_1e6, off_1e3, 100.0 * static_cast<double>(off_1e3) / static_cast<double>(std::max(both, 1L)), worst);
+    if (!where.empty()) std::printf("hit/miss disagreements at%s%s\n", where.c_str(), hit_miss > 8 ? " ..." : "");
     // Whether a change kept every stored value (colour, depth, normal, solver channels) bit for bit: the check
     // for work that must not move an image. NaNs compare by their bits too.
     const auto same_bits = [](const auto& a, const auto& b) {

@@ -206,7 +206,7 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
      * Its end coefficients are P's values: near zero there, float cannot tell; an inner one is halved until it
      * stands clear, as de Casteljau's coefficients close in on P's values (fewer rays doubted: on the Barth
      * decic's shadow rays, 10% of them doubted without this). */
-    const int near_zero = v == 0 && within_noise(noise, smallest_magnitude(cur, iso.lo));
+    const int near_zero = v == 0 && within_noise_at(noise, smallest_magnitude(cur, iso.lo), iso.lo, iso.hi);
     if (near_zero && doubted(&iso, ALGRAY_DOUBT_DISCARD, smaller_end(cur, iso.lo), noise, level PROBE_ARG)) return iso;
 #else
     const int near_zero = 0;

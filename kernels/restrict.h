@@ -73,6 +73,7 @@ typedef struct {
   __global const REAL* coefs;
   uint count;
   REAL x, y, z;
+  REAL x0, x1, y0, y1, z0, z1; /* |x|, |y|, |z| at the segment's ends, for ray_terms_local */
 } RayTerms;
 
 /* Terms of a known size (exact from the start): coefficients given as they are. */
@@ -84,6 +85,7 @@ RayTerms known_terms(REAL value) {
   t.coefs = 0;
   t.count = 0;
   t.x = t.y = t.z = 0;
+  t.x0 = t.x1 = t.y0 = t.y1 = t.z0 = t.z1 = 0;
   return t;
 }
 
@@ -107,6 +109,12 @@ RayTerms ray_terms(__global const uint* exps, __global const REAL* coefs, uint c
   t.x = fmax(fabs(fx.l0), fabs(fx.l1));
   t.y = fmax(fabs(fy.l0), fabs(fy.l1));
   t.z = fmax(fabs(fz.l0), fabs(fz.l1));
+  t.x0 = fabs(fx.l0);
+  t.x1 = fabs(fx.l1);
+  t.y0 = fabs(fy.l0);
+  t.y1 = fabs(fy.l1);
+  t.z0 = fabs(fz.l0);
+  t.z1 = fabs(fz.l1);
   t.value = terms_within(coefs, count, fmax(t.x, fmax(t.y, t.z)));
   return t;
 }
@@ -146,6 +154,33 @@ REAL ray_terms_exact(RayTerms* t) {
   t->value = (sum[0] + sum[1]) + (sum[2] + sum[3]);
   t->exact = 1;
   return t->value;
+}
+
+/* The terms over the part [lo, hi] of the segment (fractions of it): sum_m |a_m| X^i Y^j Z^k with X the larger of
+ * |x0| (1 - s) + |x1| s at s = lo and hi, x0 and x1 the coordinate at the segment's ends. That linear bound is at
+ * least |x| on [lo, hi] (|x| is convex along the segment), so these terms bound the part's coefficients as
+ * ray_terms_exact's bound the segment's. Terms of a known size have no parts. */
+ALGRAY_INLINE REAL3 part_coordinates(const RayTerms* t, REAL lo, REAL hi) {
+  return (REAL3)(fmax(mix(t->x0, t->x1, lo), mix(t->x0, t->x1, hi)), fmax(mix(t->y0, t->y1, lo), mix(t->y0, t->y1, hi)),
+                 fmax(mix(t->z0, t->z1, lo), mix(t->z0, t->z1, hi)));
+}
+REAL ray_terms_local(const RayTerms* t, REAL lo, REAL hi) {
+  if (t->coefs == 0) return t->value;
+  REAL px[NCOEF], py[NCOEF], pz[NCOEF];
+  axis_powers(part_coordinates(t, lo, hi), px, py, pz);
+  REAL sum = 0;
+  for (uint m = 0; m < t->count; ++m) {
+    const uint e = t->exps[m];
+    sum += fabs(t->coefs[m]) * px[e & 0xffu] * py[(e >> 8) & 0xffu] * pz[(e >> 16) & 0xffu];
+  }
+  return sum * (REAL)(1 + 1.0 / 1024); /* room for the sum's own rounding, as in terms_within */
+}
+
+/* An upper bound on ray_terms_local from the per-degree sums (terms_within) at the part's largest coordinate. */
+REAL ray_terms_within_part(const RayTerms* t, REAL lo, REAL hi) {
+  if (t->coefs == 0) return t->value;
+  const REAL3 q = part_coordinates(t, lo, hi);
+  return terms_within(t->coefs, t->count, fmax(q.x, fmax(q.y, q.z)));
 }
 #endif
 

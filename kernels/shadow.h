@@ -60,10 +60,8 @@ void shadow_origin(__global const REAL4* points, __global const float4* normals,
 #define SHADOW_UNDECIDED(i, mask) ((void)(mask))
 #endif
 
-/* Adaptive builds with -D ALGRAY_SETTLE_BY_SIGNS=1 settle doubted rays by sampled_sign_change (KernelConfig). */
-#ifndef ALGRAY_SETTLE_BY_SIGNS
-#define ALGRAY_SETTLE_BY_SIGNS 0
-#endif
+/* Adaptive builds with -D ALGRAY_SETTLE_DOUBTS=1 settle doubted rays by sampled_sign_change (KernelConfig), and
+ * hold values to the noise of their own interval (isolation.h). */
 
 /* The extent form's shadow rays with Bernstein isolation, in plain float, adaptive or double, look for a certain
  * sign change at a few points of the segment before the search (shadow_isolation). Mixed precision's answers
@@ -82,7 +80,7 @@ void shadow_origin(__global const REAL4* points, __global const float4* normals,
  * the Barth decic (1024x768, one ray per pixel): 8 settled a third of the searched rays in float, and took the
  * float shadow pass from 887 to 823 ms, adaptive's from 1042 to 1004. */
 #define SHADOW_SAMPLE_PIECES 8
-/* How many a doubted one is sampled in (ALGRAY_SETTLE_BY_SIGNS). Of the Barth decic's doubted shadow rays
+/* How many a doubted one is sampled in (ALGRAY_SETTLE_DOUBTS). Of the Barth decic's doubted shadow rays
  * (512x384, one ray per pixel), 8 pieces settled 33%, 16 settled 45%, 32 settled 53%; 16 measured a little faster
  * than 8 at 1024x768 with a float-float second pass. */
 #define SHADOW_DOUBT_PIECES 16
@@ -130,7 +128,8 @@ ALGRAY_INLINE int sampled_sign_change(const REAL* b, int pieces, __constant cons
   int seen = 0;
   ALGRAY_UNROLL
   for (int j = 0; j <= pieces; ++j) {
-    if (sure[j] == 0 || within_noise(&noise, sure[j] / scale[j])) continue;
+    const REAL at = (REAL)j / (REAL)pieces;
+    if (sure[j] == 0 || within_noise_at(&noise, sure[j] / scale[j], at, at)) continue;
     const int sign = sure[j] > 0 ? 1 : -1;
     if (seen && sign != seen) return 1;
     seen = sign;
@@ -152,7 +151,7 @@ Isolation shadow_isolation(const REAL* b, const REAL* b_lo, REAL t_in, REAL t_ou
     return iso;
   }
   iso = isolate_bernstein(b, b_lo, t_in, t_out, iso_c TERMS_ARG); /* leaves b as it was */
-#if ALGRAY_ESCALATE && ALGRAY_SETTLE_BY_SIGNS
+#if ALGRAY_ESCALATE && ALGRAY_SETTLE_DOUBTS
   if (iso.doubt && sampled_sign_change(b, SHADOW_DOUBT_PIECES, binomials TERMS_ARG)) {
     iso.doubt = 0;
     iso.status = ISOLATION_BRACKET;

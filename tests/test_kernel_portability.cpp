@@ -68,7 +68,7 @@ void add(std::vector<Compile>& jobs, KernelConfig config) {
   config.lanes = 8;
   if (lanes_apply(config)) jobs.push_back({kind, config.key(), config.source_file(), device_options(config)});
   config.lanes = 1;
-  config.settle_by_signs = true;  // adaptive shadow kernels' sign sampling of doubted rays
+  config.settle_doubts = true;  // adaptive shadow kernels' sign sampling of doubted rays
   if (config.precision == Precision::Adaptive && config.entry.rfind("shadow", 0) == 0)
     jobs.push_back({kind, config.key(), config.source_file(), device_options(config)});
 }

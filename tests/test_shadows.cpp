@@ -2,6 +2,8 @@
 // reference can certify whether the shadow ray meets the surface.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -220,52 +222,77 @@ TEST_CASE("shadow answers agree with the reference towards the lights of a scene
   }
 }
 
-TEST_CASE("adaptive shadow rays a certain sign change settles are only doubted ones, and hidden by the reference",
+namespace {
+
+// Surface points from a small render of a scene file in adaptive precision, and 64 light points on a sphere of 3
+// extent radii around it: every pair is one shadow ray.
+struct PairedRays {
+  Scene scene;
+  std::vector<SurfacePoint> sps;
+  std::vector<glm::dvec3> points, lights;
+  std::vector<glm::vec3> normals;
+};
+
+PairedRays paired_rays(Renderer& renderer, const char* file, unsigned seed) {
+  std::string path = ALGRAY_SOURCE_DIR "/scenes/";
+  path += file;
+  PairedRays r{load_scene_file(path, {{"image.width", "64"},
+                                      {"image.height", "48"},
+                                      {"antialias.samples", "1"},
+                                      {"render.preview", "true"},
+                                      {"render.precision", "\"adaptive\""}}),
+               {}, {}, {}, {}};
+  r.sps = surface_points(renderer, r.scene);
+  for (const SurfacePoint& sp : r.sps) {
+    r.points.push_back(sp.point);
+    r.normals.push_back(sp.normal);
+  }
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  for (int s = 0; s < 64; ++s)
+    r.lights.push_back(r.scene.extent.unit_centre() +
+                       3 * r.scene.extent.unit_scale() * glm::normalize(glm::dvec3(g(rng), g(rng), g(rng))));
+  return r;
+}
+
+// The shadow kernel of `precision` for the scene, in the extent form, one ray per work-item;
+// settle_doubts is set in adaptive precision, as the plan sets it where the second pass runs in float-float.
+KernelConfig extent_shadow_config(const Scene& scene, Precision precision) {
+  KernelConfig config = primary_config(scene, precision);
+  config.entry = "shadow";
+  config.ray_origin = RayOrigin::Extent;
+  config.lanes = 1;
+  config.settle_doubts = precision == Precision::Adaptive;
+  return config;
+}
+
+}  // namespace
+
+TEST_CASE("adaptive shadow rays that settle_doubts settles are only doubted ones, and agree with the reference",
           "[shadows]") {
-  // The float shadow kernel as the plan builds it where the second pass runs in float-float (settle_by_signs):
-  // against the same kernel without it, on the scenes whose shadow rays it doubts most. Surface points from a
-  // small render, 64 light points on a sphere of 3 extent radii: every pair is one ray.
+  // The float shadow kernel as the plan builds it where the second pass runs in float-float (settle_doubts: the
+  // noise of each interval, and a certain sign change at 16 points) against the same kernel without it, on the
+  // scenes whose shadow rays it doubts most.
   ClSession& session = testing::device_session();
   ProgramCache cache(false);
   Renderer renderer(session, cache);
-  int settled_total = 0;
+  int certified_total = 0;
   for (const char* file : {"barth_decic.toml", "endrass_octic.toml"}) {
-    std::string path = ALGRAY_SOURCE_DIR "/scenes/";
-    path += file;
-    const Scene scene = load_scene_file(path, {{"image.width", "64"},
-                                               {"image.height", "48"},
-                                               {"antialias.samples", "1"},
-                                               {"render.preview", "true"},
-                                               {"render.precision", "\"adaptive\""}});
-    const std::vector<SurfacePoint> sps = surface_points(renderer, scene);
-    REQUIRE(sps.size() > 100);
-    std::vector<glm::dvec3> points;
-    std::vector<glm::vec3> normals;
-    for (const SurfacePoint& sp : sps) {
-      points.push_back(sp.point);
-      normals.push_back(sp.normal);
-    }
-    std::mt19937 rng(kSeed + 7);
-    std::normal_distribution<double> g;
-    std::vector<glm::dvec3> lights;
-    for (int s = 0; s < 64; ++s)
-      lights.push_back(scene.extent.unit_centre() +
-                       3 * scene.extent.unit_scale() * glm::normalize(glm::dvec3(g(rng), g(rng), g(rng))));
-
-    KernelConfig config = primary_config(scene, Precision::Adaptive);
-    config.entry = "shadow";
-    config.lanes = 1;
-    const DeviceSurface surface(session.context, scene, Precision::Adaptive);
-    const double offset = shadow_offset_unit(Precision::Adaptive) * scene.extent.unit_scale();
+    const PairedRays r = paired_rays(renderer, file, kSeed + 7);
+    REQUIRE(r.sps.size() > 100);
+    KernelConfig config = extent_shadow_config(r.scene, Precision::Adaptive);
+    const DeviceSurface surface(session.context, r.scene, Precision::Adaptive);
+    const double offset = shadow_offset_unit(Precision::Adaptive) * r.scene.extent.unit_scale();
+    config.settle_doubts = false;
     ShadowTracer plain(session, cache, config, surface, offset);
-    config.settle_by_signs = true;
+    config.settle_doubts = true;
     ShadowTracer settling(session, cache, config, surface, offset);
-    const ShadowAnswer a = plain.trace(points, normals, lights);
-    const ShadowAnswer b = settling.trace(points, normals, lights);
-    REQUIRE(a.undecided.size() == points.size());
-    REQUIRE(b.undecided.size() == points.size());
-    int doubted = 0, settled = 0, wrong = 0;
-    for (std::size_t i = 0; i < points.size(); ++i) {
+    const ShadowAnswer a = plain.trace(r.points, r.normals, r.lights);
+    const ShadowAnswer b = settling.trace(r.points, r.normals, r.lights);
+    REQUIRE(a.undecided.size() == r.points.size());
+    REQUIRE(b.undecided.size() == r.points.size());
+    int doubted = 0, settled = 0, hidden = 0, certified = 0;
+    for (std::size_t i = 0; i < r.points.size(); ++i) {
       INFO(file << ", seed " << kSeed + 7 << ", point " << i);
       CHECK((b.undecided[i] & ~a.undecided[i]) == 0);             // it doubts no ray the plain one did not
       CHECK(((a.masks[i] ^ b.masks[i]) & ~a.undecided[i]) == 0);  // nor changes a decided answer
@@ -273,19 +300,66 @@ TEST_CASE("adaptive shadow rays a certain sign change settles are only doubted o
       for (std::uint64_t cleared = a.undecided[i] & ~b.undecided[i]; cleared; cleared &= cleared - 1) {
         const int s = __builtin_ctzll(cleared);
         ++settled;
-        CHECK(((b.masks[i] >> s) & 1) == 1);  // settled means hidden
+        const bool is_hidden = (b.masks[i] >> s) & 1;
+        hidden += is_hidden;
         PixelRay ray;
-        const Verdict v = reference_verdict(scene, Precision::Adaptive, sps[i], lights[s], ray);
-        if (v == Verdict::Visible) {
-          ++wrong;
-          UNSCOPED_INFO(file << " point " << i << " light " << s << ": settled hidden, the reference says visible");
-        }
+        const Verdict v = reference_verdict(r.scene, Precision::Adaptive, r.sps[i], r.lights[s], ray);
+        if (v != Verdict::Visible && v != Verdict::Hidden) continue;
+        ++certified;
+        INFO("light " << s << ": settled " << (is_hidden ? "hidden" : "visible") << ", the reference says "
+                      << name(v));
+        CHECK(is_hidden == (v == Verdict::Hidden));
       }
     }
-    INFO(file << ": " << doubted << " doubted rays, " << settled << " of them settled by signs");
-    CHECK(wrong == 0);
-    CHECK(settled > 0);
-    settled_total += settled;
+    std::printf("%s: %d doubted shadow rays, %d of them settled (%d hidden), %d of those certified\n", file,
+                doubted, settled, hidden, certified);
+    CHECK(settled * 2 > doubted);  // the noise of each interval settles most of them
+    CHECK(hidden > 0);
+    CHECK(hidden < settled);
+    certified_total += certified;
   }
-  CHECK(settled_total >= 20);  // enough settled rays for the reference's answers to mean something
+  CHECK(certified_total >= 100);  // enough certified rays for the reference's answers to mean something
+}
+
+TEST_CASE("adaptive shadow rays the float kernel decides agree with the reference wherever mixed answers otherwise",
+          "[shadows]") {
+  // The decided rays are adaptive's answers as they stand; a doubt withdrawn by the noise local to an interval
+  // (kernels/isolation.h, within_noise_at) must not turn one the wrong way. Mixed precision traces the same float
+  // rays (double's start closer to the surface) in float-float; where it answers otherwise, the reference decides.
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  for (const char* file : {"barth_decic.toml", "endrass_octic.toml"}) {
+    const PairedRays r = paired_rays(renderer, file, kSeed + 11);
+    REQUIRE(r.sps.size() > 100);
+    const DeviceSurface float_surface(session.context, r.scene, Precision::Adaptive);
+    const DeviceSurface mixed_surface(session.context, r.scene, Precision::Mixed);
+    const double offset = shadow_offset_unit(Precision::Adaptive) * r.scene.extent.unit_scale();
+    REQUIRE(offset == shadow_offset_unit(Precision::Mixed) * r.scene.extent.unit_scale());
+    ShadowTracer adaptive(session, cache, extent_shadow_config(r.scene, Precision::Adaptive), float_surface, offset);
+    ShadowTracer mixed(session, cache, extent_shadow_config(r.scene, Precision::Mixed), mixed_surface, offset);
+    const ShadowAnswer a = adaptive.trace(r.points, r.normals, r.lights);
+    const ShadowAnswer d = mixed.trace(r.points, r.normals, r.lights);
+    long decided = 0, differing = 0, certified = 0;
+    for (std::size_t i = 0; i < r.points.size(); ++i) {
+      const std::uint64_t all = r.lights.size() == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << r.lights.size()) - 1;
+      decided += __builtin_popcountll(all & ~a.undecided[i]);
+      for (std::uint64_t diff = (a.masks[i] ^ d.masks[i]) & ~a.undecided[i] & all; diff; diff &= diff - 1) {
+        const int s = __builtin_ctzll(diff);
+        ++differing;
+        PixelRay ray;
+        const Verdict v = reference_verdict(r.scene, Precision::Adaptive, r.sps[i], r.lights[s], ray);
+        if (v != Verdict::Visible && v != Verdict::Hidden) continue;
+        ++certified;
+        const bool hidden = (a.masks[i] >> s) & 1;
+        INFO(file << ", seed " << kSeed + 11 << ", point " << i << ", light " << s << ": adaptive "
+                  << (hidden ? "hidden" : "visible") << ", reference " << name(v));
+        CHECK(hidden == (v == Verdict::Hidden));
+      }
+    }
+    std::printf("%s: %ld shadow rays decided in float, %ld of them answered otherwise in mixed, %ld of those "
+                "certified\n",
+                file, decided, differing, certified);
+    CHECK(decided > 20000);
+  }
 }

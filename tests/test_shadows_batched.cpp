@@ -49,7 +49,7 @@ struct Counts {
 // The config both kernels are built with; entry names the kernel. The point form's shadow kernel runs 8 lanes,
 // and shadow_serial the same code in one.
 KernelConfig shadow_config(const Scene& scene, Precision precision, Isolation isolation, const std::string& entry,
-                           RayOrigin origin, bool settle_by_signs) {
+                           RayOrigin origin, bool settle_doubts) {
   KernelConfig config = primary_config(scene, precision);
   config.ray_origin = origin;
   config.lanes = origin == RayOrigin::Point && entry == "shadow" ? 8 : 1;
@@ -57,20 +57,20 @@ KernelConfig shadow_config(const Scene& scene, Precision precision, Isolation is
   config.refinement = Refinement::Brent;
   config.max_iterations = default_max_iterations(Refinement::Brent);
   config.entry = entry;
-  config.settle_by_signs = settle_by_signs;
+  config.settle_doubts = settle_doubts;
   return config;
 }
 
 // The shadow kernel and shadow_serial for one scene, with the renderer's shadow offset.
 struct TracerPair {
   TracerPair(const Scene& scene, Precision precision, Isolation isolation, RayOrigin origin = RayOrigin::Extent,
-             bool settle_by_signs = false)
+             bool settle_doubts = false)
       : surface(testing::device_session().context, scene, precision),
         offset(shadow_offset_unit(precision) * scene.extent.unit_scale()),
         batched(testing::device_session(), cache(),
-                shadow_config(scene, precision, isolation, "shadow", origin, settle_by_signs), surface, offset),
+                shadow_config(scene, precision, isolation, "shadow", origin, settle_doubts), surface, offset),
         serial(testing::device_session(), cache(),
-               shadow_config(scene, precision, isolation, "shadow_serial", origin, settle_by_signs), surface, offset) {}
+               shadow_config(scene, precision, isolation, "shadow_serial", origin, settle_doubts), surface, offset) {}
   static ProgramCache& cache() {
     static ProgramCache c(false);
     return c;
@@ -83,8 +83,8 @@ struct TracerPair {
 // Traces `points` random surface points towards up to 64 random light points with both kernels and requires the
 // same masks and the same count of traced rays. Some bits start set, as when another surface hid the sample.
 Counts check_same_masks(const Scene& scene, Precision precision, Isolation isolation, std::mt19937& rng,
-                        const std::string& what, RayOrigin origin = RayOrigin::Extent, bool settle_by_signs = false) {
-  TracerPair tracers(scene, precision, isolation, origin, settle_by_signs);
+                        const std::string& what, RayOrigin origin = RayOrigin::Extent, bool settle_doubts = false) {
+  TracerPair tracers(scene, precision, isolation, origin, settle_doubts);
   ShadowTracer& batched = tracers.batched;
   ShadowTracer& serial = tracers.serial;
 

@@ -66,7 +66,7 @@ std::string KernelConfig::build_options() const {
          " -D ISOLATION=" + std::to_string(isolation_id) + " -D REFINEMENT=" + std::to_string(refinement_id) +
          " -D RAY_ORIGIN=" + std::to_string(origin_id) + " -D TOLERANCE=" + tolerance_literal +
          " -D MAX_ITERATIONS=" + std::to_string(max_iterations) + " -D LANES=" + std::to_string(lanes) +
-         (settle_by_signs ? " -D ALGRAY_SETTLE_BY_SIGNS=1" : "") +
+         (settle_doubts ? " -D ALGRAY_SETTLE_DOUBTS=1" : "") +
          // PoCL prints its compiler's warning count ("4 warnings generated.") straight to stderr on a cold cache;
          // a successful command says nothing, and a failed build still reports its errors and log.
          " -w";
@@ -77,7 +77,7 @@ std::string KernelConfig::key() const {
          " isolation=" + to_string(isolation) + " refinement=" + to_string(refinement) +
          " origin=" + to_string(ray_origin) + " tolerance=" + hex_double(tolerance) +
          " max_iterations=" + std::to_string(max_iterations) + (lanes != 1 ? " lanes=" + std::to_string(lanes) : "") +
-         (settle_by_signs ? " settle_by_signs" : "");
+         (settle_doubts ? " settle_doubts" : "");
 }
 
 }  // namespace algray
