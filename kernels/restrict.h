@@ -130,14 +130,12 @@ ALGRAY_INLINE void axis_powers(REAL3 q, REAL* px, REAL* py, REAL* pz) {
   }
 }
 
-/* term_bound's sum for the ray, computed once. Measured against a nested Horner scheme in scalars (like
- * restrict_to_rays'): these power tables were faster. */
-REAL ray_terms_exact(RayTerms* t) {
-  if (t->exact) return t->value;
+/* sum_m |a_m| q.x^i q.y^j q.z^k over the monomials. Four partial sums: one would be a chain of dependent additions,
+ * each waiting for the last (measured on the Barth decic's adaptive render: 1.5% of its kernel time less). Power
+ * tables measured faster than a nested Horner scheme in scalars (like restrict_to_rays'). */
+REAL terms_at(const RayTerms* t, REAL3 q) {
   REAL px[NCOEF], py[NCOEF], pz[NCOEF];
-  axis_powers((REAL3)(t->x, t->y, t->z), px, py, pz);
-  /* Four partial sums: one would be a chain of dependent additions, each waiting for the last (measured on the
-   * Barth decic's adaptive render: 1.5% of its kernel time less). */
+  axis_powers(q, px, py, pz);
   REAL sum[4] = {0, 0, 0, 0};
   uint m = 0;
 #define ALGRAY_TERM(m)                                                                          \
@@ -151,7 +149,13 @@ REAL ray_terms_exact(RayTerms* t) {
   }
   for (; m < t->count; ++m) sum[0] += ALGRAY_TERM(m);
 #undef ALGRAY_TERM
-  t->value = (sum[0] + sum[1]) + (sum[2] + sum[3]);
+  return (sum[0] + sum[1]) + (sum[2] + sum[3]);
+}
+
+/* term_bound's sum for the ray, computed once. */
+REAL ray_terms_exact(RayTerms* t) {
+  if (t->exact) return t->value;
+  t->value = terms_at(t, (REAL3)(t->x, t->y, t->z));
   t->exact = 1;
   return t->value;
 }
@@ -166,14 +170,8 @@ ALGRAY_INLINE REAL3 part_coordinates(const RayTerms* t, REAL lo, REAL hi) {
 }
 REAL ray_terms_local(const RayTerms* t, REAL lo, REAL hi) {
   if (t->coefs == 0) return t->value;
-  REAL px[NCOEF], py[NCOEF], pz[NCOEF];
-  axis_powers(part_coordinates(t, lo, hi), px, py, pz);
-  REAL sum = 0;
-  for (uint m = 0; m < t->count; ++m) {
-    const uint e = t->exps[m];
-    sum += fabs(t->coefs[m]) * px[e & 0xffu] * py[(e >> 8) & 0xffu] * pz[(e >> 16) & 0xffu];
-  }
-  return sum * (REAL)(1 + 1.0 / 1024); /* room for the sum's own rounding, as in terms_within */
+  /* room for the sum's own rounding, as in terms_within */
+  return terms_at(t, part_coordinates(t, lo, hi)) * (REAL)(1 + 1.0 / 1024);
 }
 
 /* An upper bound on ray_terms_local from the per-degree sums (terms_within) at the part's largest coordinate. */

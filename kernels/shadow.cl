@@ -28,32 +28,34 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) { shadow_point_form_item(SHADOW_KERNE
 #else
 
 #if ALGRAY_ESCALATE
-/* The largest |b_k| of the scaled coefficients c once bernstein_from_scaled divides them, b_k = c_k / C(n,k), by
- * the same divisions: the scale of the search's noise (isolation.h, search_noise). */
-ALGRAY_INLINE REAL bernstein_scale(const REAL* c, __constant const REAL* binomials) {
+/* The Bernstein coefficients b_k = c_k / C(n,k) of the scaled coefficients c, by bernstein_from_scaled's own
+ * divisions; returns their largest magnitude, the scale of the search's noise (isolation.h, search_noise). */
+ALGRAY_INLINE REAL divided_by_binomials(const REAL* c, __constant const REAL* binomials, REAL* b) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   REAL scale = 0;
   ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(c[k] / row[k]));
+  for (int k = 0; k <= DEGREE; ++k) {
+    b[k] = c[k] / row[k];
+    scale = fmax(scale, fabs(b[k]));
+  }
   return scale;
 }
 
 /* Whether the scaled coefficients c (before bernstein_from_scaled) settle bernstein_root_by_signs' answer with
  * every coefficient it reads clear of the noise for terms of size `terms`: then no rounding could change it.
  * c_0, P at the ray's start, does not count (first_counted): the isolation takes its sign as it is.
- *  - No root (one sign throughout): each b_k = c_k / C(n,k) beyond the search's own noise, DOUBT_NOISE(scale,
- *    terms) with scale = bernstein_scale(c): the search's first interval would find no sign variation and no
- *    coefficient within its noise, and answer the same. (noise_bound, whose scale is the terms themselves,
+ *  - No root (one sign throughout): each b_k (divided_by_binomials, largest magnitude `scale`) beyond the
+ *    search's own noise, DOUBT_NOISE(scale, terms): the search's first interval would find no sign variation and
+ *    no coefficient within its noise, and answer the same. (noise_bound, whose scale is the terms themselves,
  *    settled fewer: the Barth decic's adaptive shadow pass took 950 ms with it against 909, 1024x768.)
  *  - A root (the ends' signs differ): P at the far end beyond noise_bound(terms), the bound for any scale. */
-ALGRAY_INLINE int signs_clear_of(const REAL* c, int by_signs, REAL scale, REAL terms, __constant const REAL* binomials) {
+ALGRAY_INLINE int signs_clear_of(const REAL* c, const REAL* b, int by_signs, REAL scale, REAL terms) {
   /* c_0 exactly zero: the search doubts a root at the start, so the shortcut must not settle it */
   if (by_signs == ISOLATION_BRACKET) return c[0] != 0 && fabs(c[DEGREE]) > noise_bound(terms);
   const REAL noise = DOUBT_NOISE(scale, terms);
-  __constant const REAL* row = binomials + DEGREE * NCOEF;
   int clear = 1;
   ALGRAY_UNROLL
-  for (int k = 1; k <= DEGREE; ++k) clear &= fabs(c[k] / row[k]) > noise;
+  for (int k = 1; k <= DEGREE; ++k) clear &= fabs(b[k]) > noise;
   return clear;
 }
 #endif
@@ -71,8 +73,9 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   const int by_signs = bernstein_root_by_signs(root);
 #if ALGRAY_ESCALATE
-  const REAL scale = by_signs == ISOLATION_NONE ? bernstein_scale(root, binomials) : 0;
-  if (by_signs >= 0 && signs_clear_of(root, by_signs, scale, extent_terms, binomials))
+  REAL b[NCOEF]; /* read only where by_signs is ISOLATION_NONE */
+  const REAL scale = by_signs == ISOLATION_NONE ? divided_by_binomials(root, binomials, b) : 0;
+  if (by_signs >= 0 && signs_clear_of(root, b, by_signs, scale, extent_terms))
     return by_signs != ISOLATION_NONE;
 #else
   if (by_signs >= 0) return by_signs != ISOLATION_NONE;
@@ -80,8 +83,8 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
 #endif
 #if ALGRAY_ESCALATE
   RayTerms terms = ray_terms(exps, coefs, count, fx, fy, fz);
-  if (by_signs >= 0 && (signs_clear_of(root, by_signs, scale, terms.value, binomials) ||
-                        signs_clear_of(root, by_signs, scale, ray_terms_exact(&terms), binomials)))
+  if (by_signs >= 0 && (signs_clear_of(root, b, by_signs, scale, terms.value) ||
+                        signs_clear_of(root, b, by_signs, scale, ray_terms_exact(&terms))))
     return by_signs != ISOLATION_NONE;
 #else
   (void)exps;

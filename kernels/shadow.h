@@ -60,9 +60,6 @@ void shadow_origin(__global const REAL4* points, __global const float4* normals,
 #define SHADOW_UNDECIDED(i, mask) ((void)(mask))
 #endif
 
-/* Adaptive builds with -D ALGRAY_SETTLE_DOUBTS=1 settle doubted rays by sampled_sign_change (KernelConfig), and
- * hold values to the noise of their own interval (isolation.h). */
-
 /* The extent form's shadow rays with Bernstein isolation, in plain float, adaptive or double, look for a certain
  * sign change at a few points of the segment before the search (shadow_isolation). Mixed precision's answers
  * stay its float-float search's. */
