@@ -268,6 +268,9 @@ ALGRAY_INLINE LMASK one_strict_sign(const LREAL* c) {
 #endif
 
 #if LANES > 1 && !ALGRAY_COMPENSATED
+/* isolation.h's PICK_LARGER and PICK_SMALLER, lane by lane */
+#define LANE_LARGER(a, b) LANE_SEL((a), (b), (b) > (a))
+#define LANE_SMALLER(a, b) LANE_SEL((a), (b), (b) < (a))
 #if ALGRAY_ESCALATE
 #define LANE_TERMS_PARAM , LREAL terms
 #else
@@ -344,10 +347,11 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
   LMASK budget = 0, cluster = 0, done = !running;
 #if ALGRAY_ESCALATE
   /* doubt_noise and doubted per lane: a doubted lane stops with status NONE and its ALGRAY_DOUBT_* */
-  LREAL noise = 0, doubt = 0;
+  LREAL magnitude[NCOEF], doubt = 0;
   ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) noise = fmax(noise, fabs(root[k]));
-  noise = DOUBT_NOISE(noise, terms);
+  for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(root[k]);
+  MAGNITUDE_TREE(magnitude, LANE_LARGER);
+  const LREAL noise = DOUBT_NOISE(magnitude[0], terms);
 #define DOUBT_LANES(mask, reason)                               \
   do {                                                          \
     const LMASK doubted_ = (mask);                              \
@@ -378,10 +382,10 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     DOUBT_LANES(isolated && fmin(fabs(cur[0]), fabs(cur[DEGREE])) <= noise, ALGRAY_DOUBT_ACCEPT);
 #if ALGRAY_ESCALATE
     /* isolate_bernstein's near_zero: doubted at an end, halved inside */
-    LREAL smallest = fabs(cur[0]);
     ALGRAY_UNROLL
-    for (int k = 1; k <= DEGREE; ++k) smallest = fmin(smallest, fabs(cur[k]));
-    const LMASK near_zero = !done && v == 0 && smallest <= noise;
+    for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(cur[k]);
+    MAGNITUDE_TREE(magnitude, LANE_SMALLER);
+    const LMASK near_zero = !done && v == 0 && magnitude[0] <= noise;
     DOUBT_LANES(near_zero && fmin(fabs(cur[0]), fabs(cur[DEGREE])) <= noise, ALGRAY_DOUBT_DISCARD);
     /* halve_or_settle for the lanes that may hold several roots */
     const LMASK several = !done && (v >= 1 || near_zero);

@@ -32,13 +32,9 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) { shadow_point_form_item(SHADOW_KERNE
  * divisions; returns their largest magnitude, the scale of the search's noise (isolation.h, search_noise). */
 ALGRAY_INLINE REAL divided_by_binomials(const REAL* c, __constant const REAL* binomials, REAL* b) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
-  REAL scale = 0;
   ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) {
-    b[k] = c[k] / row[k];
-    scale = fmax(scale, fabs(b[k]));
-  }
-  return scale;
+  for (int k = 0; k <= DEGREE; ++k) b[k] = c[k] / row[k];
+  return largest_magnitude(b);
 }
 
 /* Whether the scaled coefficients c (before bernstein_from_scaled) settle bernstein_root_by_signs' answer with
