@@ -443,22 +443,36 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     const LMASK from_root = move && !from_sib;
     if (LANE_ANY(from_root)) bernstein_restrict_lanes(root, width, idx, from_root, cur);
   }
-  for (uint j = 0; j < count; ++j) {
-    if (!lane_get_mask(running, j)) continue;
-    iso[j].status = (int)lane_get(status, j);
-    iso[j].budget = lane_get_mask(budget, j) != 0;
-    iso[j].cluster = lane_get_mask(cluster, j) != 0;
-    iso[j].steps = (uint)lane_get(steps, j);
+  REAL status_of[LANES], steps_of[LANES], lo_of[LANES], hi_of[LANES], f_lo_of[LANES], f_hi_of[LANES];
+  LANES_STORE(status, status_of);
+  LANES_STORE(steps, steps_of);
+  LANES_STORE(lo, lo_of);
+  LANES_STORE(hi, hi_of);
+  LANES_STORE(f_lo, f_lo_of);
+  LANES_STORE(f_hi, f_hi_of);
 #if ALGRAY_ESCALATE
-    iso[j].doubt = (uint)lane_get(doubt, j);
-    iso[j].noise = lane_get(noise, j);
+  REAL doubt_of[LANES], noise_of[LANES];
+  LANES_STORE(doubt, doubt_of);
+  LANES_STORE(noise, noise_of);
+#endif
+  const uint running_bits = lane_mask_bits(running), budget_bits = lane_mask_bits(budget),
+             cluster_bits = lane_mask_bits(cluster);
+  for (uint j = 0; j < count; ++j) {
+    if (!((running_bits >> j) & 1)) continue;
+    iso[j].status = (int)status_of[j];
+    iso[j].budget = (budget_bits >> j) & 1;
+    iso[j].cluster = (cluster_bits >> j) & 1;
+    iso[j].steps = (uint)steps_of[j];
+#if ALGRAY_ESCALATE
+    iso[j].doubt = (uint)doubt_of[j];
+    iso[j].noise = noise_of[j];
 #else
     iso[j].doubt = 0;
 #endif
-    iso[j].lo = lane_get(lo, j);
-    iso[j].hi = lane_get(hi, j);
-    iso[j].f_lo = lane_get(f_lo, j);
-    iso[j].f_hi = lane_get(f_hi, j);
+    iso[j].lo = lo_of[j];
+    iso[j].hi = hi_of[j];
+    iso[j].f_lo = f_lo_of[j];
+    iso[j].f_hi = f_hi_of[j];
   }
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) cur_out[k] = cur[k];

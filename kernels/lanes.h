@@ -97,6 +97,15 @@ ALGRAY_INLINE LMASK lanes_of_bits(uint bits) {
 #endif
 }
 
+/* The lanes of v into a[0 .. LANES), in one store: reading many lanes of a vector one by one (lane_get) stored
+ * the whole vector again for each, and the loads waited on the stores (measured: a fifth of
+ * isolate_bernstein_lanes in the Barth sextic's double preview). */
+#if LANES == 1
+#define LANES_STORE(v, a) ((a)[0] = (v))
+#else
+#define LANES_STORE(v, a) LANE_VEC(vstore, LANES)((v), 0, (a))
+#endif
+
 /* Lane j of a vector (j < LANES), read and written through its private storage. */
 ALGRAY_INLINE REAL lane_get(LREAL v, uint j) { return ((REAL*)&v)[j]; }
 ALGRAY_INLINE void lane_set(LREAL* v, uint j, REAL x) { ((REAL*)v)[j] = x; }

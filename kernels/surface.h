@@ -186,16 +186,19 @@ void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL*
     prepare_isolated(c, binomials);
     y = refine_root_lanes(c, f0, f1, tol_y, scale, running, &iterations);
   }
+  REAL y_of[LANES];
+  LANES_STORE(y, y_of);
+  const uint running_bits = lane_mask_bits(running);
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j] || iso[j].status == ISOLATION_NONE) continue;
-    const int refined = lane_get_mask(running, j) != 0;
+    const int refined = (running_bits >> j) & 1;
     roots[j].iterations = refined ? (uint)lane_get_mask(iterations, j) : 0u;
-    place_root(&roots[j], iso[j], refined ? lane_get(y, j) : (REAL)0, t_in[j], t_out[j]);
+    place_root(&roots[j], iso[j], refined ? y_of[j] : (REAL)0, t_in[j], t_out[j]);
 #if ALGRAY_ESCALATE
     if (refined) {
       REAL lane_c[NCOEF];
       for (int k = 0; k <= DEGREE; ++k) lane_c[k] = lane_get(c[k], j);
-      doubt_flat_root(&roots[j], iso[j], lane_c, lane_get(y, j), t_in[j], t_out[j]);
+      doubt_flat_root(&roots[j], iso[j], lane_c, y_of[j], t_in[j], t_out[j]);
     }
 #endif
   }
@@ -504,10 +507,16 @@ void hit_records_lanes(uint count, const Ray* rays, const SurfaceHit* hits, __gl
       lane_set(&z, j, hits[j].u.z);
       any_hit = 1;
     }
-  if (any_hit) surface_gradient_lanes(x, y, z, exps, coefs, mono_count, &gx, &gy, &gz);
+  REAL gx_of[LANES], gy_of[LANES], gz_of[LANES];
+  if (any_hit) {
+    surface_gradient_lanes(x, y, z, exps, coefs, mono_count, &gx, &gy, &gz);
+    LANES_STORE(gx, gx_of);
+    LANES_STORE(gy, gy_of);
+    LANES_STORE(gz, gz_of);
+  }
   for (uint j = 0; j < count; ++j) {
     REAL3 g = (REAL3)(0, 0, 0);
-    if (hits[j].root.flags & ALGRAY_HIT_FOUND) g = (REAL3)(lane_get(gx, j), lane_get(gy, j), lane_get(gz, j));
+    if (hits[j].root.flags & ALGRAY_HIT_FOUND) g = (REAL3)(gx_of[j], gy_of[j], gz_of[j]);
     out[j] = hit_record_with_gradient(rays[j], hits[j], g);
   }
 }
