@@ -102,6 +102,19 @@ typedef struct {
 #define ALGRAY_DOUBT_FLAT 4    /* the refined root lies where P is so flat that the noise could move it by more
                                   than ALGRAY_DOUBT_POSITION of its t (rays that need the position) */
 
+/* Rays that need their root's position doubt a refined root whose position the noise could move by more than
+ * this fraction of its t: the noise over P's slope there (surface.h, flat_root). Measured: an Endrass octic ray
+ * whose interval's ends stood just clear of the noise had its root 1.2e-3 off. Kept as digits, so that the kernels
+ * read a float literal (devices without fp64 need not accept double constants) and the host's messages the same
+ * number as text (ALGRAY_DOUBT_POSITION_TEXT). */
+#define ALGRAY_DOUBT_POSITION_DIGITS 1e-4
+#define ALGRAY_PASTE_(a, b) a##b
+#define ALGRAY_PASTE(a, b) ALGRAY_PASTE_(a, b)
+#define ALGRAY_TEXT_(x) #x
+#define ALGRAY_TEXT(x) ALGRAY_TEXT_(x)
+#define ALGRAY_DOUBT_POSITION ALGRAY_PASTE(ALGRAY_DOUBT_POSITION_DIGITS, f)
+#define ALGRAY_DOUBT_POSITION_TEXT ALGRAY_TEXT(ALGRAY_DOUBT_POSITION_DIGITS)
+
 /* ALGRAY_EVENT_STEP decisions */
 #define ALGRAY_STEP_EXACT_ZERO 1   /* P is exactly 0 at the interval's left end: the root is there */
 #define ALGRAY_STEP_CROSSED 2      /* P changed sign at the left end, between two intervals: the root is there */

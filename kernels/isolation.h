@@ -217,11 +217,6 @@ REAL smaller_end(const REAL* c, REAL lo) {
   return first_counted(lo) ? fabs(c[DEGREE]) : fmin(fabs(c[0]), fabs(c[DEGREE]));
 }
 
-/* Rays that need their root's position doubt a refined root whose position the noise could move by more than
- * this fraction of its t: the noise over P's slope there (surface.h, flat_root). Measured: an Endrass octic ray
- * whose interval's ends stood just clear of the noise had its root 1.2e-3 off. */
-#define ALGRAY_DOUBT_POSITION 1e-4f
-
 /* Ends the search undecided for `reason` when |value| is within the noise on the current interval
  * (within_noise_at); returns 1 then. Other builds compute none of its arguments. */
 #if ALGRAY_ESCALATE

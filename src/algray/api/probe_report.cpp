@@ -175,7 +175,7 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
       out << "; confirmed: P from the monomials is " << num(tr.confirmed->before, 4) << " (rounding "
           << num(tr.confirmed->before_rounding, 3) << ") before the root and " << num(tr.confirmed->after, 4)
           << " (rounding " << num(tr.confirmed->after_rounding, 3)
-          << ") after it, within 1e-4 of its t: the render keeps this root\n";
+          << ") after it, within " ALGRAY_DOUBT_POSITION_TEXT " of its t: the render keeps this root\n";
     else
       out << "; the render traces the ray again in the next trace's precision, whose answer it keeps\n";
   }

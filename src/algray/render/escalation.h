@@ -25,7 +25,8 @@ inline constexpr std::array<DoubtReason, 4> kDoubtReasons{{
     {ALGRAY_DOUBT_ACCEPT, "accept",
      "a root looked isolated, but P at an end of its interval was within rounding noise"},
     {ALGRAY_DOUBT_CLUSTER, "cluster", "the search reached the stopping width with several roots left"},
-    {ALGRAY_DOUBT_FLAT, "flat", "P is so flat at the refined root that the noise could move it by 1e-4 of its t"},
+    {ALGRAY_DOUBT_FLAT, "flat",
+     "P is so flat at the refined root that the noise could move it by " ALGRAY_DOUBT_POSITION_TEXT " of its t"},
 }};
 // The reason's entry, or nullptr for an id that is none of them.
 const DoubtReason* doubt_reason(unsigned id);
