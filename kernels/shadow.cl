@@ -43,12 +43,15 @@ ALGRAY_INLINE REAL divided_by_binomials(const REAL* c, __constant const REAL* bi
  *  - No root (one sign throughout): each b_k (divided_by_binomials, largest magnitude `scale`) beyond the
  *    search's own noise, DOUBT_NOISE(scale, terms): the search's first interval would find no sign variation and
  *    no coefficient within its noise, and answer the same. (noise_bound, whose scale is the terms themselves,
- *    settled fewer: the Barth decic's adaptive shadow pass took 950 ms with it against 909, 1024x768.)
+ *    settled fewer: the Barth decic's adaptive shadow pass took 950 ms with it against 909, 1024x768.) With
+ *    room of 8 REAL_EPS: OpenCL lets a float division be off by 2.5 ulp, so a GPU compiler may round the
+ *    search's own division (bernstein_from_scaled) differently from this one, and the terms' sums may contract
+ *    differently in another kernel; the room keeps every ray this settles one the search would settle too.
  *  - A root (the ends' signs differ): P at the far end beyond noise_bound(terms), the bound for any scale. */
 ALGRAY_INLINE int signs_clear_of(const REAL* c, const REAL* b, int by_signs, REAL scale, REAL terms) {
   /* c_0 exactly zero: the search doubts a root at the start, so the shortcut must not settle it */
   if (by_signs == ISOLATION_BRACKET) return c[0] != 0 && fabs(c[DEGREE]) > noise_bound(terms);
-  const REAL noise = DOUBT_NOISE(scale, terms);
+  const REAL noise = DOUBT_NOISE(scale, terms) * (1 + 8 * REAL_EPS);
   int clear = 1;
   ALGRAY_UNROLL
   for (int k = 1; k <= DEGREE; ++k) clear &= fabs(b[k]) > noise;
