@@ -56,10 +56,10 @@ ALGRAY_INLINE int first_counted(REAL lo) { return ALGRAY_SHADOW_RAYS && lo == 0;
  * with NaN fix-ups on each step (measured in PoCL's kernels: smallest_magnitude was 3% of the Barth decic's
  * adaptive render, its shadow pass 1023 -> 972 ms with the trees and local_scale unrolled). The same values as
  * the chains for finite coefficients. */
-#define MAGNITUDE_TREE(t, pick)                                           \
-  do {                                                                    \
-    ALGRAY_UNROLL                                                         \
-    for (int s_ = 1; s_ <= DEGREE; s_ *= 2) ALGRAY_UNROLL                 \
+#define MAGNITUDE_TREE(t, pick)                                                        \
+  do {                                                                                 \
+    ALGRAY_UNROLL                                                                      \
+    for (int s_ = 1; s_ <= DEGREE; s_ *= 2) ALGRAY_UNROLL                              \
     for (int k_ = 0; k_ + s_ <= DEGREE; k_ += 2 * s_) t[k_] = pick(t[k_], t[k_ + s_]); \
   } while (0)
 #define PICK_LARGER(a, b) ((b) > (a) ? (b) : (a))
@@ -338,7 +338,7 @@ int sign_variations(const REAL* c) {
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) {
     negative |= (SignBits)(c[k] < 0) << k;
-    signless |= (SignBits)!(c[k] > 0 || c[k] < 0) << k;
+    signless |= (SignBits) !(c[k] > 0 || c[k] < 0) << k;
   }
   if (signless == 0) return popcount((negative ^ (negative >> 1)) & (((SignBits)1 << DEGREE) - 1));
   /* Branch-free: a change is a product of signs below zero (the first nonzero sign never counts, as prev starts
