@@ -152,7 +152,7 @@ REAL terms_at(const RayTerms* t, REAL3 q) {
   return (sum[0] + sum[1]) + (sum[2] + sum[3]);
 }
 
-/* term_bound's sum for the ray, computed once. */
+/* The ray's terms summed (terms_at its largest coordinates), computed once. */
 REAL ray_terms_exact(RayTerms* t) {
   if (t->exact) return t->value;
   t->value = terms_at(t, (REAL3)(t->x, t->y, t->z));

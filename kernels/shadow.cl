@@ -28,12 +28,12 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) { shadow_point_form_item(SHADOW_KERNE
 #else
 
 #if ALGRAY_ESCALATE
-/* The Bernstein coefficients b_k = c_k / C(n,k) of the scaled coefficients c, by bernstein_from_scaled's own
- * divisions; returns their largest magnitude, the scale of the search's noise (isolation.h, search_noise). */
+/* The Bernstein coefficients b_k = c_k / C(n,k) of the scaled coefficients c, as the search gets them
+ * (bernstein_from_scaled, on a copy: c stays for the search's own); returns their largest magnitude, the scale of
+ * the search's noise (isolation.h, search_noise). */
 ALGRAY_INLINE REAL divided_by_binomials(const REAL* c, __constant const REAL* binomials, REAL* b) {
-  __constant const REAL* row = binomials + DEGREE * NCOEF;
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) b[k] = c[k] / row[k];
+  poly_copy(b, c);
+  bernstein_from_scaled(b, b, binomials); /* adaptive builds have no low parts */
   return largest_magnitude(b);
 }
 
