@@ -28,33 +28,46 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) { shadow_point_form_item(SHADOW_KERNE
 #else
 
 #if ALGRAY_ESCALATE
-/* The Bernstein coefficients b_k = c_k / C(n,k) of the scaled coefficients c, as the search gets them
- * (bernstein_from_scaled, on a copy: c stays for the search's own); returns their largest magnitude, the scale of
- * the search's noise (isolation.h, search_noise). */
-ALGRAY_INLINE REAL divided_by_binomials(const REAL* c, __constant const REAL* binomials, REAL* b) {
-  poly_copy(b, c);
-  bernstein_from_scaled(b, b, binomials); /* adaptive builds have no low parts */
-  return largest_magnitude(b);
+/* C(DEGREE, k): a constant wherever k is one (the loops below unroll), so no division is left at run time. */
+ALGRAY_INLINE REAL degree_binomial(int k) {
+  ulong c = 1;
+  ALGRAY_UNROLL
+  for (int j = 0; j < DEGREE; ++j)
+    if (j < k) c = c * (ulong)(DEGREE - j) / (ulong)(j + 1);
+  return (REAL)c;
+}
+
+/* An upper bound on the scale of the search's noise (isolation.h, search_noise): the largest |b_k|, b_k = c_k /
+ * C(n,k) the Bernstein coefficients of the scaled coefficients c (bernstein_from_scaled). Multiplied by the
+ * reciprocals instead of divided: the four divisions per ray were most of what the shortcut cost the Cayley
+ * cubic's shadow pass, which it settles almost whole. The room of 8 REAL_EPS covers the product's roundings and
+ * the search's own division, which OpenCL lets be 2.5 ulp off. */
+ALGRAY_INLINE REAL search_scale_bound(const REAL* c) {
+  REAL t[NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]) * ((REAL)1 / degree_binomial(k));
+  MAGNITUDE_TREE(t, PICK_LARGER);
+  return t[0] * (REAL)(1 + 8 * REAL_EPS);
 }
 
 /* Whether the scaled coefficients c (before bernstein_from_scaled) settle bernstein_root_by_signs' answer with
  * every coefficient it reads clear of the noise for terms of size `terms`: then no rounding could change it.
  * c_0, P at the ray's start, does not count (first_counted): the isolation takes its sign as it is.
- *  - No root (one sign throughout): each b_k (divided_by_binomials, largest magnitude `scale`) beyond the
- *    search's own noise, DOUBT_NOISE(scale, terms): the search's first interval would find no sign variation and
- *    no coefficient within its noise, and answer the same. (noise_bound, whose scale is the terms themselves,
- *    settled fewer: the Barth decic's adaptive shadow pass took 950 ms with it against 909, 1024x768.) With
- *    room of 8 REAL_EPS: OpenCL lets a float division be off by 2.5 ulp, so a GPU compiler may round the
- *    search's own division (bernstein_from_scaled) differently from this one, and the terms' sums may contract
- *    differently in another kernel; the room keeps every ray this settles one the search would settle too.
+ *  - No root (one sign throughout): each b_k beyond the search's own noise, DOUBT_NOISE(scale, terms) with
+ *    `scale` from search_scale_bound, tested as |c_k| beyond the noise times C(n,k): the search's first interval
+ *    would find no sign variation and no coefficient within its noise, and answer the same. (noise_bound, whose
+ *    scale is the terms themselves, settled fewer: the Barth decic's adaptive shadow pass took 950 ms with it
+ *    against 909, 1024x768.) With room of 8 REAL_EPS: for the product by C(n,k) and the search's division, and
+ *    the terms' sums may contract differently in another kernel; the room keeps every ray this settles one the
+ *    search would settle too.
  *  - A root (the ends' signs differ): P at the far end beyond noise_bound(terms), the bound for any scale. */
-ALGRAY_INLINE int signs_clear_of(const REAL* c, const REAL* b, int by_signs, REAL scale, REAL terms) {
+ALGRAY_INLINE int signs_clear_of(const REAL* c, int by_signs, REAL scale, REAL terms) {
   /* c_0 exactly zero: the search doubts a root at the start, so the shortcut must not settle it */
   if (by_signs == ISOLATION_BRACKET) return c[0] != 0 && fabs(c[DEGREE]) > noise_bound(terms);
   const REAL noise = DOUBT_NOISE(scale, terms) * (1 + 8 * REAL_EPS);
   int clear = 1;
   ALGRAY_UNROLL
-  for (int k = 1; k <= DEGREE; ++k) clear &= fabs(b[k]) > noise;
+  for (int k = 1; k <= DEGREE; ++k) clear &= fabs(c[k]) > noise * degree_binomial(k);
   return clear;
 }
 #endif
@@ -72,9 +85,8 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   const int by_signs = bernstein_root_by_signs(root);
 #if ALGRAY_ESCALATE
-  REAL b[NCOEF]; /* read only where by_signs is ISOLATION_NONE */
-  const REAL scale = by_signs == ISOLATION_NONE ? divided_by_binomials(root, binomials, b) : 0;
-  if (by_signs >= 0 && signs_clear_of(root, b, by_signs, scale, extent_terms))
+  const REAL scale = by_signs == ISOLATION_NONE ? search_scale_bound(root) : 0;
+  if (by_signs >= 0 && signs_clear_of(root, by_signs, scale, extent_terms))
     return by_signs != ISOLATION_NONE;
 #else
   if (by_signs >= 0) return by_signs != ISOLATION_NONE;
@@ -82,8 +94,8 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
 #endif
 #if ALGRAY_ESCALATE
   RayTerms terms = ray_terms(exps, coefs, count, fx, fy, fz);
-  if (by_signs >= 0 && (signs_clear_of(root, b, by_signs, scale, terms.value) ||
-                        signs_clear_of(root, b, by_signs, scale, ray_terms_exact(&terms))))
+  if (by_signs >= 0 && (signs_clear_of(root, by_signs, scale, terms.value) ||
+                        signs_clear_of(root, by_signs, scale, ray_terms_exact(&terms))))
     return by_signs != ISOLATION_NONE;
 #else
   (void)exps;
