@@ -16,8 +16,12 @@ ALGRAY_INLINE void ff_combine(REAL a, REAL a_lo, REAL x1, REAL x1_lo, REAL b, RE
                               REAL* lo) {
   const REAL p = x1 * a, q = x * b;
   const REAL s = p + q, bb = s - p;
-  const REAL e =
-      (p - (s - bb)) + (q - bb) + fma(x1, a, -p) + fma(x, b, -q) + x1 * a_lo + x * b_lo + x1_lo * a + x_lo * b;
+  /* The rounding errors and the low parts' products summed apart from the two-sum's chain, then added to it
+   * once: each row of de Casteljau's triangle waits on the one before, so the chain's latency sets the pace.
+   * Summed left to right in one chain, the Endrass octic's mixed render (512x384, with shadows) took 10% longer;
+   * the images came out bit-identical. */
+  const REAL lows = (fma(x1, a, -p) + fma(x, b, -q)) + ((x1 * a_lo + x * b_lo) + (x1_lo * a + x_lo * b));
+  const REAL e = ((p - (s - bb)) + (q - bb)) + lows;
   *hi = s + e;
   *lo = e - (*hi - s);
 }
