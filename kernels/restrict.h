@@ -277,13 +277,12 @@ ALGRAY_INLINE Acc acc_sum(Acc x, Acc y) {
   r.lo = e - (r.hi - s);
   return r;
 }
-/* x * f for a float vector f, the product's rounding error recovered by fma. */
+/* x * f for a float vector f, the product's rounding error recovered by fma. Not renormalised: its only use is
+ * a term of acc_sum, which renormalises the sum, and |lo| stays within an ulp or so of hi. */
 ALGRAY_INLINE Acc acc_scale(Acc x, PolyVec f) {
-  const PolyVec p = x.hi * f;
-  const PolyVec e = fma(x.hi, f, -p) + x.lo * f;
   Acc r;
-  r.hi = p + e;
-  r.lo = e - (r.hi - p);
+  r.hi = x.hi * f;
+  r.lo = fma(x.hi, f, -r.hi) + x.lo * f;
   return r;
 }
 ALGRAY_INLINE Acc acc_shifted(Acc x) {
