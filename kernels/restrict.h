@@ -130,27 +130,36 @@ ALGRAY_INLINE void axis_powers(REAL3 q, REAL* px, REAL* py, REAL* pz) {
   }
 }
 
-/* sum_m |a_m| q.x^i q.y^j q.z^k over the monomials. Four partial sums: one would be a chain of dependent additions,
+/* sum_m |a_m| x^i y^j z^k over the monomials. Four partial sums: one would be a chain of dependent additions,
  * each waiting for the last (measured on the Barth decic's adaptive render: 1.5% of its kernel time less). Power
- * tables measured faster than a nested Horner scheme in scalars (like restrict_to_rays'). */
-REAL terms_at(const RayTerms* t, REAL3 q) {
-  REAL px[NCOEF], py[NCOEF], pz[NCOEF];
-  axis_powers(q, px, py, pz);
-  REAL sum[4] = {0, 0, 0, 0};
-  uint m = 0;
-#define ALGRAY_TERM(m)                                                                          \
-  (fabs(t->coefs[m]) * px[t->exps[m] & 0xffu] * py[(t->exps[m] >> 8) & 0xffu] * \
-   pz[(t->exps[m] >> 16) & 0xffu])
-  for (; m + 4 <= t->count; m += 4) {
-    sum[0] += ALGRAY_TERM(m);
-    sum[1] += ALGRAY_TERM(m + 1);
-    sum[2] += ALGRAY_TERM(m + 2);
-    sum[3] += ALGRAY_TERM(m + 3);
+ * tables measured faster than a nested Horner scheme in scalars (like restrict_to_rays'). Defined for REALs and
+ * for lanes of them (surface.h), each lane with the operations a REAL would get. */
+#define DEFINE_TERMS_SUM(name, T)                                                                               \
+  T name(__global const uint* exps, __global const REAL* coefs, uint count, T x, T y, T z) {                    \
+    T px[NCOEF], py[NCOEF], pz[NCOEF];                                                                          \
+    px[0] = py[0] = pz[0] = (T)1;                                                                               \
+    ALGRAY_UNROLL                                                                                               \
+    for (int n = 1; n <= DEGREE; ++n) {                                                                         \
+      px[n] = px[n - 1] * x;                                                                                    \
+      py[n] = py[n - 1] * y;                                                                                    \
+      pz[n] = pz[n - 1] * z;                                                                                    \
+    }                                                                                                           \
+    T sum[4] = {(T)0, (T)0, (T)0, (T)0};                                                                        \
+    uint m = 0;                                                                                                 \
+    for (; m + 4 <= count; m += 4) {                                                                            \
+      sum[0] += TERMS_SUM_TERM(m);                                                                              \
+      sum[1] += TERMS_SUM_TERM(m + 1);                                                                          \
+      sum[2] += TERMS_SUM_TERM(m + 2);                                                                          \
+      sum[3] += TERMS_SUM_TERM(m + 3);                                                                          \
+    }                                                                                                           \
+    for (; m < count; ++m) sum[0] += TERMS_SUM_TERM(m);                                                         \
+    return (sum[0] + sum[1]) + (sum[2] + sum[3]);                                                               \
   }
-  for (; m < t->count; ++m) sum[0] += ALGRAY_TERM(m);
-#undef ALGRAY_TERM
-  return (sum[0] + sum[1]) + (sum[2] + sum[3]);
-}
+#define TERMS_SUM_TERM(m) \
+  (fabs(coefs[m]) * px[exps[m] & 0xffu] * py[(exps[m] >> 8) & 0xffu] * pz[(exps[m] >> 16) & 0xffu])
+DEFINE_TERMS_SUM(terms_sum, REAL)
+
+REAL terms_at(const RayTerms* t, REAL3 q) { return terms_sum(t->exps, t->coefs, t->count, q.x, q.y, q.z); }
 
 /* The ray's terms summed (terms_at its largest coordinates), computed once. */
 REAL ray_terms_exact(RayTerms* t) {

@@ -339,6 +339,12 @@ int isolate_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int e
 }
 
 #if LANES > 1
+#if ALGRAY_ESCALATE && !ALGRAY_COMPENSATED
+/* terms_sum over lanes (restrict.h): every lane's ray terms summed at once, each the value ray_terms_exact would
+ * give it. Summed one lane at a time, they were a tenth of the Endrass octic's adaptive camera pass. */
+DEFINE_TERMS_SUM(terms_sum_lanes, LREAL)
+#endif
+
 /* The isolations of LANES rays from their segment_coefficients (root, root_lo are consumed): together in lanes
  * (isolate_bernstein_lanes), or one lane at a time in mixed precision. c gets each lane's polynomial on its
  * isolating interval, for refine_lanes. Lanes from `count` on, and those whose ray missed the extent
@@ -358,6 +364,10 @@ void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (
   LREAL lane_root[NCOEF], lane_t_in = 0, lane_t_out = 1, lane_terms = 0;
   for (int k = 0; k <= DEGREE; ++k) lane_root[k] = 0;
   LMASK running = 0;
+#if ALGRAY_ESCALATE
+  LREAL x = 0, y = 0, z = 0; /* each ray's largest coordinates, where its terms are summed */
+  uint first = LANES; /* the first ray in the extent: its terms name the monomials */
+#endif
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j]) continue;
     lane_set_mask(&running, j, 1);
@@ -365,9 +375,24 @@ void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (
     lane_set(&lane_t_in, j, t_in[j]);
     lane_set(&lane_t_out, j, t_out[j]);
 #if ALGRAY_ESCALATE
-    lane_set(&lane_terms, j, ray_terms_exact(&terms[j]));
+    if (first == LANES) first = j;
+    lane_set(&x, j, terms[j].x);
+    lane_set(&y, j, terms[j].y);
+    lane_set(&z, j, terms[j].z);
 #endif
   }
+#if ALGRAY_ESCALATE
+  if (LANE_ANY(running)) {
+    lane_terms = terms_sum_lanes(terms[first].exps, terms[first].coefs, terms[first].count, x, y, z);
+    REAL terms_of[LANES];
+    LANES_STORE(lane_terms, terms_of);
+    for (uint j = 0; j < count; ++j) {
+      if (!in_extent[j]) continue;
+      terms[j].value = terms_of[j];
+      terms[j].exact = 1;
+    }
+  }
+#endif
   (void)lane_terms;
   if (LANE_ANY(running))
     isolate_bernstein_lanes(count, running, lane_root, lane_t_in, lane_t_out, iso, c TERMS_OUT(lane_terms));
