@@ -547,6 +547,52 @@ void hit_records_lanes(uint count, const Ray* rays, const SurfaceHit* hits, __gl
 }
 #endif
 
+#if LANES > 1 && RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && DEGREE <= 15
+#define SCREEN_LANES 1
+/* The screen form's coefficients for a group of lanes at once: screen_ray_taylor, restrict_from_taylor and
+ * bernstein_from_scaled over lanes, each lane with the operations of the vector Horner steps that those run one
+ * ray at a time (restrict.h), so every lane's coefficients are the one-ray kernel's bit for bit (tests/test_lanes).
+ * One ray's steps are chains of dependent vector operations; over lanes the D + 1 coefficients' chains run side
+ * by side. row: the image row's polynomials (screen_rows); xi: each lane's column; tau_in, tau_out: each lane's
+ * segment about the row's t0. */
+void screen_coefficients_lanes(__global const REAL* row, LREAL xi, LREAL tau_in, LREAL tau_out,
+                               __constant const REAL* binomials, LREAL* out) {
+  LREAL taylor[NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) taylor[k] = (LREAL)row[DEGREE * NCOEF + k];
+  ALGRAY_UNROLL
+  for (int j = DEGREE - 1; j >= 0; --j) ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) taylor[k] = taylor[k] * xi + row[j * NCOEF + k];
+#if RESTRICT_BERNSTEIN
+  const LREAL l0 = tau_in, l1 = tau_out;
+#else
+  const LREAL l0 = tau_in, l1 = tau_out - tau_in;
+#endif
+  LREAL c[NCOEF];
+  c[0] = taylor[DEGREE];
+  ALGRAY_UNROLL
+  for (int k = 1; k <= DEGREE; ++k) c[k] = 0;
+  ALGRAY_UNROLL
+  for (int n = DEGREE - 1; n >= 0; --n) {
+    /* acc_mul_linear: l0 c + l1 (c shifted up one, a zero below) */
+    ALGRAY_UNROLL
+    for (int k = DEGREE; k > 0; --k) c[k] = l0 * c[k] + l1 * c[k - 1];
+    c[0] = l0 * c[0] + l1 * (LREAL)0;
+    /* acc_add_constant */
+#if RESTRICT_BERNSTEIN
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) c[k] += taylor[n] * binomials[(DEGREE - n) * NCOEF + k];
+#else
+    c[0] += taylor[n];
+#endif
+  }
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) out[k] = c[k] / binomials[DEGREE * NCOEF + k]; /* bernstein_from_scaled */
+}
+#else
+#define SCREEN_LANES 0
+#endif
+
 #if LANES > 1
 /* trace_surface and hit_record for rays[0 .. count), count <= LANES: each ray is clipped and restricted on its
  * own, then all are isolated, refined and their normals taken together in vector lanes (lanes.h), with the
@@ -564,6 +610,33 @@ void trace_lanes(uint count, const Ray* rays, REAL3 centre, REAL inv_scale, REAL
 #if ALGRAY_ESCALATE
   RayTerms terms[LANES];
 #endif
+#if SCREEN_LANES
+  (void)root;
+  (void)root_lo;
+  LREAL xi = 0, tau_in = 0, tau_out = 1, lane_t_in = 0, lane_t_out = 1, lane_root[NCOEF];
+  LMASK running = 0;
+  for (uint j = 0; j < count; ++j) {
+    in_extent[j] = enter_surface(rays[j], centre, inv_scale, box_half, extent_kind, &hits[j], &t_in[j], &t_out[j]);
+    if (!in_extent[j]) continue;
+    lane_set_mask(&running, j, 1);
+    /* screen_ray_taylor's column and segment_coefficients' segment about t0 */
+    lane_set(&xi, j, ((REAL)(px0 + j) + (REAL)0.5) * xi_scale + xi_offset);
+    lane_set(&tau_in, j, t_in[j] - screen_t);
+    lane_set(&tau_out, j, t_out[j] - screen_t);
+    lane_set(&lane_t_in, j, t_in[j]);
+    lane_set(&lane_t_out, j, t_out[j]);
+  }
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) iso_c[k] = 0;
+  if (LANE_ANY(running)) {
+    screen_coefficients_lanes(screen_rows + (size_t)(py - screen_row0) * (NCOEF * NCOEF), xi, tau_in, tau_out,
+                              binomials, lane_root);
+    /* lanes outside the extent start from zeros, as isolate_lanes gives them */
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) lane_root[k] = LANE_SEL((LREAL)0, lane_root[k], running);
+    isolate_bernstein_lanes(count, running, lane_root, lane_t_in, lane_t_out, iso, iso_c);
+  }
+#else
   for (uint j = 0; j < count; ++j) {
     in_extent[j] = enter_surface(rays[j], centre, inv_scale, box_half, extent_kind, &hits[j], &t_in[j], &t_out[j]);
     if (!in_extent[j]) continue;
@@ -575,6 +648,7 @@ void trace_lanes(uint count, const Ray* rays, REAL3 centre, REAL inv_scale, REAL
                          root[j], root_lo[j] TERMS_OUT(&terms[j]) SCREEN_ARG);
   }
   isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, iso, iso_c TERMS_OUT(terms));
+#endif
   refine_lanes(count, in_extent, iso, iso_c, t_in, t_out, binomials, roots);
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j]) continue;
