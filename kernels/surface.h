@@ -37,11 +37,20 @@
 #define SCREEN_LANES_PARAM , uint px0, uint py SCREEN_ROWS_PARAM
 #define SCREEN_LANES_ARG(px0, py) , px0, py, SCREEN_ROWS_ARG
 
+/* Pixel column px's xi, where its row's polynomials are evaluated. */
+ALGRAY_INLINE REAL screen_column(uint px, REAL xi_scale, REAL xi_offset) {
+  return ((REAL)px + (REAL)0.5) * xi_scale + xi_offset;
+}
+
+/* Image row py's polynomials in xi (screen_taylor's row). */
+ALGRAY_INLINE __global const REAL* screen_row(__global const REAL* rows, uint py, uint row0) {
+  return rows + (size_t)(py - row0) * (NCOEF * NCOEF);
+}
+
 /* Pixel (px, py)'s Taylor coefficients; returns the t they are expanded about. */
 REAL screen_ray_taylor(uint px, uint py, __global const REAL* rows, uint row0, REAL t0, REAL xi_scale, REAL xi_offset,
                        REAL* taylor) {
-  const REAL xi = ((REAL)px + (REAL)0.5) * xi_scale + xi_offset;
-  screen_taylor(rows + (size_t)(py - row0) * (NCOEF * NCOEF), xi, taylor);
+  screen_taylor(screen_row(rows, py, row0), screen_column(px, xi_scale, xi_offset), taylor);
   return t0;
 }
 #else
@@ -606,13 +615,7 @@ void trace_lanes(uint count, const Ray* rays, REAL3 centre, REAL inv_scale, REAL
   REAL t_in[LANES], t_out[LANES];
   LREAL iso_c[NCOEF];
   int in_extent[LANES];
-  REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
-#if ALGRAY_ESCALATE
-  RayTerms terms[LANES];
-#endif
 #if SCREEN_LANES
-  (void)root;
-  (void)root_lo;
   LREAL xi = 0, tau_in = 0, tau_out = 1, lane_t_in = 0, lane_t_out = 1, lane_root[NCOEF];
   LMASK running = 0;
   for (uint j = 0; j < count; ++j) {
@@ -620,7 +623,7 @@ void trace_lanes(uint count, const Ray* rays, REAL3 centre, REAL inv_scale, REAL
     if (!in_extent[j]) continue;
     lane_set_mask(&running, j, 1);
     /* screen_ray_taylor's column and segment_coefficients' segment about t0 */
-    lane_set(&xi, j, ((REAL)(px0 + j) + (REAL)0.5) * xi_scale + xi_offset);
+    lane_set(&xi, j, screen_column(px0 + j, xi_scale, xi_offset));
     lane_set(&tau_in, j, t_in[j] - screen_t);
     lane_set(&tau_out, j, t_out[j] - screen_t);
     lane_set(&lane_t_in, j, t_in[j]);
@@ -629,14 +632,17 @@ void trace_lanes(uint count, const Ray* rays, REAL3 centre, REAL inv_scale, REAL
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) iso_c[k] = 0;
   if (LANE_ANY(running)) {
-    screen_coefficients_lanes(screen_rows + (size_t)(py - screen_row0) * (NCOEF * NCOEF), xi, tau_in, tau_out,
-                              binomials, lane_root);
+    screen_coefficients_lanes(screen_row(screen_rows, py, screen_row0), xi, tau_in, tau_out, binomials, lane_root);
     /* lanes outside the extent start from zeros, as isolate_lanes gives them */
     ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE; ++k) lane_root[k] = LANE_SEL((LREAL)0, lane_root[k], running);
     isolate_bernstein_lanes(count, running, lane_root, lane_t_in, lane_t_out, iso, iso_c);
   }
 #else
+  REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
+#if ALGRAY_ESCALATE
+  RayTerms terms[LANES];
+#endif
   for (uint j = 0; j < count; ++j) {
     in_extent[j] = enter_surface(rays[j], centre, inv_scale, box_half, extent_kind, &hits[j], &t_in[j], &t_out[j]);
     if (!in_extent[j]) continue;
