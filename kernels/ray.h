@@ -3,6 +3,7 @@
 #define ALGRAY_RAY_H
 
 #include "algray_shared.h"
+#include "lanes.h"
 #include "real.h"
 
 /* Pixel (px, py), py = 0 the top row, gets the ray o + t*d with
@@ -14,49 +15,96 @@ typedef struct {
   REAL3 d;
 } Ray;
 
+/* One axis (or all three, for REAL3) of the formula above: base + f_x * along_x + f_y * along_y, summed in that
+ * order; f_x, f_y are the pixel's centre, (REAL)px + 0.5 and (REAL)py + 0.5. */
+#define CAMERA_AXIS(f_x, f_y, base, along_x, along_y) (((base) + (f_x) * (along_x)) + (f_y) * (along_y))
+
 Ray camera_ray(uint px, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4 du, REAL4 dv) {
   /* No fused multiply-adds: the file's header must let anyone rebuild this ray bit for bit. */
 #pragma OPENCL FP_CONTRACT OFF
   const REAL fx = (REAL)px + (REAL)0.5;
   const REAL fy = (REAL)py + (REAL)0.5;
   Ray r;
-  const REAL3 ox = fx * ou.xyz;
-  const REAL3 oy = fy * ov.xyz;
-  r.o = (o00.xyz + ox) + oy;
-  const REAL3 dx = fx * du.xyz;
-  const REAL3 dy = fy * dv.xyz;
-  r.d = (d00.xyz + dx) + dy;
+  r.o = CAMERA_AXIS(fx, fy, o00.xyz, ou.xyz, ov.xyz);
+  r.d = CAMERA_AXIS(fx, fy, d00.xyz, du.xyz, dv.xyz);
   return r;
 }
 
-/* [t_in, t_out] of the ray inside the extent, given in unit coordinates u = (p - centre)/scale,
- * where the sphere is the unit sphere and the box is |u_i| <= half_i. Returns 0 when it misses. */
-int clip_to_extent(REAL3 o, REAL3 d, int kind, REAL3 box_half, REAL* t_in, REAL* t_out) {
-  REAL lo = 0, hi;
-  if (kind == ALGRAY_EXTENT_SPHERE) {
-    const REAL a = dot(d, d);
-    const REAL b = dot(o, d);
-    const REAL c = dot(o, o) - (REAL)1;
-    const REAL disc = b * b - a * c;
-    if (disc <= 0 || a <= 0) return 0;
-    /* The product form avoids cancellation when one intersection is near the origin. */
-    const REAL q = -(b + copysign(sqrt(disc), b));
-    REAL t0 = q / a, t1 = c / q;
-    if (t0 > t1) { const REAL s = t0; t0 = t1; t1 = s; }
-    lo = fmax(t0, (REAL)0);
-    hi = t1;
-  } else {
-    hi = REAL_MAX;
-    const REAL3 inv = (REAL)1 / d;  /* +-inf for axis-parallel rays, which the min/max below handle */
-    const REAL3 ta = (-box_half - o) * inv;
-    const REAL3 tb = (box_half - o) * inv;
-    const REAL3 tmin = fmin(ta, tb), tmax = fmax(ta, tb);
-    lo = fmax(fmax(lo, tmin.x), fmax(tmin.y, tmin.z));
-    hi = fmin(fmin(hi, tmax.x), fmin(tmax.y, tmax.z));
+/* [t_in, t_out] of rays o + t*d inside the extent, given in unit coordinates u = (p - centre)/scale, where the
+ * sphere is the unit sphere and the box is |u_i| <= half_i; returns where they enter it. Written once over a real
+ * type T and its comparisons' type M (REAL and int, or LREAL and LMASK of lanes.h), so that every lane of the
+ * vector instance is the scalar one's result bit for bit. A ray that misses leaves t_in, t_out undefined. */
+#define DEFINE_CLIP_TO_EXTENT(name, T, M)                                                                            \
+  M name(T ox, T oy, T oz, T dx, T dy, T dz, int kind, REAL3 box_half, T* t_in, T* t_out) {                          \
+    T lo = 0, hi;                                                                                                    \
+    M hit;                                                                                                           \
+    if (kind == ALGRAY_EXTENT_SPHERE) {                                                                              \
+      T a, b, c;                                                                                                     \
+      {                                                                                                              \
+        /* as dot() sums them: three products, added left to right */                                               \
+        _Pragma("OPENCL FP_CONTRACT OFF") a = (dx * dx + dy * dy) + dz * dz;                                         \
+        b = (ox * dx + oy * dy) + oz * dz;                                                                           \
+        c = ((ox * ox + oy * oy) + oz * oz) - (REAL)1;                                                               \
+      }                                                                                                              \
+      const T disc = b * b - a * c;                                                                                  \
+      hit = disc > 0 && a > 0;                                                                                       \
+      /* The product form avoids cancellation when one intersection is near the origin. */                          \
+      const T q = -(b + copysign(sqrt(disc), b));                                                                    \
+      const T t0 = q / a, t1 = c / q;                                                                                \
+      lo = fmax(fmin(t0, t1), (T)0);                                                                                 \
+      hi = fmax(t0, t1);                                                                                             \
+    } else {                                                                                                         \
+      hi = REAL_MAX;                                                                                                 \
+      /* +-inf for axis-parallel rays, which the min/max below handle */                                            \
+      const T ix = (REAL)1 / dx, iy = (REAL)1 / dy, iz = (REAL)1 / dz;                                               \
+      const T ax = (-box_half.x - ox) * ix, bx = (box_half.x - ox) * ix;                                             \
+      const T ay = (-box_half.y - oy) * iy, by = (box_half.y - oy) * iy;                                             \
+      const T az = (-box_half.z - oz) * iz, bz = (box_half.z - oz) * iz;                                             \
+      lo = fmax(fmax(lo, fmin(ax, bx)), fmax(fmin(ay, by), fmin(az, bz)));                                           \
+      hi = fmin(fmin(hi, fmax(ax, bx)), fmin(fmax(ay, by), fmax(az, bz)));                                           \
+      hit = hi > lo;                                                                                                 \
+    }                                                                                                                \
+    *t_in = lo;                                                                                                      \
+    *t_out = hi;                                                                                                     \
+    return hit && hi > lo;                                                                                           \
   }
-  *t_in = lo;
-  *t_out = hi;
-  return hi > lo;
+
+DEFINE_CLIP_TO_EXTENT(clip_axes_to_extent, REAL, int)
+
+int clip_to_extent(REAL3 o, REAL3 d, int kind, REAL3 box_half, REAL* t_in, REAL* t_out) {
+  return clip_axes_to_extent(o.x, o.y, o.z, d.x, d.y, d.z, kind, box_half, t_in, t_out);
 }
+
+#if LANES > 1
+/* LANES rays side by side, one coordinate per vector (lanes.h). */
+typedef struct {
+  LREAL ox, oy, oz, dx, dy, dz;
+} LaneRays;
+
+DEFINE_CLIP_TO_EXTENT(clip_lanes_to_extent, LREAL, LMASK)
+
+/* The pixel centres (REAL)px + 0.5 of columns px0 .. px0 + LANES - 1, each as camera_ray computes it: px0 + j is
+ * exact in REAL for any image width a float can index. */
+LREAL lane_pixel_centres(uint px0) {
+#define LANE_INDEX(j) ((REAL)(j))
+  return ((LREAL)((REAL)px0) + LANES_OF(LREAL, LANE_INDEX)) + (REAL)0.5;
+#undef LANE_INDEX
+}
+
+/* camera_ray for pixels px0 .. px0 + LANES - 1 of row py: each lane that ray bit for bit. */
+LaneRays camera_rays_lanes(uint px0, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4 du, REAL4 dv) {
+#pragma OPENCL FP_CONTRACT OFF
+  const LREAL fx = lane_pixel_centres(px0);
+  const REAL fy = (REAL)py + (REAL)0.5;
+  LaneRays r;
+  r.ox = CAMERA_AXIS(fx, fy, o00.x, ou.x, ov.x);
+  r.oy = CAMERA_AXIS(fx, fy, o00.y, ou.y, ov.y);
+  r.oz = CAMERA_AXIS(fx, fy, o00.z, ou.z, ov.z);
+  r.dx = CAMERA_AXIS(fx, fy, d00.x, du.x, dv.x);
+  r.dy = CAMERA_AXIS(fx, fy, d00.y, du.y, dv.y);
+  r.dz = CAMERA_AXIS(fx, fy, d00.z, du.z, dv.z);
+  return r;
+}
+#endif
 
 #endif /* ALGRAY_RAY_H */

@@ -37,9 +37,12 @@
 #define SCREEN_LANES_PARAM , uint px0, uint py SCREEN_ROWS_PARAM
 #define SCREEN_LANES_ARG(px0, py) , px0, py, SCREEN_ROWS_ARG
 
-/* Pixel column px's xi, where its row's polynomials are evaluated. */
+/* The xi of a pixel column whose centre is `centre` ((REAL)px + 0.5, as camera_ray's), where its row's polynomials
+ * are evaluated; of one column or of lanes (lane_pixel_centres). */
+#define SCREEN_COLUMN(centre, xi_scale, xi_offset) ((centre) * (xi_scale) + (xi_offset))
+
 ALGRAY_INLINE REAL screen_column(uint px, REAL xi_scale, REAL xi_offset) {
-  return ((REAL)px + (REAL)0.5) * xi_scale + xi_offset;
+  return SCREEN_COLUMN((REAL)px + (REAL)0.5, xi_scale, xi_offset);
 }
 
 /* Image row py's polynomials in xi (screen_taylor's row). */
@@ -336,6 +339,50 @@ int enter_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int ext
   return 1;
 }
 
+#if LANES > 1
+/* enter_surface for LANES rays at once: unit gets each lane's ray in unit coordinates, hits[j] and t_in[j], t_out[j]
+ * what enter_surface gives ray j, bit for bit, and in_extent[j] its result (0 from `count` on). Returns the lanes
+ * that enter the extent; their segments are also left in *lane_t_in, *lane_t_out (0 and 1 elsewhere). */
+LMASK enter_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
+                  LaneRays* unit, LREAL* lane_t_in, LREAL* lane_t_out, SurfaceHit* hits, REAL* t_in, REAL* t_out,
+                  int* in_extent) {
+  unit->ox = (rays->ox - centre.x) * inv_scale;
+  unit->oy = (rays->oy - centre.y) * inv_scale;
+  unit->oz = (rays->oz - centre.z) * inv_scale;
+  unit->dx = rays->dx * inv_scale;
+  unit->dy = rays->dy * inv_scale;
+  unit->dz = rays->dz * inv_scale;
+  LREAL lo, hi;
+  const LMASK inside = lanes_of_bits((1u << count) - 1u) &&
+                       clip_lanes_to_extent(unit->ox, unit->oy, unit->oz, unit->dx, unit->dy, unit->dz, extent_kind,
+                                            box_half, &lo, &hi);
+  *lane_t_in = LANE_SEL((LREAL)0, lo, inside);
+  *lane_t_out = LANE_SEL((LREAL)1, hi, inside);
+  REAL ox[LANES], oy[LANES], oz[LANES], dx[LANES], dy[LANES], dz[LANES];
+  LANES_STORE(unit->ox, ox);
+  LANES_STORE(unit->oy, oy);
+  LANES_STORE(unit->oz, oz);
+  LANES_STORE(unit->dx, dx);
+  LANES_STORE(unit->dy, dy);
+  LANES_STORE(unit->dz, dz);
+  LANES_STORE(*lane_t_in, t_in);
+  LANES_STORE(*lane_t_out, t_out);
+  const uint inside_bits = lane_mask_bits(inside);
+  for (uint j = 0; j < count; ++j) {
+    SurfaceHit* h = &hits[j];
+    in_extent[j] = (inside_bits >> j) & 1u;
+    h->root.t = INFINITY;
+    h->root.f_before = 0;
+    h->root.flags = in_extent[j] ? ALGRAY_HIT_IN_EXTENT : 0u;
+    h->root.steps = 0;
+    h->root.iterations = 0;
+    h->u = (REAL3)(ox[j], oy[j], oz[j]);
+    h->d_unit = (REAL3)(dx[j], dy[j], dz[j]);
+  }
+  return inside;
+}
+#endif
+
 /* The part of trace_surface before the refinement: enter_surface, then the isolation of P*(t)'s smallest root
  * on the segment (iso_c: the polynomial on the isolating interval). Returns 0 when the ray misses the extent. */
 int isolate_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, __global const uint* exps,
@@ -495,8 +542,8 @@ void surface_gradient_lanes(LREAL x, LREAL y, LREAL z, __global const uint* exps
   *gz = sz;
 }
 
-/* The hit record of a traced ray, given grad P at its hit (unused when it has none). */
-HitRecord hit_record_with_gradient(Ray ray, SurfaceHit h, REAL3 g) {
+/* The hit record of a traced ray of direction ray_d, given grad P at its hit (unused when it has none). */
+HitRecord hit_record_with_gradient(REAL3 ray_d, SurfaceHit h, REAL3 g) {
   HitRecord r;
   r.flags = h.root.flags;
   r.work = ALGRAY_WORK_PACK(min(h.root.steps, ALGRAY_WORK_MAX), min(h.root.iterations, ALGRAY_WORK_MAX));
@@ -508,11 +555,11 @@ HitRecord hit_record_with_gradient(Ray ray, SurfaceHit h, REAL3 g) {
 
   r.t_hi = (float)h.root.t;
   r.t_lo = (float)(h.root.t - (REAL)r.t_hi);
-  r.depth = (float)(h.root.t * length(ray.d));
+  r.depth = (float)(h.root.t * length(ray_d));
   /* Unit coordinates differ from world ones by a translation and a uniform scale: same normal direction. */
   const REAL glen = length(g);
-  REAL3 n = (glen > 0 && isfinite(glen)) ? g / glen : -normalize(ray.d);
-  if (dot(n, ray.d) > 0) n = -n;
+  REAL3 n = (glen > 0 && isfinite(glen)) ? g / glen : -normalize(ray_d);
+  if (dot(n, ray_d) > 0) n = -n;
   r.normal_x = (float)n.x;
   r.normal_y = (float)n.y;
   r.normal_z = (float)n.z;
@@ -526,11 +573,11 @@ HitRecord hit_record_with_gradient(Ray ray, SurfaceHit h, REAL3 g) {
 HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global const REAL* coefs, uint count) {
   REAL gx = 0, gy = 0, gz = 0;
   if (h.root.flags & ALGRAY_HIT_FOUND) surface_gradient_lanes(h.u.x, h.u.y, h.u.z, exps, coefs, count, &gx, &gy, &gz);
-  return hit_record_with_gradient(ray, h, (REAL3)(gx, gy, gz));
+  return hit_record_with_gradient(ray.d, h, (REAL3)(gx, gy, gz));
 }
 #else
 /* The hit records of LANES rays, their gradients taken together in lanes. */
-void hit_records_lanes(uint count, const Ray* rays, const SurfaceHit* hits, __global const uint* exps,
+void hit_records_lanes(uint count, const LaneRays* rays, const SurfaceHit* hits, __global const uint* exps,
                        __global const REAL* coefs, uint mono_count, HitRecord* out) {
   LREAL x = 0, y = 0, z = 0, gx, gy, gz;
   int any_hit = 0;
@@ -541,17 +588,20 @@ void hit_records_lanes(uint count, const Ray* rays, const SurfaceHit* hits, __gl
       lane_set(&z, j, hits[j].u.z);
       any_hit = 1;
     }
-  REAL gx_of[LANES], gy_of[LANES], gz_of[LANES];
+  REAL gx_of[LANES], gy_of[LANES], gz_of[LANES], dx_of[LANES], dy_of[LANES], dz_of[LANES];
   if (any_hit) {
     surface_gradient_lanes(x, y, z, exps, coefs, mono_count, &gx, &gy, &gz);
     LANES_STORE(gx, gx_of);
     LANES_STORE(gy, gy_of);
     LANES_STORE(gz, gz_of);
   }
+  LANES_STORE(rays->dx, dx_of);
+  LANES_STORE(rays->dy, dy_of);
+  LANES_STORE(rays->dz, dz_of);
   for (uint j = 0; j < count; ++j) {
     REAL3 g = (REAL3)(0, 0, 0);
     if (hits[j].root.flags & ALGRAY_HIT_FOUND) g = (REAL3)(gx_of[j], gy_of[j], gz_of[j]);
-    out[j] = hit_record_with_gradient(rays[j], hits[j], g);
+    out[j] = hit_record_with_gradient((REAL3)(dx_of[j], dy_of[j], dz_of[j]), hits[j], g);
   }
 }
 #endif
@@ -603,48 +653,45 @@ void screen_coefficients_lanes(__global const REAL* row, LREAL xi, LREAL tau_in,
 #endif
 
 #if LANES > 1
-/* trace_surface and hit_record for rays[0 .. count), count <= LANES: each ray is clipped and restricted on its
- * own, then all are isolated, refined and their normals taken together in vector lanes (lanes.h), with the
- * one-ray kernel's records bit for bit (tests/test_lanes). Camera and secondary rays share it. */
-void trace_lanes(uint count, const Ray* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
+/* trace_surface and hit_record for the first `count` (<= LANES) of the lanes' rays: they are clipped together, each
+ * is restricted on its own (the screen form: together), then all are isolated, refined and their normals taken
+ * together in vector lanes (lanes.h), with the one-ray kernel's records bit for bit (tests/test_lanes). Camera
+ * and secondary rays share it. */
+void trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                  __global const uint* exps, __global const REAL* coefs, uint mono_count,
                  __constant const REAL* binomials, uint even_axes, HitRecord* records SCREEN_LANES_PARAM) {
   SurfaceHit hits[LANES];
   Isolation iso[LANES];
   SegmentRoot roots[LANES];
   REAL t_in[LANES], t_out[LANES];
-  LREAL iso_c[NCOEF];
+  LREAL iso_c[NCOEF], lane_t_in, lane_t_out;
   int in_extent[LANES];
+  LaneRays unit;
+  const LMASK running = enter_lanes(count, rays, centre, inv_scale, box_half, extent_kind, &unit, &lane_t_in,
+                                    &lane_t_out, hits, t_in, t_out, in_extent);
 #if SCREEN_LANES
-  LREAL xi = 0, tau_in = 0, tau_out = 1, lane_t_in = 0, lane_t_out = 1, lane_root[NCOEF];
-  LMASK running = 0;
-  for (uint j = 0; j < count; ++j) {
-    in_extent[j] = enter_surface(rays[j], centre, inv_scale, box_half, extent_kind, &hits[j], &t_in[j], &t_out[j]);
-    if (!in_extent[j]) continue;
-    lane_set_mask(&running, j, 1);
-    /* screen_ray_taylor's column and segment_coefficients' segment about t0 */
-    lane_set(&xi, j, screen_column(px0 + j, xi_scale, xi_offset));
-    lane_set(&tau_in, j, t_in[j] - screen_t);
-    lane_set(&tau_out, j, t_out[j] - screen_t);
-    lane_set(&lane_t_in, j, t_in[j]);
-    lane_set(&lane_t_out, j, t_out[j]);
-  }
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) iso_c[k] = 0;
   if (LANE_ANY(running)) {
-    screen_coefficients_lanes(screen_row(screen_rows, py, screen_row0), xi, tau_in, tau_out, binomials, lane_root);
+    /* screen_ray_taylor's column and segment_coefficients' segment about t0 */
+    const LREAL xi = LANE_SEL((LREAL)0, SCREEN_COLUMN(lane_pixel_centres(px0), xi_scale, xi_offset), running);
+    LREAL lane_root[NCOEF];
+    screen_coefficients_lanes(screen_row(screen_rows, py, screen_row0), xi,
+                              LANE_SEL((LREAL)0, lane_t_in - screen_t, running),
+                              LANE_SEL((LREAL)1, lane_t_out - screen_t, running), binomials, lane_root);
     /* lanes outside the extent start from zeros, as isolate_lanes gives them */
     ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE; ++k) lane_root[k] = LANE_SEL((LREAL)0, lane_root[k], running);
     isolate_bernstein_lanes(count, running, lane_root, lane_t_in, lane_t_out, iso, iso_c);
   }
 #else
+  (void)running;
+  (void)unit;
   REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
 #if ALGRAY_ESCALATE
   RayTerms terms[LANES];
 #endif
   for (uint j = 0; j < count; ++j) {
-    in_extent[j] = enter_surface(rays[j], centre, inv_scale, box_half, extent_kind, &hits[j], &t_in[j], &t_out[j]);
     if (!in_extent[j]) continue;
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
     REAL taylor[NCOEF];

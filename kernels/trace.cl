@@ -31,13 +31,23 @@ __kernel void trace(__global const REAL4* origins, __global const REAL4* directi
   const uint first = get_global_id(0) * LANES;
   if (first >= count) return;
   const uint group = min((uint)LANES, count - first);
-  Ray rays[LANES];
-  for (uint j = 0; j < group; ++j) {
-    rays[j].o = origins[first + j].xyz;
-    rays[j].d = directions[first + j].xyz;
-  }
+  /* lanes from `group` on repeat the last ray; trace_lanes leaves them alone */
+#define RAY_AXIS(array, axis, j) array[first + min((uint)(j), group - 1)].axis
+#define ORIGIN_X(j) RAY_AXIS(origins, x, j)
+#define ORIGIN_Y(j) RAY_AXIS(origins, y, j)
+#define ORIGIN_Z(j) RAY_AXIS(origins, z, j)
+#define DIRECTION_X(j) RAY_AXIS(directions, x, j)
+#define DIRECTION_Y(j) RAY_AXIS(directions, y, j)
+#define DIRECTION_Z(j) RAY_AXIS(directions, z, j)
+  LaneRays rays;
+  rays.ox = LANES_OF(LREAL, ORIGIN_X);
+  rays.oy = LANES_OF(LREAL, ORIGIN_Y);
+  rays.oz = LANES_OF(LREAL, ORIGIN_Z);
+  rays.dx = LANES_OF(LREAL, DIRECTION_X);
+  rays.dy = LANES_OF(LREAL, DIRECTION_Y);
+  rays.dz = LANES_OF(LREAL, DIRECTION_Z);
   HitRecord records[LANES];
-  trace_lanes(group, rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind, mono_exps, mono_coefs,
+  trace_lanes(group, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind, mono_exps, mono_coefs,
               mono_count, binomials, even_axes, records);
   for (uint j = 0; j < group; ++j) out[first + j] = records[j];
 #endif
