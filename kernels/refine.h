@@ -60,7 +60,9 @@ LREAL refine_root_lanes(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL s
     const LREAL r = fb / fc, s = fb / fa, q = fa / fc;
     const LREAL num = s * (q * (q - r) * (cp - b) - (r - (REAL)1) * (b - a));
     const LREAL den = (q - (REAL)1) * (r - (REAL)1) * (s - (REAL)1);
-    const LREAL cand = LANE_SEL(LANE_SEL(b, b - fb * (b - a) / (fb - fa), secant), b - num / den, quadratic);
+    /* one division for either step: b - fb (b - a) / (fb - fa), or b - num / den */
+    const LREAL step_num = LANE_SEL(fb * (b - a), num, quadratic), step_den = LANE_SEL(fb - fa, den, quadratic);
+    const LREAL cand = LANE_SEL(b, b - step_num / step_den, quadratic || secant);
     /* The paper's acceptance rule: the step must stay well inside the bracket and shrink; also toward c. */
     const LREAL step = cand - b;
     const LMASK accept = (quadratic || secant) && isfinite(cand) && step * (cp - b) > 0 &&
