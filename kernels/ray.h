@@ -75,12 +75,12 @@ int clip_to_extent(REAL3 o, REAL3 d, int kind, REAL3 box_half, REAL* t_in, REAL*
   return clip_axes_to_extent(o.x, o.y, o.z, d.x, d.y, d.z, kind, box_half, t_in, t_out);
 }
 
-#if LANES > 1
-/* LANES rays side by side, one coordinate per vector (lanes.h). */
+/* LANES rays side by side, one coordinate per vector (lanes.h); with LANES = 1, one ray. */
 typedef struct {
   LREAL ox, oy, oz, dx, dy, dz;
 } LaneRays;
 
+#if LANES > 1
 DEFINE_CLIP_TO_EXTENT(clip_lanes_to_extent, LREAL, LMASK)
 
 /* The pixel centres (REAL)px + 0.5 of columns px0 .. px0 + LANES - 1, each as camera_ray computes it: px0 + j is

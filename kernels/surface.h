@@ -341,7 +341,8 @@ int enter_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int ext
 
 #if LANES > 1
 /* enter_surface for LANES rays at once: unit gets each lane's ray in unit coordinates, hits[j] and t_in[j], t_out[j]
- * what enter_surface gives ray j, bit for bit, and in_extent[j] its result (0 from `count` on). Returns the lanes
+ * what enter_surface gives ray j, bit for bit, and in_extent[j] its result (0 from `count` on, where the hits
+ * are those of missed rays). Returns the lanes
  * that enter the extent; their segments are also left in *lane_t_in, *lane_t_out (0 and 1 elsewhere). */
 LMASK enter_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                   LaneRays* unit, LREAL* lane_t_in, LREAL* lane_t_out, SurfaceHit* hits, REAL* t_in, REAL* t_out,
@@ -368,7 +369,7 @@ LMASK enter_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale
   LANES_STORE(*lane_t_in, t_in);
   LANES_STORE(*lane_t_out, t_out);
   const uint inside_bits = lane_mask_bits(inside);
-  for (uint j = 0; j < count; ++j) {
+  for (uint j = 0; j < LANES; ++j) {
     SurfaceHit* h = &hits[j];
     in_extent[j] = (inside_bits >> j) & 1u;
     h->root.t = INFINITY;
@@ -542,67 +543,104 @@ void surface_gradient_lanes(LREAL x, LREAL y, LREAL z, __global const uint* exps
   *gz = sz;
 }
 
-/* The hit record of a traced ray of direction ray_d, given grad P at its hit (unused when it has none). */
-HitRecord hit_record_with_gradient(REAL3 ray_d, SurfaceHit h, REAL3 g) {
-  HitRecord r;
-  r.flags = h.root.flags;
-  r.work = ALGRAY_WORK_PACK(min(h.root.steps, ALGRAY_WORK_MAX), min(h.root.iterations, ALGRAY_WORK_MAX));
-  r.t_hi = INFINITY;
-  r.t_lo = 0;
-  r.depth = INFINITY;
-  r.normal_x = r.normal_y = r.normal_z = 0;
-  if (!(h.root.flags & ALGRAY_HIT_FOUND)) return r;
-
-  r.t_hi = (float)h.root.t;
-  r.t_lo = (float)(h.root.t - (REAL)r.t_hi);
-  r.depth = (float)(h.root.t * length(ray_d));
-  /* Unit coordinates differ from world ones by a translation and a uniform scale: same normal direction. */
-  const REAL glen = length(g);
-  REAL3 n = (glen > 0 && isfinite(glen)) ? g / glen : -normalize(ray_d);
-  if (dot(n, ray_d) > 0) n = -n;
-  r.normal_x = (float)n.x;
-  r.normal_y = (float)n.y;
-  r.normal_z = (float)n.z;
+/* The hit records of the first `count` (<= LANES) of the lanes' rays, whose hits are hits[0 .. LANES) (flags 0 from
+ * `count` on): depth, the normal from grad P (taken together in lanes) facing the ray, and the side. With
+ * LANES = 1, one ray's record (hit_record). */
+void hit_records_lanes(uint count, const LaneRays* rays, const SurfaceHit* hits, __global const uint* exps,
+                       __global const REAL* coefs, uint mono_count, HitRecord* out) {
+  uint found_bits = 0;
+  for (uint j = 0; j < count; ++j)
+    if (hits[j].root.flags & ALGRAY_HIT_FOUND) found_bits |= 1u << j;
+  REAL depth_of[LANES], nx_of[LANES], ny_of[LANES], nz_of[LANES];
+  uint usable_bits = 0, grows_bits = 0;
+  if (found_bits) {
+    const LMASK found = lanes_of_bits(found_bits);
+#define HIT_UX(j) hits[j].u.x
+#define HIT_UY(j) hits[j].u.y
+#define HIT_UZ(j) hits[j].u.z
+#define HIT_DX(j) hits[j].d_unit.x
+#define HIT_DY(j) hits[j].d_unit.y
+#define HIT_DZ(j) hits[j].d_unit.z
+#define HIT_T(j) hits[j].root.t
+    /* lanes without a hit compute on zeros, never on a missed ray's infinities */
+    const LREAL x = LANE_SEL((LREAL)0, LANES_OF(LREAL, HIT_UX), found);
+    const LREAL y = LANE_SEL((LREAL)0, LANES_OF(LREAL, HIT_UY), found);
+    const LREAL z = LANE_SEL((LREAL)0, LANES_OF(LREAL, HIT_UZ), found);
+    const LREAL dux = LANES_OF(LREAL, HIT_DX), duy = LANES_OF(LREAL, HIT_DY), duz = LANES_OF(LREAL, HIT_DZ);
+    const LREAL t = LANE_SEL((LREAL)0, LANES_OF(LREAL, HIT_T), found);
+#undef HIT_UX
+#undef HIT_UY
+#undef HIT_UZ
+#undef HIT_DX
+#undef HIT_DY
+#undef HIT_DZ
+#undef HIT_T
+    LREAL gx, gy, gz;
+    surface_gradient_lanes(x, y, z, exps, coefs, mono_count, &gx, &gy, &gz);
+    LREAL glen, dlen, g_dot_du;
+    {
+      /* length() and dot() as PoCL computes them: three products, added left to right */
+#pragma OPENCL FP_CONTRACT OFF
+      glen = sqrt((gx * gx + gy * gy) + gz * gz);
+      dlen = sqrt((rays->dx * rays->dx + rays->dy * rays->dy) + rays->dz * rays->dz);
+      g_dot_du = (gx * dux + gy * duy) + gz * duz;
+    }
+    /* Unit coordinates differ from world ones by a translation and a uniform scale: same normal direction. */
+    LREAL nx = gx / glen, ny = gy / glen, nz = gz / glen, n_dot_d;
+    {
+#pragma OPENCL FP_CONTRACT OFF
+      n_dot_d = (nx * rays->dx + ny * rays->dy) + nz * rays->dz;
+    }
+    const LMASK away = n_dot_d > 0;
+    LANES_STORE(LANE_SEL(nx, -nx, away), nx_of);
+    LANES_STORE(LANE_SEL(ny, -ny, away), ny_of);
+    LANES_STORE(LANE_SEL(nz, -nz, away), nz_of);
+    LANES_STORE(t * dlen, depth_of);
+    usable_bits = lane_mask_bits(glen > 0 && isfinite(glen));
+    grows_bits = lane_mask_bits(g_dot_du > 0);
+  }
   /* Front is the side where P > 0; at an exact root use the direction in which P grows instead. */
-  const int back = h.root.f_before != 0 ? h.root.f_before < 0 : dot(g, h.d_unit) > 0;
-  if (back) r.flags |= ALGRAY_HIT_BACK;
-  return r;
+  for (uint j = 0; j < count; ++j) {
+    const SegmentRoot root = hits[j].root;
+    HitRecord r;
+    r.flags = root.flags;
+    r.work = ALGRAY_WORK_PACK(min(root.steps, ALGRAY_WORK_MAX), min(root.iterations, ALGRAY_WORK_MAX));
+    r.t_hi = INFINITY;
+    r.t_lo = 0;
+    r.depth = INFINITY;
+    r.normal_x = r.normal_y = r.normal_z = 0;
+    if ((found_bits >> j) & 1u) {
+      r.t_hi = (float)root.t;
+      r.t_lo = (float)(root.t - (REAL)r.t_hi);
+      r.depth = (float)depth_of[j];
+      REAL3 n = (REAL3)(nx_of[j], ny_of[j], nz_of[j]);
+      if (!((usable_bits >> j) & 1u)) { /* no gradient to speak of: face the ray */
+        const REAL3 d = (REAL3)(lane_get(rays->dx, j), lane_get(rays->dy, j), lane_get(rays->dz, j));
+        n = -normalize(d);
+        if (dot(n, d) > 0) n = -n;
+      }
+      r.normal_x = (float)n.x;
+      r.normal_y = (float)n.y;
+      r.normal_z = (float)n.z;
+      const int back = root.f_before != 0 ? root.f_before < 0 : (grows_bits >> j) & 1u;
+      if (back) r.flags |= ALGRAY_HIT_BACK;
+    }
+    out[j] = r;
+  }
 }
 
 #if LANES == 1
 HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global const REAL* coefs, uint count) {
-  REAL gx = 0, gy = 0, gz = 0;
-  if (h.root.flags & ALGRAY_HIT_FOUND) surface_gradient_lanes(h.u.x, h.u.y, h.u.z, exps, coefs, count, &gx, &gy, &gz);
-  return hit_record_with_gradient(ray.d, h, (REAL3)(gx, gy, gz));
-}
-#else
-/* The hit records of LANES rays, their gradients taken together in lanes. */
-void hit_records_lanes(uint count, const LaneRays* rays, const SurfaceHit* hits, __global const uint* exps,
-                       __global const REAL* coefs, uint mono_count, HitRecord* out) {
-  LREAL x = 0, y = 0, z = 0, gx, gy, gz;
-  int any_hit = 0;
-  for (uint j = 0; j < count; ++j)
-    if (hits[j].root.flags & ALGRAY_HIT_FOUND) {
-      lane_set(&x, j, hits[j].u.x);
-      lane_set(&y, j, hits[j].u.y);
-      lane_set(&z, j, hits[j].u.z);
-      any_hit = 1;
-    }
-  REAL gx_of[LANES], gy_of[LANES], gz_of[LANES], dx_of[LANES], dy_of[LANES], dz_of[LANES];
-  if (any_hit) {
-    surface_gradient_lanes(x, y, z, exps, coefs, mono_count, &gx, &gy, &gz);
-    LANES_STORE(gx, gx_of);
-    LANES_STORE(gy, gy_of);
-    LANES_STORE(gz, gz_of);
-  }
-  LANES_STORE(rays->dx, dx_of);
-  LANES_STORE(rays->dy, dy_of);
-  LANES_STORE(rays->dz, dz_of);
-  for (uint j = 0; j < count; ++j) {
-    REAL3 g = (REAL3)(0, 0, 0);
-    if (hits[j].root.flags & ALGRAY_HIT_FOUND) g = (REAL3)(gx_of[j], gy_of[j], gz_of[j]);
-    out[j] = hit_record_with_gradient((REAL3)(dx_of[j], dy_of[j], dz_of[j]), hits[j], g);
-  }
+  LaneRays r;
+  r.ox = ray.o.x;
+  r.oy = ray.o.y;
+  r.oz = ray.o.z;
+  r.dx = ray.d.x;
+  r.dy = ray.d.y;
+  r.dz = ray.d.z;
+  HitRecord record;
+  hit_records_lanes(1, &r, &h, exps, coefs, count, &record);
+  return record;
 }
 #endif
 
