@@ -11,6 +11,17 @@
  * of the polynomial's coefficients on the isolating interval. Returns the root's y and counts the iterations
  * (function evaluations) in *iterations. */
 
+/* Degree 1: P* on the isolating interval is the line f0 (1 - y) + f1 y, and its root f0 / (f0 - f1) is within 1.5
+ * ulps: f0 and f1 have opposite signs, so f0 - f1 does not cancel. That is far inside any stopping width, where
+ * every method would only converge to it, so at degree 1 none runs and no evaluation is counted. Over lanes, each
+ * lane's root. */
+#if DEGREE == 1
+#define REFINE_IN_CLOSED_FORM 1
+ALGRAY_INLINE LREAL line_root(LREAL f0, LREAL f1) { return f0 / (f0 - f1); }
+#else
+#define REFINE_IN_CLOSED_FORM 0
+#endif
+
 /* The paper's value stop, |P*(y)| <= eps_m, made independent of how P is scaled: the value is within the
  * rounding error of evaluating it at y, so its sign carries no more information. The error is measured at y
  * (isolated_magnitude), not by the largest coefficient: on a wide power-basis bracket the coefficients are

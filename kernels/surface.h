@@ -167,7 +167,12 @@ SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
   if (setup.refine) {
     const REAL scale = coefficient_scale(iso_c);
     prepare_isolated(iso_c, binomials);
+#if REFINE_IN_CLOSED_FORM
+    (void)scale;
+    y = line_root(iso.f_lo, iso.f_hi);
+#else
     y = refine_root(iso_c, iso.f_lo, iso.f_hi, setup.tol_y, scale, &r.iterations PROBE_ARG);
+#endif
   }
   place_root(&r, iso, y, t_in, t_out);
   if (setup.refine) doubt_flat_root(&r, iso, iso_c, y, t_in, t_out PROBE_ARG);
@@ -196,7 +201,13 @@ void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL*
   if (LANE_ANY(running)) {
     const LREAL scale = coefficient_scale(c);
     prepare_isolated(c, binomials);
+#if REFINE_IN_CLOSED_FORM
+    (void)scale;
+    (void)tol_y;
+    y = LANE_SEL((LREAL)0, line_root(f0, f1), running);
+#else
     y = refine_root_lanes(c, f0, f1, tol_y, scale, running, &iterations);
+#endif
   }
   REAL y_of[LANES];
   LANES_STORE(y, y_of);
