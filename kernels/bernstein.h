@@ -397,7 +397,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     /* halve_or_settle for the lanes that may hold several roots */
     const LMASK several = !done && v >= 1;
 #endif
-    const LMASK located = width * len <= (REAL)4 * (REAL)TOLERANCE * fmax(fabs(t_in + lo * len), (LREAL)1);
+    const LMASK located = width * len <= STOP_WIDTH(t_in + lo * len);
     const LMASK halve = several && !located && level < (REAL)REAL_MAX_HALVINGS;
     const LMASK settle = several && !halve;
     budget = budget || (settle && !located);

@@ -102,8 +102,10 @@ ALGRAY_INLINE LMASK lanes_of_bits(uint bits) {
  * isolate_bernstein_lanes in the Barth sextic's double preview). */
 #if LANES == 1
 #define LANES_STORE(v, a) ((a)[0] = (v))
+#define LANES_LOAD(a) ((a)[0])
 #else
 #define LANES_STORE(v, a) LANE_VEC(vstore, LANES)((v), 0, (a))
+#define LANES_LOAD(a) LANE_VEC(vload, LANES)(0, (a)) /* a[0 .. LANES) as one vector */
 #endif
 
 /* Lane j of a vector (j < LANES), read and written through its private storage. */

@@ -54,7 +54,9 @@ typedef float16 REAL16;
 #define MAX_ITERATIONS 100
 #endif
 
-/* The paper's stopping width: a root is located once its bracket is at most 4*eps*max(|t|, 1) wide in t. */
-REAL stop_width(REAL t) { return (REAL)4 * (REAL)TOLERANCE * fmax(fabs(t), (REAL)1); }
+/* The paper's stopping width: a root is located once its bracket is at most 4*eps*max(|t|, 1) wide in t; of one t
+ * or of lanes (lanes.h). */
+#define STOP_WIDTH(t) ((REAL)4 * (REAL)TOLERANCE * fmax(fabs(t), (REAL)1))
+REAL stop_width(REAL t) { return STOP_WIDTH(t); }
 
 #endif /* ALGRAY_REAL_H */

@@ -89,33 +89,32 @@ void probe_coefficients(const REAL* c, const REAL* c_lo, uint basis PROBE_PARAM)
 #define probe_coefficients(c, c_lo, basis) ((void)0)
 #endif
 
-/* What the refinement of an isolated root needs besides the coefficients: its stopping width. */
-typedef struct {
-  int refine; /* 0: nothing to refine (no root, or the root is the interval's left end) */
-  REAL tol_y;
-} RefineSetup;
+/* The refinement's stopping width in y on the isolating interval [lo, hi] of the segment [t_in, t_out] (lo and hi
+ * fractions of it): the stopping width at the interval's left end over the interval's width in t. Of one ray or
+ * of lanes. */
+#define ISOLATED_TOL_Y(lo, hi, t_in, t_out) \
+  (STOP_WIDTH((t_in) + (lo) * ((t_out) - (t_in))) / (((hi) - (lo)) * ((t_out) - (t_in))))
 
-/* The record of what the isolation found, before refinement. */
-SegmentRoot isolated_root(Isolation iso, REAL t_in, REAL t_out, RefineSetup* setup PROBE_PARAM) {
+/* The record of a ray that misses the extent, as enter_surface starts it. */
+ALGRAY_INLINE SegmentRoot missed_root(void) {
   SegmentRoot r;
   r.t = INFINITY;
   r.f_before = 0;
+  r.flags = 0;
+  r.steps = 0;
+  r.iterations = 0;
+  return r;
+}
+
+/* The record of what the isolation found, before refinement; a bracket (ISOLATION_BRACKET) is refined next. */
+SegmentRoot isolated_root(Isolation iso PROBE_PARAM) {
+  SegmentRoot r = missed_root();
   r.flags = iso.budget ? ALGRAY_HIT_BUDGET : 0u;
   r.steps = iso.steps;
-  r.iterations = 0;
-  setup->refine = 0;
-  setup->tol_y = 0;
   PROBE(ALGRAY_EVENT_ISOLATED, iso.budget, (uint)iso.status, 0u, iso.lo, iso.hi, iso.f_lo, iso.f_hi);
   if (iso.doubt) r.flags |= ALGRAY_HIT_DOUBT;
-  if (iso.status == ISOLATION_NONE) return r;
   if (iso.status == ISOLATION_EXACT) r.flags |= ALGRAY_HIT_EXACT;
-  if (iso.cluster) r.flags |= ALGRAY_HIT_CLUSTER;
-  if (iso.status == ISOLATION_BRACKET) {
-    const REAL len = t_out - t_in;
-    const REAL width_t = (iso.hi - iso.lo) * len;
-    setup->refine = 1;
-    setup->tol_y = stop_width(t_in + iso.lo * len) / width_t;
-  }
+  if (iso.status != ISOLATION_NONE && iso.cluster) r.flags |= ALGRAY_HIT_CLUSTER;
   return r;
 }
 
@@ -160,45 +159,56 @@ void doubt_flat_root(SegmentRoot* r, Isolation iso, const REAL* c, REAL y, REAL 
 /* Refines what the isolation found; iso_c holds the polynomial on the isolating interval (consumed). */
 SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
                             __constant const REAL* binomials PROBE_PARAM) {
-  RefineSetup setup;
-  SegmentRoot r = isolated_root(iso, t_in, t_out, &setup PROBE_ARG);
+  SegmentRoot r = isolated_root(iso PROBE_ARG);
   if (iso.status == ISOLATION_NONE) return r;
   REAL y = 0;
-  if (setup.refine) {
+  const int refine = iso.status == ISOLATION_BRACKET;
+  if (refine) {
+    const REAL tol_y = ISOLATED_TOL_Y(iso.lo, iso.hi, t_in, t_out);
     const REAL scale = coefficient_scale(iso_c);
     prepare_isolated(iso_c, binomials);
 #if REFINE_IN_CLOSED_FORM
     (void)scale;
     y = line_root(iso.f_lo, iso.f_hi);
 #else
-    y = refine_root(iso_c, iso.f_lo, iso.f_hi, setup.tol_y, scale, &r.iterations PROBE_ARG);
+    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, &r.iterations PROBE_ARG);
 #endif
   }
   place_root(&r, iso, y, t_in, t_out);
-  if (setup.refine) doubt_flat_root(&r, iso, iso_c, y, t_in, t_out PROBE_ARG);
+  if (refine) doubt_flat_root(&r, iso, iso_c, y, t_in, t_out PROBE_ARG);
   return r;
 }
 #else
 /* The roots of LANES rays' isolations, refined together in lanes (lanes.h); c holds each lane's polynomial on its
- * isolating interval (consumed). Lanes from `count` on, and those whose ray missed the extent (in_extent[j] ==
- * 0), are left alone. */
+ * isolating interval (consumed). Lanes whose ray missed the extent (in_extent[j] == 0) get missed_root(); lanes
+ * from `count` on are left alone. */
 void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL* c, const REAL* t_in, const REAL* t_out,
                   __constant const REAL* binomials, SegmentRoot* roots) {
-  LREAL f0 = 0, f1 = 0, tol_y = 0;
-  LMASK running = 0;
+  uint refine_bits = 0;
   for (uint j = 0; j < count; ++j) {
-    if (!in_extent[j]) continue;
-    RefineSetup setup;
-    roots[j] = isolated_root(iso[j], t_in[j], t_out[j], &setup);
-    if (!setup.refine) continue;
-    lane_set_mask(&running, j, 1);
-    lane_set(&f0, j, iso[j].f_lo);
-    lane_set(&f1, j, iso[j].f_hi);
-    lane_set(&tol_y, j, setup.tol_y);
+    roots[j] = in_extent[j] ? isolated_root(iso[j]) : missed_root();
+    if (in_extent[j] && iso[j].status == ISOLATION_BRACKET) refine_bits |= 1u << j;
   }
+  const LMASK running = lanes_of_bits(refine_bits);
   LREAL y = 0;
   LMASK iterations = 0;
-  if (LANE_ANY(running)) {
+  if (refine_bits) {
+    /* each refined lane's bracket, gathered from its isolation (zeros elsewhere) */
+#define ISO_FIELD(field, j) (((refine_bits >> (j)) & 1u) ? iso[j].field : (REAL)0)
+#define ISO_F_LO(j) ISO_FIELD(f_lo, j)
+#define ISO_F_HI(j) ISO_FIELD(f_hi, j)
+#define ISO_LO(j) ISO_FIELD(lo, j)
+#define ISO_HI(j) ISO_FIELD(hi, j)
+    const LREAL f0 = LANES_OF(LREAL, ISO_F_LO), f1 = LANES_OF(LREAL, ISO_F_HI);
+    const LREAL tol_y = LANE_SEL((LREAL)0,
+                                 ISOLATED_TOL_Y(LANES_OF(LREAL, ISO_LO), LANES_OF(LREAL, ISO_HI), LANES_LOAD(t_in),
+                                                LANES_LOAD(t_out)),
+                                 running);
+#undef ISO_F_LO
+#undef ISO_F_HI
+#undef ISO_LO
+#undef ISO_HI
+#undef ISO_FIELD
     const LREAL scale = coefficient_scale(c);
     prepare_isolated(c, binomials);
 #if REFINE_IN_CLOSED_FORM
@@ -211,10 +221,9 @@ void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL*
   }
   REAL y_of[LANES];
   LANES_STORE(y, y_of);
-  const uint running_bits = lane_mask_bits(running);
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j] || iso[j].status == ISOLATION_NONE) continue;
-    const int refined = (running_bits >> j) & 1;
+    const int refined = (refine_bits >> j) & 1;
     roots[j].iterations = refined ? (uint)lane_get_mask(iterations, j) : 0u;
     place_root(&roots[j], iso[j], refined ? y_of[j] : (REAL)0, t_in[j], t_out[j]);
 #if ALGRAY_ESCALATE
@@ -336,11 +345,7 @@ Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, _
  * when the ray misses the extent; *h is then the whole answer. */
 int enter_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, SurfaceHit* h, REAL* t_in,
                   REAL* t_out PROBE_PARAM) {
-  h->root.t = INFINITY;
-  h->root.f_before = 0;
-  h->root.flags = 0;
-  h->root.steps = 0;
-  h->root.iterations = 0;
+  h->root = missed_root();
   /* Unit coordinates keep every point of the extent within |u| <= 1: the conditioning step that makes float usable. */
   h->u = (ray.o - centre) * inv_scale;
   h->d_unit = ray.d * inv_scale;
@@ -351,13 +356,12 @@ int enter_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int ext
 }
 
 #if LANES > 1
-/* enter_surface for LANES rays at once: unit gets each lane's ray in unit coordinates, hits[j] and t_in[j], t_out[j]
- * what enter_surface gives ray j, bit for bit, and in_extent[j] its result (0 from `count` on, where the hits
- * are those of missed rays). Returns the lanes
- * that enter the extent; their segments are also left in *lane_t_in, *lane_t_out (0 and 1 elsewhere). */
+/* enter_surface for LANES rays at once: unit gets each lane's ray in unit coordinates (as enter_surface's h->u and
+ * h->d_unit, bit for bit), t_in[j], t_out[j] ray j's segment and in_extent[j] whether it enters the extent (0
+ * from `count` on). Returns the lanes that enter; their segments are also left in *lane_t_in, *lane_t_out (0 and
+ * 1 elsewhere). */
 LMASK enter_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
-                  LaneRays* unit, LREAL* lane_t_in, LREAL* lane_t_out, SurfaceHit* hits, REAL* t_in, REAL* t_out,
-                  int* in_extent) {
+                  LaneRays* unit, LREAL* lane_t_in, LREAL* lane_t_out, REAL* t_in, REAL* t_out, int* in_extent) {
   unit->ox = (rays->ox - centre.x) * inv_scale;
   unit->oy = (rays->oy - centre.y) * inv_scale;
   unit->oz = (rays->oz - centre.z) * inv_scale;
@@ -370,28 +374,19 @@ LMASK enter_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale
                                             box_half, &lo, &hi);
   *lane_t_in = LANE_SEL((LREAL)0, lo, inside);
   *lane_t_out = LANE_SEL((LREAL)1, hi, inside);
-  REAL ox[LANES], oy[LANES], oz[LANES], dx[LANES], dy[LANES], dz[LANES];
-  LANES_STORE(unit->ox, ox);
-  LANES_STORE(unit->oy, oy);
-  LANES_STORE(unit->oz, oz);
-  LANES_STORE(unit->dx, dx);
-  LANES_STORE(unit->dy, dy);
-  LANES_STORE(unit->dz, dz);
   LANES_STORE(*lane_t_in, t_in);
   LANES_STORE(*lane_t_out, t_out);
   const uint inside_bits = lane_mask_bits(inside);
-  for (uint j = 0; j < LANES; ++j) {
-    SurfaceHit* h = &hits[j];
-    in_extent[j] = (inside_bits >> j) & 1u;
-    h->root.t = INFINITY;
-    h->root.f_before = 0;
-    h->root.flags = in_extent[j] ? ALGRAY_HIT_IN_EXTENT : 0u;
-    h->root.steps = 0;
-    h->root.iterations = 0;
-    h->u = (REAL3)(ox[j], oy[j], oz[j]);
-    h->d_unit = (REAL3)(dx[j], dy[j], dz[j]);
-  }
+  for (uint j = 0; j < LANES; ++j) in_extent[j] = (inside_bits >> j) & 1u;
   return inside;
+}
+
+/* Lane j of rays as one ray (REAL3 origin and direction). */
+ALGRAY_INLINE REAL3 lane_origin(const LaneRays* rays, uint j) {
+  return (REAL3)(lane_get(rays->ox, j), lane_get(rays->oy, j), lane_get(rays->oz, j));
+}
+ALGRAY_INLINE REAL3 lane_direction(const LaneRays* rays, uint j) {
+  return (REAL3)(lane_get(rays->dx, j), lane_get(rays->dy, j), lane_get(rays->dz, j));
 }
 #endif
 
@@ -554,38 +549,25 @@ void surface_gradient_lanes(LREAL x, LREAL y, LREAL z, __global const uint* exps
   *gz = sz;
 }
 
-/* The hit records of the first `count` (<= LANES) of the lanes' rays, whose hits are hits[0 .. LANES) (flags 0 from
- * `count` on): depth, the normal from grad P (taken together in lanes) facing the ray, and the side. With
- * LANES = 1, one ray's record (hit_record). */
-void hit_records_lanes(uint count, const LaneRays* rays, const SurfaceHit* hits, __global const uint* exps,
-                       __global const REAL* coefs, uint mono_count, HitRecord* out) {
+/* The hit records of the first `count` (<= LANES) of the lanes' rays: roots[j] is ray j's root, `at` the rays in
+ * unit coordinates with each found root's point as the origin, `rays` the rays as traced. Depth, the normal from
+ * grad P (taken together in lanes) facing the ray, and the side. With LANES = 1, one ray's record (hit_record). */
+void hit_records_lanes(uint count, const LaneRays* rays, const LaneRays* at, const SegmentRoot* roots,
+                       __global const uint* exps, __global const REAL* coefs, uint mono_count, HitRecord* out) {
   uint found_bits = 0;
   for (uint j = 0; j < count; ++j)
-    if (hits[j].root.flags & ALGRAY_HIT_FOUND) found_bits |= 1u << j;
+    if (roots[j].flags & ALGRAY_HIT_FOUND) found_bits |= 1u << j;
   REAL depth_of[LANES], nx_of[LANES], ny_of[LANES], nz_of[LANES];
   uint usable_bits = 0, grows_bits = 0;
   if (found_bits) {
     const LMASK found = lanes_of_bits(found_bits);
-#define HIT_UX(j) hits[j].u.x
-#define HIT_UY(j) hits[j].u.y
-#define HIT_UZ(j) hits[j].u.z
-#define HIT_DX(j) hits[j].d_unit.x
-#define HIT_DY(j) hits[j].d_unit.y
-#define HIT_DZ(j) hits[j].d_unit.z
-#define HIT_T(j) hits[j].root.t
     /* lanes without a hit compute on zeros, never on a missed ray's infinities */
-    const LREAL x = LANE_SEL((LREAL)0, LANES_OF(LREAL, HIT_UX), found);
-    const LREAL y = LANE_SEL((LREAL)0, LANES_OF(LREAL, HIT_UY), found);
-    const LREAL z = LANE_SEL((LREAL)0, LANES_OF(LREAL, HIT_UZ), found);
-    const LREAL dux = LANES_OF(LREAL, HIT_DX), duy = LANES_OF(LREAL, HIT_DY), duz = LANES_OF(LREAL, HIT_DZ);
-    const LREAL t = LANE_SEL((LREAL)0, LANES_OF(LREAL, HIT_T), found);
-#undef HIT_UX
-#undef HIT_UY
-#undef HIT_UZ
-#undef HIT_DX
-#undef HIT_DY
-#undef HIT_DZ
-#undef HIT_T
+    const LREAL x = LANE_SEL((LREAL)0, at->ox, found), y = LANE_SEL((LREAL)0, at->oy, found),
+                z = LANE_SEL((LREAL)0, at->oz, found);
+    const LREAL dux = at->dx, duy = at->dy, duz = at->dz;
+#define ROOT_T(j) roots[j].t
+    const LREAL t = LANE_SEL((LREAL)0, LANES_OF(LREAL, ROOT_T), found);
+#undef ROOT_T
     LREAL gx, gy, gz;
     surface_gradient_lanes(x, y, z, exps, coefs, mono_count, &gx, &gy, &gz);
     LREAL glen, dlen, g_dot_du;
@@ -612,7 +594,7 @@ void hit_records_lanes(uint count, const LaneRays* rays, const SurfaceHit* hits,
   }
   /* Front is the side where P > 0; at an exact root use the direction in which P grows instead. */
   for (uint j = 0; j < count; ++j) {
-    const SegmentRoot root = hits[j].root;
+    const SegmentRoot root = roots[j];
     HitRecord r;
     r.flags = root.flags;
     r.work = ALGRAY_WORK_PACK(min(root.steps, ALGRAY_WORK_MAX), min(root.iterations, ALGRAY_WORK_MAX));
@@ -642,15 +624,21 @@ void hit_records_lanes(uint count, const LaneRays* rays, const SurfaceHit* hits,
 
 #if LANES == 1
 HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global const REAL* coefs, uint count) {
-  LaneRays r;
+  LaneRays r, at;
   r.ox = ray.o.x;
   r.oy = ray.o.y;
   r.oz = ray.o.z;
   r.dx = ray.d.x;
   r.dy = ray.d.y;
   r.dz = ray.d.z;
+  at.ox = h.u.x;
+  at.oy = h.u.y;
+  at.oz = h.u.z;
+  at.dx = h.d_unit.x;
+  at.dy = h.d_unit.y;
+  at.dz = h.d_unit.z;
   HitRecord record;
-  hit_records_lanes(1, &r, &h, exps, coefs, count, &record);
+  hit_records_lanes(1, &r, &at, &h.root, exps, coefs, count, &record);
   return record;
 }
 #endif
@@ -709,7 +697,6 @@ void screen_coefficients_lanes(__global const REAL* row, LREAL xi, LREAL tau_in,
 void trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                  __global const uint* exps, __global const REAL* coefs, uint mono_count,
                  __constant const REAL* binomials, uint even_axes, HitRecord* records SCREEN_LANES_PARAM) {
-  SurfaceHit hits[LANES];
   Isolation iso[LANES];
   SegmentRoot roots[LANES];
   REAL t_in[LANES], t_out[LANES];
@@ -717,7 +704,7 @@ void trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale,
   int in_extent[LANES];
   LaneRays unit;
   const LMASK running = enter_lanes(count, rays, centre, inv_scale, box_half, extent_kind, &unit, &lane_t_in,
-                                    &lane_t_out, hits, t_in, t_out, in_extent);
+                                    &lane_t_out, t_in, t_out, in_extent);
 #if SCREEN_LANES
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) iso_c[k] = 0;
@@ -735,7 +722,6 @@ void trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale,
   }
 #else
   (void)running;
-  (void)unit;
   REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
 #if ALGRAY_ESCALATE
   RayTerms terms[LANES];
@@ -746,18 +732,41 @@ void trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale,
     REAL taylor[NCOEF];
     const REAL taylor_t = screen_ray_taylor(px0 + j, py, SCREEN_ROWS_ARG, taylor);
 #endif
-    segment_coefficients(hits[j].u, hits[j].d_unit, t_in[j], t_out[j], exps, coefs, mono_count, binomials, even_axes,
-                         root[j], root_lo[j] TERMS_OUT(&terms[j]) SCREEN_ARG);
+    segment_coefficients(lane_origin(&unit, j), lane_direction(&unit, j), t_in[j], t_out[j], exps, coefs, mono_count,
+                         binomials, even_axes, root[j], root_lo[j] TERMS_OUT(&terms[j]) SCREEN_ARG);
   }
   isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, iso, iso_c TERMS_OUT(terms));
 #endif
   refine_lanes(count, in_extent, iso, iso_c, t_in, t_out, binomials, roots);
+  /* finish_surface over lanes: `at` moves each found root's ray to its point */
+  uint found_bits = 0;
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j]) continue;
-    finish_surface(&hits[j], roots[j]);
-    CONFIRM_FLAT_ROOT(&hits[j], exps, coefs, mono_count);
+    roots[j].flags |= ALGRAY_HIT_IN_EXTENT;
+    if (roots[j].flags & ALGRAY_HIT_FOUND) found_bits |= 1u << j;
   }
-  hit_records_lanes(count, rays, hits, exps, coefs, mono_count, records);
+  LaneRays at = unit;
+  if (found_bits) {
+    const LMASK found = lanes_of_bits(found_bits);
+#define ROOT_T(j) roots[j].t
+    const LREAL t = LANE_SEL((LREAL)0, LANES_OF(LREAL, ROOT_T), found);
+#undef ROOT_T
+    at.ox = LANE_SEL(unit.ox, unit.ox + t * unit.dx, found);
+    at.oy = LANE_SEL(unit.oy, unit.oy + t * unit.dy, found);
+    at.oz = LANE_SEL(unit.oz, unit.oz + t * unit.dz, found);
+  }
+#if ALGRAY_ESCALATE
+  for (uint j = 0; j < count; ++j) {
+    if (!((found_bits >> j) & 1u) || !(roots[j].flags & ALGRAY_HIT_DOUBT)) continue;
+    SurfaceHit h;
+    h.root = roots[j];
+    h.u = lane_origin(&at, j);
+    h.d_unit = lane_direction(&at, j);
+    CONFIRM_FLAT_ROOT(&h, exps, coefs, mono_count);
+    roots[j].flags = h.root.flags;
+  }
+#endif
+  hit_records_lanes(count, rays, &at, roots, exps, coefs, mono_count, records);
 }
 #endif
 
