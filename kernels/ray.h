@@ -80,7 +80,9 @@ typedef struct {
   LREAL ox, oy, oz, dx, dy, dz;
 } LaneRays;
 
-#if LANES > 1
+#if LANES == 1
+#define clip_lanes_to_extent clip_axes_to_extent /* LREAL and LMASK are REAL and int */
+#else
 DEFINE_CLIP_TO_EXTENT(clip_lanes_to_extent, LREAL, LMASK)
 
 /* The pixel centres (REAL)px + 0.5 of columns px0 .. px0 + LANES - 1, each as camera_ray computes it: px0 + j is

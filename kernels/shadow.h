@@ -169,41 +169,27 @@ Isolation shadow_isolation(const REAL* b, const REAL* b_lo, REAL t_in, REAL t_ou
 #error "the point form is built in plain float or double with Bernstein isolation"
 #endif
 
-/* shadow_segment for LANES light samples (lx, ly, lz): *self where the sample is behind the tangent plane, and the
- * lanes returned where the segment from o (t = 0) to the sample (t = 1) holds [*t_in, *t_out] of the extent. */
+/* shadow_segment for LANES light samples (lx, ly, lz), each lane its result bit for bit: *self where the sample is
+ * behind the tangent plane, and the lanes returned where the segment from o (t = 0) to the sample (t = 1) holds
+ * [*t_in, *t_out] of the extent. */
 LMASK shadow_segments(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, LREAL lx, LREAL ly, LREAL lz, REAL extent_inv_scale,
                       int extent_kind, REAL3 box_half, LMASK* self, LREAL* dx, LREAL* dy, LREAL* dz, LREAL* t_in,
                       LREAL* t_out) {
-  *self = (lx - p.x) * n.x + (ly - p.y) * n.y + (lz - p.z) * n.z <= 0;
+  {
+    /* as dot() sums them: three products, added left to right */
+#pragma OPENCL FP_CONTRACT OFF
+    *self = ((lx - p.x) * n.x + (ly - p.y) * n.y) + (lz - p.z) * n.z <= 0;
+  }
   *dx = (lx - o.x) * extent_inv_scale;
   *dy = (ly - o.y) * extent_inv_scale;
   *dz = (lz - o.z) * extent_inv_scale;
-  LREAL lo = 0, hi;
-  LMASK hit;
-  if (extent_kind == ALGRAY_EXTENT_SPHERE) {
-    /* clip_to_extent's sphere, lane by lane */
-    const LREAL a = *dx * *dx + *dy * *dy + *dz * *dz;
-    const LREAL b = o_unit.x * *dx + o_unit.y * *dy + o_unit.z * *dz;
-    const REAL c = dot(o_unit, o_unit) - (REAL)1;
-    const LREAL disc = b * b - a * c;
-    hit = disc > 0 && a > 0;
-    const LREAL q = -(b + copysign(sqrt(fmax(disc, (LREAL)0)), b));
-    const LREAL t0 = q / a, t1 = c / q;
-    lo = fmax(fmin(t0, t1), (LREAL)0);
-    hi = fmax(t0, t1);
-  } else {
-    hi = REAL_MAX;
-    const LREAL ix = (REAL)1 / *dx, iy = (REAL)1 / *dy, iz = (REAL)1 / *dz;
-    const LREAL ax = (-box_half.x - o_unit.x) * ix, bx = (box_half.x - o_unit.x) * ix;
-    const LREAL ay = (-box_half.y - o_unit.y) * iy, by = (box_half.y - o_unit.y) * iy;
-    const LREAL az = (-box_half.z - o_unit.z) * iz, bz = (box_half.z - o_unit.z) * iz;
-    lo = fmax(fmax(lo, fmin(ax, bx)), fmax(fmin(ay, by), fmin(az, bz)));
-    hi = fmin(fmin(hi, fmax(ax, bx)), fmin(fmax(ay, by), fmax(az, bz)));
-    hit = hi > lo;
-  }
-  *t_in = fmax(lo, (LREAL)0);
-  *t_out = fmin(hi, (LREAL)1);
-  return !*self && hit && hi > lo && *t_out > *t_in;
+  LREAL lo, hi;
+  const LMASK hit = clip_lanes_to_extent((LREAL)o_unit.x, (LREAL)o_unit.y, (LREAL)o_unit.z, *dx, *dy, *dz, extent_kind,
+                                         box_half, &lo, &hi);
+  /* a lane that misses the extent gets [0, 1], not the clip's NaNs, for the lanes' arithmetic that follows */
+  *t_in = LANE_SEL((LREAL)0, fmax(lo, (LREAL)0), hit);
+  *t_out = LANE_SEL((LREAL)1, fmin(hi, (LREAL)1), hit);
+  return !*self && hit && *t_out > *t_in;
 }
 
 /* Measured on the Barth sextic and decic (full mode, 1024x768): 3 levels saved the most at degree 6, 2 at degree
