@@ -46,6 +46,13 @@ __kernel void trace(__global const REAL4* origins, __global const REAL4* directi
   rays.dx = LANES_OF(LREAL, DIRECTION_X);
   rays.dy = LANES_OF(LREAL, DIRECTION_Y);
   rays.dz = LANES_OF(LREAL, DIRECTION_Z);
+#undef RAY_AXIS
+#undef ORIGIN_X
+#undef ORIGIN_Y
+#undef ORIGIN_Z
+#undef DIRECTION_X
+#undef DIRECTION_Y
+#undef DIRECTION_Z
   HitRecord records[LANES];
   trace_lanes(group, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind, mono_exps, mono_coefs,
               mono_count, binomials, even_axes, records);
