@@ -89,6 +89,19 @@ else
   step degrees_float 210 python3 bench/kernel_speed.py --only degrees --degrees $degrees --side 2048 --repeat 3 \
     --precision float
   step surfaces_double 190 python3 bench/kernel_speed.py --only surfaces --repeat 5
+
+  # Issue 18: adaptive was 2.85x float on the decic here (2026-12-04), with 35 tiles of 256x256, each with its own
+  # second pass. Does one 1024x1024 tile close the gap? Lines: tile, mode, kernel ms of all passes, passes' wall ms.
+  tiles() {
+    for tile in 256 1024; do for mode in float adaptive; do for _ in 1 2 3; do
+      "$algray" render scenes/barth_decic.toml -o /tmp/tiles.exr --width 1024 --height 768 --set antialias.samples=1 \
+        --set render.tile_size=$tile --precision $mode --stats /tmp/tiles.json >/dev/null || return 1
+      python3 -c 'import json, sys; s = json.load(open("/tmp/tiles.json")); print(*sys.argv[1:], round(sum(
+p["kernel_ms"] for p in s["passes"]), 1), round(s["render_ms"]["passes_wall"], 1))' "$tile" "$mode"
+    done; done; done
+  }
+  export -f tiles
+  step tiles_adaptive 175 bash -c tiles
   step precision_modes 160 python3 bench/precision_modes.py --no-accuracy --runs 3 --output "$logs/RESULTS.md" \
     --json "$logs/precision_modes.json" --heading "## Precision modes on a GPU" \
     --scenes ${GPU_CHECK_SCENES:-barth_decic endrass_octic chebyshev_nonic goursat12 kummer zitrus tanglecube}
@@ -105,6 +118,6 @@ run_tests() {
 export -f run_tests left
 step tests 5 bash -c run_tests
 cat "$logs/tests.log" >> "$logs/summary.txt"
-for f in "$logs"/degrees_*.log "$logs"/surfaces_*.log "$logs"/e2e_full.log; do
+for f in "$logs"/degrees_*.log "$logs"/surfaces_*.log "$logs"/e2e_full.log "$logs"/tiles_adaptive.log; do
   [ -f "$f" ] && { echo "--- $(basename "$f")"; cat "$f"; } >> "$logs/summary.txt"
 done
