@@ -14,7 +14,7 @@ __kernel void scalar_brent(__global const REAL* polys, __global REAL* roots, __g
   const REAL f0 = c[0], f1 = c[DEGREE];
   prepare_isolated(c, binomials);
   uint it;
-  roots[i] = refine_root(c, f0, f1, tol_y, scale, &it);
+  roots[i] = refine_root(c, f0, f1, tol_y, scale, (REAL)-1, &it); /* no start: as the lanes below begin */
   iters[i] = it;
 }
 

@@ -507,6 +507,27 @@ int bernstein_root_by_signs(const REAL* c) {
   return -1;
 }
 
+/* The refinement's first estimate of the root (refine.h), from the Bernstein coefficients c of the isolating
+ * interval before prepare_isolated, or -1 for none. Degree 2: the quadratic's root in (0, 1) by the formula that
+ * avoids cancellation; rounded, it is a start, not an answer: Brent evaluates it and goes on until its own stopping
+ * rule holds, as from any start (near a double root the formula loses digits, and the search then finds them). A
+ * start moves where in the stopping width a root lands, so other degrees keep the paper's start (bench/RESULTS.md:
+ * the control polygon's crossing as a start, measured and not kept). Over lanes, each lane's. */
+#if DEGREE == 2
+LREAL isolated_start(const LREAL* c) {
+  /* c0 (1 - y)^2 + 2 c1 y (1 - y) + c2 y^2 = a y^2 + b y + c0 */
+  const LREAL a = (c[0] - (REAL)2 * c[1]) + c[2], b = (REAL)2 * (c[1] - c[0]);
+  const LREAL q = (REAL)-0.5 * (b + copysign(sqrt(b * b - (REAL)4 * a * c[0]), b));
+  const LREAL near = c[0] / q, far = q / a;
+  return LANE_SEL(LANE_SEL((LREAL)-1, far, far > 0 && far < 1), near, near > 0 && near < 1);
+}
+#else
+LREAL isolated_start(const LREAL* c) {
+  (void)c;
+  return -1;
+}
+#endif
+
 /* Turns Bernstein coefficients into the form isolated_value() expects: c_k * C(n,k); over lanes, each lane's. */
 void prepare_isolated(LREAL* c, __constant const REAL* binomials) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;

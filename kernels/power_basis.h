@@ -43,7 +43,13 @@ REAL power_value_slope(const REAL* c, REAL y, REAL* slope) {
 }
 
 /* The interface refine.h expects from every isolation method (see bernstein.h): on the isolating interval the
- * polynomial is A1(y), y in [0, 1], in the power basis, ready as it is. */
+ * polynomial is A1(y), y in [0, 1], in the power basis, ready as it is; no start for the refinement, which
+ * begins as the paper has it. */
+REAL isolated_start(const REAL* c) {
+  (void)c;
+  return -1;
+}
+
 void prepare_isolated(REAL* c, __constant const REAL* binomials) {
   (void)c;
   (void)binomials;

@@ -8,7 +8,8 @@
 
 /* Needs isolated_value(c, y) from the isolation method: the polynomial at y in [0,1] of the isolating interval.
  * f0 and f1 are its values at 0 and 1, of opposite signs. tol_y is the stopping width in y; scale is the size
- * of the polynomial's coefficients on the isolating interval. Returns the root's y and counts the iterations
+ * of the polynomial's coefficients on the isolating interval; start is the isolation's estimate of the root in
+ * (0, 1) (isolated_start), or anything outside it for none. Returns the root's y and counts the iterations
  * (function evaluations) in *iterations. */
 
 /* Degree 1: P* on the isolating interval is the line f0 (1 - y) + f1 y, and its root f0 / (f0 - f1) is within 1.5
@@ -42,13 +43,29 @@ int value_within_rounding(const REAL* c, REAL y, REAL fy, REAL scale) {
 #if REFINEMENT == ALGRAY_REFINEMENT_BRENT
 /* Dekker-Brent over lanes (lanes.h): each lane where `running` is set refines its own polynomial, and a lane
  * that has stopped keeps its state, so every lane ends as the scalar loop would, bit for bit. *iterations gets
- * each lane's count of function evaluations. */
-LREAL refine_root_lanes(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL scale, LMASK running,
+ * each lane's count of function evaluations.
+ * A lane with a start in (0, 1) (isolated_start: degree 2's formula) evaluates it first: it becomes b, the
+ * bracket's end of the other sign c, and the other end a; the stopping rule then decides as always. Without a
+ * start, the secant of the ends is the first step, as the paper has it. */
+LREAL refine_root_lanes(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL scale, LREAL start, LMASK running,
                         LMASK* iterations PROBE_PARAM) {
   /* b: best estimate; c_: contrapoint, f(c_) of the other sign; a: the previous b. */
   LREAL a = 0, fa = f0, b = 1, fb = f1, cp = 0, fc = f0;
   LMASK done = !running;
   LMASK it = 0;
+  const LMASK started = running && start > 0 && start < 1;
+  if (LANE_ANY(started)) {
+    const LREAL fs = isolated_value(c, LANE_SEL((LREAL)0.5, start, started));
+    const LMASK root_above = (fs > 0) == (f0 > 0); /* the sign change is between the start and 1 */
+    a = LANE_SEL(a, LANE_SEL((LREAL)1, (LREAL)0, root_above), started);
+    fa = LANE_SEL(fa, LANE_SEL(f1, f0, root_above), started);
+    cp = LANE_SEL(cp, LANE_SEL((LREAL)0, (LREAL)1, root_above), started);
+    fc = LANE_SEL(fc, LANE_SEL(f0, f1, root_above), started);
+    b = LANE_SEL(b, start, started);
+    fb = LANE_SEL(fb, fs, started);
+    it += LANE_SEL((LMASK)0, (LMASK)1, started);
+    PROBE_ITERATE(0, b, fb, fmin(b, cp), fmax(b, cp));
+  }
   for (int n = 0; n < MAX_ITERATIONS; ++n) {
     const LMASK swap = !done && fabs(fc) < fabs(fb);
     a = LANE_SEL(a, b, swap);
@@ -90,22 +107,23 @@ LREAL refine_root_lanes(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL s
     b = LANE_SEL(next, b, done);
     fb = LANE_SEL(fnext, fb, done);
     it += LANE_SEL((LMASK)0, (LMASK)1, !done);
-    PROBE_ITERATE(n, b, fb, fmin(b, cp), fmax(b, cp));
+    PROBE_ITERATE(n + LANE_ANY(started), b, fb, fmin(b, cp), fmax(b, cp));
   }
   *iterations = it;
   return b;
 }
 
 #if LANES == 1
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations PROBE_PARAM) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations PROBE_PARAM) {
   LMASK it;
-  const REAL y = refine_root_lanes(c, f0, f1, tol_y, scale, 1, &it PROBE_ARG);
+  const REAL y = refine_root_lanes(c, f0, f1, tol_y, scale, start, 1, &it PROBE_ARG);
   *iterations = (uint)it;
   return y;
 }
 #endif
 #elif REFINEMENT == ALGRAY_REFINEMENT_BISECTION
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations PROBE_PARAM) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations PROBE_PARAM) {
+  (void)start; /* the paper's start */
   REAL lo = 0, hi = 1, flo = f0;
   (void)f1;
   (void)scale;
@@ -135,7 +153,8 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
  * good, so the bracket never shrinks below the stopping width and only |P*| <= eps_m or the iteration cap
  * stops it (the paper's Barth decic defects). The Illinois variant halves the value kept at an end that has
  * survived twice in a row, which breaks that one-sidedness. */
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations PROBE_PARAM) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations PROBE_PARAM) {
+  (void)start; /* the paper's start */
   REAL a = 0, fa = f0, b = 1, fb = f1, x = fabs(f0) < fabs(f1) ? (REAL)0 : (REAL)1;
   int kept = 0; /* +1: a survived the last step(s), -1: b did */
   uint it = 0;
@@ -173,7 +192,8 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* 
 /* Newton's method inside the bracket: a step that would leave it, or that fails to halve |P*|, is replaced by
  * bisection, so it converges like bisection at worst and quadratically near a simple root. Needs
  * isolated_value_slope(c, y, &slope) from the isolation method. */
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, uint* iterations PROBE_PARAM) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations PROBE_PARAM) {
+  (void)start; /* the paper's start */
   REAL a = 0, b = 1, fa = f0;
   REAL x = fabs(f0) < fabs(f1) ? (REAL)0 : (REAL)1, slope;
   REAL fx = isolated_value_slope(c, x, &slope);

@@ -165,13 +165,14 @@ SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
   const int refine = iso.status == ISOLATION_BRACKET;
   if (refine) {
     const REAL tol_y = ISOLATED_TOL_Y(iso.lo, iso.hi, t_in, t_out);
-    const REAL scale = coefficient_scale(iso_c);
+    const REAL scale = coefficient_scale(iso_c), start = isolated_start(iso_c);
     prepare_isolated(iso_c, binomials);
 #if REFINE_IN_CLOSED_FORM
     (void)scale;
+    (void)start;
     y = line_root(iso.f_lo, iso.f_hi);
 #else
-    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, &r.iterations PROBE_ARG);
+    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, start, &r.iterations PROBE_ARG);
 #endif
   }
   place_root(&r, iso, y, t_in, t_out);
@@ -209,14 +210,15 @@ void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL*
 #undef ISO_LO
 #undef ISO_HI
 #undef ISO_FIELD
-    const LREAL scale = coefficient_scale(c);
+    const LREAL scale = coefficient_scale(c), start = isolated_start(c);
     prepare_isolated(c, binomials);
 #if REFINE_IN_CLOSED_FORM
     (void)scale;
     (void)tol_y;
+    (void)start;
     y = LANE_SEL((LREAL)0, line_root(f0, f1), running);
 #else
-    y = refine_root_lanes(c, f0, f1, tol_y, scale, running, &iterations);
+    y = refine_root_lanes(c, f0, f1, tol_y, scale, start, running, &iterations);
 #endif
   }
   REAL y_of[LANES];
