@@ -82,6 +82,18 @@ typedef struct {
 
 #if LANES == 1
 #define clip_lanes_to_extent clip_axes_to_extent /* LREAL and LMASK are REAL and int */
+
+/* The ray o + t*d as the one lane of LaneRays. */
+ALGRAY_INLINE LaneRays one_lane_rays(REAL3 o, REAL3 d) {
+  LaneRays r;
+  r.ox = o.x;
+  r.oy = o.y;
+  r.oz = o.z;
+  r.dx = d.x;
+  r.dy = d.y;
+  r.dz = d.z;
+  return r;
+}
 #else
 DEFINE_CLIP_TO_EXTENT(clip_lanes_to_extent, LREAL, LMASK)
 

@@ -626,19 +626,8 @@ void hit_records_lanes(uint count, const LaneRays* rays, const LaneRays* at, con
 
 #if LANES == 1
 HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global const REAL* coefs, uint count) {
-  LaneRays r, at;
-  r.ox = ray.o.x;
-  r.oy = ray.o.y;
-  r.oz = ray.o.z;
-  r.dx = ray.d.x;
-  r.dy = ray.d.y;
-  r.dz = ray.d.z;
-  at.ox = h.u.x;
-  at.oy = h.u.y;
-  at.oz = h.u.z;
-  at.dx = h.d_unit.x;
-  at.dy = h.d_unit.y;
-  at.dz = h.d_unit.z;
+  /* the ray as traced, and in unit coordinates from its hit point (as trace_lanes' `at`) */
+  const LaneRays r = one_lane_rays(ray.o, ray.d), at = one_lane_rays(h.u, h.d_unit);
   HitRecord record;
   hit_records_lanes(1, &r, &at, &h.root, exps, coefs, count, &record);
   return record;
