@@ -282,31 +282,40 @@ ALGRAY_INLINE LMASK one_strict_sign(const LREAL* c) {
 #endif
 /* isolate_bernstein for LANES polynomials at once (lanes.h), lanes where `running` is clear left alone: each
  * lane takes the scalar search's decisions in its order, with the same arithmetic, so it ends with the scalar
- * result bit for bit (tests/test_lanes). The search's position (level, idx) and the interval's width are kept
- * as REALs, exact for these small integers and powers of two, so that all the state is in vector registers.
+ * result bit for bit (tests/test_lanes). The search's position is kept as the interval's left end and width,
+ * REALs that are exact for these dyadic numbers, so that all the state is in vector registers: (level, idx) is
+ * (-log2 width, left end / width).
  * A halving, a recomputation from `root` and a copy of the cached sibling each cost every lane, so this pays
  * where neighbouring rays take similar searches (bench/RESULTS.md, "Lock-step lanes"). Mixed precision keeps
  * the scalar search per lane. */
 
-/* Sign changes between consecutive nonzero coefficients, per lane, as sign_variations counts them. */
+/* Sign changes between consecutive nonzero coefficients, per lane, as sign_variations counts them (a NaN counts
+ * as a zero). The last sign seen is carried by selections alone, and the changes are summed as a tree: added one
+ * after another, each waiting on the last, they were the longest chain of the search's step. */
 LREAL sign_variations_lanes(const LREAL* c) {
-  LREAL v = 0, prev = 0;
+  LREAL change[NCOEF];
+  LMASK seen = c[0] > 0 || c[0] < 0, prev_negative = c[0] < 0;
   ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) {
-    const LREAL s = LANE_SEL((LREAL)0, (LREAL)1, c[k] > 0) - LANE_SEL((LREAL)0, (LREAL)1, c[k] < 0);
-    v += LANE_SEL((LREAL)0, (LREAL)1, s * prev < 0);
-    prev = LANE_SEL(prev, s, s != 0);
+  for (int k = 1; k <= DEGREE; ++k) {
+    const LMASK negative = c[k] < 0, strict = negative || c[k] > 0;
+    change[k] = LANE_SEL((LREAL)0, (LREAL)1, strict && seen && negative != prev_negative);
+    prev_negative = LANE_SEL(prev_negative, negative, strict);
+    seen = seen || strict;
   }
-  return v;
+  change[0] = 0;
+  ALGRAY_UNROLL
+  for (int span = 1; span <= DEGREE; span *= 2) ALGRAY_UNROLL
+  for (int k = 0; k + span <= DEGREE; k += 2 * span) change[k] += change[k + span];
+  return change[0];
 }
 
-/* bernstein_restrict per lane: the coefficients on [idx * width, (idx + 1) * width] from the whole interval's,
- * into out for the lanes in `take`. */
-void bernstein_restrict_lanes(const LREAL* root, LREAL width, LREAL idx, LMASK take, LREAL* out) {
+/* bernstein_restrict per lane: the coefficients on [lo, lo + width] from the whole interval's, into out for the
+ * lanes in `take`. */
+void bernstein_restrict_lanes(const LREAL* root, LREAL lo, LREAL width, LMASK take, LREAL* out) {
   LREAL o[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) o[k] = root[k];
-  const LREAL lo = idx * width, hi = lo + width;
+  const LREAL hi = lo + width;
   const LMASK left = take && hi < (REAL)1;
   if (LANE_ANY(left)) {
     const LREAL x1 = (REAL)1 - hi;
@@ -346,7 +355,8 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
   for (int k = 0; k <= DEGREE; ++k) cur[k] = sib[k] = root[k];
   const LREAL len = t_out - t_in;
   const LREAL start_sign = LANE_SEL((LREAL)0, (LREAL)1, root[0] > 0) - LANE_SEL((LREAL)0, (LREAL)1, root[0] < 0);
-  LREAL level = 0, idx = 0, width = 1, sib_level = -1, sib_idx = 0;
+  /* the interval searched, [at, at + width], and the cached right half of the latest split (none yet) */
+  LREAL at = 0, width = 1, sib_at = 0, sib_width = 0;
   LREAL status = ISOLATION_NONE, steps = 0, lo = 0, hi = 1, f_lo = 0, f_hi = 0;
   LMASK budget = 0, cluster = 0, done = !running;
 #if ALGRAY_ESCALATE
@@ -369,7 +379,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
   for (;;) {
     const LMASK active = !done;
     steps += LANE_SEL((LREAL)0, (LREAL)1, active);
-    lo = LANE_SEL(lo, idx * width, active);
+    lo = LANE_SEL(lo, at, active);
     hi = LANE_SEL(hi, lo + width, active);
     f_lo = LANE_SEL(f_lo, cur[0], active);
     f_hi = LANE_SEL(f_hi, cur[DEGREE], active);
@@ -398,7 +408,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     const LMASK several = !done && v >= 1;
 #endif
     const LMASK located = width * len <= STOP_WIDTH(t_in + lo * len);
-    const LMASK halve = several && !located && level < (REAL)REAL_MAX_HALVINGS;
+    const LMASK halve = several && !located && width > (REAL)1 / (REAL)FINEST_UNITS; /* level < REAL_MAX_HALVINGS */
     const LMASK settle = several && !halve;
     budget = budget || (settle && !located);
     const LMASK cluster_root = settle && ((f_lo < 0) != (f_hi < 0));
@@ -415,24 +425,20 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
         cur[k] = LANE_SEL(cur[k], left[k], halve);
         sib[k] = LANE_SEL(sib[k], right[k], halve);
       }
-      level = LANE_SEL(level, level + 1, halve);
-      idx = LANE_SEL(idx, idx * 2, halve);
       width = LANE_SEL(width, width * (REAL)0.5, halve);
-      sib_level = LANE_SEL(sib_level, level, halve);
-      sib_idx = LANE_SEL(sib_idx, idx + 1, halve);
+      sib_width = LANE_SEL(sib_width, width, halve);
+      sib_at = LANE_SEL(sib_at, at + width, halve);
     }
-    /* next_interval for the lanes moving on: climb while a right child, then step right */
+    /* next_interval for the lanes moving on, without its loop: it climbs while the interval is a right child
+     * (idx odd), then steps right, so the next interval starts where this one ends, and is as wide as the
+     * largest power of two that divides that end (idx + 1's lowest set bit, in units of width). */
     LMASK move = !done && !halve;
     if (!LANE_ANY(move)) continue;
-    for (;;) {
-      const LMASK climb = move && idx != 2 * floor(idx * (REAL)0.5);
-      if (!LANE_ANY(climb)) break;
-      idx = LANE_SEL(idx, floor(idx * (REAL)0.5), climb);
-      level = LANE_SEL(level, level - 1, climb);
-      width = LANE_SEL(width, width * 2, climb);
-    }
+    const LREAL next_at = at + width;
+    const LANE_INT_VEC units = LANE_TO_INT(next_at * (REAL)FINEST_UNITS);
+    width = LANE_SEL(width, LANE_TO_REAL(units & -units) * ((REAL)1 / (REAL)FINEST_UNITS), move);
     /* isolation_at_far_end: the whole interval searched; its far end is a root only where P is zero there */
-    const LMASK finished = move && level == 0;
+    const LMASK finished = move && next_at == 1;
     status = LANE_SEL(status, LANE_SEL((LREAL)ISOLATION_NONE, (LREAL)ISOLATION_EXACT, root[DEGREE] == 0), finished);
     lo = LANE_SEL(lo, (LREAL)1, finished);
     hi = LANE_SEL(hi, (LREAL)1, finished);
@@ -440,12 +446,12 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     f_hi = LANE_SEL(f_hi, (LREAL)0, finished);
     done = done || finished;
     move = move && !finished;
-    idx = LANE_SEL(idx, idx + 1, move);
-    const LMASK from_sib = move && sib_level == level && sib_idx == idx;
+    at = LANE_SEL(at, next_at, move);
+    const LMASK from_sib = move && sib_width == width && sib_at == at;
     ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE; ++k) cur[k] = LANE_SEL(cur[k], sib[k], from_sib);
     const LMASK from_root = move && !from_sib;
-    if (LANE_ANY(from_root)) bernstein_restrict_lanes(root, width, idx, from_root, cur);
+    if (LANE_ANY(from_root)) bernstein_restrict_lanes(root, at, width, from_root, cur);
   }
   REAL status_of[LANES], steps_of[LANES], lo_of[LANES], hi_of[LANES], f_lo_of[LANES], f_hi_of[LANES];
   LANES_STORE(status, status_of);

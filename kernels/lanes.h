@@ -33,13 +33,45 @@ typedef LANE_VEC(REAL, LANES) LREAL; /* REAL8 for LANES = 8 (real.h) */
 #else
 #define LANE_INT_NAME int
 #endif
+#if ALGRAY_DOUBLE
+#define LANE_REAL_NAME double
+#else
+#define LANE_REAL_NAME float
+#endif
 typedef LANE_INT_NAME LANE_INT;
 typedef LANE_VEC(LANE_INT_NAME, LANES) LMASK;
+typedef LANE_VEC(LANE_INT_NAME, LANES) LANE_INT_VEC; /* integers per lane, as wide as a REAL */
+/* Lanes converted between REAL and integers (toward zero): convert_long8 and convert_double8 for LANES = 8 */
+#define LANE_TO_INT(x) LANE_VEC(LANE_VEC(convert_, LANE_INT_NAME), LANES)(x)
+#define LANE_TO_REAL(x) LANE_VEC(LANE_VEC(convert_, LANE_REAL_NAME), LANES)(x)
 #define LANE_SEL(a, b, m) select((a), (b), (m))
-#define LANE_ANY(m) any(m)
-#define LANE_ALL(m) all(m)
+#define LANE_ANY(m) lane_any(m)
+#define LANE_ALL(m) (!lane_any(!(m)))
 #else
 #error "LANES must be 1, 2, 4, 8 or 16"
+#endif
+
+#if LANES > 1
+/* Whether any lane of m is set: the halves or'ed down to one lane. PoCL's any() tests each 128-bit part's sign
+ * bits in turn, branching after each; in the search's loop that was a fifth of its samples (bench/RESULTS.md). */
+ALGRAY_INLINE int lane_any(LMASK m) {
+#if LANES == 16
+  const LANE_VEC(LANE_INT_NAME, 8) m8 = m.lo | m.hi;
+#elif LANES == 8
+  const LANE_VEC(LANE_INT_NAME, 8) m8 = m;
+#endif
+#if LANES >= 8
+  const LANE_VEC(LANE_INT_NAME, 4) m4 = m8.lo | m8.hi;
+#elif LANES == 4
+  const LANE_VEC(LANE_INT_NAME, 4) m4 = m;
+#endif
+#if LANES >= 4
+  const LANE_VEC(LANE_INT_NAME, 2) m2 = m4.lo | m4.hi;
+#else
+  const LANE_VEC(LANE_INT_NAME, 2) m2 = m;
+#endif
+  return (m2.s0 | m2.s1) != 0;
+}
 #endif
 
 /* The vector of type T holding f(0), f(1), ..., f(LANES - 1), built in registers (lane_set goes through memory,

@@ -33,8 +33,10 @@ Ray camera_ray(uint px, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4
 /* [t_in, t_out] of rays o + t*d inside the extent, given in unit coordinates u = (p - centre)/scale, where the
  * sphere is the unit sphere and the box is |u_i| <= half_i; returns where they enter it. Written once over a real
  * type T and its comparisons' type M (REAL and int, or LREAL and LMASK of lanes.h), so that every lane of the
- * vector instance is the scalar one's result bit for bit. A ray that misses leaves t_in, t_out undefined. */
-#define DEFINE_CLIP_TO_EXTENT(name, T, M)                                                                            \
+ * vector instance is the scalar one's result bit for bit. A ray that misses leaves t_in, t_out undefined. ANY(m):
+ * whether any lane of m is set. Where no ray meets the sphere, its square root and divisions are skipped (more
+ * than half of a typical view's lanes miss it, in whole groups). */
+#define DEFINE_CLIP_TO_EXTENT(name, T, M, ANY)                                                                            \
   M name(T ox, T oy, T oz, T dx, T dy, T dz, int kind, REAL3 box_half, T* t_in, T* t_out) {                          \
     T lo = 0, hi;                                                                                                    \
     M hit;                                                                                                           \
@@ -48,11 +50,14 @@ Ray camera_ray(uint px, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4
       }                                                                                                              \
       const T disc = b * b - a * c;                                                                                  \
       hit = disc > 0 && a > 0;                                                                                       \
-      /* The product form avoids cancellation when one intersection is near the origin. */                          \
-      const T q = -(b + copysign(sqrt(disc), b));                                                                    \
-      const T t0 = q / a, t1 = c / q;                                                                                \
-      lo = fmax(fmin(t0, t1), (T)0);                                                                                 \
-      hi = fmax(t0, t1);                                                                                             \
+      hi = 0;                                                                                                        \
+      if (ANY(hit)) {                                                                                                \
+        /* The product form avoids cancellation when one intersection is near the origin. */                        \
+        const T q = -(b + copysign(sqrt(disc), b));                                                                  \
+        const T t0 = q / a, t1 = c / q;                                                                              \
+        lo = fmax(fmin(t0, t1), (T)0);                                                                               \
+        hi = fmax(t0, t1);                                                                                           \
+      }                                                                                                              \
     } else {                                                                                                         \
       hi = REAL_MAX;                                                                                                 \
       /* +-inf for axis-parallel rays, which the min/max below handle */                                            \
@@ -69,7 +74,9 @@ Ray camera_ray(uint px, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4
     return hit && hi > lo;                                                                                           \
   }
 
-DEFINE_CLIP_TO_EXTENT(clip_axes_to_extent, REAL, int)
+#define CLIP_ONE_ANY(m) (m)
+DEFINE_CLIP_TO_EXTENT(clip_axes_to_extent, REAL, int, CLIP_ONE_ANY)
+#undef CLIP_ONE_ANY
 
 int clip_to_extent(REAL3 o, REAL3 d, int kind, REAL3 box_half, REAL* t_in, REAL* t_out) {
   return clip_axes_to_extent(o.x, o.y, o.z, d.x, d.y, d.z, kind, box_half, t_in, t_out);
@@ -95,7 +102,7 @@ ALGRAY_INLINE LaneRays one_lane_rays(REAL3 o, REAL3 d) {
   return r;
 }
 #else
-DEFINE_CLIP_TO_EXTENT(clip_lanes_to_extent, LREAL, LMASK)
+DEFINE_CLIP_TO_EXTENT(clip_lanes_to_extent, LREAL, LMASK, LANE_ANY)
 
 /* The pixel centres (REAL)px + 0.5 of columns px0 .. px0 + LANES - 1, each as camera_ray computes it: px0 + j is
  * exact in REAL for any image width a float can index. */

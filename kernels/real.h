@@ -24,6 +24,7 @@ typedef double16 REAL16;
 #define REAL_EPS DBL_EPSILON
 #define REAL_MAX DBL_MAX
 #define REAL_MAX_HALVINGS 52   /* dyadic subintervals of [0,1] stay exact down to this level */
+#define FINEST_UNITS (1L << REAL_MAX_HALVINGS) /* the finest subintervals in [0, 1]; an integer of LANE_INT */
 #else
 typedef float REAL;
 typedef float2 REAL2;
@@ -34,6 +35,7 @@ typedef float16 REAL16;
 #define REAL_EPS FLT_EPSILON
 #define REAL_MAX FLT_MAX
 #define REAL_MAX_HALVINGS 23
+#define FINEST_UNITS (1 << REAL_MAX_HALVINGS)
 #endif
 
 /* The kernel is specialised by degree; everything sized by it lives in private arrays. */
