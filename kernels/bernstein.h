@@ -292,7 +292,7 @@ ALGRAY_INLINE LMASK one_strict_sign(const LREAL* c) {
 /* Sign changes between consecutive nonzero coefficients, per lane, as sign_variations counts them (a NaN counts
  * as a zero). The last sign seen is carried by selections alone, and the changes are summed as a tree: added one
  * after another, each waiting on the last, they were the longest chain of the search's step. */
-LREAL sign_variations_lanes(const LREAL* c) {
+ALGRAY_INLINE LREAL sign_variations_lanes(const LREAL* c) {
   LREAL change[NCOEF];
   LMASK seen = c[0] > 0 || c[0] < 0, prev_negative = c[0] < 0;
   ALGRAY_UNROLL

@@ -36,14 +36,14 @@ Ray camera_ray(uint px, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4
  * vector instance is the scalar one's result bit for bit. A ray that misses leaves t_in, t_out undefined. ANY(m):
  * whether any lane of m is set. Where no ray meets the sphere, its square root and divisions are skipped (more
  * than half of a typical view's lanes miss it, in whole groups). */
-#define DEFINE_CLIP_TO_EXTENT(name, T, M, ANY)                                                                            \
-  M name(T ox, T oy, T oz, T dx, T dy, T dz, int kind, REAL3 box_half, T* t_in, T* t_out) {                          \
+#define DEFINE_CLIP_TO_EXTENT(name, T, M, ANY)                                                                       \
+  ALGRAY_INLINE M name(T ox, T oy, T oz, T dx, T dy, T dz, int kind, REAL3 box_half, T* t_in, T* t_out) {            \
     T lo = 0, hi;                                                                                                    \
     M hit;                                                                                                           \
     if (kind == ALGRAY_EXTENT_SPHERE) {                                                                              \
       T a, b, c;                                                                                                     \
       {                                                                                                              \
-        /* as dot() sums them: three products, added left to right */                                               \
+        /* as dot() sums them: three products, added left to right */                                                \
         _Pragma("OPENCL FP_CONTRACT OFF") a = (dx * dx + dy * dy) + dz * dz;                                         \
         b = (ox * dx + oy * dy) + oz * dz;                                                                           \
         c = ((ox * ox + oy * oy) + oz * oz) - (REAL)1;                                                               \
@@ -52,7 +52,7 @@ Ray camera_ray(uint px, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4
       hit = disc > 0 && a > 0;                                                                                       \
       hi = 0;                                                                                                        \
       if (ANY(hit)) {                                                                                                \
-        /* The product form avoids cancellation when one intersection is near the origin. */                        \
+        /* The product form avoids cancellation when one intersection is near the origin. */                         \
         const T q = -(b + copysign(sqrt(disc), b));                                                                  \
         const T t0 = q / a, t1 = c / q;                                                                              \
         lo = fmax(fmin(t0, t1), (T)0);                                                                               \
@@ -60,7 +60,7 @@ Ray camera_ray(uint px, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4
       }                                                                                                              \
     } else {                                                                                                         \
       hi = REAL_MAX;                                                                                                 \
-      /* +-inf for axis-parallel rays, which the min/max below handle */                                            \
+      /* +-inf for axis-parallel rays, which the min/max below handle */                                             \
       const T ix = (REAL)1 / dx, iy = (REAL)1 / dy, iz = (REAL)1 / dz;                                               \
       const T ax = (-box_half.x - ox) * ix, bx = (box_half.x - ox) * ix;                                             \
       const T ay = (-box_half.y - oy) * iy, by = (box_half.y - oy) * iy;                                             \

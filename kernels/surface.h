@@ -642,7 +642,7 @@ HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global 
  * One ray's steps are chains of dependent vector operations; over lanes the D + 1 coefficients' chains run side
  * by side. row: the image row's polynomials (screen_rows); xi: each lane's column; tau_in, tau_out: each lane's
  * segment about the row's t0. */
-void screen_coefficients_lanes(__global const REAL* row, LREAL xi, LREAL tau_in, LREAL tau_out,
+ALGRAY_INLINE void screen_coefficients_lanes(__global const REAL* row, LREAL xi, LREAL tau_in, LREAL tau_out,
                                __constant const REAL* binomials, LREAL* out) {
   LREAL taylor[NCOEF];
   ALGRAY_UNROLL
@@ -696,6 +696,12 @@ void trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale,
   LaneRays unit;
   const LMASK running = enter_lanes(count, rays, centre, inv_scale, box_half, extent_kind, &unit, &lane_t_in,
                                     &lane_t_out, t_in, t_out, in_extent);
+  if (!LANE_ANY(running)) {
+    /* no ray enters the extent (whole groups of most views): their records straight away */
+    for (uint j = 0; j < count; ++j) roots[j] = missed_root();
+    hit_records_lanes(count, rays, &unit, roots, exps, coefs, mono_count, records);
+    return;
+  }
 #if SCREEN_LANES
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) iso_c[k] = 0;
