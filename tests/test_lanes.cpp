@@ -178,6 +178,15 @@ TEST_CASE("the plan gives lanes to the camera and secondary rays' kernels, where
   CHECK(in_double.find(PassKind::Shadow)->escalation.at(0).ray_origin == RayOrigin::Point);
   CHECK(in_double.find(PassKind::Shadow)->escalation.at(0).lanes == 8);
   CHECK(in_double.find(PassKind::Primary)->escalation.at(0).ray_origin == RayOrigin::Extent);
+  // Camera and secondary rays take 16 lanes where asked; the shadow kernel's point form at most kMaxShadowLanes.
+  const RenderPlan wide = make_render_plan(full, Precision::Double, 0, 16);
+  CHECK(wide.find(PassKind::Primary)->kernels.at(0).lanes == 16);
+  CHECK(wide.find(PassKind::Reflection)->kernels.at(0).lanes == 16);
+  CHECK(wide.find(PassKind::Shadow)->kernels.at(0).lanes == kMaxShadowLanes);
+  RenderPlan wide_adaptive = make_render_plan(full, Precision::Adaptive, 0, 16);
+  escalate_in(wide_adaptive, Precision::Double);
+  CHECK(wide_adaptive.find(PassKind::Primary)->escalation.at(0).lanes == 16);
+  CHECK(wide_adaptive.find(PassKind::Shadow)->escalation.at(0).lanes == kMaxShadowLanes);
   RenderPlan in_mixed = adaptive;
   escalate_in(in_mixed, Precision::Mixed);
   CHECK(in_mixed.find(PassKind::Shadow)->escalation.at(0).ray_origin == RayOrigin::Extent);

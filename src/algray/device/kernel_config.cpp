@@ -44,7 +44,8 @@ std::string hex_double(double v) {
 
 }  // namespace
 
-int default_lanes(const std::string& device_type) { return device_type == "CPU" ? 8 : 1; }
+int default_lanes(const std::string& device_type) { return device_type == "CPU" ? 16 : 1; }
+int shadow_lanes(int lanes) { return lanes < kMaxShadowLanes ? lanes : kMaxShadowLanes; }
 bool lanes_apply(const KernelConfig& c) {
   if (c.entry == "shadow") return c.ray_origin == RayOrigin::Point;  // the extent form batches its own way
   return (c.entry == "primary" || c.entry == "trace") && c.isolation == Isolation::Bernstein &&

@@ -10,10 +10,14 @@ namespace algray {
 struct KernelConfig;
 
 // The lane count a render uses on a device of `device_type` ("CPU", "GPU", ...) unless the scene sets
-// render.lanes: 8 on a CPU, whose work-items run one after another, 1 on devices that already run work-items in
+// render.lanes: 16 on a CPU, whose work-items run one after another, 1 on devices that already run work-items in
 // SIMD; and whether a kernel can be built with more than one lane at all.
 int default_lanes(const std::string& device_type);
 bool lanes_apply(const KernelConfig& config);
+// The shadow kernel's point form takes at most 8 light samples of a point side by side, whatever the camera rays
+// take: at 16 its pass took 1.5 times as long on the Barth sextic and decic (bench/RESULTS.md).
+constexpr int kMaxShadowLanes = 8;
+int shadow_lanes(int lanes);
 
 struct KernelConfig {
   std::string entry = "primary";  // kernel file (without .cl) and kernel function

@@ -53,7 +53,7 @@ void escalate_in(RenderPlan& plan, Precision precision) {
       // rays, their pass 132 -> 66 ms).
       if (pass.kind == PassKind::Shadow && c.ray_origin == RayOrigin::Extent && point_form_applies(c)) {
         c.ray_origin = RayOrigin::Point;
-        c.lanes = primary->kernels.at(i).lanes;
+        c.lanes = shadow_lanes(primary->kernels.at(i).lanes);
       }
       // The first pass's settling costs about what double's second pass saves (Barth decic: sign sampling 1.28x ->
       // 1.30x float's time, 1.69x -> 1.55x where the second pass is float-float; each interval's own noise 1.24x
@@ -145,7 +145,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
       c.max_iterations = default_max_iterations(Refinement::Brent);
       if (scene.render.ray_origin == RayOrigin::Auto && point_form_applies(c)) {
         c.ray_origin = RayOrigin::Point;
-        c.lanes = primary[i].lanes;
+        c.lanes = shadow_lanes(primary[i].lanes);
       }
     }
     std::size_t points = 0;
