@@ -357,8 +357,10 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
   const LREAL start_sign = LANE_SEL((LREAL)0, (LREAL)1, root[0] > 0) - LANE_SEL((LREAL)0, (LREAL)1, root[0] < 0);
   /* the interval searched, [at, at + width], and the cached right half of the latest split (none yet) */
   LREAL at = 0, width = 1, sib_at = 0, sib_width = 0;
-  LREAL status = ISOLATION_NONE, steps = 0, lo = 0, hi = 1, f_lo = 0, f_hi = 0;
-  LMASK budget = 0, cluster = 0, done = !running;
+  LREAL status = ISOLATION_NONE, steps = 0;
+  /* A lane that stops keeps its interval [at, at + width] and its coefficients cur, which are what it reports,
+   * unless it ended past the far end (searched_all). */
+  LMASK budget = 0, cluster = 0, searched_all = 0, done = !running;
 #if ALGRAY_ESCALATE
   /* doubt_noise and doubted per lane: a doubted lane stops with status NONE and its ALGRAY_DOUBT_* */
   LREAL magnitude[NCOEF], doubt = 0;
@@ -379,10 +381,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
   for (;;) {
     const LMASK active = !done;
     steps += LANE_SEL((LREAL)0, (LREAL)1, active);
-    lo = LANE_SEL(lo, at, active);
-    hi = LANE_SEL(hi, lo + width, active);
-    f_lo = LANE_SEL(f_lo, cur[0], active);
-    f_hi = LANE_SEL(f_hi, cur[DEGREE], active);
+    const LREAL f_lo = cur[0], f_hi = cur[DEGREE];
     /* settled_at_left_end: an exact zero, or the other sign than at t_in */
     const LREAL s = LANE_SEL((LREAL)0, (LREAL)1, f_lo > 0) - LANE_SEL((LREAL)0, (LREAL)1, f_lo < 0);
     const LMASK exact = active && (f_lo == 0 || (s != 0 && s != start_sign));
@@ -407,7 +406,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     /* halve_or_settle for the lanes that may hold several roots */
     const LMASK several = !done && v >= 1;
 #endif
-    const LMASK located = width * len <= STOP_WIDTH(t_in + lo * len);
+    const LMASK located = width * len <= STOP_WIDTH(t_in + at * len);
     const LMASK halve = several && !located && width > (REAL)1 / (REAL)FINEST_UNITS; /* level < REAL_MAX_HALVINGS */
     const LMASK settle = several && !halve;
     budget = budget || (settle && !located);
@@ -440,10 +439,7 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     /* isolation_at_far_end: the whole interval searched; its far end is a root only where P is zero there */
     const LMASK finished = move && next_at == 1;
     status = LANE_SEL(status, LANE_SEL((LREAL)ISOLATION_NONE, (LREAL)ISOLATION_EXACT, root[DEGREE] == 0), finished);
-    lo = LANE_SEL(lo, (LREAL)1, finished);
-    hi = LANE_SEL(hi, (LREAL)1, finished);
-    f_lo = LANE_SEL(f_lo, (LREAL)0, finished);
-    f_hi = LANE_SEL(f_hi, (LREAL)0, finished);
+    searched_all = searched_all || finished;
     done = done || finished;
     move = move && !finished;
     at = LANE_SEL(at, next_at, move);
@@ -456,10 +452,11 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
   REAL status_of[LANES], steps_of[LANES], lo_of[LANES], hi_of[LANES], f_lo_of[LANES], f_hi_of[LANES];
   LANES_STORE(status, status_of);
   LANES_STORE(steps, steps_of);
-  LANES_STORE(lo, lo_of);
-  LANES_STORE(hi, hi_of);
-  LANES_STORE(f_lo, f_lo_of);
-  LANES_STORE(f_hi, f_hi_of);
+  /* isolation_at_far_end reports [1, 1] with zero values */
+  LANES_STORE(LANE_SEL(at, (LREAL)1, searched_all), lo_of);
+  LANES_STORE(LANE_SEL(at + width, (LREAL)1, searched_all), hi_of);
+  LANES_STORE(LANE_SEL(cur[0], (LREAL)0, searched_all), f_lo_of);
+  LANES_STORE(LANE_SEL(cur[DEGREE], (LREAL)0, searched_all), f_hi_of);
 #if ALGRAY_ESCALATE
   REAL doubt_of[LANES], noise_of[LANES];
   LANES_STORE(doubt, doubt_of);

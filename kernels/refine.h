@@ -85,9 +85,12 @@ LREAL refine_root_lanes(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL s
     /* inverse quadratic interpolation through (a, fa), (b, fb), (c, fc), else the secant */
     const LMASK quadratic = fa != fc && fb != fc && fa != fb;
     const LMASK secant = !quadratic && fa != fb;
-    const LREAL r = fb / fc, s = fb / fa, q = fa / fc;
-    const LREAL num = s * (q * (q - r) * (cp - b) - (r - (REAL)1) * (b - a));
-    const LREAL den = (q - (REAL)1) * (r - (REAL)1) * (s - (REAL)1);
+    LREAL num = 0, den = 1;
+    if (LANE_ANY(quadratic)) { /* never on the first step, where a and c are one point: its three divisions wait */
+      const LREAL r = fb / fc, s = fb / fa, q = fa / fc;
+      num = s * (q * (q - r) * (cp - b) - (r - (REAL)1) * (b - a));
+      den = (q - (REAL)1) * (r - (REAL)1) * (s - (REAL)1);
+    }
     /* one division for either step: b - fb (b - a) / (fb - fa), or b - num / den */
     const LREAL step_num = LANE_SEL(fb * (b - a), num, quadratic), step_den = LANE_SEL(fb - fa, den, quadratic);
     const LREAL cand = LANE_SEL(b, b - step_num / step_den, quadratic || secant);
