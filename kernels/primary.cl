@@ -41,8 +41,9 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
   const uint count = min((uint)LANES, tile_w - x0), py = tile_y0 + gy;
   const LaneRays rays = camera_rays_lanes(tile_x0 + x0, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
   HitRecord records[LANES];
-  trace_lanes(count, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind, mono_exps, mono_coefs,
-              mono_count, binomials, even_axes, records SCREEN_LANES_ARG(tile_x0 + x0, py));
-  for (uint j = 0; j < count; ++j) out[(size_t)gy * tile_w + x0 + j] = records[j];
+  const int entered = trace_lanes(count, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
+                                  mono_exps, mono_coefs, mono_count, binomials, even_axes,
+                                  records SCREEN_LANES_ARG(tile_x0 + x0, py));
+  for (uint j = 0; j < count; ++j) out[(size_t)gy * tile_w + x0 + j] = entered ? records[j] : missed_record();
 #endif
 }

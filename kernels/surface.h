@@ -106,6 +106,18 @@ ALGRAY_INLINE SegmentRoot missed_root(void) {
   return r;
 }
 
+/* The hit record of a ray that misses the extent: hit_records_lanes starts every record from it. */
+ALGRAY_INLINE HitRecord missed_record(void) {
+  HitRecord r;
+  r.flags = 0;
+  r.work = ALGRAY_WORK_PACK(0u, 0u);
+  r.t_hi = INFINITY;
+  r.t_lo = 0;
+  r.depth = INFINITY;
+  r.normal_x = r.normal_y = r.normal_z = 0;
+  return r;
+}
+
 /* The record of what the isolation found, before refinement; a bracket (ISOLATION_BRACKET) is refined next. */
 SegmentRoot isolated_root(Isolation iso PROBE_PARAM) {
   SegmentRoot r = missed_root();
@@ -597,13 +609,9 @@ void hit_records_lanes(uint count, const LaneRays* rays, const LaneRays* at, con
   /* Front is the side where P > 0; at an exact root use the direction in which P grows instead. */
   for (uint j = 0; j < count; ++j) {
     const SegmentRoot root = roots[j];
-    HitRecord r;
+    HitRecord r = missed_record();
     r.flags = root.flags;
     r.work = ALGRAY_WORK_PACK(min(root.steps, ALGRAY_WORK_MAX), min(root.iterations, ALGRAY_WORK_MAX));
-    r.t_hi = INFINITY;
-    r.t_lo = 0;
-    r.depth = INFINITY;
-    r.normal_x = r.normal_y = r.normal_z = 0;
     if ((found_bits >> j) & 1u) {
       r.t_hi = (float)root.t;
       r.t_lo = (float)(root.t - (REAL)r.t_hi);
@@ -681,11 +689,12 @@ ALGRAY_INLINE void screen_coefficients_lanes(__global const REAL* row, LREAL xi,
 #endif
 
 #if LANES > 1
-/* trace_surface and hit_record for the first `count` (<= LANES) of the lanes' rays: they are clipped together, each
+/* trace_surface and hit_record for the first `count` (<= LANES) of the lanes' rays, or 0 when none enters the
+ * extent (records then left alone: each is missed_record()). They are clipped together, each
  * is restricted on its own (the screen form: together), then all are isolated, refined and their normals taken
  * together in vector lanes (lanes.h), with the one-ray kernel's records bit for bit (tests/test_lanes). Camera
  * and secondary rays share it. */
-void trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
+int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                  __global const uint* exps, __global const REAL* coefs, uint mono_count,
                  __constant const REAL* binomials, uint even_axes, HitRecord* records SCREEN_LANES_PARAM) {
   Isolation iso[LANES];
@@ -696,12 +705,8 @@ void trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale,
   LaneRays unit;
   const LMASK running = enter_lanes(count, rays, centre, inv_scale, box_half, extent_kind, &unit, &lane_t_in,
                                     &lane_t_out, t_in, t_out, in_extent);
-  if (!LANE_ANY(running)) {
-    /* no ray enters the extent (whole groups of most views): their records straight away */
-    for (uint j = 0; j < count; ++j) roots[j] = missed_root();
-    hit_records_lanes(count, rays, &unit, roots, exps, coefs, mono_count, records);
-    return;
-  }
+  /* no ray enters the extent (whole groups of most views): the caller writes missed_record() for each */
+  if (!LANE_ANY(running)) return 0;
 #if SCREEN_LANES
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) iso_c[k] = 0;
@@ -764,6 +769,7 @@ void trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale,
   }
 #endif
   hit_records_lanes(count, rays, &at, roots, exps, coefs, mono_count, records);
+  return 1;
 }
 #endif
 

@@ -54,8 +54,8 @@ __kernel void trace(__global const REAL4* origins, __global const REAL4* directi
 #undef DIRECTION_Y
 #undef DIRECTION_Z
   HitRecord records[LANES];
-  trace_lanes(group, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind, mono_exps, mono_coefs,
-              mono_count, binomials, even_axes, records);
-  for (uint j = 0; j < group; ++j) out[first + j] = records[j];
+  const int entered = trace_lanes(group, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
+                                  mono_exps, mono_coefs, mono_count, binomials, even_axes, records);
+  for (uint j = 0; j < group; ++j) out[first + j] = entered ? records[j] : missed_record();
 #endif
 }
