@@ -346,9 +346,9 @@ void bernstein_restrict_lanes(const LREAL* root, LREAL lo, LREAL width, LMASK ta
   for (int k = 0; k <= DEGREE; ++k) out[k] = LANE_SEL(out[k], o[k], take);
 }
 
-/* root: each lane's Bernstein coefficients on [t_in, t_out]. On return iso[j] is lane j's Isolation for every
- * running lane j < count, and cur_out holds each lane's coefficients on its isolating interval. */
-void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL t_in, LREAL t_out, Isolation* iso,
+/* root: each lane's Bernstein coefficients on [t_in, t_out]. On return each running lane of iso is that lane's
+ * Isolation (the others mean nothing), and cur_out holds each lane's coefficients on its isolating interval. */
+void isolate_bernstein_lanes(LMASK running, const LREAL* root, LREAL t_in, LREAL t_out, LaneIsolation* iso,
                              LREAL* cur_out LANE_TERMS_PARAM) {
   LREAL cur[NCOEF], sib[NCOEF];
   ALGRAY_UNROLL
@@ -449,38 +449,21 @@ void isolate_bernstein_lanes(uint count, LMASK running, const LREAL* root, LREAL
     const LMASK from_root = move && !from_sib;
     if (LANE_ANY(from_root)) bernstein_restrict_lanes(root, at, width, from_root, cur);
   }
-  REAL status_of[LANES], steps_of[LANES], lo_of[LANES], hi_of[LANES], f_lo_of[LANES], f_hi_of[LANES];
-  LANES_STORE(status, status_of);
-  LANES_STORE(steps, steps_of);
+  iso->status = status;
+  iso->steps = steps;
   /* isolation_at_far_end reports [1, 1] with zero values */
-  LANES_STORE(LANE_SEL(at, (LREAL)1, searched_all), lo_of);
-  LANES_STORE(LANE_SEL(at + width, (LREAL)1, searched_all), hi_of);
-  LANES_STORE(LANE_SEL(cur[0], (LREAL)0, searched_all), f_lo_of);
-  LANES_STORE(LANE_SEL(cur[DEGREE], (LREAL)0, searched_all), f_hi_of);
+  iso->lo = LANE_SEL(at, (LREAL)1, searched_all);
+  iso->hi = LANE_SEL(at + width, (LREAL)1, searched_all);
+  iso->f_lo = LANE_SEL(cur[0], (LREAL)0, searched_all);
+  iso->f_hi = LANE_SEL(cur[DEGREE], (LREAL)0, searched_all);
+  iso->budget = budget;
+  iso->cluster = cluster;
 #if ALGRAY_ESCALATE
-  REAL doubt_of[LANES], noise_of[LANES];
-  LANES_STORE(doubt, doubt_of);
-  LANES_STORE(noise, noise_of);
-#endif
-  const uint running_bits = lane_mask_bits(running), budget_bits = lane_mask_bits(budget),
-             cluster_bits = lane_mask_bits(cluster);
-  for (uint j = 0; j < count; ++j) {
-    if (!((running_bits >> j) & 1)) continue;
-    iso[j].status = (int)status_of[j];
-    iso[j].budget = (budget_bits >> j) & 1;
-    iso[j].cluster = (cluster_bits >> j) & 1;
-    iso[j].steps = (uint)steps_of[j];
-#if ALGRAY_ESCALATE
-    iso[j].doubt = (uint)doubt_of[j];
-    iso[j].noise = noise_of[j];
+  iso->doubt = doubt;
+  iso->noise = noise;
 #else
-    iso[j].doubt = 0;
+  iso->doubt = iso->noise = 0;
 #endif
-    iso[j].lo = lo_of[j];
-    iso[j].hi = hi_of[j];
-    iso[j].f_lo = f_lo_of[j];
-    iso[j].f_hi = f_hi_of[j];
-  }
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) cur_out[k] = cur[k];
 }

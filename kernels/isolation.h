@@ -2,6 +2,7 @@
 #ifndef ALGRAY_ISOLATION_H
 #define ALGRAY_ISOLATION_H
 
+#include "lanes.h"
 #include "probe_log.h"
 #include "real.h"
 #include "restrict.h"
@@ -21,6 +22,44 @@ typedef struct {
   REAL lo, hi;
   REAL f_lo, f_hi;
 } Isolation;
+
+#if LANES > 1
+/* The isolations of LANES rays side by side (isolate_bernstein_lanes): each field Isolation's, lane j ray j's, in
+ * vectors, so that the refinement and the records take them without a trip through memory. */
+typedef struct {
+  LREAL status, steps, lo, hi, f_lo, f_hi;
+  LMASK budget, cluster;
+  LREAL doubt, noise; /* adaptive builds; 0 elsewhere */
+} LaneIsolation;
+
+/* Lane j of lanes as one Isolation, and back. */
+Isolation lane_isolation(const LaneIsolation* lanes, uint j) {
+  Isolation iso;
+  iso.status = (int)lane_get(lanes->status, j);
+  iso.budget = lane_get_mask(lanes->budget, j) != 0;
+  iso.cluster = lane_get_mask(lanes->cluster, j) != 0;
+  iso.steps = (uint)lane_get(lanes->steps, j);
+  iso.doubt = (uint)lane_get(lanes->doubt, j);
+  iso.noise = lane_get(lanes->noise, j);
+  iso.lo = lane_get(lanes->lo, j);
+  iso.hi = lane_get(lanes->hi, j);
+  iso.f_lo = lane_get(lanes->f_lo, j);
+  iso.f_hi = lane_get(lanes->f_hi, j);
+  return iso;
+}
+void set_lane_isolation(LaneIsolation* lanes, uint j, Isolation iso) {
+  lane_set(&lanes->status, j, (REAL)iso.status);
+  lane_set_mask(&lanes->budget, j, iso.budget);
+  lane_set_mask(&lanes->cluster, j, iso.cluster);
+  lane_set(&lanes->steps, j, (REAL)iso.steps);
+  lane_set(&lanes->doubt, j, (REAL)iso.doubt);
+  lane_set(&lanes->noise, j, iso.noise);
+  lane_set(&lanes->lo, j, iso.lo);
+  lane_set(&lanes->hi, j, iso.hi);
+  lane_set(&lanes->f_lo, j, iso.f_lo);
+  lane_set(&lanes->f_hi, j, iso.f_hi);
+}
+#endif
 
 Isolation isolation_none(void) {
   Isolation iso;

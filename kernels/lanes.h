@@ -21,6 +21,8 @@
 #if LANES == 1
 typedef REAL LREAL;
 typedef int LMASK;
+typedef int LANE_INT;     /* one lane's integer */
+typedef int LANE_INT_VEC; /* integers per lane */
 #define LANE_SEL(a, b, m) ((m) ? (b) : (a))
 #define LANE_ANY(m) (m)
 #define LANE_ALL(m) (m)

@@ -260,10 +260,11 @@ ulong search_queued(SearchQueue* queue) {
   LREAL cur[NCOEF];
 #if LANES > 1
   LMASK running = lanes_of_bits((1u << queue->count) - 1);
-  Isolation iso[LANES];
-  isolate_bernstein_lanes(queue->count, running, queue->b, queue->t_in, queue->t_out, iso, cur);
+  LaneIsolation iso;
+  isolate_bernstein_lanes(running, queue->b, queue->t_in, queue->t_out, &iso, cur);
+  const uint found_bits = lane_mask_bits(running && iso.status != (REAL)ISOLATION_NONE);
   for (uint j = 0; j < queue->count; ++j)
-    if (iso[j].status != ISOLATION_NONE) found |= (ulong)1 << queue->sample[j];
+    if ((found_bits >> j) & 1u) found |= (ulong)1 << queue->sample[j];
 #else
   if (isolate_bernstein(queue->b, queue->b, queue->t_in, queue->t_out, cur).status != ISOLATION_NONE)
     found = (ulong)1 << queue->sample[0];

@@ -73,6 +73,12 @@ typedef struct {
   uint iterations; /* refinement iterations */
 } SegmentRoot;
 
+/* SegmentRoot for LANES rays side by side (trace_lanes), lane j ray j's; with LANES = 1, one ray's (hit_record). */
+typedef struct {
+  LREAL t, f_before;
+  LANE_INT_VEC flags, steps, iterations;
+} LaneRoots;
+
 typedef struct {
   SegmentRoot root; /* root.t: the ray parameter of the hit; root.flags also carries ALGRAY_HIT_IN_EXTENT */
   REAL3 u;          /* hit point in unit coordinates */
@@ -192,36 +198,27 @@ SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
   return r;
 }
 #else
-/* The roots of LANES rays' isolations, refined together in lanes (lanes.h); c holds each lane's polynomial on its
- * isolating interval (consumed). Lanes whose ray missed the extent (in_extent[j] == 0) get missed_root(); lanes
- * from `count` on are left alone. */
-void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL* c, const REAL* t_in, const REAL* t_out,
-                  __constant const REAL* binomials, SegmentRoot* roots) {
-  uint refine_bits = 0;
-  for (uint j = 0; j < count; ++j) {
-    roots[j] = in_extent[j] ? isolated_root(iso[j]) : missed_root();
-    if (in_extent[j] && iso[j].status == ISOLATION_BRACKET) refine_bits |= 1u << j;
-  }
-  const LMASK running = lanes_of_bits(refine_bits);
+/* The roots of LANES rays' isolations, refined together in lanes (lanes.h), in vectors throughout: c holds each
+ * lane's polynomial on its isolating interval (consumed); t_in, t_out each lane's segment. Lanes that missed the
+ * extent (not in `entered`) get missed_root()'s fields; every other lane isolated_root's, then place_root's where
+ * a root was found, with ALGRAY_HIT_IN_EXTENT. */
+void refine_lanes(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in, LREAL t_out,
+                  __constant const REAL* binomials, LaneRoots* roots) {
+  /* isolated_root's flags */
+#define FLAG_WHERE(flag, mask) LANE_SEL((LANE_INT_VEC)0, (LANE_INT_VEC)(flag), (mask))
+  LANE_INT_VEC flags = FLAG_WHERE(ALGRAY_HIT_IN_EXTENT, entered) | FLAG_WHERE(ALGRAY_HIT_BUDGET, entered && iso->budget) |
+                       FLAG_WHERE(ALGRAY_HIT_DOUBT, entered && iso->doubt != 0) |
+                       FLAG_WHERE(ALGRAY_HIT_EXACT, entered && iso->status == (REAL)ISOLATION_EXACT) |
+                       FLAG_WHERE(ALGRAY_HIT_CLUSTER, entered && iso->status != (REAL)ISOLATION_NONE && iso->cluster);
+  const LMASK running = entered && iso->status == (REAL)ISOLATION_BRACKET;
+  const LMASK found = entered && iso->status != (REAL)ISOLATION_NONE;
   LREAL y = 0;
   LMASK iterations = 0;
-  if (refine_bits) {
-    /* each refined lane's bracket, gathered from its isolation (zeros elsewhere) */
-#define ISO_FIELD(field, j) (((refine_bits >> (j)) & 1u) ? iso[j].field : (REAL)0)
-#define ISO_F_LO(j) ISO_FIELD(f_lo, j)
-#define ISO_F_HI(j) ISO_FIELD(f_hi, j)
-#define ISO_LO(j) ISO_FIELD(lo, j)
-#define ISO_HI(j) ISO_FIELD(hi, j)
-    const LREAL f0 = LANES_OF(LREAL, ISO_F_LO), f1 = LANES_OF(LREAL, ISO_F_HI);
-    const LREAL tol_y = LANE_SEL((LREAL)0,
-                                 ISOLATED_TOL_Y(LANES_OF(LREAL, ISO_LO), LANES_OF(LREAL, ISO_HI), LANES_LOAD(t_in),
-                                                LANES_LOAD(t_out)),
-                                 running);
-#undef ISO_F_LO
-#undef ISO_F_HI
-#undef ISO_LO
-#undef ISO_HI
-#undef ISO_FIELD
+  if (LANE_ANY(running)) {
+    /* each refined lane's bracket (zeros elsewhere) */
+    const LREAL f0 = LANE_SEL((LREAL)0, iso->f_lo, running), f1 = LANE_SEL((LREAL)0, iso->f_hi, running);
+    const LREAL lo = LANE_SEL((LREAL)0, iso->lo, running), hi = LANE_SEL((LREAL)0, iso->hi, running);
+    const LREAL tol_y = LANE_SEL((LREAL)0, ISOLATED_TOL_Y(lo, hi, t_in, t_out), running);
     const LREAL scale = coefficient_scale(c), start = isolated_start(c);
     prepare_isolated(c, binomials);
 #if REFINE_IN_CLOSED_FORM
@@ -230,24 +227,29 @@ void refine_lanes(uint count, const int* in_extent, const Isolation* iso, LREAL*
     (void)start;
     y = LANE_SEL((LREAL)0, line_root(f0, f1), running);
 #else
-    y = refine_root_lanes(c, f0, f1, tol_y, scale, start, running, &iterations);
+    y = LANE_SEL((LREAL)0, refine_root_lanes(c, f0, f1, tol_y, scale, start, running, &iterations), running);
 #endif
   }
-  REAL y_of[LANES];
-  LANES_STORE(y, y_of);
-  for (uint j = 0; j < count; ++j) {
-    if (!in_extent[j] || iso[j].status == ISOLATION_NONE) continue;
-    const int refined = (refine_bits >> j) & 1;
-    roots[j].iterations = refined ? (uint)lane_get_mask(iterations, j) : 0u;
-    place_root(&roots[j], iso[j], refined ? y_of[j] : (REAL)0, t_in[j], t_out[j]);
+  /* place_root, where the isolation found a root (a bracket refined, or one settled at an end: y = 0) */
+  roots->t = LANE_SEL((LREAL)INFINITY, t_in + (iso->lo + y * (iso->hi - iso->lo)) * (t_out - t_in), found);
+  roots->f_before = LANE_SEL((LREAL)0, iso->f_lo, found);
+  roots->flags = flags | FLAG_WHERE(ALGRAY_HIT_FOUND, found);
+#undef FLAG_WHERE
+  roots->steps = LANE_SEL((LANE_INT_VEC)0, LANE_TO_INT(iso->steps), entered);
+  roots->iterations = LANE_SEL((LANE_INT_VEC)0, iterations, running);
 #if ALGRAY_ESCALATE
-    if (refined) {
-      REAL lane_c[NCOEF];
-      for (int k = 0; k <= DEGREE; ++k) lane_c[k] = lane_get(c[k], j);
-      doubt_flat_root(&roots[j], iso[j], lane_c, y_of[j], t_in[j], t_out[j]);
-    }
-#endif
+  const uint refined_bits = lane_mask_bits(running);
+  for (uint j = 0; j < LANES; ++j) {
+    if (!((refined_bits >> j) & 1u)) continue;
+    REAL lane_c[NCOEF];
+    for (int k = 0; k <= DEGREE; ++k) lane_c[k] = lane_get(c[k], j);
+    SegmentRoot r;
+    r.t = lane_get(roots->t, j);
+    r.flags = 0;
+    doubt_flat_root(&r, lane_isolation(iso, j), lane_c, lane_get(y, j), lane_get(t_in, j), lane_get(t_out, j));
+    if (r.flags & ALGRAY_HIT_DOUBT) ((LANE_INT*)&roots->flags)[j] |= ALGRAY_HIT_DOUBT;
   }
+#endif
 }
 #endif
 
@@ -427,13 +429,15 @@ DEFINE_TERMS_SUM(terms_sum_lanes, LREAL)
  * isolating interval, for refine_lanes. Lanes from `count` on, and those whose ray missed the extent
  * (in_extent[j] == 0), are left alone. */
 void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (*root_lo)[NCOEF], const REAL* t_in,
-                   const REAL* t_out, Isolation* iso, LREAL* c TERMS_OUT_PARAM) {
+                   const REAL* t_out, LaneIsolation* iso, LREAL* c TERMS_OUT_PARAM) {
   for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
 #if ALGRAY_COMPENSATED
+  for (uint j = 0; j < LANES; ++j) set_lane_isolation(iso, j, isolation_none());
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j]) continue;
     REAL iso_c[NCOEF];
-    iso[j] = isolate_coefficients(root[j], root_lo[j], t_in[j], t_out[j], iso_c TERMS_OUT(&terms[j]));
+    set_lane_isolation(iso, j,
+                       isolate_coefficients(root[j], root_lo[j], t_in[j], t_out[j], iso_c TERMS_OUT(&terms[j])));
     for (int k = 0; k <= DEGREE; ++k) lane_set(&c[k], j, iso_c[k]);
   }
 #else
@@ -472,7 +476,7 @@ void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (
 #endif
   (void)lane_terms;
   if (LANE_ANY(running))
-    isolate_bernstein_lanes(count, running, lane_root, lane_t_in, lane_t_out, iso, c TERMS_OUT(lane_terms));
+    isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, iso, c TERMS_OUT(lane_terms));
 #endif
 }
 #endif
@@ -563,25 +567,22 @@ void surface_gradient_lanes(LREAL x, LREAL y, LREAL z, __global const uint* exps
   *gz = sz;
 }
 
-/* The hit records of the first `count` (<= LANES) of the lanes' rays: roots[j] is ray j's root, `at` the rays in
- * unit coordinates with each found root's point as the origin, `rays` the rays as traced. Depth, the normal from
- * grad P (taken together in lanes) facing the ray, and the side. With LANES = 1, one ray's record (hit_record). */
-void hit_records_lanes(uint count, const LaneRays* rays, const LaneRays* at, const SegmentRoot* roots,
+/* The hit records of the first `count` (<= LANES) of the lanes' rays: lane j of roots holds ray j's root, `at` the
+ * rays in unit coordinates with each found root's point as the origin, `rays` the rays as traced. Depth, the normal
+ * from grad P (taken together in lanes) facing the ray, and the side. With LANES = 1, one ray's record
+ * (hit_record). */
+void hit_records_lanes(uint count, const LaneRays* rays, const LaneRays* at, const LaneRoots* roots,
                        __global const uint* exps, __global const REAL* coefs, uint mono_count, HitRecord* out) {
-  uint found_bits = 0;
-  for (uint j = 0; j < count; ++j)
-    if (roots[j].flags & ALGRAY_HIT_FOUND) found_bits |= 1u << j;
+  const LMASK found = (roots->flags & (LANE_INT_VEC)ALGRAY_HIT_FOUND) != 0;
+  const uint found_bits = lane_mask_bits(found);
   REAL depth_of[LANES], nx_of[LANES], ny_of[LANES], nz_of[LANES];
   uint usable_bits = 0, grows_bits = 0;
   if (found_bits) {
-    const LMASK found = lanes_of_bits(found_bits);
     /* lanes without a hit compute on zeros, never on a missed ray's infinities */
     const LREAL x = LANE_SEL((LREAL)0, at->ox, found), y = LANE_SEL((LREAL)0, at->oy, found),
                 z = LANE_SEL((LREAL)0, at->oz, found);
     const LREAL dux = at->dx, duy = at->dy, duz = at->dz;
-#define ROOT_T(j) roots[j].t
-    const LREAL t = LANE_SEL((LREAL)0, LANES_OF(LREAL, ROOT_T), found);
-#undef ROOT_T
+    const LREAL t = LANE_SEL((LREAL)0, roots->t, found);
     LREAL gx, gy, gz;
     surface_gradient_lanes(x, y, z, exps, coefs, mono_count, &gx, &gy, &gz);
     LREAL glen, dlen, g_dot_du;
@@ -606,15 +607,22 @@ void hit_records_lanes(uint count, const LaneRays* rays, const LaneRays* at, con
     usable_bits = lane_mask_bits(glen > 0 && isfinite(glen));
     grows_bits = lane_mask_bits(g_dot_du > 0);
   }
+  REAL t_of[LANES], f_before_of[LANES];
+  LANE_INT flags_of[LANES], steps_of[LANES], iterations_of[LANES];
+  LANES_STORE(roots->t, t_of);
+  LANES_STORE(roots->f_before, f_before_of);
+  LANES_STORE(roots->flags, flags_of);
+  LANES_STORE(roots->steps, steps_of);
+  LANES_STORE(roots->iterations, iterations_of);
   /* Front is the side where P > 0; at an exact root use the direction in which P grows instead. */
   for (uint j = 0; j < count; ++j) {
-    const SegmentRoot root = roots[j];
     HitRecord r = missed_record();
-    r.flags = root.flags;
-    r.work = ALGRAY_WORK_PACK(min(root.steps, ALGRAY_WORK_MAX), min(root.iterations, ALGRAY_WORK_MAX));
+    r.flags = (uint)flags_of[j];
+    r.work = ALGRAY_WORK_PACK(min((uint)steps_of[j], ALGRAY_WORK_MAX), min((uint)iterations_of[j], ALGRAY_WORK_MAX));
     if ((found_bits >> j) & 1u) {
-      r.t_hi = (float)root.t;
-      r.t_lo = (float)(root.t - (REAL)r.t_hi);
+      const REAL root_t = t_of[j], f_before = f_before_of[j];
+      r.t_hi = (float)root_t;
+      r.t_lo = (float)(root_t - (REAL)r.t_hi);
       r.depth = (float)depth_of[j];
       REAL3 n = (REAL3)(nx_of[j], ny_of[j], nz_of[j]);
       if (!((usable_bits >> j) & 1u)) { /* no gradient to speak of: face the ray */
@@ -625,7 +633,7 @@ void hit_records_lanes(uint count, const LaneRays* rays, const LaneRays* at, con
       r.normal_x = (float)n.x;
       r.normal_y = (float)n.y;
       r.normal_z = (float)n.z;
-      const int back = root.f_before != 0 ? root.f_before < 0 : (grows_bits >> j) & 1u;
+      const int back = f_before != 0 ? f_before < 0 : (grows_bits >> j) & 1u;
       if (back) r.flags |= ALGRAY_HIT_BACK;
     }
     out[j] = r;
@@ -636,8 +644,14 @@ void hit_records_lanes(uint count, const LaneRays* rays, const LaneRays* at, con
 HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global const REAL* coefs, uint count) {
   /* the ray as traced, and in unit coordinates from its hit point (as trace_lanes' `at`) */
   const LaneRays r = one_lane_rays(ray.o, ray.d), at = one_lane_rays(h.u, h.d_unit);
+  LaneRoots root;
+  root.t = h.root.t;
+  root.f_before = h.root.f_before;
+  root.flags = (LANE_INT_VEC)h.root.flags;
+  root.steps = (LANE_INT_VEC)h.root.steps;
+  root.iterations = (LANE_INT_VEC)h.root.iterations;
   HitRecord record;
-  hit_records_lanes(1, &r, &at, &h.root, exps, coefs, count, &record);
+  hit_records_lanes(1, &r, &at, &root, exps, coefs, count, &record);
   return record;
 }
 #endif
@@ -697,8 +711,8 @@ ALGRAY_INLINE void screen_coefficients_lanes(__global const REAL* row, LREAL xi,
 int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                  __global const uint* exps, __global const REAL* coefs, uint mono_count,
                  __constant const REAL* binomials, uint even_axes, HitRecord* records SCREEN_LANES_PARAM) {
-  Isolation iso[LANES];
-  SegmentRoot roots[LANES];
+  LaneIsolation iso;
+  LaneRoots roots;
   REAL t_in[LANES], t_out[LANES];
   LREAL iso_c[NCOEF], lane_t_in, lane_t_out;
   int in_extent[LANES];
@@ -720,7 +734,7 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
     /* lanes outside the extent start from zeros, as isolate_lanes gives them */
     ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE; ++k) lane_root[k] = LANE_SEL((LREAL)0, lane_root[k], running);
-    isolate_bernstein_lanes(count, running, lane_root, lane_t_in, lane_t_out, iso, iso_c);
+    isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, &iso, iso_c);
   }
 #else
   (void)running;
@@ -737,38 +751,32 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
     segment_coefficients(lane_origin(&unit, j), lane_direction(&unit, j), t_in[j], t_out[j], exps, coefs, mono_count,
                          binomials, even_axes, root[j], root_lo[j] TERMS_OUT(&terms[j]) SCREEN_ARG);
   }
-  isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, iso, iso_c TERMS_OUT(terms));
+  isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, &iso, iso_c TERMS_OUT(terms));
 #endif
-  refine_lanes(count, in_extent, iso, iso_c, t_in, t_out, binomials, roots);
+  refine_lanes(running, &iso, iso_c, lane_t_in, lane_t_out, binomials, &roots);
   /* finish_surface over lanes: `at` moves each found root's ray to its point */
-  uint found_bits = 0;
-  for (uint j = 0; j < count; ++j) {
-    if (!in_extent[j]) continue;
-    roots[j].flags |= ALGRAY_HIT_IN_EXTENT;
-    if (roots[j].flags & ALGRAY_HIT_FOUND) found_bits |= 1u << j;
-  }
+  const LMASK found = (roots.flags & (LANE_INT_VEC)ALGRAY_HIT_FOUND) != 0;
   LaneRays at = unit;
-  if (found_bits) {
-    const LMASK found = lanes_of_bits(found_bits);
-#define ROOT_T(j) roots[j].t
-    const LREAL t = LANE_SEL((LREAL)0, LANES_OF(LREAL, ROOT_T), found);
-#undef ROOT_T
+  if (LANE_ANY(found)) {
+    const LREAL t = LANE_SEL((LREAL)0, roots.t, found);
     at.ox = LANE_SEL(unit.ox, unit.ox + t * unit.dx, found);
     at.oy = LANE_SEL(unit.oy, unit.oy + t * unit.dy, found);
     at.oz = LANE_SEL(unit.oz, unit.oz + t * unit.dz, found);
   }
 #if ALGRAY_ESCALATE
+  const uint doubted_bits = lane_mask_bits(found && (roots.flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0);
   for (uint j = 0; j < count; ++j) {
-    if (!((found_bits >> j) & 1u) || !(roots[j].flags & ALGRAY_HIT_DOUBT)) continue;
+    if (!((doubted_bits >> j) & 1u)) continue;
     SurfaceHit h;
-    h.root = roots[j];
+    h.root.t = lane_get(roots.t, j);
+    h.root.flags = (uint)((LANE_INT*)&roots.flags)[j];
     h.u = lane_origin(&at, j);
     h.d_unit = lane_direction(&at, j);
     CONFIRM_FLAT_ROOT(&h, exps, coefs, mono_count);
-    roots[j].flags = h.root.flags;
+    ((LANE_INT*)&roots.flags)[j] = (LANE_INT)h.root.flags;
   }
 #endif
-  hit_records_lanes(count, rays, &at, roots, exps, coefs, mono_count, records);
+  hit_records_lanes(count, rays, &at, &roots, exps, coefs, mono_count, records);
   return 1;
 }
 #endif
