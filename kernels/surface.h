@@ -373,11 +373,10 @@ int enter_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int ext
 
 #if LANES > 1
 /* enter_surface for LANES rays at once: unit gets each lane's ray in unit coordinates (as enter_surface's h->u and
- * h->d_unit, bit for bit), t_in[j], t_out[j] ray j's segment and in_extent[j] whether it enters the extent (0
- * from `count` on). Returns the lanes that enter; their segments are also left in *lane_t_in, *lane_t_out (0 and
- * 1 elsewhere). */
+ * h->d_unit, bit for bit), and *lane_t_in, *lane_t_out each lane's segment (0 and 1 where it misses). Returns the
+ * lanes that enter the extent (none from `count` on). */
 LMASK enter_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
-                  LaneRays* unit, LREAL* lane_t_in, LREAL* lane_t_out, REAL* t_in, REAL* t_out, int* in_extent) {
+                  LaneRays* unit, LREAL* lane_t_in, LREAL* lane_t_out) {
   unit->ox = (rays->ox - centre.x) * inv_scale;
   unit->oy = (rays->oy - centre.y) * inv_scale;
   unit->oz = (rays->oz - centre.z) * inv_scale;
@@ -390,10 +389,6 @@ LMASK enter_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale
                                             box_half, &lo, &hi);
   *lane_t_in = LANE_SEL((LREAL)0, lo, inside);
   *lane_t_out = LANE_SEL((LREAL)1, hi, inside);
-  LANES_STORE(*lane_t_in, t_in);
-  LANES_STORE(*lane_t_out, t_out);
-  const uint inside_bits = lane_mask_bits(inside);
-  for (uint j = 0; j < LANES; ++j) in_extent[j] = (inside_bits >> j) & 1u;
   return inside;
 }
 
@@ -713,12 +708,10 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
                  __constant const REAL* binomials, uint even_axes, HitRecord* records SCREEN_LANES_PARAM) {
   LaneIsolation iso;
   LaneRoots roots;
-  REAL t_in[LANES], t_out[LANES];
   LREAL iso_c[NCOEF], lane_t_in, lane_t_out;
-  int in_extent[LANES];
   LaneRays unit;
-  const LMASK running = enter_lanes(count, rays, centre, inv_scale, box_half, extent_kind, &unit, &lane_t_in,
-                                    &lane_t_out, t_in, t_out, in_extent);
+  const LMASK running =
+      enter_lanes(count, rays, centre, inv_scale, box_half, extent_kind, &unit, &lane_t_in, &lane_t_out);
   /* no ray enters the extent (whole groups of most views): the caller writes missed_record() for each */
   if (!LANE_ANY(running)) return 0;
 #if SCREEN_LANES
@@ -737,7 +730,13 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
     isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, &iso, iso_c);
   }
 #else
-  (void)running;
+  /* one ray at a time: each lane's segment and whether it entered */
+  REAL t_in[LANES], t_out[LANES];
+  LANES_STORE(lane_t_in, t_in);
+  LANES_STORE(lane_t_out, t_out);
+  int in_extent[LANES];
+  const uint entered_bits = lane_mask_bits(running);
+  for (uint j = 0; j < LANES; ++j) in_extent[j] = (entered_bits >> j) & 1u;
   REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
 #if ALGRAY_ESCALATE
   RayTerms terms[LANES];
