@@ -143,9 +143,13 @@ LREAL coefficient_scale(const LREAL* c) {
   return scale;
 }
 
+/* The ray parameter of the point y of the isolating interval [lo, hi] (fractions of [t_in, t_out]); of one ray or
+ * of lanes. */
+#define PLACED_ROOT_T(lo, hi, y, t_in, t_out) ((t_in) + ((lo) + (y) * ((hi) - (lo))) * ((t_out) - (t_in)))
+
 /* The root at y of the isolating interval (0 when the isolation settled it at the interval's left end). */
 void place_root(SegmentRoot* r, Isolation iso, REAL y, REAL t_in, REAL t_out) {
-  r->t = t_in + (iso.lo + y * (iso.hi - iso.lo)) * (t_out - t_in);
+  r->t = PLACED_ROOT_T(iso.lo, iso.hi, y, t_in, t_out);
   r->f_before = iso.f_lo;
   r->flags |= ALGRAY_HIT_FOUND;
 }
@@ -231,7 +235,7 @@ void refine_lanes(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in,
 #endif
   }
   /* place_root, where the isolation found a root (a bracket refined, or one settled at an end: y = 0) */
-  roots->t = LANE_SEL((LREAL)INFINITY, t_in + (iso->lo + y * (iso->hi - iso->lo)) * (t_out - t_in), found);
+  roots->t = LANE_SEL((LREAL)INFINITY, PLACED_ROOT_T(iso->lo, iso->hi, y, t_in, t_out), found);
   roots->f_before = LANE_SEL((LREAL)0, iso->f_lo, found);
   roots->flags = flags | FLAG_WHERE(ALGRAY_HIT_FOUND, found);
 #undef FLAG_WHERE
