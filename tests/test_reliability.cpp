@@ -113,7 +113,12 @@ TEST_CASE("a damaged program-cache entry is rebuilt, never handed to OpenCL", "[
       const Result again = box.run(render);
       REQUIRE(again.exit_code == 0);
       CHECK(box.stats()["programs"][0]["origin"] == "disk");
-      CHECK(read_text(entry) == good);
+      CHECK(read_text(box.work / "out.png") == reference);
+      // Loaded from disk, the entry passed the cache's own check of its length and checksum. It names the same
+      // program as before; its payload need not be the same bytes, since PoCL's binary of a fresh compile differs
+      // from one its own kernel cache serves (with an empty POCL_CACHE_DIR the first build here is the former).
+      const auto identity = [](const std::string& e) { return e.substr(0, e.find("payload-bytes=")); };
+      CHECK(identity(read_text(entry)) == identity(good));
       CHECK_FALSE(fs::exists(leftover));  // the rebuild's write removed it
     }
   }
