@@ -86,7 +86,7 @@ LREAL refine_root_lanes(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL s
     const LMASK quadratic = fa != fc && fb != fc && fa != fb;
     const LMASK secant = !quadratic && fa != fb;
     LREAL num = 0, den = 1;
-    if (LANE_ANY(quadratic)) { /* never on the first step, where a and c are one point: its three divisions wait */
+    if (LANE_ANY(quadratic)) { /* never on a first step without a start (a and c one point): its divisions wait */
       const LREAL r = fb / fc, s = fb / fa, q = fa / fc;
       num = s * (q * (q - r) * (cp - b) - (r - (REAL)1) * (b - a));
       den = (q - (REAL)1) * (r - (REAL)1) * (s - (REAL)1);

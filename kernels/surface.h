@@ -719,20 +719,16 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
   /* no ray enters the extent (whole groups of most views): the caller writes missed_record() for each */
   if (!LANE_ANY(running)) return 0;
 #if SCREEN_LANES
+  /* screen_ray_taylor's column and segment_coefficients' segment about t0 */
+  const LREAL xi = LANE_SEL((LREAL)0, SCREEN_COLUMN(lane_pixel_centres(px0), xi_scale, xi_offset), running);
+  LREAL lane_root[NCOEF];
+  screen_coefficients_lanes(screen_row(screen_rows, py, screen_row0), xi,
+                            LANE_SEL((LREAL)0, lane_t_in - screen_t, running),
+                            LANE_SEL((LREAL)1, lane_t_out - screen_t, running), binomials, lane_root);
+  /* lanes outside the extent start from zeros, as isolate_lanes gives them */
   ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) iso_c[k] = 0;
-  if (LANE_ANY(running)) {
-    /* screen_ray_taylor's column and segment_coefficients' segment about t0 */
-    const LREAL xi = LANE_SEL((LREAL)0, SCREEN_COLUMN(lane_pixel_centres(px0), xi_scale, xi_offset), running);
-    LREAL lane_root[NCOEF];
-    screen_coefficients_lanes(screen_row(screen_rows, py, screen_row0), xi,
-                              LANE_SEL((LREAL)0, lane_t_in - screen_t, running),
-                              LANE_SEL((LREAL)1, lane_t_out - screen_t, running), binomials, lane_root);
-    /* lanes outside the extent start from zeros, as isolate_lanes gives them */
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE; ++k) lane_root[k] = LANE_SEL((LREAL)0, lane_root[k], running);
-    isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, &iso, iso_c);
-  }
+  for (int k = 0; k <= DEGREE; ++k) lane_root[k] = LANE_SEL((LREAL)0, lane_root[k], running);
+  isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, &iso, iso_c);
 #else
   /* one ray at a time: each lane's segment and whether it entered */
   REAL t_in[LANES], t_out[LANES];
