@@ -39,9 +39,13 @@ def main():
     ap.add_argument("--binary", default=str(ROOT / "build/apps/algray/algray"))
     ap.add_argument("--width", type=int, default=1024)
     ap.add_argument("--height", type=int, default=768)
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a scene setting for every variant, as `algray render --set` takes it")
     a = ap.parse_args()
     variants = [parse_variant(v, a.binary) for v in a.variants]
     args = ["--width", str(a.width), "--height", str(a.height), "--set", "antialias.samples=1"]
+    for setting in a.set:
+        args += ["--set", setting]
     runs = {v["label"]: [] for v in variants}
     with tempfile.TemporaryDirectory() as tmp:
         for r in range(a.rounds):

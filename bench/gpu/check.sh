@@ -3,11 +3,12 @@
 # the OpenCL loader at the NVIDIA driver, then lists the devices, renders, times the kernels and runs the OpenCL
 # tests on the GPU within GPU_CHECK_SECONDS; everything lands in $OUT (logs.tgz, images), a summary on stdout.
 # GPU_CHECK_TESTS="test_a test_b" runs only those tests and no benchmarks (a second call's rerun).
+# Issue 18's steps come first (tiles_adaptive, precision_modes), as what a GPU is still wanted for.
 # GPU_CHECK_SCENES names the precision table's scenes: about 30 s each on an H200, mostly NVIDIA's compiler
-# building each mode's programs cold (0.5-2 s a program); the default is the Barth decic (issue 18's hardest,
-# changed since 2026-12-04's run: its adaptive shadow pass) and the ones that run did not reach.
-# That run (450 s) fit everything else but test_kernels, test_lanes, test_shadows_batched and test_univariate,
-# which need several minutes each there for the same reason.
+# building each mode's programs cold (0.5-2 s a program); the default is the three where adaptive costs most on
+# the CPU (the Barth decic, the Endrass octic, the Chebyshev nonic).
+# The run of 2026-12-04 (450 s) fit everything but test_kernels, test_lanes, test_shadows_batched and
+# test_univariate, which need several minutes each there for the same reason.
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 root=$PWD
@@ -60,15 +61,34 @@ export algray=build/apps/algray/algray logs bundle deadline
 if [ -n "${GPU_CHECK_TESTS:-}" ]; then
   printf '%s\n' $GPU_CHECK_TESTS > "$bundle/tests.txt"
 else
-  step devices 360 "$algray" devices --stats "$logs/devices.json"
+  step devices 420 "$algray" devices --stats "$logs/devices.json"
   cat "$logs/devices.log"
 
+  # Issue 18 first, as the reason a GPU is wanted: adaptive was 2.85x float on the decic here (2026-12-04), 12 tiles
+  # of 256x256 rays, each with its own second pass. Per pass, first and second pass apart (pass_split.py), with the
+  # second pass in double and, as on a GPU with slow fp64, in float-float; with 256 and 1024 tiles. If the first
+  # passes differ, the adaptive kernel's own checks cost the time; if the second passes do, their launches' tails.
+  tiles() {
+    for tile in 256 1024; do
+      for fp64 in "" 1; do
+        echo "--- tile_size $tile${fp64:+, ALGRAY_NO_FP64=1}"
+        ALGRAY_NO_FP64=$fp64 python3 bench/pass_split.py scenes/barth_decic.toml float=float adaptive=adaptive \
+          --rounds 3 --set render.tile_size=$tile | tail -3 || return 1
+      done
+    done
+  }
+  export -f tiles
+  step tiles_adaptive 330 bash -c tiles
+  step precision_modes 230 python3 bench/precision_modes.py --no-accuracy --runs 3 --output "$logs/RESULTS.md" \
+    --json "$logs/precision_modes.json" --heading "## Precision modes on a GPU" \
+    --scenes ${GPU_CHECK_SCENES:-barth_decic endrass_octic chebyshev_nonic}
+
   # Images to compare with the CPU's at home: full mode and preview in double, preview in adaptive.
-  step render_full 330 "$algray" render scenes/barth_sextic.toml -o "$OUT/sextic_full_double.exr" -o "$OUT/sextic_full.png" \
+  step render_full 215 "$algray" render scenes/barth_sextic.toml -o "$OUT/sextic_full_double.exr" -o "$OUT/sextic_full.png" \
     --precision double --stats "$logs/sextic_full.json"
-  step render_preview 320 "$algray" render scenes/barth_decic.toml --preview -o "$OUT/decic_preview_double.exr" \
+  step render_preview 210 "$algray" render scenes/barth_decic.toml --preview -o "$OUT/decic_preview_double.exr" \
     --precision double --stats "$logs/decic_preview.json"
-  step render_adaptive 310 "$algray" render scenes/barth_decic.toml --preview -o "$OUT/decic_preview_adaptive.exr" \
+  step render_adaptive 205 "$algray" render scenes/barth_decic.toml --preview -o "$OUT/decic_preview_adaptive.exr" \
     --precision adaptive --stats "$logs/decic_adaptive.json"
 
   # End to end, warm: full mode to PNG, wall time of the whole process (median of 5 after one warm-up).
@@ -82,30 +102,13 @@ else
     done
   }
   export -f e2e
-  step e2e_full 280 bash -c e2e
+  step e2e_full 185 bash -c e2e
 
   degrees=1,2,3,4,5,6,7,8,9,10,12,16,20,24,28,32
-  step degrees_double 260 python3 bench/kernel_speed.py --only degrees --degrees $degrees --side 2048 --repeat 3
-  step degrees_float 210 python3 bench/kernel_speed.py --only degrees --degrees $degrees --side 2048 --repeat 3 \
+  step degrees_double 165 python3 bench/kernel_speed.py --only degrees --degrees $degrees --side 2048 --repeat 3
+  step degrees_float 145 python3 bench/kernel_speed.py --only degrees --degrees $degrees --side 2048 --repeat 3 \
     --precision float
-  step surfaces_double 190 python3 bench/kernel_speed.py --only surfaces --repeat 5
-
-  # Issue 18: adaptive was 2.85x float on the decic here (2026-12-04), with 35 tiles of 256x256, each with its own
-  # second pass. Does one 1024x1024 tile close the gap? Lines: tile, mode, kernel ms of all passes, passes' wall ms.
-  tiles() {
-    for tile in 256 1024; do for mode in float adaptive; do for _ in 1 2 3; do
-      "$algray" render scenes/barth_decic.toml -o /tmp/tiles.exr --width 1024 --height 768 --set antialias.samples=1 \
-        --set render.tile_size=$tile --precision $mode --stats /tmp/tiles.json >/dev/null || return 1
-      python3 -c 'import json, sys; s = json.load(open("/tmp/tiles.json")); print(*sys.argv[1:], round(sum(
-p["kernel_ms"] for p in s["passes"]), 1), round(s["render_ms"]["passes_wall"], 1))' "$tile" "$mode"
-    done; done; done
-  }
-  export -f tiles
-  step tiles_adaptive 175 bash -c tiles
-  step precision_modes 160 python3 bench/precision_modes.py --no-accuracy --runs 3 --output "$logs/RESULTS.md" \
-    --json "$logs/precision_modes.json" --heading "## Precision modes on a GPU" \
-    --scenes ${GPU_CHECK_SCENES:-barth_decic endrass_octic chebyshev_nonic goursat12 kummer zitrus tanglecube}
-
+  step surfaces_double 130 python3 bench/kernel_speed.py --only surfaces --repeat 5
 fi
 
 # The OpenCL tests, several at once (the host has cores to spare); each one's log apart.
@@ -118,6 +121,7 @@ run_tests() {
 export -f run_tests left
 step tests 5 bash -c run_tests
 cat "$logs/tests.log" >> "$logs/summary.txt"
-for f in "$logs"/degrees_*.log "$logs"/surfaces_*.log "$logs"/e2e_full.log "$logs"/tiles_adaptive.log; do
+for f in "$logs"/degrees_*.log "$logs"/surfaces_*.log "$logs"/e2e_full.log "$logs"/tiles_adaptive.log \
+  "$logs"/precision_modes.log; do
   [ -f "$f" ] && { echo "--- $(basename "$f")"; cat "$f"; } >> "$logs/summary.txt"
 done
