@@ -73,7 +73,7 @@ else
       for fp64 in "" 1; do
         echo "--- tile_size $tile${fp64:+, ALGRAY_NO_FP64=1}"
         ALGRAY_NO_FP64=$fp64 python3 bench/pass_split.py scenes/barth_decic.toml float=float adaptive=adaptive \
-          --rounds 3 --set render.tile_size=$tile | tail -3 || return 1
+          --rounds 3 --set render.tile_size=$tile | tail -4 || return 1
       done
     done
   }
