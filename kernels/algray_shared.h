@@ -84,7 +84,8 @@ typedef struct {
                                        ends the float search. decision: ALGRAY_DOUBT_*; level: halving level;
                                        values: the interval's lo, hi, the value in question, the noise bound */
 #define ALGRAY_EVENT_CONFIRMED 8    /* adaptive precision: a flat-doubted root kept after all (confirm_flat_root).
-                                       values: P and its rounding bound at t - delta, then at t + delta */
+                                       decision: 0 evaluated in float, 1 in float-float; values: P and its
+                                       rounding bound at t - delta, then at t + delta */
 
 /* What an isolation found (kernels/isolation.h's Isolation.status) */
 #define ALGRAY_ISOLATED_NONE 0    /* certified: no root in [t_in, t_out] (up to the tolerance) */

@@ -492,7 +492,10 @@ void finish_surface(SurfaceHit* h, SegmentRoot root) {
  * then a root lies within what the flat check allows. The check held the root to the coefficients' noise, which
  * sums the terms over the whole segment, out to the extent's sphere; at a root inside, the terms are far smaller
  * (the Barth decic's flat-doubted roots: 1e-4 to 2e-3 of the segment's), and so is P's rounding there.
- * Measured on the decic at 1024x768: 61% fewer camera rays traced again (bench/RESULTS.md). */
+ * Measured on the decic at 1024x768: 61% fewer camera rays traced again (bench/RESULTS.md). Where float's
+ * rounding is still too large (surfaces whose monomials cancel by orders of magnitude, such as Chebyshev sums),
+ * P is evaluated again in float-float, whose rounding is float's squared: over the lanes together, that costs less
+ * than the second pass even in double (bench/RESULTS.md, "Flat roots confirmed in float-float"). */
 #if ALGRAY_ESCALATE
 /* P at q from the monomials (the power tables of axis_powers, restrict.h), and a bound on its rounding: the
  * products, the sum, and the rounding of q's coordinates and of the coefficients, each of at most REAL_EPS / 2
@@ -511,20 +514,132 @@ REAL direct_value(REAL3 q, __global const uint* exps, __global const REAL* coefs
   return value;
 }
 
-/* h: a found root (h->u its point); clears the doubt when P's values confirm it. */
-void confirm_flat_root(SurfaceHit* h, __global const uint* exps, __global const REAL* coefs, uint count PROBE_PARAM) {
+/* Float-float numbers hi + lo, |lo| within half an ulp of hi, of one ray or of lanes: each product and sum below
+ * keeps its rounding error (fma, Knuth's two-sum), so its relative error is a few REAL_EPS^2, not REAL_EPS. */
+typedef struct {
+  LREAL hi, lo;
+} FloatFloat;
+
+/* hi + e renormalised, for |hi| >= |e| or hi = 0 (Dekker's fast two-sum). */
+ALGRAY_INLINE FloatFloat ff_normalised(LREAL hi, LREAL e) {
+  FloatFloat r;
+  r.hi = hi + e;
+  r.lo = e - (r.hi - hi);
+  return r;
+}
+ALGRAY_INLINE FloatFloat ff_add(FloatFloat a, FloatFloat b) {
+  const LREAL s = a.hi + b.hi, bb = s - a.hi;
+  return ff_normalised(s, ((a.hi - (s - bb)) + (b.hi - bb)) + (a.lo + b.lo));
+}
+ALGRAY_INLINE FloatFloat ff_mul(FloatFloat a, FloatFloat b) {
+  const LREAL p = a.hi * b.hi;
+  return ff_normalised(p, fma(a.hi, b.hi, -p) + (a.hi * b.lo + a.lo * b.hi));
+}
+/* x + t d, exact but for the rounding of its low part */
+ALGRAY_INLINE FloatFloat ff_point_axis(LREAL x, LREAL t, LREAL d) {
+  const LREAL p = t * d;
+  FloatFloat a, b;
+  a.hi = x;
+  a.lo = 0;
+  b.hi = p;
+  b.lo = fma(t, d, -p);
+  return ff_add(a, b);
+}
+
+/* P at o + t d in float-float for each lane of r, coefficients hi + lo (adaptive builds get the low parts after
+ * the per-degree sums; DeviceSurface), and a bound on its rounding, each part with room:
+ *  - the products and sums, at most 6 (REAL_EPS / 2)^2 each relative to its operands' sizes: (3 DEGREE + count + 8)
+ *    2 REAL_EPS^2 times the terms sum_m |a_m| |x|^i |y|^j |z|^k (which also covers the coefficients' low parts);
+ *  - the point, whose coordinates are off by at most dq = REAL_EPS^2 (|o| + |t d|) each (the low part's rounding):
+ *    sum over the axes of dq times the terms' derivative along it, taken at |q| + dq, which bounds P's change.
+ * Underflowing low parts can only make the bound too small by FLT_MIN-sized amounts: the absolute term. */
+LREAL direct_value_ff(const LaneRays* r, LREAL t, __global const REAL* coefs, __global const uint* exps, uint count,
+                      LREAL* rounding) {
+  FloatFloat px[NCOEF], py[NCOEF], pz[NCOEF];
+  const FloatFloat x = ff_point_axis(r->ox, t, r->dx), y = ff_point_axis(r->oy, t, r->dy),
+                   z = ff_point_axis(r->oz, t, r->dz);
+  px[0].hi = py[0].hi = pz[0].hi = 1;
+  px[0].lo = py[0].lo = pz[0].lo = 0;
+  for (int n = 1; n <= DEGREE; ++n) {
+    px[n] = ff_mul(px[n - 1], x);
+    py[n] = ff_mul(py[n - 1], y);
+    pz[n] = ff_mul(pz[n - 1], z);
+  }
+  const LREAL eps2 = (LREAL)(REAL_EPS * REAL_EPS);
+  const LREAL dqx = (fabs(r->ox) + fabs(t * r->dx)) * eps2, dqy = (fabs(r->oy) + fabs(t * r->dy)) * eps2,
+              dqz = (fabs(r->oz) + fabs(t * r->dz)) * eps2;
+  LREAL bx[NCOEF], by[NCOEF], bz[NCOEF];
+  bx[0] = by[0] = bz[0] = 1;
+  for (int n = 1; n <= DEGREE; ++n) {
+    bx[n] = bx[n - 1] * (fabs(x.hi) + dqx);
+    by[n] = by[n - 1] * (fabs(y.hi) + dqy);
+    bz[n] = bz[n - 1] * (fabs(z.hi) + dqz);
+  }
+  __global const REAL* lows = coefs + count + NCOEF;
+  FloatFloat value;
+  value.hi = value.lo = 0;
+  LREAL size = 0, slope_x = 0, slope_y = 0, slope_z = 0;
+  for (uint m = 0; m < count; ++m) {
+    const uint i = exps[m] & 0xffu, j = (exps[m] >> 8) & 0xffu, k = (exps[m] >> 16) & 0xffu;
+    FloatFloat a;
+    a.hi = coefs[m];
+    a.lo = lows[m];
+    value = ff_add(value, ff_mul(ff_mul(a, px[i]), ff_mul(py[j], pz[k])));
+    const REAL c = fabs(coefs[m]);
+    size += c * bx[i] * by[j] * bz[k];
+    if (i) slope_x += c * (REAL)i * bx[i - 1] * by[j] * bz[k];
+    if (j) slope_y += c * (REAL)j * bx[i] * by[j - 1] * bz[k];
+    if (k) slope_z += c * (REAL)k * bx[i] * by[j] * bz[k - 1];
+  }
+  const LREAL arithmetic = size * (REAL)(2 * (3 * DEGREE + (int)count + 8)) * eps2;
+  const LREAL point = (dqx * slope_x + dqy * slope_y) + dqz * slope_z;
+  *rounding = (arithmetic + point) * (REAL)(1 + 1.0 / 1024) + (REAL)(8 * (int)count) * FLT_MIN;
+  return value.hi + value.lo;
+}
+
+/* Whether values v0 and v1 stand beyond their roundings with opposite signs (of one ray or of lanes): then P
+ * changes sign between them. */
+#define CERTAIN_SIGN_CHANGE(v0, rounding0, v1, rounding1) \
+  (fabs(v0) > (rounding0) && fabs(v1) > (rounding1) && ((v0) > 0) != ((v1) > 0))
+
+/* The float-float check of confirm_flat_root for the lanes in `doubted` (roots at t, rays r from their starts),
+ * at t -+ delta with delta shrunk by 2^-10, so that their own rounding keeps the points within
+ * ALGRAY_DOUBT_POSITION |t| of t; the lanes it confirms. *v0 ... *rounding1: the values and their bounds. */
+LMASK confirmed_in_float_float(LMASK doubted, const LaneRays* r, LREAL t, __global const REAL* coefs,
+                               __global const uint* exps, uint count, LREAL* v0, LREAL* rounding0, LREAL* v1,
+                               LREAL* rounding1) {
+  const LREAL inner = (REAL)ALGRAY_DOUBT_POSITION * (REAL)(1 - 1.0 / 1024) * fabs(t);
+  *v0 = direct_value_ff(r, t - inner, coefs, exps, count, rounding0);
+  *v1 = direct_value_ff(r, t + inner, coefs, exps, count, rounding1);
+  return doubted && CERTAIN_SIGN_CHANGE(*v0, *rounding0, *v1, *rounding1);
+}
+
+/* h: a found root (h->u its point), u the ray's start; clears the doubt when P's values confirm it, in float or
+ * else in float-float (the probe's event says which: decision 0 or 1). */
+void confirm_flat_root(SurfaceHit* h, REAL3 u, __global const uint* exps, __global const REAL* coefs,
+                       uint count PROBE_PARAM) {
   if ((h->root.flags & (ALGRAY_HIT_FOUND | ALGRAY_HIT_DOUBT)) != (ALGRAY_HIT_FOUND | ALGRAY_HIT_DOUBT)) return;
   const REAL delta = (REAL)ALGRAY_DOUBT_POSITION * fabs(h->root.t);
   REAL rounding0, rounding1;
-  const REAL v0 = direct_value(h->u - delta * h->d_unit, exps, coefs, count, &rounding0);
-  const REAL v1 = direct_value(h->u + delta * h->d_unit, exps, coefs, count, &rounding1);
-  if (!(fabs(v0) > rounding0 && fabs(v1) > rounding1 && (v0 > 0) != (v1 > 0))) return;
-  PROBE(ALGRAY_EVENT_CONFIRMED, 0, 0u, 0u, v0, rounding0, v1, rounding1);
+  REAL v0 = direct_value(h->u - delta * h->d_unit, exps, coefs, count, &rounding0);
+  REAL v1 = direct_value(h->u + delta * h->d_unit, exps, coefs, count, &rounding1);
+  uint arithmetic = 0;
+  if (!CERTAIN_SIGN_CHANGE(v0, rounding0, v1, rounding1)) {
+#if LANES == 1
+    const LaneRays r = one_lane_rays(u, h->d_unit);
+    if (!confirmed_in_float_float(1, &r, h->root.t, coefs, exps, count, &v0, &rounding0, &v1, &rounding1)) return;
+    arithmetic = 1;
+#else
+    (void)u; /* the lanes' caller checks its lanes in float-float together */
+    return;
+#endif
+  }
+  PROBE(ALGRAY_EVENT_CONFIRMED, 0, arithmetic, 0u, v0, rounding0, v1, rounding1);
   h->root.flags &= ~ALGRAY_HIT_DOUBT;
 }
-#define CONFIRM_FLAT_ROOT(h, exps, coefs, count) confirm_flat_root(h, exps, coefs, count PROBE_ARG)
+#define CONFIRM_FLAT_ROOT(h, u, exps, coefs, count) confirm_flat_root(h, u, exps, coefs, count PROBE_ARG)
 #else
-#define CONFIRM_FLAT_ROOT(h, exps, coefs, count) ((void)0)
+#define CONFIRM_FLAT_ROOT(h, u, exps, coefs, count) ((void)(u))
 #endif
 
 #if LANES == 1
@@ -535,9 +650,11 @@ SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, 
   Isolation iso;
   REAL t_in, t_out, iso_c[NCOEF];
   if (isolate_surface(ray, centre, inv_scale, box_half, extent_kind, exps, coefs, count, binomials, even_axes, &h, &iso,
-                      &t_in, &t_out, iso_c SCREEN_ARG PROBE_ARG))
+                      &t_in, &t_out, iso_c SCREEN_ARG PROBE_ARG)) {
+    const REAL3 start = h.u; /* finish_surface moves h.u to the root */
     finish_surface(&h, refine_isolated(iso, iso_c, t_in, t_out, binomials PROBE_ARG));
-  CONFIRM_FLAT_ROOT(&h, exps, coefs, count);
+    CONFIRM_FLAT_ROOT(&h, start, exps, coefs, count);
+  }
   return h;
 }
 #endif
@@ -763,6 +880,7 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
     at.oz = LANE_SEL(unit.oz, unit.oz + t * unit.dz, found);
   }
 #if ALGRAY_ESCALATE
+  /* confirm_flat_root lane by lane in float, then in float-float for the lanes still doubted, together */
   const uint doubted_bits = lane_mask_bits(found && (roots.flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0);
   for (uint j = 0; j < count; ++j) {
     if (!((doubted_bits >> j) & 1u)) continue;
@@ -771,8 +889,15 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
     h.root.flags = (uint)((LANE_INT*)&roots.flags)[j];
     h.u = lane_origin(&at, j);
     h.d_unit = lane_direction(&at, j);
-    CONFIRM_FLAT_ROOT(&h, exps, coefs, mono_count);
+    CONFIRM_FLAT_ROOT(&h, lane_origin(&unit, j), exps, coefs, mono_count);
     ((LANE_INT*)&roots.flags)[j] = (LANE_INT)h.root.flags;
+  }
+  const LMASK still = found && (roots.flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0;
+  if (LANE_ANY(still)) {
+    LREAL v0, rounding0, v1, rounding1;
+    const LMASK confirmed = confirmed_in_float_float(still, &unit, LANE_SEL((LREAL)0, roots.t, still), coefs, exps,
+                                                     mono_count, &v0, &rounding0, &v1, &rounding1);
+    roots.flags &= LANE_SEL((LANE_INT_VEC)(-1), (LANE_INT_VEC)(~ALGRAY_HIT_DOUBT), confirmed);
   }
 #endif
   hit_records_lanes(count, rays, &at, &roots, exps, coefs, mono_count, records);

@@ -75,6 +75,34 @@ TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") 
   CHECK(hits > cases.size() * 100);  // the surfaces are in view: the comparison covers refined roots
 }
 
+// Adaptive precision confirms flat-doubted roots lane by lane in float, then the lanes still in doubt together in
+// float-float (kernels/surface.h, confirmed_in_float_float); the one-ray kernel does the same one ray at a time.
+// On these two hard surfaces most doubted roots go through float-float (tests/test_probe).
+TEST_CASE("lanes confirm flat roots as the one-ray kernel does, bit for bit", "[lanes]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  for (const char* name : {"tooth_cubed", "chebyshev_decic"}) {
+    const std::string file = std::string(ALGRAY_SOURCE_DIR) + "/tests/data/hard_surfaces/" + name + ".toml";
+    const auto render = [&](int lanes) {
+      return renderer.render_with_records(load_scene_file(file, {{"image.width", "61"},
+                                                                 {"image.height", "37"},
+                                                                 {"render.tile_size", "24"},
+                                                                 {"render.precision", "\"adaptive\""},
+                                                                 {"render.lanes", std::to_string(lanes)}}));
+    };
+    const RenderResult one = render(1);
+    std::size_t found = 0;
+    for (const HitRecord& h : one.hits.records) found += (h.flags & ALGRAY_HIT_FOUND) != 0;
+    CHECK(found > 300);
+    for (int lanes : {8, 16}) {
+      const long at = first_difference(one.hits.records, render(lanes).hits.records);
+      INFO(name << ", " << lanes << " lanes: first differing record " << at);
+      CHECK(at == -1);
+    }
+  }
+}
+
 // Surfaces whose lane groups take the search's rarer exits together: on z^3 seen square on every root is an
 // exact zero at a subdivision point, so whole groups have nothing to refine; a double plane gives clusters
 // with and without a sign change; x y z has singular lines; the sphere's rim has tangent rays.

@@ -437,14 +437,16 @@ TEST_CASE("a ray adaptive precision doubts: the probe says why, and the second p
   CHECK(probed == 12);
 }
 
-TEST_CASE("a flat-doubted root that P's values confirm is kept: one trace, the render's record", "[probe]") {
-  RenderContext context("", true);
-  const Scene scene = load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_decic.toml",
-                                      {{"image.width", "96"}, {"image.height", "72"},
-                                       {"render.precision", "\"adaptive\""}, {"render.preview", "true"}});
+namespace {
+
+// Scans a preview of `file` (in the source tree) in adaptive precision for the first four roots the float kernel doubted as flat and
+// kept after all; returns how many of them P's values confirmed in float-float.
+int check_confirmed_roots(const char* file, RenderContext& context) {
+  const Scene scene = load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/" + file, {{"image.width", "96"}, {"image.height", "72"},
+                                             {"render.precision", "\"adaptive\""}, {"render.preview", "true"}});
   Renderer renderer(context.session(), context.cache());
   const RenderResult render = renderer.render_with_records(scene);
-  int confirmed = 0;
+  int confirmed = 0, in_float_float = 0;
   for (int py = 0; py < 72 && confirmed < 4; py += 2)
     for (int px = 0; px < 96 && confirmed < 4; px += 2) {
       const HitRecord& rendered = render.hits.at(px, py);
@@ -454,7 +456,8 @@ TEST_CASE("a flat-doubted root that P's values confirm is kept: one trace, the r
       const SolverTrace& trace = probes.at(0).traces.at(0);
       if (!trace.confirmed) continue;
       ++confirmed;
-      INFO("pixel (" << px << ", " << py << ")");
+      in_float_float += trace.confirmed->float_float;
+      INFO(file << ", pixel (" << px << ", " << py << ")");
       REQUIRE(trace.doubt.has_value());
       CHECK(doubt_reason(static_cast<unsigned>(trace.doubt->reason))->id == ALGRAY_DOUBT_FLAT);
       CHECK(probes[0].traces.size() == 1);
@@ -463,8 +466,25 @@ TEST_CASE("a flat-doubted root that P's values confirm is kept: one trace, the r
       CHECK(std::fabs(trace.confirmed->before) > trace.confirmed->before_rounding);
       CHECK(std::fabs(trace.confirmed->after) > trace.confirmed->after_rounding);
       CHECK((trace.confirmed->before > 0) != (trace.confirmed->after > 0));
-      // The render kept this very root.
+      // The render kept this very root,
       CHECK(std::memcmp(&trace.hit, &rendered, offsetof(HitRecord, flags)) == 0);
+      // which lies within ALGRAY_DOUBT_POSITION of its t from the certified smallest root, where there is one.
+      const PixelClass cls = probes[0].reference.certificate.cls;
+      if (cls == PixelClass::SimpleRoot || cls == PixelClass::OddMultipleRoot) {
+        const double t_ref = probes[0].reference.roots.at(0).t;
+        CHECK(std::fabs(trace.t - t_ref) <= ALGRAY_DOUBT_POSITION * std::fabs(t_ref) * 1.01);
+      }
     }
   CHECK(confirmed == 4);
+  return in_float_float;
+}
+
+}  // namespace
+
+TEST_CASE("a flat-doubted root that P's values confirm is kept: one trace, the render's record", "[probe]") {
+  RenderContext context("", true);
+  // The Barth decic's doubted roots are confirmed in float; the cubed tooth's, every root nearly triple and its
+  // monomials cancelling, need float-float.
+  check_confirmed_roots("scenes/barth_decic.toml", context);
+  CHECK(check_confirmed_roots("tests/data/hard_surfaces/tooth_cubed.toml", context) > 0);
 }

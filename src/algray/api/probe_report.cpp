@@ -172,7 +172,8 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
         << "): " << num(tr.doubt->value, 4) << " within the noise " << num(tr.doubt->noise, 4) << " on ["
         << num(tr.t_at(tr.doubt->lo)) << ", " << num(tr.t_at(tr.doubt->hi)) << "]";
     if (tr.confirmed)
-      out << "; confirmed: P from the monomials is " << num(tr.confirmed->before, 4) << " (rounding "
+      out << "; confirmed: P from the monomials" << (tr.confirmed->float_float ? " in float-float" : "") << " is "
+          << num(tr.confirmed->before, 4) << " (rounding "
           << num(tr.confirmed->before_rounding, 3) << ") before the root and " << num(tr.confirmed->after, 4)
           << " (rounding " << num(tr.confirmed->after_rounding, 3)
           << ") after it, within " ALGRAY_DOUBT_POSITION_TEXT " of its t: the render keeps this root\n";
@@ -249,7 +250,8 @@ nlohmann::json trace_json(const SolverTrace& tr) {
       j["doubt"]["confirmed"] = {{"before", tr.confirmed->before},
                                  {"before_rounding", tr.confirmed->before_rounding},
                                  {"after", tr.confirmed->after},
-                                 {"after_rounding", tr.confirmed->after_rounding}};
+                                 {"after_rounding", tr.confirmed->after_rounding},
+                                 {"float_float", tr.confirmed->float_float}};
   }
   j["found"] = tr.found();
   if (tr.found()) j["t"] = tr.t;

@@ -110,8 +110,10 @@ DeviceSurface::DeviceSurface(const cl::Context& ctx, const Scene& scene, Precisi
   // Mixed precision takes each coefficient as a float pair hi + lo (hi's, then lo's): rounding expanded,
   // cancelling coefficients to float alone would already change the surface.
   std::vector<double> coefficient_data = data_.coefficients;
-  if (precision == Precision::Mixed)
+  auto append_low_parts = [&] {
     for (double c : data_.coefficients) coefficient_data.push_back(c - static_cast<double>(static_cast<float>(c)));
+  };
+  if (precision == Precision::Mixed) append_low_parts();
   // Adaptive precision's float kernels take, after the coefficients, the sum of |a_m| over the monomials of each
   // degree 0..n: a ray whose coordinates are at most R has terms of size at most sum_d S_d R^d (ray_terms in
   // kernels/restrict.h), the cheap bound it decides by before it sums its own.
@@ -122,6 +124,9 @@ DeviceSurface::DeviceSurface(const cl::Context& ctx, const Scene& scene, Precisi
       by_degree[(e & 0xffu) + ((e >> 8) & 0xffu) + ((e >> 16) & 0xffu)] += std::fabs(data_.coefficients[m]);
     }
     coefficient_data.insert(coefficient_data.end(), by_degree.begin(), by_degree.end());
+    // Then each coefficient's low part, as mixed precision's: confirming a flat root in float-float
+    // (kernels/surface.h, direct_value_ff) needs the coefficients to float-float's digits.
+    append_low_parts();
   }
   coefs_ = real_buffer(ctx, coefficient_data, precision);
   binomials_ = real_buffer(ctx, binomial_table(data_.degree), precision);

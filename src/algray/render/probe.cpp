@@ -62,7 +62,7 @@ void decode_events(const std::vector<ProbeEvent>& events, const std::vector<doub
         trace.doubt = ProbeDoubt{static_cast<int>(e.decision), static_cast<int>(e.level), v[0], v[1], v[2], v[3]};
         break;
       case ALGRAY_EVENT_CONFIRMED:
-        trace.confirmed = ProbeConfirmed{v[0], v[1], v[2], v[3]};
+        trace.confirmed = ProbeConfirmed{v[0], v[1], v[2], v[3], e.decision == 1};
         break;
       default:
         break;

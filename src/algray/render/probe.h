@@ -56,6 +56,7 @@ struct ProbeDoubt {
 struct ProbeConfirmed {
   double before = 0, before_rounding = 0;
   double after = 0, after_rounding = 0;
+  bool float_float = false;  // evaluated in float-float, float's rounding having been too large
 };
 
 // Everything the kernel recorded for one ray and one solver configuration.
