@@ -553,7 +553,7 @@ ALGRAY_INLINE FloatFloat ff_point_axis(LREAL x, LREAL t, LREAL d) {
  *  - the point, whose coordinates are off by at most dq = REAL_EPS^2 (|o| + |t d|) each (the low part's rounding):
  *    sum over the axes of dq times the terms' derivative along it, taken at |q| + dq, which bounds P's change.
  * Underflowing low parts can only make the bound too small by FLT_MIN-sized amounts: the absolute term. */
-LREAL direct_value_ff(const LaneRays* r, LREAL t, __global const REAL* coefs, __global const uint* exps, uint count,
+LREAL direct_value_ff(const LaneRays* r, LREAL t, __global const uint* exps, __global const REAL* coefs, uint count,
                       LREAL* rounding) {
   FloatFloat px[NCOEF], py[NCOEF], pz[NCOEF];
   const FloatFloat x = ff_point_axis(r->ox, t, r->dx), y = ff_point_axis(r->oy, t, r->dy),
@@ -605,12 +605,12 @@ LREAL direct_value_ff(const LaneRays* r, LREAL t, __global const REAL* coefs, __
 /* The float-float check of confirm_flat_root for the lanes in `doubted` (roots at t, rays r from their starts),
  * at t -+ delta with delta shrunk by 2^-10, so that their own rounding keeps the points within
  * ALGRAY_DOUBT_POSITION |t| of t; the lanes it confirms. *v0 ... *rounding1: the values and their bounds. */
-LMASK confirmed_in_float_float(LMASK doubted, const LaneRays* r, LREAL t, __global const REAL* coefs,
-                               __global const uint* exps, uint count, LREAL* v0, LREAL* rounding0, LREAL* v1,
+LMASK confirmed_in_float_float(LMASK doubted, const LaneRays* r, LREAL t, __global const uint* exps,
+                               __global const REAL* coefs, uint count, LREAL* v0, LREAL* rounding0, LREAL* v1,
                                LREAL* rounding1) {
   const LREAL inner = (REAL)ALGRAY_DOUBT_POSITION * (REAL)(1 - 1.0 / 1024) * fabs(t);
-  *v0 = direct_value_ff(r, t - inner, coefs, exps, count, rounding0);
-  *v1 = direct_value_ff(r, t + inner, coefs, exps, count, rounding1);
+  *v0 = direct_value_ff(r, t - inner, exps, coefs, count, rounding0);
+  *v1 = direct_value_ff(r, t + inner, exps, coefs, count, rounding1);
   return doubted && CERTAIN_SIGN_CHANGE(*v0, *rounding0, *v1, *rounding1);
 }
 
@@ -627,7 +627,7 @@ void confirm_flat_root(SurfaceHit* h, REAL3 u, __global const uint* exps, __glob
   if (!CERTAIN_SIGN_CHANGE(v0, rounding0, v1, rounding1)) {
 #if LANES == 1
     const LaneRays r = one_lane_rays(u, h->d_unit);
-    if (!confirmed_in_float_float(1, &r, h->root.t, coefs, exps, count, &v0, &rounding0, &v1, &rounding1)) return;
+    if (!confirmed_in_float_float(1, &r, h->root.t, exps, coefs, count, &v0, &rounding0, &v1, &rounding1)) return;
     arithmetic = 1;
 #else
     (void)u; /* the lanes' caller checks its lanes in float-float together */
@@ -895,7 +895,7 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
   const LMASK still = found && (roots.flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0;
   if (LANE_ANY(still)) {
     LREAL v0, rounding0, v1, rounding1;
-    const LMASK confirmed = confirmed_in_float_float(still, &unit, LANE_SEL((LREAL)0, roots.t, still), coefs, exps,
+    const LMASK confirmed = confirmed_in_float_float(still, &unit, LANE_SEL((LREAL)0, roots.t, still), exps, coefs,
                                                      mono_count, &v0, &rounding0, &v1, &rounding1);
     roots.flags &= LANE_SEL((LANE_INT_VEC)(-1), (LANE_INT_VEC)(~ALGRAY_HIT_DOUBT), confirmed);
   }
