@@ -2,6 +2,7 @@
 #ifndef ALGRAY_BERNSTEIN_H
 #define ALGRAY_BERNSTEIN_H
 
+#include "float_float.h"
 #include "isolation.h"
 #include "lanes.h"
 
@@ -166,6 +167,21 @@ int refinable_in_float(const REAL* c) {
 #endif
 }
 
+/* Adaptive builds, one ray per work-item (camera and secondary rays): whether an isolated bracket [iso.lo, iso.hi]
+ * whose end values are within the noise (an accept doubt) is settled after all by P's values at its ends in
+ * float-float (float_float.h, bracket_ends_in_float_float). Other builds and shadow rays never settle one so. */
+#if ALGRAY_ESCALATE && LANES == 1 && !ALGRAY_SHADOW_RAYS
+int bracket_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise) {
+  const RayTerms* terms = noise->terms;
+  if (!terms->has_ray || !within_noise_at(noise, smaller_end(cur, iso->lo), iso->lo, iso->hi)) return 0;
+  const LaneRays r = one_lane_rays(terms->o, terms->d);
+  return bracket_ends_in_float_float(1, &r, terms->t_in, terms->t_out, iso->lo, iso->hi, cur[0], cur[DEGREE],
+                                     terms->exps, terms->coefs, terms->count);
+}
+#else
+#define bracket_settled(iso, cur, noise) 0
+#endif
+
 /* Finds the leftmost subinterval of [0,1] that isolates the smallest root of the polynomial with Bernstein
  * coefficients `root` (+ `root_lo` in mixed precision). Depth-first, left half first; the path is the pair
  * (level, idx), so no stack is kept. The right half of the latest split is cached, as the left half is usually
@@ -202,7 +218,7 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
     if (v == 1 && cur[DEGREE] != 0 && refinable_in_float(cur)) {
       PROBE_STEP(iso, v, ALGRAY_STEP_ISOLATED, level);
       iso.status = ISOLATION_BRACKET;
-      doubted(&iso, ALGRAY_DOUBT_ACCEPT, smaller_end(cur, iso.lo), noise, level PROBE_ARG);
+      if (!bracket_settled(&iso, cur, noise)) doubted(&iso, ALGRAY_DOUBT_ACCEPT, smaller_end(cur, iso.lo), noise, level PROBE_ARG);
       return isolation_found(iso, noise);
     }
 #if ALGRAY_ESCALATE
@@ -276,7 +292,16 @@ ALGRAY_INLINE LMASK one_strict_sign(const LREAL* c) {
 #define LANE_LARGER(a, b) LANE_SEL((a), (b), (b) > (a))
 #define LANE_SMALLER(a, b) LANE_SEL((a), (b), (b) < (a))
 #if ALGRAY_ESCALATE
-#define LANE_TERMS_PARAM , LREAL terms
+/* What the lanes' search of an adaptive build needs of its rays: their terms (the noise), and the rays in unit
+ * coordinates with the monomials, for bracket_ends_in_float_float as bracket_settled uses it. */
+typedef struct {
+  LREAL value;
+  const LaneRays* rays;
+  __global const uint* exps;
+  __global const REAL* coefs;
+  uint count;
+} LaneTerms;
+#define LANE_TERMS_PARAM , const LaneTerms* terms
 #else
 #define LANE_TERMS_PARAM
 #endif
@@ -364,10 +389,11 @@ void isolate_bernstein_lanes(LMASK running, const LREAL* root, LREAL t_in, LREAL
 #if ALGRAY_ESCALATE
   /* doubt_noise and doubted per lane: a doubted lane stops with status NONE and its ALGRAY_DOUBT_* */
   LREAL magnitude[NCOEF], doubt = 0;
+  LMASK brackets_doubted = 0; /* the lanes doubted at an isolated bracket */
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(root[k]);
   MAGNITUDE_TREE(magnitude, LANE_LARGER);
-  const LREAL noise = DOUBT_NOISE(magnitude[0], terms);
+  const LREAL noise = DOUBT_NOISE(magnitude[0], terms->value);
 #define DOUBT_LANES(mask, reason)                               \
   do {                                                          \
     const LMASK doubted_ = (mask);                              \
@@ -392,7 +418,12 @@ void isolate_bernstein_lanes(LMASK running, const LREAL* root, LREAL t_in, LREAL
     const LMASK isolated = !done && v == 1 && cur[DEGREE] != 0;
     status = LANE_SEL(status, (LREAL)ISOLATION_BRACKET, isolated);
     done = done || isolated;
-    DOUBT_LANES(isolated && fmin(fabs(cur[0]), fabs(cur[DEGREE])) <= noise, ALGRAY_DOUBT_ACCEPT);
+#if ALGRAY_ESCALATE
+    /* doubted for now; bracket_settled's check comes once for all such lanes, after the search */
+    const LMASK bracket_doubt = isolated && fmin(fabs(cur[0]), fabs(cur[DEGREE])) <= noise;
+    brackets_doubted = brackets_doubted || bracket_doubt;
+    DOUBT_LANES(bracket_doubt, ALGRAY_DOUBT_ACCEPT);
+#endif
 #if ALGRAY_ESCALATE
     /* isolate_bernstein's near_zero: doubted at an end, halved inside */
     ALGRAY_UNROLL
@@ -449,6 +480,16 @@ void isolate_bernstein_lanes(LMASK running, const LREAL* root, LREAL t_in, LREAL
     const LMASK from_root = move && !from_sib;
     if (LANE_ANY(from_root)) bernstein_restrict_lanes(root, at, width, from_root, cur);
   }
+#if ALGRAY_ESCALATE
+  /* bracket_settled: a stopped lane keeps its interval and coefficients, so the brackets doubted in any step are
+   * checked here together, in one evaluation for the lanes rather than one per step that doubted some */
+  if (LANE_ANY(brackets_doubted)) {
+    const LMASK settled = bracket_ends_in_float_float(brackets_doubted, terms->rays, t_in, t_out, at, at + width,
+                                                      cur[0], cur[DEGREE], terms->exps, terms->coefs, terms->count);
+    status = LANE_SEL(status, (LREAL)ISOLATION_BRACKET, settled);
+    doubt = LANE_SEL(doubt, (LREAL)0, settled);
+  }
+#endif
   iso->status = status;
   iso->steps = steps;
   /* isolation_at_far_end reports [1, 1] with zero values */

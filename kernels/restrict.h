@@ -74,6 +74,11 @@ typedef struct {
   uint count;
   REAL x, y, z;
   REAL x0, x1, y0, y1, z0, z1; /* |x|, |y|, |z| at the segment's ends, for ray_terms_local */
+  /* camera and secondary rays: the ray o + t d in unit coordinates and its segment, where P is evaluated again
+   * in float-float (float_float.h; has_ray 0 elsewhere) */
+  int has_ray;
+  REAL3 o, d;
+  REAL t_in, t_out;
 } RayTerms;
 
 /* Terms of a known size (exact from the start): coefficients given as they are. */
@@ -86,6 +91,7 @@ RayTerms known_terms(REAL value) {
   t.count = 0;
   t.x = t.y = t.z = 0;
   t.x0 = t.x1 = t.y0 = t.y1 = t.z0 = t.z1 = 0;
+  t.has_ray = 0;
   return t;
 }
 
@@ -127,6 +133,7 @@ RayTerms ray_terms(__global const uint* exps, __global const REAL* coefs, uint c
   t.z0 = fabs(fz.l0);
   t.z1 = fabs(fz.l1);
   t.value = terms_within(coefs, count, fmax(t.x, fmax(t.y, t.z)));
+  t.has_ray = 0;
   return t;
 }
 

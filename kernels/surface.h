@@ -3,6 +3,7 @@
 #define ALGRAY_SURFACE_H
 
 #include "algray_shared.h"
+#include "float_float.h"
 #include "lanes.h"
 #include "ray.h"
 #include "real.h"
@@ -316,6 +317,11 @@ ALGRAY_INLINE void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out,
   restrict_to_ray(exps, coefs, count, binomials, fx, fy, fz, root, root_lo);
 #if ALGRAY_ESCALATE
   *terms = ray_terms(exps, coefs, count, fx, fy, fz);
+  terms->has_ray = 1;
+  terms->o = o;
+  terms->d = d;
+  terms->t_in = t_in;
+  terms->t_out = t_out;
 #endif
 #endif
   restricted_to_isolation_basis(root, root_lo, binomials PROBE_ARG);
@@ -426,9 +432,11 @@ DEFINE_TERMS_SUM(terms_sum_lanes, LREAL)
 /* The isolations of LANES rays from their segment_coefficients (root, root_lo are consumed): together in lanes
  * (isolate_bernstein_lanes), or one lane at a time in mixed precision. c gets each lane's polynomial on its
  * isolating interval, for refine_lanes. Lanes from `count` on, and those whose ray missed the extent
- * (in_extent[j] == 0), are left alone. */
-void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (*root_lo)[NCOEF], const REAL* t_in,
-                   const REAL* t_out, LaneIsolation* iso, LREAL* c TERMS_OUT_PARAM) {
+ * (in_extent[j] == 0), are left alone. rays: the lanes' rays in unit coordinates, where adaptive builds' search
+ * evaluates P in float-float (bracket_ends_in_float_float). */
+void isolate_lanes(uint count, const int* in_extent, const LaneRays* rays, REAL (*root)[NCOEF], REAL (*root_lo)[NCOEF],
+                   const REAL* t_in, const REAL* t_out, LaneIsolation* iso, LREAL* c TERMS_OUT_PARAM) {
+  (void)rays; /* adaptive builds' search checks its accept doubts on them */
   for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
 #if ALGRAY_COMPENSATED
   for (uint j = 0; j < LANES; ++j) set_lane_isolation(iso, j, isolation_none());
@@ -474,8 +482,16 @@ void isolate_lanes(uint count, const int* in_extent, REAL (*root)[NCOEF], REAL (
   }
 #endif
   (void)lane_terms;
+#if ALGRAY_ESCALATE
+  LaneTerms search_terms;
+  search_terms.value = lane_terms;
+  search_terms.rays = rays;
+  search_terms.exps = first < LANES ? terms[first].exps : 0;
+  search_terms.coefs = first < LANES ? terms[first].coefs : 0;
+  search_terms.count = first < LANES ? terms[first].count : 0;
+#endif
   if (LANE_ANY(running))
-    isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, iso, c TERMS_OUT(lane_terms));
+    isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, iso, c TERMS_OUT(&search_terms));
 #endif
 }
 #endif
@@ -514,89 +530,6 @@ REAL direct_value(REAL3 q, __global const uint* exps, __global const REAL* coefs
   return value;
 }
 
-/* Float-float numbers hi + lo, |lo| within half an ulp of hi, of one ray or of lanes: each product and sum below
- * keeps its rounding error (fma, Knuth's two-sum), so its relative error is a few REAL_EPS^2, not REAL_EPS. */
-typedef struct {
-  LREAL hi, lo;
-} FloatFloat;
-
-/* hi + e renormalised, for |hi| >= |e| or hi = 0 (Dekker's fast two-sum). */
-ALGRAY_INLINE FloatFloat ff_normalised(LREAL hi, LREAL e) {
-  FloatFloat r;
-  r.hi = hi + e;
-  r.lo = e - (r.hi - hi);
-  return r;
-}
-ALGRAY_INLINE FloatFloat ff_add(FloatFloat a, FloatFloat b) {
-  const LREAL s = a.hi + b.hi, bb = s - a.hi;
-  return ff_normalised(s, ((a.hi - (s - bb)) + (b.hi - bb)) + (a.lo + b.lo));
-}
-ALGRAY_INLINE FloatFloat ff_mul(FloatFloat a, FloatFloat b) {
-  const LREAL p = a.hi * b.hi;
-  return ff_normalised(p, fma(a.hi, b.hi, -p) + (a.hi * b.lo + a.lo * b.hi));
-}
-/* x + t d, exact but for the rounding of its low part */
-ALGRAY_INLINE FloatFloat ff_point_axis(LREAL x, LREAL t, LREAL d) {
-  const LREAL p = t * d;
-  FloatFloat a, b;
-  a.hi = x;
-  a.lo = 0;
-  b.hi = p;
-  b.lo = fma(t, d, -p);
-  return ff_add(a, b);
-}
-
-/* P at o + t d in float-float for each lane of r, coefficients hi + lo (adaptive builds get the low parts after
- * the per-degree sums; DeviceSurface), and a bound on its rounding, each part with room:
- *  - the products and sums, at most 6 (REAL_EPS / 2)^2 each relative to its operands' sizes: (3 DEGREE + count + 8)
- *    2 REAL_EPS^2 times the terms sum_m |a_m| |x|^i |y|^j |z|^k (which also covers the coefficients' low parts);
- *  - the point, whose coordinates are off by at most dq = REAL_EPS^2 (|o| + |t d|) each (the low part's rounding):
- *    sum over the axes of dq times the terms' derivative along it, taken at |q| + dq, which bounds P's change.
- * Underflowing low parts can only make the bound too small by FLT_MIN-sized amounts: the absolute term. */
-LREAL direct_value_ff(const LaneRays* r, LREAL t, __global const uint* exps, __global const REAL* coefs, uint count,
-                      LREAL* rounding) {
-  FloatFloat px[NCOEF], py[NCOEF], pz[NCOEF];
-  const FloatFloat x = ff_point_axis(r->ox, t, r->dx), y = ff_point_axis(r->oy, t, r->dy),
-                   z = ff_point_axis(r->oz, t, r->dz);
-  px[0].hi = py[0].hi = pz[0].hi = 1;
-  px[0].lo = py[0].lo = pz[0].lo = 0;
-  for (int n = 1; n <= DEGREE; ++n) {
-    px[n] = ff_mul(px[n - 1], x);
-    py[n] = ff_mul(py[n - 1], y);
-    pz[n] = ff_mul(pz[n - 1], z);
-  }
-  const LREAL eps2 = (LREAL)(REAL_EPS * REAL_EPS);
-  const LREAL dqx = (fabs(r->ox) + fabs(t * r->dx)) * eps2, dqy = (fabs(r->oy) + fabs(t * r->dy)) * eps2,
-              dqz = (fabs(r->oz) + fabs(t * r->dz)) * eps2;
-  LREAL bx[NCOEF], by[NCOEF], bz[NCOEF];
-  bx[0] = by[0] = bz[0] = 1;
-  for (int n = 1; n <= DEGREE; ++n) {
-    bx[n] = bx[n - 1] * (fabs(x.hi) + dqx);
-    by[n] = by[n - 1] * (fabs(y.hi) + dqy);
-    bz[n] = bz[n - 1] * (fabs(z.hi) + dqz);
-  }
-  __global const REAL* lows = coefs + count + NCOEF;
-  FloatFloat value;
-  value.hi = value.lo = 0;
-  LREAL size = 0, slope_x = 0, slope_y = 0, slope_z = 0;
-  for (uint m = 0; m < count; ++m) {
-    const uint i = exps[m] & 0xffu, j = (exps[m] >> 8) & 0xffu, k = (exps[m] >> 16) & 0xffu;
-    FloatFloat a;
-    a.hi = coefs[m];
-    a.lo = lows[m];
-    value = ff_add(value, ff_mul(ff_mul(a, px[i]), ff_mul(py[j], pz[k])));
-    const REAL c = fabs(coefs[m]);
-    size += c * bx[i] * by[j] * bz[k];
-    if (i) slope_x += c * (REAL)i * bx[i - 1] * by[j] * bz[k];
-    if (j) slope_y += c * (REAL)j * bx[i] * by[j - 1] * bz[k];
-    if (k) slope_z += c * (REAL)k * bx[i] * by[j] * bz[k - 1];
-  }
-  const LREAL arithmetic = size * (REAL)(2 * (3 * DEGREE + (int)count + 8)) * eps2;
-  const LREAL point = (dqx * slope_x + dqy * slope_y) + dqz * slope_z;
-  *rounding = (arithmetic + point) * (REAL)(1 + 1.0 / 1024) + (REAL)(8 * (int)count) * FLT_MIN;
-  return value.hi + value.lo;
-}
-
 /* Whether values v0 and v1 stand beyond their roundings with opposite signs (of one ray or of lanes): then P
  * changes sign between them. */
 #define CERTAIN_SIGN_CHANGE(v0, rounding0, v1, rounding1) \
@@ -609,8 +542,8 @@ LMASK confirmed_in_float_float(LMASK doubted, const LaneRays* r, LREAL t, __glob
                                __global const REAL* coefs, uint count, LREAL* v0, LREAL* rounding0, LREAL* v1,
                                LREAL* rounding1) {
   const LREAL inner = (REAL)ALGRAY_DOUBT_POSITION * (REAL)(1 - 1.0 / 1024) * fabs(t);
-  *v0 = direct_value_ff(r, t - inner, exps, coefs, count, rounding0);
-  *v1 = direct_value_ff(r, t + inner, exps, coefs, count, rounding1);
+  *v0 = direct_value_ff(r, ff_of(t - inner), exps, coefs, count, rounding0);
+  *v1 = direct_value_ff(r, ff_of(t + inner), exps, coefs, count, rounding1);
   return doubted && CERTAIN_SIGN_CHANGE(*v0, *rounding0, *v1, *rounding1);
 }
 
@@ -867,7 +800,7 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
     segment_coefficients(lane_origin(&unit, j), lane_direction(&unit, j), t_in[j], t_out[j], exps, coefs, mono_count,
                          binomials, even_axes, root[j], root_lo[j] TERMS_OUT(&terms[j]) SCREEN_ARG);
   }
-  isolate_lanes(count, in_extent, root, root_lo, t_in, t_out, &iso, iso_c TERMS_OUT(terms));
+  isolate_lanes(count, in_extent, &unit, root, root_lo, t_in, t_out, &iso, iso_c TERMS_OUT(terms));
 #endif
   refine_lanes(running, &iso, iso_c, lane_t_in, lane_t_out, binomials, &roots);
   /* finish_surface over lanes: `at` moves each found root's ray to its point */
