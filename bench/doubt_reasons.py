@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Why adaptive precision doubts a scene's camera rays (issue 18): `algray probe --json` on random pixels, and
 each doubted ray's reason (isolation.h: discard, accept, cluster, flat) counted; flat doubts that P's values
-confirmed, which go to no second pass, apart. Pixels whose ray misses the
+confirmed and accept doubts whose brackets P's values settled, which go to no second pass, apart. Pixels whose ray misses the
 extent are counted in the sample but need no search. Prints each doubted case with the seed and its index.
 
   python3 bench/doubt_reasons.py --count 1500 scenes/barth_decic.toml
@@ -36,7 +36,8 @@ def main():
             continue
         reason = solver["doubt"]["reason"]
         if "confirmed" in solver["doubt"]:
-            reason += ", confirmed (no second pass)"  # surface.h confirm_flat_root kept the float root
+            # surface.h confirm_flat_root kept the float root, or bernstein.h bracket_settled the bracket
+            reason += ", settled (no second pass)"
         reasons[reason] += 1
         print(f"seed {a.seed} case {case} pixel {x},{y}: {reason}", flush=True)
     total = sum(reasons.values())

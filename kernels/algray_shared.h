@@ -85,7 +85,9 @@ typedef struct {
                                        values: the interval's lo, hi, the value in question, the noise bound */
 #define ALGRAY_EVENT_CONFIRMED 8    /* adaptive precision: a flat-doubted root kept after all (confirm_flat_root).
                                        decision: 0 evaluated in float, 1 in float-float; values: P and its
-                                       rounding bound at t - delta, then at t + delta */
+                                       rounding bound at t - delta, then at t + delta. Decision 2: an
+                                       accept-doubted bracket kept (bernstein.h, bracket_settled), values P
+                                       in float-float and its bound at the bracket's ends */
 
 /* What an isolation found (kernels/isolation.h's Isolation.status) */
 #define ALGRAY_ISOLATED_NONE 0    /* certified: no root in [t_in, t_out] (up to the tolerance) */

@@ -169,17 +169,24 @@ int refinable_in_float(const REAL* c) {
 
 /* Adaptive builds, one ray per work-item (camera and secondary rays): whether an isolated bracket [iso.lo, iso.hi]
  * whose end values are within the noise (an accept doubt) is settled after all by P's values at its ends in
- * float-float (float_float.h, bracket_ends_in_float_float). Other builds and shadow rays never settle one so. */
+ * float-float (float_float.h, bracket_ends_in_float_float). The probe sees the doubt, then what settled it
+ * (ALGRAY_EVENT_CONFIRMED, decision 2). Other builds and shadow rays never settle one so. */
 #if ALGRAY_ESCALATE && LANES == 1 && !ALGRAY_SHADOW_RAYS
-int bracket_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise) {
+int bracket_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise, int level PROBE_PARAM) {
   const RayTerms* terms = noise->terms;
-  if (!terms->has_ray || !within_noise_at(noise, smaller_end(cur, iso->lo), iso->lo, iso->hi)) return 0;
+  const REAL end = smaller_end(cur, iso->lo);
+  if (!terms->has_ray || !within_noise_at(noise, end, iso->lo, iso->hi)) return 0;
   const LaneRays r = one_lane_rays(terms->o, terms->d);
-  return bracket_ends_in_float_float(1, &r, terms->t_in, terms->t_out, iso->lo, iso->hi, cur[0], cur[DEGREE],
-                                     terms->exps, terms->coefs, terms->count);
+  REAL v_lo, rounding_lo, v_hi, rounding_hi;
+  if (!bracket_ends_in_float_float(1, &r, terms->t_in, terms->t_out, iso->lo, iso->hi, cur[0], cur[DEGREE],
+                                   terms->exps, terms->coefs, terms->count, &v_lo, &rounding_lo, &v_hi, &rounding_hi))
+    return 0;
+  PROBE(ALGRAY_EVENT_DOUBT, 0, ALGRAY_DOUBT_ACCEPT, (uint)level, iso->lo, iso->hi, end, noise->noise);
+  PROBE(ALGRAY_EVENT_CONFIRMED, 0, 2u, 0u, v_lo, rounding_lo, v_hi, rounding_hi);
+  return 1;
 }
 #else
-#define bracket_settled(iso, cur, noise) 0
+#define bracket_settled(iso, cur, noise, level) 0
 #endif
 
 /* Finds the leftmost subinterval of [0,1] that isolates the smallest root of the polynomial with Bernstein
@@ -218,7 +225,8 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
     if (v == 1 && cur[DEGREE] != 0 && refinable_in_float(cur)) {
       PROBE_STEP(iso, v, ALGRAY_STEP_ISOLATED, level);
       iso.status = ISOLATION_BRACKET;
-      if (!bracket_settled(&iso, cur, noise)) doubted(&iso, ALGRAY_DOUBT_ACCEPT, smaller_end(cur, iso.lo), noise, level PROBE_ARG);
+      if (!bracket_settled(&iso, cur, noise, level PROBE_ARG))
+        doubted(&iso, ALGRAY_DOUBT_ACCEPT, smaller_end(cur, iso.lo), noise, level PROBE_ARG);
       return isolation_found(iso, noise);
     }
 #if ALGRAY_ESCALATE
@@ -484,8 +492,10 @@ void isolate_bernstein_lanes(LMASK running, const LREAL* root, LREAL t_in, LREAL
   /* bracket_settled: a stopped lane keeps its interval and coefficients, so the brackets doubted in any step are
    * checked here together, in one evaluation for the lanes rather than one per step that doubted some */
   if (LANE_ANY(brackets_doubted)) {
-    const LMASK settled = bracket_ends_in_float_float(brackets_doubted, terms->rays, t_in, t_out, at, at + width,
-                                                      cur[0], cur[DEGREE], terms->exps, terms->coefs, terms->count);
+    LREAL v_lo, rounding_lo, v_hi, rounding_hi;
+    const LMASK settled =
+        bracket_ends_in_float_float(brackets_doubted, terms->rays, t_in, t_out, at, at + width, cur[0], cur[DEGREE],
+                                    terms->exps, terms->coefs, terms->count, &v_lo, &rounding_lo, &v_hi, &rounding_hi);
     status = LANE_SEL(status, (LREAL)ISOLATION_BRACKET, settled);
     doubt = LANE_SEL(doubt, (LREAL)0, settled);
   }

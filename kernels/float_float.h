@@ -106,15 +106,15 @@ LREAL direct_value_ff(const LaneRays* r, FloatFloat t, __global const uint* exps
 
 /* Lanes in `doubted` whose isolating interval [lo, hi] (fractions of [t_in, t_out]) has P, in float-float at both
  * ends, of the signs float gave there (f_lo, f_hi, which differ), each value beyond its rounding: then P changes
- * sign inside, as surely as where float's own end values stand clear of its noise. */
+ * sign inside, as surely as where float's own end values stand clear of its noise. *v_lo ... *rounding_hi: the
+ * values and their bounds. */
 LMASK bracket_ends_in_float_float(LMASK doubted, const LaneRays* r, LREAL t_in, LREAL t_out, LREAL lo, LREAL hi,
                                   LREAL f_lo, LREAL f_hi, __global const uint* exps, __global const REAL* coefs,
-                                  uint count) {
-  LREAL rounding_lo, rounding_hi;
-  const LREAL v_lo = direct_value_ff(r, ff_segment_point(t_in, t_out, lo), exps, coefs, count, &rounding_lo);
-  const LREAL v_hi = direct_value_ff(r, ff_segment_point(t_in, t_out, hi), exps, coefs, count, &rounding_hi);
-  return doubted && fabs(v_lo) > rounding_lo && fabs(v_hi) > rounding_hi && (v_lo > 0) == (f_lo > 0) &&
-         (v_hi > 0) == (f_hi > 0);
+                                  uint count, LREAL* v_lo, LREAL* rounding_lo, LREAL* v_hi, LREAL* rounding_hi) {
+  *v_lo = direct_value_ff(r, ff_segment_point(t_in, t_out, lo), exps, coefs, count, rounding_lo);
+  *v_hi = direct_value_ff(r, ff_segment_point(t_in, t_out, hi), exps, coefs, count, rounding_hi);
+  return doubted && fabs(*v_lo) > *rounding_lo && fabs(*v_hi) > *rounding_hi && (*v_lo > 0) == (f_lo > 0) &&
+         (*v_hi > 0) == (f_hi > 0);
 }
 #endif
 

@@ -439,9 +439,10 @@ TEST_CASE("a ray adaptive precision doubts: the probe says why, and the second p
 
 namespace {
 
-// Scans a preview of `file` (in the source tree) in adaptive precision for the first four roots the float kernel doubted as flat and
-// kept after all; returns how many of them P's values confirmed in float-float.
-int check_confirmed_roots(const char* file, RenderContext& context) {
+// Scans a preview of `file` (in the source tree) in adaptive precision for the first four roots the float kernel
+// doubted and kept after all: flat roots P's values confirmed, or with `brackets` isolating intervals P's values at
+// their ends settled. Returns how many of them were decided in float-float.
+int check_confirmed_roots(const char* file, bool brackets, RenderContext& context) {
   const Scene scene = load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/" + file, {{"image.width", "96"}, {"image.height", "72"},
                                              {"render.precision", "\"adaptive\""}, {"render.preview", "true"}});
   Renderer renderer(context.session(), context.cache());
@@ -454,15 +455,16 @@ int check_confirmed_roots(const char* file, RenderContext& context) {
       ProbeTarget target{false, px, py, {}, {}};
       const std::vector<SurfaceProbe> probes = probe_scene(scene, target, false, context);
       const SolverTrace& trace = probes.at(0).traces.at(0);
-      if (!trace.confirmed) continue;
+      if (!trace.confirmed || trace.confirmed->bracket != brackets) continue;
       ++confirmed;
       in_float_float += trace.confirmed->float_float;
       INFO(file << ", pixel (" << px << ", " << py << ")");
       REQUIRE(trace.doubt.has_value());
-      CHECK(doubt_reason(static_cast<unsigned>(trace.doubt->reason))->id == ALGRAY_DOUBT_FLAT);
+      CHECK(doubt_reason(static_cast<unsigned>(trace.doubt->reason))->id ==
+            (brackets ? ALGRAY_DOUBT_ACCEPT : ALGRAY_DOUBT_FLAT));
       CHECK(probes[0].traces.size() == 1);
       CHECK((trace.hit.flags & ALGRAY_HIT_DOUBT) == 0);
-      // P changes sign across the root, each value beyond its rounding.
+      // P changes sign across the root (or the bracket), each value beyond its rounding.
       CHECK(std::fabs(trace.confirmed->before) > trace.confirmed->before_rounding);
       CHECK(std::fabs(trace.confirmed->after) > trace.confirmed->after_rounding);
       CHECK((trace.confirmed->before > 0) != (trace.confirmed->after > 0));
@@ -485,6 +487,13 @@ TEST_CASE("a flat-doubted root that P's values confirm is kept: one trace, the r
   RenderContext context("", true);
   // The Barth decic's doubted roots are confirmed in float; the cubed tooth's, every root nearly triple and its
   // monomials cancelling, need float-float.
-  check_confirmed_roots("scenes/barth_decic.toml", context);
-  CHECK(check_confirmed_roots("tests/data/hard_surfaces/tooth_cubed.toml", context) > 0);
+  check_confirmed_roots("scenes/barth_decic.toml", false, context);
+  CHECK(check_confirmed_roots("tests/data/hard_surfaces/tooth_cubed.toml", false, context) > 0);
+}
+
+TEST_CASE("a bracket doubted for its end values that float-float settles is kept: one trace, the render's record",
+          "[probe]") {
+  RenderContext context("", true);
+  // The Kummer shell's two sheets lie within float's noise of each other: its brackets' end values often do too.
+  CHECK(check_confirmed_roots("tests/data/hard_surfaces/kummer_shell.toml", true, context) == 4);
 }

@@ -171,7 +171,12 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
     out << "doubted (" << (why ? why->name : "?") << ": " << (why ? why->meaning : "unknown reason")
         << "): " << num(tr.doubt->value, 4) << " within the noise " << num(tr.doubt->noise, 4) << " on ["
         << num(tr.t_at(tr.doubt->lo)) << ", " << num(tr.t_at(tr.doubt->hi)) << "]";
-    if (tr.confirmed)
+    if (tr.confirmed && tr.confirmed->bracket)
+      out << "; settled: P from the monomials in float-float is " << num(tr.confirmed->before, 4) << " (rounding "
+          << num(tr.confirmed->before_rounding, 3) << ") at the interval's start and " << num(tr.confirmed->after, 4)
+          << " (rounding " << num(tr.confirmed->after_rounding, 3)
+          << ") at its end, the signs float gave: the render keeps this bracket\n";
+    else if (tr.confirmed)
       out << "; confirmed: P from the monomials" << (tr.confirmed->float_float ? " in float-float" : "") << " is "
           << num(tr.confirmed->before, 4) << " (rounding "
           << num(tr.confirmed->before_rounding, 3) << ") before the root and " << num(tr.confirmed->after, 4)
@@ -251,7 +256,8 @@ nlohmann::json trace_json(const SolverTrace& tr) {
                                  {"before_rounding", tr.confirmed->before_rounding},
                                  {"after", tr.confirmed->after},
                                  {"after_rounding", tr.confirmed->after_rounding},
-                                 {"float_float", tr.confirmed->float_float}};
+                                 {"float_float", tr.confirmed->float_float},
+                                 {"bracket", tr.confirmed->bracket}};
   }
   j["found"] = tr.found();
   if (tr.found()) j["t"] = tr.t;

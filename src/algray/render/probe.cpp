@@ -60,9 +60,10 @@ void decode_events(const std::vector<ProbeEvent>& events, const std::vector<doub
       }
       case ALGRAY_EVENT_DOUBT:
         trace.doubt = ProbeDoubt{static_cast<int>(e.decision), static_cast<int>(e.level), v[0], v[1], v[2], v[3]};
+        trace.confirmed.reset();  // a settled bracket's root may be doubted again, as flat
         break;
       case ALGRAY_EVENT_CONFIRMED:
-        trace.confirmed = ProbeConfirmed{v[0], v[1], v[2], v[3], e.decision == 1};
+        trace.confirmed = ProbeConfirmed{v[0], v[1], v[2], v[3], e.decision >= 1, e.decision == 2};
         break;
       default:
         break;

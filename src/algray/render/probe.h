@@ -51,12 +51,14 @@ struct ProbeDoubt {
   double noise = 0;       // the noise bound it was held to
 };
 
-// A flat-doubted root kept after all (ALGRAY_EVENT_CONFIRMED, kernels/surface.h confirm_flat_root): P from the
-// monomials at t - delta and t + delta, delta = ALGRAY_DOUBT_POSITION |t|, each beyond its rounding bound.
+// A doubt settled after all (ALGRAY_EVENT_CONFIRMED): a flat-doubted root (kernels/surface.h confirm_flat_root),
+// P from the monomials at t - delta and t + delta, delta = ALGRAY_DOUBT_POSITION |t|; or an accept-doubted bracket
+// (kernels/bernstein.h bracket_settled), P at its ends. Each value beyond its rounding bound.
 struct ProbeConfirmed {
   double before = 0, before_rounding = 0;
   double after = 0, after_rounding = 0;
   bool float_float = false;  // evaluated in float-float, float's rounding having been too large
+  bool bracket = false;      // the bracket's ends, with the signs float gave there
 };
 
 // Everything the kernel recorded for one ray and one solver configuration.
