@@ -431,8 +431,6 @@ void isolate_bernstein_lanes(LMASK running, const LREAL* root, LREAL t_in, LREAL
     const LMASK bracket_doubt = isolated && fmin(fabs(cur[0]), fabs(cur[DEGREE])) <= noise;
     brackets_doubted = brackets_doubted || bracket_doubt;
     DOUBT_LANES(bracket_doubt, ALGRAY_DOUBT_ACCEPT);
-#endif
-#if ALGRAY_ESCALATE
     /* isolate_bernstein's near_zero: doubted at an end, halved inside */
     ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(cur[k]);
@@ -488,7 +486,7 @@ void isolate_bernstein_lanes(LMASK running, const LREAL* root, LREAL t_in, LREAL
     const LMASK from_root = move && !from_sib;
     if (LANE_ANY(from_root)) bernstein_restrict_lanes(root, at, width, from_root, cur);
   }
-#if ALGRAY_ESCALATE
+#if ALGRAY_ESCALATE && !ALGRAY_SHADOW_RAYS
   /* bracket_settled: a stopped lane keeps its interval and coefficients, so the brackets doubted in any step are
    * checked here together, in one evaluation for the lanes rather than one per step that doubted some */
   if (LANE_ANY(brackets_doubted)) {
