@@ -43,15 +43,9 @@ ALGRAY_INLINE FloatFloat ff_point_axis(LREAL x, FloatFloat t, LREAL d) {
   return ff_add(ff_of(x), b);
 }
 /* t_in + s (t_out - t_in) for a fraction s of at most REAL_MAX_HALVINGS bits (the search's interval ends): the
- * difference and s times it exact (two-sum, fma), the rest at REAL_EPS^2 of |t|. */
+ * difference exact (two-sum), then as ff_point_axis's point, at REAL_EPS^2 of |t|. */
 ALGRAY_INLINE FloatFloat ff_segment_point(LREAL t_in, LREAL t_out, LREAL s) {
-  const LREAL len = t_out - t_in, bb = len - t_out;
-  const LREAL len_lo = (t_out - (len - bb)) + (-t_in - bb);
-  const LREAL p = s * len;
-  FloatFloat b;
-  b.hi = p;
-  b.lo = fma(s, len, -p) + s * len_lo;
-  return ff_add(ff_of(t_in), b);
+  return ff_point_axis(t_in, ff_add(ff_of(t_out), ff_of(-t_in)), s);
 }
 
 /* P at o + t d in float-float for each lane of r, coefficients hi + lo (adaptive builds get the low parts after

@@ -482,16 +482,17 @@ void isolate_lanes(uint count, const int* in_extent, const LaneRays* rays, REAL 
   }
 #endif
   (void)lane_terms;
+  if (LANE_ANY(running)) {
 #if ALGRAY_ESCALATE
-  LaneTerms search_terms;
-  search_terms.value = lane_terms;
-  search_terms.rays = rays;
-  search_terms.exps = first < LANES ? terms[first].exps : 0;
-  search_terms.coefs = first < LANES ? terms[first].coefs : 0;
-  search_terms.count = first < LANES ? terms[first].count : 0;
+    LaneTerms search_terms;
+    search_terms.value = lane_terms;
+    search_terms.rays = rays;
+    search_terms.exps = terms[first].exps;
+    search_terms.coefs = terms[first].coefs;
+    search_terms.count = terms[first].count;
 #endif
-  if (LANE_ANY(running))
     isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, iso, c TERMS_OUT(&search_terms));
+  }
 #endif
 }
 #endif
