@@ -87,7 +87,9 @@ typedef struct {
                                        decision: 0 evaluated in float, 1 in float-float; values: P and its
                                        rounding bound at t - delta, then at t + delta. Decision 2: an
                                        accept-doubted bracket kept (bernstein.h, bracket_settled), values P
-                                       in float-float and its bound at the bracket's ends */
+                                       in float-float and its bound at the bracket's ends. Decision 3: a
+                                       discard-doubted interval settled (bernstein.h, discard_settled), values
+                                       P and its bound at the interval's ends */
 
 /* What an isolation found (kernels/isolation.h's Isolation.status) */
 #define ALGRAY_ISOLATED_NONE 0    /* certified: no root in [t_in, t_out] (up to the tolerance) */

@@ -189,6 +189,60 @@ int bracket_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise, i
 #define bracket_settled(iso, cur, noise, level) 0
 #endif
 
+/* Camera and secondary rays of adaptive builds that settle doubts (ALGRAY_SETTLE_DOUBTS: where the second pass runs
+ * in float-float; in double, tracing the ray again costs less than these checks) settle discard doubts by P's signs
+ * in float-float (discard_settled). */
+#define ALGRAY_SETTLES_DISCARDS (ALGRAY_ESCALATE && !ALGRAY_SHADOW_RAYS && ALGRAY_SETTLE_DOUBTS)
+#if ALGRAY_SETTLES_DISCARDS && LANES == 1
+
+/* The end value of an interval at fraction s as the probe shows a settled discard doubt: P in float-float and its
+ * rounding where that end was within the noise (in proven), else float's value c and the noise it stood clear of. */
+void settled_end(const ProvenEnds* proven, REAL s, REAL c, REAL noise, REAL* value, REAL* bound) {
+  *value = c;
+  *bound = noise;
+  for (int e = 0; e < 2; ++e)
+    if (proven->at[e] == s) {
+      *value = proven->value[e];
+      *bound = proven->rounding[e];
+    }
+}
+
+/* One ray per work-item (camera and secondary rays): whether an interval without sign variations doubted for an
+ * end value within the noise (a discard doubt) is root-free after all: every coefficient inside stands clear of the
+ * noise, and P in float-float at each end within it (proven, evaluated where not there yet) has the sign float
+ * gave there, beyond its rounding. Then every Bernstein coefficient has that one sign for certain. (Where one
+ * inside is within the noise too, P itself is, and halving down to the stopping width measured no better than
+ * tracing the ray again.) The probe sees the doubt, then what settled it (ALGRAY_EVENT_CONFIRMED, decision 3). */
+int discard_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise, ProvenEnds* proven,
+                    int level PROBE_PARAM) {
+  const RayTerms* terms = noise->terms;
+  if (!terms->has_ray || within_noise_at(noise, inner_smallest_magnitude(cur), iso->lo, iso->hi)) return 0;
+  const int lo_doubted = within_noise_at(noise, cur[0], iso->lo, iso->hi);
+  const int hi_doubted = within_noise_at(noise, cur[DEGREE], iso->lo, iso->hi);
+  const LaneRays r = one_lane_rays(terms->o, terms->d);
+  if (lo_doubted && !proven_at(proven, iso->lo))
+    prove_end(1, &r, terms->t_in, terms->t_out, iso->lo, iso->hi, terms->exps, terms->coefs, terms->count, proven);
+  if (hi_doubted && !proven_at(proven, iso->hi))
+    prove_end(1, &r, terms->t_in, terms->t_out, iso->hi, iso->lo, terms->exps, terms->coefs, terms->count, proven);
+  if ((lo_doubted && !proven_sign_of(proven, iso->lo, cur[0])) ||
+      (hi_doubted && !proven_sign_of(proven, iso->hi, cur[DEGREE])))
+    return 0;
+#if ALGRAY_PROBE
+  REAL v_lo, bound_lo, v_hi, bound_hi;
+  settled_end(proven, iso->lo, cur[0], noise->noise, &v_lo, &bound_lo);
+  settled_end(proven, iso->hi, cur[DEGREE], noise->noise, &v_hi, &bound_hi);
+  PROBE(ALGRAY_EVENT_DOUBT, 0, ALGRAY_DOUBT_DISCARD, (uint)level, iso->lo, iso->hi, smaller_end(cur, iso->lo),
+        noise->noise);
+  PROBE(ALGRAY_EVENT_CONFIRMED, 0, 3u, 0u, v_lo, bound_lo, v_hi, bound_hi);
+#else
+  (void)level;
+#endif
+  return 1;
+}
+#else
+#define discard_settled(iso, cur, noise, proven, level) 0
+#endif
+
 /* Finds the leftmost subinterval of [0,1] that isolates the smallest root of the polynomial with Bernstein
  * coefficients `root` (+ `root_lo` in mixed precision). Depth-first, left half first; the path is the pair
  * (level, idx), so no stack is kept. The right half of the latest split is cached, as the left half is usually
@@ -208,6 +262,10 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
 #if ALGRAY_ESCALATE
   SearchNoise noise_of_search = search_noise(root, terms);
   SearchNoise* noise = &noise_of_search;
+#endif
+#if ALGRAY_SETTLES_DISCARDS
+  ProvenEnds proven;
+  no_proven_ends(&proven);
 #endif
 
   for (;;) {
@@ -233,9 +291,16 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
     /* No sign variation, but a coefficient within the noise of zero: the interval is not yet shown root-free.
      * Its end coefficients are P's values: near zero there, float cannot tell; an inner one is halved until it
      * stands clear, as de Casteljau's coefficients close in on P's values (fewer rays doubted: on the Barth
-     * decic's shadow rays, 10% of them doubted without this). */
-    const int near_zero = v == 0 && within_noise_at(noise, smallest_magnitude(cur, iso.lo), iso.lo, iso.hi);
-    if (near_zero && doubted(&iso, ALGRAY_DOUBT_DISCARD, smaller_end(cur, iso.lo), noise, level PROBE_ARG)) return iso;
+     * decic's shadow rays, 10% of them doubted without this), unless P's signs there are proven in float-float
+     * (discard_settled). */
+    int near_zero = v == 0 && within_noise_at(noise, smallest_magnitude(cur, iso.lo), iso.lo, iso.hi);
+    if (near_zero && within_noise_at(noise, smaller_end(cur, iso.lo), iso.lo, iso.hi)) {
+      if (!discard_settled(&iso, cur, noise, &proven, level PROBE_ARG)) {
+        doubted(&iso, ALGRAY_DOUBT_DISCARD, smaller_end(cur, iso.lo), noise, level PROBE_ARG);
+        return iso;
+      }
+      near_zero = 0; /* root-free */
+    }
 #else
     const int near_zero = 0;
 #endif
@@ -398,6 +463,10 @@ void isolate_bernstein_lanes(LMASK running, const LREAL* root, LREAL t_in, LREAL
   /* doubt_noise and doubted per lane: a doubted lane stops with status NONE and its ALGRAY_DOUBT_* */
   LREAL magnitude[NCOEF], doubt = 0;
   LMASK brackets_doubted = 0; /* the lanes doubted at an isolated bracket */
+#if ALGRAY_SETTLES_DISCARDS
+  ProvenEnds proven;
+  no_proven_ends(&proven);
+#endif
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(root[k]);
   MAGNITUDE_TREE(magnitude, LANE_LARGER);
@@ -431,12 +500,40 @@ void isolate_bernstein_lanes(LMASK running, const LREAL* root, LREAL t_in, LREAL
     const LMASK bracket_doubt = isolated && fmin(fabs(cur[0]), fabs(cur[DEGREE])) <= noise;
     brackets_doubted = brackets_doubted || bracket_doubt;
     DOUBT_LANES(bracket_doubt, ALGRAY_DOUBT_ACCEPT);
-    /* isolate_bernstein's near_zero: doubted at an end, halved inside */
+    /* isolate_bernstein's near_zero: doubted at an end unless discard_settled's float-float signs settle it,
+     * halved inside */
     ALGRAY_UNROLL
     for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(cur[k]);
     MAGNITUDE_TREE(magnitude, LANE_SMALLER);
-    const LMASK near_zero = !done && v == 0 && magnitude[0] <= noise;
-    DOUBT_LANES(near_zero && fmin(fabs(cur[0]), fabs(cur[DEGREE])) <= noise, ALGRAY_DOUBT_DISCARD);
+    LMASK near_zero = !done && v == 0 && magnitude[0] <= noise;
+    const LMASK lo_doubted = fabs(cur[0]) <= noise, hi_doubted = fabs(cur[DEGREE]) <= noise;
+    const LMASK end_doubted = near_zero && (lo_doubted || hi_doubted);
+#if ALGRAY_SETTLES_DISCARDS
+    if (LANE_ANY(end_doubted)) {
+      /* inner_smallest_magnitude first: where it is within the noise, nothing is evaluated */
+      ALGRAY_UNROLL
+      for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(cur[k]);
+      magnitude[0] = magnitude[DEGREE] = INFINITY;
+      MAGNITUDE_TREE(magnitude, LANE_SMALLER);
+      const LMASK inner_clear = end_doubted && magnitude[0] > noise;
+      /* one evaluation for the lanes that need either end, a second for those that need both */
+      const LREAL hi = at + width;
+      const LMASK lo_needed = inner_clear && lo_doubted && !proven_at(&proven, at);
+      const LMASK hi_needed = inner_clear && hi_doubted && !proven_at(&proven, hi);
+      if (LANE_ANY(lo_needed || hi_needed))
+        prove_end(lo_needed || hi_needed, terms->rays, t_in, t_out, LANE_SEL(hi, at, lo_needed),
+                  LANE_SEL(at, hi, lo_needed), terms->exps, terms->coefs, terms->count, &proven);
+      if (LANE_ANY(lo_needed && hi_needed))
+        prove_end(lo_needed && hi_needed, terms->rays, t_in, t_out, hi, at, terms->exps, terms->coefs, terms->count,
+                  &proven);
+      const LMASK settled = inner_clear && (!lo_doubted || proven_sign_of(&proven, at, cur[0])) &&
+                            (!hi_doubted || proven_sign_of(&proven, hi, cur[DEGREE]));
+      DOUBT_LANES(end_doubted && !settled, ALGRAY_DOUBT_DISCARD);
+      near_zero = near_zero && !settled; /* root-free */
+    }
+#else
+    DOUBT_LANES(end_doubted, ALGRAY_DOUBT_DISCARD);
+#endif
     /* halve_or_settle for the lanes that may hold several roots */
     const LMASK several = !done && (v >= 1 || near_zero);
 #else

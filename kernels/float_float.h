@@ -110,6 +110,44 @@ LMASK bracket_ends_in_float_float(LMASK doubted, const LaneRays* r, LREAL t_in, 
   return doubted && fabs(*v_lo) > *rounding_lo && fabs(*v_hi) > *rounding_hi && (*v_lo > 0) == (f_lo > 0) &&
          (*v_hi > 0) == (f_hi > 0);
 }
+
+/* P in float-float at the search's last interval ends evaluated (fractions of [t_in, t_out]; -1 where none yet),
+ * with its rounding bounds, of one ray or of lanes: an interval doubted for an end value within the noise reads
+ * the sign there from these (proven_sign_of), and its halves and its neighbour, which share that end, read it
+ * again without evaluating P. */
+typedef struct {
+  LREAL at[2], value[2], rounding[2];
+} ProvenEnds;
+
+ALGRAY_INLINE void no_proven_ends(ProvenEnds* p) {
+  p->at[0] = p->at[1] = -1;
+  p->value[0] = p->value[1] = p->rounding[0] = p->rounding[1] = 0;
+}
+
+/* Whether P at fraction s is in p. */
+ALGRAY_INLINE LMASK proven_at(const ProvenEnds* p, LREAL s) { return p->at[0] == s || p->at[1] == s; }
+
+/* Whether p holds P at fraction s beyond its rounding, with the strict sign of c (float's value there). */
+ALGRAY_INLINE LMASK proven_sign_of(const ProvenEnds* p, LREAL s, LREAL c) {
+  const LMASK first = p->at[0] == s, second = p->at[1] == s;
+  const LREAL v = LANE_SEL(p->value[1], p->value[0], first), rounding = LANE_SEL(p->rounding[1], p->rounding[0], first);
+  return (first || second) && c != 0 && fabs(v) > rounding && (v > 0) == (c > 0);
+}
+
+/* P in float-float at the fraction s of [t_in, t_out], into p for the lanes in `take`: in the place of the one
+ * that is not at `keep` (the interval's other end). */
+void prove_end(LMASK take, const LaneRays* r, LREAL t_in, LREAL t_out, LREAL s, LREAL keep,
+               __global const uint* exps, __global const REAL* coefs, uint count, ProvenEnds* p) {
+  LREAL rounding;
+  const LREAL v = direct_value_ff(r, ff_segment_point(t_in, t_out, s), exps, coefs, count, &rounding);
+  const LMASK second = take && p->at[0] == keep, first = take && !second;
+  p->at[0] = LANE_SEL(p->at[0], s, first);
+  p->value[0] = LANE_SEL(p->value[0], v, first);
+  p->rounding[0] = LANE_SEL(p->rounding[0], rounding, first);
+  p->at[1] = LANE_SEL(p->at[1], s, second);
+  p->value[1] = LANE_SEL(p->value[1], v, second);
+  p->rounding[1] = LANE_SEL(p->rounding[1], rounding, second);
+}
 #endif
 
 #endif /* ALGRAY_FLOAT_FLOAT_H */

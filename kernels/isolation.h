@@ -76,9 +76,9 @@ Isolation isolation_none(void) {
   return iso;
 }
 
-/* Adaptive shadow kernels built with -D ALGRAY_SETTLE_DOUBTS=1 (KernelConfig::settle_doubts, where the second pass
- * runs in float-float) settle more of what they would doubt: within_noise_at here, sampled_sign_change in
- * shadow.h. */
+/* Adaptive kernels built with -D ALGRAY_SETTLE_DOUBTS=1 (KernelConfig::settle_doubts, where the second pass runs
+ * in float-float) settle more of what they would doubt: shadow kernels by within_noise_at here and
+ * sampled_sign_change in shadow.h, the others by discard_settled in bernstein.h. */
 #ifndef ALGRAY_SETTLE_DOUBTS
 #define ALGRAY_SETTLE_DOUBTS 0
 #endif
@@ -118,6 +118,16 @@ ALGRAY_INLINE REAL smallest_magnitude(const REAL* c, REAL lo) {
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]);
   if (first_counted(lo)) t[0] = INFINITY;
+  MAGNITUDE_TREE(t, PICK_SMALLER);
+  return t[0];
+}
+
+/* The smallest |c_k| inside, the ends left out. */
+ALGRAY_INLINE REAL inner_smallest_magnitude(const REAL* c) {
+  REAL t[NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]);
+  t[0] = t[DEGREE] = INFINITY;
   MAGNITUDE_TREE(t, PICK_SMALLER);
   return t[0];
 }

@@ -17,27 +17,7 @@
 
 using namespace algray;
 
-namespace {
-
-// Sets ALGRAY_NO_FP64 for one scope, and puts back what was there.
-class HiddenFp64 {
- public:
-  HiddenFp64() {
-    if (const char* v = std::getenv("ALGRAY_NO_FP64")) before_ = v;
-    ::setenv("ALGRAY_NO_FP64", "1", 1);
-  }
-  ~HiddenFp64() {
-    if (before_.empty())
-      ::unsetenv("ALGRAY_NO_FP64");
-    else
-      ::setenv("ALGRAY_NO_FP64", before_.c_str(), 1);
-  }
-
- private:
-  std::string before_;
-};
-
-}  // namespace
+using testing::HiddenFp64;
 
 TEST_CASE("ALGRAY_NO_FP64 hides double precision: auto picks float and double is refused", "[fp64]") {
   testing::device_session();  // fails loudly without a device

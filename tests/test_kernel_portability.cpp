@@ -67,10 +67,15 @@ void add(std::vector<Compile>& jobs, KernelConfig config) {
   jobs.push_back({kind, config.key(), config.source_file(), device_options(config)});
   config.lanes = 8;
   if (lanes_apply(config)) jobs.push_back({kind, config.key(), config.source_file(), device_options(config)});
-  config.lanes = 1;
-  config.settle_doubts = true;  // adaptive shadow kernels' sign sampling of doubted rays
-  if (config.precision == Precision::Adaptive && config.entry.rfind("shadow", 0) == 0)
-    jobs.push_back({kind, config.key(), config.source_file(), device_options(config)});
+  // Adaptive kernels as the plan builds them where the second pass runs in float-float (settle_doubts): shadow
+  // kernels sample doubted rays' signs, the others settle discard doubts in float-float.
+  if (config.precision != Precision::Adaptive || config.entry == "univariate") return;
+  config.settle_doubts = true;
+  for (int lanes : {1, 8}) {
+    config.lanes = lanes;
+    if (lanes == 1 || lanes_apply(config))
+      jobs.push_back({kind + " settling", config.key(), config.source_file(), device_options(config)});
+  }
 }
 
 // Every entry in every precision and ray origin, at the degrees where the kernels switch code paths, with the

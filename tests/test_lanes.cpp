@@ -105,6 +105,41 @@ TEST_CASE("lanes settle doubts in float-float as the one-ray kernel does, bit fo
   }
 }
 
+// Where the second pass runs in float-float (no fp64), the float pass also settles discard doubts in float-float
+// (bernstein.h, discard_settled) and its search goes on: lanes evaluate P for the lanes that need it together, in
+// the step that doubted. The Kummer and BC6 shells doubt most rays so; settled, fewer go to the second pass.
+TEST_CASE("lanes settle discard doubts in float-float as the one-ray kernel does, bit for bit", "[lanes]") {
+  const auto escalated = [](const RenderResult& r) {
+    std::size_t n = 0;
+    for (const HitRecord& h : r.hits.records) n += (h.flags & ALGRAY_HIT_ESCALATED) != 0;
+    return n;
+  };
+  ProgramCache cache(false);
+  Renderer with_fp64(testing::device_session(), cache);
+  const testing::HiddenFp64 hidden;
+  ClSession session(select_device(""));
+  REQUIRE_FALSE(session.info.fp64);
+  Renderer renderer(session, cache);
+  for (const char* name : {"kummer_shell", "bc6_shell"}) {
+    const std::string file = std::string(ALGRAY_SOURCE_DIR) + "/tests/data/hard_surfaces/" + name + ".toml";
+    const auto scene = [&](int lanes) {
+      return load_scene_file(file, {{"image.width", "61"},
+                                    {"image.height", "37"},
+                                    {"render.tile_size", "24"},
+                                    {"render.precision", "\"adaptive\""},
+                                    {"render.lanes", std::to_string(lanes)}});
+    };
+    const RenderResult one = renderer.render_with_records(scene(1));
+    const RenderResult lanes = renderer.render_with_records(scene(8));
+    const long at = first_difference(one.hits.records, lanes.hits.records);
+    INFO(name << ": first differing record " << at);
+    CHECK(at == -1);
+    const std::size_t settling = escalated(lanes), not_settling = escalated(with_fp64.render_with_records(scene(8)));
+    INFO("rays escalated: " << settling << " settling discard doubts, " << not_settling << " not");
+    CHECK(settling < not_settling);
+  }
+}
+
 // Surfaces whose lane groups take the search's rarer exits together: on z^3 seen square on every root is an
 // exact zero at a subdivision point, so whole groups have nothing to refine; a double plane gives clusters
 // with and without a sign change; x y z has singular lines; the sphere's rim has tangent rays.

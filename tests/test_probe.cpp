@@ -497,3 +497,58 @@ TEST_CASE("a bracket doubted for its end values that float-float settles is kept
   // The Kummer shell's two sheets lie within float's noise of each other: its brackets' end values often do too.
   CHECK(check_confirmed_roots("tests/data/hard_surfaces/kummer_shell.toml", true, context) == 4);
 }
+
+TEST_CASE("where the second pass is float-float, discard doubts settled in float-float let the search go on: "
+          "root-free intervals, the render's record, the reference's answer",
+          "[probe]") {
+  // The plan settles these only where the second pass would run in float-float, as without fp64.
+  const testing::HiddenFp64 hidden;
+  RenderContext context("", true);
+  REQUIRE(escalation_precision(context.session().info, context.cache()) == Precision::Mixed);
+  const Scene scene = load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/tests/data/hard_surfaces/kummer_shell.toml",
+                                      {{"image.width", "96"},
+                                       {"image.height", "72"},
+                                       {"render.precision", "\"adaptive\""},
+                                       {"render.preview", "true"}});
+  Renderer renderer(context.session(), context.cache());
+  const RenderResult render = renderer.render_with_records(scene);
+  int rays = 0, decided = 0;
+  for (int py = 1; py < 72 && decided < 4; py += 2)
+    for (int px = 1; px < 96 && decided < 4; px += 2) {
+      ProbeTarget target{false, px, py, {}, {}};
+      const std::vector<SurfaceProbe> probes = probe_scene(scene, target, false, context);
+      const SolverTrace& trace = probes.at(0).traces.at(0);
+      if (trace.settled_discards.empty()) continue;
+      ++rays;
+      INFO("pixel (" << px << ", " << py << ")");
+      for (const auto& [doubt, ends] : trace.settled_discards) {
+        CHECK(doubt.reason == ALGRAY_DOUBT_DISCARD);
+        CHECK(std::fabs(doubt.value) <= doubt.noise);
+        // P at both ends beyond its bound and of one sign: with the coefficients inside clear of the noise, the
+        // interval is root-free.
+        CHECK(std::fabs(ends.before) > ends.before_rounding);
+        CHECK(std::fabs(ends.after) > ends.after_rounding);
+        CHECK((ends.before > 0) == (ends.after > 0));
+        // and so it is for the reference: no certified root inside
+        for (const auto& root : probes[0].reference.roots)
+          CHECK_FALSE((root.t > trace.t_at(doubt.lo) && root.t < trace.t_at(doubt.hi)));
+      }
+      if (trace.hit.flags & ALGRAY_HIT_DOUBT) continue;  // doubted again later: the second pass answers
+      ++decided;
+      const HitRecord& rendered = render.hits.at(px, py);
+      CHECK(probes[0].traces.size() == 1);
+      CHECK((rendered.flags & ALGRAY_HIT_ESCALATED) == 0);
+      CHECK(trace.found() == ((rendered.flags & ALGRAY_HIT_FOUND) != 0));
+      if (trace.found()) CHECK(std::memcmp(&trace.hit, &rendered, offsetof(HitRecord, flags)) == 0);
+      // The float line against the certified answer.
+      const PixelClass cls = probes[0].reference.certificate.cls;
+      if (cls == PixelClass::Miss) CHECK_FALSE(trace.found());
+      if (cls == PixelClass::SimpleRoot) {
+        REQUIRE(trace.found());
+        const double t_ref = probes[0].reference.roots.at(0).t;
+        CHECK(std::fabs(trace.t - t_ref) <= 1e-3 * std::fabs(t_ref));
+      }
+    }
+  INFO(rays << " rays with settled discard doubts");
+  CHECK(decided == 4);
+}

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdlib>
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <memory>
@@ -26,6 +27,27 @@ inline ClSession& device_session() {
   }
   return *session;
 }
+
+// Sets ALGRAY_NO_FP64 for one scope, and puts back what was there: devices enumerated (and sessions opened) in it
+// count as having no double precision, so adaptive precision's second pass runs in float-float.
+class HiddenFp64 {
+ public:
+  HiddenFp64() {
+    if (const char* v = std::getenv("ALGRAY_NO_FP64")) before_ = v;
+    ::setenv("ALGRAY_NO_FP64", "1", 1);
+  }
+  ~HiddenFp64() {
+    if (before_.empty())
+      ::unsetenv("ALGRAY_NO_FP64");
+    else
+      ::setenv("ALGRAY_NO_FP64", before_.c_str(), 1);
+  }
+  HiddenFp64(const HiddenFp64&) = delete;
+  HiddenFp64& operator=(const HiddenFp64&) = delete;
+
+ private:
+  std::string before_;
+};
 
 // Every scene file in scenes/, sorted by name.
 inline std::vector<std::filesystem::path> scene_files() {

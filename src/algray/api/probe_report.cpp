@@ -166,6 +166,10 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
     out << "vs solver_ref: DISAGREES (" << (tr.found() ? "kernel hit, reference miss" : "kernel miss, reference root")
         << ")\n";
   }
+  for (const auto& [doubt, ends] : tr.settled_discards)
+    out << "settled on the way: a discard doubt on [" << num(tr.t_at(doubt.lo)) << ", " << num(tr.t_at(doubt.hi))
+        << "], P at its ends " << num(ends.before, 4) << " (bound " << num(ends.before_rounding, 3) << ") and "
+        << num(ends.after, 4) << " (bound " << num(ends.after_rounding, 3) << ")\n";
   if (tr.doubt) {
     const DoubtReason* why = doubt_reason(static_cast<unsigned>(tr.doubt->reason));
     out << "doubted (" << (why ? why->name : "?") << ": " << (why ? why->meaning : "unknown reason")
@@ -176,6 +180,12 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
           << num(tr.confirmed->before_rounding, 3) << ") at the interval's start and " << num(tr.confirmed->after, 4)
           << " (rounding " << num(tr.confirmed->after_rounding, 3)
           << ") at its end, the signs float gave: the render keeps this bracket\n";
+    else if (tr.confirmed && tr.confirmed->discard)
+      out << "; settled: P at the interval's ends is " << num(tr.confirmed->before, 4) << " (bound "
+          << num(tr.confirmed->before_rounding, 3) << ") and " << num(tr.confirmed->after, 4) << " (bound "
+          << num(tr.confirmed->after_rounding, 3)
+          << "), in float-float where float's value was within the noise, of its coefficients' sign: the search "
+             "went on\n";
     else if (tr.confirmed)
       out << "; confirmed: P from the monomials" << (tr.confirmed->float_float ? " in float-float" : "") << " is "
           << num(tr.confirmed->before, 4) << " (rounding "
@@ -247,6 +257,17 @@ nlohmann::json trace_json(const SolverTrace& tr) {
                     {"f_hi", tr.iso_f_hi},
                     {"halving_limit", tr.halving_limit}};
   j["iterates"] = iterates(tr.iterates);
+  if (!tr.settled_discards.empty()) {
+    nlohmann::json settled = nlohmann::json::array();
+    for (const auto& [doubt, ends] : tr.settled_discards)
+      settled.push_back({{"t_lo", tr.t_at(doubt.lo)},
+                         {"t_hi", tr.t_at(doubt.hi)},
+                         {"before", ends.before},
+                         {"before_rounding", ends.before_rounding},
+                         {"after", ends.after},
+                         {"after_rounding", ends.after_rounding}});
+    j["settled_discards"] = settled;
+  }
   if (tr.doubt) {
     const DoubtReason* why = doubt_reason(static_cast<unsigned>(tr.doubt->reason));
     j["doubt"] = {{"reason", why ? why->name : "?"}, {"level", tr.doubt->level}, {"t_lo", tr.t_at(tr.doubt->lo)},
@@ -257,7 +278,8 @@ nlohmann::json trace_json(const SolverTrace& tr) {
                                  {"after", tr.confirmed->after},
                                  {"after_rounding", tr.confirmed->after_rounding},
                                  {"float_float", tr.confirmed->float_float},
-                                 {"bracket", tr.confirmed->bracket}};
+                                 {"bracket", tr.confirmed->bracket},
+                                 {"discard", tr.confirmed->discard}};
   }
   j["found"] = tr.found();
   if (tr.found()) j["t"] = tr.t;
@@ -436,17 +458,22 @@ std::vector<SurfaceProbe> probe_scene(const Scene& scene, const ProbeTarget& tar
                                       RenderContext& context) {
   ClSession& session = context.session();
   const Precision precision = resolve_precision(scene, session.info, context.cache());
+  // The float kernels settle more of their doubts where the render's second pass runs in float-float (the plan's
+  // settle_doubts).
+  const Precision second_pass = escalation_precision(session.info, context.cache());
   std::vector<SurfaceProbe> probes;
   for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
     SurfaceProbe p;
     p.surface = s;
-    for (const KernelConfig& c : solver_configs(scene, precision, s, all_solvers)) {
+    for (KernelConfig& c : solver_configs(scene, precision, s, all_solvers)) {
+      c.settle_doubts = precision == Precision::Adaptive && second_pass == Precision::Mixed;
       p.traces.push_back(trace_probe(session, context.cache(), scene, s, c, target));
       // A ray adaptive precision doubts is traced again as the render does, the float ray as it was traced, in
       // the precision of the second pass: that trace follows it.
       if (p.traces.back().hit.flags & ALGRAY_HIT_DOUBT) {
         KernelConfig again = c;
-        again.precision = escalation_precision(session.info, context.cache());
+        again.precision = second_pass;
+        again.settle_doubts = false;
         ProbeTarget same_ray;
         same_ray.given_ray = true;
         same_ray.origin = p.traces.back().ray.origin;

@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "algray/device/cl_runtime.h"
@@ -53,12 +54,15 @@ struct ProbeDoubt {
 
 // A doubt settled after all (ALGRAY_EVENT_CONFIRMED): a flat-doubted root (kernels/surface.h confirm_flat_root),
 // P from the monomials at t - delta and t + delta, delta = ALGRAY_DOUBT_POSITION |t|; or an accept-doubted bracket
-// (kernels/bernstein.h bracket_settled), P at its ends. Each value beyond its rounding bound.
+// (kernels/bernstein.h bracket_settled), P at its ends; or a discard-doubted interval (bernstein.h discard_settled),
+// P at its ends. Each value beyond its rounding bound. A search may settle several doubts: this is the last.
 struct ProbeConfirmed {
   double before = 0, before_rounding = 0;
   double after = 0, after_rounding = 0;
   bool float_float = false;  // evaluated in float-float, float's rounding having been too large
   bool bracket = false;      // the bracket's ends, with the signs float gave there
+  bool discard = false;      // a root-free interval's ends, of its coefficients' sign (at an end that stood clear of
+                             // the noise, float's value and that noise)
 };
 
 // Everything the kernel recorded for one ray and one solver configuration.
@@ -80,7 +84,10 @@ struct SolverTrace {
   double iso_lo = 0, iso_hi = 0, iso_f_lo = 0, iso_f_hi = 0;
   std::vector<ProbeIterate> iterates;
   std::optional<ProbeDoubt> doubt;  // adaptive precision: the decision that sent the ray to the second pass
-  std::optional<ProbeConfirmed> confirmed;  // adaptive precision: a flat doubt withdrawn; no second pass then
+  std::optional<ProbeConfirmed> confirmed;  // adaptive precision: the doubt withdrawn; no second pass then
+  // Adaptive precision: discard doubts settled on the way (confirmed->discard), each with the doubt it settled; the
+  // search went on past each interval, and may have doubted again.
+  std::vector<std::pair<ProbeDoubt, ProbeConfirmed>> settled_discards;
   HitRecord hit{};                  // exactly what the render writes for this ray
   double t = std::numeric_limits<double>::infinity();     // hit.t_hi + hit.t_lo; +inf without a root
   std::uint32_t events_offered = 0, events_recorded = 0;  // the log overflowed if they differ
