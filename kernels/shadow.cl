@@ -50,6 +50,19 @@ ALGRAY_INLINE REAL search_scale_bound(const REAL* c) {
   return t[0] * (REAL)(1 + 8 * REAL_EPS);
 }
 
+/* Whether the scaled coefficients c have one strict sign throughout with each but c_0 beyond limit[k]: with the
+ * limits of segment_has_root's caller, what bernstein_root_by_signs and signs_clear_of settle as no root, from the
+ * compares by_signs makes alone. */
+ALGRAY_INLINE int one_sign_beyond(const REAL* c, const REAL* limit) {
+  int above = c[0] > 0, below = c[0] < 0;
+  ALGRAY_UNROLL
+  for (int k = 1; k <= DEGREE; ++k) {
+    above &= c[k] > limit[k];
+    below &= c[k] < -limit[k];
+  }
+  return above | below;
+}
+
 /* Whether the scaled coefficients c (before bernstein_from_scaled) settle bernstein_root_by_signs' answer with
  * every coefficient it reads clear of the noise for terms of size `terms`: then no rounding could change it.
  * c_0, P at the ray's start, does not count (first_counted): the isolation takes its sign as it is.
@@ -76,12 +89,20 @@ ALGRAY_INLINE int signs_clear_of(const REAL* c, int by_signs, REAL scale, REAL t
  * where it is not built, isolate_restricted) reports, without it when the coefficients' signs already settle it
  * (Bernstein builds; adaptive ones only when the signs stand clear of the noise: of extent_terms, the bound on
  * every ray's terms in the extent, then of the ray's terms' upper bound, then of their sum; each check costs more
- * and passes more rays).
+ * and passes more rays). clear_limit[k]: the noise of extent_terms for any scale times C(n,k), which most rays'
+ * coefficients stand beyond with one sign, settled without the scale's noise (one_sign_beyond: the checks were
+ * 12% of the Cayley cubic's adaptive shadow pass, whose rays each take about 90 cycles).
  * *doubt gets the search's. f: the ray's coordinates' factors, for adaptive builds' terms. */
 ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
                                    uint* doubt, __global const uint* exps, __global const REAL* coefs, uint count,
-                                   AxisFactor fx, AxisFactor fy, AxisFactor fz, REAL extent_terms) {
+                                   AxisFactor fx, AxisFactor fy, AxisFactor fz, REAL extent_terms,
+                                   const REAL* clear_limit) {
   *doubt = 0;
+#if ALGRAY_ESCALATE
+  if (one_sign_beyond(root, clear_limit)) return 0;
+#else
+  (void)clear_limit;
+#endif
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   const int by_signs = bernstein_root_by_signs(root);
 #if ALGRAY_ESCALATE
@@ -136,8 +157,15 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) {
   uint traced = 0;
 #if ALGRAY_ESCALATE
   const REAL extent_terms = terms_within(mono_coefs, mono_count, 1); /* unit coordinates are at most 1 */
+  /* Every Bernstein coefficient of a segment in the extent is at most its terms, which extent_terms bounds with
+   * room to spare, so no coefficients' scale makes the search's noise larger than noise_bound's. */
+  REAL clear_limit[NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k)
+    clear_limit[k] = noise_bound(extent_terms) * (REAL)(1 + 8 * REAL_EPS) * degree_binomial(k);
 #else
   const REAL extent_terms = 0;
+  const REAL* clear_limit = 0;
 #endif
   /* The batch waiting for its restriction: ray r is light sample sample[r] on [t_in[r], t_out[r]]. */
   AxisFactor fx[RESTRICT_RAYS], fy[RESTRICT_RAYS], fz[RESTRICT_RAYS];
@@ -172,7 +200,7 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) {
     for (int r = 0; r < pending; ++r) {
       uint doubt;
       if (segment_has_root(root[r], root_lo[r], t_in[r], t_out[r], binomials, &doubt, mono_exps, mono_coefs, mono_count,
-                           fx[r], fy[r], fz[r], extent_terms))
+                           fx[r], fy[r], fz[r], extent_terms, clear_limit))
         mask |= (ulong)1 << sample[r];
       if (doubt) unsure |= (ulong)1 << sample[r];
     }
