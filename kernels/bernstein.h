@@ -700,29 +700,41 @@ LREAL isolated_magnitude(const LREAL* c, LREAL y) {
   return h * power_of(u);
 }
 
-/* Value and slope at y in [0,1] of a prepared polynomial, for Newton's method. With r = y/(1-y) and
- * H(r) = sum c_k r^k, P = (1-y)^n H and P' = (1-y)^(n-2) (H' - n (1-y) H); mirrored past 1/2 like the value. */
-REAL isolated_value_slope(const REAL* c, REAL y, REAL* slope) {
+/* Value and slope at y in [0,1] of a prepared polynomial, for Newton's method and adaptive builds' flat check. With
+ * r = y/(1-y) and H(r) = sum c_k r^k, P = (1-y)^n H and P' = (1-y)^(n-2) (H' - n (1-y) H); mirrored past 1/2 like
+ * the value. Defined for one ray and, in lane builds, for lanes (each lane with one ray's operations, the sides
+ * picked by `pick`). */
 #if DEGREE == 1
-  *slope = c[1] - c[0];
-  return c[0] * ((REAL)1 - y) + c[1] * y;
-#else
-  const int mirrored = y > (REAL)0.5;
-  const REAL u = mirrored ? y : (REAL)1 - y; /* the factor raised to the power n */
-  const REAL r = mirrored ? ((REAL)1 - y) / y : y / ((REAL)1 - y);
-  REAL h = 0, d = 0;
-  ALGRAY_UNROLL
-  for (int k = DEGREE; k >= 0; --k) {
-    d = d * r + h;
-    h = h * r + c[mirrored ? DEGREE - k : k];
+#define DEFINE_VALUE_SLOPE(name, T, M, pick) \
+  T name(const T* c, T y, T* slope) {        \
+    *slope = c[1] - c[0];                    \
+    return c[0] * ((REAL)1 - y) + c[1] * y;  \
   }
-  REAL un2 = 1; /* u^(n-2) */
-  ALGRAY_UNROLL
-  for (int k = 0; k < DEGREE - 2; ++k) un2 *= u;
-  /* dr/dy = 1/(1-y)^2 unmirrored, -1/y^2 mirrored */
-  *slope = mirrored ? un2 * ((REAL)DEGREE * u * h - d) : un2 * (d - (REAL)DEGREE * u * h);
-  return h * un2 * u * u;
+#else
+#define DEFINE_VALUE_SLOPE(name, T, M, pick)                                                                   \
+  T name(const T* c, T y, T* slope) {                                                                          \
+    const M mirrored = y > (REAL)0.5;                                                                          \
+    const T u = pick(mirrored, y, (REAL)1 - y); /* the factor raised to the power n */                        \
+    const T r = pick(mirrored, (REAL)1 - y, y) / u;                                                            \
+    T h = 0, d = 0;                                                                                            \
+    ALGRAY_UNROLL                                                                                              \
+    for (int k = DEGREE; k >= 0; --k) {                                                                        \
+      d = d * r + h;                                                                                           \
+      h = h * r + pick(mirrored, c[DEGREE - k], c[k]);                                                         \
+    }                                                                                                          \
+    T un2 = 1; /* u^(n-2) */                                                                                   \
+    ALGRAY_UNROLL                                                                                              \
+    for (int k = 0; k < DEGREE - 2; ++k) un2 *= u;                                                             \
+    /* dr/dy = 1/(1-y)^2 unmirrored, -1/y^2 mirrored */                                                        \
+    *slope = pick(mirrored, un2 * ((REAL)DEGREE * u * h - d), un2 * (d - (REAL)DEGREE * u * h));              \
+    return h * un2 * u * u;                                                                                    \
+  }
 #endif
-}
+#define PICK_OF_ONE(m, a, b) ((m) ? (a) : (b))
+DEFINE_VALUE_SLOPE(isolated_value_slope, REAL, int, PICK_OF_ONE)
+#if LANES > 1
+#define PICK_OF_LANES(m, a, b) LANE_SEL((b), (a), (m))
+DEFINE_VALUE_SLOPE(isolated_value_slope_lanes, LREAL, LMASK, PICK_OF_LANES)
+#endif
 
 #endif /* ALGRAY_BERNSTEIN_H */
