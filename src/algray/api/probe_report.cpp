@@ -166,10 +166,14 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
     out << "vs solver_ref: DISAGREES (" << (tr.found() ? "kernel hit, reference miss" : "kernel miss, reference root")
         << ")\n";
   }
-  for (const auto& [doubt, ends] : tr.settled_discards)
+  // The last settled discard is the doubt line below when nothing was doubted after it.
+  const std::size_t shown_below = tr.confirmed && tr.confirmed->discard ? 1 : 0;
+  for (std::size_t i = 0; i + shown_below < tr.settled_discards.size(); ++i) {
+    const auto& [doubt, ends] = tr.settled_discards[i];
     out << "settled on the way: a discard doubt on [" << num(tr.t_at(doubt.lo)) << ", " << num(tr.t_at(doubt.hi))
         << "], P at its ends " << num(ends.before, 4) << " (bound " << num(ends.before_rounding, 3) << ") and "
         << num(ends.after, 4) << " (bound " << num(ends.after_rounding, 3) << ")\n";
+  }
   if (tr.doubt) {
     const DoubtReason* why = doubt_reason(static_cast<unsigned>(tr.doubt->reason));
     out << "doubted (" << (why ? why->name : "?") << ": " << (why ? why->meaning : "unknown reason")
