@@ -2,7 +2,7 @@
 """Issue 18 beyond the repository's scenes: classic surfaces that are in neither scenes/ nor
 tests/data/hard_surfaces, each written to a temporary scene at 160x120 (camera three extent radii out), with the
 accuracy of camera rays in float, adaptive, mixed and double against solver_ref (precision_modes.py's
-accuracy()), and with --speed adaptive's kernel time over float's at 1024x768, with fp64 and without.
+accuracy()), and with --speed adaptive's kernel time over float's at --size (1024x768), with fp64 and without.
 
   python3 bench/outside_surfaces.py [--speed] [--only NAME ...]
 """
@@ -46,10 +46,10 @@ def write_scene(folder, name, equation, radius):
     return path
 
 
-def speed_ratio(binary, scene, rounds, work, no_fp64):
-    """Median over interleaved rounds of adaptive's kernel time over float's."""
+def speed_ratio(binary, scene, rounds, work, no_fp64, size):
+    """Median over interleaved rounds of adaptive's kernel time over float's, at size (width, height)."""
     env = dict(os.environ, ALGRAY_NO_FP64="1" if no_fp64 else "")
-    args = ["--width", "1024", "--height", "768"]
+    args = ["--width", str(size[0]), "--height", str(size[1])]
     ratios = []
     for r in range(rounds):
         times = {}
@@ -63,10 +63,18 @@ def speed_ratio(binary, scene, rounds, work, no_fp64):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--only", nargs="*", help="surface names (default: all)")
-    ap.add_argument("--speed", action="store_true", help="also adaptive over float at 1024x768 (5 rounds)")
+    ap.add_argument("--speed", action="store_true", help="also adaptive over float (--size, --rounds)")
     ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--size", default="1024x768",
+                    help="WIDTHxHEIGHT of the speed renders: previews of a few ms at 1024x768 read to 0.1-0.2 only")
     ap.add_argument("--binary", default=str(ROOT / "build/apps/algray/algray"))
     a = ap.parse_args()
+    try:
+        size = tuple(int(v) for v in a.size.lower().split("x"))
+        if len(size) != 2 or min(size) < 1:
+            raise ValueError
+    except ValueError:
+        sys.exit(f"--size: expected WIDTHxHEIGHT, got {a.size!r}")
     names = a.only or list(SURFACES)
     unknown = [n for n in names if n not in SURFACES]
     if unknown:
@@ -88,8 +96,8 @@ def main():
                    f"{cell['adaptive, no fp64']} | {acc['adaptive, no fp64']['escalated_share']:.1%} | "
                    f"{cell['mixed']} | {cell['double']} |")
             if a.speed:
-                ratio = speed_ratio(a.binary, scene, a.rounds, Path(tmp), False)
-                ratio_no = speed_ratio(a.binary, scene, a.rounds, Path(tmp), True)
+                ratio = speed_ratio(a.binary, scene, a.rounds, Path(tmp), False, size)
+                ratio_no = speed_ratio(a.binary, scene, a.rounds, Path(tmp), True, size)
                 row += f" {ratio:.2f} | {ratio_no:.2f} |"
             print(row, flush=True)
 
