@@ -98,6 +98,10 @@ LREAL direct_value_ff(const LaneRays* r, FloatFloat t, __global const uint* exps
   return value.hi + value.lo;
 }
 
+/* Whether v, P with its rounding bound `rounding`, stands beyond it with the strict sign of c (float's value at the
+ * same point): float's sign there proven. Of one ray or of lanes. */
+#define SIGN_PROVEN(v, rounding, c) ((c) != 0 && fabs(v) > (rounding) && ((v) > 0) == ((c) > 0))
+
 /* Lanes in `doubted` whose isolating interval [lo, hi] (fractions of [t_in, t_out]) has P, in float-float at both
  * ends, of the signs float gave there (f_lo, f_hi, which differ), each value beyond its rounding: then P changes
  * sign inside, as surely as where float's own end values stand clear of its noise. *v_lo ... *rounding_hi: the
@@ -107,8 +111,7 @@ LMASK bracket_ends_in_float_float(LMASK doubted, const LaneRays* r, LREAL t_in, 
                                   uint count, LREAL* v_lo, LREAL* rounding_lo, LREAL* v_hi, LREAL* rounding_hi) {
   *v_lo = direct_value_ff(r, ff_segment_point(t_in, t_out, lo), exps, coefs, count, rounding_lo);
   *v_hi = direct_value_ff(r, ff_segment_point(t_in, t_out, hi), exps, coefs, count, rounding_hi);
-  return doubted && fabs(*v_lo) > *rounding_lo && fabs(*v_hi) > *rounding_hi && (*v_lo > 0) == (f_lo > 0) &&
-         (*v_hi > 0) == (f_hi > 0);
+  return doubted && SIGN_PROVEN(*v_lo, *rounding_lo, f_lo) && SIGN_PROVEN(*v_hi, *rounding_hi, f_hi);
 }
 
 /* P in float-float at the search's last interval ends evaluated (fractions of [t_in, t_out]; -1 where none yet),
@@ -131,7 +134,7 @@ ALGRAY_INLINE LMASK proven_at(const ProvenEnds* p, LREAL s) { return p->at[0] ==
 ALGRAY_INLINE LMASK proven_sign_of(const ProvenEnds* p, LREAL s, LREAL c) {
   const LMASK first = p->at[0] == s, second = p->at[1] == s;
   const LREAL v = LANE_SEL(p->value[1], p->value[0], first), rounding = LANE_SEL(p->rounding[1], p->rounding[0], first);
-  return (first || second) && c != 0 && fabs(v) > rounding && (v > 0) == (c > 0);
+  return (first || second) && SIGN_PROVEN(v, rounding, c);
 }
 
 /* P in float-float at the fraction s of [t_in, t_out], into p for the lanes in `take`: in the place of the one

@@ -159,12 +159,15 @@ void place_root(SegmentRoot* r, Isolation iso, REAL y, REAL t_in, REAL t_out) {
  * than ALGRAY_DOUBT_POSITION of its t under the coefficients' noise, read off P's slope there: the secant of the
  * isolating interval can be many times steeper than P at the root (a Kummer shell ray: 60 times, with the root
  * 1e-3 off). Then r is marked doubted. */
+/* How far the root at t may move, read off P's slope on the isolating interval [lo, hi]: for one ray and for lanes
+ * alike, so that both take the same operations. */
+#define FLAT_ROOT_MARGIN(slope, t, lo, hi, t_in, t_out) \
+  (fabs(slope) * ALGRAY_DOUBT_POSITION * fabs(t) / (((hi) - (lo)) * ((t_out) - (t_in))))
 void doubt_flat_root(SegmentRoot* r, Isolation iso, const REAL* c, REAL y, REAL t_in, REAL t_out PROBE_PARAM) {
 #if ALGRAY_ESCALATE
   REAL slope;
   (void)isolated_value_slope(c, y, &slope);
-  const REAL width_t = (iso.hi - iso.lo) * (t_out - t_in);
-  const REAL margin = fabs(slope) * ALGRAY_DOUBT_POSITION * fabs(r->t) / width_t;
+  const REAL margin = FLAT_ROOT_MARGIN(slope, r->t, iso.lo, iso.hi, t_in, t_out);
   if (!(margin <= iso.noise)) return;
   PROBE(ALGRAY_EVENT_DOUBT, 0, ALGRAY_DOUBT_FLAT, 0u, iso.lo, iso.hi, margin, iso.noise);
   r->flags |= ALGRAY_HIT_DOUBT;
@@ -248,8 +251,7 @@ void refine_lanes(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in,
   if (LANE_ANY(running)) {
     LREAL slope;
     (void)isolated_value_slope_lanes(c, y, &slope);
-    const LREAL width_t = (iso->hi - iso->lo) * (t_out - t_in);
-    const LREAL margin = fabs(slope) * ALGRAY_DOUBT_POSITION * fabs(roots->t) / width_t;
+    const LREAL margin = FLAT_ROOT_MARGIN(slope, roots->t, iso->lo, iso->hi, t_in, t_out);
     roots->flags |= LANE_SEL((LANE_INT_VEC)0, (LANE_INT_VEC)ALGRAY_HIT_DOUBT, running && margin <= iso->noise);
   }
 #endif
