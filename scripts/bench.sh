@@ -3,7 +3,7 @@
 # issue 4: bench/solvers.py with the arguments given (--quick, --only PART..., --device SPEC, --plot-only).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh
+scripts/install-deps.sh test
 if ! /usr/bin/python3 -c "import matplotlib" 2>/dev/null; then
   if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends python3-matplotlib

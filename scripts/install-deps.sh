@@ -1,14 +1,21 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages that algray's build, tests and benchmarks need; skips those already present.
+# Installs the Debian 12 packages of one set, render (default) or test, skipping those already present.
+#   scripts/install-deps.sh render   building `algray` and rendering: the first command of README.md
+#   scripts/install-deps.sh test     render's set plus everything the whole test suite and the benchmarks need
+# Each set is written once here; the render set stays small so that a fresh machine has its first picture in
+# minutes (bench/RESULTS.md, "Set-up and test time").
 set -euo pipefail
 
-packages=(
-  build-essential cmake pkg-config git
-  ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd clinfo
+render_packages=(
+  build-essential cmake ninja-build pkg-config git
+  ocl-icd-opencl-dev opencl-headers opencl-clhpp-headers pocl-opencl-icd
   libglm-dev libopenexr-dev libpng-dev
-  catch2 libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
+  libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgmp-dev
-  libcpp-httplib-dev  # `algray view`'s local web server
+  libcpp-httplib-dev  # `algray view`'s local web server, in algray-full, which `algray` is built with
+)
+test_packages=(
+  clinfo catch2
   chromium chromium-driver python3-selenium  # test_view_browser drives the page in headless Chromium
   python3
   python3-dev pybind11-dev  # the Python package (python/)
@@ -19,9 +26,15 @@ packages=(
   clang-15                  # the sanitizer tree and libFuzzer targets of scripts/test.sh: the clang PoCL already
                             # depends on, with ASan, UBSan and libFuzzer in its libclang-common-15-dev; and
                             # test_kernel_portability's strict OpenCL C 1.2 front end
-  ninja-build               # scripts/test.sh builds with Ninja
   help2man                  # the man page
 )
+
+set_name=${1:-render}
+case "$set_name" in
+  render) packages=("${render_packages[@]}") ;;
+  test) packages=("${render_packages[@]}" "${test_packages[@]}") ;;
+  *) echo "install-deps: unknown set '$set_name' (render or test)" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do
@@ -31,11 +44,11 @@ for p in "${packages[@]}"; do
 done
 
 if [ ${#missing[@]} -eq 0 ]; then
-  echo "install-deps: all ${#packages[@]} packages already installed"
+  echo "install-deps: all ${#packages[@]} packages of the $set_name set already installed"
   exit 0
 fi
 
-echo "install-deps: installing ${missing[*]}"
+echo "install-deps ($set_name): installing ${missing[*]}"
 if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq

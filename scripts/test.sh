@@ -23,10 +23,10 @@ generator() {
   if [ ! -f "$1/CMakeCache.txt" ] && command -v ninja >/dev/null; then echo Ninja; fi
 }
 
-scripts/install-deps.sh
+scripts/install-deps.sh test
 phase "dependencies installed"
 gen=$(generator build)
-cmake -S . -B build ${gen:+-G "$gen"} -DCMAKE_BUILD_TYPE=Release
+cmake -S . -B build ${gen:+-G "$gen"} -DCMAKE_BUILD_TYPE=Release -DBUILD_TESTING=ON
 cmake --build build -j"$(nproc)"
 # The Python package into the system Python, where `import algray` finds it; the tests use the build tree's copy.
 scripts/install-python.sh
