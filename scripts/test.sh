@@ -32,8 +32,10 @@ cmake --build build -j"$(nproc)"
 scripts/install-python.sh
 phase "release build done"
 # In parallel: tests that assert their own wall time are RUN_SERIAL (TIMED in tests/CMakeLists.txt), and the
-# longest start first (COST), so the single-threaded kernel builds of one test overlap another's.
-ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)"
+# longest start first (COST), so the single-threaded kernel builds of one test overlap another's. Every test
+# shares one kernel cache, build/kernel-cache (algray's and PoCL's). The sweeps run a seeded sample with their
+# ends; their every case is the `exhaustive` label's (`ctest --test-dir build -L exhaustive`).
+ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)" -LE exhaustive
 phase "full test suite passed"
 
 # The same code once more under AddressSanitizer and UndefinedBehaviorSanitizer, in a clang tree of its own that
@@ -50,8 +52,9 @@ if [ -z "$cxx" ]; then
   exit 1
 fi
 gen=$(generator build-sanitize)
+# Its tests use the Release tree's kernel cache: the kernels are the same, so none is compiled twice.
 cmake -S . -B build-sanitize ${gen:+-G "$gen"} -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER="$cxx" \
-      -DALGRAY_SANITIZE=ON -DALGRAY_FUZZ=ON
+      -DALGRAY_SANITIZE=ON -DALGRAY_FUZZ=ON -DALGRAY_TEST_KERNEL_CACHE="$PWD/build/kernel-cache"
 cmake --build build-sanitize -j"$(nproc)" --target algray_fast_tests algray_fuzzers
 phase "sanitizer build done"
 ctest --test-dir build-sanitize -L fast --output-on-failure --timeout 900 -j"$(nproc)"

@@ -1,4 +1,4 @@
-// Every kernel specialisation (DEGREE 1..32, float and double) builds, runs and finds a known root.
+// Kernel specialisations of every DEGREE and precision (a seeded sample, all when exhaustive) build and find a root.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <sstream>
@@ -7,6 +7,7 @@
 #include "algray/device/program_cache.h"
 #include "algray/render/renderer.h"
 #include "algray/scene/scene.h"
+#include "sweep.h"
 #include "test_support.h"
 
 using namespace algray;
@@ -66,6 +67,8 @@ void check_known_root(const RenderResult& result, int degree, const std::string&
 
 }  // namespace
 
+// Every specialisation under the `exhaustive` label; on other runs each precision's degree ends (1, 2, its
+// largest) and a seeded sample of the degrees between.
 TEST_CASE("every DEGREE from 1 to 32 builds and finds the smallest root, in float and double", "[kernels]") {
   ClSession& session = testing::device_session();
   ProgramCache no_cache(false);  // compile every specialisation from source
@@ -77,7 +80,7 @@ TEST_CASE("every DEGREE from 1 to 32 builds and finds the smallest root, in floa
     // layer refuses them above.
     const bool compensated = choice.value == Precision::Mixed || choice.value == Precision::Adaptive;
     const int max_degree = compensated ? kMaxMixedDegree : 32;
-    for (int degree = 1; degree <= max_degree; ++degree) {
+    for (int degree : testing::sampled_degrees(std::string("test_kernels ") + precision + " degrees", max_degree)) {
       INFO("DEGREE=" << degree << " precision=" << precision);
       const Scene scene = degree_scene(degree, precision);
       REQUIRE(scene.surface().polynomial.degree() == degree);

@@ -7,12 +7,15 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include "algray/device/program_cache.h"
 #include "kernels/algray_shared.h"
 #include "solver_ref/solver_ref.h"
+#include "sweep.h"
 #include "test_seed.h"
 #include "test_support.h"
 #include "tolerances.h"
@@ -130,6 +133,27 @@ double scaled_derivative(const Poly& p, int m, double t) {
   return std::fabs(v);
 }
 
+// The reference's answers for one case: its smallest root in [0, 1] and, after a simple one, the next.
+struct CaseReference {
+  ref::Answer smallest, next;
+};
+
+// The cases of one degree are the same polynomials for every method of one basis and coefficient rounding, so
+// the reference solves them once a run. Key: (Bernstein basis, rounding: 0 float, 1 float pairs, 2 double, degree).
+const std::vector<CaseReference>& case_references(const std::vector<Poly>& exact, std::tuple<bool, int, int> key) {
+  static std::map<std::tuple<bool, int, int>, std::vector<CaseReference>> solved;
+  if (const auto it = solved.find(key); it != solved.end()) return it->second;
+  const mpq_class width(1, 1000000000000000L);
+  std::vector<CaseReference> answers(exact.size());
+  for (std::size_t c = 0; c < exact.size(); ++c) {
+    answers[c].smallest = ref::smallest_root(exact[c], 0, 1, width);
+    const ref::Answer& a = answers[c].smallest;
+    if (a.kind == ref::Classification::SimpleRoot && a.hi + width < 1)
+      answers[c].next = ref::smallest_root(exact[c], a.hi + width, 1, width);
+  }
+  return solved.emplace(key, std::move(answers)).first->second;
+}
+
 // Runs kCases seeded cases per degree 1..max_degree through the univariate kernel built with `solver` and
 // checks each against the reference. The polynomials go to the kernel in the basis its isolation works in.
 void check_solver(const KernelConfig& solver, int max_degree) {
@@ -146,7 +170,9 @@ void check_solver(const KernelConfig& solver, int max_degree) {
     // position is held to float's.
     const double eps = is_double ? std::numeric_limits<double>::epsilon() : is_mixed ? std::ldexp(1.0, -46) : float_eps;
     const double refine_eps = is_mixed ? float_eps : eps;
-    for (int degree = 1; degree <= max_degree; ++degree) {
+    const std::string sweep = std::string("test_univariate ") + name + " " + to_string(solver.isolation) + "/" +
+                              to_string(solver.refinement) + " degrees";
+    for (int degree : testing::sampled_degrees(sweep, max_degree)) {
       KernelConfig config = solver;
       config.entry = "univariate";
       config.degree = degree;
@@ -236,12 +262,13 @@ void check_solver(const KernelConfig& solver, int max_degree) {
         }
       }
 
-      const mpq_class width(1, 1000000000000000L);
+      const std::vector<CaseReference>& references =
+          case_references(exact, {bernstein, is_double ? 2 : is_mixed ? 1 : 0, degree});
       int stuck_at_cap = 0;
       for (int c = 0; c < kCases; ++c) {
         const Poly& p = exact[static_cast<std::size_t>(c)];
         const HitRecord& h = results[static_cast<std::size_t>(c)];
-        const ref::Answer a = ref::smallest_root(p, 0, 1, width);
+        const ref::Answer& a = references[static_cast<std::size_t>(c)].smallest;
         const bool hit = (h.flags & ALGRAY_HIT_FOUND) != 0;
         const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
         const double noise = degree * eps * abs_sums[static_cast<std::size_t>(c)];
@@ -261,7 +288,7 @@ void check_solver(const KernelConfig& solver, int max_degree) {
           // Never miss a certified simple root, unless the next root is so close that P between them stays
           // within the rounding noise of the coefficients: then the pair is numerically one double root,
           // which a kernel may see as a tangent hit or not at all.
-          const ref::Answer next = a.hi + width < 1 ? ref::smallest_root(p, a.hi + width, 1, width) : ref::Answer{};
+          const ref::Answer& next = references[static_cast<std::size_t>(c)].next;
           // In the power basis P(1) is a rounded sum of all coefficients, so a root at the far end, within
           // rounding of it (a ray ending on the surface), can round either way; the Bernstein basis holds P(1)
           // exactly.

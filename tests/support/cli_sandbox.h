@@ -40,13 +40,23 @@ inline void write_text(const fs::path& p, const std::string& text) {
   REQUIRE(out.good());
 }
 
-// Compiled kernels are shared by all tests of this run but never by the user's own cache.
+// Compiled kernels are shared by all tests of this run but never by the user's own cache: under CTest the run's
+// kernel cache (ALGRAY_TEST_KERNEL_CACHE, tests/CMakeLists.txt), otherwise one for this test program.
 inline const fs::path& shared_cache_dir() {
   struct Owned {
-    fs::path dir = unique_temp_dir("cache");
+    fs::path dir;
+    bool temporary = false;
+    Owned() {
+      if (const char* run = std::getenv("ALGRAY_TEST_KERNEL_CACHE"); run && *run) {
+        dir = fs::path(run) / "algray";
+      } else {
+        dir = unique_temp_dir("cache");
+        temporary = true;
+      }
+    }
     ~Owned() {
       std::error_code ec;
-      fs::remove_all(dir, ec);
+      if (temporary) fs::remove_all(dir, ec);
     }
   };
   static const Owned owned;
