@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "algray/device/program_cache.h"
 #include "algray/render/renderer.h"
@@ -109,8 +110,11 @@ TEST_CASE("the paper's power-basis method and plain bisection build and find the
   // held to the range where it works: the eye to the paper's decic, the entry point to degree 16.
   for (const auto& solver : solvers) {
     const bool power = solver.front().value == "descartes", eye = solver.size() > 1;
-    for (int degree : {1, 2, 3, 5, 8, 10, 13, 16, 21, 32}) {
-      if ((eye && degree > 10) || (power && degree > 16)) continue;
+    std::vector<int> degrees;
+    for (int degree : {1, 2, 3, 5, 8, 10, 13, 16, 21, 32})
+      if (!(eye && degree > 10) && !(power && degree > 16)) degrees.push_back(degree);
+    const std::string name = solver.front().value + (eye ? " from the eye" : "");
+    for (int degree : testing::sampled("test_kernels " + name + " degrees", degrees, {1, 2, degrees.back()}, 2)) {
       INFO("DEGREE=" << degree << " solver=" << solver.front().key << "=" << solver.front().value
                      << (eye ? " ray_origin=eye" : ""));
       const Scene scene = degree_scene(degree, "double", solver);
@@ -138,8 +142,11 @@ TEST_CASE("power-basis isolation refines a wide bracket to the stopping width at
       const char* const isolation = choice.name;
       const bool is_double = std::string(precision) == "double", chain = std::string(isolation) == "derivative-chain";
       const int max_degree = is_double ? 24 : chain ? 9 : 13;
-      for (int degree : {5, 9, 13, 17, 21, 24}) {
-        if (degree > max_degree) continue;
+      std::vector<int> degrees;
+      for (int degree : {5, 9, 13, 17, 21, 24})
+        if (degree <= max_degree) degrees.push_back(degree);
+      for (int degree : testing::sampled(std::string("test_kernels wide brackets ") + isolation + " " + precision,
+                                         degrees, {degrees.front(), degrees.back()}, 1)) {
         INFO("DEGREE=" << degree << " isolation=" << isolation << " precision=" << precision);
         const Scene scene = degree_scene(degree, precision, {{"render.isolation", isolation}}, 64);
         RenderResult result;
