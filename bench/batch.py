@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Batch benchmark (issue 7): a 100-frame parameter sweep of the Kummer quartic at 512x512, rendered as one
-`algray batch` and as 100 separate `algray render` processes; writes its section of bench/RESULTS.md.
+`algray batch` and as 100 separate `algray render` processes; writes its section of bench/RESULTS.md ("Batch"),
+with the date, machine, commit and command.
 
 Both start with the program cache warm (one render beforehand), so the difference is what one process saves:
 opening the OpenCL device, creating the context, loading the programs, and the process itself. Per-frame
@@ -19,8 +20,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from bench_common import ROOT, machine, replace_section
+from bench_common import ROOT, command_line, commit, machine, replace_section
 
+HEADING = "## Batch"
 SCENE = ROOT / "scenes/kummer.toml"
 # mu2 in (1/3, 3) keeps the Kummer family's lambda = (3 mu2 - 1)/(3 - mu2) finite.
 SWEEP_FROM, SWEEP_TO = 1.0, 2.9
@@ -113,13 +115,13 @@ def main():
             rows.append(row)
             print(json.dumps(row), flush=True)
 
-    cmd = "/usr/bin/python3 bench/batch.py" + ("" if args.frames == 100 and args.size == 512 and args.chunks == 10
-                                               else f" --frames {args.frames} --size {args.size} --chunks {args.chunks}")
     lines = [
-        "## Batch: one process against one process per frame (issue 7)",
+        HEADING,
         "",
-        f"- Date: {datetime.date.today()}; machine: {machine()}; device: PoCL (CPU).",
-        f"- Command: `{cmd}`",
+        "One process for a whole sweep (`algray batch`) against one process per frame (`algray render`).",
+        "",
+        f"- Date: {datetime.date.today()}; machine: {machine()}; device: PoCL (CPU); commit: {commit(args.binary)}.",
+        f"- Command: `{command_line()}`",
         f"- {args.frames} frames of `scenes/kummer.toml` at {args.size}x{args.size}, mu2 swept from {SWEEP_FROM} to "
         f"{SWEEP_TO}; program cache warm for both. Batch: `algray batch` over {args.chunks} chunks of the sweep "
         "(whole-process wall time, so each chunk's start-up counts; the median frame is from its log). "
@@ -144,7 +146,7 @@ def main():
                  "frame. The frames themselves cost the same; on a GPU, where creating a context and loading "
                  "programs take longer, the saving per frame grows accordingly.")
     lines.append("")
-    replace_section(args.output, lines[0], "\n".join(lines) + "\n")
+    replace_section(args.output, HEADING, "\n".join(lines) + "\n")
     print(f"wrote {args.output}")
 
 

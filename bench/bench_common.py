@@ -1,13 +1,18 @@
-"""What the render benchmarks share: running `algray render` with --stats, naming the machine, and replacing
-one section of bench/RESULTS.md."""
+"""What the render benchmarks share: running `algray render` with --stats, naming the machine and the commit, the
+command line as run, and replacing one section of bench/RESULTS.md (a page of current figures, a table per area
+with its date, machine, commit and command; the history is in bench/history/)."""
 import json
 import os
 import platform
+import re
+import shlex
 import subprocess
+import sys
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+RESULTS_MD = ROOT / "bench" / "RESULTS.md"
 
 
 def run_render(binary, scene, args, env, workdir):
@@ -38,14 +43,84 @@ def machine():
     return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
 
 
-def replace_section(path, heading, section):
-    """Puts `section` (starting with `heading`) in place of the old one in the Markdown file, or appends it."""
+def commit(binary=None):
+    """The commit the figures are of. For an algray binary, the git revision its `--version` names (what it was
+    built from, "-dirty" when its tree had changes), or "not recorded"; without one (a tool built from this tree),
+    the working tree's HEAD, "-dirty" when tracked files differ from it."""
+    if binary is not None:
+        try:
+            out = subprocess.run([str(binary), "--version"], capture_output=True, text=True, timeout=30).stdout
+            found = re.search(r"\(git ([0-9a-f]{7,40}(?:-dirty)?)\)", out)
+            return found.group(1) if found else "not recorded"
+        except (OSError, subprocess.SubprocessError):
+            return "not recorded"
+    try:
+        head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True, timeout=30)
+        if head.returncode != 0 or not head.stdout.strip():
+            return "not recorded"
+        dirty = subprocess.run(["git", "-C", str(ROOT), "diff", "--no-ext-diff", "--quiet", "HEAD", "--"],
+                               capture_output=True, timeout=60).returncode == 1
+        return head.stdout.strip() + ("-dirty" if dirty else "")
+    except (OSError, subprocess.SubprocessError):
+        return "not recorded"
+
+
+def command_line(prefix="python3"):
+    """The command as run, quoted so that it can be pasted back into a shell: `python3 bench/NAME.py ARGS`."""
+    script = Path(sys.argv[0]).resolve()
+    try:
+        script = script.relative_to(ROOT)
+    except ValueError:
+        pass
+    return shlex.join(([prefix] if prefix else []) + [str(script)] + sys.argv[1:])
+
+
+def heading_level(heading):
+    return len(heading) - len(heading.lstrip("#"))
+
+
+def _find_heading(text, heading):
+    """Where the line that is exactly `heading` starts, or None."""
+    found = re.search(r"^" + re.escape(heading.rstrip()) + r"[ \t]*$", text, re.MULTILINE)
+    return found.start() if found else None
+
+
+def _section_end(text, start, level):
+    """Where the section whose heading line starts at `start` ends: at the next heading of its level or above."""
+    line_end = text.find("\n", start)
+    if line_end == -1:
+        return len(text)
+    found = re.compile(r"^#{1,%d} " % level, re.MULTILINE).search(text, line_end + 1)
+    return found.start() if found else len(text)
+
+
+def _join(before, section, after):
+    """before + section + after, with one blank line between the section and what comes after it."""
+    section = section.rstrip("\n") + "\n"
+    if after.strip():
+        section += "\n"
+    return before + section + after
+
+
+def replace_section(path, heading, section, under=None):
+    """Puts `section` (starting with the Markdown heading line `heading`) in place of the old one in the file: from
+    that heading's line to the next heading of the same or a higher level, so that a `##` section keeps going past
+    its `###` ones and a `###` one stops at the next `###` or `##`. Where the file has no such heading, the section
+    is appended: at the end of the section `under` names (its area's `##` heading, added too when missing), or
+    at the end of the file."""
     out = Path(path)
     text = out.read_text() if out.exists() else "# Benchmark results\n\n"
-    if heading in text:
-        start = text.index(heading)
-        end = text.find("\n## ", start + len(heading))
-        text = text[:start] + section + (text[end + 1:] if end != -1 else "")
+    start = _find_heading(text, heading)
+    if start is not None:
+        end = _section_end(text, start, heading_level(heading))
+        text = _join(text[:start], section, text[end:])
+    elif under and _find_heading(text, under) is not None:
+        parent = _find_heading(text, under)
+        end = _section_end(text, parent, heading_level(under))
+        text = _join(text[:end].rstrip("\n") + "\n\n", section, text[end:])
     else:
-        text = text.rstrip("\n") + "\n\n" + section
+        if under:
+            section = under + "\n\n" + section
+        text = text.rstrip("\n") + "\n\n" + section.rstrip("\n") + "\n"
     out.write_text(text)

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """jsurf comparison (issue 7): every example .jsurf file of Debian's jsurf-alggeo, rendered by jsurf and by
 algray at the same size; how well the silhouettes agree (intersection over union of the pixels that are not
-background) and how far the colours are apart inside both. Writes its section of bench/RESULTS.md.
+background) and how far the colours are apart inside both. Writes its section of bench/RESULTS.md ("jsurf's own
+examples", under "Against the peers"): the date, machine, commit and command, the summary and the files whose
+silhouettes agree least (IoU under 0.98); every file's row is printed as it goes.
 
 Needs `apt-get install jsurf-alggeo` (its launcher wants JAVA_HOME; this script finds a JDK). jsurf renders
 with -q 0 (one ray per pixel) and algray without antialiasing, so the masks are the surfaces' own.
@@ -18,9 +20,13 @@ import tempfile
 import zlib
 from pathlib import Path
 
-from bench_common import ROOT, machine, replace_section
+from bench_common import ROOT, command_line, commit, machine, replace_section
 
 EXAMPLES = "/usr/share/doc/jsurf-alggeo/examples"
+AREA = "## Against the peers"
+HEADING = "### jsurf's own examples"
+# Files whose IoU is under this are named on the page; the others are summed up in one line.
+SHOWN_BELOW = 0.98
 
 
 def read_png(path):
@@ -130,10 +136,10 @@ def main():
     if not ious:
         sys.exit("no file rendered: nothing to compare")
     lines = [
-        "## jsurf framing: algray against jsurf-alggeo on its examples (issue 7)",
+        HEADING,
         "",
-        f"- Date: {datetime.date.today()}; machine: {machine()}.",
-        f"- Command: `/usr/bin/python3 bench/jsurf_compare.py` (needs `apt-get install jsurf-alggeo`); jsurf-alggeo "
+        f"- Date: {datetime.date.today()}; machine: {machine()}; commit: {commit(args.binary)}.",
+        f"- Command: `{command_line()}` (needs `apt-get install jsurf-alggeo`); jsurf-alggeo "
         f"{'0.4.1' if ok else '?'}, `-s {args.size} -q 0`; algray at {args.size}x{args.size} without antialiasing.",
         "- IoU: intersection over union of the non-background pixels of the two images (1 = the same silhouette). "
         "Colour: median over the pixels both cover of the mean |difference| of the 8-bit channels; the shading "
@@ -143,17 +149,21 @@ def main():
         "tutorial_kreis is a cylinder seen along its axis, a ring a few pixels wide (the two images look alike).",
         f"- {len(ok)} of {len(rows)} files render; IoU median {statistics.median(ious):.4f}, lowest "
         f"{min(ious):.4f} ({min(ok, key=lambda r: r[1])[0]}).",
-        "",
-        "| file | IoU | colour difference (of 255) | pixels in either |",
-        "|---|---|---|---|",
     ]
-    for name, iou, colour, either, note in rows:
-        if iou is None:
-            lines.append(f"| {name} | failed: {note} | | |")
-        else:
-            lines.append(f"| {name} | {iou:.4f} | {colour:.1f} | {either} |")
+    low = sorted((r for r in ok if r[1] < SHOWN_BELOW), key=lambda r: r[1])
+    rest = [r for r in ok if r[1] >= SHOWN_BELOW]
+    if low:
+        lines.append(f"- IoU under {SHOWN_BELOW}: " + ", ".join(
+            f"{name} {iou:.4f} (colour {colour:.1f} of 255, {either} pixels in either)"
+            for name, iou, colour, either, _ in low) + ".")
+    if rest:
+        lines.append(f"- The other {len(rest)} files: IoU {min(r[1] for r in rest):.4f}-{max(r[1] for r in rest):.4f}"
+                     " (every file's row is in the script's output).")
+    failed = [r for r in rows if r[1] is None]
+    if failed:
+        lines.append("- Failed: " + ", ".join(f"{name} ({note})" for name, _, _, _, note in failed) + ".")
     lines.append("")
-    replace_section(args.output, lines[0], "\n".join(lines) + "\n")
+    replace_section(args.output, HEADING, "\n".join(lines) + "\n", under=AREA)
     print(f"wrote {args.output}")
 
 

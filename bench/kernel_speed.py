@@ -1,15 +1,24 @@
 #!/usr/bin/env python3
 """Primary-kernel speed of two algray binaries side by side: rays/s per degree on seeded random surfaces and
-kernel ms on the paper's surfaces, each pair of runs interleaved, with the ratio's median and spread."""
+kernel ms on the paper's surfaces, each pair of runs interleaved, with the ratio's median and spread.
+
+With --results each table replaces its section of bench/RESULTS.md ("Random surfaces, per degree" and "The paper's
+surfaces, preview kernel", under "Rays per second per degree"), with the date, machine, commit and command; the
+whole output goes to bench/results/kernel_speed_SIDE_COMMIT.md (degrees) and kernel_speed_surfaces_COMMIT.md,
+and the page shows the degrees in PAGE_DEGREES when more than 16 were run."""
 import argparse
+import datetime
 import random
 import statistics
 import tempfile
 from pathlib import Path
 
-from bench_common import ROOT, machine, run_render
+from bench_common import RESULTS_MD, ROOT, command_line, commit, machine, replace_section, run_render
 
 PAPER_SURFACES = ["barth_sextic", "cusp_catastrophe", "torus", "tooth", "lemniscate", "tanglecube", "barth_decic"]
+AREA = "## Rays per second per degree"
+HEADINGS = {"degrees": "### Random surfaces, per degree", "surfaces": "### The paper's surfaces, preview kernel"}
+PAGE_DEGREES = {1, 2, 3, 4, 5, 6, 8, 12, 16, 24, 32}
 
 
 def random_surface(degree, seed, side):
@@ -83,6 +92,8 @@ def main():
     ap.add_argument("--degrees", default="1-32", help="e.g. 1-32 or 2,6,10")
     ap.add_argument("--only", choices=["degrees", "surfaces"])
     ap.add_argument("--precision", default="double")
+    ap.add_argument("--results", action="store_true", help="write the tables into their sections of "
+                    "bench/RESULTS.md and the whole output to bench/results/")
     a = ap.parse_args()
     if "-" in a.degrees:
         lo, hi = (int(x) for x in a.degrees.split("-"))
@@ -91,31 +102,65 @@ def main():
         degrees = [int(x) for x in a.degrees.split(",")]
     if a.baseline is None:  # a device where no earlier build is at hand (a lent GPU)
         binaries = [a.algray]
-        print(f"Machine: {machine()}. `{a.algray}`; kernel ms of the primary pass, median of {a.repeat} runs after "
-              f"one warm-up. Precision {a.precision}.\n")
+        about = (f"`{a.algray}`; kernel ms of the primary pass, median of {a.repeat} runs after one warm-up. "
+                 f"Precision {a.precision}.")
         heads = [f"| degree | Mrays/s ({a.side}x{a.side}) | min-max |\n|---|---|---|",
                  "| surface (1024x768 preview, one ray per pixel) | kernel ms | min-max |\n|---|---|---|"]
     else:
         binaries = [a.baseline, a.algray]
-        print(f"Machine: {machine()}. Baseline `{a.baseline}`, current `{a.algray}`; kernel ms of the primary pass, "
-              f"median of {a.repeat} interleaved runs each after one warm-up; ratio = current/baseline time per pair "
-              f"(median, min-max). Precision {a.precision}.\n")
+        about = (f"Baseline `{a.baseline}`, current `{a.algray}`; kernel ms of the primary pass, median of {a.repeat} "
+                 "interleaved runs each after one warm-up; ratio = current/baseline time per pair (median, min-max). "
+                 f"Precision {a.precision}.")
         heads = ["| degree | baseline Mrays/s | current Mrays/s | speed-up (median) | min-max |\n|---|---|---|---|---|",
                  "| surface (1024x768 preview, one ray per pixel) | baseline kernel ms | current kernel ms | "
                  "speed-up (median) | min-max |\n|---|---|---|---|---|"]
+    print(f"Machine: {machine()}. {about}\n")
+    tables = {}
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         if a.only != "surfaces":
             print(heads[0])
+            tables["degrees"] = []
             for d in degrees:
                 scene = work / f"random{d}.toml"
                 scene.write_text(random_surface(d, 1000 + d, a.side))
-                print(degree_row(binaries, d, scene, a, work), flush=True)
+                tables["degrees"].append((d, degree_row(binaries, d, scene, a, work)))
+                print(tables["degrees"][-1][1], flush=True)
             print()
         if a.only != "degrees":
             print(heads[1])
+            tables["surfaces"] = []
             for name in PAPER_SURFACES:
-                print(surface_row(binaries, name, a, work), flush=True)
+                tables["surfaces"].append((name, surface_row(binaries, name, a, work)))
+                print(tables["surfaces"][-1][1], flush=True)
+    if a.results:
+        write_results(a, binaries, about, heads, tables)
+
+
+def write_results(a, binaries, about, heads, tables):
+    """Each table in place of its section of RESULTS.md; the whole output in bench/results/."""
+    revision = commit(binaries[-1])
+    baseline = f" against the baseline's {commit(binaries[0])}" if len(binaries) == 2 else ""
+    for part, head in zip(("degrees", "surfaces"), heads):
+        if part not in tables:
+            continue
+        rows = tables[part]
+        name = f"kernel_speed_{a.side if part == 'degrees' else 'surfaces'}_{revision.replace(' ', '_')}.md"
+        whole = ROOT / "bench" / "results" / name
+        whole.write_text(f"Machine: {machine()}. {about}\n\n{head}\n" + "\n".join(r for _, r in rows) + "\n")
+        shown = [r for d, r in rows if d in PAGE_DEGREES] if part == "degrees" and len(rows) > 16 else \
+            [r for _, r in rows]
+        what = (f"Seeded random surfaces of each degree (x^n + y^n + z^n - 1/4 and 3n random lower monomials, seed "
+                f"1000 + n), {a.side}x{a.side} rays" if part == "degrees" else
+                "The paper's surfaces, preview at 1024x768, one ray per pixel")
+        lines = [HEADINGS[part], "",
+                 f"- Date: {datetime.date.today().isoformat()}; machine: {machine()}; commit: {revision}{baseline}",
+                 f"- Command: `{command_line()}`",
+                 f"- {what}. {about} Whole output: [bench/results/{name}](results/{name})"
+                 + (f"; the page shows degrees {', '.join(str(d) for d in sorted(PAGE_DEGREES))}." if
+                    len(shown) < len(rows) else "."), "", head] + shown
+        replace_section(RESULTS_MD, HEADINGS[part], "\n".join(lines) + "\n", under=AREA)
+        print(f"wrote {RESULTS_MD} and {whole}")
 
 
 if __name__ == "__main__":

@@ -4,7 +4,8 @@
 Renders the scene as shipped (the Barth sextic: 2x2 antialiasing, two 5x5 area lights casting shadows) at each
 size to EXR and PNG under /usr/bin/time -v, and reads the peak resident set size. --before adds a second binary
 (the pre-change build) for the sizes up to --before-max pixels. Prints a table; --results also writes
-bench/results/memory.json and the "Memory: tile by tile" section of bench/RESULTS.md.
+bench/results/memory.json and the "Peak memory by image size" section of bench/RESULTS.md (under "Memory"), with the
+date, machine, commit and command.
 """
 import argparse
 import datetime
@@ -15,9 +16,10 @@ import sys
 import tempfile
 from pathlib import Path
 
-from bench_common import ROOT, machine, replace_section
+from bench_common import ROOT, command_line, commit, machine, replace_section
 
-HEADING = "## Memory: tile by tile (issue 14)"
+AREA = "## Memory"
+HEADING = "### Peak memory by image size"
 # Besides the scene as shipped: what else a tile's work grows with (after only).
 VARIANTS = [
     ("sextic, reflection 0.5 and transmission 0.5 to depth 8", "barth_sextic.toml",
@@ -112,16 +114,19 @@ def main():
     print(table)
     if not args.results:
         return
-    command = "python3 bench/memory.py " + " ".join(sys.argv[1:])
+    command = command_line()
+    revision = commit(args.binary)
     out = ROOT / "bench" / "results"
     out.mkdir(exist_ok=True)
     (out / "memory.json").write_text(json.dumps({"machine": machine(), "date": datetime.date.today().isoformat(),
-                                                 "command": command, "rows": rows}, indent=2) + "\n")
+                                                 "commit": revision, "command": command, "rows": rows},
+                                                indent=2) + "\n")
     section = "\n".join([
         HEADING, "",
         f"- Date: {datetime.date.today().isoformat()}",
         f"- Machine: {machine()}",
-        f"- Command: `{command}`",
+        f"- Commit: {revision}" + (f"; before: {commit(args.before)}" if args.before else ""),
+        f"- Command: `{command}`; raw figures in [bench/results/memory.json](results/memory.json)",
         "- Each size in full mode as the scene ships (2x2 antialiasing, two 5x5 area lights casting shadows), EXR "
         "and PNG written; peak resident set size from `/usr/bin/time -v`. Before: " + args.before_name + "; after: tile by tile through every pass into a film of 32 bytes per "
         "pixel, the writers converting a strip at a time. The bound is 40 bytes per output pixel plus 300 MB "
@@ -131,7 +136,7 @@ def main():
         "built cold adds LLVM's compiler to the peak, 150 to 250 MB once per machine and kernel (the two-surface "
         "scene at 1024x768: 404 MB cold), which is not the render's. Wall times are of one run each: a guide only.",
         "", table, ""])
-    replace_section(ROOT / "bench" / "RESULTS.md", HEADING, section)
+    replace_section(ROOT / "bench" / "RESULTS.md", HEADING, section, under=AREA)
 
 
 if __name__ == "__main__":

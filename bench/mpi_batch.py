@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """MPI batch benchmark (issue 17): a 20-frame preview sweep of the Kummer quartic's mu2 (as bench/batch.py
 sweeps it) by `mpirun -n 1` and by `mpirun -n 2 algray batch`, each rank with a one-thread PoCL, so that two
-ranks have one core each; writes its section of bench/RESULTS.md.
+ranks have one core each; writes its section of bench/RESULTS.md ("A batch across 2 MPI ranks", under "Several
+devices, MPI and Slurm"), with the date, machine, commit and command.
 
 The 1-rank and 2-rank runs alternate, so that a shared machine's load falls on both alike; each figure is the
 whole mpirun's wall time, start-up included. The program cache is warm for all (one batch beforehand).
@@ -16,10 +17,11 @@ import tempfile
 import time
 from pathlib import Path
 
-from bench_common import ROOT, machine, replace_section
+from bench_common import ROOT, command_line, commit, machine, replace_section
 
 SCENE = ROOT / "scenes/kummer.toml"
-HEADING = "## MPI: a batch across 2 ranks (issue 17)"
+AREA = "## Several devices, MPI and Slurm"
+HEADING = "### A batch across 2 MPI ranks"
 
 
 def write_jobs(workdir, frames, size):
@@ -70,8 +72,9 @@ def main():
     cmd = " ".join(mpirun(2, "algray", "jobs.toml"))
     section = f"""{HEADING}
 
-- Date: {datetime.date.today().isoformat()}; machine: {machine()}; device: PoCL (CPU), one thread per rank.
-- Command: `python3 bench/mpi_batch.py` (after `cmake --build build --target algray`), which runs `{cmd}` and the
+- Date: {datetime.date.today().isoformat()}; machine: {machine()}; device: PoCL (CPU), one thread per rank;
+  commit: {commit(args.binary)}.
+- Command: `{command_line()}` (after `cmake --build build --target algray`), which runs `{cmd}` and the
   same with `-n 1`, alternating, {args.runs} runs each.
 - {args.frames} frames of `scenes/kummer.toml` at {args.size}x{args.size}, preview (2x2 antialiased camera rays),
   mu2 swept from 1.0 to 2.9; program cache warm. Wall time of the whole mpirun, start-up included.
@@ -83,7 +86,7 @@ def main():
 
 - Speed-up (median 1 rank / median 2 ranks): **{ratio:.2f}x** (target: at least 1.8x).
 """
-    replace_section(args.results, HEADING, section)
+    replace_section(args.results, HEADING, section, under=AREA)
     print(section)
 
 

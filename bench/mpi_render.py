@@ -3,7 +3,8 @@
 PoCL (POCL_MAX_PTHREAD_COUNT=1), so that two ranks have a core each. The scene as shipped (full mode) at
 1024x768 by default. Runs alternate after one warm-up each; each figure is the whole mpirun's wall time,
 start-up included. Checks that the two images are bit-identical in every channel, and reports each rank's
-share of the bands. Writes its section of bench/RESULTS.md."""
+share of the bands. Writes its section of bench/RESULTS.md ("One image across 2 MPI ranks", under "Several
+devices, MPI and Slurm"), with the date, machine, commit and command."""
 import argparse
 import datetime
 import json
@@ -13,9 +14,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from bench_common import ROOT, machine, replace_section
+from bench_common import ROOT, command_line, commit, machine, replace_section
 
-HEADING = "## MPI: one image across 2 ranks (issue 17)"
+AREA = "## Several devices, MPI and Slurm"
+HEADING = "### One image across 2 MPI ranks"
 
 
 def mpirun(ranks, binary, scene, args, out, stats):
@@ -61,8 +63,9 @@ def main():
     cmd = " ".join(mpirun(2, "algray", f"scenes/{a.scene}.toml", args, "out.exr", "stats.json"))
     section = f"""{HEADING}
 
-- Date: {datetime.date.today().isoformat()}; machine: {machine()}; device: PoCL (CPU), one thread per rank.
-- Command: `python3 bench/mpi_render.py` (after `cmake --build build --target algray exr_compare`): `{cmd}`
+- Date: {datetime.date.today().isoformat()}; machine: {machine()}; device: PoCL (CPU), one thread per rank;
+  commit: {commit(a.binary)}.
+- Command: `{command_line()}` (after `cmake --build build --target algray exr_compare`): `{cmd}`
   against the same with `-n 1`, alternating, {a.runs} runs each after one warm-up; program cache warm. Wall time
   of the whole mpirun.
 
@@ -74,7 +77,7 @@ def main():
 - Speed-up (1 rank / 2 ranks, per pair): **{statistics.median(pairs):.2f}x** median, {min(pairs):.2f}-{max(pairs):.2f}
   (target: at least 1.8x). Tiles per rank's devices: {tiles}. Images {'bit-identical in every channel' if same else 'DIFFER'}.
 """
-    replace_section(a.results, HEADING, section)
+    replace_section(a.results, HEADING, section, under=AREA)
     print(section)
 
 

@@ -4,16 +4,20 @@ tests/data/hard_surfaces, each written to a temporary scene at 160x120 (camera t
 accuracy of camera rays in float, adaptive, mixed and double against solver_ref (precision_modes.py's
 accuracy()), and with --speed adaptive's kernel time over float's at --size (1024x768), with fp64 and without.
 
-  python3 bench/outside_surfaces.py [--speed] [--only NAME ...]
+  python3 bench/outside_surfaces.py [--speed] [--only NAME ...] [--results]
+
+With --results the table replaces its section of bench/RESULTS.md ("Surfaces outside the repository", under
+"Precision modes: time and accuracy"), with the date, machine, commit and command.
 """
 import argparse
+import datetime
 import os
 import statistics
 import sys
 import tempfile
 from pathlib import Path
 
-from bench_common import ROOT, machine, run_render
+from bench_common import RESULTS_MD, ROOT, command_line, commit, machine, replace_section, run_render
 from precision_modes import FLOAT_LINE, accuracy
 
 # name: (equation, extent radius). Facts from the literature (surfaces.md's sources, MathWorld); the shells and
@@ -34,6 +38,10 @@ SURFACES = {
     "sphere_cylinder_cubic": ("(x^2+y^2+z^2-1)*(x^2+y^2-0.25)*(z^3-0.5*x^2*z+0.1)", 1.6),
     "whitney_shell": ("(x^2-y^2*z)^2-0.0001", 1.5),
 }
+
+
+AREA = "## Precision modes: time and accuracy"
+HEADING = "### Surfaces outside the repository"
 
 
 def write_scene(folder, name, equation, radius):
@@ -68,6 +76,7 @@ def main():
     ap.add_argument("--size", default="1024x768",
                     help="WIDTHxHEIGHT of the speed renders: previews of a few ms at 1024x768 read to 0.1-0.2 only")
     ap.add_argument("--binary", default=str(ROOT / "build/apps/algray/algray"))
+    ap.add_argument("--results", action="store_true", help="write the table into its section of bench/RESULTS.md")
     a = ap.parse_args()
     try:
         size = tuple(int(v) for v in a.size.lower().split("x"))
@@ -79,14 +88,18 @@ def main():
     unknown = [n for n in names if n not in SURFACES]
     if unknown:
         sys.exit(f"unknown surface(s) {', '.join(unknown)}; known: {', '.join(SURFACES)}")
-    print(f"Machine: {machine()}. Accuracy: camera rays at 160x120 against solver_ref, disagreements among "
-          f"certified pixels / worst relative depth error (the float line: {FLOAT_LINE[0]:.1%} and "
-          f"{FLOAT_LINE[1]:g}).\n")
+    about = (f"Accuracy: camera rays at 160x120 against solver_ref, disagreements among certified pixels / worst "
+             f"relative depth error (the float line: {FLOAT_LINE[0]:.1%} and {FLOAT_LINE[1]:g}); escalated: the "
+             "share of camera rays adaptive sent to its second pass.")
+    if a.speed:
+        about += (f" Speed: adaptive's kernel time over float's at {size[0]}x{size[1]}, previews, median of "
+                  f"{a.rounds} interleaved pairs, with fp64 and without (ALGRAY_NO_FP64=1).")
+    print(f"Machine: {machine()}. {about}\n")
     head = "| surface | float | adaptive | escalated | adaptive, no fp64 | escalated | mixed | double |"
     if a.speed:
         head += " adaptive / float | (no fp64) |"
-    print(head)
-    print("|---" * (head.count("|") - 1) + "|")
+    table = [head, "|---" * (head.count("|") - 1) + "|"]
+    print("\n".join(table))
     with tempfile.TemporaryDirectory() as tmp:
         for name in names:
             scene = write_scene(tmp, name, *SURFACES[name])
@@ -99,7 +112,17 @@ def main():
                 ratio = speed_ratio(a.binary, scene, a.rounds, Path(tmp), False, size)
                 ratio_no = speed_ratio(a.binary, scene, a.rounds, Path(tmp), True, size)
                 row += f" {ratio:.2f} | {ratio_no:.2f} |"
+            table.append(row)
             print(row, flush=True)
+    if a.results:
+        lines = [HEADING, "",
+                 f"- Date: {datetime.date.today().isoformat()}; machine: {machine()}; "
+                 f"commit: {commit(a.binary if a.speed else None)}",
+                 f"- Command: `{command_line()}`",
+                 "- Classic surfaces in neither scenes/ nor tests/data/hard_surfaces, each written to a temporary "
+                 f"scene. {about}", ""] + table
+        replace_section(RESULTS_MD, HEADING, "\n".join(lines) + "\n", under=AREA)
+        print(f"wrote {RESULTS_MD}")
 
 
 if __name__ == "__main__":

@@ -11,6 +11,8 @@ POV-Ray with the scene's two 5x5 area lights and 2x2 antialiasing. Every time is
 untimed run of each program first), and each (algray, peer) pair runs interleaved, so that load from other
 users of the machine falls on both alike; ratios are per pair, reported as median and range, for wall time
 and for CPU time. The silhouettes of the last images are compared, with a warning where a peer's differs.
+With --results the tables replace their own sections of bench/RESULTS.md ("Against the peers": "Preview against
+POV-Ray and jsurf", "Full mode against POV-Ray"), with the date, machine, commit and command.
 
 Installs povray and jsurf-alggeo with apt-get when they are missing (as root). Standard library only.
 """
@@ -33,7 +35,7 @@ import tomllib
 from fractions import Fraction
 from pathlib import Path
 
-from bench_common import ROOT, machine
+from bench_common import RESULTS_MD, ROOT, command_line, commit, machine, replace_section
 from jsurf_compare import mask, read_png
 
 SURFACES = ["barth_sextic", "cusp_catastrophe", "torus", "tooth", "lemniscate", "tanglecube", "barth_decic"]
@@ -55,6 +57,9 @@ DEFAULT_MATERIAL = {
 AREA_TOLERANCE = 0.03
 BOX_TOLERANCE = 0.02
 IOU_TOLERANCE = 0.95
+# bench/RESULTS.md: the area and the two sections this script writes.
+AREA = "## Against the peers"
+HEADINGS = {"preview": "### Preview against POV-Ray and jsurf", "full": "### Full mode against POV-Ray"}
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -627,32 +632,66 @@ def table(rows):
     full = [r for r in rows if r["mode"] == "full"]
     if preview:
         lines += [f"Preview, {PREVIEW_SIZE[0]}x{PREVIEW_SIZE[1]} PNG, whole process, median wall seconds; ratios "
-                  "algray / peer per interleaved pair, median (min-max); CPU: the same ratio of CPU seconds:", "",
-                  "| surface | degree | algray s | POV-Ray s | jsurf s | algray / POV-Ray | algray / jsurf "
-                  f"| / faster peer | target {PREVIEW_TARGET:.2f} | CPU / faster peer "
-                  "| silhouette IoU (POV-Ray, jsurf) |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|"]
-        for r in preview:
-            s = r["silhouettes"]["programs"]
-            lines.append(f"| {r['name']} | {r['degree']} | {r['median_s']['algray']:.2f} | "
-                         f"{r['median_s']['povray']:.2f} | {r['median_s']['jsurf']:.2f} | "
-                         f"{ratio_cell(r['ratio']['povray'])} | {ratio_cell(r['ratio']['jsurf'])} | "
-                         f"{r['ratio'][r['faster']]['median']:.3f} ({PEER_NAMES[r['faster']]}) | "
-                         f"{'met' if r['met'] else '**missed**'} | {ratio_cell(r['cpu_ratio'][r['faster']])} | "
-                         f"{s['povray']['iou']:.3f}, {s['jsurf']['iou']:.3f} |")
+                  "algray / peer per interleaved pair, median (min-max); CPU: the same ratio of CPU seconds:", ""]
+        lines += preview_table(preview)
     if full:
         if preview:
             lines.append("")
         lines += [f"Full mode, {FULL_SIZE[0]}x{FULL_SIZE[1]} PNG (algray: the scene as shipped; POV-Ray: two 5x5 "
-                  "area lights, 2x2 antialiasing), whole process, median wall seconds:", "",
-                  f"| surface | degree | algray s | POV-Ray s | algray / POV-Ray | target {FULL_TARGET:.2f} "
-                  "| CPU ratio | silhouette IoU |", "|---|---|---|---|---|---|---|---|"]
-        for r in full:
-            lines.append(f"| {r['name']} | {r['degree']} | {r['median_s']['algray']:.2f} | "
-                         f"{r['median_s']['povray']:.2f} | {ratio_cell(r['ratio']['povray'])} | "
-                         f"{'met' if r['met'] else '**missed**'} | {ratio_cell(r['cpu_ratio']['povray'])} | "
-                         f"{r['silhouettes']['programs']['povray']['iou']:.3f} |")
+                  "area lights, 2x2 antialiasing), whole process, median wall seconds:", ""]
+        lines += full_table(full)
     return "\n".join(lines)
+
+
+def preview_table(preview):
+    lines = ["| surface | degree | algray s | POV-Ray s | jsurf s | algray / POV-Ray | algray / jsurf "
+             f"| / faster peer | target {PREVIEW_TARGET:.2f} | CPU / faster peer "
+             "| silhouette IoU (POV-Ray, jsurf) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in preview:
+        s = r["silhouettes"]["programs"]
+        lines.append(f"| {r['name']} | {r['degree']} | {r['median_s']['algray']:.2f} | "
+                     f"{r['median_s']['povray']:.2f} | {r['median_s']['jsurf']:.2f} | "
+                     f"{ratio_cell(r['ratio']['povray'])} | {ratio_cell(r['ratio']['jsurf'])} | "
+                     f"{r['ratio'][r['faster']]['median']:.3f} ({PEER_NAMES[r['faster']]}) | "
+                     f"{'met' if r['met'] else '**missed**'} | {ratio_cell(r['cpu_ratio'][r['faster']])} | "
+                     f"{s['povray']['iou']:.3f}, {s['jsurf']['iou']:.3f} |")
+    return lines
+
+
+def full_table(full):
+    lines = [f"| surface | degree | algray s | POV-Ray s | algray / POV-Ray | target {FULL_TARGET:.2f} "
+             "| CPU ratio | silhouette IoU |", "|---|---|---|---|---|---|---|---|"]
+    for r in full:
+        lines.append(f"| {r['name']} | {r['degree']} | {r['median_s']['algray']:.2f} | "
+                     f"{r['median_s']['povray']:.2f} | {ratio_cell(r['ratio']['povray'])} | "
+                     f"{'met' if r['met'] else '**missed**'} | {ratio_cell(r['cpu_ratio']['povray'])} | "
+                     f"{r['silhouettes']['programs']['povray']['iou']:.3f} |")
+    return lines
+
+
+def write_results(path, rows, versions, revision, command, repeat):
+    """Each mode's table in place of its section of RESULTS.md (under "Against the peers")."""
+    about = {
+        "preview": f"{PREVIEW_SIZE[0]}x{PREVIEW_SIZE[1]} PNG, one camera ray per pixel in all three programs, whole "
+                   "process, warm, interleaved pairs; median wall seconds; ratios algray / peer per pair, median "
+                   "(min-max); CPU: the same ratio of CPU seconds. Target (issue 14, goal 1): at most "
+                   f"{PREVIEW_TARGET:.2f}x the faster peer.",
+        "full": f"{FULL_SIZE[0]}x{FULL_SIZE[1]} PNG: algray's scene as shipped (2x2 antialiasing, two 5x5 area "
+                "lights) against POV-Ray with the same two lights as 5x5 area lights and 2x2 antialiasing; whole "
+                f"process, warm, interleaved pairs; median wall seconds. Target (issue 14, goal 1): at most "
+                f"{FULL_TARGET:.2f}x POV-Ray.",
+    }
+    for mode, make in (("preview", preview_table), ("full", full_table)):
+        mine = [r for r in rows if r["mode"] == mode]
+        if not mine:
+            continue
+        lines = [HEADINGS[mode], "",
+                 f"- Date: {datetime.date.today().isoformat()}; machine: {machine()}; commit: {revision}",
+                 f"- Command: `{command}` ({repeat} timed pairs per surface)",
+                 f"- Peers: {versions['povray']}; jsurf-alggeo {versions['jsurf']}. {about[mode]}", ""]
+        lines += make(mine)
+        replace_section(path, HEADINGS[mode], "\n".join(lines) + "\n", under=AREA)
 
 
 def peer_versions(env):
@@ -676,6 +715,9 @@ def main():
     ap.add_argument("--only", choices=["preview", "full"], help="one of the two comparisons")
     ap.add_argument("--keep", type=Path, help="write the peer scene files and every image here, and keep them")
     ap.add_argument("--json", type=Path, help="write the results as JSON here")
+    ap.add_argument("--results", action="store_true", help="write each table into its section of bench/RESULTS.md")
+    ap.add_argument("--results-file", type=Path, default=RESULTS_MD, help="the page --results writes "
+                    "(default bench/RESULTS.md)")
     ap.add_argument("--pov-threshold", type=float, default=0.0, help="POV-Ray's antialiasing threshold in full "
                     "mode (default 0.0: every pixel supersampled, as algray's 2x2; POV-Ray's own default is 0.3)")
     args = ap.parse_args()
@@ -704,11 +746,17 @@ def main():
     warnings = [w for r in rows for w in r["silhouettes"]["warnings"]]
     for w in warnings:
         print(f"\nWARNING: {w}")
+    command = command_line()
+    versions = peer_versions(env) if args.json or args.results else None
+    revision = commit(args.algray)
     if args.json:
         args.json.write_text(json.dumps({
-            "date": datetime.date.today().isoformat(), "machine": machine(),
-            "command": " ".join(["python3", "bench/peers.py"] + sys.argv[1:]), "algray": str(args.algray),
-            "peers": peer_versions(env), "repeat": args.repeat, "rows": rows, "warnings": warnings}, indent=1) + "\n")
+            "date": datetime.date.today().isoformat(), "machine": machine(), "commit": revision,
+            "command": command, "algray": str(args.algray),
+            "peers": versions, "repeat": args.repeat, "rows": rows, "warnings": warnings}, indent=1) + "\n")
+    if args.results:
+        write_results(args.results_file, rows, versions, revision, command, args.repeat)
+        print(f"wrote {args.results_file}", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,7 @@
 #!/usr/bin/env python3
-"""Preview-mode benchmark: every scene at 1024x768, cold and warm program cache; writes bench/RESULTS.md.
+"""Preview-mode benchmark: every scene at 1024x768, cold and warm program cache; writes its section of
+bench/RESULTS.md ("Preview per scene, cold and warm caches", under "Against the peers"), with the date, machine,
+commit and command.
 
 Cold: empty algray and PoCL caches, so the time includes compiling the kernel. Warm: the same command again
 with both caches filled; median of --runs runs. Kernel ms comes from --stats (device time of the launches),
@@ -12,7 +14,10 @@ import sys
 import tempfile
 from pathlib import Path
 
-from bench_common import ROOT, fresh_caches, machine, replace_section, run_render
+from bench_common import ROOT, command_line, commit, fresh_caches, machine, replace_section, run_render
+
+AREA = "## Against the peers"
+HEADING = "### Preview per scene, cold and warm caches"
 
 # The paper's surfaces, with the targets of issue 2 (end to end, warm cache).
 PAPER = {"barth_sextic", "cusp_catastrophe", "torus", "tooth", "lemniscate", "barth_decic", "tanglecube"}
@@ -68,13 +73,13 @@ def main():
                   f"{d['warm_e2e']:7.1f} ms, cold {d['cold_e2e']:7.1f} ms   float: kernel "
                   f"{row['float']['kernel']:7.1f} ms", file=sys.stderr)
 
-    command = "python3 bench/preview.py " + " ".join(sys.argv[1:])
     lines = [
-        "## Preview mode, 1024x768 (issue 2)",
+        HEADING,
         "",
         f"- Date: {datetime.date.today().isoformat()}",
         f"- Machine: {machine()}; OpenCL device: {device}",
-        f"- Command: `{command.strip()}` (after `cmake --build build`)",
+        f"- Commit: {commit(args.binary)}",
+        f"- Command: `{command_line()}` (after `cmake --build build`)",
         f"- Each scene at {args.width}x{args.height}, preview shading, EXR written. Cold: empty algray and PoCL "
         "caches (includes compiling the kernel). Warm: both caches filled, median of "
         f"{args.runs} runs. Kernel: device time of the primary launches (median of the warm runs).",
@@ -98,7 +103,7 @@ def main():
                      f"{f['kernel'] / d['kernel']:.2f} | {target} |")
     section = "\n".join(lines) + "\n"
 
-    replace_section(args.output, "## Preview mode, 1024x768 (issue 2)", section)
+    replace_section(args.output, HEADING, section, under=AREA)
     print(f"wrote {args.output}", file=sys.stderr)
 
 

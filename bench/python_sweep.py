@@ -1,8 +1,12 @@
 #!/usr/bin/env python3
 """What Python adds per frame: a parameter sweep rendered from Python (render, then save as PNG) against the same
 sweep through `algray batch`, which writes the same PNGs; rounds alternate between the two, per-frame medians.
-Run with the package on the path: PYTHONPATH=build/python python3 bench/python_sweep.py"""
+Run with the package on the path: PYTHONPATH=build/python python3 bench/python_sweep.py
+
+With --results the table replaces its section of bench/RESULTS.md (under "Python per frame": "Python rendering what
+a PNG holds", or with --depth "Python keeping depth and normals"), with the date, machine, commit and command."""
 import argparse
+import datetime
 import json
 import statistics
 import subprocess
@@ -12,7 +16,10 @@ from pathlib import Path
 
 import algray
 
-from bench_common import ROOT, machine
+from bench_common import RESULTS_MD, ROOT, command_line, commit, machine, replace_section
+
+AREA = "## Python per frame"
+HEADINGS = {False: "### Python rendering what a PNG holds", True: "### Python keeping depth and normals"}
 
 
 def main():
@@ -25,6 +32,7 @@ def main():
     ap.add_argument("--key", default="r", help="the swept parameter or scene key")
     ap.add_argument("--range", default="0.3,1.2")
     ap.add_argument("--depth", action="store_true", help="keep depth and normals in Python (a PNG holds neither)")
+    ap.add_argument("--results", action="store_true", help="write the table into its section of bench/RESULTS.md")
     a = ap.parse_args()
     lo, hi = (float(x) for x in a.range.split(","))
     scene_path = ROOT / "scenes" / f"{a.scene}.toml"
@@ -57,14 +65,24 @@ def main():
             if r > 0:  # round 0 warms both
                 batch_ms.append(statistics.median(frames))
                 python_ms.append(statistics.median(times))
-    print(f"Machine: {machine()}. {a.frames}-frame sweep of {a.key} in {lo}..{hi} on {a.scene}, {a.size}x{a.size} "
-          f"preview, PNG per frame{'; Python keeps depth and normals' if a.depth else ''}; per-frame median of each round, {a.rounds} rounds alternating.\n")
-    print("| round | algray batch ms/frame | Python ms/frame | Python / batch |")
-    print("|---|---|---|---|")
+    about = (f"{a.frames}-frame sweep of {a.key} in {lo}..{hi} on {a.scene}, {a.size}x{a.size} preview, PNG per "
+             f"frame{'; Python keeps depth and normals' if a.depth else ''}; per-frame median of each round, "
+             f"{a.rounds} rounds alternating (round 0 discarded as a warm-up).")
+    table = ["| round | algray batch ms/frame | Python ms/frame | Python / batch |", "|---|---|---|---|"]
     for k, (b, p) in enumerate(zip(batch_ms, python_ms)):
-        print(f"| {k + 1} | {b:.1f} | {p:.1f} | {p / b:.3f} |")
+        table.append(f"| {k + 1} | {b:.1f} | {p:.1f} | {p / b:.3f} |")
     ratios = [p / b for b, p in zip(batch_ms, python_ms)]
-    print(f"\nmedian Python / batch: {statistics.median(ratios):.3f}")
+    median = f"median Python / batch: {statistics.median(ratios):.3f}"
+    print(f"Machine: {machine()}. {about}\n")
+    print("\n".join(table))
+    print(f"\n{median}")
+    if a.results:
+        lines = [HEADINGS[a.depth], "",
+                 f"- Date: {datetime.date.today().isoformat()}; machine: {machine()}; commit: {commit(a.algray)}",
+                 f"- Command: `PYTHONPATH=build/python {command_line()}`",
+                 f"- {about}", ""] + table + ["", median]
+        replace_section(RESULTS_MD, HEADINGS[a.depth], "\n".join(lines) + "\n", under=AREA)
+        print(f"wrote {RESULTS_MD}")
 
 
 if __name__ == "__main__":

@@ -4,27 +4,36 @@
   bench/solvers.py --quick            # every part in its quick form (under 10 minutes on a 2-core CPU)
   bench/solvers.py --only fig2 decic  # some parts; the others keep their last results
   bench/solvers.py --plot-only        # redraw plots and RESULTS.md from bench/results/*.json
+  bench/solvers.py --plot-only --no-plots  # RESULTS.md and bench/results/solvers.md only (no matplotlib)
 
 Parts: degrees (rays/s and build times per degree), accuracy (time against error per tolerance), fig2 (the
 paper's Fig. 2) and decic (the paper's Barth decic experiment). JSON goes to bench/results/, plots as PNG and
-SVG to bench/figures/.
+SVG to bench/figures/. The section "Solvers: what accuracy costs" of bench/RESULTS.md gets each part's date,
+machine, commit and command and a short table; every table in full goes to bench/results/solvers.md.
 """
 import argparse
 import datetime
 import json
 import os
 import platform
+import re
 import statistics
 import subprocess
 import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+from bench_common import RESULTS_MD, ROOT, commit, replace_section
+
 RESULTS = ROOT / "bench" / "results"
 FIGURES = ROOT / "bench" / "figures"
 PARTS = ["degrees", "accuracy", "fig2", "decic"]
-BEGIN, END = "<!-- solvers:begin -->", "<!-- solvers:end -->"
+HEADING = "## Solvers: what accuracy costs"
+FULL = RESULTS / "solvers.md"
+# What the page's per-degree table shows (the rest is in FULL): double, Brent after each isolation.
+PAGE_PRECISION = "double"
+PAGE_METHODS = ["bernstein/brent", "descartes/brent", "sturm/brent", "derivative-chain/brent"]
+PAGE_DEGREES = [1, 2, 4, 6, 8, 10, 16, 24, 32]
 
 
 def run_part(binary, part, quick, device, env):
@@ -41,6 +50,7 @@ def run_part(binary, part, quick, device, env):
     subprocess.run(cmd, check=True, env=env)
     data = json.loads(out.read_text())
     data["command"] = " ".join(["bench/solvers.py"] + (["--quick"] if quick else []) + ["--only", part])
+    data["commit"] = commit()
     data["date"] = datetime.date.today().isoformat()
     data["seconds"] = round(time.perf_counter() - start, 1)
     data["cpu"] = cpu_name()
@@ -154,16 +164,39 @@ def plot_accuracy(data, plt):
 
 def header(data):
     return (f"- Machine: {data.get('cpu', '?')}; device {data['machine']['device']} "
-            f"({data['machine']['platform']}). Date: {data.get('date', '?')}.\n"
+            f"({data['machine']['platform']}). Date: {data.get('date', '?')}; commit: "
+            f"{data.get('commit', 'not recorded')}.\n"
             f"- Command: `{data.get('command', '?')}` ({data.get('seconds', '?')} s).\n")
 
 
-def section_degrees(data):
+def provenance(data):
+    """Date, machine and commit of a part, as the page gives them."""
+    platform_text = data["machine"].get("platform", "")
+    pocl = re.search(r"PoCL \S+", platform_text)
+    runtime = pocl.group(0) if pocl else f"driver {data['machine'].get('driver', '?')}"
+    return (f"Date: {data.get('date', '?')}; machine: {data.get('cpu', '?')}, device {data['machine']['device']} "
+            f"({runtime}); commit: {data.get('commit', 'not recorded')}")
+
+
+def page_header(data, shared):
+    """The page's lines on when, where and how a part ran; the date, machine and commit only where the parts'
+    differ (`shared` is None), else they are said once for all."""
+    command = f"`{data.get('command', '?')}` ({data.get('seconds', '?')} s)"
+    if shared:
+        return [f"- Command: {command}"]
+    return [f"- {provenance(data)}", f"- Command: {command}"]
+
+
+def figure(name, prefix):
+    return f"[{name}.png]({prefix}{name}.png)"
+
+
+def section_degrees(data, figures="../figures/"):
     rows = data["rows"]
     out = ["### 1. Rays per second against degree", "", header(data),
            f"Seeded random surfaces of each degree in the unit sphere, {data['side']}x{data['side']} rays, median of "
-           f"{data['runs']} runs. Plot: `figures/rays_per_degree.png` (and `.svg`); build times: "
-           "`figures/build_per_degree.png`.", ""]
+           f"{data['runs']} runs. Plot: {figure('rays_per_degree', figures)} (and `.svg`); build times: "
+           f"{figure('build_per_degree', figures)}.", ""]
     degrees = sorted({r["degree"] for r in rows})
     for precision in ("float", "double", "mixed"):
         mine = [r for r in rows if r["precision"] == precision]
@@ -197,15 +230,8 @@ def section_degrees(data):
     return out
 
 
-def section_accuracy(data):
-    rows = data["rows"]
-    out = ["### 2. Accuracy against time", "", header(data),
-           f"Each surface at {data['width']}x{data['height']}, kernel ms median of {data['runs']} runs, errors "
-           "against solver_ref over the pixels it certifies (float and mixed against float rays, double against "
-           "double rays). Pareto fronts: `figures/accuracy_pareto.png` (and `.svg`).", "",
-           "Cheapest setting per surface that meets each accuracy line (no hit/miss disagreement beyond 0.1% of "
-           "certified pixels, and the stated maximum relative depth error):", "",
-           "| surface | error <= 1e-3 | error <= 1e-6 | error <= 1e-9 |", "|---|---|---|---|"]
+def cheapest_table(rows):
+    out = ["| surface | error <= 1e-3 | error <= 1e-6 | error <= 1e-9 |", "|---|---|---|---|"]
     for surface in dict.fromkeys(r["surface"] for r in rows):
         cells = []
         for line in (1e-3, 1e-6, 1e-9):
@@ -216,6 +242,18 @@ def section_accuracy(data):
             else:
                 cells.append("none")
         out.append(f"| {surface} | " + " | ".join(cells) + " |")
+    return out
+
+
+def section_accuracy(data, figures="../figures/"):
+    rows = data["rows"]
+    out = ["### 2. Accuracy against time", "", header(data),
+           f"Each surface at {data['width']}x{data['height']}, kernel ms median of {data['runs']} runs, errors "
+           "against solver_ref over the pixels it certifies (float and mixed against float rays, double against "
+           f"double rays). Pareto fronts: {figure('accuracy_pareto', figures)} (and `.svg`).", "",
+           "Cheapest setting per surface that meets each accuracy line (no hit/miss disagreement beyond 0.1% of "
+           "certified pixels, and the stated maximum relative depth error):", ""]
+    out += cheapest_table(rows)
     out.append("")
     out.append("What tightening the tolerance costs, per surface and precision, for the default method "
                "(bernstein/brent): kernel ms and max depth error at the loosest and the tightest tolerance.")
@@ -251,15 +289,17 @@ def section_accuracy(data):
     return out
 
 
-def section_fig2(data):
-    rows = data["rows"]
-    out = ["### 3. The paper's Fig. 2", "", header(data),
-           f"Preview mode at {data['width']}x{data['height']} with {data['supersampling']}x{data['supersampling']} "
+def fig2_about(data):
+    return (f"Preview mode at {data['width']}x{data['height']} with {data['supersampling']}x{data['supersampling']} "
            f"supersampling (the rays of a {data['width'] * data['supersampling']}x{data['height'] * data['supersampling']} "
            "image), double, tolerance 1e-6. \"paper\": the paper's solver (power basis around the eye, Descartes); "
            f"\"ours\": Bernstein over the extent. Kernel ms, median of {data['runs']} runs. The paper's times are whole "
-           "preview renders on a 1.1 GHz Celeron.", "",
-           "| surface | setup | bisection ms | regula falsi ms | Brent ms | spread (max/min - 1) | paper: Brent s, spread |",
+           "preview renders on a 1.1 GHz Celeron.")
+
+
+def fig2_table(data):
+    rows = data["rows"]
+    out = ["| surface | setup | bisection ms | regula falsi ms | Brent ms | spread (max/min - 1) | paper: Brent s, spread |",
            "|---|---|---|---|---|---|---|"]
     paper_spread = {"barth_sextic": (464, 457, 457), "cusp_catastrophe": (115, 114, 114), "torus": (258, 260, 255),
                     "tooth": (116, 115, 114), "lemniscate": (248, 247, 245), "tanglecube": (243, 241, 239)}
@@ -271,36 +311,99 @@ def section_fig2(data):
             p = paper_spread[surface]
             out.append(f"| {surface} | {setup} | " + " | ".join(f"{v:.0f}" for v in values) +
                        f" | {spread * 100:.1f}% | {p[2]} s, {(max(p) / min(p) - 1) * 100:.1f}% |")
-    out.append("")
     return out
 
 
-def section_decic(data):
+def fig2_page_table(data):
+    """Fig. 2 with one row per surface: each setup's three times and spread, and the paper's."""
     rows = data["rows"]
-    out = ["### 4. The paper's Barth decic experiment", "", header(data),
-           f"Barth decic at {data['width']}x{data['height']}, double, tolerance {data['tolerance']:g}, every method "
-           f"capped at {data['max_iterations']} iterations. A defect is a certified pixel where the method disagrees "
-           "with solver_ref on hit or miss, or whose root misses the requested accuracy (10x the stopping width "
-           "4 eps max(|t|, 1)). Images, defects in red, regula falsi | Brent | bisection: "
-           "`figures/decic_methods_paper.png` and `figures/decic_methods_ours.png`.", "",
-           "| setup | method | defects | of them wrong hit/miss | pixels at the iteration cap | kernel ms |",
+    out = ["| surface | paper's setup: bisection, regula falsi, Brent ms | spread | ours: bisection, regula falsi, Brent "
+           "ms | spread | the paper: Brent s, spread |", "|---|---|---|---|---|---|"]
+    for line in fig2_table(data)[2:]:
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        surface, setup = cells[0], cells[1]
+        if setup == "paper":
+            current = [surface, ", ".join(cells[2:5]), cells[5]]
+        else:
+            out.append("| " + " | ".join(current + [", ".join(cells[2:5]), cells[5], cells[6]]) + " |")
+    return out
+
+
+def section_fig2(data):
+    return ["### 3. The paper's Fig. 2", "", header(data), fig2_about(data), ""] + fig2_table(data) + [""]
+
+
+def decic_about(data, figures):
+    return (f"Barth decic at {data['width']}x{data['height']}, double, tolerance {data['tolerance']:g}, every method "
+            f"capped at {data['max_iterations']} iterations. A defect is a certified pixel where the method disagrees "
+            "with solver_ref on hit or miss, or whose root misses the requested accuracy (10x the stopping width "
+            "4 eps max(|t|, 1)). Images, defects in red, regula falsi | Brent | bisection: "
+            f"{figure('decic_methods_paper', figures)} and {figure('decic_methods_ours', figures)}.")
+
+
+def decic_table(data):
+    out = ["| setup | method | defects | of them wrong hit/miss | pixels at the iteration cap | kernel ms |",
            "|---|---|---|---|---|---|"]
-    for r in rows:
+    for r in data["rows"]:
         out.append(f"| {r['setup']} | {r['refinement']} | {r['defects']} | {r['wrong_hit_miss']} | "
                    f"{r['at_iteration_cap']} | {r['kernel_ms']:.0f} |")
-    out.append("")
     return out
 
 
-def write_results(sections):
-    path = ROOT / "bench" / "RESULTS.md"
-    text = path.read_text() if path.exists() else "# Benchmark results\n"
-    body = "\n".join([BEGIN, "## Solvers: what accuracy costs (issue 4)", ""] + sections + [END])
-    if BEGIN in text and END in text:
-        text = text[:text.index(BEGIN)] + body + text[text.index(END) + len(END):]
-    else:
-        text = text.rstrip() + "\n\n" + body + "\n"
-    path.write_text(text)
+def section_decic(data, figures="../figures/"):
+    return ["### 4. The paper's Barth decic experiment", "", header(data), decic_about(data, figures), ""] + \
+        decic_table(data) + [""]
+
+
+def page_degrees(data, shared):
+    """The page's part of the per-degree run: PAGE_PRECISION's rays/s for PAGE_METHODS at PAGE_DEGREES."""
+    rows = [r for r in data["rows"] if r["precision"] == PAGE_PRECISION]
+    degrees = [d for d in PAGE_DEGREES if any(r["degree"] == d for r in rows)]
+    methods = [m for m in PAGE_METHODS if any(method(r) == m for r in rows)]
+    out = ["### Rays per second against degree", ""] + page_header(data, shared) + [
+        f"- Seeded random surfaces of each degree in the unit sphere, {data['side']}x{data['side']} rays, median of "
+        f"{data['runs']} runs, every pair of isolation and refinement in float, double and mixed: "
+        f"{figure('rays_per_degree', 'figures/')}; program build times: {figure('build_per_degree', 'figures/')}. "
+        f"Below, million rays/s in {PAGE_PRECISION} with Brent's refinement after each isolation.", "",
+        "| method | " + " | ".join(str(d) for d in degrees) + " |", "|---|" + "---|" * len(degrees)]
+    for m in methods:
+        cells = []
+        for d in degrees:
+            r = [x for x in rows if method(x) == m and x["degree"] == d]
+            cells.append(f"{r[0]['rays_per_s'] / 1e6:.2f}" if r else "")
+        out.append(f"| {m} | " + " | ".join(cells) + " |")
+    return out + [""]
+
+
+def page_accuracy(data, shared):
+    return ["### Accuracy against time", ""] + page_header(data, shared) + [
+        f"- Each surface at {data['width']}x{data['height']}, kernel ms median of {data['runs']} runs, errors against "
+        "solver_ref over the pixels it certifies; Pareto fronts of every run: "
+        f"{figure('accuracy_pareto', 'figures/')}. Below, the cheapest setting per surface that meets each accuracy "
+        "line (no hit/miss disagreement beyond 0.1% of certified pixels, and the stated maximum relative depth "
+        "error).", ""] + cheapest_table(data["rows"]) + [""]
+
+
+def page_fig2(data, shared):
+    return ["### The paper's Fig. 2", ""] + page_header(data, shared) + ["- " + fig2_about(data), ""] + \
+        fig2_page_table(data) + [""]
+
+
+def page_decic(data, shared):
+    return ["### The paper's Barth decic experiment", ""] + page_header(data, shared) + \
+        ["- " + decic_about(data, "figures/"), ""] + decic_table(data) + [""]
+
+
+def write_results(page, full, shared):
+    """The page's section in place in bench/RESULTS.md; every table in bench/results/solvers.md."""
+    FULL.write_text("\n".join([
+        "# Solvers: every table", "",
+        "Written by `bench/solvers.py` from bench/results/{degrees,accuracy,fig2,decic}.json; the short tables are in "
+        "[../RESULTS.md](../RESULTS.md#solvers-what-accuracy-costs).", ""] + full).rstrip("\n") + "\n")
+    body = [HEADING, "",
+            "solver_bench's four parts, each isolation and refinement in float, double and mixed. Every table in full: "
+            "[bench/results/solvers.md](results/solvers.md).", ""] + ([f"- {shared}", ""] if shared else []) + page
+    replace_section(RESULTS_MD, HEADING, "\n".join(body).rstrip("\n") + "\n")
 
 
 def main():
@@ -310,6 +413,7 @@ def main():
     ap.add_argument("--device", help="device index or name substring")
     ap.add_argument("--binary", default=str(ROOT / "build" / "bench" / "solver_bench"))
     ap.add_argument("--plot-only", action="store_true", help="redraw from bench/results without running")
+    ap.add_argument("--no-plots", action="store_true", help="write the tables only, without redrawing the figures")
     args = ap.parse_args()
 
     RESULTS.mkdir(parents=True, exist_ok=True)
@@ -318,25 +422,36 @@ def main():
         for part in args.only or PARTS:
             run_part(args.binary, part, args.quick, args.device, dict(os.environ))
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = None
+    if not args.no_plots:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
 
-    sections = []
-    writers = {"degrees": (plot_degrees, section_degrees), "accuracy": (plot_accuracy, section_accuracy),
-               "fig2": (None, section_fig2), "decic": (None, section_decic)}
+    page, full = [], []
+    writers = {"degrees": (plot_degrees, page_degrees, section_degrees),
+               "accuracy": (plot_accuracy, page_accuracy, section_accuracy),
+               "fig2": (None, page_fig2, section_fig2), "decic": (None, page_decic, section_decic)}
+    parts = {}
     for part in PARTS:
         path = RESULTS / f"{part}.json"
-        if not path.exists():
-            continue
-        data = json.loads(path.read_text())
-        plot, section = writers[part]
-        if plot:
-            plot(data[part], plt)
-        data[part].update({k: data[k] for k in ("machine", "cpu", "date", "command", "seconds") if k in data})
-        sections += section(data[part])
-    write_results(sections)
-    print("solvers: wrote bench/RESULTS.md and bench/figures/", file=sys.stderr)
+        if path.exists():
+            data = json.loads(path.read_text())
+            data[part].update({k: data[k] for k in ("machine", "cpu", "date", "command", "seconds", "commit")
+                               if k in data})
+            parts[part] = data[part]
+    # The parts' date, machine and commit, said once on the page where they all agree.
+    said = {provenance(d) for d in parts.values()}
+    shared = said.pop() if len(said) == 1 else None
+    for part, data in parts.items():
+        plot, short, section = writers[part]
+        if plot and plt:
+            plot(data, plt)
+        page += short(data, shared)
+        full += section(data)
+    write_results(page, full, shared)
+    print("solvers: wrote bench/RESULTS.md, bench/results/solvers.md" + ("" if args.no_plots else " and bench/figures/"),
+          file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -3,7 +3,8 @@
 during a scripted 10-second orbit whose frames are 512x512 previews (the page renders half its 1024x1024 size
 while the input moves). The page reports both: its frame counter and its per-frame latencies.
 
-Writes its section of bench/RESULTS.md. Usage: python3 bench/view_fps.py [--seconds S] [--scenes NAME ...]"""
+Writes its section of bench/RESULTS.md ("algray view: frames per second"), with the date, machine, commit and
+command. Usage: python3 bench/view_fps.py [--seconds S] [--scenes NAME ...]"""
 import argparse
 import datetime
 import statistics
@@ -13,9 +14,9 @@ import sys
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
 
-from bench_common import ROOT, machine, replace_section
+from bench_common import ROOT, command_line, commit, machine, replace_section
 
-HEADING = "## algray view: frames per second in the browser (issue 19)"
+HEADING = "## algray view: frames per second"
 
 ORBIT = """
 const seconds = arguments[0], done = arguments[arguments.length - 1];
@@ -68,9 +69,9 @@ def main():
         fps, latency, n = measure(args.binary, ROOT / "scenes" / f"{name}.toml", args.seconds)
         rows.append((name, fps, latency, n))
         print(f"{name}: {fps:.1f} fps, median latency {latency:.0f} ms over {n} frames", file=sys.stderr)
-    command = "python3 bench/view_fps.py " + " ".join(sys.argv[1:])
     lines = [HEADING, "", f"- Date: {datetime.date.today().isoformat()}", f"- Machine: {machine()}",
-             f"- Command: `{command.strip()}` (headless Chromium on the same 2 cores as the server)", "",
+             f"- Commit: {commit(args.binary)}",
+             f"- Command: `{command_line()}` (headless Chromium on the same machine as the server)", "",
              f"A scripted {args.seconds:g}-second orbit (the eye turned 0.02 rad every 16 ms), frames 512x512 in "
              "preview; fps is frames shown per second, latency the median time from an input to the frame that "
              "includes it. Targets: 15 fps on the sextic, 6 on the decic, latency under 150 ms.", "",
