@@ -384,7 +384,7 @@ typedef struct {
  * REALs that are exact for these dyadic numbers, so that all the state is in vector registers: (level, idx) is
  * (-log2 width, left end / width).
  * A halving, a recomputation from `root` and a copy of the cached sibling each cost every lane, so this pays
- * where neighbouring rays take similar searches (bench/RESULTS.md, "Lock-step lanes"). Mixed precision keeps
+ * where neighbouring rays take similar searches (bench/history/2026-12.md, "Lock-step lanes"). Mixed precision keeps
  * the scalar search per lane. */
 
 /* Sign changes between consecutive nonzero coefficients, per lane, as sign_variations counts them (a NaN counts

@@ -137,8 +137,8 @@ ALGRAY_INLINE REAL inner_smallest_magnitude(const REAL* c) {
  * noise is REAL_EPS * max(ALGRAY_DOUBT_FACTOR * DEGREE * max |b_k|, ALGRAY_TERMS_FACTOR * terms), b the segment's
  * coefficients and terms the size of the terms they were summed from (RayTerms in restrict.h): de Casteljau's
  * convex combinations add no more than that, so it bounds every subinterval's coefficients too. The factors were
- * measured on the scenes and tests/data/hard_surfaces at 160x120 against solver_ref (bench/RESULTS.md, "Adaptive
- * precision"): at 1 and 1 the worst depth error was 7e-6 and the Barth decic doubted 17% of its camera rays; at
+ * measured on the scenes and tests/data/hard_surfaces at 160x120 against solver_ref
+ * (bench/history/2026-12.md, "Adaptive precision"): at 1 and 1 the worst depth error was 7e-6 and the Barth decic doubted 17% of its camera rays; at
  * 0.5 and 0.25, 4e-5 and 10%; without the terms (max |b_k| alone) a Kummer shell ray's root was 1e-3 off. */
 #ifndef ALGRAY_DOUBT_FACTOR
 #define ALGRAY_DOUBT_FACTOR 0.5f

@@ -1,4 +1,4 @@
-/* Camera rays and their clipping to the extent; the README's camera convention, as the kernels compute it. */
+/* Camera rays and their clipping to the extent; docs/outputs.md's camera convention, as the kernels compute it. */
 #ifndef ALGRAY_RAY_H
 #define ALGRAY_RAY_H
 

@@ -512,7 +512,7 @@ void finish_surface(SurfaceHit* h, SegmentRoot root) {
  * Measured on the decic at 1024x768: 61% fewer camera rays traced again (bench/RESULTS.md). Where float's
  * rounding is still too large (surfaces whose monomials cancel by orders of magnitude, such as Chebyshev sums),
  * P is evaluated again in float-float, whose rounding is float's squared: over the lanes together, that costs less
- * than the second pass even in double (bench/RESULTS.md, "Flat roots confirmed in float-float"). */
+ * than the second pass even in double (bench/history/2026-12.md, "Flat roots confirmed in float-float"). */
 #if ALGRAY_ESCALATE
 /* P at q from the monomials (the power tables of axis_powers, restrict.h), and a bound on its rounding: the
  * products, the sum, and the rounding of q's coordinates and of the coefficients, each of at most REAL_EPS / 2

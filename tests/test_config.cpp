@@ -172,7 +172,7 @@ TEST_CASE("the surface in unit coordinates vanishes where the world surface does
   CHECK(glm::length(half) == Approx(1.0));
 }
 
-TEST_CASE("the ray basis follows the README's convention", "[config]") {
+TEST_CASE("the ray basis follows docs/outputs.md's convention", "[config]") {
   CameraSpec cam;
   cam.eye = {0, 0, 5};
   cam.look_at = {0, 0, 0};

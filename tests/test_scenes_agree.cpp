@@ -41,7 +41,7 @@ struct Vec {
 };
 Vec at(const Vec& o, const Vec& d, Real t) { return {o.x + t * d.x, o.y + t * d.y, o.z + t * d.z}; }
 
-// The README's ray convention, evaluated in the kernel's precision R, each operation rounded, no fused ops.
+// docs/outputs.md's ray convention, evaluated in the kernel's precision R, each operation rounded, no fused ops.
 template <typename R>
 void rebuild_ray(const RayBasis& b, int px, int py, Vec& o, Vec& d) {
   const R fx = static_cast<R>(px) + R(0.5), fy = static_cast<R>(py) + R(0.5);

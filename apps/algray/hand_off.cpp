@@ -1,7 +1,7 @@
 // `algray` hands `algray view` and runs under an MPI launcher to algray-full, which links cpp-httplib and Open MPI.
 // Linked into every run, their 14 libraries load and relocate at each start, and every symbol PoCL's LLVM and
 // clang look up when the device opens passes them first: 1-3 ms of a 1024^2 preview's 100-150, 3.6 ms of its CPU
-// time (bench/RESULTS.md, "Two binaries").
+// time (bench/history/2026-12.md, "Two binaries").
 #include "hand_off.h"
 
 #include <unistd.h>

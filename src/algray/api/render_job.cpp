@@ -42,7 +42,7 @@ std::string vec_text(const glm::dvec3& v) {
   return buf;
 }
 
-// Metadata that lets anyone rebuild any pixel's ray from the file and the README's camera convention.
+// Metadata that lets anyone rebuild any pixel's ray from the file and docs/outputs.md's camera convention.
 void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, const DeviceInfo& device) {
   const RayBasis& b = r.basis;
   std::string devices = device.name + " (" + device.platform_name + ", " + device.driver_version + ")";

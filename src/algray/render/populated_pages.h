@@ -12,7 +12,7 @@ namespace algray {
 // took to load from the disk cache. 4 KB pages on purpose (MADV_NOHUGEPAGE, whatever the system's default):
 // transparent huge pages populate 4x faster back to back, but on a VM that hands free memory back to its host
 // (Firecracker here) a fresh process's 2 MB pages are often host-faulted, and a 1024^2 preview at a user's pace
-// took 242 ms against 167 (bench/RESULTS.md, "Transparent huge pages: tried").
+// took 242 ms against 167 (bench/history/2026-12.md, "Transparent huge pages: tried").
 class PopulatedPages {
  public:
   explicit PopulatedPages(std::size_t bytes);

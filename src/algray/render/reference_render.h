@@ -65,7 +65,7 @@ struct RayCertificate {
 RayCertificate certify_ray(const Polynomial& polynomial, const std::vector<Monomial>& monomials, const Extent& extent,
                            const PixelRay& ray, Precision ray_precision);
 
-// Rays are rebuilt in `ray_precision` exactly as the kernels build them (README convention), and P is the
+// Rays are rebuilt in `ray_precision` exactly as the kernels build them (docs/outputs.md's convention), and P is the
 // scene's exact polynomial. threads = 0 uses every core.
 ReferenceResult render_reference(const Scene& scene, Precision ray_precision, unsigned threads = 0);
 

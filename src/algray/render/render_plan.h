@@ -78,7 +78,7 @@ struct RenderPlan {
   // The device buffers together (one tile's and one batch's), the film, and the peak memory of the whole render
   // on the host: a base for the process and the OpenCL runtime, the film, one tile's work on the host and on
   // the device (which on a CPU is host memory too), and the writers' strips. Checked against peak RSS by
-  // bench/memory.py (bench/RESULTS.md, "Memory: tile by tile"); kept on the generous side.
+  // bench/memory.py (bench/history/2026-12.md, "Memory: tile by tile"); kept on the generous side.
   std::uint64_t buffer_bytes() const;
   std::uint64_t film_bytes() const;
   std::uint64_t estimated_memory_bytes() const;
@@ -99,7 +99,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
 // Whether RayOrigin::Auto means the screen form for camera rays: in double, with the camera outside the extent,
 // facing its centre. Measured to keep the double line at every degree; in float it found the wrong sheet on the
 // Chebyshev nonic and the Roman surface (depth errors 0.15 and 0.08), so float keeps the extent construction
-// (bench/RESULTS.md, "The screen form").
+// (bench/history/2026-12.md, "The screen form").
 bool screen_form_applies(const Scene& scene, Precision precision);
 
 // Whether RayOrigin::Auto means the point form for a shadow kernel (kernels/point_form.h: P expanded once about

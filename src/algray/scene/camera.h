@@ -28,7 +28,7 @@ struct RayBasis {
 RayBasis make_ray_basis(const CameraSpec& camera, int width, int height);
 
 // The ray of pixel (px, py) exactly as a kernel of the given precision computes it: the basis rounded to that
-// precision, then each product and sum rounded in the README's order. The result is that ray's exact value.
+// precision, then each product and sum rounded in docs/outputs.md's order. The result is that ray's exact value.
 struct PixelRay {
   glm::dvec3 origin, direction;
 };
