@@ -76,19 +76,9 @@ Isolation isolation_none(void) {
   return iso;
 }
 
-/* Adaptive kernels built with -D ALGRAY_SETTLE_DOUBTS=1 (KernelConfig::settle_doubts, where the second pass runs
- * in float-float) settle more of what they would doubt: shadow kernels by within_noise_at here and
- * sampled_sign_change in shadow.h, the others by discard_settled in bernstein.h. */
-#ifndef ALGRAY_SETTLE_DOUBTS
-#define ALGRAY_SETTLE_DOUBTS 0
-#endif
-
-/* Shadow kernels define ALGRAY_SHADOW_RAYS. Their rays start off the surface on purpose (the shadow offset), so
- * P's value at their start, however small, is no sign of a root: the coefficient c_0 of an interval starting
- * there (lo == 0) does not count. And they ask only whether there is a root, not where. */
-#ifndef ALGRAY_SHADOW_RAYS
-#define ALGRAY_SHADOW_RAYS 0
-#endif
+/* Shadow kernels define ALGRAY_SHADOW_RAYS (build_switches.h). Their rays start off the surface on purpose (the
+ * shadow offset), so P's value at their start, however small, is no sign of a root: the coefficient c_0 of an
+ * interval starting there (lo == 0) does not count. And they ask only whether there is a root, not where. */
 ALGRAY_INLINE int first_counted(REAL lo) { return ALGRAY_SHADOW_RAYS && lo == 0; }
 
 /* The largest and the smallest |c_k|, by a tree of compares: fmin and fmax chains compiled to a dependent chain
@@ -140,12 +130,6 @@ ALGRAY_INLINE REAL inner_smallest_magnitude(const REAL* c) {
  * measured on the scenes and tests/data/hard_surfaces at 160x120 against solver_ref
  * (bench/history/2026-12.md, "Adaptive precision"): at 1 and 1 the worst depth error was 7e-6 and the Barth decic doubted 17% of its camera rays; at
  * 0.5 and 0.25, 4e-5 and 10%; without the terms (max |b_k| alone) a Kummer shell ray's root was 1e-3 off. */
-#ifndef ALGRAY_DOUBT_FACTOR
-#define ALGRAY_DOUBT_FACTOR 0.5f
-#endif
-#ifndef ALGRAY_TERMS_FACTOR
-#define ALGRAY_TERMS_FACTOR 0.25f
-#endif
 /* The noise for coefficients of largest size `scale` summed from terms of size `terms`: for REALs and lanes alike. */
 #define DOUBT_NOISE(scale, terms) \
   (REAL_EPS * fmax((REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * (scale), (REAL)ALGRAY_TERMS_FACTOR * (terms)))
@@ -212,9 +196,6 @@ REAL local_scale(const REAL* c, REAL lo, REAL hi) {
  * of roots at 512x384 (which needed 1.25), and from 4 on neither it nor the Barth decic differed from double
  * anywhere (tests/test_reference_agree); 16 keeps 4 times that margin. On shadow rays, factor 0 (no doubt near
  * the start) answers certified rays wrongly and 1 does not (tests/test_shadows). */
-#ifndef ALGRAY_LOCAL_FACTOR
-#define ALGRAY_LOCAL_FACTOR 16
-#endif
 REAL local_noise(const REAL* c, REAL scale, RayTerms* terms, REAL lo, REAL hi) {
   return (REAL)ALGRAY_LOCAL_FACTOR * DOUBT_NOISE(fmin(scale, local_scale(c, lo, hi)), ray_terms_local(terms, lo, hi));
 }

@@ -14,10 +14,6 @@
  *
  * LMASK is what a comparison of LREALs gives: 0 or 1 for scalars, 0 or -1 (all bits) per lane for vectors. So
  * masks combine with !, && and ||, never ~, and count with LANE_SEL((LMASK)0, (LMASK)1, m). */
-#ifndef LANES
-#define LANES 1
-#endif
-
 #if LANES == 1
 typedef REAL LREAL;
 typedef int LMASK;

@@ -5,10 +5,6 @@
 #include "algray_shared.h"
 #include "real.h"
 
-#ifndef ALGRAY_PROBE
-#define ALGRAY_PROBE 0
-#endif
-
 /* The hooks are macros, and the log travels as an extra trailing parameter (PROBE_PARAM / PROBE_ARG), so that a
  * render build contains no trace of them: the probe runs the render's solver code with the recording added, and
  * nothing it records is computed unless it is recording. */

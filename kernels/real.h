@@ -2,16 +2,7 @@
 #ifndef ALGRAY_REAL_H
 #define ALGRAY_REAL_H
 
-#ifndef ALGRAY_ESCALATE
-#define ALGRAY_ESCALATE 0 /* 1: float that marks the rays it cannot decide (adaptive precision; isolation.h) */
-#endif
-#if ALGRAY_ESCALATE && (ALGRAY_DOUBLE || ALGRAY_COMPENSATED)
-#error "ALGRAY_ESCALATE is a plain float build"
-#endif
-
-#ifndef ALGRAY_COMPENSATED
-#define ALGRAY_COMPENSATED 0 /* 1: float, but P*(t) built in compensated (float-float) arithmetic */
-#endif
+#include "build_switches.h"
 
 #if ALGRAY_DOUBLE
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
@@ -39,22 +30,12 @@ typedef float16 REAL16;
 #endif
 
 /* The kernel is specialised by degree; everything sized by it lives in private arrays. */
-#ifndef DEGREE
-#error "DEGREE must be defined (-D DEGREE=n, 1..32)"
-#endif
 #define NCOEF (DEGREE + 1)
 
 /* The polynomial loops run over DEGREE + 1 coefficients, a compile-time constant: fully unrolled and inlined
  * they keep the coefficients in registers (measured: 30% fewer instructions in the restriction). */
 #define ALGRAY_UNROLL _Pragma("unroll")
 #define ALGRAY_INLINE inline __attribute__((always_inline))
-
-#ifndef TOLERANCE
-#define TOLERANCE 1e-9
-#endif
-#ifndef MAX_ITERATIONS
-#define MAX_ITERATIONS 100
-#endif
 
 /* The paper's stopping width: a root is located once its bracket is at most 4*eps*max(|t|, 1) wide in t; of one t
  * or of lanes (lanes.h). */

@@ -5,9 +5,8 @@
 #include "algray_shared.h"
 #include "real.h"
 
-#ifndef RESTRICT_BERNSTEIN
+/* Which basis the restriction builds: Bernstein for Bernstein isolation, the power basis for the others. */
 #define RESTRICT_BERNSTEIN (ISOLATION == ALGRAY_ISOLATION_BERNSTEIN)
-#endif
 
 /* Every coordinate along the ray is a linear polynomial in s. Multiplying by linear factors and adding
  * constants builds P*(s) from the monomial list by a sparse, homogeneous Horner scheme.
@@ -393,13 +392,10 @@ typedef REAL Acc;
 #define acc_store(out, out_lo, c) ((void)(out_lo), poly_copy(out, c))
 #endif
 
-/* How many rays restrict_to_rays expands side by side: -D RESTRICT_RAYS=n before this header, 1 by default.
+/* How many rays restrict_to_rays expands side by side: RESTRICT_RAYS (build_switches.h; the entry file sets it).
  * One ray's Horner scheme is a chain of dependent vector operations, so a core waits on their latency; the
  * rays of a batch share the walk over the monomials and interleave their chains. Every ray gets exactly the
  * operations it would get alone. */
-#ifndef RESTRICT_RAYS
-#define RESTRICT_RAYS 1
-#endif
 
 /* One accumulator per ray of the batch. */
 typedef Acc RayAccs[RESTRICT_RAYS][ACC_SLOTS];

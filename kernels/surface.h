@@ -8,9 +8,6 @@
 #include "ray.h"
 #include "real.h"
 
-#ifndef RAY_ORIGIN
-#define RAY_ORIGIN ALGRAY_ORIGIN_EXTENT
-#endif
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EYE && ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
 #error "RAY_ORIGIN=eye needs a power-basis isolation method"
 #endif

@@ -1,8 +1,14 @@
 // Host pieces that need no device: kernel configuration keys, precision choice, tiles, cameras, unit coordinates.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <random>
+#include <regex>
 #include <set>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "algray/device/kernel_config.h"
 #include "algray/device/kernel_sources.h"
@@ -210,4 +216,40 @@ TEST_CASE("kernel sources resolve their includes from the embedded files", "[con
   const auto power_branch = source.find("#elif ISOLATION == ALGRAY_ISOLATION_POWER");
   REQUIRE(power_branch != std::string::npos);
   CHECK(source.find("int sign_variations(", power_branch) != std::string::npos);
+}
+
+// The -D switches: declared once, in kernels/build_switches.h, and the host writes exactly those of its host part.
+TEST_CASE("every build switch is declared once, and the host writes each one it owns", "[config]") {
+  const auto read = [](const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+  };
+  // `#ifndef NAME` followed by `#define NAME`: a default (include guards, ALGRAY_*_H, define no value after).
+  const std::regex default_of(R"(#ifndef ([A-Z_][A-Z0-9_]*)\s*\n#define \1 \S)");
+  const std::string header = read(ALGRAY_SOURCE_DIR "/kernels/build_switches.h");
+  const auto host_end = header.find("---- From the entry file");
+  REQUIRE(host_end != std::string::npos);
+  std::set<std::string> host_declared;
+  for (auto it = std::sregex_iterator(header.begin(), header.end(), default_of); it != std::sregex_iterator(); ++it)
+    if (static_cast<std::size_t>(it->position()) < host_end) host_declared.insert((*it)[1]);
+  // DEGREE has no default, only a required value.
+  CHECK(header.find("#ifndef DEGREE\n#error") != std::string::npos);
+  host_declared.insert("DEGREE");
+  const std::vector<std::string> written = build_switch_names();
+  CHECK(std::set<std::string>(written.begin(), written.end()) == host_declared);
+  KernelConfig config;
+  config.degree = 7;
+  for (const std::string& name : written) {
+    INFO(name);
+    CHECK(config.build_options().find(" -D " + name + "=") != std::string::npos);
+  }
+  // No other kernel file defaults a switch, declared there or not.
+  for (const auto& entry : std::filesystem::directory_iterator(ALGRAY_SOURCE_DIR "/kernels")) {
+    if (entry.path().filename() == "build_switches.h") continue;
+    const std::string text = read(entry.path());
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), default_of); it != std::sregex_iterator(); ++it)
+      FAIL_CHECK(entry.path().filename().string() << " defaults " << (*it)[1] << " outside build_switches.h");
+  }
 }

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "kernels/algray_shared.h"
 
@@ -42,6 +44,34 @@ std::string hex_double(double v) {
   return buf;
 }
 
+// Every -D switch the host sets, in the order the options name them, and its value for a config. Each is declared
+// once, with its default, legal values and meaning, in kernels/build_switches.h (test_config holds the two lists
+// to each other); the host writes every one on every build, so no kernel default decides a render.
+struct BuildSwitch {
+  const char* name;
+  std::string (*value)(const KernelConfig&);
+};
+std::string flag(bool on) { return on ? "1" : "0"; }
+const BuildSwitch kBuildSwitches[] = {
+    {"DEGREE", [](const KernelConfig& c) { return std::to_string(c.degree); }},
+    {"ALGRAY_DOUBLE", [](const KernelConfig& c) { return flag(c.precision == Precision::Double); }},
+    {"ALGRAY_COMPENSATED", [](const KernelConfig& c) { return flag(c.precision == Precision::Mixed); }},
+    {"ALGRAY_ESCALATE", [](const KernelConfig& c) { return flag(c.precision == Precision::Adaptive); }},
+    {"ISOLATION", [](const KernelConfig& c) { return std::to_string(kernel_id(kIsolationIds, c.isolation)); }},
+    {"REFINEMENT", [](const KernelConfig& c) { return std::to_string(kernel_id(kRefinementIds, c.refinement)); }},
+    {"RAY_ORIGIN", [](const KernelConfig& c) { return std::to_string(kernel_id(kOriginIds, c.ray_origin)); }},
+    // Hexadecimal literals carry the tolerance bit for bit; float builds get a float literal, as devices without
+    // fp64 need not accept double constants.
+    {"TOLERANCE",
+     [](const KernelConfig& c) {
+       return c.precision == Precision::Double ? hex_double(c.tolerance)
+                                               : hex_double(static_cast<float>(c.tolerance)) + "f";
+     }},
+    {"MAX_ITERATIONS", [](const KernelConfig& c) { return std::to_string(c.max_iterations); }},
+    {"LANES", [](const KernelConfig& c) { return std::to_string(c.lanes); }},
+    {"ALGRAY_SETTLE_DOUBTS", [](const KernelConfig& c) { return flag(c.settle_doubts); }},
+};
+
 }  // namespace
 
 int default_lanes(const std::string& device_type) { return device_type == "CPU" ? 16 : 1; }
@@ -53,24 +83,17 @@ bool lanes_apply(const KernelConfig& c) {
 }
 
 std::string KernelConfig::build_options() const {
-  const int isolation_id = kernel_id(kIsolationIds, isolation);
-  const int refinement_id = kernel_id(kRefinementIds, refinement);
-  const int origin_id = kernel_id(kOriginIds, ray_origin);
-  // Hexadecimal literals carry the tolerance bit for bit; float builds get a float literal, as devices
-  // without fp64 need not accept double constants.
-  const std::string tolerance_literal =
-      precision == Precision::Double ? hex_double(tolerance) : hex_double(static_cast<float>(tolerance)) + "f";
-  return "-cl-std=CL1.2 -D DEGREE=" + std::to_string(degree) +
-         " -D ALGRAY_DOUBLE=" + (precision == Precision::Double ? "1" : "0") +
-         " -D ALGRAY_COMPENSATED=" + (precision == Precision::Mixed ? "1" : "0") +
-         " -D ALGRAY_ESCALATE=" + (precision == Precision::Adaptive ? "1" : "0") +
-         " -D ISOLATION=" + std::to_string(isolation_id) + " -D REFINEMENT=" + std::to_string(refinement_id) +
-         " -D RAY_ORIGIN=" + std::to_string(origin_id) + " -D TOLERANCE=" + tolerance_literal +
-         " -D MAX_ITERATIONS=" + std::to_string(max_iterations) + " -D LANES=" + std::to_string(lanes) +
-         (settle_doubts ? " -D ALGRAY_SETTLE_DOUBTS=1" : "") +
-         // PoCL prints its compiler's warning count ("4 warnings generated.") straight to stderr on a cold cache;
-         // a successful command says nothing, and a failed build still reports its errors and log.
-         " -w";
+  std::string options = "-cl-std=CL1.2";
+  for (const BuildSwitch& s : kBuildSwitches) options += std::string(" -D ") + s.name + "=" + s.value(*this);
+  // PoCL prints its compiler's warning count ("4 warnings generated.") straight to stderr on a cold cache; a
+  // successful command says nothing, and a failed build still reports its errors and log.
+  return options + " -w";
+}
+
+std::vector<std::string> build_switch_names() {
+  std::vector<std::string> names;
+  for (const BuildSwitch& s : kBuildSwitches) names.emplace_back(s.name);
+  return names;
 }
 
 std::string KernelConfig::key() const {

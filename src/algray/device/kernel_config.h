@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "algray/scene/solver_options.h"
 
@@ -18,6 +19,9 @@ bool lanes_apply(const KernelConfig& config);
 // take: at 16 its pass took 1.5 times as long on the Barth sextic and decic (bench/RESULTS.md).
 constexpr int kMaxShadowLanes = 8;
 int shadow_lanes(int lanes);
+
+// The -D switches build_options() writes, in its order; kernels/build_switches.h declares each one.
+std::vector<std::string> build_switch_names();
 
 struct KernelConfig {
   std::string entry = "primary";  // kernel file (without .cl) and kernel function
