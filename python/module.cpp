@@ -69,6 +69,20 @@ void call_python(F&& f) {
 PYBIND11_MODULE(_algray, m) {
   m.doc() = "algray: ray tracing of real algebraic surfaces on any OpenCL device (compiled part)";
   m.attr("__version__") = api::version();
+  // The library's warnings (a kernel cache that cannot be used) to sys.stderr, where a notebook shows them.
+  api::set_warning_handler([](const std::string& text) {
+    if (!Py_IsInitialized()) return;
+    py::gil_scoped_acquire gil;
+    PyObject* pending_type = nullptr;
+    PyObject* pending_value = nullptr;
+    PyObject* pending_trace = nullptr;
+    PyErr_Fetch(&pending_type, &pending_value, &pending_trace);  // a Ctrl-C waiting to be raised stays pending
+    try {
+      py::module_::import("sys").attr("stderr").attr("write")(text);
+    } catch (py::error_already_set&) {
+    }
+    PyErr_Restore(pending_type, pending_value, pending_trace);
+  });
 
   // Exceptions: SceneError carries where the input went wrong.
   static py::exception<api::SceneError> scene_error(m, "SceneError", PyExc_ValueError);
@@ -215,12 +229,14 @@ PYBIND11_MODULE(_algray, m) {
                 });
               };
             if (message) settings.on_message = [&](const std::string& text) { call_python([&] { message(text); }); };
+            // Ctrl-C (or a callback's exception) stops the batch before its next frame, as render stops before
+            // its next tile; the error is raised once the batch has stopped.
+            settings.cancelled = python_interrupted;
             api::BatchResult result;
             {
               py::gil_scoped_release released;
               result = r.batch(settings);
             }
-            // A callback's exception ends nothing early in a batch (frames are not cancelled), but is raised now.
             if (PyErr_Occurred()) throw py::error_already_set();
             switch (result) {
               case api::BatchResult::Done:

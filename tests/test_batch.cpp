@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <map>
+#include <sstream>
 
 #include "cli_sandbox.h"
 #include "algray/io/image_io.h"
@@ -356,4 +357,104 @@ TEST_CASE("a shard comes from --shard or the Slurm array's variables, and a bad 
   CHECK(frames == std::vector<int>{1, 4});  // grow 1 and 4: numbers 1 and 4
   REQUIRE(box.run("batch jobs.toml --shard 0/2").exit_code == 0);
   CHECK(fs::exists(box.work / "jobs.log.shard-0-of-2.jsonl"));
+}
+
+TEST_CASE("--resume after a torn last log line starts its entries on a line of their own, and says so",
+          "[batch][cli]") {
+  Sandbox box;
+  write_text(box.work / "ball.toml", kBall);
+  write_text(box.work / "jobs.toml",
+             "[[job]]\nscene = \"ball.toml\"\noutput = \"t_{frame}.png\"\n"
+             "set = { image = { width = 8, height = 8 } }\n"
+             "sweep.r = { from = 0.5, to = 1, steps = 3 }\n");
+  REQUIRE(box.run("batch jobs.toml").exit_code == 0);
+  // A kill (or a full disk) in the middle of the last append: half its line, no newline.
+  const fs::path log_path = box.work / "jobs.log.jsonl";
+  const std::string whole = read_text(log_path);
+  const std::size_t last_start = whole.rfind('\n', whole.size() - 2) + 1;
+  const std::string torn = whole.substr(0, last_start + (whole.size() - last_start) / 2);
+  write_text(log_path, torn);
+  fs::remove(box.work / "t_2.png");
+  const Result r = box.run("batch jobs.toml --resume");
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK_THAT(r.err, Catch::Contains("jobs.log.jsonl:3: the last entry is torn"));
+  const std::string after = read_text(log_path);
+  REQUIRE(after.compare(0, torn.size(), torn) == 0);  // the torn line is left as it was
+  std::vector<std::string> lines;
+  std::istringstream in(after.substr(torn.size()));
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  // A newline that ends the torn line, then one whole entry per frame of this run.
+  REQUIRE(lines.size() == 4);
+  CHECK(lines[0].empty());
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    INFO("new line " << i << ": " << lines[i]);
+    const nlohmann::json entry = nlohmann::json::parse(lines[i], nullptr, false);
+    REQUIRE(entry.is_object());
+    CHECK(entry["frame"] == static_cast<int>(i - 1));
+    CHECK(entry["status"] == (i == 3 ? "ok" : "skipped"));
+  }
+}
+
+TEST_CASE("--merge-logs refuses mixed shard counts, reports conflicts and keeps a log it did not write",
+          "[batch][cli][shard]") {
+  Sandbox box;
+  write_text(box.work / "ball.toml", kBall);
+  write_text(box.work / "jobs.toml",
+             "[[job]]\nname = \"m\"\nscene = \"ball.toml\"\noutput = \"m_{frame}.png\"\n"
+             "set = { image = { width = 8, height = 8 } }\n"
+             "sweep.r = { from = 0.5, to = 1, steps = 5 }\n");
+  REQUIRE(box.run("batch jobs.toml").exit_code == 0);
+  // The shard logs of a 3-way run made from the whole run's entries, and a stale 0-of-2 beside them whose entry
+  // for frame 2 says it failed.
+  const fs::path whole_log = box.work / "jobs.log.jsonl";
+  const std::string history = read_text(whole_log) + read_text(whole_log);  // as after a --resume
+  const std::vector<nlohmann::json> entries = read_log(whole_log);
+  REQUIRE(entries.size() == 5);
+  std::string shard_text[3], stale_text;
+  for (int frame = 0; frame < 5; ++frame) {
+    shard_text[frame % 3] += entries[static_cast<std::size_t>(frame)].dump() + "\n";
+    if (frame % 2 == 0) {
+      nlohmann::json e = entries[static_cast<std::size_t>(frame)];
+      if (frame == 2) e["status"] = "failed";
+      stale_text += e.dump() + "\n";
+    }
+  }
+  for (int k = 0; k < 3; ++k)
+    write_text(box.work / ("jobs.log.shard-" + std::to_string(k) + "-of-3.jsonl"), shard_text[k]);
+  write_text(box.work / "jobs.log.shard-0-of-2.jsonl", stale_text);
+  write_text(whole_log, history);
+
+  const Result refused = box.run("batch jobs.toml --merge-logs");
+  INFO(refused.err);
+  CHECK(refused.exit_code == 2);
+  for (const char* name : {"jobs.log.shard-0-of-2.jsonl", "jobs.log.shard-0-of-3.jsonl", "jobs.log.shard-1-of-3.jsonl",
+                           "jobs.log.shard-2-of-3.jsonl"})
+    CHECK_THAT(refused.err, Catch::Contains(name));
+  CHECK_THAT(refused.err, Catch::Contains("different shard counts"));
+  CHECK(read_text(whole_log) == history);  // nothing written
+
+  const Result mixed = box.run("batch jobs.toml --merge-logs --mixed-shard-counts");
+  INFO(mixed.err);
+  CHECK(mixed.exit_code == 0);
+  CHECK_THAT(mixed.err, Catch::Contains("conflicting shard logs: job m frame 2: "));
+  CHECK_THAT(mixed.err, Catch::Contains("failed in jobs.log.shard-0-of-2.jsonl:2"));
+  CHECK_THAT(mixed.err, Catch::Contains("1 in conflict"));
+  const std::vector<nlohmann::json> merged = read_log(whole_log);
+  REQUIRE(merged.size() == 5);
+  for (int frame = 0; frame < 5; ++frame) {
+    INFO("frame " << frame);
+    CHECK(merged[static_cast<std::size_t>(frame)]["frame"] == frame);
+    CHECK(merged[static_cast<std::size_t>(frame)]["status"] == "ok");
+    CHECK(merged[static_cast<std::size_t>(frame)].contains("merged_from"));
+  }
+  // The run's own log, --resume history and all, is kept beside the merge rather than replaced.
+  const fs::path kept = box.work / "jobs.log.before-merge.jsonl";
+  REQUIRE(fs::exists(kept));
+  CHECK(read_text(kept) == history);
+  CHECK_THAT(mixed.err, Catch::Contains("kept as jobs.log.before-merge.jsonl"));
+  // A log the merge wrote is its own: merging again replaces it and keeps nothing more.
+  REQUIRE(box.run("batch jobs.toml --merge-logs --mixed-shard-counts").exit_code == 0);
+  CHECK_FALSE(fs::exists(box.work / "jobs.log.before-merge-1.jsonl"));
+  CHECK(read_log(whole_log).size() == 5);
 }

@@ -1,4 +1,5 @@
 // Hostile input, full disks, damaged caches: each a failure once found in algray, now an error or a render.
+#include <algray/algray.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -11,6 +12,8 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -18,8 +21,10 @@
 #include "algray/io/image_io.h"
 #include "algray/scene/expression.h"
 #include "algray/util/host_memory.h"
+#include "algray/util/json_text.h"
 #include "cli_sandbox.h"
 #include "scene_fixtures.h"
+#include "test_seed.h"
 
 namespace fs = std::filesystem;
 using namespace algray::testing;
@@ -60,6 +65,27 @@ void write_ball_sweep(const Sandbox& box, const std::string& range) {
              "set = { image = { width = 8, height = 8 } }\nsweep.r = { " +
                  range + ", steps = 3 }\n");
 }
+
+// The bytes that hex_bytes wrote: two hex digits each.
+std::string from_hex(const std::string& hex) {
+  std::string out;
+  for (std::size_t i = 0; i + 1 < hex.size(); i += 2)
+    out += static_cast<char>(std::stoi(hex.substr(i, 2), nullptr, 16));
+  return out;
+}
+
+bool ends_with(const std::string& text, const std::string& tail) {
+  return text.size() >= tail.size() && text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+std::size_t occurrences(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// Bytes Linux allows in a file name and UTF-8 does not: a Latin-1 "café", a lone continuation byte, 0xff.
+const std::string kNotUtf8 = "caf\xe9_\x80\xff";
 
 }  // namespace
 
@@ -470,5 +496,118 @@ TEST_CASE("what the one-hour fuzz runs found is refused with a located error", "
   } catch (const algray::SceneError& e) {
     CHECK(e.where == "jobs.toml:5:9");
     CHECK_THAT(e.message, Catch::Contains("unknown placeholder {$name}"));
+  }
+}
+
+TEST_CASE("file names that are not UTF-8 go into every JSON exactly, and no JSON write fails on them",
+          "[reliability][output]") {
+  require_device();
+  Sandbox box;
+  box.cache = box.root / ("cache_" + kNotUtf8);
+  SECTION("batch: the log and the stats of every frame") {
+    write_ball_sweep(box, "from = 0.5, to = 1");
+    const Result r = box.run("batch jobs.toml --stats b.json");
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    std::istringstream log(read_text(box.work / "jobs.log.jsonl"));
+    int lines = 0;
+    for (std::string line; std::getline(log, line); ++lines) {
+      INFO(line);
+      const nlohmann::json entry = nlohmann::json::parse(line);
+      CHECK(entry["status"] == "ok");
+      CHECK(from_hex(entry["stats"]["cache_bytes"].get<std::string>()) == box.cache.string());
+      CHECK_THAT(entry["stats"]["cache"].get<std::string>(), Catch::Contains("cache_caf\xEF\xBF\xBD_"));
+    }
+    CHECK(lines == 3);
+    CHECK(box.stats("b.json")["frames"]["ok"] == 3);
+  }
+  SECTION("render --stats: the scene, the outputs and the cache") {
+    const std::string scene = "ball_" + kNotUtf8 + ".toml", image = "out_" + kNotUtf8 + ".png";
+    write_text(box.work / scene, kBall);
+    const Result r = box.run("render " + quoted(scene) + " " + kTiny + " -o " + quoted(image) + " --stats s.json");
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(fs::exists(box.work / image));
+    const nlohmann::json stats = box.stats();
+    CHECK(ends_with(from_hex(stats["scene_bytes"].get<std::string>()), scene));
+    REQUIRE(stats["outputs_bytes"].size() == 1);
+    CHECK(ends_with(from_hex(stats["outputs_bytes"][0].get<std::string>()), image));
+    CHECK(from_hex(stats["cache_bytes"].get<std::string>()) == box.cache.string());
+  }
+  SECTION("the API's stats_json, which `algray view` answers each frame with") {
+    const fs::path scene = box.in / ("ball_" + kNotUtf8 + ".toml");
+    write_text(scene, kBall);
+    // The library reads its cache directory from the environment, as the view server's does.
+    const char* given = std::getenv("ALGRAY_CACHE_DIR");
+    const std::optional<std::string> before = given ? std::optional<std::string>(given) : std::nullopt;
+    ::setenv("ALGRAY_CACHE_DIR", box.cache.c_str(), 1);
+    struct Restore {
+      const std::optional<std::string>& value;
+      ~Restore() { value ? ::setenv("ALGRAY_CACHE_DIR", value->c_str(), 1) : ::unsetenv("ALGRAY_CACHE_DIR"); }
+    } restore{before};
+    algray::api::RenderSettings settings;
+    settings.width = 16;
+    settings.height = 12;
+    settings.preview = true;
+    const algray::api::Image image = algray::api::Renderer().render(algray::api::Scene::load(scene.string()), settings);
+    const nlohmann::json stats = nlohmann::json::parse(image.stats_json());
+    CHECK(from_hex(stats["scene_bytes"].get<std::string>()) == scene.string());
+    CHECK(from_hex(stats["cache_bytes"].get<std::string>()) == box.cache.string());
+  }
+}
+
+TEST_CASE("a cache directory that cannot be used is named once per process, with the reason", "[reliability][cache]") {
+  require_device();
+  Sandbox box;
+  write_ball_sweep(box, "from = 0.5, to = 1");
+  const fs::path file = box.root / "a_file";
+  write_text(file, "where the cache directory should be");
+  for (const fs::path& cache : {file, file / "below"}) {
+    DYNAMIC_SECTION(cache.filename().string()) {
+      box.cache = cache;
+      const Result r = box.run("batch jobs.toml");  // three frames, each storing its programs
+      INFO(r.err);
+      REQUIRE(r.exit_code == 0);
+      CHECK(occurrences(r.err, "the kernel cache " + cache.string() + " cannot be used (") == 1);
+      CHECK(occurrences(r.err, "cannot be used") == 1);
+      CHECK(read_text(file) == "where the cache directory should be");  // and it was left alone
+    }
+  }
+}
+
+TEST_CASE("text from outside is UTF-8 exactly when nlohmann would write it, and JSON of any bytes is written",
+          "[reliability][output]") {
+  const unsigned seed = fresh_test_seed();
+  std::mt19937 rng(seed);
+  // Bytes weighted towards the ones UTF-8's rules are about: lead bytes, continuations, E0/ED/F0/F4's edges.
+  const std::vector<unsigned char> interesting = {0x00, 0x41, 0x7f, 0x80, 0x8f, 0x90, 0x9f, 0xa0, 0xbf, 0xc0,
+                                                  0xc1, 0xc2, 0xdf, 0xe0, 0xed, 0xef, 0xf0, 0xf4, 0xf5, 0xff};
+  std::uniform_int_distribution<int> length(0, 8), pick(0, 2 * static_cast<int>(interesting.size()) - 1);
+  for (int c = 0; c < 20000; ++c) {
+    std::string text;
+    for (int n = length(rng); n > 0; --n) {
+      const int k = pick(rng);
+      text += static_cast<char>(k < static_cast<int>(interesting.size()) ? interesting[static_cast<std::size_t>(k)]
+                                                                         : rng() & 0xff);
+    }
+    bool strict_ok = true;
+    try {
+      (void)nlohmann::json(text).dump();
+    } catch (const nlohmann::json::type_error&) {
+      strict_ok = false;
+    }
+    const nlohmann::json object = [&] {
+      nlohmann::json o;
+      algray::put_path(o, "path", text);
+      return o;
+    }();
+    INFO("seed " << seed << " (ALGRAY_TEST_SEED), case " << c << ": bytes " << algray::hex_bytes(text));
+    REQUIRE(algray::is_utf8(text) == strict_ok);
+    REQUIRE(algray::is_utf8(algray::utf8_for_json(text)));
+    const nlohmann::json back = nlohmann::json::parse(object.dump());  // dump() itself must not throw now
+    REQUIRE(back.contains("path_bytes") == !strict_ok);
+    if (strict_ok) REQUIRE(back["path"] == text);
+    if (!strict_ok) REQUIRE(from_hex(back["path_bytes"].get<std::string>()) == text);
+    REQUIRE_NOTHROW(algray::dump_json(nlohmann::json{{"raw", text}}));
   }
 }

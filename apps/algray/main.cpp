@@ -14,6 +14,7 @@
 #include "algray/cluster/mpi_batch.h"
 #include "algray/cluster/mpi_world.h"
 #endif
+#include "algray/device/program_cache.h"
 #include "algray/io/image_io.h"
 #include "algray/render/solver_aov.h"
 #include "algray/scene/solver_options.h"
@@ -290,6 +291,9 @@ struct BatchCommand {
     cmd->add_flag("--merge-logs", merge_logs,
                   "render nothing: join the shard logs (<log>.shard-K-of-N) into the batch's log and report "
                   "frames that no shard rendered");
+    cmd->add_flag("--mixed-shard-counts", request.merge_mixed_counts,
+                  "with --merge-logs: join shard logs of different shard counts too (refused by default: one count "
+                  "is a stale run)");
   }
 
   int run() {
@@ -372,6 +376,7 @@ struct ViewCommand {
 
 int main(int argc, char** argv) {
   install_output_cleanup_handlers();
+  set_cache_warning_handler([](const std::string& text) { std::cerr << text << std::flush; });
 
   CLI::App app{"algray: ray tracing of real algebraic surfaces P(x,y,z) = 0 on any OpenCL device"};
   app.set_version_flag("--version", version_string(), "print the version and the git revision, and exit");

@@ -1,5 +1,6 @@
 // `algray probe`: one ray's report and plot from the parsed request, failures to exit codes.
 #include "algray/io/image_io.h"
+#include "algray/util/json_text.h"
 #include "commands.h"
 #include "exit_codes.h"
 
@@ -33,8 +34,9 @@ int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
     const std::vector<SurfaceProbe> probes = probe_scene(scene, req.target, req.all_solvers, context);
     if (req.json || req.stats_path) {
       const nlohmann::json j = probe_json(scene, req.target, probes);
-      if (req.json) out << j.dump(2) << "\n";
-      if (req.stats_path) writer.write(*req.stats_path, [&] { write_text_file(*req.stats_path, j.dump(2) + "\n"); });
+      if (req.json) out << dump_json(j, 2) << "\n";
+      if (req.stats_path)
+        writer.write(*req.stats_path, [&] { write_text_file(*req.stats_path, dump_json(j, 2) + "\n"); });
     }
     if (!req.json) print_probe(out, scene, req.target, probes);
     if (req.plot_path) {

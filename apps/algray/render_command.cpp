@@ -6,6 +6,7 @@
 #include "algray/device/cl_runtime.h"
 #include "algray/device/fp64_speed.h"
 #include "algray/io/image_io.h"
+#include "algray/util/json_text.h"
 #include "algray/util/version.h"
 #ifdef ALGRAY_WITH_MPI
 #include "algray/cluster/mpi_render.h"
@@ -202,7 +203,7 @@ int run_devices(const std::string& stats_path, std::ostream& out, std::ostream& 
          {"max_alloc_bytes", d.max_alloc_bytes}});
   try {
     check_output_writable(stats_path);
-    write_text_file(stats_path, j.dump(2) + "\n");
+    write_text_file(stats_path, dump_json(j, 2) + "\n");
   } catch (const std::exception& e) {
     return report_error(e, err);
   }

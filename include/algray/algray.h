@@ -28,6 +28,10 @@ namespace algray::api {
 // "algray 0.1.0 (git abc1234)": the release and the revision the library was built from.
 std::string version();
 
+// Where the library's warnings about the process as a whole go, each one or more lines ending in a newline: so
+// far, a kernel cache directory that cannot be used (said once per directory). Unset, they are dropped.
+void set_warning_handler(std::function<void(const std::string&)> handler);
+
 // Bad scene input. `file`, `line` and `column` say where (line and column are 0 where the input has none, as
 // for a --set key or a missing file); `message` says what, `excerpt` shows the line with a caret under the
 // column. what() is the whole text the command line prints.
@@ -103,7 +107,7 @@ struct Progress {
 };
 
 struct RenderSettings {
-  int width = 0, height = 0;  // 0: the scene's image size
+  int width = 0, height = 0;  // 0: the scene's image size; negative is refused (SceneError)
   bool preview = false;       // the paper's preview mode: no shadows (render.preview)
   std::string precision;      // "float", "double", "mixed" or "auto"; empty: the scene's
   // Solver channels: "iterations", "isolation", "classification", "flags" (the command line's --aov).
@@ -163,6 +167,8 @@ struct BatchSettings {
   int shard_index = 0, shard_count = 1;
   std::function<void(const BatchFrame&)> on_frame;
   std::function<void(const std::string&)> on_message;  // warnings and failures, one or more lines each
+  // Asked before each frame; true stops the batch there, which returns Stopped (the frames done are logged).
+  std::function<bool()> cancelled;
 };
 
 enum class BatchResult { Done, FramesFailed, BadInput, Stopped };

@@ -152,6 +152,37 @@ def test_a_batch_of_scenes_and_a_jobs_file(renderer, tmp_path):
         renderer.batch(str(tmp_path / "sweep.toml"), shard=(2, 2))
 
 
+def test_ctrl_c_stops_a_jobs_file_batch_between_frames_and_resume_finishes_it(renderer, tmp_path):
+    (tmp_path / "ball.toml").write_text('[surface]\nequation = "x^2+y^2+z^2-1"\n[extent]\nradius = 2\n'
+                                        "[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n")
+    (tmp_path / "jobs.toml").write_text('[defaults]\nset = { image = { width = 16, height = 12 } }\n[[job]]\n'
+                                        'name = "s"\nscene = "ball.toml"\noutput = "s_{frame}.png"\n'
+                                        "frames = 12\norbit = { degrees = 90 }\n")
+    frames = []
+
+    def interrupt_after_second_frame(frame):
+        frames.append(frame)
+        if len(frames) == 2:
+            signal.raise_signal(signal.SIGINT)  # what Ctrl-C does: Python's handler runs at the next check
+
+    with pytest.raises(KeyboardInterrupt):
+        renderer.batch(str(tmp_path / "jobs.toml"), progress=interrupt_after_second_frame)
+    assert len(frames) == 2, [f["frame"] for f in frames]  # stopped before the third frame, not after the last
+    assert sorted(p.name for p in tmp_path.glob("s_*.png")) == ["s_0.png", "s_1.png"]
+    assert renderer.batch(str(tmp_path / "jobs.toml"), resume=True) == "done"
+    assert len(list(tmp_path.glob("s_*.png"))) == 12
+
+
+def test_a_negative_image_size_is_refused(renderer):
+    scene = algray.Scene.load(TORUS)
+    for size in ({"width": -1}, {"height": -16}, {"width": -32, "height": 24}):
+        with pytest.raises(algray.SceneError, match="an image size is positive"):
+            renderer.render(scene, preview=True, **size)
+    with pytest.raises(algray.SceneError, match="width"):
+        renderer.batch([scene], width=-1, preview=True)
+    assert renderer.render(scene, width=8, height=0, preview=True).width == 8  # 0 still keeps the scene's
+
+
 def test_the_gil_is_released_while_rendering(renderer):
     scene = algray.Scene.load(TORUS)
     renderer.render(scene, width=16, height=16, preview=True)  # the program built before timing

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
@@ -22,6 +23,7 @@
 #include "algray/io/image_io.h"
 #include "algray/api/render_job.h"
 #include "algray/scene/toml_reader.h"
+#include "algray/util/json_text.h"
 #include "algray/util/version.h"
 
 namespace algray {
@@ -229,13 +231,20 @@ class JsonLinesLog {
     using std::runtime_error::runtime_error;
   };
 
-  JsonLinesLog(const std::string& path, bool append)
-      : path_(path), out_(path, append ? std::ios::app : std::ios::trunc) {
+  JsonLinesLog(const std::string& path, bool append) : path_(path) {
+    // A run killed mid-line (or a disk that filled) leaves a last line with no newline; appending to it would
+    // glue the next entry on and lose both as JSON. The torn line stays, for whoever wants to look at it, and
+    // the new entries start on a line of their own.
+    if (append) torn_line_ = torn_last_line(path);
+    out_.open(path, append ? std::ios::app : std::ios::trunc);
     if (!out_) throw OutputError("cannot write the batch log " + path);
+    if (torn_line_) out_ << "\n";
   }
+  // The number of the last line, where it was torn (no newline) before this run appended.
+  std::optional<int> torn_line() const { return torn_line_; }
   void write(const nlohmann::json& j) {
     errno = 0;
-    out_ << j.dump() << "\n";
+    out_ << dump_json(j) << "\n";
     out_.flush();
     if (!out_)
       throw WriteFailed("cannot write the batch log " + path_ + ": " +
@@ -243,8 +252,20 @@ class JsonLinesLog {
   }
 
  private:
+  static std::optional<int> torn_last_line(const std::string& path) {
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    if (!in || in.tellg() <= 0) return std::nullopt;
+    in.seekg(-1, std::ios::end);
+    char last = '\n';
+    if (!in.get(last) || last == '\n') return std::nullopt;
+    in.seekg(0);
+    const auto newlines = std::count(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>(), '\n');
+    return static_cast<int>(newlines) + 1;
+  }
+
   std::string path_;
   std::ofstream out_;
+  std::optional<int> torn_line_;
 };
 
 }  // namespace
@@ -528,19 +549,19 @@ class FrameRenderer {
     FrameReport report;
     report.number = number;
     nlohmann::json& entry = report.entry;
-    entry = {{"version", version_string()}, {"job", job.name}, {"frame", frame}, {"frames", job.frames},
-             {"scene", job.scene}};
+    entry = {{"version", version_string()}, {"job", job.name}, {"frame", frame}, {"frames", job.frames}};
+    put_path(entry, "scene", job.scene);
     if (req_.shard) entry["shard"] = shard_text(*req_.shard);
     try {
       std::vector<std::string> outputs;
       for (const std::string& o : job.outputs) outputs.push_back(expand_pattern(o, job, frame));
       std::optional<std::string> stats;
       if (job.stats) stats = expand_pattern(*job.stats, job, frame);
-      entry["outputs"] = outputs;
+      put_paths(entry, "outputs", outputs);
       std::vector<Override> overrides = frame_overrides(job, frame);
       overrides.insert(overrides.end(), req_.overrides.begin(), req_.overrides.end());
       nlohmann::json set = nlohmann::json::object();
-      for (const Override& o : overrides) set[o.key] = o.value;
+      for (const Override& o : overrides) set[utf8_for_json(o.key)] = utf8_for_json(o.value);
       entry["set"] = set;
       const bool complete =
           std::all_of(outputs.begin(), outputs.end(), file_exists) && (!stats || file_exists(*stats));
@@ -566,14 +587,14 @@ class FrameRenderer {
     } catch (const DeviceError& e) {
       report.message = std::string("algray: ") + e.what() + "\n";
       entry["status"] = "failed";
-      entry["error"] = e.what();
+      entry["error"] = utf8_for_json(e.what());
       report.device_lost = true;
       return report;
     } catch (const std::exception& e) {
       const std::string why = describe_error(e).text;
       report.message = "algray: job " + job.name + " frame " + std::to_string(frame) + " failed:\n" + why;
       entry["status"] = "failed";
-      entry["error"] = why;
+      entry["error"] = utf8_for_json(why);
     }
     entry["ms"] = ms_since(start);
     return report;
@@ -613,7 +634,12 @@ struct BatchRecorder::State {
   std::vector<bool> warned;
 
   State(const BatchRequest& r, const BatchPlan& p, const BatchCallbacks& c)
-      : req(r), plan(p), callbacks(c), log(p.log_path, r.resume), tallies(p.jobs.size()), warned(p.jobs.size()) {}
+      : req(r), plan(p), callbacks(c), log(p.log_path, r.resume), tallies(p.jobs.size()), warned(p.jobs.size()) {
+    if (const std::optional<int> torn = log.torn_line())
+      message("algray: warning: " + p.log_path + ":" + std::to_string(*torn) +
+              ": the last entry is torn (no newline: an earlier run stopped mid-write); it is left as it is and "
+              "the new entries start on the next line\n");
+  }
 };
 
 BatchRecorder::BatchRecorder(const BatchRequest& request, const BatchPlan& plan, const BatchCallbacks& callbacks)
@@ -622,6 +648,16 @@ BatchRecorder::BatchRecorder(const BatchRequest& request, const BatchPlan& plan,
 BatchRecorder::~BatchRecorder() = default;
 
 bool BatchRecorder::stopped() const { return state_->stopped; }
+
+bool BatchRecorder::cancel_requested() {
+  State& s = *state_;
+  if (s.stopped) return true;
+  if (!s.callbacks.cancelled || !s.callbacks.cancelled()) return false;
+  s.message("algray: cancelled after " + std::to_string(s.done) + " of " + std::to_string(s.plan.total_frames) +
+            " frames; --resume continues where the images end\n");
+  s.stopped = true;
+  return true;
+}
 
 void BatchRecorder::record(const FrameReport& report) {
   State& s = *state_;
@@ -680,17 +716,17 @@ BatchOutcome BatchRecorder::finish(int renderers) {
   const int total = s.plan.total_frames;
   nlohmann::json summary_jobs = nlohmann::json::array();
   for (std::size_t j = 0; j < s.plan.jobs.size(); ++j) summary_jobs.push_back(s.tallies[j].json(s.plan.jobs[j]));
-  const nlohmann::json summary = {
+  nlohmann::json summary = {
       {"version", version_string()},
-      {"jobs_file", s.req.jobs_path},
-      {"log", s.plan.log_path},
       {"shard", s.req.shard ? nlohmann::json(shard_text(*s.req.shard)) : nlohmann::json()},
       {"frames", {{"total", total}, {"ok", s.ok}, {"failed", s.failed}, {"skipped", s.skipped}}},
       {"jobs", summary_jobs},
       {"total_ms", ms_since(s.start)}};
+  put_path(summary, "jobs_file", s.req.jobs_path);
+  put_path(summary, "log", s.plan.log_path);
   if (s.plan.stats_path) {
     try {
-      write_text_file(*s.plan.stats_path, summary.dump(2) + "\n");
+      write_text_file(*s.plan.stats_path, dump_json(summary, 2) + "\n");
     } catch (const std::exception& e) {
       // After the frames: a failure to write, not bad input.
       s.message(std::string("algray: the frames are done, but the batch stats were not written: ") + e.what() +
@@ -724,7 +760,7 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks,
         : req_(req), plan_(plan), recorder_(recorder) {}
     std::optional<int> next_frame() override {
       while (next_ < plan_.numbered_frames && !in_shard(req_, next_)) ++next_;
-      if (next_ >= plan_.numbered_frames || recorder_.stopped()) return std::nullopt;
+      if (next_ >= plan_.numbered_frames || recorder_.cancel_requested()) return std::nullopt;
       return next_++;
     }
     void finished(FrameReport report) override { recorder_.record(report); }
@@ -738,6 +774,34 @@ BatchOutcome run_batch(const BatchRequest& req, const BatchCallbacks& callbacks,
   render_dealt_frames(req, plan, context, own);
   return recorder->finish(1);
 }
+
+namespace {
+
+// Moves aside a log at `path` that a merge did not write (some line lacks "merged_from"), to the first free
+// <stem>.before-merge[-N]<ext>, and returns that name; "" where there is none or it is a merge's own.
+std::string keep_unmerged_log(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return "";
+  bool ours = true;
+  for (std::string line; ours && std::getline(in, line);) {
+    if (line.empty()) continue;
+    const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+    ours = j.is_object() && j.contains("merged_from");
+  }
+  in.close();
+  if (ours) return "";
+  const fs::path p(path);
+  for (int n = 0; n < 1000; ++n) {
+    const std::string suffix = n ? "-" + std::to_string(n) : "";
+    const fs::path aside = p.parent_path() / (p.stem().string() + ".before-merge" + suffix + p.extension().string());
+    if (fs::exists(aside)) continue;
+    fs::rename(p, aside);
+    return aside.string();
+  }
+  throw OutputError("cannot keep " + path + " aside: every " + p.stem().string() + ".before-merge-N name is taken");
+}
+
+}  // namespace
 
 BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& callbacks) {
   const BatchReporter message{callbacks};
@@ -755,36 +819,72 @@ BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& cal
   const auto literal = [](const std::string& text) {
     return std::regex_replace(text, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)");
   };
-  const std::regex shard_name(literal(log.stem().string()) + R"(\.shard-[0-9]+-of-[0-9]+)" +
+  const std::regex shard_name(literal(log.stem().string()) + R"(\.shard-[0-9]+-of-([0-9]+))" +
                               literal(log.extension().string()));
   std::vector<fs::path> shard_logs;
+  std::map<std::string, std::vector<std::string>> by_count;  // shard count -> its logs' names
   std::error_code ec;
-  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
-    if (std::regex_match(e.path().filename().string(), shard_name)) shard_logs.push_back(e.path());
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    std::smatch m;
+    if (!std::regex_match(name, m, shard_name)) continue;
+    shard_logs.push_back(log.parent_path() / name);  // named as the batch's log is, without a "./"
+    by_count[m[1].str()].push_back(name);
+  }
   std::sort(shard_logs.begin(), shard_logs.end());
   if (shard_logs.empty()) {
     message("algray: no shard logs beside " + plan.log_path + " (" + log.stem().string() + ".shard-K-of-N" +
             log.extension().string() + "): nothing to merge\n");
     return BatchOutcome::BadInput;
   }
-  // Each frame's last entry: a later line of a shard's log is a later attempt (--resume appends).
-  std::map<std::pair<std::string, int>, nlohmann::json> last;
+  // Two shard counts side by side are two runs, one of them stale: which frames came from which is the user's
+  // call, not ours.
+  if (by_count.size() > 1 && !req.merge_mixed_counts) {
+    std::string counts;
+    for (auto& [count, names] : by_count) {
+      std::sort(names.begin(), names.end());
+      counts += "\n  " + count + " shards: ";
+      for (std::size_t i = 0; i < names.size(); ++i) counts += (i ? ", " : "") + names[i];
+    }
+    message("algray: the shard logs beside " + plan.log_path + " are of different shard counts:" + counts +
+            "\nalgray: remove the stale ones, or pass --mixed-shard-counts to merge them all; nothing merged\n");
+    return BatchOutcome::BadInput;
+  }
+  // Each frame's last entry: a later line of a shard's log is a later attempt (--resume appends). Across logs, a
+  // frame one shard rendered and another failed is a conflict: reported, and the rendered one kept.
+  struct Kept {
+    nlohmann::json entry;
+    std::string where;  // file:line
+    std::string file;
+  };
+  std::map<std::pair<std::string, int>, Kept> last;
+  std::vector<std::string> conflicts;
   for (const fs::path& p : shard_logs) {
     std::ifstream in(p);
     int line_number = 0;
     for (std::string line; std::getline(in, line);) {
       ++line_number;
+      const std::string where = p.string() + ":" + std::to_string(line_number);
       try {
         nlohmann::json j = nlohmann::json::parse(line);
-        // The key before the move: json's assignment takes its argument by value, evaluated first.
         std::pair<std::string, int> key{j.at("job").get<std::string>(), j.at("frame").get<int>()};
-        last[std::move(key)] = std::move(j);
+        const auto it = last.find(key);
+        if (it != last.end() && it->second.file != p.string()) {
+          const std::string was = it->second.entry.value("status", ""), now = j.value("status", "");
+          if ((was == "ok" && now == "failed") || (was == "failed" && now == "ok")) {
+            conflicts.push_back("job " + key.first + " frame " + std::to_string(key.second) + ": " + was + " in " +
+                                it->second.where + ", " + now + " in " + where + "; the ok entry is kept");
+            if (now == "failed") continue;
+          }
+        }
+        put_path(j, "merged_from", p.filename());
+        last[std::move(key)] = Kept{std::move(j), where, p.string()};
       } catch (const std::exception& e) {
-        message("algray: warning: " + p.string() + ":" + std::to_string(line_number) + ": not a log entry (" +
-                e.what() + "), ignored\n");
+        message("algray: warning: " + where + ": not a log entry (" + e.what() + "), ignored\n");
       }
     }
   }
+  for (const std::string& c : conflicts) message("algray: warning: conflicting shard logs: " + c + "\n");
   std::string merged;
   int missing = 0, failed = 0, total = 0;
   std::string missing_names;
@@ -795,18 +895,24 @@ BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& cal
         if (missing++ < 10) missing_names += (missing_names.empty() ? "" : ", ") + job.name + "/" + std::to_string(frame);
         continue;
       }
-      failed += it->second.value("status", "") == "failed";
-      merged += it->second.dump() + "\n";
+      failed += it->second.entry.value("status", "") == "failed";
+      merged += dump_json(it->second.entry) + "\n";
     }
+  std::string kept_as;
   try {
+    kept_as = keep_unmerged_log(plan.log_path);
     write_text_file(plan.log_path, merged);
   } catch (const std::exception& e) {
     message(describe_error(e).text);
     return BatchOutcome::Stopped;
   }
+  if (!kept_as.empty())
+    message("algray: " + plan.log_path + " held entries that no merge wrote (a run's log and its --resume " +
+            "history); it is kept as " + kept_as + "\n");
   message("algray: merged " + std::to_string(shard_logs.size()) + " shard logs into " + plan.log_path + ": " +
           std::to_string(total) + " frames, " + std::to_string(failed) + " failed, " + std::to_string(missing) +
-          " in no log" + (missing ? " (" + missing_names + (missing > 10 ? ", ..." : "") + ")" : "") + "\n");
+          " in no log" + (missing ? " (" + missing_names + (missing > 10 ? ", ..." : "") + ")" : "") +
+          (conflicts.empty() ? "" : ", " + std::to_string(conflicts.size()) + " in conflict") + "\n");
   return missing || failed ? BatchOutcome::FramesFailed : BatchOutcome::Done;
 }
 

@@ -91,6 +91,8 @@ struct BatchRequest {
   std::optional<std::string> stats_path;  // a summary of the whole batch
   // Only this share of the frames; the log and the stats become the shard's own (shard_file).
   std::optional<BatchShard> shard;
+  // --merge-logs only: join shard logs of different shard counts too (by default refused: one count is a stale run).
+  bool merge_mixed_counts = false;
   // Runs the batch in place of this process alone, from the same request and callbacks: set by the command line
   // under an MPI launcher (cluster/mpi_batch.h), which sits above this layer. run_batch calls it when set.
   std::function<BatchOutcome(const BatchRequest&, const BatchCallbacks&)> distribute;
@@ -109,10 +111,17 @@ struct BatchCallbacks {
   std::function<void(const BatchProgress&)> on_frame;
   // Lines for the person running the batch: warnings and failures, each ending in a newline.
   std::function<void(const std::string&)> on_message;
+  // Asked before each frame; true stops the batch there (Stopped), as RenderCallbacks::cancelled stops a render
+  // before a tile. A frame under way is finished and logged, so --resume picks up after it.
+  std::function<bool()> cancelled;
 };
 
-// Joins the shard logs of a batch (shard_file of its log, any shard count) into its log: each frame's last entry,
-// in job and frame order. Frames no shard rendered or skipped are reported (FramesFailed), as is a bad jobs file.
+// Joins the shard logs of a batch (shard_file of its log) into its log: each frame's last entry, in job and frame
+// order, each with the shard log it came from ("merged_from"). Frames no shard rendered or skipped are reported
+// (FramesFailed), as is a bad jobs file. Logs of different shard counts are refused (BadInput, nothing written)
+// unless request.merge_mixed_counts; a frame logged ok by one shard and failed by another is reported, and the ok
+// entry kept. An existing log that holds entries no merge wrote (an unsharded run's, with its --resume history) is
+// kept under a new name, never replaced.
 BatchOutcome merge_shard_logs(const BatchRequest& request, const BatchCallbacks& callbacks);
 
 // Runs every frame of every job, in order, on one device with one program cache. A failing frame is reported
@@ -170,8 +179,11 @@ class BatchRecorder {
   BatchRecorder& operator=(const BatchRecorder&) = delete;
 
   void record(const FrameReport& report);
-  // The log could not be written: the batch stops, and no later report is recorded.
+  // The log could not be written, or the callbacks cancelled the batch: it stops, and no later report is
+  // recorded.
   bool stopped() const;
+  // Asks the callbacks' `cancelled`; when it says stop, says so once and stops the batch. Between frames.
+  bool cancel_requested();
   // The outcome once every renderer is done, the summary written and the failures counted. `renderers` of them
   // rendered: when every one lost its device, the batch ends as a device that cannot be opened does.
   BatchOutcome finish(int renderers);

@@ -16,6 +16,7 @@
 #include "algray/render/escalation.h"
 #include "algray/render/render_plan.h"
 #include "algray/render/renderer.h"
+#include "algray/util/json_text.h"
 #include "algray/util/version.h"
 #include "solver_ref/solver_ref.h"
 
@@ -427,7 +428,8 @@ void print_probe(std::ostream& out, const Scene& scene, const ProbeTarget& targe
 }
 
 nlohmann::json probe_json(const Scene& scene, const ProbeTarget& target, const std::vector<SurfaceProbe>& probes) {
-  nlohmann::json j = {{"version", version_string()}, {"scene", scene.source}, {"name", scene.name}};
+  nlohmann::json j = {{"version", version_string()}, {"name", utf8_for_json(scene.name)}};
+  put_path(j, "scene", scene.source);
   if (target.given_ray)
     j["ray"] = {{"origin", {target.origin.x, target.origin.y, target.origin.z}},
                 {"direction", {target.direction.x, target.direction.y, target.direction.z}}};
@@ -438,8 +440,8 @@ nlohmann::json probe_json(const Scene& scene, const ProbeTarget& target, const s
     nlohmann::json solvers = nlohmann::json::array();
     for (const SolverTrace& tr : p.traces) solvers.push_back(trace_json(tr));
     surfaces.push_back({{"surface", p.surface},
-                        {"name", scene.surfaces[p.surface].name},
-                        {"equation", scene.surfaces[p.surface].equation},
+                        {"name", utf8_for_json(scene.surfaces[p.surface].name)},
+                        {"equation", utf8_for_json(scene.surfaces[p.surface].equation)},
                         {"reference", reference_json(p.reference)},
                         {"solvers", solvers}});
   }

@@ -7,7 +7,9 @@
 #include "algray/api/batch.h"
 #include "algray/api/probe_report.h"
 #include "algray/api/render_job.h"
+#include "algray/device/program_cache.h"
 #include "algray/scene/jsurf.h"
+#include "algray/util/json_text.h"
 #include "algray/util/version.h"
 
 namespace algray::api {
@@ -103,6 +105,10 @@ SceneError::SceneError(const std::string& what, std::string file_, int line_, in
 
 std::string version() { return version_string(); }
 
+void set_warning_handler(std::function<void(const std::string&)> handler) {
+  set_cache_warning_handler(std::move(handler));
+}
+
 std::vector<Device> devices() {
   std::vector<Device> out;
   for (const DeviceInfo& d : enumerate_devices()) out.push_back(to_device(d));
@@ -182,6 +188,10 @@ Image Renderer::render(const Scene& scene, const RenderSettings& settings) {
   return translated([&] {
     // The settings are overrides like the command line's flags, applied after the scene's own keys; without any
     // the scene as read already is the one to render.
+    // 0 means the scene's size; a negative one is a mistake, not a request for that.
+    for (const auto& [key, size] : {std::pair{"width", settings.width}, std::pair{"height", settings.height}})
+      if (size < 0)
+        throw algray::SceneError(key, std::to_string(size) + ": an image size is positive (0 keeps the scene's)");
     std::vector<Override> overrides = scene.state_->overrides;
     if (settings.width > 0) overrides.push_back({"image.width", std::to_string(settings.width)});
     if (settings.height > 0) overrides.push_back({"image.height", std::to_string(settings.height)});
@@ -205,7 +215,7 @@ Image Renderer::render(const Scene& scene, const RenderSettings& settings) {
       callbacks.on_progress = [&](const RenderProgress& p) { settings.on_progress({p.tiles_done, p.tiles_total}); };
     callbacks.cancelled = settings.cancelled;
     RenderedFrame frame = render_frame(s, request, state_->context, callbacks);
-    std::string stats = frame_stats(s, frame, {}, state_->context.uses_cache()).dump(2);
+    std::string stats = dump_json(frame_stats(s, frame, {}, state_->context.uses_cache()), 2);
     return Image(std::make_shared<const Image::State>(Image::State{std::move(frame.image), std::move(stats)}));
   });
 }
@@ -215,7 +225,7 @@ namespace {
 std::string probe_report(const algray::Scene& scene, const ProbeTarget& target, bool all_solvers,
                          RenderContext& context) {
   check_probe_target(scene, target);
-  return probe_json(scene, target, probe_scene(scene, target, all_solvers, context)).dump(2);
+  return dump_json(probe_json(scene, target, probe_scene(scene, target, all_solvers, context)), 2);
 }
 
 }  // namespace
@@ -257,6 +267,7 @@ BatchResult Renderer::batch(const BatchSettings& settings) {
   }
   BatchCallbacks callbacks;
   callbacks.on_message = settings.on_message;
+  callbacks.cancelled = settings.cancelled;
   if (settings.on_frame)
     callbacks.on_frame = [&](const BatchProgress& p) {
       settings.on_frame(

@@ -25,6 +25,7 @@
 #include "algray/render/renderer.h"
 #include "algray/render/shade.h"
 #include "algray/scene/jsurf.h"
+#include "algray/util/json_text.h"
 #include "algray/util/version.h"
 
 namespace algray {
@@ -122,25 +123,31 @@ nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const
   const DeviceInfo& device = frame.device;
   nlohmann::json j;
   j["version"] = version_string();
-  j["scene"] = scene.source;
-  j["name"] = scene.name;
-  j["outputs"] = images;
+  put_path(j, "scene", scene.source);
+  j["name"] = utf8_for_json(scene.name);
+  put_paths(j, "outputs", images);
   j["image"] = {{"width", scene.image.width}, {"height", scene.image.height}};
-  j["device"] = {{"name", device.name},
-                 {"platform", device.platform_name},
+  // Drivers' strings and .jsurf equations come from outside and need not be UTF-8.
+  j["device"] = {{"name", utf8_for_json(device.name)},
+                 {"platform", utf8_for_json(device.platform_name)},
                  {"type", device.type},
                  {"fp64", device.fp64},
-                 {"driver", device.driver_version}};
-  j["surface"] = {{"equation", scene.surface().equation}, {"degree", r.config.degree}};
+                 {"driver", utf8_for_json(device.driver_version)}};
+  j["surface"] = {{"equation", utf8_for_json(scene.surface().equation)}, {"degree", r.config.degree}};
   for (const SceneSurface& s : scene.surfaces)
-    j["surfaces"].push_back({{"name", s.name}, {"equation", s.equation}, {"degree", s.polynomial.degree()}});
+    j["surfaces"].push_back({{"name", utf8_for_json(s.name)},
+                             {"equation", utf8_for_json(s.equation)},
+                             {"degree", s.polynomial.degree()}});
   j["solver"] = {{"isolation", to_string(r.config.isolation)},
                  {"refinement", to_string(r.config.refinement)},
                  {"ray_origin", to_string(r.config.ray_origin)},
                  {"precision", to_string(r.config.precision)},
                  {"tolerance", r.config.tolerance},
                  {"max_iterations", r.config.max_iterations}};
-  j["cache"] = cache_used ? ProgramCache::default_directory().string() : "off";
+  if (cache_used)
+    put_path(j, "cache", ProgramCache::default_directory());
+  else
+    j["cache"] = "off";
   for (const ProgramRecord& p : r.programs) {
     double kernel_ms = 0;
     for (const PassStats& pass : r.passes)
@@ -191,7 +198,7 @@ nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const
   for (const DeviceShare& d : r.devices)
     j["devices"].push_back({{"rank", d.rank},
                             {"index", d.index},
-                            {"name", d.name},
+                            {"name", utf8_for_json(d.name)},
                             {"tiles", d.tiles},
                             {"rays", d.rays},
                             {"kernel_ms", d.kernel_ms},
@@ -453,7 +460,7 @@ nlohmann::json render_scene(const Scene& scene, const RenderOutputs& outputs, Re
   frame.timer.mark("write");
   nlohmann::json stats = frame_stats(scene, frame, outputs.images, context.uses_cache());
   if (outputs.stats_path)
-    writer.write(*outputs.stats_path, [&] { write_text_file(*outputs.stats_path, stats.dump(2) + "\n"); });
+    writer.write(*outputs.stats_path, [&] { write_text_file(*outputs.stats_path, dump_json(stats, 2) + "\n"); });
   return stats;
 }
 

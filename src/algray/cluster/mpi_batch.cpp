@@ -12,6 +12,8 @@
 #include <thread>
 #include <vector>
 
+#include "algray/util/json_text.h"
+
 namespace algray {
 namespace {
 
@@ -34,7 +36,7 @@ std::string encode(const FrameReport& report) {
                       {"message", report.message},
                       {"device_lost", report.device_lost}};
   if (report.warnings) j["warnings"] = *report.warnings;
-  return j.dump();
+  return dump_json(j);
 }
 
 FrameReport decode(const std::string& text) {

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "algray/render/shade.h"
+#include "algray/util/json_text.h"
 
 namespace algray {
 namespace {
@@ -397,7 +398,7 @@ void render_bands_as_worker(Renderer* renderer, const Scene& scene, const std::s
   };
   std::string tally;
   try {
-    tally = band_tally(renderer->render(scene, bands)).dump();
+    tally = dump_json(band_tally(renderer->render(scene, bands)));
   } catch (const std::exception& e) {
     // Between bands: the last request was answered, so rank 0 waits for this message next.
     return send_text(kFailed, e.what());

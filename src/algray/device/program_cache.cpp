@@ -11,6 +11,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <mutex>
+#include <set>
 #include <sstream>
 
 #include "algray/device/kernel_sources.h"
@@ -58,7 +60,33 @@ std::string build_log(const cl::Program& program, const cl::Device& device) {
   }
 }
 
+struct CacheWarnings {
+  std::mutex lock;
+  std::function<void(const std::string&)> handler;
+  std::set<std::filesystem::path> warned;  // directories already reported
+};
+
+CacheWarnings& cache_warnings() {
+  static CacheWarnings w;
+  return w;
+}
+
 }  // namespace
+
+void set_cache_warning_handler(std::function<void(const std::string&)> handler) {
+  CacheWarnings& w = cache_warnings();
+  const std::lock_guard<std::mutex> hold(w.lock);
+  w.handler = std::move(handler);
+}
+
+void ProgramCache::warn_unusable(const std::error_code& why) const {
+  CacheWarnings& w = cache_warnings();
+  const std::lock_guard<std::mutex> hold(w.lock);
+  if (!w.handler || !w.warned.insert(dir_).second) return;
+  w.handler("algray: warning: the kernel cache " + dir_.string() + " cannot be used (" + why.message() +
+            "): kernels are compiled on every run; set ALGRAY_CACHE_DIR to a writable directory, or pass "
+            "--no-cache to silence this\n");
+}
 
 ProgramCache::ProgramCache(bool enabled, std::filesystem::path dir) : enabled_(enabled), dir_(std::move(dir)) {}
 
@@ -117,9 +145,11 @@ double ProgramCache::remembered(const DeviceInfo& device, const std::string& nam
   if (enabled_) {
     char text[64];
     std::snprintf(text, sizeof text, "%.17g", value);
-    std::error_code ignored;
-    std::filesystem::create_directories(dir_, ignored);
-    write_entry(file, entry_header(identity, text) + text);  // a cache that cannot be written just measures again
+    // A cache that cannot be written just measures again, with a word why.
+    std::error_code ec;
+    std::filesystem::create_directories(dir_, ec);
+    if (!ec) ec = write_entry(file, entry_header(identity, text) + text);
+    if (ec) warn_unusable(ec);
   }
   return value;
 }
@@ -199,37 +229,46 @@ bool ProgramCache::read_entry(const std::filesystem::path& file, const std::stri
 
 void ProgramCache::store_on_disk(const cl::Program& program, const std::filesystem::path& file,
                                  const std::string& identity) {
-  // The cache is an optimisation: failing to write it must never fail a render.
+  // The cache is an optimisation: failing to write it must never fail a render, only be said once.
+  std::error_code ec;
   try {
     const auto binaries = program.getInfo<CL_PROGRAM_BINARIES>();
     if (binaries.empty() || binaries[0].empty()) return;
-    std::filesystem::create_directories(dir_);
+    std::filesystem::create_directories(dir_, ec);
     const std::string payload(binaries[0].begin(), binaries[0].end());
-    write_entry(file, entry_header(identity, payload) + payload);
+    if (!ec) ec = write_entry(file, entry_header(identity, payload) + payload);
+  } catch (const std::filesystem::filesystem_error& e) {
+    ec = e.code();
   } catch (const std::exception&) {
+    return;  // no binary from the driver: nothing the directory could help
   }
+  if (ec) warn_unusable(ec);
 }
 
-bool ProgramCache::write_entry(const std::filesystem::path& file, const std::string& content) {
+std::error_code ProgramCache::write_entry(const std::filesystem::path& file, const std::string& content) {
   // Written in full and fsync'd before the rename, so that no crash or power cut can leave a short entry under the
   // final name; pid and counter keep concurrent writers (threads or processes) apart.
   const std::string prefix = file.filename().string() + ".tmp-";
   remove_stale_temps(file.parent_path(), prefix);  // left by writers killed mid-write
   const std::string tmp = (file.parent_path() / temp_file_name(prefix)).string();
+  const auto failed = [] { return std::error_code(errno ? errno : EIO, std::generic_category()); };
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return false;
-  bool ok = true;
-  for (std::size_t done = 0; ok && done < content.size();) {
+  if (fd < 0) return failed();
+  std::error_code ec;
+  for (std::size_t done = 0; !ec && done < content.size();) {
+    errno = 0;
     const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
     if (n < 0 && errno == EINTR) continue;
-    ok = n > 0;
-    if (ok) done += static_cast<std::size_t>(n);
+    if (n > 0)
+      done += static_cast<std::size_t>(n);
+    else
+      ec = n == 0 ? std::make_error_code(std::errc::no_space_on_device) : failed();
   }
-  ok = ok && ::fsync(fd) == 0;
-  ok = ::close(fd) == 0 && ok;
-  ok = ok && ::rename(tmp.c_str(), file.c_str()) == 0;
-  if (!ok) ::unlink(tmp.c_str());
-  return ok;
+  if (!ec && ::fsync(fd) != 0) ec = failed();
+  if (::close(fd) != 0 && !ec) ec = failed();
+  if (!ec && ::rename(tmp.c_str(), file.c_str()) != 0) ec = failed();
+  if (ec) ::unlink(tmp.c_str());
+  return ec;
 }
 
 }  // namespace algray

@@ -6,6 +6,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 
 #include "algray/device/cl_runtime.h"
 #include "algray/device/kernel_config.h"
@@ -23,6 +24,11 @@ struct ProgramRecord {
   std::string origin;   // "built", "memory" or "disk"
   double build_ms = 0;  // wall time to obtain the program (compile, or load and link a binary)
 };
+
+// Where a warning that the disk cache cannot be used goes: the command line prints it, the Python module writes
+// it to sys.stderr. This layer writes nothing to the terminal itself; with no handler set the warning is lost.
+// Called at most once per process and cache directory, from whichever thread first failed to use it.
+void set_cache_warning_handler(std::function<void(const std::string&)> handler);
 
 class ProgramCache {
  public:
@@ -52,7 +58,11 @@ class ProgramCache {
   static std::string entry_header(const std::string& identity, const std::string& payload);
   // The payload of a well-formed entry for `identity`; false for anything missing, foreign, short or damaged.
   static bool read_entry(const std::filesystem::path& file, const std::string& identity, std::string& payload);
-  static bool write_entry(const std::filesystem::path& file, const std::string& content);
+  // Empty on success, else why the entry could not be written.
+  static std::error_code write_entry(const std::filesystem::path& file, const std::string& content);
+  // A disk cache that cannot be used falls back to compiling every time: say so, once per process and directory,
+  // so that a user who wonders why every run compiles finds out.
+  void warn_unusable(const std::error_code& why) const;
 
   bool enabled_;
   std::filesystem::path dir_;
