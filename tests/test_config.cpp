@@ -253,3 +253,29 @@ TEST_CASE("every build switch is declared once, and the host writes each one it 
       FAIL_CHECK(entry.path().filename().string() << " defaults " << (*it)[1] << " outside build_switches.h");
   }
 }
+
+// What each method can do is one table (solver_options.h): every method has its row, and the scene's check, the
+// plan's lanes and the messages all follow it.
+TEST_CASE("every method has its row of abilities, and lanes follow the rows", "[config]") {
+  for (const NamedChoice<Isolation>& i : kIsolations) {
+    INFO(i.name);
+    CHECK(abilities(i.value).method == i.value);
+    CHECK(isolates_in_power_basis(i.value) == abilities(i.value).power_basis);
+    CHECK(adaptive_unsupported(6, i.value).empty() == abilities(i.value).adaptive);
+    for (const NamedChoice<Refinement>& r : kRefinements) {
+      INFO(r.name);
+      CHECK(abilities(r.value).method == r.value);
+      KernelConfig config;
+      config.isolation = i.value;
+      config.refinement = r.value;
+      CHECK(lanes_apply(config) == (abilities(i.value).lanes && abilities(r.value).lanes));
+      const std::string lanes = "[render]\nlanes = 8\nisolation = \"" + std::string(i.name) + "\"\nrefinement = \"" +
+                                r.name + "\"\n";
+      if (lanes_supported(i.value, r.value))
+        CHECK_NOTHROW(load_scene_text(kSphereScene + lanes, "lanes.toml"));
+      else
+        CHECK_THROWS_WITH(load_scene_text(kSphereScene + lanes, "lanes.toml"), Catch::Contains(lanes_methods()));
+    }
+  }
+  CHECK(lanes_methods() == "isolation = \"bernstein\" and refinement = \"brent\"");
+}

@@ -78,8 +78,7 @@ int default_lanes(const std::string& device_type) { return device_type == "CPU" 
 int shadow_lanes(int lanes) { return lanes < kMaxShadowLanes ? lanes : kMaxShadowLanes; }
 bool lanes_apply(const KernelConfig& c) {
   if (c.entry == "shadow") return c.ray_origin == RayOrigin::Point;  // the extent form batches its own way
-  return (c.entry == "primary" || c.entry == "trace") && c.isolation == Isolation::Bernstein &&
-         c.refinement == Refinement::Brent;
+  return (c.entry == "primary" || c.entry == "trace") && lanes_supported(c.isolation, c.refinement);
 }
 
 std::string KernelConfig::build_options() const {

@@ -19,7 +19,7 @@ bool screen_form_applies(const Scene& scene, Precision precision) {
 }
 
 bool point_form_applies(const KernelConfig& shadow) {
-  return shadow.precision == Precision::Double && shadow.isolation == Isolation::Bernstein &&
+  return shadow.precision == Precision::Double && abilities(shadow.isolation).point_form &&
          shadow.degree <= kMaxPointFormDegree;
 }
 

@@ -480,8 +480,8 @@ void read_render(const TomlReader& r, const toml::table& root, int degree, Rende
   if (const toml::node* n = render->get("lanes")) {
     rs.lanes = static_cast<int>(r.integer(*n, "render.lanes", 1, 16));
     if (!valid_lanes(rs.lanes)) r.fail(n->source(), "render.lanes must be " + lanes_choices());
-    if (rs.lanes > 1 && (rs.isolation != Isolation::Bernstein || rs.refinement != Refinement::Brent))
-      r.fail(n->source(), "render.lanes > 1 needs isolation = \"bernstein\" and refinement = \"brent\"");
+    if (rs.lanes > 1 && !lanes_supported(rs.isolation, rs.refinement))
+      r.fail(n->source(), "render.lanes > 1 needs " + lanes_methods());
   }
   if (const toml::node* n = render->get("preview")) rs.preview = r.boolean(*n, "render.preview");
   if (const toml::node* n = render->get("max_depth"))

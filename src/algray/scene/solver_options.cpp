@@ -46,6 +46,15 @@ std::string enum_choices(const std::array<NamedChoice<E>, N>& choices, const cha
   return enum_choices(choices, last, [](E) { return true; });
 }
 
+// "a" or "a", "b": the names `keep` accepts, quoted as a scene file writes them.
+template <typename E, std::size_t N, typename Keep>
+std::string quoted_names(const std::array<NamedChoice<E>, N>& choices, Keep keep) {
+  std::string s;
+  for (const auto& c : choices)
+    if (keep(c.value)) s += (s.empty() ? "\"" : ", \"") + std::string(c.name) + "\"";
+  return s;
+}
+
 }  // namespace
 
 std::string to_string(Precision p) { return enum_name(kPrecisions, p); }
@@ -60,7 +69,22 @@ std::string precision_choices(const char* last) { return enum_choices(kPrecision
 std::string isolation_choices(const char* last) { return enum_choices(kIsolations, last); }
 std::string refinement_choices(const char* last) { return enum_choices(kRefinements, last); }
 std::string ray_origin_choices() { return enum_choices(kRayOrigins); }
-bool isolates_in_power_basis(Isolation i) { return i != Isolation::Bernstein; }
+const IsolationAbilities& abilities(Isolation i) {
+  for (const IsolationAbilities& a : kIsolationAbilities)
+    if (a.method == i) return a;
+  return kIsolationAbilities.front();  // unreachable: every Isolation has its row (test_config)
+}
+const RefinementAbilities& abilities(Refinement r) {
+  for (const RefinementAbilities& a : kRefinementAbilities)
+    if (a.method == r) return a;
+  return kRefinementAbilities.front();  // unreachable: every Refinement has its row (test_config)
+}
+bool lanes_supported(Isolation i, Refinement r) { return abilities(i).lanes && abilities(r).lanes; }
+std::string lanes_methods() {
+  return "isolation = " + quoted_names(kIsolations, [](Isolation i) { return abilities(i).lanes; }) +
+         " and refinement = " + quoted_names(kRefinements, [](Refinement r) { return abilities(r).lanes; });
+}
+bool isolates_in_power_basis(Isolation i) { return abilities(i).power_basis; }
 std::string power_basis_isolation_choices(const char* last) {
   return enum_choices(kIsolations, last, isolates_in_power_basis);
 }
@@ -78,8 +102,10 @@ std::string lanes_choices() {
 int default_max_iterations(Refinement r) { return r == Refinement::RegulaFalsi ? 1000 : 100; }
 
 std::string adaptive_unsupported(int degree, Isolation isolation) {
-  if (isolation != Isolation::Bernstein)
-    return "adaptive precision needs render.isolation = \"bernstein\", whose search it checks against rounding noise";
+  if (!abilities(isolation).adaptive)
+    return "adaptive precision needs render.isolation = " +
+           quoted_names(kIsolations, [](Isolation i) { return abilities(i).adaptive; }) +
+           ", whose search it checks against rounding noise";
   if (degree > kMaxMixedDegree)
     return "adaptive precision escalates to mixed, which supports degrees up to " + std::to_string(kMaxMixedDegree) +
            "; this surface has degree " + std::to_string(degree);

@@ -45,6 +45,39 @@ inline constexpr std::array<NamedChoice<Refinement>, 5> kRefinements{{{Refinemen
 inline constexpr std::array<NamedChoice<RayOrigin>, 4> kRayOrigins{
     {{RayOrigin::Auto, "auto"}, {RayOrigin::Extent, "extent"}, {RayOrigin::Eye, "eye"}, {RayOrigin::Screen, "screen"}}};
 
+// What each method can do, written once: scene validation, the plan and the build options all read these tables.
+// A new method adds its row; the kernels refuse by #error what a row says a method cannot do.
+struct IsolationAbilities {
+  Isolation method;
+  bool power_basis;  // isolates P*(t) in the power basis, and so takes ray_origin = "eye" as the paper does
+  bool lanes;        // has a lane build (kernels/lanes.h), with a refinement that has one
+  bool adaptive;     // adaptive precision checks its search against rounding noise and escalates what it doubts
+  bool point_form;   // shadow rays can be built in the point form (kernels/point_form.h)
+};
+inline constexpr std::array<IsolationAbilities, 4> kIsolationAbilities{{
+    {Isolation::Bernstein, false, true, true, true},
+    {Isolation::PowerDescartes, true, false, false, false},
+    {Isolation::Sturm, true, false, false, false},
+    {Isolation::DerivativeChain, true, false, false, false},
+}};
+struct RefinementAbilities {
+  Refinement method;
+  bool lanes;  // has a lane build
+};
+inline constexpr std::array<RefinementAbilities, 5> kRefinementAbilities{{
+    {Refinement::Brent, true},
+    {Refinement::Bisection, false},
+    {Refinement::RegulaFalsi, false},
+    {Refinement::Illinois, false},
+    {Refinement::Newton, false},
+}};
+const IsolationAbilities& abilities(Isolation i);
+const RefinementAbilities& abilities(Refinement r);
+// Whether rays can run in lanes (more than one per work-item) with this pair of methods.
+bool lanes_supported(Isolation i, Refinement r);
+// `isolation = "a" and refinement = "b"`: the pairs lanes_supported takes, for messages.
+std::string lanes_methods();
+
 std::string to_string(Precision p);
 std::string to_string(Isolation i);
 std::string to_string(Refinement r);
