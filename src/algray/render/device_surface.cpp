@@ -73,10 +73,13 @@ cl::Buffer real_buffer(const cl::Context& ctx, const std::vector<double>& values
 }
 
 cl::Buffer real4_buffer(const cl::Context& ctx, const std::vector<glm::dvec3>& values, Precision precision) {
-  std::vector<double> flat;
-  flat.reserve(4 * values.size());
-  for (const glm::dvec3& v : values) flat.insert(flat.end(), {v.x, v.y, v.z, 0});
-  return real_buffer(ctx, flat, precision);
+  Real4Staging staging;
+  staging.pack(values.size(), precision == Precision::Double, [&](std::size_t i) { return values[i]; });
+  return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, staging.bytes(), const_cast<void*>(staging.data()));
+}
+
+void Real4Staging::write(cl::CommandQueue& queue, const cl::Buffer& buffer) const {
+  queue.enqueueWriteBuffer(buffer, CL_TRUE, 0, bytes(), data());
 }
 
 SurfaceData prepare_surface(const Scene& scene, std::size_t surface) {

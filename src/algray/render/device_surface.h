@@ -58,6 +58,43 @@ cl::Buffer real_buffer(const cl::Context& ctx, const std::vector<double>& values
 // Buffer of REAL4 values (x, y, z, 0) from points or directions.
 cl::Buffer real4_buffer(const cl::Context& ctx, const std::vector<glm::dvec3>& values, Precision precision);
 
+// REAL4 values (x, y, z, 0) on their way to a device, in double or in float: each component rounded to the
+// kernel's REAL on its own. Kept by a tracer between batches, so that its uploads allocate nothing.
+class Real4Staging {
+ public:
+  // vector_of(i) for i < count, packed in double (in_double) or float.
+  template <typename VectorOf>
+  void pack(std::size_t count, bool in_double, VectorOf vector_of) {
+    in_double_ = in_double;
+    count_ = count;
+    if (in_double)
+      fill(doubles_, vector_of);
+    else
+      fill(floats_, vector_of);
+  }
+  // Writes what pack() holds to the start of `buffer`, blocking.
+  void write(cl::CommandQueue& queue, const cl::Buffer& buffer) const;
+  const void* data() const { return in_double_ ? static_cast<const void*>(doubles_.data()) : floats_.data(); }
+  std::size_t bytes() const { return 4 * count_ * (in_double_ ? sizeof(double) : sizeof(float)); }
+
+ private:
+  template <typename T, typename VectorOf>
+  void fill(std::vector<T>& out, VectorOf vector_of) {
+    out.resize(4 * count_);
+    for (std::size_t i = 0; i < count_; ++i) {
+      const glm::dvec3 v = vector_of(i);
+      out[4 * i] = static_cast<T>(v.x);
+      out[4 * i + 1] = static_cast<T>(v.y);
+      out[4 * i + 2] = static_cast<T>(v.z);
+      out[4 * i + 3] = 0;
+    }
+  }
+  bool in_double_ = true;
+  std::size_t count_ = 0;
+  std::vector<double> doubles_;
+  std::vector<float> floats_;
+};
+
 // One surface's buffers in one precision, shared by every pass's kernel.
 class DeviceSurface {
  public:

@@ -23,33 +23,11 @@ TracedBatch RayTracer::trace(const std::vector<PixelRay>& rays) {
     directions_ = cl::Buffer(ctx, CL_MEM_READ_ONLY, capacity_ * real4_size);
     out_ = cl::Buffer(ctx, CL_MEM_WRITE_ONLY, capacity_ * sizeof(HitRecord));
   }
-  // As real4_buffer converts: each component rounded to the kernel's REAL on its own.
   cl::CommandQueue& queue = session_.queue;
-  auto upload = [&](cl::Buffer& buffer, auto vector_of) {
-    if (is_double) {
-      staging_.resize(4 * count);
-      for (std::size_t i = 0; i < count; ++i) {
-        const glm::dvec3& v = vector_of(rays[i]);
-        staging_[4 * i] = v.x;
-        staging_[4 * i + 1] = v.y;
-        staging_[4 * i + 2] = v.z;
-        staging_[4 * i + 3] = 0;
-      }
-      queue.enqueueWriteBuffer(buffer, CL_TRUE, 0, count * real4_size, staging_.data());
-    } else {
-      staging_float_.resize(4 * count);
-      for (std::size_t i = 0; i < count; ++i) {
-        const glm::dvec3& v = vector_of(rays[i]);
-        staging_float_[4 * i] = static_cast<float>(v.x);
-        staging_float_[4 * i + 1] = static_cast<float>(v.y);
-        staging_float_[4 * i + 2] = static_cast<float>(v.z);
-        staging_float_[4 * i + 3] = 0;
-      }
-      queue.enqueueWriteBuffer(buffer, CL_TRUE, 0, count * real4_size, staging_float_.data());
-    }
-  };
-  upload(origins_, [](const PixelRay& r) -> const glm::dvec3& { return r.origin; });
-  upload(directions_, [](const PixelRay& r) -> const glm::dvec3& { return r.direction; });
+  staging_.pack(count, is_double, [&](std::size_t i) { return rays[i].origin; });
+  staging_.write(queue, origins_);
+  staging_.pack(count, is_double, [&](std::size_t i) { return rays[i].direction; });
+  staging_.write(queue, directions_);
   KernelArgs args(kernel_, surface_.precision());
   args.plain(origins_);
   args.plain(directions_);

@@ -32,8 +32,7 @@ class RayTracer {
   std::size_t lanes_ = 1;          // rays per work-item (KernelConfig::lanes)
   std::size_t capacity_ = 0;
   cl::Buffer origins_, directions_, out_;
-  std::vector<double> staging_;  // REAL4 values before the upload, in double or (staging_float_) float
-  std::vector<float> staging_float_;
+  Real4Staging staging_;  // REAL4 values before the upload
 };
 
 }  // namespace algray

@@ -38,35 +38,11 @@ void ShadowPoints::upload(const std::vector<glm::dvec3>& points, const std::vect
     if (precision_ == Precision::Adaptive)
       undecided_ = cl::Buffer(ctx, CL_MEM_WRITE_ONLY, capacity_ * sizeof(cl_ulong));
   }
-  // As real4_buffer converts: each component rounded to the kernel's REAL on its own.
-  cl::CommandQueue& queue = session_.queue;
-  if (is_double) {
-    staging_.resize(4 * count_);
-    for (std::size_t i = 0; i < count_; ++i) {
-      staging_[4 * i] = points[i].x;
-      staging_[4 * i + 1] = points[i].y;
-      staging_[4 * i + 2] = points[i].z;
-      staging_[4 * i + 3] = 0;
-    }
-    queue.enqueueWriteBuffer(points_, CL_TRUE, 0, 4 * count_ * sizeof(double), staging_.data());
-  } else {
-    staging_float_.resize(4 * count_);
-    for (std::size_t i = 0; i < count_; ++i) {
-      staging_float_[4 * i] = static_cast<float>(points[i].x);
-      staging_float_[4 * i + 1] = static_cast<float>(points[i].y);
-      staging_float_[4 * i + 2] = static_cast<float>(points[i].z);
-      staging_float_[4 * i + 3] = 0;
-    }
-    queue.enqueueWriteBuffer(points_, CL_TRUE, 0, 4 * count_ * sizeof(float), staging_float_.data());
-  }
-  staging_float_.resize(4 * count_);
-  for (std::size_t i = 0; i < count_; ++i) {
-    staging_float_[4 * i] = normals[i].x;
-    staging_float_[4 * i + 1] = normals[i].y;
-    staging_float_[4 * i + 2] = normals[i].z;
-    staging_float_[4 * i + 3] = 0;
-  }
-  queue.enqueueWriteBuffer(normals_, CL_TRUE, 0, 4 * count_ * sizeof(float), staging_float_.data());
+  staging_.pack(count_, is_double, [&](std::size_t i) { return points[i]; });
+  staging_.write(session_.queue, points_);
+  // Normals are float4 in every precision; a float survives the round trip through double exactly.
+  staging_.pack(count_, false, [&](std::size_t i) { return glm::dvec3(normals[i]); });
+  staging_.write(session_.queue, normals_);
 }
 
 ShadowTracer::ShadowTracer(ClSession& session, ProgramCache& cache, const KernelConfig& config,

@@ -49,8 +49,7 @@ class ShadowPoints {
   Precision precision_;
   std::size_t count_ = 0, capacity_ = 0;
   cl::Buffer points_, normals_, masks_, undecided_;  // undecided_: adaptive precision only
-  std::vector<double> staging_;                      // REAL4 values in double, converted to the precision on upload
-  std::vector<float> staging_float_;
+  Real4Staging staging_;  // points and normals before the upload
 };
 
 // Built once per render (one program, one upload of the surface), then asked once per light and batch.
