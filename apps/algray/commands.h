@@ -10,6 +10,7 @@
 #include "algray/api/probe_report.h"
 #include "algray/api/render_job.h"
 #include "algray/scene/scene.h"
+#include "view_limits.h"
 #ifdef ALGRAY_WITH_MPI
 #include "algray/cluster/mpi_world.h"
 #endif
@@ -46,6 +47,8 @@ struct ViewRequest {
   int port = 0;                    // 0: any free port
   bool open = false;               // open the URL in a browser (xdg-open)
   bool use_cache = true;
+  ViewLimits limits;  // what one client may cost the server (view_limits.h)
+  std::string token;  // required in every URL when set; off loopback a random one when empty
 };
 
 // Each prints errors (and nothing else on success, unless progress) to `err`; probe's report goes to `out`.

@@ -359,6 +359,32 @@ struct ViewCommand {
     cmd->add_option("--host", request.host,
                     "address to listen on (default 127.0.0.1; any other is reachable from other machines)");
     cmd->add_flag("--open", request.open, "open the page in the default browser (xdg-open)");
+    cmd->add_option("--token", request.token,
+                    "require ?token=TOKEN in every URL (default: none on loopback, else a random one, printed)");
+    ViewLimits& l = request.limits;
+    cmd->add_option("--max-connections", l.max_connections, "connections open at once; more are answered 429")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1024));
+    cmd->add_option("--max-header-bytes", l.max_header_bytes, "bytes of a request's line and headers; more: 431")
+        ->capture_default_str()
+        ->check(CLI::Range(1024, 1 << 24));
+    cmd->add_option("--header-timeout", l.header_timeout_s, "seconds to receive a request's line and headers")
+        ->capture_default_str()
+        ->check(CLI::Range(0.1, 3600.0));
+    cmd->add_option("--request-timeout", l.request_timeout_s,
+                    "seconds from a request's first byte to its answer, waiting and rendering included")
+        ->capture_default_str()
+        ->check(CLI::Range(0.1, 86400.0));
+    cmd->add_option("--max-settings", l.max_settings, "set= items per request")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 4096));
+    cmd->add_option("--max-parse-ms", l.max_parse_ms, "milliseconds applying one request's set= items")
+        ->capture_default_str()
+        ->check(CLI::Range(1.0, 3600e3));
+    cmd->add_option("--max-frame-samples", l.max_frame_samples,
+                    "camera rays x (1 + shadow points) x (1 + bounces) per frame")
+        ->capture_default_str()
+        ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 50));
   }
 
 #ifdef ALGRAY_FULL

@@ -5,16 +5,24 @@
 
 #include <algorithm>
 #include <charconv>
+#include <condition_variable>
 #include <cstdlib>
+#include <functional>
+#include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <random>
 #include <regex>
 #include <stdexcept>
 
 #include "algray/scene/solver_options.h"
 #include "algray/util/embedded_files.h"
+#include "algray/util/json_text.h"
 #include "commands.h"
 #include "exit_codes.h"
+#include "view_query.h"
+#include "view_server.h"
 
 namespace algray {
 // The page and its script (apps/algray/view/), embedded at build time.
@@ -25,15 +33,6 @@ namespace algray::cli {
 namespace {
 
 using nlohmann::json;
-
-// A request the page should not have sent, or a scene setting the scene refuses: answered 400 with its reason,
-// never a crash. key: the setting at fault, if one; column: where in its value (the command line's "character").
-struct BadRequest : std::runtime_error {
-  BadRequest(const std::string& what, std::string key_ = {}, int column_ = 0)
-      : std::runtime_error(what), key(std::move(key_)), column(column_) {}
-  std::string key;
-  int column;
-};
 
 // The largest frame the view renders: a poster is a job for `algray render`.
 constexpr int kMaxViewSide = 4096;
@@ -63,18 +62,36 @@ int equation_column(const std::string& message) {
   return std::regex_search(message, m, at) ? std::atoi(m[1].str().c_str()) : 0;
 }
 
-FrameQuery parse_query(const api::Scene& base, const httplib::Request& req) {
+// Why a request's work stops early, asked between steps: its client left, its time ran out, or (a frame) a newer
+// frame of its page came. Throws the answer; a client that left never reads it.
+void check_going_on(const ViewLimits& limits, const std::function<bool()>& superseded = {}) {
+  if (ViewServer::client_gone()) throw BadRequest("the client closed the connection", {}, 0, 408);
+  if (ViewClock::now() > ViewServer::deadline())
+    throw BadRequest("the request took longer than --request-timeout (" + format_number(limits.request_timeout_s) +
+                         " s)",
+                     {}, 0, 408, "--request-timeout");
+  if (superseded && superseded()) throw BadRequest("a newer frame of this page replaced this one", {}, 0, 409);
+}
+
+FrameQuery parse_query(const api::Scene& base, const httplib::Request& req, const ViewLimits& limits) {
   FrameQuery q{base};
-  const std::size_t sets = req.get_param_value_count("set");
-  for (std::size_t i = 0; i < sets; ++i) {
-    const std::string item = req.get_param_value("set", i);
-    const std::size_t eq = item.find('=');
-    if (eq == 0 || eq == std::string::npos) throw BadRequest("a setting is key=value, not '" + item + "'");
-    const std::string key = item.substr(0, eq);
+  std::vector<std::string> items;
+  for (std::size_t i = 0, n = req.get_param_value_count("set"); i < n; ++i)
+    items.push_back(req.get_param_value("set", i));
+  const std::vector<Setting> settings = parse_settings(items, limits.max_settings);
+  // One equation's expansion is bounded by the parser's own budget; what a request may add up is bounded here.
+  const auto parse_deadline = ViewClock::now() + std::chrono::duration_cast<ViewClock::duration>(
+                                                     std::chrono::duration<double, std::milli>(limits.max_parse_ms));
+  for (const Setting& s : settings) {
+    check_going_on(limits);
+    if (ViewClock::now() > parse_deadline)
+      throw BadRequest("applying the request's set= items took longer than --max-parse-ms (" +
+                           format_number(limits.max_parse_ms) + " ms)",
+                       s.key, 0, 413, "--max-parse-ms");
     try {
-      q.scene.set(key, item.substr(eq + 1));
+      q.scene.set(s.key, s.value);
     } catch (const api::SceneError& e) {
-      throw BadRequest(e.what(), key, equation_column(e.what()));
+      throw BadRequest(e.what(), s.key, equation_column(e.what()));
     }
   }
   q.width = int_param(req, "width", base.width(), 1, kMaxViewSide);
@@ -128,11 +145,14 @@ json scene_summary(const api::Scene& scene, const std::string& device) {
 }
 
 void answer_bad_request(httplib::Response& res, const BadRequest& e) {
-  res.status = 400;
-  res.set_content(json{{"error", e.what()}, {"key", e.key}, {"column", e.column}}.dump(), "application/json");
+  res.status = e.status;
+  json body{{"error", e.what()}, {"key", e.key}, {"column", e.column}};
+  if (!e.limit.empty()) body["limit"] = e.limit;
+  // Replaced rather than thrown on: a message may quote bytes of the request.
+  res.set_content(algray::dump_json(body), "application/json");
 }
 
-// Every handler's errors become a response: bad input 400, anything else 500; the server goes on.
+// Every handler's errors become a response: bad input and limits 4xx, anything else 500; the server goes on.
 template <class F>
 httplib::Server::Handler guarded(F handle) {
   return [handle](const httplib::Request& req, httplib::Response& res) {
@@ -146,9 +166,69 @@ httplib::Server::Handler guarded(F handle) {
       answer_bad_request(res, BadRequest(e.what()));
     } catch (const std::exception& e) {
       res.status = 500;
-      res.set_content(json{{"error", e.what()}}.dump(), "application/json");
+      res.set_content(error_json(e.what()), "application/json");
     }
   };
+}
+
+// The one OpenCL queue, taken by one frame at a time. A frame waits for it only while it is still wanted: its
+// client there, its time left, and no newer frame of its page (the page's `page` parameter) come since.
+class FrameQueue {
+ public:
+  // A frame's place: its page's generation when it came; superseded once a newer one of the page came.
+  struct Ticket {
+    std::string page;
+    std::uint64_t generation = 0;
+  };
+  Ticket arrive(const std::string& page) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return {page, page.empty() ? 0 : ++latest_[page]};
+  }
+  bool superseded(const Ticket& t) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return !t.page.empty() && latest_[t.page] != t.generation;
+  }
+  void leave(const Ticket& t) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (!t.page.empty() && latest_[t.page] == t.generation) latest_.erase(t.page);
+  }
+  // Waits for the queue, checking `going_on` (which throws to give up) every 50 ms.
+  void take(const std::function<void()>& going_on) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (busy_) {
+      lock.unlock();
+      going_on();
+      lock.lock();
+      free_.wait_for(lock, std::chrono::milliseconds(50), [&] { return !busy_; });
+    }
+    busy_ = true;
+  }
+  void give_back() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      busy_ = false;
+    }
+    free_.notify_one();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable free_;
+  bool busy_ = false;
+  std::map<std::string, std::uint64_t> latest_;  // a page's newest frame; only pages with frames pending
+};
+
+// A token as Jupyter's: 24 random bytes in hex, from the system's entropy source.
+std::string random_token() {
+  std::random_device entropy;
+  std::string token;
+  static const char hex[] = "0123456789abcdef";
+  for (int i = 0; i < 24; ++i) {
+    const unsigned byte = entropy() & 0xFF;
+    token += hex[byte >> 4];
+    token += hex[byte & 15];
+  }
+  return token;
 }
 
 }  // namespace
@@ -173,7 +253,11 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
     err << "algray: " << e.what() << "\n";
     return kExitBadInput;
   }
-  std::mutex render_mutex;  // one OpenCL queue: frames render one at a time
+  const ViewLimits& limits = request.limits;
+  FrameQueue frames;
+  const bool loopback = is_loopback(request.host);
+  // Off loopback anyone who can reach the port could use it: a token in the URL, as Jupyter's, keeps them out.
+  const std::string token = !request.token.empty() ? request.token : loopback ? std::string() : random_token();
 
   const std::string page = [] {
     for (const EmbeddedFile& f : embedded_view_files())
@@ -181,25 +265,77 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
     throw std::logic_error("the view page was not embedded");
   }();
 
-  httplib::Server server;
+  ViewServer server(limits);
+  // Before any route: the token, the Host header (a page of another site that rebinds its name to 127.0.0.1
+  // sends its own name, and must not read the scene, which names its file), and parameters that are text.
+  server.set_pre_routing_handler([&](const httplib::Request& req, httplib::Response& res) {
+    const auto refuse = [&](int status, const std::string& message) {
+      res.status = status;
+      res.set_content(error_json(message), "application/json");
+      return httplib::Server::HandlerResponse::Handled;
+    };
+    if (!token.empty() && !token_matches(req.get_param_value("token"), token))
+      return refuse(403, "this server needs the token it printed at its start: add ?token=... to the URL");
+    if (token.empty() && !is_loopback_host_header(req.get_header_value("Host")))
+      return refuse(403, "the Host header '" + req.get_header_value("Host") +
+                             "' is not a loopback address or localhost, so the page is not this machine's");
+    for (const auto& [name, value] : req.params) {
+      if (const auto problem = text_problem(name)) return refuse(400, "a parameter name " + *problem);
+      if (const auto problem = text_problem(value)) return refuse(400, "the value of " + name + " " + *problem);
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
   server.Get("/", [&](const httplib::Request&, httplib::Response& res) { res.set_content(page, "text/html"); });
   server.Get("/scene.json", guarded([&](const httplib::Request&, httplib::Response& res) {
-               res.set_content(scene_summary(base, device).dump(), "application/json");
+               res.set_content(algray::dump_json(scene_summary(base, device)), "application/json");
              }));
   server.Get("/frame.png", guarded([&](const httplib::Request& req, httplib::Response& res) {
-               const FrameQuery q = parse_query(base, req);
+               const FrameQueue::Ticket ticket = frames.arrive(req.get_param_value("page"));
+               struct Leave {
+                 FrameQueue& frames;
+                 const FrameQueue::Ticket& ticket;
+                 ~Leave() { frames.leave(ticket); }
+               } leave{frames, ticket};
+               const auto superseded = [&] { return frames.superseded(ticket); };
+               const FrameQuery q = parse_query(base, req, limits);
                api::RenderSettings settings;
                settings.width = q.width;
                settings.height = q.height;
                settings.preview = !q.full;
                settings.depth_and_normal = false;
+               const std::uint64_t samples = frame_samples(q.scene.to_toml(), q.width, q.height, q.full);
+               if (samples > limits.max_frame_samples)
+                 throw BadRequest("the frame needs " + std::to_string(samples) +
+                                      " samples (camera rays x (1 + shadow points) x (1 + bounces)); "
+                                      "--max-frame-samples allows " +
+                                      std::to_string(limits.max_frame_samples),
+                                  {}, 0, 413, "--max-frame-samples");
+               // Asked between tiles: the render stops, and gives the queue to the next frame, as soon as this
+               // one is not wanted.
+               std::optional<BadRequest> stopped;
+               settings.cancelled = [&] {
+                 try {
+                   check_going_on(limits, superseded);
+                   return false;
+                 } catch (const BadRequest& e) {
+                   stopped = e;
+                   return true;
+                 }
+               };
                std::string png, stats;
-               {
-                 const std::lock_guard<std::mutex> lock(render_mutex);
+               frames.take([&] { check_going_on(limits, superseded); });
+               try {
                  const api::Image image = renderer->render(q.scene, settings);
                  png = image.png();
                  stats = image.stats_json();
+               } catch (const api::Cancelled&) {
+                 frames.give_back();
+                 throw stopped ? *stopped : BadRequest("the frame was cancelled", {}, 0, 408);
+               } catch (...) {
+                 frames.give_back();
+                 throw;
                }
+               frames.give_back();
                const json s = json::parse(stats);
                double kernel_ms = 0;
                for (const json& p : s["passes"]) kernel_ms += p.value("kernel_ms", 0.0);
@@ -214,7 +350,7 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
                res.set_content(png, "image/png");
              }));
   server.Get("/scene.toml", guarded([&](const httplib::Request& req, httplib::Response& res) {
-               FrameQuery q = parse_query(base, req);
+               FrameQuery q = parse_query(base, req, limits);
                q.scene.set("image.width", std::to_string(q.width));
                q.scene.set("image.height", std::to_string(q.height));
                q.scene.set("render.preview", q.full ? "false" : "true");
@@ -222,14 +358,14 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
                res.set_content(q.scene.to_toml(), "application/toml");
              }));
   server.Get("/orbit.toml", guarded([&](const httplib::Request& req, httplib::Response& res) {
-               const int frames = int_param(req, "frames", 36, 2, 3600);
-               (void)parse_query(base, req);  // the same settings as scene.toml, checked alike
+               const int frames_wanted = int_param(req, "frames", 36, 2, 3600);
+               (void)parse_query(base, req, limits);  // the same settings as scene.toml, checked alike
                res.set_header("Content-Disposition", "attachment; filename=\"orbit.toml\"");
                res.set_content(
                    "# An orbit about the look-at point of the scene as `algray view` showed it. With scene.toml "
                    "beside this file\n# (the page saves both): algray batch orbit.toml\n[[job]]\nname = \"orbit\"\n"
                    "scene = \"scene.toml\"\noutput = \"orbit_{frame:03}.png\"\norbit = { frames = " +
-                       std::to_string(frames) + ", degrees = 360 }\n",
+                       std::to_string(frames_wanted) + ", degrees = 360 }\n",
                    "application/toml");
              }));
   server.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
@@ -237,19 +373,22 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
     res.set_content(R"({"error":"internal error"})", "application/json");
   });
 
-  if (request.host != "127.0.0.1" && request.host != "localhost")
+  if (!loopback)
     err << "algray view: warning: listening on " << request.host
-        << ", so other machines can reach this server; it has no authentication\n";
+        << ", so other machines can reach this server; only URLs with its token are answered\n";
   const int port = request.port == 0 ? server.bind_to_any_port(request.host) : request.port;
   if (request.port != 0 && !server.bind_to_port(request.host, port)) {
-    err << "algray view: cannot listen on " << request.host << ":" << port << "\n";
+    err << "algray view: cannot listen on " << request.host << ":" << port
+        << " (in use by another server, or not an address of this machine)\n";
     return kExitBadInput;
   }
   if (port < 0) {
     err << "algray view: cannot listen on " << request.host << "\n";
     return kExitBadInput;
   }
-  const std::string url = "http://" + request.host + ":" + std::to_string(port) + "/";
+  const std::string shown_host = request.host.find(':') != std::string::npos ? "[" + request.host + "]" : request.host;
+  const std::string url =
+      "http://" + shown_host + ":" + std::to_string(port) + "/" + (token.empty() ? "" : "?token=" + token);
   out << url << std::endl;
   if (request.open) {
     const std::string command = "xdg-open '" + url + "' >/dev/null 2>&1 &";
