@@ -16,6 +16,7 @@
 #include <regex>
 #include <stdexcept>
 
+#include "algray/math/polynomial.h"
 #include "algray/scene/solver_options.h"
 #include "algray/util/embedded_files.h"
 #include "algray/util/json_text.h"
@@ -79,19 +80,30 @@ FrameQuery parse_query(const api::Scene& base, const httplib::Request& req, cons
   for (std::size_t i = 0, n = req.get_param_value_count("set"); i < n; ++i)
     items.push_back(req.get_param_value("set", i));
   const std::vector<Setting> settings = parse_settings(items, limits.max_settings);
-  // One equation's expansion is bounded by the parser's own budget; what a request may add up is bounded here.
+  // One equation's expansion is bounded by the parser's own budget, and stops when its client leaves (below); what a
+  // request may add up is bounded here.
   const auto parse_deadline = ViewClock::now() + std::chrono::duration_cast<ViewClock::duration>(
                                                      std::chrono::duration<double, std::milli>(limits.max_parse_ms));
   for (const Setting& s : settings) {
     check_going_on(limits);
-    if (ViewClock::now() > parse_deadline)
-      throw BadRequest("applying the request's set= items took longer than --max-parse-ms (" +
-                           format_number(limits.max_parse_ms) + " ms)",
-                       s.key, 0, 413, "--max-parse-ms");
+    const auto too_long = [&] {
+      return BadRequest("applying the request's set= items took longer than --max-parse-ms (" +
+                            format_number(limits.max_parse_ms) + " ms)",
+                        s.key, 0, 413, "--max-parse-ms");
+    };
+    if (ViewClock::now() > parse_deadline) throw too_long();
     try {
+      // One equation the parser's budget admits can still take seconds to expand: it stops too when the client
+      // leaves or the time runs out.
+      const ExpansionWatch watch([&] {
+        return !ViewServer::client_gone() && ViewClock::now() <= std::min(parse_deadline, ViewServer::deadline());
+      });
       q.scene.set(s.key, s.value);
     } catch (const api::SceneError& e) {
       throw BadRequest(e.what(), s.key, equation_column(e.what()));
+    } catch (const ExpansionStopped&) {
+      check_going_on(limits);  // the client left or the request's time ran out: that is the answer
+      throw too_long();
     }
   }
   q.width = int_param(req, "width", base.width(), 1, kMaxViewSide);

@@ -194,6 +194,10 @@ try:
     if problem:
         fail(f"60 equations: {problem}")
     idle_after(server, "150 equations")
+    # One costly equation the parser admits (seconds of expansion), its client gone after 0.3 s: the expansion
+    # stops with it.
+    request(host, port, "/scene.toml?set=surface.equation%3D(x%2By%2Bz%2B.123456789)%5E32", timeout=0.3)
+    idle_after(server, "one costly equation, its client gone")
 
     # 4. Abandoned frames: clients that ask for 1024^2 full frames and leave after 0.5 s cost nothing after.
     def abandon(k):

@@ -158,9 +158,25 @@ Polynomial Polynomial::operator-() const {
   return r;
 }
 
+namespace {
+thread_local ExpansionWatch* innermost_watch = nullptr;
+}  // namespace
+
+ExpansionWatch::ExpansionWatch(std::function<bool()> keep_going)
+    : keep_going_(std::move(keep_going)), outer_(innermost_watch) {
+  innermost_watch = this;
+}
+
+ExpansionWatch::~ExpansionWatch() { innermost_watch = outer_; }
+
+void ExpansionWatch::check() {
+  if (innermost_watch && !innermost_watch->keep_going_()) throw ExpansionStopped();
+}
+
 Polynomial Polynomial::operator*(const Polynomial& other) const {
   Polynomial r;
   for (const auto& [ea, ca] : terms_) {
+    ExpansionWatch::check();  // a row is other.terms_.size() products: milliseconds at most
     for (const auto& [eb, cb] : other.terms_) {
       const Exponents e{ea[0] + eb[0], ea[1] + eb[1], ea[2] + eb[2]};
       auto [it, inserted] = r.terms_.try_emplace(e);

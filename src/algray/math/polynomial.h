@@ -4,8 +4,10 @@
 #include <gmpxx.h>
 
 #include <array>
+#include <functional>
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,28 @@ namespace algray {
 struct Monomial {
   int i, j, k;
   double coef;
+};
+
+// Thrown by a product that an ExpansionWatch of its thread stopped.
+struct ExpansionStopped : std::runtime_error {
+  ExpansionStopped() : std::runtime_error("the expansion was stopped") {}
+};
+
+// While a watch is alive, this thread's products ask its `keep_going` between rows of terms and throw
+// ExpansionStopped when it answers false. An equation the parser's budget admits can still take seconds to expand:
+// a server stops it when the client that asked has left (apps/algray/view_command.cpp).
+class ExpansionWatch {
+ public:
+  explicit ExpansionWatch(std::function<bool()> keep_going);
+  ~ExpansionWatch();
+  ExpansionWatch(const ExpansionWatch&) = delete;
+  ExpansionWatch& operator=(const ExpansionWatch&) = delete;
+  // Throws ExpansionStopped when the innermost watch of this thread says stop; nothing without one.
+  static void check();
+
+ private:
+  std::function<bool()> keep_going_;
+  ExpansionWatch* outer_;
 };
 
 class Polynomial {
