@@ -25,8 +25,9 @@ trap unmount_all EXIT
 
 if [ ! -f "$tarball" ]; then
   command -v debootstrap >/dev/null || { apt-get update -qq && apt-get install -y -qq debootstrap; }
-  mirror=$(grep -hoE '^(URIs:|deb) +https?://[^ ]+' /etc/apt/sources.list.d/*.sources /etc/apt/sources.list \
-             2>/dev/null | head -1 | awk '{print $2}')
+  # This machine's Debian mirror (a deb822 .sources file or sources.list, whichever it has).
+  mirror=$(cat /etc/apt/sources.list.d/*.sources /etc/apt/sources.list 2>/dev/null |
+             grep -oE '^(URIs:|deb) +https?://[^ ]+' | head -1 | awk '{print $2}' || true)
   rm -rf --one-file-system "$root"
   debootstrap --variant=minbase bookworm "$root" "${mirror:-http://deb.debian.org/debian}" > "$dir/debootstrap.log"
   # Apt as on this machine (its mirror), name resolution, and nothing cached: a fresh machine downloads it all.
