@@ -10,33 +10,15 @@
 #include <set>
 #include <sstream>
 
+#include "algray/util/json_text.h"
+
 namespace algray::cli {
 
 std::optional<std::string> text_problem(std::string_view text) {
-  for (std::size_t i = 0; i < text.size();) {
-    const auto byte = static_cast<unsigned char>(text[i]);
-    if (byte == 0) return "holds a NUL byte at byte " + std::to_string(i + 1);
-    // The length of the sequence the lead byte starts, and the least code point it may encode (no overlong forms).
-    std::size_t length = 1;
-    char32_t point = byte, least = 0;
-    if (byte >= 0xF0 && byte <= 0xF4)
-      length = 4, point = byte & 0x07, least = 0x10000;
-    else if (byte >= 0xE0 && byte <= 0xEF)
-      length = 3, point = byte & 0x0F, least = 0x800;
-    else if (byte >= 0xC2 && byte <= 0xDF)
-      length = 2, point = byte & 0x1F, least = 0x80;
-    else if (byte >= 0x80)
-      length = 0;
-    bool valid = length != 0 && i + length <= text.size();
-    for (std::size_t k = 1; valid && k < length; ++k) {
-      const auto next = static_cast<unsigned char>(text[i + k]);
-      valid = (next & 0xC0) == 0x80;
-      point = (point << 6) | (next & 0x3F);
-    }
-    valid = valid && point >= least && point <= 0x10FFFF && !(point >= 0xD800 && point <= 0xDFFF);
-    if (!valid) return "is not UTF-8 (byte " + std::to_string(i + 1) + ")";
-    i += length;
-  }
+  // Whichever problem comes first in the text (a NUL byte is itself UTF-8).
+  const std::size_t nul = text.find('\0'), bad = first_non_utf8(text);
+  if (bad < nul) return "is not UTF-8 (byte " + std::to_string(bad + 1) + ")";
+  if (nul != std::string_view::npos) return "holds a NUL byte at byte " + std::to_string(nul + 1);
   return std::nullopt;
 }
 

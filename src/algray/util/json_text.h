@@ -11,6 +11,8 @@ namespace algray {
 
 // Whether `text` is well-formed UTF-8 (no overlong forms, surrogates or code points past U+10FFFF).
 bool is_utf8(std::string_view text);
+// The offset of the byte that starts the first sequence that is not, or npos where all of `text` is.
+std::size_t first_non_utf8(std::string_view text);
 
 // `text` as UTF-8 for reading: unchanged when it is UTF-8 already, else with each byte that is not replaced by
 // U+FFFD. For messages and names, where a reader needs the gist rather than the bytes.
