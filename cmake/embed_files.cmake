@@ -1,9 +1,14 @@
-# Script mode: writes OUTPUT, a C++ file defining algray::FUNCTION() (a list of EmbeddedFile) from FILES.
+# Script mode: writes OUTPUT, a C++ file defining algray::FUNCTION() (a list of EmbeddedFile) from FILES, each named
+# by its path under BASE_DIR when that is given, else by its file name.
 # Raw string literals are cut into chunks so no single literal exceeds compiler limits.
 set(chunk_size 4000)
 set(body "")
 foreach(path IN LISTS FILES)
-  get_filename_component(name "${path}" NAME)
+  if(BASE_DIR)
+    file(RELATIVE_PATH name "${BASE_DIR}" "${path}")
+  else()
+    get_filename_component(name "${path}" NAME)
+  endif()
   file(READ "${path}" text)
   string(LENGTH "${text}" len)
   set(literal "")

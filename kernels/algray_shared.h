@@ -47,6 +47,26 @@ typedef cl_int algray_i32;
 #define ALGRAY_ORIGIN_POINT 4          /* shadow rays: P expanded once about their shared origin (point_form.h);
                                           other rays as ALGRAY_ORIGIN_EXTENT */
 
+/* Each kernel's arguments by name, in the order it declares them. The host sets them by these names
+ * (render/kernel_binder.h), never by position, and test_kernel_args reads every kernel's names back from the driver
+ * to hold each list to its kernel. REAL-typed arguments follow the build's precision; arguments a build does not
+ * use (the screen form's rows elsewhere, `undecided` outside adaptive builds) are still passed, and never read. */
+#define ALGRAY_EXTENT_ARG_NAMES(X) X(extent_centre) X(extent_inv_scale) X(extent_box_half) X(extent_kind)
+#define ALGRAY_SURFACE_ARG_NAMES(X) X(mono_exps) X(mono_coefs) X(mono_count) X(binomials) X(even_axes)
+#define ALGRAY_CAMERA_ARG_NAMES(X) X(ray_o00) X(ray_ou) X(ray_ov) X(ray_d00) X(ray_du) X(ray_dv)
+#define ALGRAY_SCREEN_ARG_NAMES(X) X(screen_rows) X(screen_row0) X(screen_t) X(xi_scale) X(xi_offset)
+#define ALGRAY_PRIMARY_ARG_NAMES(X)                                                                    \
+  ALGRAY_CAMERA_ARG_NAMES(X) ALGRAY_EXTENT_ARG_NAMES(X) ALGRAY_SURFACE_ARG_NAMES(X) ALGRAY_SCREEN_ARG_NAMES(X) X(tile_x0) \
+  X(tile_y0) X(tile_w) X(tile_h) X(out)
+#define ALGRAY_TRACE_ARG_NAMES(X) X(origins) X(directions) X(count) ALGRAY_EXTENT_ARG_NAMES(X) ALGRAY_SURFACE_ARG_NAMES(X) X(out)
+#define ALGRAY_SHADOW_ARG_NAMES(X)                                                                                   \
+  X(points) X(normals) X(point_count) X(light_points) X(light_count) X(offset) ALGRAY_EXTENT_ARG_NAMES(X)          \
+  ALGRAY_SURFACE_ARG_NAMES(X) X(occluded) X(rays_traced) X(undecided)
+#define ALGRAY_PROBE_ARG_NAMES(X)                                                                                  \
+  ALGRAY_CAMERA_ARG_NAMES(X) X(px) X(py) X(use_given_ray) X(given_o) X(given_d) ALGRAY_EXTENT_ARG_NAMES(X)            \
+  ALGRAY_SURFACE_ARG_NAMES(X) ALGRAY_SCREEN_ARG_NAMES(X) X(out) X(ray_out) X(events) X(values) X(capacity) X(event_count)
+#define ALGRAY_UNIVARIATE_ARG_NAMES(X) X(polys) X(count) X(binomials) X(out)
+
 /* Per-pixel result of the primary kernel; 32 bytes. */
 typedef struct {
   algray_f32 t_hi;      /* ray parameter of the hit along o + t*d (d not normalised); +inf on a miss */
@@ -86,9 +106,9 @@ typedef struct {
 #define ALGRAY_EVENT_CONFIRMED 8    /* adaptive precision: a flat-doubted root kept after all (confirm_flat_root).
                                        decision: 0 evaluated in float, 1 in float-float; values: P and its
                                        rounding bound at t - delta, then at t + delta. Decision 2: an
-                                       accept-doubted bracket kept (bernstein.h, bracket_settled), values P
+                                       accept-doubted bracket kept (methods/bernstein.h, bracket_settled), values P
                                        in float-float and its bound at the bracket's ends. Decision 3: a
-                                       discard-doubted interval settled (bernstein.h, discard_settled), values
+                                       discard-doubted interval settled (methods/bernstein.h, discard_settled), values
                                        P and its bound at the interval's ends */
 
 /* What an isolation found (kernels/isolation.h's Isolation.status) */

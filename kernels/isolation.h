@@ -228,19 +228,8 @@ int within_noise_at(SearchNoise* n, REAL value, REAL lo, REAL hi) {
 }
 #endif
 
-/* The scalar isolation is handed the ray's terms (RayTerms in restrict.h) in adaptive builds, nothing in others;
- * TERMS_OUT passes segment_coefficients where to put them. */
-#if ALGRAY_ESCALATE
-#define TERMS_PARAM , RayTerms* terms
-#define TERMS_ARG , terms
-#define TERMS_OUT_PARAM , RayTerms* terms
-#define TERMS_OUT(p) , p
-#else
-#define TERMS_PARAM
-#define TERMS_ARG
-#define TERMS_OUT_PARAM
-#define TERMS_OUT(p)
-#endif
+/* Every isolation takes the ray's terms (RayTerms in restrict.h), which adaptive builds measure their noise by and
+ * others never read: callers outside adaptive builds may pass a RayTerms they never filled. */
 
 /* The smaller |P| at the interval's ends that counts (c_0 and c_n are P's values there). */
 REAL smaller_end(const REAL* c, REAL lo) {
@@ -250,7 +239,7 @@ REAL smaller_end(const REAL* c, REAL lo) {
 /* Ends the search undecided for `reason` when |value| is within the noise on the current interval
  * (within_noise_at); returns 1 then. Other builds compute none of its arguments. */
 #if ALGRAY_ESCALATE
-int doubted(Isolation* iso, uint reason, REAL value, SearchNoise* noise, int level PROBE_PARAM) {
+int doubted(Isolation* iso, uint reason, REAL value, SearchNoise* noise, int level, ProbeLog* probe_log) {
   if (!within_noise_at(noise, value, iso->lo, iso->hi)) return 0;
   PROBE(ALGRAY_EVENT_DOUBT, 0, reason, (uint)level, iso->lo, iso->hi, value, noise->noise);
   iso->doubt = reason;
@@ -265,9 +254,8 @@ Isolation isolation_found(Isolation iso, SearchNoise* noise) {
   return iso;
 }
 #else
-/* Named parameters: OpenCL C before 3.0 has no variadic macros (NVIDIA's compiler refuses them). The probe's
- * extra argument rides inside `level`, as the call sites write `level PROBE_ARG`. */
-#define doubted(iso, reason, value, noise, level) 0
+/* Named parameters: OpenCL C before 3.0 has no variadic macros (NVIDIA's compiler refuses them). */
+#define doubted(iso, reason, value, noise, level, probe_log) 0
 #define isolation_found(iso, noise) (iso)
 #endif
 
@@ -301,7 +289,7 @@ int crossed_at_left_end(Isolation* iso, int start_sign) {
 
 /* The checks every subdividing method makes first on an interval (iso.lo, iso.f_lo set): P exactly zero at its
  * left end, or of the other sign there than at t_in. Returns 1 when it settled iso->status. */
-int settled_at_left_end(Isolation* iso, int start_sign, int level PROBE_PARAM) {
+int settled_at_left_end(Isolation* iso, int start_sign, int level, ProbeLog* probe_log) {
   if (iso->f_lo == 0) {
     PROBE_STEP(*iso, -1, ALGRAY_STEP_EXACT_ZERO, level);
     iso->status = ISOLATION_EXACT;
@@ -318,7 +306,7 @@ int settled_at_left_end(Isolation* iso, int start_sign, int level PROBE_PARAM) {
 #define INTERVAL_HALVE 0   /* halve it: go one level down, left half first */
 #define INTERVAL_SETTLED 1 /* a cluster with a sign change: iso->status is set */
 #define INTERVAL_NEXT 2    /* a cluster without one: go on to the next interval */
-int halve_or_settle(Isolation* iso, int count, int level, REAL width, REAL t_in, REAL len PROBE_PARAM) {
+int halve_or_settle(Isolation* iso, int count, int level, REAL width, REAL t_in, REAL len, ProbeLog* probe_log) {
   const int located = interval_located(width, iso->lo, t_in, len);
   if (!located && level < REAL_MAX_HALVINGS) {
     PROBE_STEP(*iso, count, ALGRAY_STEP_SPLIT, level);
@@ -334,7 +322,7 @@ int halve_or_settle(Isolation* iso, int count, int level, REAL width, REAL t_in,
 
 /* Every interval has been searched. They are half open, so the far end is the one point left: a root when
  * `zero` (P there is f_end). */
-Isolation isolation_at_far_end(Isolation iso, int zero, REAL f_end PROBE_PARAM) {
+Isolation isolation_at_far_end(Isolation iso, int zero, REAL f_end, ProbeLog* probe_log) {
   iso.status = zero ? ISOLATION_EXACT : ISOLATION_NONE;
   PROBE(ALGRAY_EVENT_STEP, -1, zero ? ALGRAY_STEP_END_ZERO : ALGRAY_STEP_END_NONE, 0u, (REAL)1, (REAL)1, f_end, f_end);
   iso.lo = iso.hi = 1;

@@ -13,11 +13,13 @@
  * The polynomial is given in unit coordinates u = (p - centre) * inv_scale, with max |coefficient| = 1.
  * binomials[n * (DEGREE + 1) + k] = C(n, k) for 0 <= k <= n <= DEGREE (zero elsewhere).
  * even_axes: bit 0, 1, 2 set when every exponent of x, y, z in the polynomial is even.
- * Screen builds also take the image rows' polynomials (SCREEN_ROWS_PARAM, surface.h). */
+ * screen_rows .. xi_offset: the image rows' polynomials of the screen form (surface.h), which other builds never
+ * read. The arguments are ALGRAY_PRIMARY_ARG_NAMES (algray_shared.h), by which the host sets them. */
 __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, REAL4 ray_du, REAL4 ray_dv,
                       REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
                       __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
-                      __constant const REAL* binomials, uint even_axes SCREEN_ROWS_PARAM, uint tile_x0, uint tile_y0,
+                      __constant const REAL* binomials, uint even_axes, __global const REAL* screen_rows,
+                      uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset, uint tile_x0, uint tile_y0,
                       uint tile_w, uint tile_h, __global HitRecord* out) {
 #if LANES == 1
   const uint gx = get_global_id(0), gy = get_global_id(1);
@@ -25,12 +27,13 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
   const uint px = tile_x0 + gx, py = tile_y0 + gy;
 
   const Ray ray = camera_ray(px, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
+  REAL taylor[NCOEF], taylor_t = 0;
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
-  REAL taylor[NCOEF];
-  const REAL taylor_t = screen_ray_taylor(px, py, SCREEN_ROWS_ARG, taylor);
+  taylor_t = screen_ray_taylor(px, py, screen_rows, screen_row0, screen_t, xi_scale, xi_offset, taylor);
 #endif
   const SurfaceHit hit = trace_surface(ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                       mono_exps, mono_coefs, mono_count, binomials, even_axes SCREEN_ARG);
+                                       mono_exps, mono_coefs, mono_count, binomials, even_axes, taylor, taylor_t,
+                                       NO_PROBE);
   out[(size_t)gy * tile_w + gx] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
 #else
   /* LANES pixels of a row per work-item, traced together (trace_lanes). Global size (ceil(tile_w / LANES),
@@ -43,7 +46,7 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
   HitRecord records[LANES];
   const int entered = trace_lanes(count, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
                                   mono_exps, mono_coefs, mono_count, binomials, even_axes,
-                                  records SCREEN_LANES_ARG(tile_x0 + x0, py));
+                                  records, tile_x0 + x0, py, screen_rows, screen_row0, screen_t, xi_scale, xi_offset);
   for (uint j = 0; j < count; ++j) out[(size_t)gy * tile_w + x0 + j] = entered ? records[j] : missed_record();
 #endif
 }

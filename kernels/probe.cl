@@ -12,13 +12,15 @@
  * kernel builds it, or, with use_given_ray, given_o + t * given_d (world coordinates, as the trace kernel takes
  * rays). out gets the hit record the render would write; ray_out the ray (origin, direction) that was traced;
  * events and values the log (see ALGRAY_EVENT_* in algray_shared.h); event_count[0] how many events were
- * offered, which may exceed capacity. Screen builds also take the rows of the primary kernel (surface.h), of
- * which the host passes py's alone. */
+ * offered, which may exceed capacity. screen_rows .. xi_offset: the rows of the primary kernel's screen form
+ * (surface.h), of which the host passes py's alone; other builds never read them. The arguments are
+ * ALGRAY_PROBE_ARG_NAMES (algray_shared.h), by which the host sets them. */
 __kernel void probe(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, REAL4 ray_du, REAL4 ray_dv, uint px,
                     uint py, int use_given_ray, REAL4 given_o, REAL4 given_d, REAL4 extent_centre,
                     REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind, __global const uint* mono_exps,
-                    __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials, uint even_axes
-                    SCREEN_ROWS_PARAM, __global HitRecord* out, __global REAL4* ray_out, __global ProbeEvent* events,
+                    __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials, uint even_axes,
+                    __global const REAL* screen_rows, uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset,
+                    __global HitRecord* out, __global REAL4* ray_out, __global ProbeEvent* events,
                     __global REAL* values, uint capacity, __global uint* event_count) {
   if (get_global_id(0) != 0) return;
   Ray ray;
@@ -34,13 +36,14 @@ __kernel void probe(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, RE
   log.capacity = capacity;
   log.count = 0;
   ProbeLog* probe_log = &log;
-#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
   /* Camera rays only: the host probes a given ray with the trace kernel's construction (RAY_ORIGIN=extent). */
-  REAL taylor[NCOEF];
-  const REAL taylor_t = screen_ray_taylor(px, py, SCREEN_ROWS_ARG, taylor);
+  REAL taylor[NCOEF], taylor_t = 0;
+#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
+  taylor_t = screen_ray_taylor(px, py, screen_rows, screen_row0, screen_t, xi_scale, xi_offset, taylor);
 #endif
   const SurfaceHit hit = trace_surface(ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                       mono_exps, mono_coefs, mono_count, binomials, even_axes SCREEN_ARG PROBE_ARG);
+                                       mono_exps, mono_coefs, mono_count, binomials, even_axes, taylor, taylor_t,
+                                       probe_log);
   out[0] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
   ray_out[0] = (REAL4)(ray.o, 0);
   ray_out[1] = (REAL4)(ray.d, 0);

@@ -5,17 +5,18 @@
 #include "algray_shared.h"
 #include "real.h"
 
-/* The hooks are macros, and the log travels as an extra trailing parameter (PROBE_PARAM / PROBE_ARG), so that a
- * render build contains no trace of them: the probe runs the render's solver code with the recording added, and
- * nothing it records is computed unless it is recording. */
-#if ALGRAY_PROBE
+/* The log is a parameter of every function that records (ProbeLog* probe_log), always passed: render kernels pass
+ * NO_PROBE, and with ALGRAY_PROBE 0 the hooks are ((void)probe_log), so a render build contains no trace of them.
+ * The hooks are macros so that nothing they record is computed unless the probe is recording. */
 typedef struct {
   __global ProbeEvent* events;
   __global REAL* values; /* 4 per event */
   uint capacity;
   uint count; /* events offered, which may exceed capacity: the host reports the overflow */
 } ProbeLog;
+#define NO_PROBE ((ProbeLog*)0)
 
+#if ALGRAY_PROBE
 void probe_record(ProbeLog* log, uint kind, int count, uint decision, uint level, REAL a, REAL b, REAL c, REAL d) {
   const uint i = log->count++;
   if (i >= log->capacity) return;
@@ -31,14 +32,10 @@ void probe_record(ProbeLog* log, uint kind, int count, uint decision, uint level
   log->values[4 * i + 3] = d;
 }
 
-#define PROBE_PARAM , ProbeLog *probe_log
-#define PROBE_ARG , probe_log
 #define PROBE(kind, count, decision, level, a, b, c, d) \
   probe_record(probe_log, kind, count, decision, level, a, b, c, d)
 #else
-#define PROBE_PARAM
-#define PROBE_ARG
-#define PROBE(kind, count, decision, level, a, b, c, d) ((void)0)
+#define PROBE(kind, count, decision, level, a, b, c, d) ((void)probe_log)
 #endif
 
 /* One isolation step on the interval iso describes. */

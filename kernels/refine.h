@@ -48,7 +48,7 @@ int value_within_rounding(const REAL* c, REAL y, REAL fy, REAL scale) {
  * bracket's end of the other sign c, and the other end a; the stopping rule then decides as always. Without a
  * start, the secant of the ends is the first step, as the paper has it. */
 LREAL refine_root_lanes(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL scale, LREAL start, LMASK running,
-                        LMASK* iterations PROBE_PARAM) {
+                        LMASK* iterations, ProbeLog* probe_log) {
   /* b: best estimate; c_: contrapoint, f(c_) of the other sign; a: the previous b. */
   LREAL a = 0, fa = f0, b = 1, fb = f1, cp = 0, fc = f0;
   LMASK done = !running;
@@ -117,15 +117,17 @@ LREAL refine_root_lanes(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL s
 }
 
 #if LANES == 1
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations PROBE_PARAM) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations,
+                 ProbeLog* probe_log) {
   LMASK it;
-  const REAL y = refine_root_lanes(c, f0, f1, tol_y, scale, start, 1, &it PROBE_ARG);
+  const REAL y = refine_root_lanes(c, f0, f1, tol_y, scale, start, 1, &it, probe_log);
   *iterations = (uint)it;
   return y;
 }
 #endif
 #elif REFINEMENT == ALGRAY_REFINEMENT_BISECTION
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations PROBE_PARAM) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations,
+                 ProbeLog* probe_log) {
   (void)start; /* the paper's start */
   REAL lo = 0, hi = 1, flo = f0;
   (void)f1;
@@ -156,7 +158,8 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL s
  * good, so the bracket never shrinks below the stopping width and only |P*| <= eps_m or the iteration cap
  * stops it (the paper's Barth decic defects). The Illinois variant halves the value kept at an end that has
  * survived twice in a row, which breaks that one-sidedness. */
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations PROBE_PARAM) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations,
+                 ProbeLog* probe_log) {
   (void)start; /* the paper's start */
   REAL a = 0, fa = f0, b = 1, fb = f1, x = fabs(f0) < fabs(f1) ? (REAL)0 : (REAL)1;
   int kept = 0; /* +1: a survived the last step(s), -1: b did */
@@ -195,7 +198,8 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL s
 /* Newton's method inside the bracket: a step that would leave it, or that fails to halve |P*|, is replaced by
  * bisection, so it converges like bisection at worst and quadratically near a simple root. Needs
  * isolated_value_slope(c, y, &slope) from the isolation method. */
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations PROBE_PARAM) {
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations,
+                 ProbeLog* probe_log) {
   (void)start; /* the paper's start */
   REAL a = 0, b = 1, fa = f0;
   REAL x = fabs(f0) < fabs(f1) ? (REAL)0 : (REAL)1, slope;

@@ -53,7 +53,6 @@ AxisFactor axis_factor(REAL l0, REAL l1, int even) {
   return f;
 }
 
-#if ALGRAY_ESCALATE
 /* The size of the terms P*(s)'s coefficients are sums of, for the coordinates' factors fx, fy, fz (their l0, l1:
  * the coordinate at the segment's ends, Bernstein form): sum_m |a_m| X^i Y^j Z^k, X = max(|l0|, |l1|) of x and so
  * on. It bounds each monomial's Bernstein coefficients on the segment, so every coefficient of P* is computed to a
@@ -79,6 +78,8 @@ typedef struct {
   REAL3 o, d;
   REAL t_in, t_out;
 } RayTerms;
+
+#if ALGRAY_ESCALATE
 
 /* Terms of a known size (exact from the start): coefficients given as they are. */
 RayTerms known_terms(REAL value) {
@@ -250,7 +251,7 @@ ALGRAY_INLINE void poly_set_constant(REAL* c, REAL a) {
 #define ACC_WIDTH 8
 typedef REAL8 PolyVec;
 #define VEC_SHIFT(c) ((PolyVec)((REAL)0, (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6))
-/* The other way, lane k from lane k + 1: de Casteljau's halving (bernstein.h). */
+/* The other way, lane k from lane k + 1: de Casteljau's halving (methods/bernstein.h). */
 #define VEC_SHIFT_DOWN(c) ((PolyVec)((c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6, (c).s7, (REAL)0))
 #define VEC_LOAD(p) vload8(0, p)
 #define VEC_STORE(v, p) vstore8(v, 0, p)
@@ -295,7 +296,7 @@ typedef struct {
 ALGRAY_INLINE Acc acc_sum(Acc x, Acc y) {
   const PolyVec s = x.hi + y.hi;
   const PolyVec bb = s - x.hi;
-  /* the low parts summed apart from the two-sum's chain, as in ff_combine (bernstein.h): 5% of the Endrass octic's
+  /* the low parts summed apart from the two-sum's chain, as in ff_combine (bernstein): 5% of the Endrass octic's
    * mixed render */
   const PolyVec e = ((x.hi - (s - bb)) + (y.hi - bb)) + (x.lo + y.lo);
   Acc r;

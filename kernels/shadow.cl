@@ -22,10 +22,7 @@
 #error "the screen form is for camera rays; the host builds this kernel with RAY_ORIGIN=extent or point"
 #endif
 
-#if RAY_ORIGIN == ALGRAY_ORIGIN_POINT
-/* The point form (point_form.h): the arguments and the result are the extent form's below. */
-__kernel void shadow(SHADOW_KERNEL_PARAMS) { shadow_point_form_item(SHADOW_KERNEL_ARGS); }
-#else
+#if RAY_ORIGIN != ALGRAY_ORIGIN_POINT
 
 #if ALGRAY_ESCALATE
 /* C(DEGREE, k): a constant wherever k is one (the loops below unroll), so no division is left at run time. */
@@ -113,8 +110,9 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
   if (by_signs >= 0) return by_signs != ISOLATION_NONE;
 #endif
 #endif
+  RayTerms terms;
 #if ALGRAY_ESCALATE
-  RayTerms terms = ray_terms(exps, coefs, count, fx, fy, fz);
+  terms = ray_terms(exps, coefs, count, fx, fy, fz);
   if (by_signs >= 0 && (signs_clear_of(root, by_signs, scale, terms.value) ||
                         signs_clear_of(root, by_signs, scale, ray_terms_exact(&terms))))
     return by_signs != ISOLATION_NONE;
@@ -129,14 +127,16 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
 #endif
   REAL iso_c[NCOEF];
 #if SHADOW_SAMPLED
-  restricted_to_isolation_basis(root, root_lo, binomials);
-  const Isolation iso = shadow_isolation(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(&terms));
+  restricted_to_isolation_basis(root, root_lo, binomials, NO_PROBE);
+  const Isolation iso = shadow_isolation(root, root_lo, t_in, t_out, binomials, iso_c, &terms);
 #else
-  const Isolation iso = isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(&terms));
+  const Isolation iso = isolate_restricted(root, root_lo, t_in, t_out, binomials, iso_c, &terms, NO_PROBE);
 #endif
   *doubt = iso.doubt;
   return iso.status != ISOLATION_NONE;
 }
+
+#endif
 
 /* One work-item per surface point. points[i].xyz is the point (world), normals[i].xyz its unit normal on the
  * side the camera sees; light_points[0 .. light_count) are the light's sample points. Bit s of occluded[i]
@@ -145,10 +145,24 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
  * not traced again. The shadow ray stops at the first evidence of a root, an isolating interval, and never
  * refines it. offset: how far the origin moves along the normal, in world units. rays_traced counts the
  * shadow rays that reached the root isolation, for the render statistics.
- * Adaptive builds also set bit s of undecided[i] where the float search doubted sample s (SHADOW_UNDECIDED).
+ * Adaptive builds also set bit s of undecided[i] where the float search doubted sample s; others never touch it.
  * The answers are shadow_serial's, bit for bit: the segments are restricted RESTRICT_RAYS at a time, each
- * with the operations it would get alone, and the shortcuts return what the search would. */
-__kernel void shadow(SHADOW_KERNEL_PARAMS) {
+ * with the operations it would get alone, and the shortcuts return what the search would. The point form
+ * (point_form.h) takes the same arguments and gives the same answers. The arguments are ALGRAY_SHADOW_ARG_NAMES
+ * (algray_shared.h), by which the host sets them. */
+__kernel void shadow(__global const REAL4* points, __global const float4* normals, uint point_count,
+                     __global const REAL4* light_points, uint light_count, REAL offset, REAL4 extent_centre,
+                     REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind, __global const uint* mono_exps,
+                     __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
+                     uint even_axes, __global ulong* occluded, __global uint* rays_traced,
+                     __global ulong* undecided) {
+#if RAY_ORIGIN == ALGRAY_ORIGIN_POINT
+  (void)even_axes;
+  (void)undecided;
+  shadow_point_form_item(points, normals, point_count, light_points, light_count, offset, extent_centre,
+                         extent_inv_scale, extent_box_half, extent_kind, mono_exps, mono_coefs, mono_count, binomials,
+                         occluded, rays_traced);
+#else
   const uint i = get_global_id(0);
   if (i >= point_count) return;
   REAL3 p, n, o, o_unit;
@@ -207,7 +221,7 @@ __kernel void shadow(SHADOW_KERNEL_PARAMS) {
     pending = 0;
   }
   occluded[i] = mask;
-  SHADOW_UNDECIDED(i, unsure);
+  if (ALGRAY_ESCALATE) undecided[i] = unsure;
   if (traced) atomic_add(rays_traced, traced);
+#endif
 }
-#endif /* RAY_ORIGIN == ALGRAY_ORIGIN_POINT */

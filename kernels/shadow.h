@@ -35,31 +35,6 @@ void shadow_origin(__global const REAL4* points, __global const float4* normals,
   *o_unit = (*o - extent_centre.xyz) * extent_inv_scale;
 }
 
-/* The kernels' common arguments and the work-item's surface point: see shadow.cl. */
-#define SHADOW_KERNEL_PARAMS                                                                                         \
-  __global const REAL4 *points, __global const float4 *normals, uint point_count, __global const REAL4 *light_points, \
-      uint light_count, REAL offset, REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half,              \
-      int extent_kind, __global const uint *mono_exps, __global const REAL *mono_coefs, uint mono_count,             \
-      __constant const REAL *binomials, uint even_axes, __global ulong *occluded,                                \
-      __global uint *rays_traced SHADOW_UNDECIDED_PARAM
-
-/* The same arguments, passed on. */
-#define SHADOW_KERNEL_ARGS                                                                                          \
-  points, normals, point_count, light_points, light_count, offset, extent_centre, extent_inv_scale, extent_box_half, \
-      extent_kind, mono_exps, mono_coefs, mono_count, binomials, even_axes, occluded, rays_traced SHADOW_UNDECIDED_ARG
-
-/* Adaptive builds take one more argument, undecided: per surface point, the samples whose shadow rays the
- * float search doubted, which the host traces again in float-float. Other builds take nothing more. */
-#if ALGRAY_ESCALATE
-#define SHADOW_UNDECIDED_PARAM , __global ulong *undecided
-#define SHADOW_UNDECIDED_ARG , undecided
-#define SHADOW_UNDECIDED(i, mask) (undecided[i] = (mask))
-#else
-#define SHADOW_UNDECIDED_PARAM
-#define SHADOW_UNDECIDED_ARG
-#define SHADOW_UNDECIDED(i, mask) ((void)(mask))
-#endif
-
 /* The extent form's shadow rays with Bernstein isolation, in plain float, adaptive or double, look for a certain
  * sign change at a few points of the segment before the search (shadow_isolation). Mixed precision's answers
  * stay its float-float search's. */
@@ -70,7 +45,7 @@ void shadow_origin(__global const REAL4* points, __global const float4* normals,
 #endif
 
 #if SHADOW_SAMPLED
-#include "bernstein.h"
+#include "methods/bernstein.h"
 #include "isolation.h"
 
 /* How many pieces a shadow ray's segment is sampled in before its search: values at 0, 1/n, ..., 1. Measured on
@@ -87,7 +62,7 @@ void shadow_origin(__global const REAL4* points, __global const float4* normals,
  * then P* has a root between them whatever the rounding, and the shadow ray is hidden however a search would
  * go. Inside, the value is Horner's on sum_k C(n,k) b_k u^k, u = s / (1 - s): P*(s) / (1 - s)^n, of P*'s sign,
  * which an error e in every b_k moves by at most e (1 + u)^n. pieces: at most SHADOW_DOUBT_PIECES. */
-ALGRAY_INLINE int sampled_sign_change(const REAL* b, int pieces, __constant const REAL* binomials TERMS_PARAM) {
+ALGRAY_INLINE int sampled_sign_change(const REAL* b, int pieces, __constant const REAL* binomials, RayTerms* terms) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   /* sure[j]: the part of value j's magnitude that its rounding cannot take away, with its sign; scale[j] turns a
    * coefficient's error into the value's */
@@ -144,15 +119,15 @@ ALGRAY_INLINE int sampled_sign_change(const REAL* b, int pieces, __constant cons
  * sampled_sign_change finds one, else the search's; in builds that settle doubts by signs, a doubt settled as a
  * root where a finer sampling finds one. What shadow and shadow_serial both answer. */
 Isolation shadow_isolation(const REAL* b, const REAL* b_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
-                           REAL* iso_c TERMS_PARAM) {
+                           REAL* iso_c, RayTerms* terms) {
   Isolation iso = isolation_none();
-  if (sampled_sign_change(b, SHADOW_SAMPLE_PIECES, binomials TERMS_ARG)) {
+  if (sampled_sign_change(b, SHADOW_SAMPLE_PIECES, binomials, terms)) {
     iso.status = ISOLATION_BRACKET;
     return iso;
   }
-  iso = isolate_bernstein(b, b_lo, t_in, t_out, iso_c TERMS_ARG); /* leaves b as it was */
+  iso = isolate_bernstein(b, b_lo, t_in, t_out, iso_c, terms, NO_PROBE); /* leaves b as it was */
 #if ALGRAY_ESCALATE && ALGRAY_SETTLE_DOUBTS
-  if (iso.doubt && sampled_sign_change(b, SHADOW_DOUBT_PIECES, binomials TERMS_ARG)) {
+  if (iso.doubt && sampled_sign_change(b, SHADOW_DOUBT_PIECES, binomials, terms)) {
     iso.doubt = 0;
     iso.status = ISOLATION_BRACKET;
   }
@@ -162,7 +137,7 @@ Isolation shadow_isolation(const REAL* b, const REAL* b_lo, REAL t_in, REAL t_ou
 #endif
 
 #if RAY_ORIGIN == ALGRAY_ORIGIN_POINT
-#include "bernstein.h"
+#include "methods/bernstein.h"
 #include "point_form.h"
 
 #if ALGRAY_ESCALATE || ALGRAY_COMPENSATED || ISOLATION != ALGRAY_ISOLATION_BERNSTEIN
@@ -261,12 +236,13 @@ ulong search_queued(SearchQueue* queue) {
 #if LANES > 1
   LMASK running = lanes_of_bits((1u << queue->count) - 1);
   LaneIsolation iso;
-  isolate_bernstein_lanes(running, queue->b, queue->t_in, queue->t_out, &iso, cur);
+  isolate_bernstein_lanes(running, queue->b, queue->t_in, queue->t_out, &iso, cur, (const LaneTerms*)0);
   const uint found_bits = lane_mask_bits(running && iso.status != (REAL)ISOLATION_NONE);
   for (uint j = 0; j < queue->count; ++j)
     if ((found_bits >> j) & 1u) found |= (ulong)1 << queue->sample[j];
 #else
-  if (isolate_bernstein(queue->b, queue->b, queue->t_in, queue->t_out, cur).status != ISOLATION_NONE)
+  if (isolate_bernstein(queue->b, queue->b, queue->t_in, queue->t_out, cur, (RayTerms*)0, NO_PROBE).status !=
+      ISOLATION_NONE)
     found = (ulong)1 << queue->sample[0];
 #endif
   queue->count = 0;
@@ -350,10 +326,14 @@ ulong shadow_mask_point_form(__global const REAL4* points, __global const float4
 
 /* One work-item of the point form's kernels (shadow.cl, and shadow_serial.cl with one lane): surface point i's
  * mask, and its traced rays counted. */
-void shadow_point_form_item(SHADOW_KERNEL_PARAMS) {
+/* The point form's work-item of the shadow kernels, whose arguments these are (shadow.cl). */
+void shadow_point_form_item(__global const REAL4* points, __global const float4* normals, uint point_count,
+                            __global const REAL4* light_points, uint light_count, REAL offset, REAL4 extent_centre,
+                            REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
+                            __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
+                            __constant const REAL* binomials, __global ulong* occluded, __global uint* rays_traced) {
   const uint i = get_global_id(0);
   if (i >= point_count) return;
-  (void)even_axes;
   uint traced = 0;
   occluded[i] = shadow_mask_point_form(points, normals, i, light_points, light_count, offset, extent_centre,
                                        extent_inv_scale, extent_box_half, extent_kind, mono_exps, mono_coefs,

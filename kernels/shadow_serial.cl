@@ -13,14 +13,24 @@
 #error "the screen form is for camera rays; the host builds this kernel with RAY_ORIGIN=extent"
 #endif
 
-/* The arguments and the result are shadow's (shadow.cl). */
-__kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
-#if RAY_ORIGIN == ALGRAY_ORIGIN_POINT
-  /* The point form one ray at a time: shadow.cl's code built with one lane. */
-#if LANES != 1
+#if RAY_ORIGIN == ALGRAY_ORIGIN_POINT && LANES != 1
 #error "shadow_serial is built with one lane"
 #endif
-  shadow_point_form_item(SHADOW_KERNEL_ARGS);
+
+/* The arguments and the result are shadow's (shadow.cl): ALGRAY_SHADOW_ARG_NAMES (algray_shared.h). */
+__kernel void shadow_serial(__global const REAL4* points, __global const float4* normals, uint point_count,
+                            __global const REAL4* light_points, uint light_count, REAL offset, REAL4 extent_centre,
+                            REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
+                            __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
+                            __constant const REAL* binomials, uint even_axes, __global ulong* occluded,
+                            __global uint* rays_traced, __global ulong* undecided) {
+#if RAY_ORIGIN == ALGRAY_ORIGIN_POINT
+  /* The point form one ray at a time: shadow.cl's code built with one lane. */
+  (void)even_axes;
+  (void)undecided;
+  shadow_point_form_item(points, normals, point_count, light_points, light_count, offset, extent_centre,
+                         extent_inv_scale, extent_box_half, extent_kind, mono_exps, mono_coefs, mono_count, binomials,
+                         occluded, rays_traced);
 #else
   const uint i = get_global_id(0);
   if (i >= point_count) return;
@@ -42,21 +52,19 @@ __kernel void shadow_serial(SHADOW_KERNEL_PARAMS) {
 #if SHADOW_SAMPLED
     /* isolate_on_segment's two steps, the search's through shadow_isolation (shadow.h) */
     REAL root[NCOEF], root_lo[NCOEF];
-#if ALGRAY_ESCALATE
     RayTerms terms;
-#endif
     segment_coefficients(o_unit, d_unit, t_in, t_out, mono_exps, mono_coefs, mono_count, binomials, even_axes, root,
-                         root_lo TERMS_OUT(&terms));
-    const Isolation iso = shadow_isolation(root, root_lo, t_in, t_out, binomials, iso_c TERMS_OUT(&terms));
+                         root_lo, &terms, 0, 0, NO_PROBE);
+    const Isolation iso = shadow_isolation(root, root_lo, t_in, t_out, binomials, iso_c, &terms);
 #else
     const Isolation iso = isolate_on_segment(o_unit, d_unit, t_in, t_out, mono_exps, mono_coefs, mono_count,
-                                             binomials, even_axes, iso_c);
+                                             binomials, even_axes, iso_c, 0, 0, NO_PROBE);
 #endif
     if (iso.status != ISOLATION_NONE) mask |= bit;
     if (iso.doubt) unsure |= bit;
   }
   occluded[i] = mask;
-  SHADOW_UNDECIDED(i, unsure);
+  if (ALGRAY_ESCALATE) undecided[i] = unsure;
   if (traced) atomic_add(rays_traced, traced);
 #endif
 }

@@ -21,19 +21,11 @@
 #error "RAY_ORIGIN=screen is built in plain float or double"
 #endif
 
-/* The screen form hands each camera ray's Taylor coefficients, about t = taylor_t, to the solver; other builds
- * take nothing more. */
+/* The screen form hands each camera ray's Taylor coefficients, about t = taylor_t, to the solver (taylor and
+ * taylor_t, which other builds pass as 0 and never read). Its kernels take the image rows' polynomials:
+ * screen_rows[(py - screen_row0) * NCOEF * NCOEF + j * NCOEF + k] is the xi^j coefficient of row py's taylor[k],
+ * expanded about t = screen_t; a pixel's xi = (px + 1/2) * xi_scale + xi_offset. */
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
-#define SCREEN_PARAM , const REAL *taylor, REAL taylor_t
-#define SCREEN_ARG , taylor, taylor_t
-/* The kernel arguments of the screen form: rows[(py - row0) * NCOEF * NCOEF + j * NCOEF + k] is the xi^j
- * coefficient of row py's taylor[k], expanded about t = taylor_t; a pixel's xi = (px + 1/2) * xi_scale + xi_offset. */
-#define SCREEN_ROWS_PARAM \
-  , __global const REAL *screen_rows, uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset
-#define SCREEN_ROWS_ARG screen_rows, screen_row0, screen_t, xi_scale, xi_offset
-/* A group of lanes (trace_lanes) is LANES pixels of one row from px0 on, whose Taylor coefficients it takes. */
-#define SCREEN_LANES_PARAM , uint px0, uint py SCREEN_ROWS_PARAM
-#define SCREEN_LANES_ARG(px0, py) , px0, py, SCREEN_ROWS_ARG
 
 /* The xi of a pixel column whose centre is `centre` ((REAL)px + 0.5, as camera_ray's), where its row's polynomials
  * are evaluated; of one column or of lanes (lane_pixel_centres). */
@@ -54,12 +46,6 @@ REAL screen_ray_taylor(uint px, uint py, __global const REAL* rows, uint row0, R
   screen_taylor(screen_row(rows, py, row0), screen_column(px, xi_scale, xi_offset), taylor);
   return t0;
 }
-#else
-#define SCREEN_PARAM
-#define SCREEN_ARG
-#define SCREEN_ROWS_PARAM
-#define SCREEN_LANES_PARAM
-#define SCREEN_LANES_ARG(px0, py)
 #endif
 
 /* The outcome of isolating and refining the smallest root of P*(t) on [t_in, t_out]. */
@@ -85,12 +71,12 @@ typedef struct {
 
 /* The probe records the coefficients the isolation starts from, in its basis; a render build has no such call. */
 #if ALGRAY_PROBE
-void probe_coefficients(const REAL* c, const REAL* c_lo, uint basis PROBE_PARAM) {
+void probe_coefficients(const REAL* c, const REAL* c_lo, uint basis, ProbeLog* probe_log) {
   for (int k = 0; k <= DEGREE; ++k)
     PROBE(ALGRAY_EVENT_COEFFICIENT, k, basis, 0u, c[k], ALGRAY_COMPENSATED ? c_lo[k] : (REAL)0, (REAL)0, (REAL)0);
 }
 #else
-#define probe_coefficients(c, c_lo, basis) ((void)0)
+#define probe_coefficients(c, c_lo, basis, probe_log) ((void)0)
 #endif
 
 /* The refinement's stopping width in y on the isolating interval [lo, hi] of the segment [t_in, t_out] (lo and hi
@@ -123,7 +109,7 @@ ALGRAY_INLINE HitRecord missed_record(void) {
 }
 
 /* The record of what the isolation found, before refinement; a bracket (ISOLATION_BRACKET) is refined next. */
-SegmentRoot isolated_root(Isolation iso PROBE_PARAM) {
+SegmentRoot isolated_root(Isolation iso, ProbeLog* probe_log) {
   SegmentRoot r = missed_root();
   r.flags = iso.budget ? ALGRAY_HIT_BUDGET : 0u;
   r.steps = iso.steps;
@@ -160,7 +146,7 @@ void place_root(SegmentRoot* r, Isolation iso, REAL y, REAL t_in, REAL t_out) {
  * alike, so that both take the same operations. */
 #define FLAT_ROOT_MARGIN(slope, t, lo, hi, t_in, t_out) \
   (fabs(slope) * ALGRAY_DOUBT_POSITION * fabs(t) / (((hi) - (lo)) * ((t_out) - (t_in))))
-void doubt_flat_root(SegmentRoot* r, Isolation iso, const REAL* c, REAL y, REAL t_in, REAL t_out PROBE_PARAM) {
+void doubt_flat_root(SegmentRoot* r, Isolation iso, const REAL* c, REAL y, REAL t_in, REAL t_out, ProbeLog* probe_log) {
 #if ALGRAY_ESCALATE
   REAL slope;
   (void)isolated_value_slope(c, y, &slope);
@@ -181,8 +167,8 @@ void doubt_flat_root(SegmentRoot* r, Isolation iso, const REAL* c, REAL y, REAL 
 #if LANES == 1
 /* Refines what the isolation found; iso_c holds the polynomial on the isolating interval (consumed). */
 SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
-                            __constant const REAL* binomials PROBE_PARAM) {
-  SegmentRoot r = isolated_root(iso PROBE_ARG);
+                            __constant const REAL* binomials, ProbeLog* probe_log) {
+  SegmentRoot r = isolated_root(iso, probe_log);
   if (iso.status == ISOLATION_NONE) return r;
   REAL y = 0;
   const int refine = iso.status == ISOLATION_BRACKET;
@@ -195,11 +181,11 @@ SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
     (void)start;
     y = line_root(iso.f_lo, iso.f_hi);
 #else
-    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, start, &r.iterations PROBE_ARG);
+    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, start, &r.iterations, probe_log);
 #endif
   }
   place_root(&r, iso, y, t_in, t_out);
-  if (refine) doubt_flat_root(&r, iso, iso_c, y, t_in, t_out PROBE_ARG);
+  if (refine) doubt_flat_root(&r, iso, iso_c, y, t_in, t_out, probe_log);
   return r;
 }
 #else
@@ -232,7 +218,7 @@ void refine_lanes(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in,
     (void)start;
     y = LANE_SEL((LREAL)0, line_root(f0, f1), running);
 #else
-    y = LANE_SEL((LREAL)0, refine_root_lanes(c, f0, f1, tol_y, scale, start, running, &iterations), running);
+    y = LANE_SEL((LREAL)0, refine_root_lanes(c, f0, f1, tol_y, scale, start, running, &iterations, NO_PROBE), running);
 #endif
   }
   /* place_root, where the isolation found a root (a bracket refined, or one settled at an end: y = 0) */
@@ -274,16 +260,16 @@ void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, Ax
 #endif
 
 /* The restriction's result (scaled Bernstein coefficients, or a power basis) as the isolation method takes it. */
-void restricted_to_isolation_basis(REAL* root, REAL* root_lo, __constant const REAL* binomials PROBE_PARAM) {
+void restricted_to_isolation_basis(REAL* root, REAL* root_lo, __constant const REAL* binomials, ProbeLog* probe_log) {
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   bernstein_from_scaled(root, root_lo, binomials);
-  probe_coefficients(root, root_lo, ALGRAY_BASIS_BERNSTEIN PROBE_ARG);
+  probe_coefficients(root, root_lo, ALGRAY_BASIS_BERNSTEIN, probe_log);
 #elif RAY_ORIGIN == ALGRAY_ORIGIN_EYE
   (void)binomials;
-  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_EYE PROBE_ARG);
+  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_EYE, probe_log);
 #else
   (void)binomials;
-  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_SEGMENT PROBE_ARG);
+  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_SEGMENT, probe_log);
 #endif
 }
 
@@ -292,7 +278,8 @@ void restricted_to_isolation_basis(REAL* root, REAL* root_lo, __constant const R
 ALGRAY_INLINE void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
                                         __global const REAL* coefs, uint count, __constant const REAL* binomials,
                                         uint even_axes, REAL* root,
-                                        REAL* root_lo TERMS_OUT_PARAM SCREEN_PARAM PROBE_PARAM) {
+                                        REAL* root_lo, RayTerms* terms, const REAL* taylor, REAL taylor_t,
+                                        ProbeLog* probe_log) {
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
   /* The same coefficients the extent construction computes from the monomials, from D + 1 numbers instead. */
   (void)o;
@@ -321,21 +308,7 @@ ALGRAY_INLINE void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out,
   terms->t_out = t_out;
 #endif
 #endif
-  restricted_to_isolation_basis(root, root_lo, binomials PROBE_ARG);
-}
-
-/* The smallest root of segment_coefficients' polynomial (root, root_lo are consumed); iso_c gets the polynomial
- * on the isolating interval. */
-Isolation isolate_coefficients(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c TERMS_PARAM PROBE_PARAM) {
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c TERMS_ARG PROBE_ARG);
-#elif RAY_ORIGIN == ALGRAY_ORIGIN_EYE
-  (void)root_lo;
-  return isolate_power_basis(root, t_in, t_out - t_in, t_in, t_out, iso_c PROBE_ARG);
-#else
-  (void)root_lo;
-  return isolate_power_basis(root, (REAL)0, (REAL)1, t_in, t_out, iso_c PROBE_ARG);
-#endif
+  restricted_to_isolation_basis(root, root_lo, binomials, probe_log);
 }
 
 /* Isolates the smallest root of P*(t) on [t_in, t_out] for the ray o + t*d in unit coordinates; iso_c gets
@@ -343,14 +316,12 @@ Isolation isolate_coefficients(REAL* root, REAL* root_lo, REAL t_in, REAL t_out,
  * returns, the other only asks whether there is anything to refine. */
 Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
                              __global const REAL* coefs, uint count, __constant const REAL* binomials, uint even_axes,
-                             REAL* iso_c SCREEN_PARAM PROBE_PARAM) {
+                             REAL* iso_c, const REAL* taylor, REAL taylor_t, ProbeLog* probe_log) {
   REAL root[NCOEF], root_lo[NCOEF];
-#if ALGRAY_ESCALATE
   RayTerms terms;
-#endif
   segment_coefficients(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, root,
-                       root_lo TERMS_OUT(&terms) SCREEN_ARG PROBE_ARG);
-  return isolate_coefficients(root, root_lo, t_in, t_out, iso_c TERMS_OUT(&terms) PROBE_ARG);
+                       root_lo, &terms, taylor, taylor_t, probe_log);
+  return isolate_method(root, root_lo, t_in, t_out, iso_c, &terms, probe_log);
 }
 
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EXTENT
@@ -358,16 +329,16 @@ Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global c
  * factors (root, root_lo are consumed), as isolate_on_segment would; iso_c gets the polynomial on the isolating
  * interval. */
 Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
-                             REAL* iso_c TERMS_PARAM PROBE_PARAM) {
-  restricted_to_isolation_basis(root, root_lo, binomials PROBE_ARG);
-  return isolate_coefficients(root, root_lo, t_in, t_out, iso_c TERMS_ARG PROBE_ARG);
+                             REAL* iso_c, RayTerms* terms, ProbeLog* probe_log) {
+  restricted_to_isolation_basis(root, root_lo, binomials, probe_log);
+  return isolate_method(root, root_lo, t_in, t_out, iso_c, terms, probe_log);
 }
 #endif
 
 /* The start of trace_surface: the ray in unit coordinates (h->u, h->d_unit), clipped to the extent. Returns 0
  * when the ray misses the extent; *h is then the whole answer. */
 int enter_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, SurfaceHit* h, REAL* t_in,
-                  REAL* t_out PROBE_PARAM) {
+                  REAL* t_out, ProbeLog* probe_log) {
   h->root = missed_root();
   /* Unit coordinates keep every point of the extent within |u| <= 1: the conditioning step that makes float usable. */
   h->u = (ray.o - centre) * inv_scale;
@@ -412,10 +383,11 @@ ALGRAY_INLINE REAL3 lane_direction(const LaneRays* rays, uint j) {
  * on the segment (iso_c: the polynomial on the isolating interval). Returns 0 when the ray misses the extent. */
 int isolate_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, __global const uint* exps,
                     __global const REAL* coefs, uint count, __constant const REAL* binomials, uint even_axes,
-                    SurfaceHit* h, Isolation* iso, REAL* t_in, REAL* t_out, REAL* iso_c SCREEN_PARAM PROBE_PARAM) {
-  if (!enter_surface(ray, centre, inv_scale, box_half, extent_kind, h, t_in, t_out PROBE_ARG)) return 0;
+                    SurfaceHit* h, Isolation* iso, REAL* t_in, REAL* t_out, REAL* iso_c, const REAL* taylor,
+                    REAL taylor_t, ProbeLog* probe_log) {
+  if (!enter_surface(ray, centre, inv_scale, box_half, extent_kind, h, t_in, t_out, probe_log)) return 0;
   *iso = isolate_on_segment(h->u, h->d_unit, *t_in, *t_out, exps, coefs, count, binomials, even_axes,
-                            iso_c SCREEN_ARG PROBE_ARG);
+                            iso_c, taylor, taylor_t, probe_log);
   return 1;
 }
 
@@ -432,7 +404,7 @@ DEFINE_TERMS_SUM(terms_sum_lanes, LREAL)
  * (in_extent[j] == 0), are left alone. rays: the lanes' rays in unit coordinates, where adaptive builds' search
  * evaluates P in float-float (bracket_ends_in_float_float). */
 void isolate_lanes(uint count, const int* in_extent, const LaneRays* rays, REAL (*root)[NCOEF], REAL (*root_lo)[NCOEF],
-                   const REAL* t_in, const REAL* t_out, LaneIsolation* iso, LREAL* c TERMS_OUT_PARAM) {
+                   const REAL* t_in, const REAL* t_out, LaneIsolation* iso, LREAL* c, RayTerms* terms) {
   (void)rays; /* adaptive builds' search checks its accept doubts on them */
   for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
 #if ALGRAY_COMPENSATED
@@ -441,7 +413,7 @@ void isolate_lanes(uint count, const int* in_extent, const LaneRays* rays, REAL 
     if (!in_extent[j]) continue;
     REAL iso_c[NCOEF];
     set_lane_isolation(iso, j,
-                       isolate_coefficients(root[j], root_lo[j], t_in[j], t_out[j], iso_c TERMS_OUT(&terms[j])));
+                       isolate_method(root[j], root_lo[j], t_in[j], t_out[j], iso_c, &terms[j], NO_PROBE));
     for (int k = 0; k <= DEGREE; ++k) lane_set(&c[k], j, iso_c[k]);
   }
 #else
@@ -480,15 +452,15 @@ void isolate_lanes(uint count, const int* in_extent, const LaneRays* rays, REAL 
 #endif
   (void)lane_terms;
   if (LANE_ANY(running)) {
-#if ALGRAY_ESCALATE
     LaneTerms search_terms;
+#if ALGRAY_ESCALATE
     search_terms.value = lane_terms;
     search_terms.rays = rays;
     search_terms.exps = terms[first].exps;
     search_terms.coefs = terms[first].coefs;
     search_terms.count = terms[first].count;
 #endif
-    isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, iso, c TERMS_OUT(&search_terms));
+    isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, iso, c, &search_terms);
   }
 #endif
 }
@@ -548,7 +520,7 @@ LMASK confirmed_in_float_float(LMASK doubted, const LaneRays* r, LREAL t, __glob
 /* h: a found root (h->u its point), u the ray's start; clears the doubt when P's values confirm it, in float or
  * else in float-float (the probe's event says which: decision 0 or 1). */
 void confirm_flat_root(SurfaceHit* h, REAL3 u, __global const uint* exps, __global const REAL* coefs,
-                       uint count PROBE_PARAM) {
+                       uint count, ProbeLog* probe_log) {
   if ((h->root.flags & (ALGRAY_HIT_FOUND | ALGRAY_HIT_DOUBT)) != (ALGRAY_HIT_FOUND | ALGRAY_HIT_DOUBT)) return;
   const REAL delta = (REAL)ALGRAY_DOUBT_POSITION * fabs(h->root.t);
   REAL rounding0, rounding1;
@@ -568,23 +540,23 @@ void confirm_flat_root(SurfaceHit* h, REAL3 u, __global const uint* exps, __glob
   PROBE(ALGRAY_EVENT_CONFIRMED, 0, arithmetic, 0u, v0, rounding0, v1, rounding1);
   h->root.flags &= ~ALGRAY_HIT_DOUBT;
 }
-#define CONFIRM_FLAT_ROOT(h, u, exps, coefs, count) confirm_flat_root(h, u, exps, coefs, count PROBE_ARG)
 #else
-#define CONFIRM_FLAT_ROOT(h, u, exps, coefs, count) ((void)(u))
+#define confirm_flat_root(h, u, exps, coefs, count, probe_log) ((void)(u))
 #endif
 
 #if LANES == 1
 SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                          __global const uint* exps, __global const REAL* coefs, uint count,
-                         __constant const REAL* binomials, uint even_axes SCREEN_PARAM PROBE_PARAM) {
+                         __constant const REAL* binomials, uint even_axes, const REAL* taylor, REAL taylor_t,
+                         ProbeLog* probe_log) {
   SurfaceHit h;
   Isolation iso;
   REAL t_in, t_out, iso_c[NCOEF];
   if (isolate_surface(ray, centre, inv_scale, box_half, extent_kind, exps, coefs, count, binomials, even_axes, &h, &iso,
-                      &t_in, &t_out, iso_c SCREEN_ARG PROBE_ARG)) {
+                      &t_in, &t_out, iso_c, taylor, taylor_t, probe_log)) {
     const REAL3 start = h.u; /* finish_surface moves h.u to the root */
-    finish_surface(&h, refine_isolated(iso, iso_c, t_in, t_out, binomials PROBE_ARG));
-    CONFIRM_FLAT_ROOT(&h, start, exps, coefs, count);
+    finish_surface(&h, refine_isolated(iso, iso_c, t_in, t_out, binomials, probe_log));
+    confirm_flat_root(&h, start, exps, coefs, count, probe_log);
   }
   return h;
 }
@@ -757,7 +729,8 @@ ALGRAY_INLINE void screen_coefficients_lanes(__global const REAL* row, LREAL xi,
  * and secondary rays share it. */
 int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
                  __global const uint* exps, __global const REAL* coefs, uint mono_count,
-                 __constant const REAL* binomials, uint even_axes, HitRecord* records SCREEN_LANES_PARAM) {
+                 __constant const REAL* binomials, uint even_axes, HitRecord* records, uint px0, uint py,
+                 __global const REAL* screen_rows, uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset) {
   LaneIsolation iso;
   LaneRoots roots;
   LREAL iso_c[NCOEF], lane_t_in, lane_t_out;
@@ -776,7 +749,7 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
   /* lanes outside the extent start from zeros, as isolate_lanes gives them */
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) lane_root[k] = LANE_SEL((LREAL)0, lane_root[k], running);
-  isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, &iso, iso_c);
+  isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, &iso, iso_c, (const LaneTerms*)0);
 #else
   /* one ray at a time: each lane's segment and whether it entered */
   REAL t_in[LANES], t_out[LANES];
@@ -786,19 +759,17 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
   const uint entered_bits = lane_mask_bits(running);
   for (uint j = 0; j < LANES; ++j) in_extent[j] = (entered_bits >> j) & 1u;
   REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
-#if ALGRAY_ESCALATE
   RayTerms terms[LANES];
-#endif
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j]) continue;
+    REAL taylor[NCOEF], taylor_t = 0;
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
-    REAL taylor[NCOEF];
-    const REAL taylor_t = screen_ray_taylor(px0 + j, py, SCREEN_ROWS_ARG, taylor);
+    taylor_t = screen_ray_taylor(px0 + j, py, screen_rows, screen_row0, screen_t, xi_scale, xi_offset, taylor);
 #endif
     segment_coefficients(lane_origin(&unit, j), lane_direction(&unit, j), t_in[j], t_out[j], exps, coefs, mono_count,
-                         binomials, even_axes, root[j], root_lo[j] TERMS_OUT(&terms[j]) SCREEN_ARG);
+                         binomials, even_axes, root[j], root_lo[j], &terms[j], taylor, taylor_t, NO_PROBE);
   }
-  isolate_lanes(count, in_extent, &unit, root, root_lo, t_in, t_out, &iso, iso_c TERMS_OUT(terms));
+  isolate_lanes(count, in_extent, &unit, root, root_lo, t_in, t_out, &iso, iso_c, terms);
 #endif
   refine_lanes(running, &iso, iso_c, lane_t_in, lane_t_out, binomials, &roots);
   /* finish_surface over lanes: `at` moves each found root's ray to its point */
@@ -820,7 +791,7 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
     h.root.flags = (uint)((LANE_INT*)&roots.flags)[j];
     h.u = lane_origin(&at, j);
     h.d_unit = lane_direction(&at, j);
-    CONFIRM_FLAT_ROOT(&h, lane_origin(&unit, j), exps, coefs, mono_count);
+    confirm_flat_root(&h, lane_origin(&unit, j), exps, coefs, mono_count, NO_PROBE);
     ((LANE_INT*)&roots.flags)[j] = (LANE_INT)h.root.flags;
   }
   const LMASK still = found && (roots.flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0;

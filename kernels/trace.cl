@@ -25,7 +25,7 @@ __kernel void trace(__global const REAL4* origins, __global const REAL4* directi
   ray.o = origins[i].xyz;
   ray.d = directions[i].xyz;
   const SurfaceHit hit = trace_surface(ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                       mono_exps, mono_coefs, mono_count, binomials, even_axes);
+                                       mono_exps, mono_coefs, mono_count, binomials, even_axes, 0, 0, NO_PROBE);
   out[i] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
 #else
   const uint first = get_global_id(0) * LANES;
@@ -55,7 +55,8 @@ __kernel void trace(__global const REAL4* origins, __global const REAL4* directi
 #undef DIRECTION_Z
   HitRecord records[LANES];
   const int entered = trace_lanes(group, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                  mono_exps, mono_coefs, mono_count, binomials, even_axes, records);
+                                  mono_exps, mono_coefs, mono_count, binomials, even_axes, records, 0, 0, 0, 0, 0,
+                                  0, 0);
   for (uint j = 0; j < group; ++j) out[first + j] = entered ? records[j] : missed_record();
 #endif
 }

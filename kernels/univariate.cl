@@ -22,16 +22,13 @@ __kernel void univariate(__global const REAL* polys, uint count, __constant cons
     root_lo[k] = 0;
 #endif
   }
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  /* The coefficients are given, rounded once: their own size is their noise's. */
+  RayTerms terms;
 #if ALGRAY_ESCALATE
-  RayTerms terms = known_terms(0);
+  /* The coefficients are given, rounded once: their own size is their noise's. */
+  terms = known_terms(0);
 #endif
-  const Isolation iso = isolate_bernstein(root, root_lo, (REAL)0, (REAL)1, iso_c TERMS_OUT(&terms));
-#else
-  const Isolation iso = isolate_power_basis(root, (REAL)0, (REAL)1, (REAL)0, (REAL)1, iso_c);
-#endif
-  const SegmentRoot sr = refine_isolated(iso, iso_c, (REAL)0, (REAL)1, binomials);
+  const Isolation iso = isolate_method(root, root_lo, (REAL)0, (REAL)1, iso_c, &terms, NO_PROBE);
+  const SegmentRoot sr = refine_isolated(iso, iso_c, (REAL)0, (REAL)1, binomials, NO_PROBE);
   HitRecord r;
   r.t_hi = (float)sr.t;
   r.t_lo = (sr.flags & ALGRAY_HIT_FOUND) ? (float)(sr.t - (REAL)r.t_hi) : 0.0f;

@@ -80,7 +80,7 @@ TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") 
 
 // Adaptive precision's float-float checks (kernels/float_float.h): flat-doubted roots confirmed lane by lane in
 // float, then the lanes still in doubt together (surface.h, confirmed_in_float_float); brackets doubted for their
-// end values settled together after the search (bernstein.h). The one-ray kernel does both one ray at a time. On
+// end values settled together after the search (bernstein method). The one-ray kernel does both one ray at a time. On
 // the first two hard surfaces most doubted roots go through float-float (tests/test_probe); the torus shell's
 // doubts are mostly brackets.
 TEST_CASE("lanes settle doubts in float-float as the one-ray kernel does, bit for bit", "[lanes]") {
@@ -109,7 +109,7 @@ TEST_CASE("lanes settle doubts in float-float as the one-ray kernel does, bit fo
 }
 
 // Where the second pass runs in float-float (no fp64), the float pass also settles discard doubts in float-float
-// (bernstein.h, discard_settled) and its search goes on: lanes evaluate P for the lanes that need it together, in
+// (discard_settled) and its search goes on: lanes evaluate P for the lanes that need it together, in
 // the step that doubted. The Kummer and BC6 shells doubt most rays so; settled, fewer go to the second pass.
 TEST_CASE("lanes settle discard doubts in float-float as the one-ray kernel does, bit for bit", "[lanes]") {
   const auto escalated = [](const RenderResult& r) {

@@ -12,6 +12,7 @@
 #include <tuple>
 #include <vector>
 
+#include "algray/device/kernel_binder.h"
 #include "algray/device/program_cache.h"
 #include "kernels/algray_shared.h"
 #include "solver_ref/solver_ref.h"
@@ -223,10 +224,11 @@ void check_solver(const KernelConfig& solver, int max_degree) {
                                        : cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                                     table_float.size() * sizeof(float), table_float.data());
       cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, kCases * sizeof(HitRecord));
-      kernel.setArg(0, polys);
-      kernel.setArg(1, static_cast<cl_uint>(kCases));
-      kernel.setArg(2, binomials);
-      kernel.setArg(3, out);
+      KernelBinder args(kernel, "univariate", config.precision);
+      args.plain("polys", polys);
+      args.plain("count", static_cast<cl_uint>(kCases));
+      args.plain("binomials", binomials);
+      args.plain("out", out);
       session.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(kCases));
       std::vector<HitRecord> results(kCases);
       session.queue.enqueueReadBuffer(out, CL_TRUE, 0, kCases * sizeof(HitRecord), results.data());
@@ -250,10 +252,11 @@ void check_solver(const KernelConfig& solver, int max_degree) {
           cl::Buffer again_polys(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, values.size() * sizeof(float),
                                  values.data());
           cl::Buffer again_out(ctx, CL_MEM_WRITE_ONLY, again.size() * sizeof(HitRecord));
-          second.setArg(0, again_polys);
-          second.setArg(1, static_cast<cl_uint>(again.size()));
-          second.setArg(2, binomials);
-          second.setArg(3, again_out);
+          KernelBinder again_args(second, "univariate", mixed.precision);
+          again_args.plain("polys", again_polys);
+          again_args.plain("count", static_cast<cl_uint>(again.size()));
+          again_args.plain("binomials", binomials);
+          again_args.plain("out", again_out);
           session.queue.enqueueNDRangeKernel(second, cl::NullRange, cl::NDRange(again.size()));
           std::vector<HitRecord> answers(again.size());
           session.queue.enqueueReadBuffer(again_out, CL_TRUE, 0, answers.size() * sizeof(HitRecord), answers.data());

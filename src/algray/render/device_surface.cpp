@@ -45,24 +45,6 @@ double ms_between(const cl::Event& e) {
   return static_cast<double>(end - start) * 1e-6;
 }
 
-void KernelArgs::real_vec(const glm::dvec3& v) {
-  if (double_)
-    kernel_.setArg(index_++, cl_double4{{v.x, v.y, v.z, 0}});
-  else
-    kernel_.setArg(index_++, cl_float4{{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0}});
-}
-
-void KernelArgs::ray_basis(const RayBasis& b) {
-  for (const glm::dvec3* v : {&b.o00, &b.ou, &b.ov, &b.d00, &b.du, &b.dv}) real_vec(*v);
-}
-
-void KernelArgs::real(double v) {
-  if (double_)
-    kernel_.setArg(index_++, v);
-  else
-    kernel_.setArg(index_++, static_cast<float>(v));
-}
-
 // Buffer of REAL values from doubles.
 cl::Buffer real_buffer(const cl::Context& ctx, const std::vector<double>& values, Precision precision) {
   if (precision == Precision::Double)
@@ -135,19 +117,20 @@ DeviceSurface::DeviceSurface(const cl::Context& ctx, const Scene& scene, Precisi
   binomials_ = real_buffer(ctx, binomial_table(data_.degree), precision);
 }
 
-void DeviceSurface::set_extent_args(KernelArgs& args) const {
-  args.real_vec(extent_.unit_centre());
-  args.real(1 / extent_.unit_scale());
-  args.real_vec(extent_.unit_box_half());
-  args.plain(static_cast<cl_int>(extent_.kind == ExtentKind::Sphere ? ALGRAY_EXTENT_SPHERE : ALGRAY_EXTENT_BOX));
+void DeviceSurface::set_extent_args(KernelBinder& args) const {
+  args.real_vec("extent_centre", extent_.unit_centre());
+  args.real("extent_inv_scale", 1 / extent_.unit_scale());
+  args.real_vec("extent_box_half", extent_.unit_box_half());
+  args.plain("extent_kind",
+             static_cast<cl_int>(extent_.kind == ExtentKind::Sphere ? ALGRAY_EXTENT_SPHERE : ALGRAY_EXTENT_BOX));
 }
 
-void DeviceSurface::set_surface_args(KernelArgs& args) const {
-  args.plain(exps_);
-  args.plain(coefs_);
-  args.plain(static_cast<cl_uint>(data_.coefficients.size()));
-  args.plain(binomials_);
-  args.plain(data_.even_axes);
+void DeviceSurface::set_surface_args(KernelBinder& args) const {
+  args.plain("mono_exps", exps_);
+  args.plain("mono_coefs", coefs_);
+  args.plain("mono_count", static_cast<cl_uint>(data_.coefficients.size()));
+  args.plain("binomials", binomials_);
+  args.plain("even_axes", data_.even_axes);
 }
 
 struct DeviceSurface::ScreenCache {
@@ -160,9 +143,14 @@ struct DeviceSurface::ScreenCache {
   }
 };
 
-cl::Buffer DeviceSurface::set_screen_args(KernelArgs& args, const cl::Context& ctx, const KernelConfig& config,
+cl::Buffer DeviceSurface::set_screen_args(KernelBinder& args, const cl::Context& ctx, const KernelConfig& config,
                                           const RayBasis& basis, int width, int height, int row0, int rows) const {
-  if (config.ray_origin != RayOrigin::Screen) return {};
+  if (config.ray_origin != RayOrigin::Screen) {
+    args.unused_buffer("screen_rows");
+    args.plain("screen_row0", cl_uint{0});
+    for (const char* name : {"screen_t", "xi_scale", "xi_offset"}) args.real(name, 0);
+    return {};
+  }
   const ScreenGeometry geometry = screen_geometry(basis, width, height, extent_);
   if (!screen_ || !screen_->same_camera(geometry, height)) {
     screen_ = std::make_shared<const ScreenCache>(
@@ -170,11 +158,11 @@ cl::Buffer DeviceSurface::set_screen_args(KernelArgs& args, const cl::Context& c
   }
   const ScreenForm& form = screen_->form;
   cl::Buffer buffer = real_buffer(ctx, form.rows(row0, rows, height), precision_);
-  args.plain(buffer);
-  args.plain(static_cast<cl_uint>(row0));
-  args.real(geometry.t0);
-  args.real(geometry.xi_scale);
-  args.real(geometry.xi_offset);
+  args.plain("screen_rows", buffer);
+  args.plain("screen_row0", static_cast<cl_uint>(row0));
+  args.real("screen_t", geometry.t0);
+  args.real("xi_scale", geometry.xi_scale);
+  args.real("xi_offset", geometry.xi_offset);
   return buffer;
 }
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "algray/device/cl_runtime.h"
+#include "algray/device/kernel_binder.h"
 #include "algray/device/kernel_config.h"
 #include "algray/scene/scene.h"
 
@@ -31,27 +32,6 @@ struct RayLaunch {
 };
 RayLaunch ray_launch(std::size_t count, std::size_t largest_group);
 std::size_t largest_group(const cl::Kernel& kernel, const cl::Device& device);
-
-// Sets kernel arguments in declaration order; REAL-typed ones follow the build's precision.
-class KernelArgs {
- public:
-  KernelArgs(cl::Kernel& k, Precision p) : kernel_(k), double_(p == Precision::Double) {}
-  void real_vec(const glm::dvec3& v);
-  // ray_o00 .. ray_dv, in the order camera_ray() takes them (kernels/ray.h).
-  void ray_basis(const RayBasis& b);
-  void real(double v);
-  template <typename T>
-  void plain(const T& v) {
-    kernel_.setArg(index_++, v);
-  }
-  cl_uint next() const { return index_; }
-  void skip(cl_uint n) { index_ += n; }
-
- private:
-  cl::Kernel& kernel_;
-  bool double_;
-  cl_uint index_ = 0;
-};
 
 // Buffer of REAL values (double, or float for float and mixed precision) from doubles.
 cl::Buffer real_buffer(const cl::Context& ctx, const std::vector<double>& values, Precision precision);
@@ -101,13 +81,13 @@ class DeviceSurface {
   DeviceSurface(const cl::Context& ctx, const Scene& scene, Precision precision, std::size_t surface = 0);
   Precision precision() const { return precision_; }
   const SurfaceData& data() const { return data_; }
-  // Extent and surface arguments, in the order primary.cl and shadow.cl declare them.
-  void set_extent_args(KernelArgs& args) const;
-  void set_surface_args(KernelArgs& args) const;
-  // A screen-form build's extra primary and probe arguments (SCREEN_ROWS_PARAM in kernels/surface.h): rows
-  // row0 .. row0 + rows - 1 of the width x height camera image of `basis`. Sets nothing for other builds. The
-  // kernel reads the returned buffer: keep it until the launches are done.
-  cl::Buffer set_screen_args(KernelArgs& args, const cl::Context& ctx, const KernelConfig& config,
+  // The extent's and the surface's arguments of every kernel (ALGRAY_EXTENT_ARGS, ALGRAY_SURFACE_ARGS).
+  void set_extent_args(KernelBinder& args) const;
+  void set_surface_args(KernelBinder& args) const;
+  // The screen form's arguments of the primary and probe kernels (ALGRAY_SCREEN_ARGS): rows row0 .. row0 + rows - 1
+  // of the width x height camera image of `basis`; unused values for other builds. The kernel reads the returned
+  // buffer: keep it until the launches are done.
+  cl::Buffer set_screen_args(KernelBinder& args, const cl::Context& ctx, const KernelConfig& config,
                              const RayBasis& basis, int width, int height, int row0, int rows) const;
 
  private:

@@ -122,24 +122,24 @@ SolverTrace trace_probe(ClSession& session, ProgramCache& cache, const Scene& sc
 
   // The same basis the primary pass builds for a render at the scene's size without antialiasing.
   const RayBasis b = make_ray_basis(scene.camera, scene.image.width, scene.image.height);
-  KernelArgs args(kernel, config.precision);
+  KernelBinder args(kernel, "probe", config.precision);
   args.ray_basis(b);
-  args.plain(static_cast<cl_uint>(target.px));
-  args.plain(static_cast<cl_uint>(target.py));
-  args.plain(static_cast<cl_int>(target.given_ray ? 1 : 0));
-  args.real_vec(target.origin);
-  args.real_vec(target.direction);
+  args.plain("px", static_cast<cl_uint>(target.px));
+  args.plain("py", static_cast<cl_uint>(target.py));
+  args.plain("use_given_ray", static_cast<cl_int>(target.given_ray ? 1 : 0));
+  args.real_vec("given_o", target.origin);
+  args.real_vec("given_d", target.direction);
   surface.set_extent_args(args);
   surface.set_surface_args(args);
   // The render computes every row; the probe only its own, with the same arithmetic.
   const cl::Buffer screen_rows = surface.set_screen_args(args, ctx, config, b, scene.image.width, scene.image.height,
                                                          static_cast<int>(target.py), 1);
-  args.plain(out);
-  args.plain(ray_out);
-  args.plain(events);
-  args.plain(values);
-  args.plain(log_capacity);
-  args.plain(count);
+  args.plain("out", out);
+  args.plain("ray_out", ray_out);
+  args.plain("events", events);
+  args.plain("values", values);
+  args.plain("capacity", log_capacity);
+  args.plain("event_count", count);
   session.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(1), cl::NullRange);
   session.queue.finish();
 

@@ -54,7 +54,7 @@ struct ProbeDoubt {
 
 // A doubt settled after all (ALGRAY_EVENT_CONFIRMED): a flat-doubted root (kernels/surface.h confirm_flat_root),
 // P from the monomials at t - delta and t + delta, delta = ALGRAY_DOUBT_POSITION |t|; or an accept-doubted bracket
-// (kernels/bernstein.h bracket_settled), P at its ends; or a discard-doubted interval (bernstein.h discard_settled),
+// (kernels/methods/bernstein.h bracket_settled), P at its ends; or a discard-doubted interval (discard_settled),
 // P at its ends. Each value beyond its rounding bound. A search may settle several doubts: this is the last.
 struct ProbeConfirmed {
   double before = 0, before_rounding = 0;

@@ -28,13 +28,13 @@ TracedBatch RayTracer::trace(const std::vector<PixelRay>& rays) {
   staging_.write(queue, origins_);
   staging_.pack(count, is_double, [&](std::size_t i) { return rays[i].direction; });
   staging_.write(queue, directions_);
-  KernelArgs args(kernel_, surface_.precision());
-  args.plain(origins_);
-  args.plain(directions_);
-  args.plain(static_cast<cl_uint>(count));
+  KernelBinder args(kernel_, "trace", surface_.precision());
+  args.plain("origins", origins_);
+  args.plain("directions", directions_);
+  args.plain("count", static_cast<cl_uint>(count));
   surface_.set_extent_args(args);
   surface_.set_surface_args(args);
-  args.plain(out_);
+  args.plain("out", out_);
   cl::Event done;
   const RayLaunch launch = ray_launch((count + lanes_ - 1) / lanes_, largest_group_);
   queue.enqueueNDRangeKernel(kernel_, cl::NullRange, launch.global, launch.local, nullptr, &done);

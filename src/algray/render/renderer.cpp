@@ -220,7 +220,6 @@ struct Renderer::Passes {
   std::vector<std::unique_ptr<DeviceSurface>> surfaces;  // one per scene surface
   std::vector<PassStats> stats;                          // one per planned pass, in plan order
   std::vector<cl::Kernel> primary;                       // one per surface
-  std::vector<cl_uint> primary_tile_arg;                 // per surface: the index of its tile_x0 argument
   std::vector<int> primary_lanes;                        // per surface: its kernel's camera rays per work-item
   std::vector<cl::Buffer> screen_rows;                   // per surface: a band's rows for screen-form builds
   std::unique_ptr<TileHits> primary_out;                 // a tile's hit records, of the first surface
@@ -645,7 +644,6 @@ void Renderer::prepare_passes(Passes& passes, bool first_device) {
   for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
     ProgramRecord record;
     passes.primary.push_back(cache_.kernel(passes.session, plan.find(PassKind::Primary)->kernels[s], &record));
-    passes.primary_tile_arg.push_back(0);
     passes.primary_lanes.push_back(plan.find(PassKind::Primary)->kernels[s].lanes);
     passes.screen_rows.emplace_back();
     passes.programs.push_back(record);
@@ -717,7 +715,7 @@ void Renderer::set_band_args(Passes& passes, const Tile& first) {
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t s = 0; s < passes.surfaces.size(); ++s) {
     const DeviceSurface& surface = *passes.surfaces[s];
-    KernelArgs args(passes.primary[s], surface.precision());
+    KernelBinder args(passes.primary[s], "primary", surface.precision());
     args.ray_basis(result.basis);
     surface.set_extent_args(args);
     surface.set_surface_args(args);
@@ -726,9 +724,7 @@ void Renderer::set_band_args(Passes& passes, const Tile& first) {
     passes.screen_rows[s] =
         surface.set_screen_args(args, passes.session.context, plan.find(PassKind::Primary)->kernels[s], result.basis,
                                 plan.trace_width(), plan.trace_height(), first.trace_y0, first.trace_h);
-    passes.primary_tile_arg[s] = args.next();  // tile_x0, tile_y0, tile_w, tile_h: set per launch
-    args.skip(4);
-    args.plain((s == 0 ? passes.primary_out : passes.other_out)->buffer());
+    args.plain("out", (s == 0 ? passes.primary_out : passes.other_out)->buffer());  // the tile: per launch
   }
   passes.stats_of(PassKind::Primary)->wall_ms += ms_since(start);
 }
@@ -741,11 +737,11 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
   for (std::size_t s = 0; s < passes.surfaces.size(); ++s) {
     const auto start = std::chrono::steady_clock::now();
     cl::Kernel& kernel = passes.primary[s];
-    const cl_uint tile_arg = passes.primary_tile_arg[s];
-    kernel.setArg(tile_arg, static_cast<cl_uint>(tile.trace_x0));
-    kernel.setArg(tile_arg + 1, static_cast<cl_uint>(tile.trace_y0));
-    kernel.setArg(tile_arg + 2, static_cast<cl_uint>(tile.trace_w));
-    kernel.setArg(tile_arg + 3, static_cast<cl_uint>(tile.trace_h));
+    KernelBinder args(kernel, "primary", passes.surfaces[s]->precision());
+    args.plain("tile_x0", static_cast<cl_uint>(tile.trace_x0));
+    args.plain("tile_y0", static_cast<cl_uint>(tile.trace_y0));
+    args.plain("tile_w", static_cast<cl_uint>(tile.trace_w));
+    args.plain("tile_h", static_cast<cl_uint>(tile.trace_h));
     cl::Event done;
     passes.session.queue.enqueueNDRangeKernel(kernel, cl::NullRange,
                                               primary_global_size(passes.primary_lanes[s], tile.trace_w, tile.trace_h),

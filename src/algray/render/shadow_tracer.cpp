@@ -47,7 +47,7 @@ void ShadowPoints::upload(const std::vector<glm::dvec3>& points, const std::vect
 
 ShadowTracer::ShadowTracer(ClSession& session, ProgramCache& cache, const KernelConfig& config,
                            const DeviceSurface& surface, double offset)
-    : session_(session), surface_(surface), offset_(offset) {
+    : session_(session), surface_(surface), offset_(offset), entry_(config.entry) {
   kernel_ = cache.kernel(session, config, &record_);
   largest_group_ = largest_group(kernel_, session.info.device);
   traced_ = cl::Buffer(session.context, CL_MEM_READ_WRITE, sizeof(cl_uint));
@@ -85,18 +85,21 @@ ShadowAnswer ShadowTracer::trace(ShadowPoints& points, const std::vector<glm::dv
   cl_uint traced = 0;
   queue.enqueueWriteBuffer(traced_, CL_TRUE, 0, sizeof(cl_uint), &traced);
 
-  KernelArgs args(kernel_, precision);
-  args.plain(points.points_);
-  args.plain(points.normals_);
-  args.plain(static_cast<cl_uint>(count));
-  args.plain(light_buffer);
-  args.plain(static_cast<cl_uint>(light_points.size()));
-  args.real(offset_);
+  KernelBinder args(kernel_, entry_, precision);
+  args.plain("points", points.points_);
+  args.plain("normals", points.normals_);
+  args.plain("point_count", static_cast<cl_uint>(count));
+  args.plain("light_points", light_buffer);
+  args.plain("light_count", static_cast<cl_uint>(light_points.size()));
+  args.real("offset", offset_);
   surface_.set_extent_args(args);
   surface_.set_surface_args(args);
-  args.plain(points.masks_);
-  args.plain(traced_);
-  if (precision == Precision::Adaptive) args.plain(points.undecided_);
+  args.plain("occluded", points.masks_);
+  args.plain("rays_traced", traced_);
+  if (precision == Precision::Adaptive)
+    args.plain("undecided", points.undecided_);
+  else
+    args.unused_buffer("undecided");
   cl::Event done;
   const RayLaunch launch = ray_launch(count, largest_group_);
   queue.enqueueNDRangeKernel(kernel_, cl::NullRange, launch.global, launch.local, nullptr, &done);

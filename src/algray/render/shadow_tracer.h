@@ -74,6 +74,7 @@ class ShadowTracer {
   const DeviceSurface& surface_;
   double offset_;
   ProgramRecord record_;
+  std::string entry_;  // shadow or shadow_serial: whose argument list the kernel has
   cl::Kernel kernel_;
   std::size_t largest_group_ = 1;  // the kernel's work-group limit on the device
   cl::Buffer traced_;              // the kernel's count of traced rays

@@ -42,9 +42,15 @@ REAL power_value_slope(const REAL* c, REAL y, REAL* slope) {
   return h;
 }
 
-/* The interface refine.h expects from every isolation method (see bernstein.h): on the isolating interval the
- * polynomial is A1(y), y in [0, 1], in the power basis, ready as it is; no start for the refinement, which
- * begins as the paper has it. */
+/* Where the power-basis methods' P*(s) starts, in t, and how long a step of s is: s in [0, 1] over the segment
+ * [t_in, t_out], or, built around the ray's origin as the paper does (RAY_ORIGIN=eye), t itself from t_in. */
+ALGRAY_INLINE REAL power_s0(REAL t_in) { return RAY_ORIGIN == ALGRAY_ORIGIN_EYE ? t_in : (REAL)0; }
+ALGRAY_INLINE REAL power_len_s(REAL t_in, REAL t_out) {
+  return RAY_ORIGIN == ALGRAY_ORIGIN_EYE ? t_out - t_in : (REAL)1;
+}
+
+/* isolate.h's interface for the refinement: on the isolating interval the polynomial is A1(y), y in [0, 1], in the
+ * power basis, ready as it is; no start for the refinement, which begins as the paper has it. */
 REAL isolated_start(const REAL* c) {
   (void)c;
   return -1;

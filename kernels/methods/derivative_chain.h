@@ -2,7 +2,7 @@
 #ifndef ALGRAY_DERIVATIVE_CHAIN_H
 #define ALGRAY_DERIVATIVE_CHAIN_H
 
-#include "power_basis.h"
+#include "methods/power_basis.h"
 
 /* The chain: level m (CHAIN_BOTTOM <= m < DEGREE) is the derivative of A of degree m, its m + 1 coefficients
  * starting at chain_offset(m); level DEGREE is A itself, kept apart. All levels at once is ~DEGREE^2/2 values:
@@ -70,7 +70,8 @@ REAL chain_value_at_one(const REAL* a) {
  * stopping width tol lets pass as located (no sign change, as in settle_cluster). Below A', such a missed pair
  * leaves a wiggle of order d^3 in the level above that: a near triple root of A, found within ~2d either way.
  * The last Newton step usually lands far closer than tol anyway. */
-REAL chain_root(const REAL* c, int m, REAL lo, REAL hi, REAL f_lo, REAL f_hi, REAL tol, Isolation* iso PROBE_PARAM) {
+REAL chain_root(const REAL* c, int m, REAL lo, REAL hi, REAL f_lo, REAL f_hi, REAL tol, Isolation* iso,
+                ProbeLog* probe_log) {
   const int rising = f_lo < 0;
   REAL x = lo - f_lo * ((hi - lo) / (f_hi - f_lo));
   if (!(x > lo && x < hi)) x = (REAL)0.5 * (lo + hi);
@@ -154,7 +155,7 @@ typedef struct {
  * on a boundary is a root only if A has the other sign after it (a double root only touches, and is invisible
  * as in settle_cluster), or if it is the far end, where nothing follows to tell. A NaN is neither a sign nor a
  * zero, so a degenerate polynomial finds nothing. Returns 1 when it settled iso->status. */
-int chain_visit(ChainWalk* w, Isolation* iso, const REAL* a, REAL x PROBE_PARAM) {
+int chain_visit(ChainWalk* w, Isolation* iso, const REAL* a, REAL x, ProbeLog* probe_log) {
   ++iso->steps;
   const REAL f = x == (REAL)1 ? chain_value_at_one(a) : power_value(a, x);
   const int s = (f > 0) - (f < 0);
@@ -196,7 +197,7 @@ int chain_visit(ChainWalk* w, Isolation* iso, const REAL* a, REAL x PROBE_PARAM)
  * evaluations: piece ends at every level, inner solver iterations, the closed-form bottom as one. On return
  * `a1` is A1 on [lo, hi] when the status is a bracket. */
 Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out,
-                                   REAL* a1 PROBE_PARAM) {
+                                   REAL* a1, ProbeLog* probe_log) {
   Isolation iso = isolation_none();
   REAL a[NCOEF];
   power_on_interval(p, s0, len_s, a);
@@ -258,7 +259,7 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
       const REAL u = last_f[m];
       REAL root = -1;
       if ((u < 0 && v > 0) || (u > 0 && v < 0))
-        root = chain_root(c, m, last_x[m], y, u, v, tol, &iso PROBE_ARG);
+        root = chain_root(c, m, last_x[m], y, u, v, tol, &iso, probe_log);
       else if (v == 0 && y < (REAL)1)
         root = y; /* a root on a boundary: one too many is harmless, a monotone piece split in two */
       last_x[m] = y;
@@ -273,7 +274,7 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
     }
     /* y is the next root of level m, or the end 1: the next piece boundary of the level above */
     if (m == DEGREE - 1) {
-      if (chain_visit(&walk, &iso, a, y PROBE_ARG) || y == (REAL)1) break;
+      if (chain_visit(&walk, &iso, a, y, probe_log) || y == (REAL)1) break;
       have = 0;
     } else {
       ++m;
@@ -283,13 +284,19 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
 #else
   (void)t_in;
   (void)t_out;
-  chain_visit(&walk, &iso, a, (REAL)1 PROBE_ARG);
+  chain_visit(&walk, &iso, a, (REAL)1, probe_log);
 #endif
   /* The bracket's own polynomial, from A as its end values were, so that refinement sees the same signs. */
   if (iso.status == ISOLATION_BRACKET) power_on_interval(a, iso.lo, iso.hi - iso.lo, a1);
   return iso;
 }
 
-#define isolate_power_basis isolate_derivative_chain
+/* The method's entry (isolate.h): P*(s) in the power basis as power_s0 and power_len_s place it. */
+Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
+                         ProbeLog* probe_log) {
+  (void)root_lo;
+  (void)terms;
+  return isolate_derivative_chain(root, power_s0(t_in), power_len_s(t_in, t_out), t_in, t_out, iso_c, probe_log);
+}
 
 #endif /* ALGRAY_DERIVATIVE_CHAIN_H */

@@ -172,7 +172,7 @@ int refinable_in_float(const REAL* c) {
  * float-float (float_float.h, bracket_ends_in_float_float). The probe sees the doubt, then what settled it
  * (ALGRAY_EVENT_CONFIRMED, decision 2). Other builds and shadow rays never settle one so. */
 #if ALGRAY_ESCALATE && LANES == 1 && !ALGRAY_SHADOW_RAYS
-int bracket_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise, int level PROBE_PARAM) {
+int bracket_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise, int level, ProbeLog* probe_log) {
   const RayTerms* terms = noise->terms;
   const REAL end = smaller_end(cur, iso->lo);
   if (!terms->has_ray || !within_noise_at(noise, end, iso->lo, iso->hi)) return 0;
@@ -186,7 +186,7 @@ int bracket_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise, i
   return 1;
 }
 #else
-#define bracket_settled(iso, cur, noise, level) 0
+#define bracket_settled(iso, cur, noise, level, probe_log) 0
 #endif
 
 /* Camera and secondary rays of adaptive builds that settle doubts (ALGRAY_SETTLE_DOUBTS: where the second pass runs
@@ -214,7 +214,7 @@ void settled_end(const ProvenEnds* proven, REAL s, REAL c, REAL noise, REAL* val
  * inside is within the noise too, P itself is, and halving down to the stopping width measured no better than
  * tracing the ray again.) The probe sees the doubt, then what settled it (ALGRAY_EVENT_CONFIRMED, decision 3). */
 int discard_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise, ProvenEnds* proven,
-                    int level PROBE_PARAM) {
+                    int level, ProbeLog* probe_log) {
   const RayTerms* terms = noise->terms;
   if (!terms->has_ray || within_noise_at(noise, inner_smallest_magnitude(cur), iso->lo, iso->hi)) return 0;
   const int lo_doubted = within_noise_at(noise, cur[0], iso->lo, iso->hi);
@@ -240,7 +240,7 @@ int discard_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise, P
   return 1;
 }
 #else
-#define discard_settled(iso, cur, noise, proven, level) 0
+#define discard_settled(iso, cur, noise, proven, level, probe_log) 0
 #endif
 
 /* Finds the leftmost subinterval of [0,1] that isolates the smallest root of the polynomial with Bernstein
@@ -249,7 +249,7 @@ int discard_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise, P
  * rejected at once. On return `cur` holds the Bernstein coefficients on [iso.lo, iso.hi] (rounded to float in
  * mixed precision, where they are accurate relative to their own size). */
 Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out,
-                            REAL* cur TERMS_PARAM PROBE_PARAM) {
+                            REAL* cur, RayTerms* terms, ProbeLog* probe_log) {
   Isolation iso = isolation_none();
   REAL cur_lo[NCOEF], sib[NCOEF], sib_lo[NCOEF];
   int sib_level = -1;
@@ -275,16 +275,16 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
     iso.hi = iso.lo + width;
     iso.f_lo = cur[0];
     iso.f_hi = cur[DEGREE];
-    if (settled_at_left_end(&iso, start_sign, level PROBE_ARG)) {
-      doubted(&iso, ALGRAY_DOUBT_ACCEPT, iso.f_lo, noise, level PROBE_ARG);
+    if (settled_at_left_end(&iso, start_sign, level, probe_log)) {
+      doubted(&iso, ALGRAY_DOUBT_ACCEPT, iso.f_lo, noise, level, probe_log);
       return isolation_found(iso, noise);
     }
     const int v = sign_variations(cur);
     if (v == 1 && cur[DEGREE] != 0 && refinable_in_float(cur)) {
       PROBE_STEP(iso, v, ALGRAY_STEP_ISOLATED, level);
       iso.status = ISOLATION_BRACKET;
-      if (!bracket_settled(&iso, cur, noise, level PROBE_ARG))
-        doubted(&iso, ALGRAY_DOUBT_ACCEPT, smaller_end(cur, iso.lo), noise, level PROBE_ARG);
+      if (!bracket_settled(&iso, cur, noise, level, probe_log))
+        doubted(&iso, ALGRAY_DOUBT_ACCEPT, smaller_end(cur, iso.lo), noise, level, probe_log);
       return isolation_found(iso, noise);
     }
 #if ALGRAY_ESCALATE
@@ -295,8 +295,8 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
      * (discard_settled). */
     int near_zero = v == 0 && within_noise_at(noise, smallest_magnitude(cur, iso.lo), iso.lo, iso.hi);
     if (near_zero && within_noise_at(noise, smaller_end(cur, iso.lo), iso.lo, iso.hi)) {
-      if (!discard_settled(&iso, cur, noise, &proven, level PROBE_ARG)) {
-        doubted(&iso, ALGRAY_DOUBT_DISCARD, smaller_end(cur, iso.lo), noise, level PROBE_ARG);
+      if (!discard_settled(&iso, cur, noise, &proven, level, probe_log)) {
+        doubted(&iso, ALGRAY_DOUBT_DISCARD, smaller_end(cur, iso.lo), noise, level, probe_log);
         return iso;
       }
       near_zero = 0; /* root-free */
@@ -305,7 +305,7 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
     const int near_zero = 0;
 #endif
     if (v >= 1 || near_zero) {
-      const int next = halve_or_settle(&iso, v, level, width, t_in, len PROBE_ARG);
+      const int next = halve_or_settle(&iso, v, level, width, t_in, len, probe_log);
       if (next == INTERVAL_HALVE) {
         casteljau_halve(cur, cur_lo, sib, sib_lo);
         ++level;
@@ -315,17 +315,23 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
         continue;
       }
       /* A cluster is always in doubt: float cannot tell a close pair from a complex one there. */
-      if (doubted(&iso, ALGRAY_DOUBT_CLUSTER, 0, noise, level PROBE_ARG)) return iso;
+      if (doubted(&iso, ALGRAY_DOUBT_CLUSTER, 0, noise, level, probe_log)) return iso;
       if (next == INTERVAL_SETTLED) return isolation_found(iso, noise);
     } else {
       PROBE_STEP(iso, v, ALGRAY_STEP_NO_ROOT, level);
     }
-    if (!next_interval(&level, &idx)) return isolation_at_far_end(iso, root[DEGREE] == 0, root[DEGREE] PROBE_ARG);
+    if (!next_interval(&level, &idx)) return isolation_at_far_end(iso, root[DEGREE] == 0, root[DEGREE], probe_log);
     if (sib_level == level && sib_idx == idx)
       coefs_copy(cur, cur_lo, sib, sib_lo);
     else
       bernstein_restrict(root, root_lo, level, idx, cur, cur_lo);
   }
+}
+
+/* The method's entry (isolate.h). */
+Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
+                         ProbeLog* probe_log) {
+  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c, terms, probe_log);
 }
 
 #if !ALGRAY_COMPENSATED
@@ -364,9 +370,9 @@ ALGRAY_INLINE LMASK one_strict_sign(const LREAL* c) {
 /* isolation.h's PICK_LARGER and PICK_SMALLER, lane by lane */
 #define LANE_LARGER(a, b) LANE_SEL((a), (b), (b) > (a))
 #define LANE_SMALLER(a, b) LANE_SEL((a), (b), (b) < (a))
-#if ALGRAY_ESCALATE
 /* What the lanes' search of an adaptive build needs of its rays: their terms (the noise), and the rays in unit
- * coordinates with the monomials, for bracket_ends_in_float_float as bracket_settled uses it. */
+ * coordinates with the monomials, for bracket_ends_in_float_float as bracket_settled uses it. Other builds never
+ * read it. */
 typedef struct {
   LREAL value;
   const LaneRays* rays;
@@ -374,10 +380,6 @@ typedef struct {
   __global const REAL* coefs;
   uint count;
 } LaneTerms;
-#define LANE_TERMS_PARAM , const LaneTerms* terms
-#else
-#define LANE_TERMS_PARAM
-#endif
 /* isolate_bernstein for LANES polynomials at once (lanes.h), lanes where `running` is clear left alone: each
  * lane takes the scalar search's decisions in its order, with the same arithmetic, so it ends with the scalar
  * result bit for bit (tests/test_lanes). The search's position is kept as the interval's left end and width,
@@ -447,7 +449,7 @@ void bernstein_restrict_lanes(const LREAL* root, LREAL lo, LREAL width, LMASK ta
 /* root: each lane's Bernstein coefficients on [t_in, t_out]. On return each running lane of iso is that lane's
  * Isolation (the others mean nothing), and cur_out holds each lane's coefficients on its isolating interval. */
 void isolate_bernstein_lanes(LMASK running, const LREAL* root, LREAL t_in, LREAL t_out, LaneIsolation* iso,
-                             LREAL* cur_out LANE_TERMS_PARAM) {
+                             LREAL* cur_out, const LaneTerms* terms) {
   LREAL cur[NCOEF], sib[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) cur[k] = sib[k] = root[k];

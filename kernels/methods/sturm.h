@@ -2,7 +2,7 @@
 #ifndef ALGRAY_STURM_H
 #define ALGRAY_STURM_H
 
-#include "power_basis.h"
+#include "methods/power_basis.h"
 
 /* Member k of the sequence has degree at most DEGREE - k, as degrees strictly fall, so the members share one
  * triangular store: slot k holds DEGREE - k + 1 coefficients from this offset, zero past the member's degree. */
@@ -175,7 +175,7 @@ void sturm_bracket(Isolation* iso, REAL* a1) {
  * on A1 over the whole interval; then the dyadic (level, idx) pieces of [0, 1] are visited depth first, left
  * first, each needing the sequence at its right end only: its left end is its parent's, or the right end of
  * the interval examined before it. On return `a1` is A1 on [lo, hi]. */
-Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1 PROBE_PARAM) {
+Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1, ProbeLog* probe_log) {
   Isolation iso = isolation_none();
   const REAL len = t_out - t_in;
   power_on_interval(p, s0, len_s, a1);
@@ -203,7 +203,7 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
     const int v_hi = sturm_variations(seq, iso.hi, &f_hi, &noise_hi);
     iso.f_lo = f_lo;
     iso.f_hi = f_hi;
-    if (settled_at_left_end(&iso, start_sign, level PROBE_ARG)) return iso;
+    if (settled_at_left_end(&iso, start_sign, level, probe_log)) return iso;
     /* Distinct roots in (lo, hi): the count is of (lo, hi], and a root exactly at hi belongs to the next
      * interval, which finds it as an exact zero at its left end. */
     const int roots = v_lo - v_hi - (f_hi == 0);
@@ -223,7 +223,7 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
      * there with what may be a second root just before it (measured: the smaller of a pair 2^-20 apart,
      * lost): only halving sorts these out. */
     if (roots != 0 || crosses || f_hi == 0) {
-      const int next = halve_or_settle(&iso, roots, level, width, t_in, len PROBE_ARG);
+      const int next = halve_or_settle(&iso, roots, level, width, t_in, len, probe_log);
       if (next == INTERVAL_HALVE) {
         ++level;
         idx *= 2;
@@ -240,7 +240,7 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
       /* Intervals are half open; the far end is the one point left to look at. A root within rounding of it
        * may have come out just outside, where the counts, reading the same value, agree: it is numerically
        * at 1. */
-      return isolation_at_far_end(iso, fabs(f_hi) <= noise_hi, f_hi PROBE_ARG);
+      return isolation_at_far_end(iso, fabs(f_hi) <= noise_hi, f_hi, probe_log);
     }
     f_lo = f_hi;
     noise_lo = noise_hi;
@@ -248,6 +248,12 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
   }
 }
 
-#define isolate_power_basis isolate_sturm
+/* The method's entry (isolate.h): P*(s) in the power basis as power_s0 and power_len_s place it. */
+Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
+                         ProbeLog* probe_log) {
+  (void)root_lo;
+  (void)terms;
+  return isolate_sturm(root, power_s0(t_in), power_len_s(t_in, t_out), t_in, t_out, iso_c, probe_log);
+}
 
 #endif /* ALGRAY_STURM_H */

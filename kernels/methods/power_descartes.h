@@ -2,7 +2,7 @@
 #ifndef ALGRAY_POWER_DESCARTES_H
 #define ALGRAY_POWER_DESCARTES_H
 
-#include "power_basis.h"
+#include "methods/power_basis.h"
 
 /* Sign variations of A2(x) = (x+1)^n A1(1/(x+1)), whose positive roots are those of A1 in (0, 1]...
  * except a root at 1, which maps to x = 0 and is not counted. */
@@ -16,7 +16,7 @@ int descartes_unit_interval(const REAL* a1) {
 
 /* p is P*(s) in the power basis, the extent interval being s in [s0, s0 + len_s]. Subintervals are the dyadic
  * (level, idx) pieces of that interval, visited depth first, left first. On return `a1` is A1 on [lo, hi]. */
-Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1 PROBE_PARAM) {
+Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1, ProbeLog* probe_log) {
   Isolation iso = isolation_none();
   int level = 0;
   ulong idx = 0;
@@ -32,7 +32,7 @@ Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
     iso.f_lo = a1[0];
     iso.f_hi = power_value(a1, (REAL)1);
     if (iso.steps == 1) start_sign = (a1[0] > 0) - (a1[0] < 0);
-    if (settled_at_left_end(&iso, start_sign, level PROBE_ARG)) return iso;
+    if (settled_at_left_end(&iso, start_sign, level, probe_log)) return iso;
     const int v = descartes_unit_interval(a1);
     if (v == 1 && iso.f_hi != 0) {
       PROBE_STEP(iso, v, ALGRAY_STEP_ISOLATED, level);
@@ -41,7 +41,7 @@ Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
     }
     /* v counts roots in (lo, hi); a root exactly at hi is found as the right neighbour's EXACT case. */
     if (v >= 1) {
-      const int next = halve_or_settle(&iso, v, level, width, t_in, len PROBE_ARG);
+      const int next = halve_or_settle(&iso, v, level, width, t_in, len, probe_log);
       if (next == INTERVAL_HALVE) {
         ++level;
         idx *= 2;
@@ -52,10 +52,16 @@ Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
       PROBE_STEP(iso, v, ALGRAY_STEP_NO_ROOT, level);
     }
     /* The last interval visited is the rightmost one, so its f_hi is P at the far end. */
-    if (!next_interval(&level, &idx)) return isolation_at_far_end(iso, iso.f_hi == 0, iso.f_hi PROBE_ARG);
+    if (!next_interval(&level, &idx)) return isolation_at_far_end(iso, iso.f_hi == 0, iso.f_hi, probe_log);
   }
 }
 
-#define isolate_power_basis isolate_power
+/* The method's entry (isolate.h): P*(s) in the power basis as power_s0 and power_len_s place it. */
+Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
+                         ProbeLog* probe_log) {
+  (void)root_lo;
+  (void)terms;
+  return isolate_power(root, power_s0(t_in), power_len_s(t_in, t_out), t_in, t_out, iso_c, probe_log);
+}
 
 #endif /* ALGRAY_POWER_DESCARTES_H */

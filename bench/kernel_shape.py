@@ -1,0 +1,83 @@
+#!/usr/bin/env python3
+"""The shape figures of issue 43 for a tree: preprocessor branches in kernels/, function-defining and
+signature-splicing macros, *_lanes twins, and functions over 80 lines in kernels/ and src/.
+
+    bench/kernel_shape.py [ROOT]        (ROOT: a checkout; default the one this script is in)
+
+Counted by the rules printed with each figure, so that a later count can be compared with an earlier one."""
+import pathlib
+import re
+import sys
+
+root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else pathlib.Path(__file__).resolve().parent.parent)
+kernel_files = sorted(p for p in (root / "kernels").glob("*") if p.suffix in (".h", ".cl")) + sorted(
+    (root / "kernels").glob("*/*.h")) + sorted((root / "kernels").glob("*/*.cl"))
+source_files = sorted(p for p in (root / "src").rglob("*") if p.suffix in (".cpp", ".h"))
+
+
+def logical_lines(text):
+    """Lines with backslash continuations joined: a macro is one line."""
+    return text.replace("\\\n", " ").split("\n")
+
+
+branches = 0
+function_macros, splicing_macros = [], []
+lanes_twins = []
+for path in kernel_files:
+    text = path.read_text()
+    lines = logical_lines(text)
+    guard_seen = False
+    for line in lines:
+        m = re.match(r"\s*#\s*(if|ifdef|ifndef|elif|else)\b", line)
+        if m:
+            # the include guard is not a branch of the code
+            if m.group(1) == "ifndef" and not guard_seen and re.match(r"\s*#\s*ifndef\s+ALGRAY_\w+_H\b", line):
+                guard_seen = True
+                continue
+            branches += 1
+        d = re.match(r"\s*#\s*define\s+(\w+)(\([^)]*\))?\s*(.*)", line)
+        if d:
+            name, params, body = d.group(1), d.group(2), d.group(3)
+            # a macro whose body defines a function: a declarator followed by a body in braces
+            if params and re.search(r"\b\w+\s*\([^)]*\)\s*\{", body) and not body.lstrip().startswith("do"):
+                function_macros.append(f"{path.name}:{name}")
+            # a macro spliced into parameter or argument lists: its body starts with a comma, or it is named so
+            if re.search(r"_(PARAMS?|ARGS?)$", name) or body.lstrip().startswith(","):
+                splicing_macros.append(f"{path.name}:{name}")
+    for m in re.finditer(r"^[A-Za-z_][\w \*]*?\b(\w+_lanes)\s*\(", text, re.M):
+        lanes_twins.append(f"{path.name}:{m.group(1)}")
+
+long_functions = []
+for path in kernel_files + source_files:
+    lines = path.read_text().split("\n")
+    start = None
+    for i, line in enumerate(lines):
+        if start is None:
+            if (re.match(r"[A-Za-z_]", line) and "(" in line and not re.match(
+                    r"(struct|typedef|namespace|class|enum|union|using|static_assert|#)\b", line)
+                    and not line.rstrip().endswith(";")):
+                # the definition's opening brace ends this line or one of the next few (a wrapped signature)
+                for j in range(i, min(i + 6, len(lines))):
+                    if lines[j].rstrip().endswith("{"):
+                        start = i
+                        break
+                    if lines[j].rstrip().endswith(";"):
+                        break
+        elif lines[i].startswith("}"):
+            length = i - start + 1
+            if length > 80:
+                name = re.search(r"([\w:~]+)\s*\(", lines[start])
+                long_functions.append((length, f"{path.relative_to(root)}:{start + 1} {name.group(1) if name else '?'}"))
+            start = None
+
+print(f"#if/#ifdef/#ifndef/#elif/#else lines in kernels/ (include guards left out): {branches}")
+function_macros = sorted(set(function_macros))
+splicing_macros = sorted(set(splicing_macros))
+print(f"function-defining macros: {len(function_macros)} {' '.join(function_macros)}")
+print(f"signature-splicing macros (named *_PARAM(S)/*_ARG(S), or a body starting with a comma): "
+      f"{len(splicing_macros)} {' '.join(splicing_macros)}")
+print(f"*_lanes functions: {len(set(lanes_twins))} {' '.join(sorted(set(lanes_twins)))}")
+long_functions.sort(reverse=True)
+print(f"functions over 80 lines in kernels/ and src/: {len(long_functions)}")
+for length, where in long_functions:
+    print(f"  {length:4d} {where}")
