@@ -92,10 +92,11 @@ TEST_CASE("parameters are substituted into the equation as their double values",
     CHECK(o.parameters.at("a") == 3.0);
     CHECK(o.surface().polynomial == equation("x^2+y^2+z^2-3"));
   }
-  SECTION("a bare override may add a parameter the file lacks") {
+  SECTION("parameters.NAME adds a parameter the file lacks; a bare name may not (issue 46: a typo is refused)") {
     const std::string uses_b = sphere_with({{3, "equation = \"x^2+y^2+z^2-b\""}});
-    CHECK(algray::load_scene_text(uses_b, "t.toml", {{"b", "0.25"}}).surface().polynomial ==
+    CHECK(algray::load_scene_text(uses_b, "t.toml", {{"parameters.b", "0.25"}}).surface().polynomial ==
           equation("x^2+y^2+z^2-0.25"));
+    CHECK_THROWS_AS(algray::load_scene_text(uses_b, "t.toml", {{"b", "0.25"}}), SceneError);
   }
 }
 
@@ -465,7 +466,7 @@ TEST_CASE("camera.azimuth, elevation and distance place the eye about look_at", 
   CHECK(a.elevation == Approx(std::asin(0.8) * 180 / 3.14159265358979323846));
   CHECK(a.distance == Approx(5));
 
-  check_error(sphere_with({}, {"azimuth = 10"}), "t.toml:11:1", "not both");
+  check_error(sphere_with({}, {"azimuth = 10"}), "t.toml:11:11", "not both");
   check_error("[surface]\nequation = \"x-1\"\n[camera]\nelevation = 91\n", "t.toml:4:13", "camera.elevation");
   check_error("[surface]\nequation = \"x-1\"\n[camera]\ndistance = 0\n", "t.toml:4:12", "distance must be positive");
 }
