@@ -131,6 +131,13 @@ PYBIND11_MODULE(_algray, m) {
                                return out;
                              })
       .def_property_readonly("warnings", &api::Scene::warnings)
+      .def_property_readonly(
+          "camera_angles",
+          [](const api::Scene& s) {
+            const std::array<double, 3> a = s.camera_angles();
+            return py::dict(py::arg("azimuth") = a[0], py::arg("elevation") = a[1], py::arg("distance") = a[2]);
+          },
+          "the camera as the keys camera.azimuth, camera.elevation (degrees) and camera.distance about look_at")
       .def("__copy__", [](const api::Scene& s) { return api::Scene(s); })
       .def("__repr__", [](const api::Scene& s) { return "<algray.Scene " + s.name() + " from " + s.source() + ">"; });
 
@@ -154,6 +161,16 @@ PYBIND11_MODULE(_algray, m) {
                              })
       .def_property_readonly("aov", &solver_channels)
       .def_property_readonly("stats_json", &api::Image::stats_json)
+      .def(
+          "srgb",
+          [](const api::Image& i) {
+            const std::vector<std::uint8_t> bytes = i.srgba();
+            py::array_t<std::uint8_t> out({static_cast<py::ssize_t>(i.height()), static_cast<py::ssize_t>(i.width()),
+                                           static_cast<py::ssize_t>(4)});
+            std::copy(bytes.begin(), bytes.end(), out.mutable_data());
+            return out;
+          },
+          "8-bit sRGB RGBA as a numpy uint8 array (height, width, 4): the pixels of png(), for imshow")
       .def("save", &api::Image::save, py::arg("path"), py::call_guard<py::gil_scoped_release>())
       .def(
           "png",

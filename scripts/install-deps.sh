@@ -20,6 +20,7 @@ test_packages=(
   python3
   python3-dev pybind11-dev  # the Python package (python/)
   python3-numpy python3-pytest python3-ipywidgets  # its arrays, its tests, and algray.explore's sliders
+  python3-sympy python3-pil  # Scene.from_equation of a sympy expression, and Image.to_pil(), in test_python
   jupyter-nbconvert python3-ipykernel python3-matplotlib  # the notebook of docs/, run headless by the tests
   munge slurmctld slurmd slurm-client  # test_slurm_array: a single-node Slurm started by the test itself
   libopenmpi-dev openmpi-bin  # `mpirun -n N algray batch` (the cluster layer) and test_mpi_batch

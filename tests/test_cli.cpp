@@ -72,8 +72,9 @@ TEST_CASE("the default render writes EXR, PNG and stats", "[cli]") {
   REQUIRE(r.exit_code == 0);
   CHECK(fs::exists(box.work / "out.png"));
   REQUIRE(fs::exists(box.work / "out.exr"));
-  // Success is silent when stderr is not a terminal.
+  // Success says on stdout what it wrote and how long it took, and nothing on stderr when it is not a terminal.
   CHECK(r.err.empty());
+  CHECK_THAT(r.out, Catch::StartsWith("wrote out.exr, out.png and s.json (32x24) in ") && Catch::EndsWith(" s\n"));
 
   const algray::FrameImage img = algray::read_exr(box.work / "out.exr");
   CHECK(img.width == 32);
@@ -472,4 +473,52 @@ TEST_CASE("algray links neither Open MPI nor the web server, and hands `view` to
     const Result r = box.run("view --port 70000");
     CHECK(r.exit_code == 2);
   }
+}
+
+TEST_CASE("an equation alone renders to algray.png with the defaults, which the PNG and --stats record",
+          "[cli][equation]") {
+  require_device();
+  Sandbox box;
+  const Result r = box.run("render -e 'x^4+y^4+z^4-1' --preview --radius 1.5 --stats s.json " + kTiny);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.empty());
+  CHECK_THAT(r.out, Catch::StartsWith("wrote algray.png and s.json (32x24) in "));
+  REQUIRE(fs::exists(box.work / "algray.png"));
+  // The stats hold the scene as rendered, defaults included; the PNG carries it and renders the same pixels.
+  const std::string stats = read_text(box.work / "s.json");
+  CHECK_THAT(stats, Catch::Contains("radius = 1.5") && Catch::Contains("azimuth = 30") &&
+                        Catch::Contains("frame = \\\"camera\\\""));
+  const Result again = box.run("render algray.png -o again.exr --quiet");
+  INFO(again.err);
+  REQUIRE(again.exit_code == 0);
+  CHECK(again.out.empty());
+  const Result first = box.run("render -e 'x^4+y^4+z^4-1' --preview --radius 1.5 -o first.exr -q " + kTiny);
+  REQUIRE(first.exit_code == 0);
+  const std::vector<float> pixels = algray::read_exr(box.work / "first.exr").rgba;
+  CHECK(algray::read_exr(box.work / "again.exr").rgba == pixels);
+  // A TOML file holding only the equation is the same scene.
+  write_text(box.in / "eq.toml", "[surface]\nequation = \"x^4+y^4+z^4-1\"\n");
+  const Result file = box.run("render " + (box.in / "eq.toml").string() +
+                              " --preview --radius 1.5 -o file.exr --quiet " + kTiny);
+  REQUIRE(file.exit_code == 0);
+  CHECK(algray::read_exr(box.work / "file.exr").rgba == pixels);
+}
+
+TEST_CASE("-e's errors name the equation's column; --set of a missing parameter exits 2, writing nothing",
+          "[cli][equation][errors]") {
+  Sandbox box;
+  const Result bad = box.run("render -e 'x^2+*y' -o out.png " + kTiny);
+  CHECK(bad.exit_code == 2);
+  CHECK_THAT(bad.err, Catch::StartsWith("--equation:1:5: error: ") && Catch::Contains("  x^2+*y\n      ^"));
+  const Result both = box.run("render " + (box.in / "x.toml").string() + " -e 'x-1' -o out.png");
+  CHECK(both.exit_code == 2);
+  const std::string torus = (fs::path(ALGRAY_SOURCE_DIR) / "scenes" / "torus.toml").string();
+  const Result missing = box.run("render " + torus + " --set b=2 -o out.png " + kTiny);
+  CHECK(missing.exit_code == 2);
+  CHECK_THAT(missing.err, Catch::StartsWith("--set b=2: error: the scene has no parameter 'b'; its parameters: a, r"));
+  const Result typo = box.run("render " + torus + " --set camera.fovy=30 -o out.png " + kTiny);
+  CHECK(typo.exit_code == 2);
+  CHECK_THAT(typo.err, Catch::Contains("did you mean 'fov_y'"));
+  CHECK_FALSE(fs::exists(box.work / "out.png"));
 }

@@ -92,10 +92,11 @@ TEST_CASE("parameters are substituted into the equation as their double values",
     CHECK(o.parameters.at("a") == 3.0);
     CHECK(o.surface().polynomial == equation("x^2+y^2+z^2-3"));
   }
-  SECTION("a bare override may add a parameter the file lacks") {
+  SECTION("parameters.NAME adds a parameter the file lacks; a bare name may not (issue 46: a typo is refused)") {
     const std::string uses_b = sphere_with({{3, "equation = \"x^2+y^2+z^2-b\""}});
-    CHECK(algray::load_scene_text(uses_b, "t.toml", {{"b", "0.25"}}).surface().polynomial ==
+    CHECK(algray::load_scene_text(uses_b, "t.toml", {{"parameters.b", "0.25"}}).surface().polynomial ==
           equation("x^2+y^2+z^2-0.25"));
+    CHECK_THROWS_AS(algray::load_scene_text(uses_b, "t.toml", {{"b", "0.25"}}), SceneError);
   }
 }
 
@@ -391,5 +392,177 @@ TEST_CASE("scene_to_toml reads back to the same scene, for every shipped scene a
     CHECK(again.camera.eye == scene.camera.eye);
     CHECK(again.image.width == scene.image.width);
     CHECK(again.lights.size() == scene.lights.size());
+  }
+}
+
+// Issue 46: an equation is a scene, the camera by angles, lights attached to the camera, --set's checks and
+// extent.type switching.
+
+TEST_CASE("an equation alone gets algray's defaults: sphere of radius 2, framed from 3R, key and fill, 2x2",
+          "[scene][defaults]") {
+  const Scene s = algray::load_scene_text("[surface]\nequation = \"x^4+y^4+z^4-1\"\n", "eq.toml");
+  CHECK(s.extent.kind == algray::ExtentKind::Sphere);
+  CHECK(s.extent.radius == algray::kDefaultExtentRadius);
+  CHECK(s.extent.centre == glm::dvec3(0));
+  REQUIRE(s.camera.angles);
+  CHECK(s.camera.angles->azimuth == 30);
+  CHECK(s.camera.angles->elevation == 20);
+  CHECK(s.camera.angles->distance == algray::kFramingDistance * 2);
+  CHECK(glm::length(s.camera.eye - s.camera.look_at) == Approx(6).epsilon(1e-12));
+  CHECK(s.camera.fov_y_degrees == 45);
+  CHECK(s.antialias.samples == 2);
+  REQUIRE(s.lights.size() == 2);
+  for (const algray::Light& l : s.lights) {
+    CHECK(l.kind == algray::LightKind::Rectangle);
+    CHECK(l.in_camera);
+    CHECK(l.shadows);
+  }
+  // The key light is above and to the left of the eye, in the image's frame.
+  const algray::RayBasis b = algray::make_ray_basis(s.camera, 800, 600);
+  CHECK(glm::dot(s.lights[0].position - s.camera.eye, b.right) < 0);
+  CHECK(glm::dot(s.lights[0].position - s.camera.eye, b.true_up) > 0);
+  // The same as load_equation gives.
+  const Scene e = algray::load_equation("x^4+y^4+z^4-1");
+  CHECK(e.camera.eye == s.camera.eye);
+  CHECK(e.lights[1].position == s.lights[1].position);
+}
+
+TEST_CASE("a scene that places its eye keeps the headlight and one ray per pixel", "[scene][defaults]") {
+  const Scene s = algray::load_scene_text(sphere_with({}), "t.toml");
+  CHECK(s.lights.empty());
+  CHECK(s.antialias.samples == 1);
+  CHECK_FALSE(s.camera.angles);
+  // Setting an angle later does not change what the scene as written gets.
+  const Scene turned = algray::load_scene_text(sphere_with({}), "t.toml", {{"camera.azimuth", "90"}});
+  CHECK(turned.lights.empty());
+  CHECK(turned.antialias.samples == 1);
+  // Only eye and up: look_at is the extent's centre.
+  const Scene no_look = algray::load_scene_text(sphere_with({{8, "# no look_at"}, {9, "# no up"}}), "t.toml");
+  CHECK(no_look.camera.look_at == glm::dvec3(0));
+  CHECK(no_look.camera.up == glm::dvec3(0, 1, 0));
+}
+
+TEST_CASE("camera.azimuth, elevation and distance place the eye about look_at", "[scene][camera]") {
+  const auto eye_of = [](const std::string& camera) {
+    return algray::load_scene_text("[surface]\nequation = \"x^2+y^2+z^2-1\"\n[camera]\n" + camera, "t.toml").camera;
+  };
+  const algray::CameraSpec front = eye_of("azimuth = 0\nelevation = 0\ndistance = 5\nlook_at = [1, 0, 0]\n");
+  CHECK(glm::length(front.eye - glm::dvec3(1, 0, 5)) < 1e-12);
+  const algray::CameraSpec side = eye_of("azimuth = 90\nelevation = 0\ndistance = 5\n");
+  CHECK(glm::length(side.eye - glm::dvec3(5, 0, 0)) < 1e-12);
+  // Straight down the up axis is a camera too: the image's up is then -z (azimuth 0).
+  const algray::CameraSpec top = eye_of("azimuth = 0\nelevation = 90\ndistance = 5\n");
+  CHECK(glm::length(top.eye - glm::dvec3(0, 5, 0)) < 1e-12);
+  const algray::RayBasis b = algray::make_ray_basis(top, 64, 48);
+  CHECK(glm::length(b.true_up - glm::dvec3(0, 0, -1)) < 1e-12);
+  CHECK(glm::length(b.right - glm::dvec3(1, 0, 0)) < 1e-12);
+  // With up along z, azimuth 0 looks from +x.
+  const algray::CameraSpec z_up = eye_of("azimuth = 0\nelevation = 0\ndistance = 2\nup = [0, 0, 1]\n");
+  CHECK(glm::length(z_up.eye - glm::dvec3(2, 0, 0)) < 1e-12);
+  // camera_angles reads them back from any eye.
+  const algray::CameraAngles a = algray::camera_angles(
+      algray::load_scene_text(sphere_with({{7, "eye = [3, 4, 0]"}}), "t.toml").camera);
+  CHECK(a.azimuth == Approx(90));
+  CHECK(a.elevation == Approx(std::asin(0.8) * 180 / 3.14159265358979323846));
+  CHECK(a.distance == Approx(5));
+
+  check_error(sphere_with({}, {"azimuth = 10"}), "t.toml:11:11", "not both");
+  check_error("[surface]\nequation = \"x-1\"\n[camera]\nelevation = 91\n", "t.toml:4:13", "camera.elevation");
+  check_error("[surface]\nequation = \"x-1\"\n[camera]\ndistance = 0\n", "t.toml:4:12", "distance must be positive");
+}
+
+TEST_CASE("--set camera.azimuth on a scene with an eye keeps its elevation and distance", "[scene][camera]") {
+  const Scene before = algray::load_scene_text(sphere_with({{7, "eye = [0, 3, 4]"}}), "t.toml");
+  const Scene after = algray::load_scene_text(sphere_with({{7, "eye = [0, 3, 4]"}}), "t.toml",
+                                              {{"camera.azimuth", "90"}});
+  CHECK(glm::length(after.camera.eye - glm::dvec3(4, 3, 0)) < 1e-12);
+  const Scene back = algray::load_scene_text(sphere_with({{7, "eye = [0, 3, 4]"}}), "t.toml",
+                                             {{"camera.azimuth", "90"}, {"camera.eye", "[0, 3, 4]"}});
+  CHECK(back.camera.eye == before.camera.eye);
+  CHECK_FALSE(back.camera.angles);
+}
+
+TEST_CASE("lights attached to the camera follow it, and scene_to_toml keeps them attached", "[scene][camera]") {
+  const std::string text = "[surface]\nequation = \"x^2+y^2+z^2-1\"\n[[light]]\nframe = \"camera\"\n"
+                           "position = [1, 2, 0]\n";
+  for (const double azimuth : {0.0, 75.0, -160.0}) {
+    INFO("azimuth " << azimuth);
+    const Scene s = algray::load_scene_text(text, "t.toml", {{"camera.azimuth", std::to_string(azimuth)}});
+    const algray::RayBasis b = algray::make_ray_basis(s.camera, 8, 8);
+    const glm::dvec3 offset = s.lights[0].position - s.camera.eye;
+    CHECK(glm::dot(offset, b.right) == Approx(1));
+    CHECK(glm::dot(offset, b.true_up) == Approx(2));
+    CHECK(glm::dot(offset, b.forward) == Approx(0).margin(1e-12));
+    // Written back and read again: the same rays and the same light, bit for bit.
+    const Scene again = algray::load_scene_text(algray::scene_to_toml(s), "again.toml");
+    CHECK(again.camera.eye == s.camera.eye);
+    CHECK(again.camera.up == s.camera.up);
+    CHECK(again.lights[0].position == s.lights[0].position);
+    CHECK(again.lights[0].in_camera);
+    CHECK(again.antialias.samples == s.antialias.samples);
+  }
+  check_error("[surface]\nequation = \"x-1\"\n[[light]]\nposition = [0, 0, 1]\nframe = \"eye\"\n", "t.toml:5:9",
+              "light.frame must be");
+}
+
+TEST_CASE("--set of a parameter the scene does not have is refused, naming its parameters", "[scene][errors]") {
+  const std::string torus = "[surface]\nequation = \"x^2+y^2+z^2-r^2\"\n[parameters]\nr = 1\n";
+  try {
+    algray::load_scene_text(torus, "t.toml", {{"a", "2"}});
+    FAIL("--set a=2 was accepted");
+  } catch (const SceneError& e) {
+    CHECK(e.where == "--set a=2");
+    CHECK_THAT(e.message, Catch::Contains("no parameter 'a'") && Catch::Contains("its parameters: r"));
+  }
+  try {
+    algray::load_scene_text(sphere_with({}), "t.toml", {{"a", "2"}});
+    FAIL("--set a=2 was accepted");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.message, Catch::Contains("it has no parameters"));
+  }
+  // A key the scene does not know gets the nearest spelling.
+  try {
+    algray::load_scene_text(torus, "t.toml", {{"camera.fovy", "30"}});
+    FAIL("camera.fovy was accepted");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.message, Catch::Contains("did you mean 'fov_y'"));
+  }
+  // parameters.NAME adds one; the bare name then sets it.
+  const Scene added = algray::load_scene_text(torus, "t.toml", {{"parameters.a", "2"}, {"a", "3"}});
+  CHECK(added.parameters.at("a") == 3);
+}
+
+TEST_CASE("--set extent.type switches the kind, dropping the other kind's keys with a note", "[scene][extent]") {
+  const Scene box = algray::load_scene_text(sphere_with({}), "t.toml", {{"extent.type", "box"}});
+  CHECK(box.extent.kind == algray::ExtentKind::Box);
+  CHECK(box.extent.min == glm::dvec3(-2));
+  CHECK(box.extent.max == glm::dvec3(2));
+  REQUIRE(box.warnings.size() == 1);
+  CHECK_THAT(box.warnings[0], Catch::Contains("extent.radius") && Catch::Contains("dropped"));
+  // And back: the sphere inscribed in the box's largest side.
+  const Scene sphere = algray::load_scene_text(
+      sphere_with({{5, "type = \"box\"\nmin = [-1, -3, -1]\nmax = [1, 1, 1]"}}), "t.toml", {{"extent.type", "sphere"}});
+  CHECK(sphere.extent.kind == algray::ExtentKind::Sphere);
+  CHECK(sphere.extent.centre == glm::dvec3(0, -1, 0));
+  CHECK(sphere.extent.radius == 2);
+  REQUIRE(sphere.warnings.size() == 1);
+  CHECK_THAT(sphere.warnings[0], Catch::Contains("extent.min and extent.max"));
+  // Keys given after the switch win; a box without a radius to start from needs its own min and max.
+  const Scene given = algray::load_scene_text(sphere_with({}), "t.toml",
+                                              {{"extent.type", "box"}, {"extent.max", "[3, 3, 3]"}});
+  CHECK(given.extent.max == glm::dvec3(3));
+  // In a file, keys of another kind are still a located error.
+  check_error(sphere_with({{5, "type = \"box\"\nradius = 2"}}), "t.toml:6:10", "belongs to a sphere extent");
+  check_error(sphere_with({{5, "type = \"cone\""}}), "t.toml:5:8", "\"sphere\" or \"box\"");
+}
+
+TEST_CASE("an error in -e's equation names its column in the equation", "[scene][errors]") {
+  try {
+    algray::load_equation("x^2+*y");
+    FAIL("x^2+*y was accepted");
+  } catch (const SceneError& e) {
+    CHECK(e.where == "--equation:1:5");
+    CHECK_THAT(e.message, Catch::Contains("at character 5 of the equation"));
+    CHECK(e.excerpt == "  x^2+*y\n      ^");
   }
 }

@@ -19,15 +19,18 @@ namespace algray::cli {
 
 struct RenderRequest {
   std::optional<std::string> scene_path;  // unset: the built-in default scene
+  std::optional<std::string> equation;    // -e: an equation alone, instead of a scene
   std::vector<Override> overrides;        // --set, --width, --height, --precision, in order
   RenderOutputs outputs;                  // -o, --stats, --reference, --aov, --heatmap
   std::string device_spec;                // --device
   bool use_cache = true;                  // --no-cache turns it off
   bool progress = false;                  // per-tile progress on stderr
+  bool quiet = false;                     // --quiet: nothing on `out` on success
 };
 
 struct ProbeRequest {
   std::optional<std::string> scene_path;  // unset: the built-in default scene
+  std::optional<std::string> equation;    // -e: an equation alone, instead of a scene
   std::vector<Override> overrides;        // --set and the solver flags, in order
   std::string device_spec;
   ProbeTarget target;
@@ -41,6 +44,7 @@ struct ProbeRequest {
 
 struct ViewRequest {
   std::optional<std::string> scene_path;  // unset: the built-in default scene
+  std::optional<std::string> equation;    // -e: an equation alone, instead of a scene
   std::vector<Override> overrides;        // --set, --precision, in order
   std::string device_spec;
   std::string host = "127.0.0.1";  // another address (--host) is reachable from other machines: a warning says so
@@ -51,8 +55,9 @@ struct ViewRequest {
   std::string token;  // required in every URL when set; off loopback a random one when empty
 };
 
-// Each prints errors (and nothing else on success, unless progress) to `err`; probe's report goes to `out`.
-int run_render(const RenderRequest& request, std::ostream& err);
+// Each prints errors (and nothing else on success, unless progress) to `err`; probe's report goes to `out`, and a
+// render's one line on what it wrote and how long it took (unless quiet).
+int run_render(const RenderRequest& request, std::ostream& out, std::ostream& err);
 #ifdef ALGRAY_WITH_MPI
 // `algray render` under an MPI launcher: every rank renders bands of the image, rank 0 writes the files. Every
 // rank returns the same exit code.

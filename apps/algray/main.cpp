@@ -31,6 +31,8 @@ using namespace algray::cli;
 // The options every scene-taking command shares: the scene, its overrides and the device.
 struct SceneOptions {
   std::string scene_path;
+  std::string equation;  // -e: an equation alone, with algray's defaults for the rest
+  double radius = 0;     // --radius: extent.radius
   std::vector<std::string> sets;
   int width = 0, height = 0;
   std::string precision, isolation, refinement, tolerance, max_iterations;
@@ -49,9 +51,17 @@ void add_no_fp64_flag(CLI::App* cmd) {
 
 // Batch takes a jobs file where the others take a scene, and no scene positional.
 void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = true) {
-  if (scene_positional)
-    cmd->add_option("scene", o.scene_path,
-                    "scene file (.toml or .jsurf), or - for standard input; default: the built-in Barth sextic");
+  if (scene_positional) {
+    auto* scene = cmd->add_option(
+        "scene", o.scene_path,
+        "scene file (.toml or .jsurf), or - for standard input; default: the built-in Barth sextic");
+    cmd->add_option("-e,--equation", o.equation,
+                    "render this equation P(x,y,z) (as `x^4+y^4+z^4-1`) with algray's defaults: a sphere extent of "
+                    "radius 2 (--radius), framed from 3R through 45 degrees, a key and a fill light, 2x2 "
+                    "antialiasing")
+        ->excludes(scene);
+  }
+  cmd->add_option("--radius", o.radius, "the sphere extent's radius (overrides extent.radius)");
   cmd->add_option("--width", o.width, "image width in pixels (overrides image.width)");
   cmd->add_option("--height", o.height, "image height in pixels (overrides image.height)");
   cmd->add_option("--device", o.device_spec,
@@ -83,6 +93,8 @@ bool collect_overrides(const CLI::App* cmd, const SceneOptions& o, std::vector<O
     }
     out.push_back({s.substr(0, eq), s.substr(eq + 1)});
   }
+  // Written back as the shortest text that reads to the same double, so that the scene records what was given.
+  if (cmd->count("--radius")) out.push_back({"extent.radius", cmd->get_option("--radius")->as<std::string>()});
   if (cmd->count("--width")) out.push_back({"image.width", std::to_string(o.width)});
   if (cmd->count("--height")) out.push_back({"image.height", std::to_string(o.height)});
   if (!o.precision.empty()) out.push_back({"render.precision", "\"" + o.precision + "\""});
@@ -132,6 +144,9 @@ bool parse_numbers(const std::string& text, std::size_t n, std::vector<double>& 
   std::_Exit(code);
 }
 
+// Where `algray render` writes without -o: a PNG, which every image viewer opens and which carries its scene.
+constexpr const char* kDefaultOutput = "algray.png";
+
 // `algray render`: its options, then the request they make.
 struct RenderCommand {
   CLI::App* cmd = nullptr;
@@ -143,7 +158,8 @@ struct RenderCommand {
     cmd = app.add_subcommand("render", "render a scene (default: the built-in Barth sextic)");
     add_scene_options(cmd, scene);
     cmd->add_option("-o,--output", request.outputs.images, "output image; .exr or .png by extension; may be repeated")
-        ->default_str("algray.exr");
+        ->default_str(kDefaultOutput);
+    cmd->add_flag("-q,--quiet", request.quiet, "print nothing on success (else: what was written, and how long it took)");
     cmd->add_option("--stats", stats_path, "write render statistics as JSON");
     cmd->add_flag("--reference", request.outputs.reference,
                   "solve every pixel exactly on the CPU (solver_ref, all cores, slow); adds a reference.class channel");
@@ -154,7 +170,8 @@ struct RenderCommand {
 
   int run() {
     if (!scene.scene_path.empty()) request.scene_path = scene.scene_path;
-    if (request.outputs.images.empty()) request.outputs.images.push_back("algray.exr");
+    if (!scene.equation.empty()) request.equation = scene.equation;
+    if (request.outputs.images.empty()) request.outputs.images.push_back(kDefaultOutput);
     if (!collect_overrides(cmd, scene, request.overrides)) return kExitBadInput;
     request.device_spec = scene.device_spec;
     if (!aov_text.empty()) {
@@ -180,7 +197,7 @@ struct RenderCommand {
       return run_render_across_ranks(request, *world, std::cerr);
     }
 #endif
-    return run_render(request, std::cerr);
+    return run_render(request, std::cout, std::cerr);
   }
 };
 
@@ -260,6 +277,7 @@ struct ProbeCommand {
 
   int run() {
     if (!scene.scene_path.empty()) request.scene_path = scene.scene_path;
+    if (!scene.equation.empty()) request.equation = scene.equation;
     if (!collect_overrides(cmd, scene, request.overrides)) return kExitBadInput;
     request.device_spec = scene.device_spec;
     request.use_cache = !scene.no_cache;
@@ -390,6 +408,7 @@ struct ViewCommand {
 #ifdef ALGRAY_FULL
   int run() {
     if (!scene.scene_path.empty()) request.scene_path = scene.scene_path;
+    if (!scene.equation.empty()) request.equation = scene.equation;
     if (!collect_overrides(cmd, scene, request.overrides)) return kExitBadInput;
     request.device_spec = scene.device_spec;
     request.use_cache = !scene.no_cache;

@@ -9,7 +9,7 @@ namespace algray::cli {
 int run_probe(const ProbeRequest& req, std::ostream& out, std::ostream& err) {
   Scene scene;
   try {
-    scene = SceneLoader().load(req.scene_path, req.overrides);
+    scene = req.equation ? load_equation(*req.equation, req.overrides) : SceneLoader().load(req.scene_path, req.overrides);
     err << warning_text(scene);
     check_probe_target(scene, req.target);
     if (req.plot_path) {

@@ -57,12 +57,31 @@ RenderCallbacks progress_callbacks(ProgressLine& progress, const std::string& wh
 
 }  // namespace
 
-int run_render(const RenderRequest& req, std::ostream& err) {
+// "wrote a.png and s.json (800x600) in 1.23 s": what a render wrote, once it is all written.
+std::string written_line(const Scene& scene, const RenderOutputs& outputs, double seconds) {
+  std::vector<std::string> files;
+  if (outputs.heatmap_path) files.push_back(*outputs.heatmap_path);
+  files.insert(files.end(), outputs.images.begin(), outputs.images.end());
+  if (outputs.stats_path) files.push_back(*outputs.stats_path);
+  std::string list;
+  for (std::size_t i = 0; i < files.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == files.size() ? " and " : ", ") + files[i];
+  char tail[128];
+  std::snprintf(tail, sizeof tail, " (%dx%d) in %.2f s\n", scene.image.width, scene.image.height, seconds);
+  return "wrote " + list + tail;
+}
+
+Scene load_request_scene(const std::optional<std::string>& path, const std::optional<std::string>& equation,
+                         const std::vector<Override>& overrides) {
+  return equation ? load_equation(*equation, overrides) : SceneLoader().load(path, overrides);
+}
+
+int run_render(const RenderRequest& req, std::ostream& out, std::ostream& err) {
   const auto started = std::chrono::steady_clock::now();
   // Everything the user gave is checked before any device work, so bad input costs nothing and writes nothing.
   Scene scene;
   try {
-    scene = SceneLoader().load(req.scene_path, req.overrides);
+    scene = load_request_scene(req.scene_path, req.equation, req.overrides);
     err << warning_text(scene);
     check_outputs(scene, req.outputs, req.scene_path.value_or(""));
   } catch (const std::exception& e) {
@@ -77,6 +96,11 @@ int run_render(const RenderRequest& req, std::ostream& err) {
     progress.finish();
     return report_error(e, err);
   }
+  progress.finish();
+  if (!req.quiet)
+    out << written_line(scene, req.outputs,
+                        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count())
+        << std::flush;
   return kExitOk;
 }
 
@@ -95,7 +119,7 @@ int run_render_across_ranks(const RenderRequest& req, MpiWorld& world, std::ostr
       throw SceneError("mpirun",
                        "--reference, --aov and --heatmap are not available across MPI ranks yet; render "
                        "them in one process");
-    scene = SceneLoader().load(req.scene_path, req.overrides);
+    scene = load_request_scene(req.scene_path, req.equation, req.overrides);
     if (lead) {
       err << warning_text(scene);
       check_outputs(scene, req.outputs, req.scene_path.value_or(""));

@@ -129,9 +129,29 @@ json choice_names(const Choices& choices) {
   return names;
 }
 
+// The first surface's material prefix for --set: "surface.material", or "surface.0.material" where the scene's
+// surfaces are a [[surface]] list, whatever its length (the key that fails is the other one).
+std::string material_prefix(const api::Scene& scene, const toml::table& t) {
+  api::Scene probe = scene;
+  const double transparency = t["surface"]["material"]["front"]["transparency"].value_or(0.0);
+  try {
+    probe.set("surface.material.front.transparency", format_number(transparency));
+    return "surface.material";
+  } catch (const api::SceneError&) {
+    return "surface.0.material";
+  }
+}
+
 // What the page starts from: the scene's equation, parameters, camera, extent and solver, and the choices.
 json scene_summary(const api::Scene& scene, const std::string& device) {
   const toml::table t = toml::parse(scene.to_toml());
+  // The first surface's sides, as scene_to_toml writes a single surface ([[surface]] for several).
+  const toml::node_view<const toml::node> surface =
+      t["surface"].is_array() ? t["surface"][0] : toml::node_view<const toml::node>(t["surface"]);
+  json lights = json::array();
+  if (const toml::array* list = t["light"].as_array())
+    for (const toml::node& l : *list) lights.push_back(l.as_table()->get("intensity")->value_or(1.0));
+  const std::array<double, 3> angles = scene.camera_angles();
   json parameters = json::object();
   for (const auto& [name, value] : scene.parameters()) parameters[name] = value;
   json precisions = choice_names(kPrecisions);
@@ -143,7 +163,16 @@ json scene_summary(const api::Scene& scene, const std::string& device) {
           {"camera",
            {{"eye", numbers(t["camera"]["eye"].node())},
             {"look_at", numbers(t["camera"]["look_at"].node())},
-            {"up", numbers(t["camera"]["up"].node())}}},
+            {"up", numbers(t["camera"]["up"].node())},
+            {"azimuth", angles[0]},
+            {"elevation", angles[1]},
+            {"distance", angles[2]}}},
+          {"material_prefix", material_prefix(scene, t)},
+          {"front_colour", numbers(surface["material"]["front"]["colour"].node())},
+          {"back_colour", numbers(surface["material"]["back"]["colour"].node())},
+          {"transparency", surface["material"]["front"]["transparency"].value_or(0.0)},
+          {"background", numbers(t["image"]["background"].node())},
+          {"light_intensities", lights},
           {"extent_radius", t["extent"]["radius"].value_or(1.0)},
           {"precision", t["render"]["precision"].value_or(std::string("auto"))},
           {"isolation", t["render"]["isolation"].value_or(std::string("bernstein"))},
@@ -248,7 +277,9 @@ std::string random_token() {
 int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
   std::optional<api::Scene> loaded;
   try {
-    loaded = request.scene_path ? api::Scene::load(*request.scene_path) : api::Scene::default_scene();
+    loaded = request.equation      ? api::Scene::from_equation(*request.equation)
+             : request.scene_path ? api::Scene::load(*request.scene_path)
+                                  : api::Scene::default_scene();
     for (const Override& o : request.overrides) loaded->set(o.key, o.value);
   } catch (const api::SceneError& e) {
     err << e.what() << "\n";

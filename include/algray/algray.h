@@ -77,6 +77,8 @@ class Scene {
   static Scene from_jsurf(const std::string& text, const std::string& name = "<string>");
   // The built-in default scene (the Barth sextic), as `algray render` without a scene renders it.
   static Scene default_scene();
+  // An equation alone, with algray's defaults for the rest (`algray render -e EQUATION`).
+  static Scene from_equation(const std::string& equation);
 
   // Sets a dotted scene key, or a parameter by its bare name, as `--set key=value` does: the value is read as
   // TOML ("30", "[0, 0, 5]", "\"sturm\""), or as a string when it is not valid TOML. Throws SceneError, and
@@ -92,6 +94,9 @@ class Scene {
   std::vector<std::string> equations() const;                      // one per surface, as written
   std::vector<std::pair<std::string, double>> parameters() const;  // name and value, sorted by name
   std::vector<std::string> warnings() const;                       // what the reader could not render as written
+  // The camera as camera.azimuth, camera.elevation and camera.distance (degrees, degrees, world units) about its
+  // look-at point, whether the scene placed it by them or by its eye: what set("camera.azimuth", ...) changes.
+  std::array<double, 3> camera_angles() const;
 
   struct State;  // the library's scene and how to read it again
 
@@ -138,6 +143,8 @@ class Image {
   void save(const std::string& path) const;
   // The bytes save("x.png") writes, the scene included, without a file.
   std::string png() const;
+  // 8-bit sRGB RGBA, 4 bytes per pixel, row-major: the pixels of png() (alpha 255 where the PNG has none).
+  std::vector<std::uint8_t> srgba() const;
 
   struct State;
 

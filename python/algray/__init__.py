@@ -23,8 +23,21 @@ __all__ = ["Scene", "Renderer", "Image", "SceneError", "DeviceError", "OutputErr
 
 
 def _scene_set(self, key, value):
-    """Sets a dotted scene key, or a parameter by its bare name, as `algray render --set key=value` does. The
-    value may be a Python number, bool, string or list (written as TOML), and returns the scene for chaining."""
+    """Changes this scene in place, and returns it for chaining: sets a dotted scene key, or a parameter by its
+    bare name, as `algray render --set key=value` does. The value may be a Python number, bool, string or list
+    (written as TOML). Use copy.copy(scene) first to keep the original.
+
+    >>> scene = algray.Scene.from_equation("x^2+y^2+z^2-r^2", parameters={"r": 1})
+    >>> scene.set("r", 0.5).set("camera.azimuth", 90) is scene
+    True
+    >>> scene.parameters
+    {'r': 0.5}
+    >>> try:
+    ...     scene.set("q", 1)
+    ... except algray.SceneError as e:
+    ...     print(e.message)
+    the scene has no parameter 'q'; its parameters: r (--set parameters.q=VALUE adds one)
+    """
     self._set(key, _toml.value(value))
     return self
 
@@ -35,14 +48,31 @@ def _scene_from_dict(data, name="<dict>"):
 
 
 def _scene_from_equation(equation, parameters=None, extent=None, camera=None, name="<equation>", **tables):
-    """The common case by keywords: Scene.from_equation("x^2+y^2+z^2-r^2", parameters={"r": 1},
-    extent={"radius": 2}, camera={"eye": [0, 0, 5]}); further tables (image=, light=[...], render=) as in TOML."""
-    data = {"surface": {"equation": equation}}
-    for key, table in (("parameters", parameters), ("extent", extent), ("camera", camera)):
-        if table:
-            data[key] = table
+    """A scene from an equation alone, with algray's defaults for everything else (README, "An equation is a
+    scene"): a sphere extent of radius 2, the camera framing it from 3R through 45 degrees, a key and a fill light
+    that follow the camera, 2x2 antialiasing. `equation` is a string ("x^4+y^4+z^4-1", with ^ or **) or anything
+    whose str() is one, such as a sympy expression. parameters={"r": 1} names the equation's constants; extent=,
+    camera= and further tables (image=, material=, light=[...], antialias=, render=) are as in a TOML file. The
+    camera's keys are set on the framed camera, as --set does, so the default lights stay.
+
+    >>> scene = algray.Scene.from_equation("x^4+y^4+z^4-1")
+    >>> scene.to_dict()["extent"]["radius"], scene.to_dict()["antialias"]["samples"], len(scene.to_dict()["light"])
+    (2.0, 2, 2)
+    >>> import sympy
+    >>> x, y, z = sympy.symbols("x y z")
+    >>> algray.Scene.from_equation(x**4 - sympy.Rational(3, 2)*x*y*z + y**4 + z**4 - 1).equations
+    ['x**4 - 3*x*y*z/2 + y**4 + z**4 - 1']
+    """
+    data = {"surface": {"equation": str(equation)}}
+    if parameters:
+        data["parameters"] = {str(k): float(v) for k, v in parameters.items()}
+    if extent:
+        data["extent"] = extent
     data.update(tables)
-    return _scene_from_dict(data, name)
+    scene = _scene_from_dict(data, name)
+    for key, value in (camera or {}).items():
+        scene.set("camera." + key, value)
+    return scene
 
 
 def _scene_to_dict(self):
@@ -61,7 +91,20 @@ def _image_stats(self):
     return json.loads(self.stats_json)
 
 
+def _image_to_pil(self):
+    """The image as a PIL image (RGBA, 8-bit sRGB: the pixels a PNG of it holds). Needs Pillow (python3-pil).
+
+    >>> image = algray.Renderer().render(algray.Scene.from_equation("x^2+y^2+z^2-1"), width=32, height=24,
+    ...                                  preview=True)
+    >>> image.srgb().shape, image.srgb().dtype.name, image.to_pil().size
+    ((24, 32, 4), 'uint8', (32, 24))
+    """
+    from PIL import Image as PilImage
+    return PilImage.fromarray(self.srgb(), "RGBA")
+
+
 Image.stats = property(_image_stats)
+Image.to_pil = _image_to_pil
 Image._repr_png_ = Image.png  # Jupyter shows an Image by its PNG bytes
 Image.__repr__ = lambda self: f"<algray.Image {self.width}x{self.height}>"
 

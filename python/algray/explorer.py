@@ -1,55 +1,7 @@
 """Live exploration in Jupyter: sliders for a scene's parameters, the camera's orbit and zoom, re-rendering a
-preview as they move, as SURFER does."""
+preview as they move, as SURFER does. The camera sliders are the scene keys camera.azimuth, camera.elevation and
+camera.distance, which the command line's --set and the view page use too."""
 import copy
-import math
-
-
-def _sub(a, b):
-    return [x - y for x, y in zip(a, b)]
-
-
-def _add(a, b):
-    return [x + y for x, y in zip(a, b)]
-
-
-def _scale(a, s):
-    return [x * s for x in a]
-
-
-def _cross(a, b):
-    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-
-
-def _dot(a, b):
-    return sum(x * y for x, y in zip(a, b))
-
-
-def _unit(a):
-    n = math.sqrt(_dot(a, a))
-    return _scale(a, 1 / n)
-
-
-class Orbit:
-    """The scene's camera as angles about its look-at point: azimuth about the up vector and elevation above the
-    plane through the look-at point normal to it, both in degrees from the scene's own view, and a zoom that
-    divides the eye's distance."""
-
-    def __init__(self, camera):
-        self.look_at = list(camera.get("look_at", [0, 0, 0]))
-        eye = list(camera["eye"])
-        self.up = _unit(list(camera.get("up", [0, 1, 0])))
-        offset = _sub(eye, self.look_at)
-        self.distance = math.sqrt(_dot(offset, offset))
-        self.forward = _unit(_sub(offset, _scale(self.up, _dot(offset, self.up))))  # in the plane normal to up
-        self.side = _cross(self.up, self.forward)
-        self.elevation0 = math.degrees(math.asin(max(-1.0, min(1.0, _dot(offset, self.up) / self.distance))))
-
-    def eye(self, azimuth, elevation, zoom):
-        a = math.radians(azimuth)
-        e = math.radians(max(-89.0, min(89.0, self.elevation0 + elevation)))
-        horizontal = _add(_scale(self.forward, math.cos(a)), _scale(self.side, math.sin(a)))
-        direction = _add(_scale(horizontal, math.cos(e)), _scale(self.up, math.sin(e)))
-        return _add(self.look_at, _scale(direction, self.distance / zoom))
 
 
 class Explorer:
@@ -60,9 +12,12 @@ class Explorer:
         self.scene = scene
         self.renderer = renderer
         self.width, self.height = width, height
-        self.orbit = Orbit(scene.to_dict()["camera"])
-        self.values = {"azimuth": 0.0, "elevation": 0.0, "zoom": 1.0}
-        self.ranges = {"azimuth": (-180.0, 180.0), "elevation": (-85.0, 85.0), "zoom": (0.25, 4.0)}
+        # The camera by the scene keys camera.azimuth, .elevation and .distance, as the view page sets them.
+        angles = scene.camera_angles
+        self.values = dict(angles)
+        distance = angles["distance"]
+        self.ranges = {"azimuth": (-180.0, 180.0), "elevation": (-90.0, 90.0),
+                       "distance": (distance / 4, distance * 4)}
         for name, value in scene.parameters.items():
             self.values[name] = value
             span = max(abs(value), 1.0)
@@ -78,7 +33,8 @@ class Explorer:
         s = copy.copy(self.scene)
         for name in self.scene.parameters:
             s.set(name, float(self.values[name]))
-        s.set("camera.eye", self.orbit.eye(self.values["azimuth"], self.values["elevation"], self.values["zoom"]))
+        for key in ("azimuth", "elevation", "distance"):
+            s.set("camera." + key, float(self.values[key]))
         return s
 
     def render(self):

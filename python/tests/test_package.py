@@ -121,10 +121,11 @@ def test_the_explorer_re_renders_when_a_slider_moves(renderer):
     assert eye == pytest.approx([5, 0, 0], abs=1e-9)
     # The widgets themselves: moving a slider from Python runs its callback, which re-renders into the picture.
     box = explorer.widget
-    assert set(explorer.sliders) == {"r", "azimuth", "elevation", "zoom"}
+    assert set(explorer.sliders) == {"r", "azimuth", "elevation", "distance"}
     shown = explorer._picture.value
-    explorer.sliders["zoom"].value = 2.0
-    assert explorer.renders == 4 and explorer.values["zoom"] == 2.0
+    explorer.sliders["distance"].value = 2.5
+    assert explorer.renders == 4 and explorer.values["distance"] == 2.5
+    assert explorer.current_scene().camera_angles["distance"] == pytest.approx(2.5)
     assert explorer._picture.value == explorer.png != shown
     assert box.children[0] is explorer._picture
 
@@ -209,3 +210,57 @@ def test_the_renderers_precision_and_a_missing_device():
     assert image.stats["solver"]["precision"] == "float"
     with pytest.raises(algray.DeviceError):
         algray.Renderer(device="no such device 12345").device
+
+
+def test_the_docstrings_examples_run():
+    import doctest
+
+    import algray.explorer
+
+    for module in (algray, algray.explorer):
+        result = doctest.testmod(module, extraglobs={"algray": algray}, optionflags=doctest.ELLIPSIS)
+        assert result.failed == 0, f"{module.__name__}: {result.failed} of {result.attempted} examples failed"
+    assert doctest.testmod(algray, extraglobs={"algray": algray}).attempted >= 5
+
+
+def test_an_equation_alone_is_a_scene_with_the_defaults_from_a_string_or_sympy(renderer, tmp_path):
+    import sympy  # python3-sympy, in scripts/install-deps.sh's test set: missing, this fails
+
+    x, y, z = sympy.symbols("x y z")
+    from_sympy = algray.Scene.from_equation(x**4 + y**4 + z**4 - sympy.Rational(1, 2))
+    from_text = algray.Scene.from_equation("x^4+y^4+z^4-1/2")
+    assert from_sympy.equations == ["x**4 + y**4 + z**4 - 1/2"]
+    a, b = from_sympy.to_dict(), from_text.to_dict()
+    for table in ("extent", "camera", "light", "antialias"):
+        assert a[table] == b[table], table
+    assert a["extent"]["radius"] == 2.0 and a["antialias"]["samples"] == 2 and len(a["light"]) == 2
+    assert from_text.camera_angles == pytest.approx({"azimuth": 30, "elevation": 20, "distance": 6})
+    # The same pixels either way, and the command line's -e gives them too.
+    one = renderer.render(from_sympy, width=40, height=30, preview=True)
+    two = renderer.render(from_text, width=40, height=30, preview=True)
+    assert np.array_equal(one.rgba, two.rgba)
+    assert BINARY, "ALGRAY_BINARY must name the built command line (CTest sets it)"
+    out = tmp_path / "cli.png"
+    subprocess.run([BINARY, "render", "-e", "x^4+y^4+z^4-1/2", "--preview", "--width", "40", "--height", "30",
+                    "-o", str(out), "--quiet"], check=True)
+    from PIL import Image as PilImage
+    assert np.array_equal(np.asarray(PilImage.open(out).convert("RGBA")), two.srgb())
+    # A camera given as keywords is set on the framed camera: the default lights stay.
+    turned = algray.Scene.from_equation("x^2+y^2+z^2-1", camera={"eye": [0, 0, 5]})
+    assert len(turned.to_dict()["light"]) == 2 and turned.to_dict()["camera"]["eye"] == [0, 0, 5]
+
+
+def test_srgb_is_the_pngs_pixels_and_to_pil_shows_them(renderer):
+    from PIL import Image as PilImage
+    import io
+
+    scene = algray.Scene.load(TORUS)
+    image = renderer.render(scene, width=48, height=36, preview=True)
+    srgb = image.srgb()
+    assert srgb.shape == (36, 48, 4) and srgb.dtype == np.uint8
+    assert np.array_equal(np.asarray(PilImage.open(io.BytesIO(image.png())).convert("RGBA")), srgb)
+    assert np.array_equal(np.asarray(image.to_pil()), srgb)
+    # Not the linear values: mid-grey linear 0.2 is sRGB 124.
+    linear = image.rgba[..., :3]
+    lit = (linear > 0.15) & (linear < 0.25)
+    assert lit.any() and np.all(np.abs(srgb[..., :3][lit].astype(int) - 124) < 20)

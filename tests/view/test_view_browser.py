@@ -73,20 +73,27 @@ try:
     if not first.startswith(b"\x89PNG"):
         fail("the first frame is not a PNG")
     info = driver.find_element(By.ID, "info").text
-    if "degree 6" not in info or "fps" not in info:
-        fail(f"info line: {info!r}")
+    if "degree 6" not in info or "fps" in info:
+        fail(f"info line at rest (degree, no fps): {info!r}")
+    hint = driver.find_element(By.ID, "hint").text
+    if "Drag" not in hint or "zoom" not in hint:
+        fail(f"gesture hint: {hint!r}")
+    # The solver selectors are under a closed "Advanced" fold.
+    if driver.execute_script("return document.getElementById('advanced').open") or \
+            driver.execute_script("return document.getElementById('isolation').closest('details').id") != "advanced":
+        fail("the solver selectors are not in a closed Advanced fold")
 
     original = driver.execute_script("return view.equation")
     # A drag turns the camera about the look-at point, and the image changes.
-    eye = driver.execute_script("return view.camera.eye.slice()")
+    camera = driver.execute_script("return Object.assign({}, view.camera)")
     n = frames()
     ActionChains(driver).move_to_element(driver.find_element(By.ID, "frame")).click_and_hold() \
         .move_by_offset(40, 0).move_by_offset(40, 15).release().perform()
     dragged = settle(n)
-    new_eye = driver.execute_script("return view.camera.eye")
-    dist = lambda e: sum(x * x for x in e) ** 0.5
-    if new_eye == eye or abs(dist(new_eye) - dist(eye)) > 1e-6 * dist(eye):
-        fail(f"the drag moved the eye from {eye} to {new_eye}, not about the look-at point")
+    turned = driver.execute_script("return Object.assign({}, view.camera)")
+    if turned["azimuth"] == camera["azimuth"] or turned["distance"] != camera["distance"] \
+            or turned["look_at"] != camera["look_at"]:
+        fail(f"the drag changed the camera from {camera} to {turned}, not its angles about the look-at point")
     if dragged == first:
         fail("the image did not change with the drag")
 
@@ -103,7 +110,7 @@ try:
 
     # The wheel and a two-finger pinch zoom: the eye moves along its line to the look-at point.
     def distance():
-        return driver.execute_script("return Math.hypot(...sub(view.camera.eye, view.camera.look_at))")
+        return driver.execute_script("return view.camera.distance")
     before = distance()
     n = frames()
     driver.execute_script("document.getElementById('frame').dispatchEvent("
@@ -121,6 +128,62 @@ try:
     zoomed = settle(n)
     if zoomed == slid:
         fail("the image did not change with the zoom")
+
+    # Each control of the panel changes what the server renders, by the scene keys it names.
+    def control(script, *args):
+        n = frames()
+        driver.execute_script(script, *args)
+        return settle(n)
+
+    def sent(key):
+        return driver.execute_script("return Object.fromEntries(settings())[arguments[0]]", key)
+
+    shown = zoomed
+    for cid, key, value in (("front-colour", "surface.material.front.colour", "#20c040"),
+                            ("back-colour", "surface.material.back.colour", "#c02020"),
+                            ("background", "image.background", "#102030")):
+        picture = control("""const e = document.getElementById(arguments[0]); e.value = arguments[1];
+                             e.dispatchEvent(new Event('input'));""", cid, value)
+        if picture == shown:
+            fail(f"the image did not change with {cid}")
+        if not sent(key).startswith("["):
+            fail(f"{cid} sends no {key}")
+        shown = picture
+    lights = driver.execute_script("return view.lights.slice()")
+    picture = control("""const e = document.getElementById('light'); e.value = '2';
+                         e.dispatchEvent(new Event('input'));""")
+    if not lights or abs(float(sent("light.0.intensity")) - 2 * lights[0]) > 1e-9 or picture == shown:
+        fail(f"the light slider: intensities {lights}, light.0.intensity sent {sent('light.0.intensity')}")
+    shown = picture
+    control("""const e = document.getElementById('transparency'); e.value = '0.5';
+               e.dispatchEvent(new Event('input'));""")
+    if sent("surface.material.front.transparency") != "0.5" or sent("surface.material.back.transparency") != "0.5":
+        fail("the transparency slider does not set both sides' transparency")
+    picture = control("document.getElementById('view-y').click()")
+    if driver.execute_script("return [view.camera.azimuth, view.camera.elevation]") != [0, 90] or picture == shown:
+        fail("the y axis button does not look down the y axis")
+    shown = picture
+    picture = control("document.getElementById('view-x').click()")
+    if driver.execute_script("return [view.camera.azimuth, view.camera.elevation]") != [90, 0] or picture == shown:
+        fail("the x axis button does not look along the x axis")
+    # Reset: the scene's own view and colours again, and its first frame's pixels.
+    n = frames()
+    driver.execute_script("document.getElementById('reset').click()")
+    reset = settle(n)
+    if driver.execute_script("return [view.camera.azimuth, view.light, view.transparency]") != \
+            [camera["azimuth"], 1, 0] or idat(reset) != idat(first):
+        fail("Reset does not bring back the scene's own view")
+    # Save image: the server renders the size and quality asked for, not the frame on screen.
+    driver.execute_script("""document.getElementById('save-width').value = '50';
+                             document.getElementById('save-height').value = '30';
+                             document.getElementById('save-quality').value = 'preview';
+                             document.getElementById('save-png').click();""")
+    wait.until(lambda d: d.find_element(By.ID, "save-png").get_attribute("data-saved") == "50x30 preview")
+    image_url = url.rstrip("/") + driver.execute_script("return '/frame.png?' + query(50, 30, false)")
+    with urllib.request.urlopen(image_url, timeout=60) as r:
+        saved_png = r.read()
+    if saved_png[16:24] != (50).to_bytes(4, "big") + (30).to_bytes(4, "big"):
+        fail("the saved image is not 50x30")
 
     # A bad equation: the error under the column the command line reports, and the last good image stays.
     n = frames()
@@ -158,4 +221,5 @@ finally:
         driver.quit()
     server.terminate()
     server.wait(timeout=30)
-print("test_view_browser: first frame, drag, slider, located error and saved scene all hold in Chromium")
+print("test_view_browser: first frame, hint, drag, slider, zoom, colours, lights, transparency, axis views, reset, "
+      "saved image, located error and saved scene all hold in Chromium")

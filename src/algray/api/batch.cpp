@@ -349,13 +349,27 @@ std::vector<Override> frame_overrides(const BatchJob& job, int frame) {
 
 void apply_orbit(Scene& scene, const Orbit& orbit, int frame, int frames) {
   CameraSpec& cam = scene.camera;
-  const glm::dvec3 axis = glm::normalize(orbit.axis.value_or(cam.up));
+  // A camera placed by angles turns about the up it was given (its `up` is the image's, tilted with the view).
+  const glm::dvec3 axis = glm::normalize(orbit.axis.value_or(cam.angles ? cam.written_up : cam.up));
   const double radians = orbit_angle(orbit, frame, frames) * 3.14159265358979323846 / 180;
   const glm::dvec3 pivot = cam.look_at;
   cam.eye = pivot + rotated(cam.eye - pivot, axis, radians);
   cam.up = rotated(cam.up, axis, radians);
-  if (!orbit.lights_follow_camera) return;
+  cam.angles.reset();  // the eye is placed now, not by the scene's angles
   for (Light& l : scene.lights) {
+    // A light attached to the camera follows it by being placed again in the camera's frame, as reading the
+    // frame's scene (its PNG) places it; with lights = world it stays where it was, a world light now.
+    if (l.in_camera) {
+      if (orbit.lights_follow_camera) {
+        std::vector<Light> one{l};
+        place_camera_lights(one, cam);
+        l = one.front();
+      } else {
+        l.in_camera.reset();
+      }
+      continue;
+    }
+    if (!orbit.lights_follow_camera) continue;
     l.position = pivot + rotated(l.position - pivot, axis, radians);
     l.edge_u = rotated(l.edge_u, axis, radians);
     l.edge_v = rotated(l.edge_v, axis, radians);

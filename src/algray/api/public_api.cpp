@@ -7,6 +7,7 @@
 #include "algray/api/batch.h"
 #include "algray/api/probe_report.h"
 #include "algray/api/render_job.h"
+#include "algray/io/image_io.h"
 #include "algray/device/program_cache.h"
 #include "algray/scene/jsurf.h"
 #include "algray/util/json_text.h"
@@ -15,7 +16,7 @@
 namespace algray::api {
 
 struct Scene::State {
-  enum class Kind { File, Toml, Jsurf, Default } kind = Kind::Default;
+  enum class Kind { File, Toml, Jsurf, Equation, Default } kind = Kind::Default;
   std::string text_or_path;
   std::string name;  // of a text
   std::vector<Override> overrides;
@@ -74,6 +75,8 @@ algray::Scene read_scene(const Scene::State& s, const std::vector<Override>& ove
       return load_scene_text(s.text_or_path, s.name, overrides);
     case Scene::State::Kind::Jsurf:
       return load_jsurf_text(s.text_or_path, s.name, overrides);
+    case Scene::State::Kind::Equation:
+      return load_equation(s.text_or_path, overrides);
     case Scene::State::Kind::Default:
       break;
   }
@@ -123,6 +126,9 @@ Scene Scene::from_jsurf(const std::string& text, const std::string& name) {
   return Scene(read_state({State::Kind::Jsurf, text, name, {}, {}}));
 }
 Scene Scene::default_scene() { return Scene(read_state({})); }
+Scene Scene::from_equation(const std::string& equation) {
+  return Scene(read_state({State::Kind::Equation, equation, "--equation", {}, {}}));
+}
 
 Scene& Scene::set(const std::string& key, const std::string& value) {
   State next = *state_;
@@ -145,6 +151,10 @@ std::vector<std::pair<std::string, double>> Scene::parameters() const {
   return {state_->scene.parameters.begin(), state_->scene.parameters.end()};
 }
 std::vector<std::string> Scene::warnings() const { return state_->scene.warnings; }
+std::array<double, 3> Scene::camera_angles() const {
+  const CameraAngles a = algray::camera_angles(state_->scene.camera);
+  return {a.azimuth, a.elevation, a.distance};
+}
 
 int Image::width() const { return state_->image.width; }
 int Image::height() const { return state_->image.height; }
@@ -171,6 +181,7 @@ const std::string& Image::stats_json() const { return state_->stats; }
 void Image::save(const std::string& path) const {
   translated([&] { write_image(path, state_->image); });
 }
+std::vector<std::uint8_t> Image::srgba() const { return srgba_bytes(state_->image); }
 std::string Image::png() const {
   return translated([&] { return png_bytes(state_->image); });
 }

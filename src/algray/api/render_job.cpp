@@ -125,6 +125,8 @@ nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const
   j["version"] = version_string();
   put_path(j, "scene", scene.source);
   j["name"] = utf8_for_json(scene.name);
+  // Every value the render used, defaults included, as a scene file that renders the same picture again.
+  j["scene_toml"] = utf8_for_json(scene_to_toml(scene));
   put_paths(j, "outputs", images);
   j["image"] = {{"width", scene.image.width}, {"height", scene.image.height}};
   // Drivers' strings and .jsurf equations come from outside and need not be UTF-8.

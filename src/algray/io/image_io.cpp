@@ -868,4 +868,15 @@ std::vector<std::pair<std::string, std::string>> read_png_text(const fs::path& p
   return out;
 }
 
+std::vector<std::uint8_t> srgba_bytes(const FrameImage& image) {
+  const std::size_t n = checked_pixel_count(image);
+  std::vector<std::uint8_t> out(4 * n);
+  const SrgbEncoder& srgb = srgb_encoder();
+  for (std::size_t i = 0; i < 4 * n; i += 4) {
+    for (std::size_t c = 0; c < 3; ++c) out[i + c] = srgb(image.rgba[i + c]);
+    out[i + 3] = encode_alpha(image.rgba[i + 3]);
+  }
+  return out;
+}
+
 }  // namespace algray

@@ -83,6 +83,10 @@ enum class ImageFormat { Exr, Png };
 // 0 for NaN and values <= 0, 255 from 1 on.
 std::uint8_t srgb_byte(float linear);
 
+// The image as 8-bit sRGB RGBA, 4 bytes per pixel, row-major: the bytes write_png stores for each pixel (its
+// alpha 255 where the PNG has none), for callers that show an image rather than save it.
+std::vector<std::uint8_t> srgba_bytes(const FrameImage& image);
+
 // Case-insensitive .exr / .png; anything else throws OutputError.
 ImageFormat format_from_extension(const std::filesystem::path& p);
 

@@ -1,6 +1,7 @@
 // Camera frame, per-pixel ray coefficients and the EXR camera matrices.
 #include "algray/scene/camera.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace algray {
@@ -27,6 +28,64 @@ RayBasis make_ray_basis(const CameraSpec& camera, int width, int height) {
     b.du = b.dv = glm::dvec3(0);
   }
   return b;
+}
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double radians(double degrees) { return degrees * kPi / 180; }
+double degrees(double radians) { return radians * 180 / kPi; }
+
+// The horizontal frame azimuths are measured in: the reference direction (azimuth 0) and the one at +90 degrees.
+void azimuth_frame(const glm::dvec3& unit_up, glm::dvec3& reference, glm::dvec3& side) {
+  glm::dvec3 r = glm::dvec3(0, 0, 1) - unit_up.z * unit_up;
+  if (glm::length(r) < 1e-6) r = glm::dvec3(1, 0, 0) - unit_up.x * unit_up;
+  reference = glm::normalize(r);
+  side = glm::cross(unit_up, reference);
+}
+
+}  // namespace
+
+void place_camera_by_angles(CameraSpec& camera, const CameraAngles& angles, const glm::dvec3& given_up) {
+  const glm::dvec3 up = given_up;  // a copy: `given_up` may be camera.up, which is set below
+  const glm::dvec3 u = glm::normalize(up);
+  glm::dvec3 reference, side;
+  azimuth_frame(u, reference, side);
+  const double a = radians(angles.azimuth), e = radians(angles.elevation);
+  const glm::dvec3 horizontal = std::cos(a) * reference + std::sin(a) * side;
+  const glm::dvec3 towards_eye = std::cos(e) * horizontal + std::sin(e) * u;
+  camera.eye = camera.look_at + angles.distance * towards_eye;
+  camera.up = std::cos(e) * u - std::sin(e) * horizontal;  // normal to the view, in the plane of up and the view
+  camera.angles = angles;
+  camera.written_up = up;
+}
+
+CameraAngles camera_angles(const CameraSpec& camera) {
+  if (camera.angles) return *camera.angles;
+  const glm::dvec3 u = glm::normalize(camera.up);
+  glm::dvec3 reference, side;
+  azimuth_frame(u, reference, side);
+  const glm::dvec3 offset = camera.eye - camera.look_at;
+  CameraAngles out;
+  out.distance = glm::length(offset);
+  out.elevation = degrees(std::asin(std::clamp(glm::dot(offset, u) / out.distance, -1.0, 1.0)));
+  const glm::dvec3 horizontal = offset - glm::dot(offset, u) * u;
+  out.azimuth = glm::length(horizontal) > 1e-12 * out.distance
+                    ? degrees(std::atan2(glm::dot(horizontal, side), glm::dot(horizontal, reference)))
+                    : 0;
+  return out;
+}
+
+glm::dvec3 camera_vector_to_world(const CameraSpec& camera, const glm::dvec3& v) {
+  const glm::dvec3 forward = glm::normalize(camera.look_at - camera.eye);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, camera.up));
+  const glm::dvec3 up = glm::cross(right, forward);
+  return v.x * right + v.y * up - v.z * forward;
+}
+
+glm::dvec3 camera_point_to_world(const CameraSpec& camera, const glm::dvec3& p) {
+  return camera.eye + camera_vector_to_world(camera, p);
 }
 
 namespace {

@@ -32,14 +32,21 @@ std::string format_what(const std::string& where, const std::string& message, co
 const std::set<std::string> kTopKeys{"surface",  "parameters", "extent",    "camera", "image",
                                      "material", "light",      "antialias", "render"};
 const std::set<std::string> kSurfaceKeys{"name", "equation", "terms", "material"};
-const std::set<std::string> kExtentKeys{"type", "centre", "radius", "min", "max"};
-const std::set<std::string> kCameraKeys{"projection", "eye", "look_at", "up", "fov_y", "height"};
+const std::set<std::string> kExtentKeys = [] {
+  std::set<std::string> keys{"type"};
+  for (const ExtentKindInfo& k : extent_kinds()) keys.insert(k.keys.begin(), k.keys.end());
+  return keys;
+}();
+// The eye, or the angles about look_at (camera.h's CameraAngles): one or the other.
+const std::set<std::string> kCameraAngleKeys{"azimuth", "elevation", "distance"};
+const std::set<std::string> kCameraKeys{"projection", "eye",     "look_at",   "up",      "fov_y",
+                                        "height",     "azimuth", "elevation", "distance"};
 const std::set<std::string> kImageKeys{"width", "height", "background"};
 const std::set<std::string> kMaterialKeys{"front", "back"};
 const std::set<std::string> kMaterialSideKeys{"colour",   "ambient",      "diffuse",     "specular",
                                               "exponent", "reflectivity", "transparency"};
-const std::set<std::string> kLightKeys{"type",   "position", "edge_u", "edge_v",    "normal",
-                                       "radius", "samples",  "colour", "intensity", "shadows"};
+const std::set<std::string> kLightKeys{"type",    "position", "edge_u",    "edge_v",  "normal", "radius",
+                                       "samples", "colour",   "intensity", "shadows", "frame"};
 const std::set<std::string> kAntialiasKeys{"samples", "adaptive", "threshold"};
 const std::set<std::string> kRenderKeys{"precision",      "tolerance", "isolation", "refinement", "ray_origin",
                                         "max_iterations", "tile_size", "lanes",     "preview",    "max_depth"};
@@ -60,14 +67,120 @@ bool is_index(const std::string& s) {
          std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
 }
 
-void apply_override(toml::table& root, const Override& o) {
+// A vector of three numbers in `node`, or nothing: for the exchanges below, which leave checking to the reader.
+std::optional<glm::dvec3> loose_vec3(const toml::node* node) {
+  const toml::array* a = node ? node->as_array() : nullptr;
+  if (!a || a->size() != 3) return std::nullopt;
+  glm::dvec3 v;
+  for (int i = 0; i < 3; ++i) {
+    const toml::node* x = a->get(static_cast<std::size_t>(i));
+    if (auto d = x->value<double>())
+      v[i] = *d;
+    else
+      return std::nullopt;
+  }
+  return v;
+}
+
+toml::array toml_array(const glm::dvec3& v) { return toml::array{v.x, v.y, v.z}; }
+
+// The extent's centre as the [extent] table gives it (before it is checked), for a camera's default look_at.
+glm::dvec3 loose_extent_centre(const toml::table& root) {
+  const toml::table* extent = root["extent"].as_table();
+  if (!extent) return glm::dvec3(0);
+  if (const auto mn = loose_vec3(extent->get("min")), mx = loose_vec3(extent->get("max")); mn && mx)
+    return (*mn + *mx) * 0.5;
+  return loose_vec3(extent->get("centre")).value_or(glm::dvec3(0));
+}
+
+// --set camera.azimuth (or elevation, distance) on a camera placed by its eye: the eye becomes the three angles
+// first, so that the keys not set keep the view; --set camera.eye drops the angles. Nothing is lost either way.
+void exchange_camera_keys(toml::table& root, const std::string& key) {
+  toml::table* camera = root["camera"].as_table();
+  if (!camera) return;
+  if (key == "eye") {
+    for (const std::string& k : kCameraAngleKeys) camera->erase(k);
+    return;
+  }
+  if (!kCameraAngleKeys.count(key) || !camera->get("eye")) return;
+  const auto eye = loose_vec3(camera->get("eye"));
+  if (!eye) return;  // the reader reports it
+  CameraSpec c;
+  c.eye = *eye;
+  c.look_at = camera->get("look_at") ? loose_vec3(camera->get("look_at")).value_or(glm::dvec3(0))
+                                     : loose_extent_centre(root);
+  c.up = loose_vec3(camera->get("up")).value_or(glm::dvec3(0, 1, 0));
+  if (!(glm::length(c.up) > 0) || !(glm::length(c.eye - c.look_at) > 0)) return;
+  const CameraAngles a = camera_angles(c);
+  camera->erase("eye");
+  camera->insert("azimuth", a.azimuth);
+  camera->insert("elevation", a.elevation);
+  camera->insert("distance", a.distance);
+}
+
+// --set extent.type=KIND: the keys of the other kinds are dropped, with a note, and the new kind's keys that are
+// missing are made from the old ones so that the same part of space stays in view: a sphere of radius R becomes
+// the cube of side 2R about its centre, and a box the sphere inscribed in its largest side.
+void switch_extent_kind(toml::table& root, const std::string& label, std::vector<std::string>& notes) {
+  toml::table* extent = root["extent"].as_table();
+  if (!extent) return;
+  const auto type = extent->get("type") ? extent->get("type")->value<std::string>() : std::nullopt;
+  const auto to = std::find_if(extent_kinds().begin(), extent_kinds().end(),
+                               [&](const ExtentKindInfo& k) { return type && *type == k.name; });
+  if (to == extent_kinds().end()) return;  // the reader names the kinds
+  std::vector<std::string> dropped;
+  for (const ExtentKindInfo& k : extent_kinds())
+    for (const std::string& key : k.keys)
+      if (std::find(to->keys.begin(), to->keys.end(), key) == to->keys.end() && extent->get(key))
+        dropped.push_back(key);
+  if (dropped.empty()) return;
+  std::string made;
+  const auto centre = loose_vec3(extent->get("centre")).value_or(glm::dvec3(0));
+  const auto radius = extent->get("radius") ? extent->get("radius")->value<double>() : std::nullopt;
+  const auto mn = loose_vec3(extent->get("min")), mx = loose_vec3(extent->get("max"));
+  if (to->kind == ExtentKind::Box && radius && !extent->get("min") && !extent->get("max")) {
+    extent->insert("min", toml_array(centre - *radius));
+    extent->insert("max", toml_array(centre + *radius));
+    made = "; the box is the cube about the sphere, min = " + toml_vector(centre - *radius) +
+           ", max = " + toml_vector(centre + *radius);
+  } else if (to->kind == ExtentKind::Sphere && mn && mx && !extent->get("radius")) {
+    const glm::dvec3 half = (*mx - *mn) * 0.5;
+    const double r = std::max({half.x, half.y, half.z});
+    extent->insert_or_assign("centre", toml_array((*mn + *mx) * 0.5));
+    extent->insert("radius", r);
+    made = "; the sphere is centre = " + toml_vector((*mn + *mx) * 0.5) + ", radius = " + toml_number(r);
+    dropped.erase(std::remove(dropped.begin(), dropped.end(), "centre"), dropped.end());
+  }
+  std::string names;
+  for (const std::string& key : dropped) {
+    extent->erase(key);
+    names += (names.empty() ? "extent." : " and extent.") + key;
+  }
+  notes.push_back(label + ": " + names + " do" + (dropped.size() == 1 ? "es" : "") + " not apply to a " + to->name +
+                  " extent and " + (dropped.size() == 1 ? "was" : "were") + " dropped" + made);
+}
+
+void apply_override(toml::table& root, const Override& o, std::vector<std::string>& notes) {
   // A hostile key or value may be megabytes long: messages show its start.
   const auto shown = [](const std::string& t) {
     return t.size() <= 120 ? t : t.substr(0, 100) + "...(" + std::to_string(t.size()) + " characters)";
   };
   const std::string label = (o.origin.empty() ? "--set " : o.origin + ": set ") + shown(o.key) + "=" + shown(o.value);
-  // A bare name is a parameter; any other key is a dotted path into the scene.
-  const std::string key = o.key.find('.') == std::string::npos ? "parameters." + o.key : o.key;
+  // A bare name is a parameter; any other key is a dotted path into the scene. A bare name must be one of the
+  // scene's parameters, so that a typo is not a new parameter nothing uses; parameters.NAME adds one.
+  const bool bare = o.key.find('.') == std::string::npos;
+  if (bare && is_identifier(o.key)) {
+    const toml::table* params = root["parameters"].as_table();
+    if (!params || !params->get(o.key)) {
+      std::string names;
+      if (params)
+        for (auto&& [name, node] : *params) names += (names.empty() ? "" : ", ") + std::string(name.str());
+      throw SceneError(label, "the scene has no parameter '" + o.key + "'; " +
+                                  (names.empty() ? "it has no parameters" : "its parameters: " + names) +
+                                  " (--set parameters." + o.key + "=VALUE adds one)");
+    }
+  }
+  const std::string key = bare ? "parameters." + o.key : o.key;
   std::vector<std::string> parts;
   for (std::size_t start = 0;;) {
     const std::size_t dot = key.find('.', start);
@@ -142,7 +255,9 @@ void apply_override(toml::table& root, const Override& o) {
       throw SceneError(label, "value is neither valid TOML nor a plain string");
     }
   }
+  if (parts.size() == 2 && parts[0] == "camera") exchange_camera_keys(root, parts[1]);
   merge_tables(*target, std::move(parsed));
+  if (key == "extent.type") switch_extent_kind(root, label, notes);
 }
 
 Polynomial polynomial_from_terms(const TomlReader& r, const toml::node& terms_node) {
@@ -213,7 +328,7 @@ SceneSurface read_surface(const TomlReader& r, const toml::table& surface,
   return out;
 }
 
-Light read_light(const TomlReader& r, const toml::table& t) {
+Light read_light(const TomlReader& r, const toml::table& t, const CameraSpec& camera) {
   r.check_keys(t, "light", kLightKeys);
   Light light;
   const std::string type = t.get("type") ? r.string(*t.get("type"), "light.type") : "point";
@@ -264,6 +379,18 @@ Light read_light(const TomlReader& r, const toml::table& t) {
     if (light.intensity < 0) r.fail(n->source(), "light.intensity must not be negative");
   }
   if (const toml::node* n = t.get("shadows")) light.shadows = r.boolean(*n, "light.shadows");
+  if (const toml::node* n = t.get("frame")) {
+    const std::string frame = r.string(*n, "light.frame");
+    if (frame == "camera")
+      light.in_camera = Light::CameraFrame{light.position, light.edge_u, light.edge_v, light.normal};
+    else if (frame != "world")
+      r.fail(n->source(), "light.frame must be \"world\" or \"camera\" (attached to the camera, following it)");
+  }
+  if (light.in_camera) {
+    std::vector<Light> one{light};
+    place_camera_lights(one, camera);
+    light = one.front();
+  }
   return light;
 }
 
@@ -331,10 +458,22 @@ void read_box_extent(const TomlReader& r, const toml::table& extent, Extent& out
     r.fail(mx->source(), "the extent is too small to render: its half-diagonal must be at least 1e-18");
 }
 
+// "\"sphere\" or \"box\"", from extent_kinds().
+std::string extent_kind_choices() {
+  std::string out;
+  const auto& kinds = extent_kinds();
+  for (std::size_t i = 0; i < kinds.size(); ++i)
+    out += std::string(i == 0 ? "" : i + 1 == kinds.size() ? " or " : ", ") + "\"" + kinds[i].name + "\"";
+  return out;
+}
+
 void read_extent(const TomlReader& r, const toml::table& root, Extent& out) {
   const toml::table* extent = r.subtable(root, "extent");
-  if (!extent)
-    r.fail(root.source(), "missing [extent] table (a sphere with centre and radius, or a box with min and max)");
+  if (!extent) {  // algray's default: a sphere about the origin
+    out.kind = ExtentKind::Sphere;
+    out.radius = kDefaultExtentRadius;
+    return;
+  }
   r.check_keys(*extent, "extent", kExtentKeys);
   const std::string type = extent->get("type") ? r.string(*extent->get("type"), "extent.type") : "sphere";
   if (type == "sphere")
@@ -342,12 +481,15 @@ void read_extent(const TomlReader& r, const toml::table& root, Extent& out) {
   else if (type == "box")
     read_box_extent(r, *extent, out);
   else
-    r.fail(extent->get("type")->source(), "extent.type must be \"sphere\" or \"box\"");
+    r.fail(extent->get("type")->source(), "extent.type must be " + extent_kind_choices());
 }
 
-void read_camera(const TomlReader& r, const toml::table& root, CameraSpec& cam) {
-  const toml::table* camera = r.subtable(root, "camera");
-  if (!camera) r.fail(root.source(), "missing [camera] table (eye, look_at, up)");
+// The camera: by its eye, or by angles about look_at (CameraAngles), which is algray's framing when the scene
+// gives neither: look_at the extent's centre, up +y, kFramingDistance times the extent's radius away.
+void read_camera(const TomlReader& r, const toml::table& root, const Extent& extent, CameraSpec& cam) {
+  static const toml::table none;
+  const toml::table* given = r.subtable(root, "camera");
+  const toml::table* camera = given ? given : &none;
   r.check_keys(*camera, "camera", kCameraKeys);
   if (const toml::node* n = camera->get("projection")) {
     const std::string p = r.string(*n, "camera.projection");
@@ -359,16 +501,34 @@ void read_camera(const TomlReader& r, const toml::table& root, CameraSpec& cam) 
       r.fail(n->source(), "camera.projection must be \"perspective\" or \"orthographic\"");
   }
   // Where it looks from and to, and which way is up.
-  for (const char* k : {"eye", "look_at", "up"})
-    if (!camera->get(k)) r.fail(camera->source(), std::string("camera.") + k + " is required");
-  cam.eye = r.vec3(*camera->get("eye"), "camera.eye");
-  cam.look_at = r.vec3(*camera->get("look_at"), "camera.look_at");
-  cam.up = r.vec3(*camera->get("up"), "camera.up");
-  const glm::dvec3 view = cam.look_at - cam.eye;
-  if (glm::length(view) <= 1e-12 * std::max(1.0, glm::length(cam.eye)))
-    r.fail(camera->get("look_at")->source(), "degenerate camera: look_at coincides with eye");
-  if (glm::length(glm::cross(glm::normalize(view), cam.up)) <= 1e-9 * glm::length(cam.up) || glm::length(cam.up) == 0)
-    r.fail(camera->get("up")->source(), "degenerate camera: up is zero or parallel to the viewing direction");
+  cam.look_at = camera->get("look_at") ? r.vec3(*camera->get("look_at"), "camera.look_at") : extent.unit_centre();
+  cam.up = camera->get("up") ? r.vec3(*camera->get("up"), "camera.up") : glm::dvec3(0, 1, 0);
+  if (const toml::node* eye = camera->get("eye")) {
+    for (const std::string& k : kCameraAngleKeys)
+      if (const toml::node* n = camera->get(k))
+        r.fail(n->source(), "camera." + k + " places the eye by angles: give camera.eye or the angles (azimuth, " +
+                                "elevation, distance), not both");
+    cam.eye = r.vec3(*eye, "camera.eye");
+    const glm::dvec3 view = cam.look_at - cam.eye;
+    const toml::node* look_at = camera->get("look_at");
+    if (glm::length(view) <= 1e-12 * std::max(1.0, glm::length(cam.eye)))
+      r.fail((look_at ? look_at : eye)->source(), "degenerate camera: look_at coincides with eye");
+    const toml::node* up = camera->get("up");
+    if (glm::length(glm::cross(glm::normalize(view), cam.up)) <= 1e-9 * glm::length(cam.up) ||
+        glm::length(cam.up) == 0)
+      r.fail((up ? up : eye)->source(), "degenerate camera: up is zero or parallel to the viewing direction");
+  } else {
+    CameraAngles a;
+    a.distance = kFramingDistance * extent.unit_scale();
+    if (const toml::node* n = camera->get("azimuth")) a.azimuth = r.number_in(*n, "camera.azimuth", -3600, 3600);
+    if (const toml::node* n = camera->get("elevation")) a.elevation = r.number_in(*n, "camera.elevation", -90, 90);
+    if (const toml::node* n = camera->get("distance")) {
+      a.distance = r.coordinate(*n, "camera.distance");
+      if (!(a.distance > 1 / kMaxCoordinate)) r.fail(n->source(), "degenerate camera: distance must be positive");
+    }
+    if (!(glm::length(cam.up) > 0)) r.fail(camera->get("up")->source(), "degenerate camera: up is zero");
+    place_camera_by_angles(cam, a, cam.up);
+  }
   // How much it sees: an angle for a perspective camera, a height for an orthographic one.
   if (const toml::node* n = camera->get("fov_y")) {
     if (cam.projection != Projection::Perspective) r.fail(n->source(), "camera.fov_y applies to perspective cameras");
@@ -382,7 +542,8 @@ void read_camera(const TomlReader& r, const toml::table& root, CameraSpec& cam) 
     cam.ortho_height = r.coordinate(*n, "camera.height");
     if (!(cam.ortho_height > 0)) r.fail(n->source(), "degenerate camera: height must be positive");
   } else if (cam.projection == Projection::Orthographic) {
-    r.fail(camera->source(), "an orthographic camera needs camera.height (the view height in world units)");
+    r.fail(camera->get("projection")->source(),
+           "an orthographic camera needs camera.height (the view height in world units)");
   }
 }
 
@@ -411,13 +572,37 @@ void read_surface_materials(const TomlReader& r, const toml::table& root,
   }
 }
 
-void read_lights(const TomlReader& r, const toml::table& root, std::vector<Light>& out) {
+// The key and fill light of a scene that leaves its view to algray: the shipped scenes' two rectangle lights of 5x5
+// points, attached to the camera (so that they follow it), in units of the extent's radius R: the key above and
+// to the left of the eye, the fill to its right.
+struct FramingLight {
+  glm::dvec3 position, edge_u, edge_v;
+  double intensity;
+};
+const FramingLight kFramingLights[] = {{{-2.4, 2.6, 0}, {0.47, 0, 0.375}, {0.21, 0.5, -0.26}, 0.8},
+                                       {{2.2, 0.2, 0}, {0.48, 0, -0.355}, {-0.02, 0.6, -0.03}, 0.3}};
+
+std::vector<Light> framing_lights(double radius, const CameraSpec& camera) {
+  std::vector<Light> out;
+  for (const FramingLight& f : kFramingLights) {
+    Light l;
+    l.kind = LightKind::Rectangle;
+    l.samples = 5;
+    l.intensity = f.intensity;
+    l.in_camera = Light::CameraFrame{f.position * radius, f.edge_u * radius, f.edge_v * radius, glm::dvec3(0, 0, 1)};
+    out.push_back(l);
+  }
+  place_camera_lights(out, camera);
+  return out;
+}
+
+void read_lights(const TomlReader& r, const toml::table& root, const CameraSpec& camera, std::vector<Light>& out) {
   const toml::node* lights = root.get("light");
   if (!lights) return;
   const toml::array* list = lights->as_array();
   if (!list || !list->is_array_of_tables())
     r.fail(lights->source(), "lights are written as [[light]] tables, one per light");
-  for (const toml::node& node : *list) out.push_back(read_light(r, *node.as_table()));
+  for (const toml::node& node : *list) out.push_back(read_light(r, *node.as_table(), camera));
 }
 
 void read_antialias(const TomlReader& r, const toml::table& root, Antialias& out) {
@@ -489,7 +674,10 @@ void read_render(const TomlReader& r, const toml::table& root, int degree, Rende
 }
 
 // Table by table, in a fixed order: where several are wrong, the first of them in this order is reported.
-Scene interpret(const TomlReader& r, const toml::table& root, const std::string& source) {
+// `framed`: the scene as written leaves its view to algray (it gives no camera.eye), so that a scene without
+// [[light]] or [antialias] gets the shipped scenes' key and fill light and 2x2 antialiasing; a scene that places
+// its eye keeps a headlight and one ray per pixel there, as scenes always did.
+Scene interpret(const TomlReader& r, const toml::table& root, const std::string& source, bool framed) {
   Scene scene;
   scene.source = source;
   r.check_keys(root, "", kTopKeys);
@@ -498,10 +686,12 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
   int degree = 0;
   for (const SceneSurface& s : scene.surfaces) degree = std::max(degree, s.polynomial.degree());
   read_extent(r, root, scene.extent);
-  read_camera(r, root, scene.camera);
+  read_camera(r, root, scene.extent, scene.camera);
   read_image(r, root, scene.image);
   read_surface_materials(r, root, surface_tables, scene.surfaces);
-  read_lights(r, root, scene.lights);
+  read_lights(r, root, scene.camera, scene.lights);
+  if (framed && !root.get("light")) scene.lights = framing_lights(scene.extent.unit_scale(), scene.camera);
+  if (framed && !root.get("antialias")) scene.antialias.samples = 2;
   read_antialias(r, root, scene.antialias);
   read_render(r, root, degree, scene.render);
   return scene;
@@ -554,6 +744,16 @@ std::vector<glm::dvec3> Light::sample_points() const {
   return points;
 }
 
+void place_camera_lights(std::vector<Light>& lights, const CameraSpec& camera) {
+  for (Light& l : lights) {
+    if (!l.in_camera) continue;
+    l.position = camera_point_to_world(camera, l.in_camera->position);
+    l.edge_u = camera_vector_to_world(camera, l.in_camera->edge_u);
+    l.edge_v = camera_vector_to_world(camera, l.in_camera->edge_v);
+    l.normal = camera_vector_to_world(camera, l.in_camera->normal);
+  }
+}
+
 Scene load_scene_text(const std::string& text, const std::string& source_name, const std::vector<Override>& overrides) {
   TomlReader reader(source_name, text);
   check_toml_shape(text, source_name);
@@ -563,8 +763,12 @@ Scene load_scene_text(const std::string& text, const std::string& source_name, c
   } catch (const toml::parse_error& e) {
     reader.fail(e.source(), std::string(e.description()));
   }
-  for (const Override& o : overrides) apply_override(root, o);
-  Scene scene = interpret(reader, root, source_name);
+  const toml::table* written_camera = root["camera"].as_table();
+  const bool framed = !written_camera || !written_camera->get("eye");
+  std::vector<std::string> notes;
+  for (const Override& o : overrides) apply_override(root, o, notes);
+  Scene scene = interpret(reader, root, source_name, framed);
+  scene.warnings.insert(scene.warnings.end(), notes.begin(), notes.end());
   if (scene.name.empty()) {
     const auto slash = source_name.find_last_of('/');
     std::string stem = source_name.substr(slash == std::string::npos ? 0 : slash + 1);
@@ -593,7 +797,7 @@ Scene load_jsurf_text(const std::string& text, const std::string& source_name, c
     throw SceneError(source_name, e.message);
   }
   scene.source = source_name;
-  scene.warnings = std::move(warnings);
+  scene.warnings.insert(scene.warnings.begin(), warnings.begin(), warnings.end());
   return scene;
 }
 
@@ -658,7 +862,13 @@ std::string scene_to_toml(const Scene& scene) {
     out << "\n[extent]\ntype = \"box\"\nmin = " << toml_vector(e.min) << "\nmax = " << toml_vector(e.max) << "\n";
   const CameraSpec& c = scene.camera;
   const bool perspective = c.projection == Projection::Perspective;
-  out << "\n[camera]\nprojection = \"" << (perspective ? "perspective" : "orthographic")
+  out << "\n[camera]\n";
+  // The eye as placed, which reads back to the same rays; the angles it was placed by, for people.
+  if (c.angles)
+    out << "# placed by angles about look_at: azimuth = " << toml_number(c.angles->azimuth)
+        << ", elevation = " << toml_number(c.angles->elevation) << ", distance = " << toml_number(c.angles->distance)
+        << ", up = " << toml_vector(c.written_up) << "\n";
+  out << "projection = \"" << (perspective ? "perspective" : "orthographic")
       << "\"\neye = " << toml_vector(c.eye) << "\nlook_at = " << toml_vector(c.look_at)
       << "\nup = " << toml_vector(c.up) << "\n"
       << (perspective ? "fov_y = " + toml_number(c.fov_y_degrees) : "height = " + toml_number(c.ortho_height)) << "\n";
@@ -666,15 +876,19 @@ std::string scene_to_toml(const Scene& scene) {
   out << "\n[image]\nwidth = " << scene.image.width << "\nheight = " << scene.image.height << "\nbackground = ["
       << toml_number(bg.r) << ", " << toml_number(bg.g) << ", " << toml_number(bg.b) << ", " << toml_number(bg.a)
       << "]\n";
-  for (const Light& l : scene.lights) {
-    out << "\n[[light]]\ntype = \"" << light_type(l.kind) << "\"\nposition = " << toml_vector(l.position) << "\n";
-    if (l.kind == LightKind::Rectangle)
+  for (const Light& world : scene.lights) {
+    // A light attached to the camera is written in the camera's frame, as it was given, so that it still follows.
+    const Light::CameraFrame l = world.in_camera.value_or(
+        Light::CameraFrame{world.position, world.edge_u, world.edge_v, world.normal});
+    out << "\n[[light]]\ntype = \"" << light_type(world.kind) << "\"\n"
+        << (world.in_camera ? "frame = \"camera\"\n" : "") << "position = " << toml_vector(l.position) << "\n";
+    if (world.kind == LightKind::Rectangle)
       out << "edge_u = " << toml_vector(l.edge_u) << "\nedge_v = " << toml_vector(l.edge_v) << "\n";
-    if (l.kind == LightKind::Disc)
-      out << "normal = " << toml_vector(l.normal) << "\nradius = " << toml_number(l.radius) << "\n";
-    if (l.kind != LightKind::Point) out << "samples = " << l.samples << "\n";
-    out << "colour = " << toml_vector(l.colour) << "\nintensity = " << toml_number(l.intensity)
-        << "\nshadows = " << (l.shadows ? "true" : "false") << "\n";
+    if (world.kind == LightKind::Disc)
+      out << "normal = " << toml_vector(l.normal) << "\nradius = " << toml_number(world.radius) << "\n";
+    if (world.kind != LightKind::Point) out << "samples = " << world.samples << "\n";
+    out << "colour = " << toml_vector(world.colour) << "\nintensity = " << toml_number(world.intensity)
+        << "\nshadows = " << (world.shadows ? "true" : "false") << "\n";
   }
   const Antialias& aa = scene.antialias;
   out << "\n[antialias]\nsamples = " << aa.samples << "\nadaptive = " << (aa.adaptive ? "true" : "false")
@@ -723,6 +937,23 @@ Scene load_scene_file(const std::string& path, const std::vector<Override>& over
   const std::string text = read_input_file(path, "scene file");
   if (lowercase_extension(path) == ".jsurf") return load_jsurf_text(text, path, overrides);
   return load_scene_text(text, path, overrides);
+}
+
+Scene load_equation(const std::string& equation, const std::vector<Override>& overrides) {
+  // One line, `surface.equation = "..."`: a column of it is a character of the equation, shifted by the key.
+  static const std::string source = "--equation", key = "surface.equation = ";
+  const std::string quoted = toml_quoted(equation);
+  try {
+    return load_scene_text(key + quoted + "\n", source, overrides);
+  } catch (const SceneError& e) {
+    // An error in the equation names its character in the equation as given, with the equation as the excerpt.
+    const std::string prefix = source + ":1:";
+    if (e.where.compare(0, prefix.size(), prefix) != 0 || quoted != "\"" + equation + "\"") throw;
+    const long column = std::atol(e.where.c_str() + prefix.size()) - static_cast<long>(key.size() + 1);
+    if (column < 1 || column > static_cast<long>(equation.size()) + 1) throw;
+    throw SceneError(source + ":1:" + std::to_string(column), e.message,
+                     "  " + equation + "\n  " + std::string(static_cast<std::size_t>(column - 1), ' ') + "^");
+  }
 }
 
 Scene default_scene(const std::vector<Override>& overrides) {

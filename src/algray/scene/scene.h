@@ -23,6 +23,23 @@ struct SceneError : std::runtime_error {
 
 enum class ExtentKind { Sphere, Box };
 
+// The extent kinds: the name extent.type takes and the keys that belong to each, besides type. One row per kind,
+// read by the scene reader and by --set extent.type, which drops the keys of the other kinds (with a note). A
+// cylinder is a row here, its fields in Extent, its reading in scene.cpp, and its clipping in the kernels.
+struct ExtentKindInfo {
+  ExtentKind kind;
+  const char* name;
+  std::vector<std::string> keys;
+};
+inline const std::vector<ExtentKindInfo>& extent_kinds() {
+  static const std::vector<ExtentKindInfo> kinds{{ExtentKind::Sphere, "sphere", {"centre", "radius"}},
+                                                 {ExtentKind::Box, "box", {"min", "max"}}};
+  return kinds;
+}
+
+// A scene that gives no [extent] is a sphere of this radius about the origin (`algray render -e ... --radius R`).
+inline constexpr double kDefaultExtentRadius = 2;
+
 struct Extent {
   ExtentKind kind = ExtentKind::Sphere;
   glm::dvec3 centre{0};  // sphere
@@ -78,6 +95,13 @@ struct Light {
   glm::dvec3 colour{1};
   double intensity = 1;
   bool shadows = true;
+  // A light attached to the camera (light.frame = "camera"), so that it follows the camera: its position, edges
+  // and normal as written, in the camera's frame (camera_point_to_world). The world fields above are placed
+  // from them whenever the scene is read.
+  struct CameraFrame {
+    glm::dvec3 position{0}, edge_u{0}, edge_v{0}, normal{0, 0, 1};
+  };
+  std::optional<CameraFrame> in_camera;
 
   // The light's sample points: cell centres of an n x n grid over the rectangle, or the same grid mapped to
   // the disc by an area-preserving (concentric) map.
@@ -108,6 +132,10 @@ struct RenderSettings {
   // Secondary bounces after the camera ray: reflection and transmission rays stop after this many.
   int max_depth = 5;
 };
+
+// Places the lights attached to the camera (Light::in_camera) in the world, from the scene's camera: after the
+// camera moved (a batch's orbit), so that they follow it.
+void place_camera_lights(std::vector<Light>& lights, const CameraSpec& camera);
 
 // One surface of a scene: its polynomial and how its two sides look.
 struct SceneSurface {
@@ -156,6 +184,9 @@ Scene load_scene_text(const std::string& text, const std::string& source_name,
 Scene load_jsurf_text(const std::string& text, const std::string& source_name,
                       const std::vector<Override>& overrides = {});
 Scene default_scene(const std::vector<Override>& overrides = {});
+// An equation alone as a scene (`algray render -e`): "[surface] equation" and algray's defaults for the rest, as a
+// TOML file holding only that table gets. Errors in the equation name "--equation:1:COLUMN".
+Scene load_equation(const std::string& equation, const std::vector<Override>& overrides = {});
 
 // The scene as TOML that reads back to the same Scene, value for value (floats to 17 digits, the equations as
 // written with their parameters): what PNG files embed so that `algray render image.png` renders them again, and
