@@ -338,10 +338,7 @@ TEST_CASE("a kernel that fails to build exits 1 with the build log and the optio
   Sandbox box;
   // A copy of the kernels with a syntax error, read through ALGRAY_KERNEL_DIR instead of the embedded ones.
   const fs::path kernels = box.in / "kernels";
-  fs::create_directories(kernels);
-  for (const auto& e : fs::directory_iterator(fs::path(ALGRAY_SOURCE_DIR) / "kernels"))
-    if (e.path().extension() == ".cl" || e.path().extension() == ".h")
-      fs::copy_file(e.path(), kernels / e.path().filename());
+  fs::copy(fs::path(ALGRAY_SOURCE_DIR) / "kernels", kernels, fs::copy_options::recursive);  // methods/ too
   write_text(kernels / "primary.cl", read_text(kernels / "primary.cl") + "\nthis is not OpenCL C;\n");
   const std::string cmd = "ALGRAY_KERNEL_DIR=" + quoted(kernels.string()) + " ";
   const fs::path err = box.in / "build_err.txt";
