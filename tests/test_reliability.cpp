@@ -480,12 +480,13 @@ TEST_CASE("the memory a process may take is the least of the machine's, its cgro
 TEST_CASE("what the one-hour fuzz runs found is refused with a located error", "[reliability][errors][fuzz]") {
   // fuzz_scene: an --set value that is neither TOML nor valid as a literal string (bytes that are not UTF-8)
   // escaped as toml::parse_error from the second parse and terminated the process.
+  // (A bare name must now be one of the scene's parameters, so the new parameter is named in full.)
   const std::string text = sphere_with({});
   try {
-    algray::load_scene_text(text, "t.toml", {{"r", std::string("0],\xff\xff]]")}});
+    algray::load_scene_text(text, "t.toml", {{"parameters.r", std::string("0],\xff\xff]]")}});
     FAIL("accepted");
   } catch (const algray::SceneError& e) {
-    CHECK(e.where == "--set r=0],\xff\xff]]");
+    CHECK(e.where == "--set parameters.r=0],\xff\xff]]");
     CHECK_THAT(e.message, Catch::Contains("neither valid TOML nor a plain string"));
   }
   // fuzz_jobs: a stats pattern's unknown placeholder was reported under the job's name, not where it is written.
