@@ -93,6 +93,20 @@ TEST_CASE("only the passes a scene calls for are built, launched and counted", "
   }
 }
 
+TEST_CASE("the paper's ray origin (eye) builds camera rays about the eye and shadow rays on their segments",
+          "[plan]") {
+  // The shadow kernel has no eye construction: a plan that asked for one failed to build it (found 2026-12-06).
+  const nlohmann::json stats =
+      stats_of_unit_sphere(light_lines(), "--isolation sturm --set render.ray_origin=\"eye\"");
+  std::set<std::string> origins;  // pass name and the origin= of its kernels' keys
+  for (const auto& pass : stats.at("plan").at("passes"))
+    for (const auto& kernel : pass.at("kernels")) {
+      const std::string key = kernel.get<std::string>(), at = key.substr(key.find(" origin=") + 8);
+      origins.insert(pass.at("name").get<std::string>() + " " + at.substr(0, at.find(' ')));
+    }
+  CHECK(origins == std::set<std::string>{"primary eye", "shadow extent"});
+}
+
 TEST_CASE("antialiasing traces samples x samples camera rays per pixel, and no more", "[plan]") {
   require_device();
   for (int samples : {1, 3}) {

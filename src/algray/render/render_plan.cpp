@@ -87,46 +87,23 @@ const PlannedPass* RenderPlan::find(PassKind kind) const {
   return nullptr;
 }
 
-RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size, int lanes) {
-  RenderPlan plan;
-  plan.width = scene.image.width;
-  plan.height = scene.image.height;
-  plan.tile_size = tile_size > 0 ? tile_size : scene.render.tile_size > 0 ? scene.render.tile_size : 1024;
-  // Preview mode is the paper's quick look: one camera ray per pixel, whatever the scene's antialiasing.
-  const int samples = scene.render.preview ? 1 : scene.antialias.samples;
-  const bool adaptive = scene.antialias.adaptive && samples > 1;
-  plan.samples = adaptive ? 1 : samples;
-  if (adaptive) {
-    plan.refine_samples = scene.antialias.samples;
-    plan.refine_threshold = scene.antialias.threshold;
-  }
-  // The device holds one tile's camera rays, and one batch of other rays at a time.
-  const std::size_t rays = plan.tile_rays();
-  const std::size_t real_size = precision == Precision::Double ? sizeof(double) : sizeof(float);
+namespace {
 
-  // Every pass has one kernel per surface: each surface's degree specialises its own.
-  std::vector<KernelConfig> primary;
-  for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-    primary.push_back(primary_config(scene, precision, i));
-    if (lanes_apply(primary.back())) primary.back().lanes = scene.render.lanes > 0 ? scene.render.lanes : lanes;
+// The primary kernels' configurations for another entry: the shadow kernel batches its rays its own way
+// (kernels/shadow.cl) where lanes do not apply, and the screen form is camera rays' alone.
+std::vector<KernelConfig> kernels_for(const std::vector<KernelConfig>& primary, const std::string& entry) {
+  std::vector<KernelConfig> configs = primary;
+  for (KernelConfig& c : configs) {
+    c.entry = entry;
+    if (!lanes_apply(c)) c.lanes = 1;
+    if (c.ray_origin == RayOrigin::Screen) c.ray_origin = RayOrigin::Extent;
   }
-  auto with_entry = [&](const std::string& entry) {
-    std::vector<KernelConfig> configs = primary;
-    for (KernelConfig& c : configs) {
-      c.entry = entry;
-      if (!lanes_apply(c)) c.lanes = 1;  // the shadow kernel batches its rays its own way (kernels/shadow.cl)
-      if (c.ray_origin == RayOrigin::Screen) c.ray_origin = RayOrigin::Extent;  // the screen form is camera rays'
-    }
-    return configs;
-  };
-  plan.passes.push_back({PassKind::Primary,
-                         plan.samples > 1 ? "camera rays, " + std::to_string(plan.samples) + "x" +
-                                                std::to_string(plan.samples) + " per pixel"
-                                          : "camera rays, one per pixel",
-                         primary,
-                         {}});
-  plan.buffers.push_back({"primary hits", rays * sizeof(HitRecord)});
+  return configs;
+}
 
+// The shadow pass, when a light casts shadows and the scene is not a preview; else why not, in plan.skipped.
+void plan_shadows(RenderPlan& plan, const Scene& scene, const std::vector<KernelConfig>& primary, std::size_t rays,
+                  std::size_t real_size) {
   for (std::size_t i = 0; i < scene.lights.size(); ++i)
     if (scene.lights[i].shadows) plan.shadow_lights.push_back(static_cast<int>(i));
   if (scene.render.preview) {
@@ -137,34 +114,39 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
   } else if (plan.shadow_lights.empty()) {
     plan.skipped.push_back("shadow: no light casts shadows");
   }
-  if (!plan.shadow_lights.empty()) {
-    // The shadow kernel isolates roots and never refines them: the refinement is not part of its code.
-    std::vector<KernelConfig> shadow = with_entry("shadow");
-    for (std::size_t i = 0; i < shadow.size(); ++i) {
-      KernelConfig& c = shadow[i];
-      c.refinement = Refinement::Brent;
-      c.max_iterations = default_max_iterations(Refinement::Brent);
-      if (scene.render.ray_origin == RayOrigin::Auto && point_form_applies(c)) {
-        c.ray_origin = RayOrigin::Point;
-        c.lanes = shadow_lanes(primary[i].lanes);
-      }
+  if (plan.shadow_lights.empty()) return;
+  // The shadow kernel isolates roots and never refines them: the refinement is not part of its code.
+  std::vector<KernelConfig> shadow = kernels_for(primary, "shadow");
+  for (std::size_t i = 0; i < shadow.size(); ++i) {
+    KernelConfig& c = shadow[i];
+    c.refinement = Refinement::Brent;
+    c.max_iterations = default_max_iterations(Refinement::Brent);
+    // Its batched search restricts P on segments (kernels/shadow.cl): the paper's construction about the ray's
+    // origin is camera and secondary rays' alone, and a shadow ray's origin is the surface point anyway.
+    if (c.ray_origin == RayOrigin::Eye) c.ray_origin = RayOrigin::Extent;
+    if (scene.render.ray_origin == RayOrigin::Auto && point_form_applies(c)) {
+      c.ray_origin = RayOrigin::Point;
+      c.lanes = shadow_lanes(primary[i].lanes);
     }
-    std::size_t points = 0;
-    for (int i : plan.shadow_lights) points += scene.lights[static_cast<std::size_t>(i)].sample_points().size();
-    plan.passes.push_back({PassKind::Shadow,
-                           std::to_string(plan.shadow_lights.size()) + " shadow-casting light(s), " +
-                               std::to_string(points) + " sample point(s) per lit surface point",
-                           shadow,
-                           {}});
-    // A batch of surface points at a time, asked about each light in turn.
-    const std::size_t batch = std::min(rays, kBatchRays);
-    plan.buffers.push_back({"shading points (per batch)", batch * 4 * real_size});
-    plan.buffers.push_back({"shading normals (per batch)", batch * 4 * sizeof(float)});
-    plan.buffers.push_back({"light sample points", points * 4 * real_size});
-    plan.buffers.push_back({"occlusion masks (per batch)", batch * sizeof(cl_ulong)});
   }
-  // Secondary rays: one pass per effect a material asks for, sharing the one "trace" kernel.
-  const std::vector<KernelConfig> trace = with_entry("trace");
+  std::size_t points = 0;
+  for (int i : plan.shadow_lights) points += scene.lights[static_cast<std::size_t>(i)].sample_points().size();
+  plan.passes.push_back({PassKind::Shadow,
+                         std::to_string(plan.shadow_lights.size()) + " shadow-casting light(s), " +
+                             std::to_string(points) + " sample point(s) per lit surface point",
+                         shadow,
+                         {}});
+  // A batch of surface points at a time, asked about each light in turn.
+  const std::size_t batch = std::min(rays, kBatchRays);
+  plan.buffers.push_back({"shading points (per batch)", batch * 4 * real_size});
+  plan.buffers.push_back({"shading normals (per batch)", batch * 4 * sizeof(float)});
+  plan.buffers.push_back({"light sample points", points * 4 * real_size});
+  plan.buffers.push_back({"occlusion masks (per batch)", batch * sizeof(cl_ulong)});
+}
+
+// Secondary rays: one pass per effect a material asks for, sharing the one "trace" kernel.
+void plan_bounces(RenderPlan& plan, const Scene& scene, const std::vector<KernelConfig>& trace, std::size_t rays,
+                  std::size_t real_size) {
   bool reflective = false, transparent = false;
   for (const SceneSurface& s : scene.surfaces) {
     reflective |= s.materials.front.reflectivity > 0 || s.materials.back.reflectivity > 0;
@@ -199,7 +181,12 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
       plan.buffers.push_back({name + " hits (per batch)", batch * sizeof(HitRecord)});
     }
   }
-  if (adaptive) {
+}
+
+// Adaptive antialiasing's pass, or why there is none.
+void plan_antialias(RenderPlan& plan, const Scene& scene, const std::vector<KernelConfig>& trace, std::size_t rays,
+                    std::size_t real_size) {
+  if (plan.refine_samples > 0) {
     const std::string n = std::to_string(plan.refine_samples);
     plan.passes.push_back({PassKind::Antialias,
                            n + "x" + n + " camera rays in pixels whose colour differs from a neighbour's",
@@ -215,25 +202,33 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
                                                        : scene.antialias.samples > 1 ? "uniform supersampling"
                                                                                      : "off (one ray per pixel)"));
   }
-  if (precision == Precision::Adaptive) {
-    // Rays the float kernels doubt go again through mixed precision's own kernels (or double's: escalate_in), a
-    // batch at a time.
-    for (PlannedPass& pass : plan.passes) {
-      pass.escalation = pass.kind == PassKind::Primary ? with_entry("trace") : pass.kernels;
-      for (KernelConfig& c : pass.escalation) c.precision = Precision::Mixed;
-      // Rays the float pass can settle after all need no float-float pass (escalate_in undoes it for double).
-      for (KernelConfig& c : pass.kernels) c.settle_doubts = true;
-    }
-    const std::size_t batch = std::min(rays, kBatchRays);
-    // Sized for double, which escalate_in may choose.
-    plan.buffers.push_back({"escalated rays (per batch)", batch * (8 * sizeof(double) + sizeof(HitRecord))});
-  } else {
+}
+
+// Adaptive precision: every pass's kernels settle what they can, and the rays they doubt go again through mixed
+// precision's own kernels (or double's: escalate_in), a batch at a time.
+void plan_escalation(RenderPlan& plan, Precision precision, const std::vector<KernelConfig>& primary,
+                     std::size_t rays) {
+  if (precision != Precision::Adaptive) {
     plan.skipped.push_back("escalation: only adaptive precision traces doubted rays again in float-float");
+    return;
   }
-  // The host's share of one tile's work, per camera ray of the tile: its hit record (twice, and which surface,
-  // with several), the shadow answers (an index each way, a mask per light), what its bounces bring back; and
-  // per ray of the batch in flight (rays, hits, weights, staging, the rays waiting for the next bounce), about
-  // 100 bytes for shadow rays alone and 600 with bounces.
+  for (PlannedPass& pass : plan.passes) {
+    pass.escalation = pass.kind == PassKind::Primary ? kernels_for(primary, "trace") : pass.kernels;
+    for (KernelConfig& c : pass.escalation) c.precision = Precision::Mixed;
+    // Rays the float pass can settle after all need no float-float pass (escalate_in undoes it for double).
+    for (KernelConfig& c : pass.kernels) c.settle_doubts = true;
+  }
+  const std::size_t batch = std::min(rays, kBatchRays);
+  // Sized for double, which escalate_in may choose.
+  plan.buffers.push_back({"escalated rays (per batch)", batch * (8 * sizeof(double) + sizeof(HitRecord))});
+}
+
+// The host's share of one tile's work, per camera ray of the tile: its hit record (twice, and which surface, with
+// several), the shadow answers (an index each way, a mask per light), what its bounces bring back; and per ray of
+// the batch in flight (rays, hits, weights, staging, the rays waiting for the next bounce), about 100 bytes for
+// shadow rays alone and 600 with bounces.
+std::uint64_t host_bytes_per_tile(const RenderPlan& plan, const Scene& scene, std::size_t rays) {
+  const bool adaptive = plan.refine_samples > 0;
   const bool several = scene.surfaces.size() > 1;
   const bool shadows = plan.find(PassKind::Shadow) != nullptr;
   const bool bounces = plan.find(PassKind::Reflection) || plan.find(PassKind::Transmission);
@@ -245,7 +240,78 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
       kBatchRays, static_cast<std::uint64_t>(rays) * (adaptive ? plan.refine_samples * plan.refine_samples : 1) *
                       (bounces ? 2 : 1));
   const std::uint64_t per_batch_ray = bounces || adaptive ? 600 : shadows ? 100 : 0;
-  plan.tile_host_bytes = rays * per_ray + batch * per_batch_ray;
+  return rays * per_ray + batch * per_batch_ray;
+}
+
+}  // namespace
+
+RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size, int lanes) {
+  RenderPlan plan;
+  plan.width = scene.image.width;
+  plan.height = scene.image.height;
+  plan.tile_size = tile_size > 0 ? tile_size : scene.render.tile_size > 0 ? scene.render.tile_size : 1024;
+  // Preview mode is the paper's quick look: one camera ray per pixel, whatever the scene's antialiasing.
+  const int samples = scene.render.preview ? 1 : scene.antialias.samples;
+  const bool adaptive = scene.antialias.adaptive && samples > 1;
+  plan.samples = adaptive ? 1 : samples;
+  if (adaptive) {
+    plan.refine_samples = scene.antialias.samples;
+    plan.refine_threshold = scene.antialias.threshold;
+  }
+  // The device holds one tile's camera rays, and one batch of other rays at a time.
+  const std::size_t rays = plan.tile_rays();
+  const std::size_t real_size = precision == Precision::Double ? sizeof(double) : sizeof(float);
+
+  // Every pass has one kernel per surface: each surface's degree specialises its own.
+  std::vector<KernelConfig> primary;
+  for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+    primary.push_back(primary_config(scene, precision, i));
+    if (lanes_apply(primary.back())) primary.back().lanes = scene.render.lanes > 0 ? scene.render.lanes : lanes;
+  }
+  plan.passes.push_back({PassKind::Primary,
+                         plan.samples > 1 ? "camera rays, " + std::to_string(plan.samples) + "x" +
+                                                std::to_string(plan.samples) + " per pixel"
+                                          : "camera rays, one per pixel",
+                         primary,
+                         {}});
+  plan.buffers.push_back({"primary hits", rays * sizeof(HitRecord)});
+  plan_shadows(plan, scene, primary, rays, real_size);
+  const std::vector<KernelConfig> trace = kernels_for(primary, "trace");
+  plan_bounces(plan, scene, trace, rays, real_size);
+  plan_antialias(plan, scene, trace, rays, real_size);
+  plan_escalation(plan, precision, primary, rays);
+  plan.tile_host_bytes = host_bytes_per_tile(plan, scene, rays);
+  return plan;
+}
+
+int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 256 : 1024; }
+
+RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::vector<PlanDevice>& devices) {
+  if (devices.empty()) throw std::invalid_argument("a render plan needs at least one device");
+  const int lanes = default_lanes(devices.front().info.type);
+  RenderPlan plan;
+  if (scene.render.tile_size > 0) {
+    plan = make_render_plan(scene, precision, scene.render.tile_size, lanes);
+  } else {
+    int side = default_tile_size(devices.front().info);
+    for (const PlanDevice& device : devices) side = std::min(side, default_tile_size(device.info));
+    plan = make_render_plan(scene, precision, side, lanes);
+    // Several devices take tiles from one queue: with about 8 tiles each, a device that finds its tiles cheaper
+    // takes more of them, and none idles long at the end. The tile size changes no pixel (test_multi_device).
+    const std::size_t wanted = devices.size() > 1 ? 8 * devices.size() : 1;
+    auto tiles = [](const RenderPlan& p) {
+      const std::size_t side_pixels = static_cast<std::size_t>(p.tile_pixels());
+      return ((static_cast<std::size_t>(p.width) + side_pixels - 1) / side_pixels) *
+             ((static_cast<std::size_t>(p.height) + side_pixels - 1) / side_pixels);
+    };
+    while (tiles(plan) < wanted && plan.tile_size / 2 >= 16 * plan.samples)
+      plan = make_render_plan(scene, precision, plan.tile_size / 2, lanes);
+  }
+  if (precision == Precision::Adaptive) {
+    const bool all_fast = std::all_of(devices.begin(), devices.end(),
+                                      [](const PlanDevice& d) { return d.escalation == Precision::Double; });
+    escalate_in(plan, all_fast ? Precision::Double : Precision::Mixed);
+  }
   return plan;
 }
 

@@ -112,6 +112,23 @@ bool screen_form_applies(const Scene& scene, Precision precision);
 inline constexpr int kMaxPointFormDegree = 15;
 bool point_form_applies(const KernelConfig& shadow);
 
+// What the plan needs to know of a device that will carry it out.
+struct PlanDevice {
+  DeviceInfo info;
+  Precision escalation = Precision::Mixed;  // adaptive precision's second pass there (escalation_precision)
+};
+
+// Tile side, in traced rays, for a device when the scene leaves it open. GPUs get launches short enough for
+// display watchdogs; CPUs (PoCL) lose ~2 ms per launch and idle cores at each launch's tail, so they get few,
+// large launches: measured on the Barth sextic at 1024x768, 256-ray tiles 137 ms, one 1024-ray tile 109 ms.
+int default_tile_size(const DeviceInfo& device);
+
+// The render's plan, settled once for the devices that carry it out (at least one): its passes and their kernels,
+// the lanes (the first device's kind's), the tile size (the scene's; else the devices' smallest default, halved
+// until several devices have about 8 tiles each) and adaptive precision's second pass (double only where every
+// device's fp64 is fast: escalate_in). The renderer, --stats and the api read it and change nothing.
+RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::vector<PlanDevice>& devices);
+
 // Adaptive precision's escalation kernels in `precision` instead: double where every device's fp64 is fast (the
 // doubted rays then cost about what float does; shadow rays in the point form where it applies), mixed otherwise
 // (what make_render_plan plans).

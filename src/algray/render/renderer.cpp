@@ -24,8 +24,6 @@
 
 namespace algray {
 
-int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 256 : 1024; }
-
 std::size_t tile_memory_bytes(const RenderPlan& plan) { return plan.tile_rays() * sizeof(HitRecord); }
 
 Precision float_precision_for(const Scene& scene) {
@@ -404,30 +402,13 @@ Precision escalation_precision(const DeviceInfo& device, ProgramCache& cache) {
   return slowdown && *slowdown <= kFastFp64Slowdown ? Precision::Double : Precision::Mixed;
 }
 
-Precision Renderer::escalation_precision() const {
+std::vector<PlanDevice> Renderer::plan_devices(Precision precision) const {
+  std::vector<PlanDevice> devices;
   for (const ClSession* session : sessions_)
-    if (algray::escalation_precision(session->info, cache_) == Precision::Mixed) return Precision::Mixed;
-  return Precision::Double;
-}
-
-RenderPlan Renderer::plan_of(const Scene& scene, Precision precision) const {
-  const DeviceInfo& first = sessions_.front()->info;
-  const int lanes = default_lanes(first.type);
-  if (scene.render.tile_size > 0) return make_render_plan(scene, precision, scene.render.tile_size, lanes);
-  int side = default_tile_size(first);
-  for (const ClSession* session : sessions_) side = std::min(side, default_tile_size(session->info));
-  RenderPlan plan = make_render_plan(scene, precision, side, lanes);
-  // Several devices take tiles from one queue: with about 8 tiles each, a device that finds its tiles cheaper
-  // takes more of them, and none idles long at the end. The tile size changes no pixel (test_multi_device).
-  const std::size_t wanted = sessions_.size() > 1 ? 8 * sessions_.size() : 1;
-  auto tiles = [](const RenderPlan& p) {
-    const std::size_t side_pixels = static_cast<std::size_t>(p.tile_pixels());
-    return ((static_cast<std::size_t>(p.width) + side_pixels - 1) / side_pixels) *
-           ((static_cast<std::size_t>(p.height) + side_pixels - 1) / side_pixels);
-  };
-  while (tiles(plan) < wanted && plan.tile_size / 2 >= 16 * plan.samples)
-    plan = make_render_plan(scene, precision, plan.tile_size / 2, lanes);
-  return plan;
+    devices.push_back({session->info, precision == Precision::Adaptive
+                                          ? algray::escalation_precision(session->info, cache_)
+                                          : Precision::Mixed});
+  return devices;
 }
 
 void Renderer::sweep(std::vector<std::unique_ptr<Passes>>& devices, const std::vector<Tile>& tiles,
@@ -464,10 +445,9 @@ void Renderer::sweep(std::vector<std::unique_ptr<Passes>>& devices, const std::v
 RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) {
   RenderResult result;
   const Precision precision = precision_of(scene);
-  result.plan = plan_of(scene, precision);
-  if (precision == Precision::Adaptive) escalate_in(result.plan, escalation_precision());
+  result.plan = make_render_plan(scene, precision, plan_devices(precision));
   for (const ClSession* session : sessions_) check_plan_fits(result.plan, session->info);
-  result.config = primary_config(scene, precision);
+  result.config = result.plan.passes.front().kernels.front();
   const RenderPlan& plan = result.plan;
   const int trace_width = plan.trace_width(), trace_height = plan.trace_height();
   result.basis = make_ray_basis(scene.camera, trace_width, trace_height);

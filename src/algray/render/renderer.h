@@ -148,11 +148,6 @@ Precision escalation_precision(const DeviceInfo& device, ProgramCache& cache);
 // The precision left open resolves to on a device without fast fp64.
 Precision float_precision_for(const Scene& scene);
 
-// Tile side, in traced rays, for a device when the scene leaves it open. GPUs get launches short enough for
-// display watchdogs; CPUs (PoCL) lose ~2 ms per launch and idle cores at each launch's tail, so they get few,
-// large launches: measured on the Barth sextic at 1024x768, 256-ray tiles 137 ms, one 1024-ray tile 109 ms.
-int default_tile_size(const DeviceInfo& device);
-
 // The output image from a render's records (RenderOptions::keep_records, or the reference's hits), shaded as
 // the renderer shades its film.
 FrameImage shade_frame(const Scene& scene, const RenderResult& result);
@@ -178,9 +173,8 @@ class Renderer {
   struct Tile;
   class TileHits;
   Precision precision_of(const Scene& scene) const;
-  RenderPlan plan_of(const Scene& scene, Precision precision) const;
-  // Adaptive precision's second pass: double where every device's fp64 is fast, mixed elsewhere.
-  Precision escalation_precision() const;
+  // The devices as make_render_plan takes them: with adaptive precision, each one's second-pass precision.
+  std::vector<PlanDevice> plan_devices(Precision precision) const;
   // Deals `tiles` to the devices from one queue, each device's on its own thread, until every tile is done or one
   // fails; the first failure is thrown on.
   void sweep(std::vector<std::unique_ptr<Passes>>& devices, const std::vector<Tile>& tiles,
