@@ -2,82 +2,126 @@
 """The shape figures of issue 43 for a tree: preprocessor branches in kernels/, function-defining and
 signature-splicing macros, *_lanes twins, and functions over 80 lines in kernels/ and src/.
 
-    bench/kernel_shape.py [ROOT]        (ROOT: a checkout; default the one this script is in)
+    bench/kernel_shape.py [ROOT]                 the figures of a checkout (default: the one this script is in)
+    bench/kernel_shape.py --results BASE_COMMIT  BASE_COMMIT's figures against the working tree's, into
+                                                 bench/RESULTS.md ("Code shape")
 
 Counted by the rules printed with each figure, so that a later count can be compared with an earlier one."""
+import datetime
 import pathlib
 import re
+import subprocess
 import sys
+import tempfile
 
-root = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else pathlib.Path(__file__).resolve().parent.parent)
-kernel_files = sorted(p for p in (root / "kernels").glob("*") if p.suffix in (".h", ".cl")) + sorted(
-    (root / "kernels").glob("*/*.h")) + sorted((root / "kernels").glob("*/*.cl"))
-source_files = sorted(p for p in (root / "src").rglob("*") if p.suffix in (".cpp", ".h"))
+HERE = pathlib.Path(__file__).resolve().parent
 
 
-def logical_lines(text):
-    """Lines with backslash continuations joined: a macro is one line."""
-    return text.replace("\\\n", " ").split("\n")
+def figures(root):
+    """The figures of the tree at root, as (name, value, detail) rows."""
+    return _figures(pathlib.Path(root))
 
 
-branches = 0
-function_macros, splicing_macros = [], []
-lanes_twins = []
-for path in kernel_files:
-    text = path.read_text()
-    lines = logical_lines(text)
-    guard_seen = False
-    for line in lines:
-        m = re.match(r"\s*#\s*(if|ifdef|ifndef|elif|else)\b", line)
-        if m:
-            # the include guard is not a branch of the code
-            if m.group(1) == "ifndef" and not guard_seen and re.match(r"\s*#\s*ifndef\s+ALGRAY_\w+_H\b", line):
-                guard_seen = True
-                continue
-            branches += 1
-        d = re.match(r"\s*#\s*define\s+(\w+)(\([^)]*\))?\s*(.*)", line)
-        if d:
-            name, params, body = d.group(1), d.group(2), d.group(3)
-            # a macro whose body defines a function: a declarator followed by a body in braces
-            if params and re.search(r"\b\w+\s*\([^)]*\)\s*\{", body) and not body.lstrip().startswith("do"):
-                function_macros.append(f"{path.name}:{name}")
-            # a macro spliced into parameter or argument lists: its body starts with a comma, or it is named so
-            if re.search(r"_(PARAMS?|ARGS?)$", name) or body.lstrip().startswith(","):
-                splicing_macros.append(f"{path.name}:{name}")
-    for m in re.finditer(r"^[A-Za-z_][\w \*]*?\b(\w+_lanes)\s*\(", text, re.M):
-        lanes_twins.append(f"{path.name}:{m.group(1)}")
+def _figures(root):
+    kernel_files = sorted(p for p in (root / "kernels").glob("*") if p.suffix in (".h", ".cl")) + sorted(
+        (root / "kernels").glob("*/*.h")) + sorted((root / "kernels").glob("*/*.cl"))
+    source_files = sorted(p for p in (root / "src").rglob("*") if p.suffix in (".cpp", ".h"))
 
-long_functions = []
-for path in kernel_files + source_files:
-    lines = path.read_text().split("\n")
-    start = None
-    for i, line in enumerate(lines):
-        if start is None:
-            if (re.match(r"[A-Za-z_]", line) and "(" in line and not re.match(
-                    r"(struct|typedef|namespace|class|enum|union|using|static_assert|#)\b", line)
-                    and not line.rstrip().endswith(";")):
-                # the definition's opening brace ends this line or one of the next few (a wrapped signature)
-                for j in range(i, min(i + 6, len(lines))):
-                    if lines[j].rstrip().endswith("{"):
-                        start = i
-                        break
-                    if lines[j].rstrip().endswith(";"):
-                        break
-        elif lines[i].startswith("}"):
-            length = i - start + 1
-            if length > 80:
-                name = re.search(r"([\w:~]+)\s*\(", lines[start])
-                long_functions.append((length, f"{path.relative_to(root)}:{start + 1} {name.group(1) if name else '?'}"))
-            start = None
 
-print(f"#if/#ifdef/#ifndef/#elif/#else lines in kernels/ (include guards left out): {branches}")
-function_macros = sorted(set(function_macros))
-splicing_macros = sorted(set(splicing_macros))
-print(f"function-defining macros: {len(function_macros)} {' '.join(function_macros)}")
-print(f"signature-splicing macros (named *_PARAM(S)/*_ARG(S), or a body starting with a comma): "
-      f"{len(splicing_macros)} {' '.join(splicing_macros)}")
-print(f"*_lanes functions: {len(set(lanes_twins))} {' '.join(sorted(set(lanes_twins)))}")
-long_functions.sort(reverse=True)
-print(f"functions over 80 lines in kernels/ and src/: {len(long_functions)}")
-for length, where in long_functions:
-    print(f"  {length:4d} {where}")
+    def logical_lines(text):
+        """Lines with backslash continuations joined: a macro is one line."""
+        return text.replace("\\\n", " ").split("\n")
+
+
+    branches = 0
+    function_macros, splicing_macros = [], []
+    lanes_twins = []
+    for path in kernel_files:
+        text = path.read_text()
+        lines = logical_lines(text)
+        guard_seen = False
+        for line in lines:
+            m = re.match(r"\s*#\s*(if|ifdef|ifndef|elif|else)\b", line)
+            if m:
+                # the include guard is not a branch of the code
+                if m.group(1) == "ifndef" and not guard_seen and re.match(r"\s*#\s*ifndef\s+ALGRAY_\w+_H\b", line):
+                    guard_seen = True
+                    continue
+                branches += 1
+            d = re.match(r"\s*#\s*define\s+(\w+)(\([^)]*\))?\s*(.*)", line)
+            if d:
+                name, params, body = d.group(1), d.group(2), d.group(3)
+                # a macro whose body defines a function: a declarator followed by a body in braces
+                if params and re.search(r"\b\w+\s*\([^)]*\)\s*\{", body) and not body.lstrip().startswith("do"):
+                    function_macros.append(f"{path.name}:{name}")
+                # a macro spliced into parameter or argument lists: its body starts with a comma, or it is named so
+                if re.search(r"_(PARAMS?|ARGS?)$", name) or body.lstrip().startswith(","):
+                    splicing_macros.append(f"{path.name}:{name}")
+        for m in re.finditer(r"^[A-Za-z_][\w \*]*?\b(\w+_lanes)\s*\(", text, re.M):
+            lanes_twins.append(f"{path.name}:{m.group(1)}")
+
+    long_functions = []
+    for path in kernel_files + source_files:
+        lines = path.read_text().split("\n")
+        start = None
+        for i, line in enumerate(lines):
+            if start is None:
+                if (re.match(r"[A-Za-z_]", line) and "(" in line and not re.match(
+                        r"(struct|typedef|namespace|class|enum|union|using|static_assert|#)\b", line)
+                        and not line.rstrip().endswith(";")):
+                    # the definition's opening brace ends this line or one of the next few (a wrapped signature)
+                    for j in range(i, min(i + 6, len(lines))):
+                        if lines[j].rstrip().endswith("{"):
+                            start = i
+                            break
+                        if lines[j].rstrip().endswith(";"):
+                            break
+            elif lines[i].startswith("}"):
+                length = i - start + 1
+                if length > 80:
+                    name = re.search(r"([\w:~]+)\s*\(", lines[start])
+                    long_functions.append((length, f"{path.relative_to(root)}:{start + 1} {name.group(1) if name else '?'}"))
+                start = None
+
+    long_functions.sort(reverse=True)
+    function_macros = sorted(set(function_macros))
+    splicing_macros = sorted(set(splicing_macros))
+    return [
+        ("#if/#ifdef/#ifndef/#elif/#else lines in kernels/ (include guards left out)", branches, ""),
+        ("function-defining macros", len(function_macros), " ".join(function_macros)),
+        ("signature-splicing macros (named *_PARAM(S)/*_ARG(S), or a body starting with a comma)",
+         len(splicing_macros), " ".join(splicing_macros)),
+        ("*_lanes functions", len(set(lanes_twins)), " ".join(sorted(set(lanes_twins)))),
+        ("functions over 80 lines in kernels/ and src/", len(long_functions),
+         ", ".join(f"{where} ({length})" for length, where in long_functions[:5]) + (", ..." if len(long_functions) > 5 else "")),
+    ]
+
+
+def main():
+    if len(sys.argv) > 2 and sys.argv[1] == "--results":
+        sys.path.insert(0, str(HERE))
+        from bench_common import RESULTS_MD, command_line, commit, machine, replace_section
+        base = sys.argv[2]
+        with tempfile.TemporaryDirectory() as tmp:
+            archive = subprocess.run(["git", "-C", str(HERE.parent), "archive", base, "kernels", "src"],
+                                     check=True, capture_output=True).stdout
+            subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
+            before = figures(tmp)
+        after = figures(HERE.parent)
+        lines = ["### Code shape", "",
+                 f"- Date: {datetime.date.today().isoformat()}; machine: {machine()}; commit: {commit()}",
+                 f"- Command: `{command_line()}`; the rules: the script's docstring and issue 43's figures", "",
+                 f"| figure | {base[:7]} | now | goal |", "|---|---|---|---|"]
+        goals = ["at most 120", "0", "0", "0", "0"]
+        for (name, old, _), (_, new, detail), goal in zip(before, after, goals):
+            lines.append(f"| {name} | {old} | {new} | {goal} |")
+        replace_section(RESULTS_MD, "### Code shape", "\n".join(lines) + "\n", under="## Code shape")
+        print(f"wrote {RESULTS_MD}")
+        return
+    root = sys.argv[1] if len(sys.argv) > 1 else HERE.parent
+    for name, value, detail in figures(root):
+        print(f"{name}: {value} {detail}")
+
+
+if __name__ == "__main__":
+    main()
