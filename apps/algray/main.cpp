@@ -17,6 +17,7 @@
 #include "algray/device/program_cache.h"
 #include "algray/io/image_io.h"
 #include "algray/render/solver_aov.h"
+#include "algray/scene/scene_formats.h"
 #include "algray/scene/solver_options.h"
 #include "algray/util/version.h"
 #include "commands.h"
@@ -51,7 +52,8 @@ void add_no_fp64_flag(CLI::App* cmd) {
 void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = true) {
   if (scene_positional)
     cmd->add_option("scene", o.scene_path,
-                    "scene file (.toml or .jsurf), or - for standard input; default: the built-in Barth sextic");
+                    "scene file: " + readable_scene_types() +
+                        "; or - for standard input; default: the built-in Barth sextic");
   cmd->add_option("--width", o.width, "image width in pixels (overrides image.width)");
   cmd->add_option("--height", o.height, "image height in pixels (overrides image.height)");
   cmd->add_option("--device", o.device_spec,

@@ -14,9 +14,10 @@
 
 #include "algray/scene/expression.h"
 #include "algray/scene/jsurf.h"
+#include "algray/scene/scene_formats.h"
+#include "algray/scene/surf_script.h"
 #include "algray/scene/toml_reader.h"
 #include "algray/util/embedded_files.h"
-#include "algray/util/file_names.h"
 
 namespace algray {
 namespace {
@@ -597,6 +598,32 @@ Scene load_jsurf_text(const std::string& text, const std::string& source_name, c
   return scene;
 }
 
+Scene load_surf_script_text(const std::string& text, const std::string& source_name,
+                            const std::vector<Override>& overrides) {
+  // surf frames by the shorter side, so the translation needs the size the image will have.
+  int size[2] = {0, 0};
+  for (const Override& o : overrides)
+    if (o.key == "image.width" || o.key == "image.height") {
+      char* end = nullptr;
+      const long v = std::strtol(o.value.c_str(), &end, 10);
+      if (end && *end == '\0' && v > 0 && v <= 1 << 20) size[o.key == "image.height"] = static_cast<int>(v);
+    }
+  std::vector<std::string> warnings;
+  const SurfTranslation surf = surf_script_to_toml(text, source_name, warnings, size[0], size[1]);
+  const std::string translated = source_name + " (translated to TOML)";
+  Scene scene;
+  try {
+    scene = load_scene_text(surf.toml, translated, overrides);
+  } catch (const SceneError& e) {
+    // The translation's values are computed by the script; the drawing statement is where they take effect.
+    if (e.where.compare(0, translated.size(), translated) != 0) throw;
+    throw SceneError(surf.drawn_at, "the surface drawn here: " + e.message, surf.drawn_excerpt);
+  }
+  scene.source = source_name;
+  scene.warnings = std::move(warnings);
+  return scene;
+}
+
 namespace {
 
 void write_material(std::ostringstream& out, const std::string& table, const Material& m) {
@@ -720,8 +747,13 @@ std::string read_input_file(const std::string& path, const std::string& what) {
 }
 
 Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides) {
-  const std::string text = read_input_file(path, "scene file");
-  if (lowercase_extension(path) == ".jsurf") return load_jsurf_text(text, path, overrides);
+  const std::optional<SceneFormat> format = scene_format_of(path);
+  if (!format) throw SceneError(path, unknown_scene_type_message(path));
+  const std::string text = read_input_file(path, "scene file");  // a missing file is said so first
+  if (*format == SceneFormat::Png)
+    throw SceneError(path, "is not a PNG file (it does not start with PNG's signature), so it carries no scene");
+  if (*format == SceneFormat::Jsurf) return load_jsurf_text(text, path, overrides);
+  if (*format == SceneFormat::SurfScript) return load_surf_script_text(text, path, overrides);
   return load_scene_text(text, path, overrides);
 }
 

@@ -133,7 +133,7 @@ struct Scene {
   Antialias antialias;
   RenderSettings render;
   // What the scene's reader could not render as written (a .jsurf feature algray draws differently, an unknown
-  // key it ignored); commands print them as warnings.
+  // key it ignored, a surf statement outside the subset); commands print them as warnings.
   std::vector<std::string> warnings;
 
   // The first surface: the one single-surface tools (the reference solver, the solver benchmarks) work on.
@@ -149,12 +149,17 @@ struct Override {
   std::string origin = {};
 };
 
-// A .toml scene, or a SURFER/jsurf .jsurf file (by extension, any case), translated with jsurf's framing.
+// A scene file by its extension (any case, scene_formats.h): a .toml scene (also a path without an extension),
+// a SURFER/jsurf .jsurf file translated with jsurf's framing, or a surf script (.pic) with surf's. Any other
+// extension is a SceneError listing the types algray reads, before the file is opened. (PNGs that carry a
+// scene are read a layer up, where the PNG reader is: api's SceneLoader.)
 Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides = {});
 Scene load_scene_text(const std::string& text, const std::string& source_name,
                       const std::vector<Override>& overrides = {});
 Scene load_jsurf_text(const std::string& text, const std::string& source_name,
                       const std::vector<Override>& overrides = {});
+Scene load_surf_script_text(const std::string& text, const std::string& source_name,
+                            const std::vector<Override>& overrides = {});
 Scene default_scene(const std::vector<Override>& overrides = {});
 
 // The scene as TOML that reads back to the same Scene, value for value (floats to 17 digits, the equations as
