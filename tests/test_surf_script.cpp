@@ -210,7 +210,8 @@ TEST_CASE("surf's language: types, precedence, functions, if/goto", "[surf]") {
   CHECK(front.exponent == 20);
   CHECK(s.surfaces[0].materials.back.colour.r == Approx(srgb_to_linear(230 / 255.0)));
   CHECK(s.surfaces[1].materials.front.colour.g == Approx(1));
-  CHECK(s.surfaces[1].materials.front.transparency == 0);  // transmitted light is not in the default illumination
+  // Measured with surf: without transmitted_light in the illumination (the default), transparence changes nothing.
+  CHECK(s.surfaces[1].materials.front.transparency == 0);
   REQUIRE(s.lights.size() == 1);
   CHECK(s.lights[0].position == glm::dvec3(0, 100, 100));
   CHECK(s.lights[0].colour.r == 0);
@@ -252,6 +253,9 @@ TEST_CASE("bad surf scripts get located errors; statements outside the subset lo
   CHECK(error_of("surface=1;\ndraw_surface;\n").where == "bad.pic:1:1");
   CHECK(error_of("surface=sqrt(-1)*x;\n").where == "bad.pic:1:9");
   CHECK(error_of("surface=x;\n draw_surface\n").where == "bad.pic:3:1");  // the missing ';'
+  CHECK_THAT(error_of("surface=x;\nstereo_eye=1.2;\ndraw_surface;\n").message, Catch::Contains("stereo"));
+  CHECK(load_surf_script_text("clip=sphere;\nsurface=x;\ndraw_surface;\n", "t.pic").extent.kind ==
+        ExtentKind::Sphere);
 
   const auto w = warnings_of(
       "surface=x^2+y^2+z^2-9;\ndraw_surface;\nplane=x;\ncut_with_plane;\ndepth_cueing=yes;\nfoo=3;\n"

@@ -120,11 +120,12 @@ const std::set<std::string>& quiet_commands() {
 }
 
 // The constants of surf's language that the subset reads (choices of perspective, clip, order, axes, lighting).
+// surf also takes clip = sphere, and draws it as the ball.
 const std::map<std::string, double>& constants() {
   static const std::map<std::string, double> names = {
       {"yes", 1},           {"no", 0},       {"parallel", 0},        {"central", 1},        {"translate", 0},
       {"rotate", 1},        {"scale", 2},    {"ball", 0},            {"cylinder_xaxis", 1}, {"cylinder_yaxis", 2},
-      {"cylinder_zaxis", 3}, {"cube", 4},    {"none", 5},            {"xAxis", 0},          {"yAxis", 1},
+      {"cylinder_zaxis", 3}, {"cube", 4},    {"none", 5},            {"sphere", 0},            {"xAxis", 0},          {"yAxis", 1},
       {"zAxis", 2},         {"ambient_light", 1}, {"diffuse_light", 2}, {"reflected_light", 4},
       {"transmitted_light", 8}};
   return names;
@@ -148,6 +149,7 @@ std::map<std::string, Value> reserved_defaults() {
     d(std::string("center_") + axis, 0);
   }
   d("spec_z", 25);
+  d("stereo_eye", 0);
   i("perspective", 0);
   i("first", 0);
   i("second", 1);
@@ -200,7 +202,7 @@ std::string canonical_name(const std::string& name) {
 bool is_known_unsupported(const std::string& name) {
   static const std::set<std::string> names = {
       "depth_cueing", "depth_value", "depth", "normalize", "normalize_factor", "normalize_brightness",
-      "antialiasing_radius", "stereo_eye", "stereo_z", "stereo_red", "stereo_green", "stereo_blue", "display_numeric",
+      "antialiasing_radius", "stereo_z", "stereo_red", "stereo_green", "stereo_blue", "display_numeric",
       "light_settings"};
   return names.count(name) > 0;
 }
@@ -729,6 +731,8 @@ class Script {
                "clip_front)");
     if (key == "clip" && !(v.number == 0 || v.number == 4 || v.number == 5))
       fail(at, "clip is ball, cube, none or a cylinder");
+    if (key == "stereo_eye" && v.number != 0)
+      fail(at, "stereo_eye: surf draws a red/green stereo pair, algray one view; set stereo_eye = 0 for that view");
     if (key.compare(0, 9, "thickness") == 0 && v.number != 0)
       warn_once(at, key, key + ": algray's transparent surfaces have no thickness; ignored");
   }
