@@ -134,25 +134,22 @@ def main():
         sys.exit("no script rendered: nothing to compare")
     ious = [r[1] for r in ok]
     version = subprocess.run([surf, "--version"], capture_output=True, text=True).stdout.strip().split("\n")[0] or "?"
+    low = sorted((r for r in ok if r[1] < SHOWN_BELOW), key=lambda r: r[1])
+    failed = [r for r in rows if r[1] is None]
+    # Two lines: RESULTS.md is kept short; every script's row is in this script's output.
     lines = [
         HEADING,
         "",
-        f"- Date: {datetime.date.today()}; machine: {machine()}; commit: {commit(args.binary)}; surf-alggeo "
-        f"{version}. Command: `{command_line()}`.",
-        f"- Every script of surf-alggeo-doc's examples that draws a surface, at {args.scale} times its size, "
-        "antialiasing and depth cueing off (bench/surf_compare.py says how the copies differ); algray one ray "
-        "per pixel. Plane sections (cut_with_plane) are surf's alone: their curves count against the IoU. "
-        "IoU: intersection over union of the pixels that show a surface.",
+        f"- {datetime.date.today()}, {machine()}, commit {commit(args.binary)}, surf-alggeo {version}: "
+        f"`{command_line()}`. Every script of surf-alggeo-doc's examples that draws a surface, at {args.scale}x "
+        "its size, antialiasing and depth cueing off (the script says how the copies differ), algray one ray per "
+        "pixel; IoU of the pixels that show a surface (surf's plane-section curves count against it).",
         f"- {len(ok)} of {len(rows)} scripts render ({len(skipped)} more draw plane curves only); IoU median "
-        f"{statistics.median(ious):.4f}, lowest {min(ious):.4f} ({min(ok, key=lambda r: r[1])[0]}).",
+        f"{statistics.median(ious):.4f}" +
+        (f"; under {SHOWN_BELOW}: " + ", ".join(f"{name} {iou:.4f}" for name, iou, _, _ in low) if low else "") +
+        ("; refused: " + ", ".join(f"{name} ({note.split(' error: ', 1)[-1]})" for name, _, _, note in failed)
+         if failed else "") + ".",
     ]
-    low = sorted((r for r in ok if r[1] < SHOWN_BELOW), key=lambda r: r[1])
-    if low:
-        lines.append(f"- IoU under {SHOWN_BELOW}: " +
-                     ", ".join(f"{name} {iou:.4f} ({either} px)" for name, iou, either, _ in low) + ".")
-    failed = [r for r in rows if r[1] is None]
-    if failed:
-        lines.append("- Failed: " + ", ".join(f"{name} ({note})" for name, _, _, note in failed) + ".")
     lines.append("")
     replace_section(args.output, HEADING, "\n".join(lines) + "\n", under=AREA)
     print(f"wrote {args.output}")
