@@ -150,7 +150,8 @@ struct Override {
 };
 
 // A scene file by its extension (any case, scene_formats.h): a .toml scene (also a path without an extension),
-// a SURFER/jsurf .jsurf file translated with jsurf's framing, or a surf script (.pic) with surf's. Any other
+// a SURFER/jsurf .jsurf file translated with jsurf's framing, a surf script (.pic) with surf's, or a POV-Ray
+// scene (.pov) as POV-Ray shows it. Any other
 // extension is a SceneError listing the types algray reads, before the file is opened. (PNGs that carry a
 // scene are read a layer up, where the PNG reader is: api's SceneLoader.)
 Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides = {});
@@ -160,6 +161,8 @@ Scene load_jsurf_text(const std::string& text, const std::string& source_name,
                       const std::vector<Override>& overrides = {});
 Scene load_surf_script_text(const std::string& text, const std::string& source_name,
                             const std::vector<Override>& overrides = {});
+Scene load_povray_text(const std::string& text, const std::string& source_name,
+                       const std::vector<Override>& overrides = {});
 Scene default_scene(const std::vector<Override>& overrides = {});
 
 // The scene as TOML that reads back to the same Scene, value for value (floats to 17 digits, the equations as

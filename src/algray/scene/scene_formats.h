@@ -8,7 +8,7 @@
 
 namespace algray {
 
-enum class SceneFormat { Toml, Jsurf, SurfScript, Png };
+enum class SceneFormat { Toml, Jsurf, SurfScript, PovRay, Png };
 
 struct SceneFormatInfo {
   SceneFormat format;
@@ -16,10 +16,11 @@ struct SceneFormatInfo {
   const char* what;       // for people: "a SURFER file"
 };
 
-inline constexpr std::array<SceneFormatInfo, 4> kSceneFormats = {{
+inline constexpr std::array<SceneFormatInfo, 5> kSceneFormats = {{
     {SceneFormat::Toml, ".toml", "an algray scene"},
     {SceneFormat::Jsurf, ".jsurf", "a SURFER/jsurf file"},
     {SceneFormat::SurfScript, ".pic", "a surf script"},
+    {SceneFormat::PovRay, ".pov", "a POV-Ray scene"},
     {SceneFormat::Png, ".png", "an image algray rendered, which carries its scene"},
 }};
 

@@ -26,6 +26,7 @@
 #include "algray/math/colour.h"
 #include "algray/scene/scene.h"
 #include "algray/scene/solver_options.h"
+#include "algray/scene/sparse_poly.h"
 #include "algray/scene/toml_reader.h"
 
 namespace algray {
@@ -33,7 +34,6 @@ namespace {
 
 // Untrusted scripts stop here rather than loop for ever (surf has `if (...) goto`) or expand for minutes.
 constexpr long kMaxStatements = 200000;
-constexpr double kMaxPolynomialWork = 2e8;  // coefficient products, over the whole script
 constexpr int kSurfaces = 9;
 constexpr int kLights = 9;
 
@@ -44,33 +44,8 @@ struct Token {
   int line = 1, column = 1;
 };
 
-using Exponents = std::array<int, 3>;
-
-// A polynomial in x, y, z with double coefficients, as surf keeps them.
-struct Poly {
-  std::map<Exponents, double> terms;
-  int degree() const {
-    int d = -1;
-    for (const auto& [e, c] : terms) d = std::max(d, e[0] + e[1] + e[2]);
-    return d;
-  }
-  static Poly constant(double c) {
-    Poly p;
-    if (c != 0) p.terms[{0, 0, 0}] = c;
-    return p;
-  }
-  static Poly variable(int axis) {
-    Poly p;
-    Exponents e{0, 0, 0};
-    e[static_cast<std::size_t>(axis)] = 1;
-    p.terms[e] = 1;
-    return p;
-  }
-  void add(const Exponents& e, double c) {
-    const double sum = (terms[e] += c);
-    if (sum == 0) terms.erase(e);
-  }
-};
+using Poly = SparsePoly;
+using Exponents = SparsePoly::Exponents;
 
 struct Value {
   enum Kind { Int, Real, Polynomial, String } kind = Int;
@@ -365,60 +340,26 @@ class Script {
   }
 
   // --- expressions ---
-  void spend(double work, const Token& at) {
-    work_ += work;
-    if (work_ > kMaxPolynomialWork)
-      fail(at, "the script's polynomial arithmetic is too large to expand here (more than " +
-                   std::to_string(static_cast<long long>(kMaxPolynomialWork)) + " coefficient products)");
-  }
   Poly multiply(const Poly& a, const Poly& b, const Token& at) {
-    if (a.terms.empty() || b.terms.empty()) return {};
-    if (a.degree() + b.degree() > kMaxDegree)
-      fail(at, "this product has degree " + std::to_string(a.degree() + b.degree()) + "; algray draws degrees up to " +
-                   std::to_string(kMaxDegree));
-    spend(static_cast<double>(a.terms.size()) * static_cast<double>(b.terms.size()), at);
-    Poly out;
-    for (const auto& [ea, ca] : a.terms)
-      for (const auto& [eb, cb] : b.terms) out.add({ea[0] + eb[0], ea[1] + eb[1], ea[2] + eb[2]}, ca * cb);
-    return out;
+    try {
+      return algray::multiply(a, b, budget_);
+    } catch (const PolyTooLarge& e) {
+      fail(at, e.what());
+    }
   }
   Poly power(const Poly& p, long e, const Token& at) {
-    if (p.terms.empty()) return e == 0 ? Poly::constant(1) : Poly{};
-    if (static_cast<long>(p.degree()) * e > kMaxDegree)
-      fail(at, "this power has degree " + std::to_string(static_cast<long>(p.degree()) * e) +
-                   "; algray draws degrees up to " + std::to_string(kMaxDegree));
-    Poly out = Poly::constant(1);
-    for (long k = 0; k < e; ++k) out = multiply(out, p, at);
-    return out;
+    try {
+      return algray::power(p, e, budget_);
+    } catch (const PolyTooLarge& error) {
+      fail(at, error.what());
+    }
   }
-  // P(M x + b): the polynomial of the surface that the affine map's inverse carries P's surface to.
   Poly substitute(const Poly& p, const std::array<std::array<double, 4>, 3>& m, const Token& at) {
-    std::array<Poly, 3> forms;
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c)
-        if (m[r][c] != 0) {
-          Exponents e{0, 0, 0};
-          e[static_cast<std::size_t>(c)] = 1;
-          forms[r].add(e, m[r][c]);
-        }
-      if (m[r][3] != 0) forms[r].add({0, 0, 0}, m[r][3]);
+    try {
+      return algray::substitute(p, m, budget_);
+    } catch (const PolyTooLarge& e) {
+      fail(at, e.what());
     }
-    std::array<std::vector<Poly>, 3> powers;
-    std::map<std::pair<int, int>, Poly> xy;  // forms[0]^i forms[1]^j, made as needed
-    auto pow_of = [&](int axis, int e) -> const Poly& {
-      auto& list = powers[static_cast<std::size_t>(axis)];
-      if (list.empty()) list.push_back(Poly::constant(1));
-      while (static_cast<int>(list.size()) <= e) list.push_back(multiply(list.back(), forms[axis], at));
-      return list[static_cast<std::size_t>(e)];
-    };
-    Poly out;
-    for (const auto& [e, c] : p.terms) {
-      auto it = xy.find({e[0], e[1]});
-      if (it == xy.end()) it = xy.emplace(std::make_pair(e[0], e[1]), multiply(pow_of(0, e[0]), pow_of(1, e[1]), at)).first;
-      const Poly term = multiply(it->second, pow_of(2, e[2]), at);
-      for (const auto& [f, d] : term.terms) out.add(f, c * d);
-    }
-    return out;
   }
   // surf's rotation by `angle` about an axis (0 x, 1 y, 2 z) as the matrix that moves points.
   static std::array<std::array<double, 3>, 3> rotation(std::size_t axis, double angle) {
@@ -820,7 +761,7 @@ class Script {
   std::vector<Token> tokens_;
   std::size_t pos_ = 0;
   long statements_ = 0;
-  double work_ = 0;
+  PolyBudget budget_;  // the script's polynomial arithmetic, all of it
   std::map<std::string, Value> locals_, globals_;
   std::map<std::string, Token> assigned_at_;
   std::map<std::string, std::size_t> labels_;
