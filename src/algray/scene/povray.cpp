@@ -55,7 +55,8 @@ struct Object {
   std::optional<Clip> natural;                     // the bound of a sphere or torus, in object coordinates
   std::optional<glm::dvec3> front, back;
   bool inverse = false;
-  double ambient = 0.1, diffuse = 0.6, specular = 0, exponent = 40;
+  double ambient = 0.1, diffuse = 0.6, specular = 0, exponent = 40;  // POV-Ray's default finish
+  bool finished = false;  // a finish was given
   Token at;
   std::string kind;
 };
@@ -502,6 +503,7 @@ class PovReader {
     return c;
   }
   void finish(Object& o) {
+    o.finished = true;
     const Token open = peek();
     expect("{", "'{' after finish");
     while (!at_op("}")) {
@@ -523,7 +525,14 @@ class PovReader {
     }
     next();
   }
-  // texture { pigment {...} finish {...} ... }; interior_texture likewise for the inside.
+  static void take_finish(Object& o, const Object& from) {
+    o.ambient = from.ambient;
+    o.diffuse = from.diffuse;
+    o.specular = from.specular;
+    o.exponent = from.exponent;
+    o.finished = true;
+  }
+  // texture { pigment {...} finish {...} ... }; interior_texture likewise for the inside (its finish is skipped).
   void texture(Object& o, bool inside) {
     const Token open = peek();
     expect("{", "'{' after texture");
@@ -666,20 +675,12 @@ class PovReader {
         for (Object* o : objects) {
           if (scratch.front && !o->front) o->front = scratch.front;
           if (scratch.back && !o->back) o->back = scratch.back;
-          o->ambient = scratch.ambient;
-          o->diffuse = scratch.diffuse;
-          o->specular = scratch.specular;
-          o->exponent = scratch.exponent;
+          if (scratch.finished) take_finish(*o, scratch);
         }
       } else if (t.text == "finish") {
         Object scratch;
         finish(scratch);
-        for (Object* o : objects) {
-          o->ambient = scratch.ambient;
-          o->diffuse = scratch.diffuse;
-          o->specular = scratch.specular;
-          o->exponent = scratch.exponent;
-        }
+        for (Object* o : objects) take_finish(*o, scratch);
       } else if (t.text == "clipped_by" || t.text == "bounded_by") {
         if (objects.size() != 1) fail(t, t.text + " on a union: give it to each object inside");
         clip_block(*objects.front(), t);
@@ -890,7 +891,12 @@ class PovReader {
       const Token name = next();
       if (name.kind != Token::Name) fail(name, "expected a name after #" + d.text);
       expect("=", "'='");
-      if (peek().kind == Token::Name && at_op("{", 1) && !at_name("color")) {
+      static const std::set<std::string> colour_words = {"color", "colour", "rgb", "rgbf", "rgbt", "rgbft", "srgb",
+                                                          "srgbf", "srgbt", "srgbft", "red", "green", "blue"};
+      if (peek().kind == Token::Name && colour_words.count(peek().text)) {
+        const glm::dvec3 c = colour(name);
+        declared_[name.text] = {c.x, c.y, c.z};
+      } else if (peek().kind == Token::Name && at_op("{", 1)) {
         warn(name, "#" + d.text + " " + name.text + " = " + peek().text + " { ... } is ignored: only floats and " +
                        "vectors are declared here");
         next();
@@ -943,11 +949,17 @@ class PovReader {
     auto place = [&](const Clip& c, const glm::dmat4& t, bool loose) {
       const glm::dmat3 l(t);
       Clip w = c;
-      if (c.sphere && loose) {  // a sphere or torus' own bound need only enclose it: the matrix norm is enough
-        double frobenius = 0;
-        for (int i = 0; i < 3; ++i) frobenius += glm::dot(l[i], l[i]);
+      if (c.sphere && loose) {  // a sphere or torus' own bound need only enclose it: the largest stretch will do
+        const glm::dmat3 g = glm::transpose(l) * l;
+        glm::dvec3 v(1, 0.7, 0.3);
+        double stretch2 = 0;
+        for (int k = 0; k < 60; ++k) {  // power iteration: the largest eigenvalue of L^T L
+          const glm::dvec3 next = g * v;
+          stretch2 = glm::length(next) / glm::length(v);
+          v = next / glm::length(next);
+        }
         w.centre = glm::dvec3(t * glm::dvec4(c.centre, 1));
-        w.radius = c.radius * std::sqrt(frobenius);
+        w.radius = c.radius * std::sqrt(stretch2) * 1.001;
       } else if (c.sphere) {
         const glm::dmat3 g = glm::transpose(l) * l;
         const double s2 = g[0][0];
