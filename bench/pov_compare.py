@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """POV-Ray comparison (issue 47): .pov scenes rendered by Debian's povray and by algray from the same file; how
 well the silhouettes agree (intersection over union of the pixels that show a surface) and how far the depths
-are apart where both show one. Writes its section of bench/RESULTS.md ("POV-Ray's scenes", under "Against the
-peers"); every scene's row is printed as it goes.
+are apart where both show one. Writes its line of bench/RESULTS.md ("surf's and POV-Ray's own scenes",
+under "Against the peers"); every scene's row is printed as it goes.
 
 The scenes: the twelve of tests/data/pov (poly, polynomial, quartic, cubic, sphere and torus objects with their
 transforms and clips, a right-handed, an orthographic and a tilted camera, an area light), and the paper's seven
@@ -29,10 +29,10 @@ import tempfile
 import zlib
 from pathlib import Path
 
-from bench_common import ROOT, command_line, commit, machine, replace_section
+from bench_common import ROOT, command_line, commit, machine, replace_bullet
 
 AREA = "## Against the peers"
-HEADING = "### POV-Ray's scenes"
+HEADING = "### surf's and POV-Ray's own scenes"  # one section, a line per script (surf_compare.py writes the other)
 SHOWN_BELOW = 0.99  # scenes whose IoU is under this are named on the page
 SCENES = ROOT / "tests/data/pov"
 
@@ -260,22 +260,18 @@ def main():
     failed = [r for r in rows if r[1] is None]
     medians = [r[2] for r in ok if r[2] is not None]
     p99s = [r[3] for r in ok if r[3] is not None]
-    # Two lines: RESULTS.md is kept short; every scene's row is in this script's output.
-    lines = [
-        HEADING,
-        "",
-        f"- {datetime.date.today()}, {machine()}, commit {commit(args.binary)}, POV-Ray "
-        f"{found.group(1) if found else '?'}: `{command_line()}`. tests/data/pov's twelve scenes and the paper's "
-        f"seven surfaces as bench/peers.py writes them, {w}x{h}, one ray per pixel; IoU of the pixels that show a "
-        "surface; depth against a 16-bit distance image of POV-Ray's, away from silhouettes (the script says how).",
-        f"- {len(ok)} of {len(rows)} scenes render; IoU median {statistics.median(ious):.4f}, lowest {min(ious):.4f} "
-        f"({min(ok, key=lambda r: r[1])[0]}); depth relative difference: median per scene at most "
+    # One line: RESULTS.md is kept short; every scene's row is in this script's output.
+    bullet = (
+        f"- POV-Ray: {datetime.date.today()}, {machine()}, commit {commit(args.binary)}, POV-Ray "
+        f"{found.group(1) if found else '?'}, `{command_line()}`: tests/data/pov's twelve scenes and the paper's "
+        f"seven surfaces as bench/peers.py writes them, {w}x{h}, one ray per pixel. {len(ok)} of {len(rows)} render; "
+        f"silhouette IoU median {statistics.median(ious):.4f}, lowest {min(ious):.4f} "
+        f"({min(ok, key=lambda r: r[1])[0]}); depth against POV-Ray's 16-bit distance image (step "
+        f"{args.far / 65535:.1e}), away from silhouettes: relative difference median per scene at most "
         f"{max(medians):.1e}, 99th percentile at most {max(p99s):.1e}" +
         (f"; IoU under {SHOWN_BELOW}: " + ", ".join(f"{r[0]} {r[1]:.4f}" for r in low) if low else "") +
-        ("; failed: " + ", ".join(f"{r[0]} ({r[4]})" for r in failed) if failed else "") + ".",
-    ]
-    lines.append("")
-    replace_section(args.output, HEADING, "\n".join(lines) + "\n", under=AREA)
+        ("; failed: " + ", ".join(f"{r[0]} ({r[4]})" for r in failed) if failed else "") + ".")
+    replace_bullet(args.output, HEADING, "- POV-Ray:", bullet, under=AREA)
     print(f"wrote {args.output}")
 
 

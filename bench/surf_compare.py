@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """surf comparison (issue 47): the surface scripts among surf's own examples (Debian's surf-alggeo-doc), run by
 surf-alggeo and rendered by algray from the same script; how well the silhouettes agree (intersection over union
-of the pixels that show a surface). Writes its section of bench/RESULTS.md ("surf's own examples", under "Against
-the peers"); every script's row is printed as it goes.
+of the pixels that show a surface). Writes its line of bench/RESULTS.md ("surf's and POV-Ray's own scenes",
+under "Against the peers"); every script's row is printed as it goes.
 
 Needs `apt-get install surf-alggeo surf-alggeo-doc` (installed here when missing and run as root). Both programs
 read the same copy of each script, changed only where the comparison needs it: before every draw_surface the
@@ -26,13 +26,13 @@ import sys
 import tempfile
 from pathlib import Path
 
-from bench_common import ROOT, command_line, commit, machine, replace_section
+from bench_common import ROOT, command_line, commit, machine, replace_bullet
 from jsurf_compare import read_png
 
 # SURF and SURF_EXAMPLES point elsewhere (a surf unpacked with dpkg -x, say); by default the installed ones.
 EXAMPLES = os.environ.get("SURF_EXAMPLES", "/usr/share/doc/surf-alggeo/examples")
 AREA = "## Against the peers"
-HEADING = "### surf's own examples"
+HEADING = "### surf's and POV-Ray's own scenes"  # one section, a line per script (pov_compare.py writes the other)
 SHOWN_BELOW = 0.97  # scripts whose IoU is under this are named on the page
 
 
@@ -136,22 +136,18 @@ def main():
     version = subprocess.run([surf, "--version"], capture_output=True, text=True).stdout.strip().split("\n")[0] or "?"
     low = sorted((r for r in ok if r[1] < SHOWN_BELOW), key=lambda r: r[1])
     failed = [r for r in rows if r[1] is None]
-    # Two lines: RESULTS.md is kept short; every script's row is in this script's output.
-    lines = [
-        HEADING,
-        "",
-        f"- {datetime.date.today()}, {machine()}, commit {commit(args.binary)}, surf-alggeo {version}: "
-        f"`{command_line()}`. Every script of surf-alggeo-doc's examples that draws a surface, at {args.scale}x "
-        "its size, antialiasing and depth cueing off (the script says how the copies differ), algray one ray per "
-        "pixel; IoU of the pixels that show a surface (surf's plane-section curves count against it).",
-        f"- {len(ok)} of {len(rows)} scripts render ({len(skipped)} more draw plane curves only); IoU median "
+    # One line: RESULTS.md is kept short; every script's row is in this script's output.
+    bullet = (
+        f"- surf: {datetime.date.today()}, {machine()}, commit {commit(args.binary)}, surf-alggeo {version}, "
+        f"`{command_line()}`: every script of surf-alggeo-doc's examples that draws a surface, at {args.scale}x its "
+        "size, antialiasing and depth cueing off (the script says how the copies differ), algray one ray per pixel. "
+        f"{len(ok)} of {len(rows)} render ({len(skipped)} more draw plane curves only); silhouette IoU median "
         f"{statistics.median(ious):.4f}" +
-        (f"; under {SHOWN_BELOW}: " + ", ".join(f"{name} {iou:.4f}" for name, iou, _, _ in low) if low else "") +
+        (f"; under {SHOWN_BELOW}: " + ", ".join(f"{name} {iou:.4f}" for name, iou, _, _ in low) +
+         " (surf's plane-section curves count against them)" if low else "") +
         ("; refused: " + ", ".join(f"{name} ({note.split(' error: ', 1)[-1]})" for name, _, _, note in failed)
-         if failed else "") + ".",
-    ]
-    lines.append("")
-    replace_section(args.output, HEADING, "\n".join(lines) + "\n", under=AREA)
+         if failed else "") + ".")
+    replace_bullet(args.output, HEADING, "- surf:", bullet, under=AREA)
     print(f"wrote {args.output}")
 
 

@@ -176,7 +176,8 @@ class PovReader {
         if (std::string("{}<>,()+-*/:;.=[]").find(c) == std::string::npos) {
           const unsigned char u = static_cast<unsigned char>(c);
           fail(t, u >= 0x20 && u < 0x7f ? std::string("unexpected character '") + c + "'"
-                                         : "unexpected byte " + std::to_string(u) + " (outside strings, scenes are ASCII)");
+                                         : "unexpected byte " + std::to_string(u) +
+                                               " (outside strings, scenes are ASCII)");
         }
         t.text = std::string(1, c);
         advance(1);
@@ -996,7 +997,9 @@ class PovReader {
   }
   static bool same(const Clip& a, const Clip& b) {
     if (a.sphere != b.sphere) return false;
-    if (a.sphere) return glm::length(a.centre - b.centre) < 1e-9 * (1 + a.radius) && std::fabs(a.radius - b.radius) < 1e-9 * (1 + a.radius);
+    const double tolerance = 1e-9 * (1 + a.radius);
+    if (a.sphere)
+      return glm::length(a.centre - b.centre) < tolerance && std::fabs(a.radius - b.radius) < tolerance;
     return glm::length(a.min - b.min) + glm::length(a.max - b.max) < 1e-9 * (1 + glm::length(a.max - a.min));
   }
   // Whether a lies within b.
@@ -1043,7 +1046,8 @@ class PovReader {
 
 PovTranslation PovReader::run() {
   while (peek().kind != Token::End) item();
-  if (objects_.empty()) fail(peek(), "the scene holds no object algray reads (poly, polynomial, quartic, cubic, sphere, torus)");
+  if (objects_.empty())
+    fail(peek(), "the scene holds no object algray reads (poly, polynomial, quartic, cubic, sphere, torus)");
   if (objects_.size() > kMaxSurfaces)
     fail(objects_[kMaxSurfaces].at, std::to_string(objects_.size()) + " objects: algray draws up to " +
                                         std::to_string(kMaxSurfaces) + " surfaces in one scene");

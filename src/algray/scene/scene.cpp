@@ -633,7 +633,8 @@ Scene load_translation(const std::string& toml, const std::string& source_name, 
 
 }  // namespace
 
-Scene load_povray_text(const std::string& text, const std::string& source_name, const std::vector<Override>& overrides) {
+Scene load_povray_text(const std::string& text, const std::string& source_name,
+                       const std::vector<Override>& overrides) {
   const std::array<int, 2> size = overridden_size(overrides);
   std::vector<std::string> warnings;
   const PovTranslation pov = povray_to_toml(text, source_name, warnings, size[0], size[1]);

@@ -98,10 +98,10 @@ const std::set<std::string>& quiet_commands() {
 // surf also takes clip = sphere, and draws it as the ball.
 const std::map<std::string, double>& constants() {
   static const std::map<std::string, double> names = {
-      {"yes", 1},           {"no", 0},       {"parallel", 0},        {"central", 1},        {"translate", 0},
-      {"rotate", 1},        {"scale", 2},    {"ball", 0},            {"cylinder_xaxis", 1}, {"cylinder_yaxis", 2},
-      {"cylinder_zaxis", 3}, {"cube", 4},    {"none", 5},            {"sphere", 0},            {"xAxis", 0},          {"yAxis", 1},
-      {"zAxis", 2},         {"ambient_light", 1}, {"diffuse_light", 2}, {"reflected_light", 4},
+      {"yes", 1},          {"no", 0},           {"parallel", 0},      {"central", 1},         {"translate", 0},
+      {"rotate", 1},       {"scale", 2},        {"ball", 0},          {"sphere", 0},          {"cylinder_xaxis", 1},
+      {"cylinder_yaxis", 2}, {"cylinder_zaxis", 3}, {"cube", 4},      {"none", 5},            {"xAxis", 0},
+      {"yAxis", 1},        {"zAxis", 2},        {"ambient_light", 1}, {"diffuse_light", 2},   {"reflected_light", 4},
       {"transmitted_light", 8}};
   return names;
 }
