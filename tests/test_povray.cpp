@@ -201,6 +201,12 @@ TEST_CASE("bad POV-Ray scenes get located errors; what is skipped, located warni
   CHECK(error_of("object { Thing }\n").where == "bad.pov:1:1");
   CHECK(error_of("camera { location 0 }\n").message.find("no object") != std::string::npos);
   CHECK(error_of("sphere { 0, 1 } /* open\n").where == "bad.pov:1:17");
+  // A dense poly of degree 32 moved by a transform is refused at the budget, where it is, in well under a second.
+  std::string dense = "\n poly { 32, <1";
+  for (int i = 1; i < 6545; ++i) dense += ",1";
+  const SceneError big = error_of(dense + "> clipped_by { sphere { 0, 1 } } rotate <10, 20, 30> translate x }\n");
+  CHECK(big.where == "bad.pov:2:2");
+  CHECK_THAT(big.message, Catch::Contains("too large to expand"));
   const auto w = load_povray_text(
                      "#include \"colors.inc\"\nplane { y, -1 }\nsphere { 0, 1 finish { reflection 0.3 } }\n"
                      "media { }\n",

@@ -245,6 +245,8 @@ TEST_CASE("bad surf scripts get located errors; statements outside the subset lo
   CHECK(error_of("surface=x;\nfilename=\"a.ppm;\n").where == "bad.pic:2:10");
   CHECK_THAT(error_of("surface=(x+y)^40;\ndraw_surface;\n").message, Catch::Contains("degree"));
   CHECK_THAT(error_of("surface=x/y;\n").message, Catch::Contains("numbers only"));
+  CHECK_THAT(error_of("surface=x+2^1000000;\n").message, Catch::Contains("infinity"));
+  CHECK_THAT(error_of("poly p=(x+1)^0+2;\nsurface=x+(p-1)^1000000;\n").message, Catch::Contains("overflows"));
   CHECK_THAT(error_of("loop:\nif(1) goto loop;\n").message, Catch::Contains("goto loop that does not end"));
   CHECK_THAT(error_of("surface=x;\n").message, Catch::Contains("never draws"));
   CHECK_THAT(error_of("curve=x^2-y;\ndraw_curve;\n").message, Catch::Contains("plane curves"));

@@ -2,6 +2,7 @@
 #include "algray/scene/sparse_poly.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -42,14 +43,30 @@ SparsePoly multiply(const SparsePoly& a, const SparsePoly& b, PolyBudget& budget
   if (budget.work > budget.limit)
     throw PolyTooLarge("the polynomial arithmetic is too large to expand here (more than " +
                        std::to_string(static_cast<long long>(budget.limit)) + " coefficient products)");
-  SparsePoly out;
+  // Products are summed in a dense table of the result's degree, far cheaper per product than map inserts.
+  const int d = a.degree() + b.degree(), side = d + 1;
+  thread_local std::vector<double> table;
+  table.assign(static_cast<std::size_t>(side * side * side), 0.0);
+  auto at = [side](int i, int j, int k) { return static_cast<std::size_t>((i * side + j) * side + k); };
+  std::vector<std::pair<SparsePoly::Exponents, double>> bs(b.terms.begin(), b.terms.end());
   for (const auto& [ea, ca] : a.terms)
-    for (const auto& [eb, cb] : b.terms) out.add({ea[0] + eb[0], ea[1] + eb[1], ea[2] + eb[2]}, ca * cb);
+    for (const auto& [eb, cb] : bs) table[at(ea[0] + eb[0], ea[1] + eb[1], ea[2] + eb[2])] += ca * cb;
+  SparsePoly out;
+  for (int i = 0; i <= d; ++i)
+    for (int j = 0; i + j <= d; ++j)
+      for (int k = 0; i + j + k <= d; ++k)
+        if (const double c = table[at(i, j, k)]; c != 0)
+          out.terms.emplace_hint(out.terms.end(), SparsePoly::Exponents{i, j, k}, c);
   return out;
 }
 
 SparsePoly power(const SparsePoly& p, long e, PolyBudget& budget) {
   if (p.terms.empty()) return e == 0 ? SparsePoly::constant(1) : SparsePoly{};
+  if (p.degree() == 0) {  // a constant: one pow, not e products
+    const double c = std::pow(p.terms.begin()->second, static_cast<double>(e));
+    if (!std::isfinite(c)) throw PolyTooLarge("this power of a constant overflows");
+    return SparsePoly::constant(c);
+  }
   if (static_cast<long>(p.degree()) * e > budget.max_degree)
     throw PolyTooLarge("this power has degree " + std::to_string(static_cast<long>(p.degree()) * e) +
                        "; algray draws degrees up to " + std::to_string(budget.max_degree));

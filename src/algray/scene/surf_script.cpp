@@ -681,6 +681,12 @@ class Script {
     expect(";", "';' after the command");
     const std::string& c = name.text;
     if (c == "draw_surface") {
+      // A picture is a copy of every reserved value: counted like arithmetic, so that a loop of thousands of
+      // draws of large surfaces stops at the budget instead of copying for minutes.
+      double terms = 0;
+      for (const auto& [key, v] : globals_) terms += 1 + static_cast<double>(v.poly.terms.size());
+      budget_.work += terms;
+      if (budget_.work > budget_.limit) fail(name, "the script's pictures and arithmetic are too large to follow here");
       last_drawn_ = Snapshot{globals_, name};
       ++draws_;
     } else if (c == "save_color_image") {
