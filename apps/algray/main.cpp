@@ -16,6 +16,7 @@
 #endif
 #include "algray/device/program_cache.h"
 #include "algray/io/image_io.h"
+#include "algray/io/video_writer.h"
 #include "algray/render/solver_aov.h"
 #include "algray/scene/scene_formats.h"
 #include "algray/scene/solver_options.h"
@@ -287,6 +288,10 @@ struct BatchCommand {
     cmd->add_option("--log", request.log_path,
                     "JSON-lines log, one line per frame (default: beside the jobs file, <name>.log.jsonl)");
     cmd->add_option("--stats", request.stats_path, "write a summary of the batch as JSON");
+    cmd->add_option("--video", request.video_path,
+                    "encode every frame of every job, in order, into this " + video_extensions() +
+                        " as the frames come (with the ffmpeg program), at the first job's fps (default 30); jobs "
+                        "may then have no output of their own");
     cmd->add_option("--shard", shard_text,
                     "K/N: render only frames K, K+N, K+2N, ... of all (0 <= K < N), writing the shard's own log and "
                     "stats; default in a Slurm array job: from SLURM_ARRAY_TASK_ID and _COUNT (or _MIN/_MAX)");

@@ -714,6 +714,33 @@ std::string png_bytes(const FrameImage& image) {
   return bytes;
 }
 
+struct PendingOutput::State {
+  fs::path destination;
+  TempFile temp;
+  explicit State(const fs::path& d) : destination(d), temp(d) {}
+};
+
+PendingOutput::PendingOutput(const fs::path& destination) {
+  check_output_path(destination);
+  const fs::path absolute = fs::absolute(destination);
+  remove_stale_temps(absolute.parent_path(), temp_prefix(absolute));
+  state_ = std::make_unique<State>(absolute);
+}
+
+PendingOutput::~PendingOutput() = default;
+
+const fs::path& PendingOutput::temp_path() const { return state_->temp.path(); }
+
+void PendingOutput::commit() {
+  try {
+    sync_file(state_->temp.path());
+    state_->temp.commit(state_->destination);
+    sync_directory(state_->destination.parent_path());
+  } catch (const std::exception& e) {
+    throw WriteError(cannot_write(state_->destination) + e.what());
+  }
+}
+
 void write_text_file(const fs::path& path, const std::string& text) {
   write_atomically(path, [&](const fs::path& temp) { encode_text(temp, text); });
 }
