@@ -125,6 +125,37 @@ TEST_CASE("jobs without outputs render into the video alone; without --video the
   }
 }
 
+TEST_CASE("Slurm-style shards render apart; --merge-logs --video encodes their images in order", "[video][cli]") {
+  algray::testing::require_device();
+  require_ffmpeg();
+  algray::testing::Sandbox box;
+  const fs::path file = box.scene("jobs.toml", jobs("output = \"f_{frame:02}.png\"\n"));
+  for (const char* shard : {"0/2", "1/2"})
+    REQUIRE(box.run("batch " + quoted(file.string()) + " --preview --shard " + shard).exit_code == 0);
+  const auto merged = box.run("batch " + quoted(file.string()) + " --merge-logs --video merged.mp4");
+  REQUIRE(merged.exit_code == 0);
+  CHECK_THAT(merged.err, Catch::Contains("wrote merged.mp4 (5 frames, 64x48) from the shards' images"));
+  const std::string video = decoded(box.work / "merged.mp4");
+  const std::size_t frame_bytes = 3 * kWidth * kHeight;
+  REQUIRE(video.size() == kFrames * frame_bytes);
+  // Each frame is its own image, not another's: nearest to the PNG of its own number.
+  for (int frame = 0; frame < kFrames; ++frame) {
+    CAPTURE(frame);
+    int nearest = -1;
+    double best = 1e9;
+    for (int k = 0; k < kFrames; ++k) {
+      char name[32];
+      std::snprintf(name, sizeof name, "f_%02d.png", k);
+      const double d =
+          difference(video.substr(static_cast<std::size_t>(frame) * frame_bytes, frame_bytes), decoded(box.in / name))
+              .first;
+      if (d < best) best = d, nearest = k;
+    }
+    CHECK(nearest == frame);
+    CHECK(best < 3.0);
+  }
+}
+
 TEST_CASE("the video writer refuses what it cannot encode and leaves nothing behind", "[video]") {
   require_ffmpeg();
   const fs::path dir = algray::testing::unique_temp_dir("video");

@@ -24,6 +24,7 @@
 #include "algray/io/video_writer.h"
 #include "algray/api/render_job.h"
 #include "algray/scene/toml_reader.h"
+#include "algray/util/file_names.h"
 #include "algray/util/json_text.h"
 #include "algray/util/version.h"
 
@@ -516,8 +517,8 @@ BatchPlan plan_batch(const BatchRequest& req) {
   if (req.video_path) {
     // One writer takes every frame in order: a shard has only some, and --resume renders only some.
     if (req.shard)
-      throw OutputError("--video needs every frame in one process: run the batch without --shard (or encode the "
-                        "shards' images afterwards)");
+      throw OutputError("--video needs every frame in one process: run the shards without it, then `algray batch "
+                        "JOBS --merge-logs --video OUT` encodes their images in order");
     if (req.resume) throw OutputError("--video renders every frame; it does not combine with --resume");
     if (!video_format_of(*req.video_path))
       throw OutputError("cannot write '" + *req.video_path + "': --video takes " + video_extensions());
@@ -928,6 +929,39 @@ std::string keep_unmerged_log(const std::string& path) {
 
 }  // namespace
 
+namespace {
+
+// The image of a frame that a video can be made from: its first PNG or EXR output.
+std::optional<std::string> frame_image_pattern(const BatchJob& job) {
+  for (const std::string& o : job.outputs)
+    if (lowercase_extension(o) == ".png" || lowercase_extension(o) == ".exr") return o;
+  return std::nullopt;
+}
+
+// Slurm shards render in separate processes: once their logs are merged, one writer reads every frame's image in
+// the batch's order and encodes the video.
+BatchOutcome encode_shards_video(const BatchRequest& req, const BatchPlan& plan, const BatchReporter& message) {
+  try {
+    std::unique_ptr<VideoWriter> video;
+    for (const BatchJob& job : plan.jobs)
+      for (int frame = 0; frame < job.frames; ++frame) {
+        const std::string path = expand_pattern(*frame_image_pattern(job), job, frame);
+        const FrameImage image = lowercase_extension(path) == ".png" ? read_png_pixels(path) : read_exr(path);
+        if (!video) video = std::make_unique<VideoWriter>(*req.video_path, image.width, image.height, job.fps);
+        video->add(image);
+      }
+    video->finish();
+    message("algray: wrote " + *req.video_path + " (" + std::to_string(video->frames()) + " frames, " +
+            std::to_string(video->width()) + "x" + std::to_string(video->height()) + ") from the shards' images\n");
+    return BatchOutcome::Done;
+  } catch (const std::exception& e) {
+    message(std::string("algray: the video was not written: ") + e.what() + "\n");
+    return BatchOutcome::Stopped;
+  }
+}
+
+}  // namespace
+
 BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& callbacks) {
   const BatchReporter message{callbacks};
   BatchRequest whole = req;
@@ -935,6 +969,11 @@ BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& cal
   BatchPlan plan;
   try {
     plan = plan_batch(whole);
+    if (req.video_path)
+      for (const BatchJob& job : plan.jobs)
+        if (!frame_image_pattern(job))
+          throw SceneError(job.origin, "--merge-logs --video makes the video from the shards' images: job '" +
+                                           job.name + "' needs a .png or .exr output");
   } catch (const std::exception& e) {
     return message.refused(e);
   }
@@ -1038,7 +1077,12 @@ BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& cal
           std::to_string(total) + " frames, " + std::to_string(failed) + " failed, " + std::to_string(missing) +
           " in no log" + (missing ? " (" + missing_names + (missing > 10 ? ", ..." : "") + ")" : "") +
           (conflicts.empty() ? "" : ", " + std::to_string(conflicts.size()) + " in conflict") + "\n");
-  return missing || failed ? BatchOutcome::FramesFailed : BatchOutcome::Done;
+  if (missing || failed) {
+    if (req.video_path) message("algray: the video " + *req.video_path + " was not written: frames are missing\n");
+    return BatchOutcome::FramesFailed;
+  }
+  if (req.video_path) return encode_shards_video(req, plan, message);
+  return BatchOutcome::Done;
 }
 
 }  // namespace algray

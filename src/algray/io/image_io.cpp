@@ -847,6 +847,26 @@ FrameImage read_exr(const fs::path& path) {
   }
 }
 
+FrameImage read_png_pixels(const fs::path& path) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&png, path.c_str()))
+    throw OutputError("cannot read '" + path.string() + "': " + png.message);
+  png.format = PNG_FORMAT_RGBA;
+  std::vector<png_byte> bytes(PNG_IMAGE_SIZE(png));
+  if (!png_image_finish_read(&png, nullptr, bytes.data(), 0, nullptr))
+    throw OutputError("cannot read '" + path.string() + "': " + png.message);
+  FrameImage image;
+  image.width = static_cast<int>(png.width);
+  image.height = static_cast<int>(png.height);
+  image.rgba.resize(bytes.size());
+  float linear[256];
+  for (int v = 0; v < 256; ++v) linear[v] = static_cast<float>(srgb_to_linear(v / 255.0));
+  for (std::size_t i = 0; i < bytes.size(); ++i)
+    image.rgba[i] = i % 4 == 3 ? static_cast<float>(bytes[i]) / 255.0f : linear[bytes[i]];
+  return image;
+}
+
 bool is_png_file(const fs::path& path) {
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> fp(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!fp) return false;

@@ -146,6 +146,10 @@ void install_output_cleanup_handlers();
 // on failure.
 FrameImage read_exr(const std::filesystem::path& path);
 
+// Reads a PNG's pixels back as a frame (sRGB values to linear, straight alpha), for a video made of images
+// written earlier (`algray batch --merge-logs --video`). Throws OutputError on failure.
+FrameImage read_png_pixels(const std::filesystem::path& path);
+
 // Whether the file starts with the 8-byte PNG signature. False when it cannot be read; never throws.
 bool is_png_file(const std::filesystem::path& path);
 
