@@ -124,3 +124,19 @@ def replace_section(path, heading, section, under=None):
             section = under + "\n\n" + section
         text = text.rstrip("\n") + "\n\n" + section.rstrip("\n") + "\n"
     out.write_text(text)
+
+
+def replace_bullet(path, heading, prefix, bullet, under=None):
+    """Puts the one-line `bullet` (starting with `prefix`, such as "- surf:") in place of the section's line that
+    starts with `prefix`, keeping its other lines: for sections that several scripts write a line each of, where
+    RESULTS.md has no room for a section apiece. The section is made when missing."""
+    out = Path(path)
+    text = out.read_text() if out.exists() else "# Benchmark results\n\n"
+    start = _find_heading(text, heading)
+    lines = []
+    if start is not None:
+        end = _section_end(text, start, heading_level(heading))
+        lines = [l for l in text[start:end].splitlines()[1:] if l.startswith("- ")]
+    lines = sorted([l for l in lines if not l.startswith(prefix)] + [bullet])
+    replace_section(path, heading, heading + "\n\n" + "\n".join(lines) + "\n", under=under)
+

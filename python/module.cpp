@@ -184,6 +184,12 @@ PYBIND11_MODULE(_algray, m) {
           },
           "the bytes save(\"x.png\") writes, the scene included, without a file");
 
+  py::class_<api::Video>(m, "_Video")
+      .def(py::init<const std::string&, double>(), py::arg("path"), py::arg("fps"))
+      .def("add", &api::Video::add, py::arg("image"))
+      .def("finish", &api::Video::finish, py::call_guard<py::gil_scoped_release>())
+      .def_property_readonly("frames", &api::Video::frames);
+
   py::class_<api::Renderer>(m, "_Renderer")
       .def(py::init<const std::string&, bool>(), py::arg("device") = "", py::arg("cache") = true)
       .def("device", [](api::Renderer& r) { return device_dict(r.device()); })

@@ -28,6 +28,7 @@ test_packages=(
                             # depends on, with ASan, UBSan and libFuzzer in its libclang-common-15-dev; and
                             # test_kernel_portability's strict OpenCL C 1.2 front end
   help2man                  # the man page
+  ffmpeg                    # `algray batch --video` runs the ffmpeg program; test_video writes and decodes videos
 )
 
 set_name=${1:-render}

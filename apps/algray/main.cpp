@@ -16,7 +16,9 @@
 #endif
 #include "algray/device/program_cache.h"
 #include "algray/io/image_io.h"
+#include "algray/io/video_writer.h"
 #include "algray/render/solver_aov.h"
+#include "algray/scene/scene_formats.h"
 #include "algray/scene/solver_options.h"
 #include "algray/util/version.h"
 #include "commands.h"
@@ -52,9 +54,9 @@ void add_no_fp64_flag(CLI::App* cmd) {
 // Batch takes a jobs file where the others take a scene, and no scene positional.
 void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = true) {
   if (scene_positional) {
-    auto* scene = cmd->add_option(
-        "scene", o.scene_path,
-        "scene file (.toml or .jsurf), or - for standard input; default: the built-in Barth sextic");
+    auto* scene = cmd->add_option("scene", o.scene_path,
+                                  "scene file: " + readable_scene_types() +
+                                      "; or - for standard input; default: the built-in Barth sextic");
     cmd->add_option("-e,--equation", o.equation,
                     "render this equation P(x,y,z) (as `x^4+y^4+z^4-1`) with algray's defaults: a sphere extent of "
                     "radius 2 (--radius), framed from 3R through 45 degrees, a key and a fill light, 2x2 "
@@ -303,6 +305,10 @@ struct BatchCommand {
     cmd->add_option("--log", request.log_path,
                     "JSON-lines log, one line per frame (default: beside the jobs file, <name>.log.jsonl)");
     cmd->add_option("--stats", request.stats_path, "write a summary of the batch as JSON");
+    cmd->add_option("--video", request.video_path,
+                    "encode every frame of every job, in order, into this " + video_extensions() +
+                        " as the frames come (with the ffmpeg program), at the first job's fps (default 30); jobs "
+                        "may then have no output of their own");
     cmd->add_option("--shard", shard_text,
                     "K/N: render only frames K, K+N, K+2N, ... of all (0 <= K < N), writing the shard's own log and "
                     "stats; default in a Slurm array job: from SLURM_ARRAY_TASK_ID and _COUNT (or _MIN/_MAX)");

@@ -152,6 +152,25 @@ class Image {
   explicit Image(std::shared_ptr<const State> state) : state_(std::move(state)) {}
   std::shared_ptr<const State> state_;
   friend class Renderer;
+  friend class Video;
+};
+
+// A video of images added one at a time, in order: .mp4 (H.264), .webm (VP9) or .gif, encoded as they come by the
+// ffmpeg program and put in place atomically by finish(). The first image sets the size; destroyed unfinished,
+// nothing is left. OutputError for a bad path or another size; std::runtime_error when ffmpeg is missing or fails.
+class Video {
+ public:
+  Video(const std::string& path, double fps);
+  ~Video();
+  Video(const Video&) = delete;
+  Video& operator=(const Video&) = delete;
+  void add(const Image& image);
+  void finish();
+  int frames() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
 };
 
 // What one frame of a batch ended as, for a progress display.

@@ -14,11 +14,11 @@ import json
 import os
 
 from . import _toml
-from ._algray import DeviceError, Image, OutputError, Scene, SceneError, _Renderer
+from ._algray import DeviceError, Image, OutputError, Scene, SceneError, _Renderer, _Video
 from ._algray import __version__
 from ._algray import devices
 
-__all__ = ["Scene", "Renderer", "Image", "SceneError", "DeviceError", "OutputError", "devices", "explore",
+__all__ = ["Scene", "Renderer", "Image", "Animation", "SceneError", "DeviceError", "OutputError", "devices", "explore",
            "__version__"]
 
 
@@ -154,6 +154,52 @@ class Renderer:
             if progress:
                 progress(index, images[-1])
         return images
+
+
+class Animation:
+    """A video that Renderer.animate wrote: its path, frames and fps; Jupyter shows it inline (a <video> element,
+    or an <img> for a GIF, holding the file's bytes)."""
+
+    def __init__(self, path, frames, fps):
+        self.path, self.frames, self.fps = path, frames, fps
+
+    def _repr_html_(self):
+        import base64
+        data = base64.b64encode(open(self.path, "rb").read()).decode("ascii")
+        kind = os.path.splitext(self.path)[1].lower().lstrip(".")
+        if kind == "gif":
+            return f'<img src="data:image/gif;base64,{data}"/>'
+        return f'<video controls autoplay loop muted src="data:video/{kind};base64,{data}"></video>'
+
+    def __repr__(self):
+        return f"<algray.Animation {self.path}: {self.frames} frames at {self.fps} fps>"
+
+
+def _animate(self, scene, sweep, seconds=5, fps=30, path=None, width=0, height=0, preview=False, progress=None):
+    """Renders `scene` with each key of `sweep` ({"a": (0, 1)}: a parameter or dotted key, from, to) going
+    evenly from its first value to its last over seconds x fps frames, both ends included, into a video at `path`
+    (.mp4, .webm or .gif; None: a temporary .mp4) through the same writer as `algray batch --video`, and returns
+    an Animation, which Jupyter shows inline. progress(index, frames) after each frame."""
+    frames = max(1, round(seconds * fps))
+    if path is None:
+        import tempfile
+        handle, path = tempfile.mkstemp(prefix="algray-", suffix=".mp4")
+        os.close(handle)
+        os.unlink(path)
+    video = _Video(os.fspath(path), float(fps))
+    for index in range(frames):
+        t = index / (frames - 1) if frames > 1 else 0.0
+        frame_scene = scene.__copy__()
+        for key, (start, end) in sweep.items():
+            frame_scene.set(key, start + (end - start) * t)
+        video.add(self.render(frame_scene, width, height, preview=preview, depth=False))
+        if progress:
+            progress(index, frames)
+    video.finish()
+    return Animation(os.fspath(path), frames, fps)
+
+
+Renderer.animate = _animate
 
 
 def explore(scene, renderer=None, width=480, height=360, **sliders):

@@ -264,3 +264,25 @@ def test_srgb_is_the_pngs_pixels_and_to_pil_shows_them(renderer):
     linear = image.rgba[..., :3]
     lit = (linear > 0.15) & (linear < 0.25)
     assert lit.any() and np.all(np.abs(srgb[..., :3][lit].astype(int) - 124) < 20)
+
+def test_animate_writes_a_video_of_the_sweep_that_jupyter_shows(renderer, tmp_path):
+    # Needs the ffmpeg program, as algray batch --video does; without it the test fails saying so.
+    assert subprocess.run(["ffmpeg", "-version"], capture_output=True).returncode == 0, "install ffmpeg"
+    scene = algray.Scene.load(os.path.join(ROOT, "scenes", "torus.toml"))
+    seen = []
+    movie = renderer.animate(scene, sweep={"r": (0.4, 0.9)}, seconds=0.5, fps=8, path=str(tmp_path / "a.mp4"),
+                             width=48, height=32, preview=True, progress=lambda i, n: seen.append((i, n)))
+    assert (movie.frames, movie.fps, seen[-1]) == (4, 8, (3, 4))
+    probe = subprocess.run(["ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                            "stream=nb_read_frames,width,height", "-of", "csv=p=0", movie.path],
+                           capture_output=True, text=True, check=True).stdout
+    assert probe.startswith("48,32,4")
+    assert '<video controls' in movie._repr_html_() and "data:video/mp4;base64," in movie._repr_html_()
+    # The first frame is the scene at the sweep's start, as render gives it (within H.264's loss).
+    first = subprocess.run(["ffmpeg", "-v", "error", "-i", movie.path, "-frames:v", "1", "-f", "rawvideo", "-pix_fmt",
+                            "rgb24", "-"], capture_output=True, check=True).stdout
+    still = renderer.render(scene.__copy__().set("r", 0.4), 48, 32, preview=True, depth=False)
+    expected = np.round(np.clip(still.rgba[..., :3], 0, 1) ** (1 / 2.2) * 255)  # near enough to sRGB for this
+    decoded = np.frombuffer(first, np.uint8).reshape(32, 48, 3).astype(float)
+    assert np.abs(decoded - expected).mean() < 8
+    assert list(tmp_path.iterdir()) == [tmp_path / "a.mp4"]  # nothing else left beside it

@@ -1,4 +1,5 @@
-# Writes a fuzz target's seed corpus into OUT (cmake -DKIND=equation|scene|jsurf|jobs -DSOURCE_DIR=repo -DOUT=dir -P).
+# Writes a fuzz target's seed corpus into OUT (cmake -DKIND=equation|scene|jsurf|surf|pov|jobs
+# -DSOURCE_DIR=repo -DOUT=dir -P).
 #
 # Seeds come from the repository as it is: the shipped scenes (their equations and parameters for the equation
 # parser), plus the small hand-written files under tests/fuzz/seeds/KIND. Nothing generated is committed.
@@ -51,8 +52,12 @@ elseif(KIND STREQUAL "scene")
     file(WRITE ${OUT}/${name} "${text}")
     file(WRITE ${OUT}/set_${name} "--set image.width=16\n--set image.height=12\n--set antialias.samples=1\n${text}")
   endforeach()
-elseif(NOT KIND MATCHES "^(jsurf|jobs)$")
-  message(FATAL_ERROR "make_seeds.cmake: unknown KIND '${KIND}' (equation, scene, jsurf or jobs)")
+elseif(KIND STREQUAL "pov")
+  # The POV-Ray scenes the tests and the comparison use.
+  file(GLOB pov_scenes ${SOURCE_DIR}/tests/data/pov/*.pov)
+  file(COPY ${pov_scenes} DESTINATION ${OUT})
+elseif(NOT KIND MATCHES "^(jsurf|surf|jobs)$")
+  message(FATAL_ERROR "make_seeds.cmake: unknown KIND '${KIND}' (equation, scene, jsurf, surf, pov or jobs)")
 endif()
 
 file(GLOB seeds ${OUT}/*)

@@ -1,6 +1,6 @@
 # Runs one fuzz target for a fixed time from a fresh copy of its seeds; fails on any finding or if it did not fuzz.
 #
-# cmake -DFUZZER=path -DKIND=equation|scene|jsurf|jobs -DSOURCE_DIR=repo -DWORK=scratch-dir [-DSECONDS=30]
+# cmake -DFUZZER=path -DKIND=equation|scene|jsurf|surf|pov|jobs -DSOURCE_DIR=repo -DWORK=scratch-dir [-DSECONDS=30]
 #       [-DDICT=file] -P run_fuzz.cmake
 # -timeout=60: the worst equation the parser admits (degree 32, dense, long constants) takes seconds in Release and
 # about 30x that in this -O0 sanitizer build; a hang is what it must catch, not that.

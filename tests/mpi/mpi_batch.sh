@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # test_mpi_batch: `mpirun -n 2 algray batch` on this machine. A 16-frame sweep must have every frame rendered
-# exactly once, by both ranks between them, byte-identical to a single-process batch; a batch with one failing
+# exactly once, by both ranks between them, byte-identical to a single-process batch, and with --video encoded in
+# the sweep's order by rank 0; a batch with one failing
 # frame must report and log it and render the rest (exit 1); a bad jobs file must end every rank with exit 2 and
 # nothing written. Without mpirun it fails, saying what to install.
 #   mpi_batch.sh ALGRAY_BINARY WORK_DIR
@@ -50,6 +51,29 @@ done
 grep -q '"ok": 16' "$work/mpi/summary.json" || { echo "the summary does not count 16 frames ok" >&2; status=1; }
 [ $status = 0 ] || fail "the 2-rank sweep is wrong (above)"
 
+# --video under MPI: both ranks render, rank 0's one writer encodes the frames in the sweep's order. Each decoded
+# frame must be nearest to its own single-process PNG (the frames differ from each other by far more than H.264).
+command -v ffmpeg >/dev/null || fail "ffmpeg is missing (scripts/install-deps.sh test installs it)"
+(cd "$work/mpi" && "${mpirun_2[@]}" "$algray" batch jobs.toml --log video.jsonl --video sweep.mp4 2> video.txt) ||
+  fail "the 2-rank --video batch failed: $(cat "$work/mpi/video.txt")"
+python3 - "$work/mpi/sweep.mp4" "$work/single" "$work/mpi/video.jsonl" <<'PY' || fail "the 2-rank video is wrong (above)"
+import json, subprocess, sys
+def frames(path):
+    return subprocess.run(["ffmpeg", "-v", "error", "-i", path, "-f", "rawvideo", "-pix_fmt", "rgb24", "-"],
+                          capture_output=True, check=True).stdout
+size = 160 * 120 * 3
+video = frames(sys.argv[1])
+pngs = [frames(f"{sys.argv[2]}/grow_{i:02}.png") for i in range(16)]
+problems = [] if len(video) == 16 * size else [f"{len(video) / size} frames in the video, not 16"]
+for i in range(len(video) // size):
+    frame = video[i * size:(i + 1) * size]
+    nearest = min(range(16), key=lambda k: sum(abs(a - b) for a, b in zip(frame[::7], pngs[k][::7])))
+    if nearest != i: problems.append(f"video frame {i} is nearest to PNG {nearest}")
+if {json.loads(l)["rank"] for l in open(sys.argv[3])} != {0, 1}: problems.append("not both ranks rendered")
+for p in problems: print("test_mpi_batch:", p, file=sys.stderr)
+sys.exit(1 if problems else 0)
+PY
+
 # One failing frame among six: reported on rank 0's stderr, logged with its error, the rest rendered.
 cat > "$work/failing/jobs.toml" <<'JOBS'
 [defaults]
@@ -96,4 +120,4 @@ grep -q "jobs.toml:2:9" "$work/bad/stderr.txt" || fail "the jobs file's error do
 code=$?
 [ $code = 2 ] || fail "--shard under MPI exited $code, not 2"
 grep -q "does not combine with MPI" "$work/mpi/shard.txt" || fail "--shard under MPI was not refused: $(cat "$work/mpi/shard.txt")"
-echo "test_mpi_batch: 2 ranks, 16 frames each once and identical to one process; a failing frame logged; bad input exit 2"
+echo "test_mpi_batch: 2 ranks, 16 frames each once and identical to one process; their --video in order; a failing frame logged; bad input exit 2"

@@ -21,8 +21,10 @@
 #include <system_error>
 
 #include "algray/io/image_io.h"
+#include "algray/io/video_writer.h"
 #include "algray/api/render_job.h"
 #include "algray/scene/toml_reader.h"
+#include "algray/util/file_names.h"
 #include "algray/util/json_text.h"
 #include "algray/util/version.h"
 
@@ -32,7 +34,8 @@ namespace {
 namespace fs = std::filesystem;
 
 const std::set<std::string> kBatchTopKeys{"defaults", "job"};
-const std::set<std::string> kJobKeys{"name", "scene", "set", "output", "stats", "frames", "sweep", "orbit"};
+const std::set<std::string> kJobKeys{"name",  "scene", "set",   "output",  "stats",
+                                     "frames", "sweep", "orbit", "seconds", "fps"};
 // What every job may share; frames, sweeps and orbits belong to one job.
 const std::set<std::string> kDefaultsKeys{"scene", "set", "output", "stats"};
 const std::set<std::string> kSweepKeys{"from", "to", "steps"};
@@ -92,6 +95,7 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
   };
   BatchJob job;
   job.line = static_cast<int>(t.source().begin.line);
+  job.origin = origin_of(r, t);
   const toml::node* scene = get("scene");
   if (!scene) r.fail(t.source(), "job " + std::to_string(index) + " needs a scene (a .toml or .jsurf path)");
   job.scene = r.string(*scene, "job.scene");
@@ -108,9 +112,10 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
     if (!n->is_table()) r.fail(n->source(), "set must be a table of scene keys and values");
     collect_sets(r, *n->as_table(), "", job.overrides);
   }
+  // Without an output, the frames go only into the batch's --video (plan_batch checks there is one).
   const toml::node* output = get("output");
-  if (!output) r.fail(t.source(), "job '" + job.name + "' needs an output (a file name pattern, or a list of them)");
-  for (const std::string& o : string_or_list(r, *output, "job.output")) job.outputs.push_back(resolve(base_dir, o));
+  if (output)
+    for (const std::string& o : string_or_list(r, *output, "job.output")) job.outputs.push_back(resolve(base_dir, o));
   if (const toml::node* n = get("stats")) job.stats = resolve(base_dir, r.string(*n, "job.stats"));
 
   std::optional<int> frames;
@@ -122,6 +127,18 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
                                  std::to_string(*frames) + " (all sweeps and the orbit step together)");
     frames = n;
   };
+  // A duration and a frame rate: seconds x fps frames (a sweep or orbit then needs no steps or frames).
+  if (const toml::node* n = t.get("fps")) {
+    job.fps = r.number(*n, "job.fps");
+    if (!(job.fps > 0 && job.fps <= 1000)) r.fail(n->source(), "job.fps must be above 0 and at most 1000");
+  }
+  if (const toml::node* n = t.get("seconds")) {
+    const double seconds = r.number(*n, "job.seconds");
+    const double count = std::round(seconds * job.fps);
+    if (!(seconds > 0) || !(count >= 1 && count <= 1000000))
+      r.fail(n->source(), "job.seconds x fps must make 1 to 1000000 frames");
+    agree(static_cast<int>(count), *n, "seconds x fps");
+  }
   if (const toml::node* n = t.get("sweep")) {
     const toml::table* sweeps = n->as_table();
     if (!sweeps || sweeps->empty())
@@ -131,14 +148,17 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
       const toml::table* s = node.as_table();
       if (!s) r.fail(node.source(), what + " must be { from = ..., to = ..., steps = ... }");
       r.check_keys(*s, what, kSweepKeys);
-      for (const char* k : {"from", "to", "steps"})
+      for (const char* k : {"from", "to"})
         if (!s->get(k)) r.fail(node.source(), what + " needs '" + k + "'");
+      if (!s->get("steps") && !frames)
+        r.fail(node.source(), what + " needs 'steps', or the job frames or seconds (and fps)");
       Sweep sweep;
       sweep.key = std::string(key.str());
       sweep.origin = origin_of(r, node);
       sweep.from = r.number(*s->get("from"), what + ".from");
       sweep.to = r.number(*s->get("to"), what + ".to");
-      agree(static_cast<int>(r.integer(*s->get("steps"), what + ".steps", 1, 1000000)), node, what);
+      if (const toml::node* steps = s->get("steps"))
+        agree(static_cast<int>(r.integer(*steps, what + ".steps", 1, 1000000)), node, what);
       job.sweeps.push_back(sweep);
     }
   }
@@ -189,7 +209,7 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
       r.fail(get("stats")->source(), e.message);
     }
   }
-  job.output_origin = origin_of(r, *output);
+  job.output_origin = output ? origin_of(r, *output) : job.origin;
   return job;
 }
 
@@ -475,6 +495,17 @@ std::string batch_log_path(const BatchRequest& req, const std::string& base_dir)
   return (fs::path(base_dir) / (fs::path(req.jobs_path).stem().string() + ".log.jsonl")).string();
 }
 
+// Makes `dir` and its missing parents, each recorded in `made`; OutputError when one cannot be made.
+void make_folders(const fs::path& dir, std::vector<fs::path>& made) {
+  if (dir.empty()) return;
+  std::error_code ec;
+  if (fs::exists(dir, ec)) return;
+  make_folders(dir.parent_path(), made);
+  if (!fs::create_directory(dir, ec) && ec)
+    throw OutputError("cannot make the folder '" + dir.string() + "' an output pattern names: " + ec.message());
+  made.push_back(dir);
+}
+
 std::string shard_text(const BatchShard& shard) {
   return std::to_string(shard.index) + "/" + std::to_string(shard.count);
 }
@@ -491,6 +522,26 @@ BatchPlan plan_batch(const BatchRequest& req) {
     base_dir = fs::path(req.jobs_path).parent_path().string();
   }
   plan.jobs = load_jobs(text, req.jobs_path == "-" ? "<stdin>" : req.jobs_path, base_dir);
+  if (!req.video_path)
+    for (const BatchJob& job : plan.jobs)
+      if (job.outputs.empty())
+        throw SceneError(job.origin, "job '" + job.name +
+                                         "' needs an output (a file name pattern, or a list of them), or the batch a "
+                                         "--video to put its frames in");
+  if (req.video_path) {
+    // One writer takes every frame in order: a shard has only some, and --resume renders only some.
+    if (req.shard)
+      throw OutputError("--video needs every frame in one process: run the shards without it, then `algray batch "
+                        "JOBS --merge-logs --video OUT` encodes their images in order");
+    if (req.resume) throw OutputError("--video renders every frame; it does not combine with --resume");
+    if (!video_format_of(*req.video_path))
+      throw OutputError("cannot write '" + *req.video_path + "': --video takes " + video_extensions());
+    for (const BatchJob& job : plan.jobs)
+      if (job.fps != plan.jobs.front().fps)
+        throw SceneError(job.origin, "job '" + job.name + "' has fps " + toml_number(job.fps) + ", the first job " +
+                                         toml_number(plan.jobs.front().fps) + ": one --video has one frame rate");
+    check_output_writable(*req.video_path);
+  }
   plan.log_path = batch_log_path(req, base_dir);
   if (req.shard) plan.log_path = shard_file(plan.log_path, *req.shard);
   if (req.stats_path) plan.stats_path = req.shard ? shard_file(*req.stats_path, *req.shard) : *req.stats_path;
@@ -499,6 +550,7 @@ BatchPlan plan_batch(const BatchRequest& req) {
   // No file the batch writes may be one it reads, or another it writes, by any name.
   std::vector<RoleAndPath> inputs{{"jobs file", req.jobs_path}}, outputs{{"--log", plan.log_path}};
   if (plan.stats_path) outputs.push_back({"--stats", *plan.stats_path});
+  if (req.video_path) outputs.push_back({"--video", *req.video_path});
   int number = 0;  // of each frame in the whole batch, which decides its shard
   for (const BatchJob& job : plan.jobs) {
     inputs.push_back({"scene of job " + job.name, job.scene});
@@ -512,9 +564,29 @@ BatchPlan plan_batch(const BatchRequest& req) {
   }
   plan.numbered_frames = number;
   check_distinct_files(inputs, outputs);
-  // Every frame's paths are checked now, as render checks its own, so that a bad one is bad input (exit 2)
-  // before anything renders rather than a failure of each frame.
-  for (const RoleAndPath& o : outputs) check_output_writable(o.path);
+  // Folders that output patterns name with placeholders ("out/{name}/f{frame}.png") are made now; the rest must
+  // exist. Should a path still be bad, the folders made for it are taken away again: bad input writes nothing.
+  std::vector<fs::path> made;
+  try {
+    for (const BatchJob& job : plan.jobs) {
+      std::vector<std::string> patterns = job.outputs;
+      if (job.stats) patterns.push_back(*job.stats);
+      for (const std::string& pattern : patterns) {
+        if (fs::path(pattern).parent_path().string().find('{') == std::string::npos) continue;
+        for (int frame = 0; frame < job.frames; ++frame)
+          make_folders(fs::path(expand_pattern(pattern, job, frame)).parent_path(), made);
+      }
+    }
+    // Every frame's paths are checked now, as render checks its own, so that a bad one is bad input (exit 2)
+    // before anything renders rather than a failure of each frame.
+    for (const RoleAndPath& o : outputs) check_output_writable(o.path);
+  } catch (...) {
+    for (auto it = made.rbegin(); it != made.rend(); ++it) {
+      std::error_code ignored;
+      fs::remove(*it, ignored);  // only if still empty
+    }
+    throw;
+  }
   return plan;
 }
 
@@ -595,6 +667,10 @@ class FrameRenderer {
       RenderOutputs render;
       render.images = outputs;
       render.stats_path = stats;
+      if (req_.video_path)
+        render.keep_image = [&report](FrameImage&& image) {
+          report.image = std::make_shared<const FrameImage>(std::move(image));
+        };
       check_outputs(scene, render);
       entry["stats"] = render_scene(scene, render, context_, {}, start);
       entry["status"] = "ok";
@@ -646,6 +722,39 @@ struct BatchRecorder::State {
   std::vector<JobTally> tallies;
   // A job's warnings are shown once, from the first of its frames that read the scene.
   std::vector<bool> warned;
+  // --video: opened at the first frame (which gives the size) and fed every frame in the batch's order, however
+  // the frames arrive (MPI ranks finish them out of order: those ahead wait here). The first frame that cannot
+  // go in (failed, skipped, another size) abandons it, with the reason said once.
+  std::unique_ptr<VideoWriter> video;
+  std::optional<std::string> video_lost;
+  std::map<int, std::pair<std::shared_ptr<const FrameImage>, std::string>> video_waiting;  // number -> image, why not
+  int video_next = 0;
+
+  void add_to_video(const FrameReport& report, const std::string& status, const BatchJob& job, int frame) {
+    if (!req.video_path || video_lost) return;
+    const std::string why = status == "ok" && report.image
+                                ? std::string()
+                                : "job " + job.name + " frame " + std::to_string(frame) + " " +
+                                      (status.empty() ? "failed" : status);
+    video_waiting[report.number] = {report.image, why};
+    for (auto it = video_waiting.find(video_next); it != video_waiting.end() && !video_lost;
+         it = video_waiting.find(video_next)) {
+      const auto [image, problem] = it->second;
+      video_waiting.erase(it);
+      ++video_next;
+      try {
+        if (!problem.empty()) throw std::runtime_error(problem);
+        if (!video)
+          video = std::make_unique<VideoWriter>(*req.video_path, image->width, image->height, plan.jobs.front().fps);
+        video->add(*image);
+      } catch (const std::exception& e) {
+        video.reset();
+        video_waiting.clear();
+        video_lost = e.what();
+        message("algray: the video " + *req.video_path + " will not be written: " + *video_lost + "\n");
+      }
+    }
+  }
 
   State(const BatchRequest& r, const BatchPlan& p, const BatchCallbacks& c)
       : req(r), plan(p), callbacks(c), log(p.log_path, r.resume), tallies(p.jobs.size()), warned(p.jobs.size()) {
@@ -695,6 +804,7 @@ void BatchRecorder::record(const FrameReport& report) {
   ++s.done;
   JobTally& tally = s.tallies[job_index];
   const std::string status = report.entry.value("status", "");
+  s.add_to_video(report, status, job, frame);
   if (report.device_lost) {
     ++s.devices_lost;
     ++s.failed;
@@ -751,6 +861,22 @@ BatchOutcome BatchRecorder::finish(int renderers) {
   if (s.failed)
     s.message("algray: " + std::to_string(s.failed) + " of " + std::to_string(total) + " frames failed (see " +
               s.plan.log_path + ")\n");
+  if (s.req.video_path && s.video) {
+    try {
+      s.video->finish();
+      s.message("algray: wrote " + *s.req.video_path + " (" + std::to_string(s.video->frames()) + " frames, " +
+                std::to_string(s.video->width()) + "x" + std::to_string(s.video->height()) + ")\n");
+    } catch (const std::exception& e) {
+      s.message(std::string("algray: ") + e.what() + "\n");
+      s.video.reset();
+      return BatchOutcome::Stopped;
+    }
+    s.video.reset();
+  } else if (s.req.video_path && !s.video_lost) {
+    s.message("algray: the video " + *s.req.video_path + " was not written: no frame was rendered\n");
+    return BatchOutcome::Stopped;
+  }
+  if (s.video_lost && !s.failed) return BatchOutcome::Stopped;
   return s.failed ? BatchOutcome::FramesFailed : BatchOutcome::Done;
 }
 
@@ -817,6 +943,39 @@ std::string keep_unmerged_log(const std::string& path) {
 
 }  // namespace
 
+namespace {
+
+// The image of a frame that a video can be made from: its first PNG or EXR output.
+std::optional<std::string> frame_image_pattern(const BatchJob& job) {
+  for (const std::string& o : job.outputs)
+    if (lowercase_extension(o) == ".png" || lowercase_extension(o) == ".exr") return o;
+  return std::nullopt;
+}
+
+// Slurm shards render in separate processes: once their logs are merged, one writer reads every frame's image in
+// the batch's order and encodes the video.
+BatchOutcome encode_shards_video(const BatchRequest& req, const BatchPlan& plan, const BatchReporter& message) {
+  try {
+    std::unique_ptr<VideoWriter> video;
+    for (const BatchJob& job : plan.jobs)
+      for (int frame = 0; frame < job.frames; ++frame) {
+        const std::string path = expand_pattern(*frame_image_pattern(job), job, frame);
+        const FrameImage image = lowercase_extension(path) == ".png" ? read_png_pixels(path) : read_exr(path);
+        if (!video) video = std::make_unique<VideoWriter>(*req.video_path, image.width, image.height, job.fps);
+        video->add(image);
+      }
+    video->finish();
+    message("algray: wrote " + *req.video_path + " (" + std::to_string(video->frames()) + " frames, " +
+            std::to_string(video->width()) + "x" + std::to_string(video->height()) + ") from the shards' images\n");
+    return BatchOutcome::Done;
+  } catch (const std::exception& e) {
+    message(std::string("algray: the video was not written: ") + e.what() + "\n");
+    return BatchOutcome::Stopped;
+  }
+}
+
+}  // namespace
+
 BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& callbacks) {
   const BatchReporter message{callbacks};
   BatchRequest whole = req;
@@ -824,6 +983,11 @@ BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& cal
   BatchPlan plan;
   try {
     plan = plan_batch(whole);
+    if (req.video_path)
+      for (const BatchJob& job : plan.jobs)
+        if (!frame_image_pattern(job))
+          throw SceneError(job.origin, "--merge-logs --video makes the video from the shards' images: job '" +
+                                           job.name + "' needs a .png or .exr output");
   } catch (const std::exception& e) {
     return message.refused(e);
   }
@@ -927,7 +1091,12 @@ BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& cal
           std::to_string(total) + " frames, " + std::to_string(failed) + " failed, " + std::to_string(missing) +
           " in no log" + (missing ? " (" + missing_names + (missing > 10 ? ", ..." : "") + ")" : "") +
           (conflicts.empty() ? "" : ", " + std::to_string(conflicts.size()) + " in conflict") + "\n");
-  return missing || failed ? BatchOutcome::FramesFailed : BatchOutcome::Done;
+  if (missing || failed) {
+    if (req.video_path) message("algray: the video " + *req.video_path + " was not written: frames are missing\n");
+    return BatchOutcome::FramesFailed;
+  }
+  if (req.video_path) return encode_shards_video(req, plan, message);
+  return BatchOutcome::Done;
 }
 
 }  // namespace algray

@@ -43,7 +43,9 @@ struct BatchJob {
   int frames = 1;
   std::vector<Sweep> sweeps;  // all swept together, frame by frame
   std::optional<Orbit> orbit;
-  int line = 0;  // in the jobs file, for messages
+  double fps = 30;  // frames per second of a --video; `seconds` in the jobs file times this gives the frames
+  int line = 0;     // in the jobs file, for messages
+  std::string origin;  // "file:line:column" of the job's table, for messages
 };
 
 // Reads a jobs file; errors name file:line:column (SceneError).
@@ -93,6 +95,9 @@ struct BatchRequest {
   std::optional<BatchShard> shard;
   // --merge-logs only: join shard logs of different shard counts too (by default refused: one count is a stale run).
   bool merge_mixed_counts = false;
+  // --video: every frame of every job, in order, encoded into this .mp4, .webm or .gif as it is rendered
+  // (io/video_writer.h), at the first job's fps. Jobs may then have no output of their own.
+  std::optional<std::string> video_path;
   // Runs the batch in place of this process alone, from the same request and callbacks: set by the command line
   // under an MPI launcher (cluster/mpi_batch.h), which sits above this layer. run_batch calls it when set.
   std::function<BatchOutcome(const BatchRequest&, const BatchCallbacks&)> distribute;
@@ -148,6 +153,7 @@ BatchPlan plan_batch(const BatchRequest& request);
 // A frame finished (rendered, failed or skipped) by whichever process rendered it.
 struct FrameReport {
   int number = 0;        // in the numbering of the whole batch that shards use
+  std::shared_ptr<const FrameImage> image;  // the frame's pixels, kept for a --video
   nlohmann::json entry;  // its log line
   std::string message;   // why it failed, for the person running the batch; empty when it did not
   std::optional<std::string> warnings;  // the scene's warning lines, once the frame has read its scene

@@ -9,6 +9,7 @@
 #include "algray/api/render_job.h"
 #include "algray/io/image_io.h"
 #include "algray/device/program_cache.h"
+#include "algray/io/video_writer.h"
 #include "algray/scene/jsurf.h"
 #include "algray/util/json_text.h"
 #include "algray/util/version.h"
@@ -296,5 +297,42 @@ BatchResult Renderer::batch(const BatchSettings& settings) {
   }
   return BatchResult::Stopped;
 }
+
+struct Video::State {
+  std::string path;
+  double fps;
+  std::unique_ptr<VideoWriter> writer;
+};
+
+Video::Video(const std::string& path, double fps) : state_(std::make_unique<State>(State{path, fps, nullptr})) {
+  translated([&] {
+    if (!video_format_of(path))
+      throw algray::OutputError("cannot write '" + path + "': a video is " + video_extensions());
+    if (!(fps > 0 && fps <= 1000)) throw algray::OutputError("cannot write '" + path + "': fps must be in (0, 1000]");
+    return 0;
+  });
+}
+
+Video::~Video() = default;
+
+void Video::add(const Image& image) {
+  translated([&] {
+    const FrameImage& frame = image.state_->image;
+    if (!state_->writer)
+      state_->writer = std::make_unique<VideoWriter>(state_->path, frame.width, frame.height, state_->fps);
+    state_->writer->add(frame);
+    return 0;
+  });
+}
+
+void Video::finish() {
+  translated([&] {
+    if (!state_->writer) throw algray::OutputError("cannot write '" + state_->path + "': no image was added");
+    state_->writer->finish();
+    return 0;
+  });
+}
+
+int Video::frames() const { return state_->writer ? state_->writer->frames() : 0; }
 
 }  // namespace algray::api

@@ -463,6 +463,7 @@ nlohmann::json render_scene(const Scene& scene, const RenderOutputs& outputs, Re
   nlohmann::json stats = frame_stats(scene, frame, outputs.images, context.uses_cache());
   if (outputs.stats_path)
     writer.write(*outputs.stats_path, [&] { write_text_file(*outputs.stats_path, dump_json(stats, 2) + "\n"); });
+  if (outputs.keep_image) outputs.keep_image(std::move(frame.image));
   return stats;
 }
 

@@ -24,6 +24,8 @@ struct RenderOutputs {
   bool reference = false;                   // solve on the CPU with solver_ref instead of a device
   std::vector<SolverAov> aovs;              // solver channels added to EXR images
   std::optional<std::string> heatmap_path;  // solver work per pixel as a picture
+  // Handed the rendered image after the files are written (a batch's --video keeps it); may be empty.
+  std::function<void(FrameImage&&)> keep_image;
 };
 
 // How a render reports back while it runs: after each tile, and whether to stop (RenderCancelled).

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -30,12 +31,50 @@ void say(const BatchCallbacks& callbacks, const std::string& text) {
   if (callbacks.on_message) callbacks.on_message(text);
 }
 
+constexpr char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+std::string base64(const void* data, std::size_t size) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  std::string out;
+  out.reserve((size + 2) / 3 * 4);
+  for (std::size_t i = 0; i < size; i += 3) {
+    const unsigned v = (p[i] << 16) | (i + 1 < size ? p[i + 1] << 8 : 0) | (i + 2 < size ? p[i + 2] : 0);
+    out += kBase64[(v >> 18) & 63];
+    out += kBase64[(v >> 12) & 63];
+    out += i + 1 < size ? kBase64[(v >> 6) & 63] : '=';
+    out += i + 2 < size ? kBase64[v & 63] : '=';
+  }
+  return out;
+}
+
+std::string unbase64(const std::string& text) {
+  std::string out;
+  unsigned value = 0;
+  int bits = 0;
+  for (const char c : text) {
+    const char* at = std::strchr(kBase64, c);
+    if (c == '=' || !c || !at) continue;
+    value = (value << 6) | static_cast<unsigned>(at - kBase64);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out += static_cast<char>((value >> bits) & 0xff);
+    }
+  }
+  return out;
+}
+
 std::string encode(const FrameReport& report) {
   nlohmann::json j = {{"number", report.number},
                       {"entry", report.entry},
                       {"message", report.message},
                       {"device_lost", report.device_lost}};
   if (report.warnings) j["warnings"] = *report.warnings;
+  // A --video frame travels to rank 0, whose one writer encodes the frames in order.
+  if (report.image)
+    j["image"] = {{"width", report.image->width},
+                  {"height", report.image->height},
+                  {"rgba", base64(report.image->rgba.data(), report.image->rgba.size() * sizeof(float))}};
   return dump_json(j);
 }
 
@@ -47,6 +86,15 @@ FrameReport decode(const std::string& text) {
   report.message = j.at("message").get<std::string>();
   report.device_lost = j.at("device_lost").get<bool>();
   if (j.contains("warnings")) report.warnings = j["warnings"].get<std::string>();
+  if (j.contains("image")) {
+    auto image = std::make_shared<FrameImage>();
+    image->width = j["image"].at("width").get<int>();
+    image->height = j["image"].at("height").get<int>();
+    const std::string bytes = unbase64(j["image"].at("rgba").get<std::string>());
+    image->rgba.resize(bytes.size() / sizeof(float));
+    std::memcpy(image->rgba.data(), bytes.data(), image->rgba.size() * sizeof(float));
+    report.image = std::move(image);
+  }
   return report;
 }
 

@@ -714,6 +714,33 @@ std::string png_bytes(const FrameImage& image) {
   return bytes;
 }
 
+struct PendingOutput::State {
+  fs::path destination;
+  TempFile temp;
+  explicit State(const fs::path& d) : destination(d), temp(d) {}
+};
+
+PendingOutput::PendingOutput(const fs::path& destination) {
+  check_output_path(destination);
+  const fs::path absolute = fs::absolute(destination);
+  remove_stale_temps(absolute.parent_path(), temp_prefix(absolute));
+  state_ = std::make_unique<State>(absolute);
+}
+
+PendingOutput::~PendingOutput() = default;
+
+const fs::path& PendingOutput::temp_path() const { return state_->temp.path(); }
+
+void PendingOutput::commit() {
+  try {
+    sync_file(state_->temp.path());
+    state_->temp.commit(state_->destination);
+    sync_directory(state_->destination.parent_path());
+  } catch (const std::exception& e) {
+    throw WriteError(cannot_write(state_->destination) + e.what());
+  }
+}
+
 void write_text_file(const fs::path& path, const std::string& text) {
   write_atomically(path, [&](const fs::path& temp) { encode_text(temp, text); });
 }
@@ -818,6 +845,26 @@ FrameImage read_exr(const fs::path& path) {
   } catch (const std::exception& e) {
     throw OutputError("cannot read '" + path.string() + "': " + e.what());
   }
+}
+
+FrameImage read_png_pixels(const fs::path& path) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&png, path.c_str()))
+    throw OutputError("cannot read '" + path.string() + "': " + png.message);
+  png.format = PNG_FORMAT_RGBA;
+  std::vector<png_byte> bytes(PNG_IMAGE_SIZE(png));
+  if (!png_image_finish_read(&png, nullptr, bytes.data(), 0, nullptr))
+    throw OutputError("cannot read '" + path.string() + "': " + png.message);
+  FrameImage image;
+  image.width = static_cast<int>(png.width);
+  image.height = static_cast<int>(png.height);
+  image.rgba.resize(bytes.size());
+  float linear[256];
+  for (int v = 0; v < 256; ++v) linear[v] = static_cast<float>(srgb_to_linear(v / 255.0));
+  for (std::size_t i = 0; i < bytes.size(); ++i)
+    image.rgba[i] = i % 4 == 3 ? static_cast<float>(bytes[i]) / 255.0f : linear[bytes[i]];
+  return image;
 }
 
 bool is_png_file(const fs::path& path) {

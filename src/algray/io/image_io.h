@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -119,6 +120,24 @@ std::string png_bytes(const FrameImage& image);
 // Text (SVG, JSON, ...) byte for byte, through the same temporary file and rename as the images.
 void write_text_file(const std::filesystem::path& path, const std::string& text);
 
+// A file written over a long time by someone else (a video, by the ffmpeg program), with the writers' guarantees:
+// check_output_path's checks on construction (OutputError), a hidden temporary beside the destination that a
+// signal, the destructor or a failure removes, and commit() to fsync it and rename it over the destination
+// (WriteError).
+class PendingOutput {
+ public:
+  explicit PendingOutput(const std::filesystem::path& destination);
+  ~PendingOutput();
+  PendingOutput(const PendingOutput&) = delete;
+  PendingOutput& operator=(const PendingOutput&) = delete;
+  const std::filesystem::path& temp_path() const;
+  void commit();
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
 // Installs (once) SIGINT/SIGTERM/SIGHUP handlers that unlink any temporary file being written, then
 // re-raise the signal with its default action, so interrupted runs leave nothing behind. A signal that
 // is ignored at the time of the call (e.g. SIGHUP under nohup) stays ignored. Call at program start.
@@ -130,6 +149,10 @@ void install_output_cleanup_handlers();
 // string/double attributes and the two matrices. Vectors for absent channels stay empty. Throws OutputError
 // on failure.
 FrameImage read_exr(const std::filesystem::path& path);
+
+// Reads a PNG's pixels back as a frame (sRGB values to linear, straight alpha), for a video made of images
+// written earlier (`algray batch --merge-logs --video`). Throws OutputError on failure.
+FrameImage read_png_pixels(const std::filesystem::path& path);
 
 // Whether the file starts with the 8-byte PNG signature. False when it cannot be read; never throws.
 bool is_png_file(const std::filesystem::path& path);

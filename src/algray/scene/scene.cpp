@@ -4,6 +4,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -14,9 +15,11 @@
 
 #include "algray/scene/expression.h"
 #include "algray/scene/jsurf.h"
+#include "algray/scene/povray.h"
+#include "algray/scene/scene_formats.h"
+#include "algray/scene/surf_script.h"
 #include "algray/scene/toml_reader.h"
 #include "algray/util/embedded_files.h"
-#include "algray/util/file_names.h"
 
 namespace algray {
 namespace {
@@ -803,6 +806,59 @@ Scene load_jsurf_text(const std::string& text, const std::string& source_name, c
 
 namespace {
 
+// The image size that overrides set, 0 where none does: the surf and POV-Ray framings depend on it.
+std::array<int, 2> overridden_size(const std::vector<Override>& overrides) {
+  std::array<int, 2> size = {0, 0};
+  for (const Override& o : overrides)
+    if (o.key == "image.width" || o.key == "image.height") {
+      char* end = nullptr;
+      const long v = std::strtol(o.value.c_str(), &end, 10);
+      if (end && *end == '\0' && v > 0 && v <= 1 << 20) size[o.key == "image.height"] = static_cast<int>(v);
+    }
+  return size;
+}
+
+// A translated scene read as TOML; an error in the translation, which the user never saw, is put at `at`.
+Scene load_translation(const std::string& toml, const std::string& source_name, const std::vector<Override>& overrides,
+                       const std::string& at, const std::string& excerpt, const std::string& what,
+                       std::vector<std::string> warnings) {
+  const std::string translated = source_name + " (translated to TOML)";
+  Scene scene;
+  try {
+    scene = load_scene_text(toml, translated, overrides);
+  } catch (const SceneError& e) {
+    if (e.where.compare(0, translated.size(), translated) != 0) throw;
+    throw SceneError(at, what + ": " + e.message, excerpt);
+  }
+  scene.source = source_name;
+  scene.warnings = std::move(warnings);
+  return scene;
+}
+
+}  // namespace
+
+Scene load_povray_text(const std::string& text, const std::string& source_name,
+                       const std::vector<Override>& overrides) {
+  const std::array<int, 2> size = overridden_size(overrides);
+  std::vector<std::string> warnings;
+  const PovTranslation pov = povray_to_toml(text, source_name, warnings, size[0], size[1]);
+  return load_translation(pov.toml, source_name, overrides, pov.first_object_at, pov.first_object_excerpt,
+                          "the scene of the object here", std::move(warnings));
+}
+
+Scene load_surf_script_text(const std::string& text, const std::string& source_name,
+                            const std::vector<Override>& overrides) {
+  // surf frames by the shorter side, so the translation needs the size the image will have.
+  const std::array<int, 2> size = overridden_size(overrides);
+  std::vector<std::string> warnings;
+  const SurfTranslation surf = surf_script_to_toml(text, source_name, warnings, size[0], size[1]);
+  // The translation's values are computed by the script; the drawing statement is where they take effect.
+  return load_translation(surf.toml, source_name, overrides, surf.drawn_at, surf.drawn_excerpt,
+                          "the surface drawn here", std::move(warnings));
+}
+
+namespace {
+
 void write_material(std::ostringstream& out, const std::string& table, const Material& m) {
   out << "\n[" << table << "]\ncolour = " << toml_vector(m.colour) << "\nambient = " << toml_number(m.ambient)
       << "\ndiffuse = " << toml_number(m.diffuse) << "\nspecular = " << toml_number(m.specular)
@@ -934,8 +990,14 @@ std::string read_input_file(const std::string& path, const std::string& what) {
 }
 
 Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides) {
-  const std::string text = read_input_file(path, "scene file");
-  if (lowercase_extension(path) == ".jsurf") return load_jsurf_text(text, path, overrides);
+  const std::optional<SceneFormat> format = scene_format_of(path);
+  if (!format) throw SceneError(path, unknown_scene_type_message(path));
+  const std::string text = read_input_file(path, "scene file");  // a missing file is said so first
+  if (*format == SceneFormat::Png)
+    throw SceneError(path, "is not a PNG file (it does not start with PNG's signature), so it carries no scene");
+  if (*format == SceneFormat::Jsurf) return load_jsurf_text(text, path, overrides);
+  if (*format == SceneFormat::SurfScript) return load_surf_script_text(text, path, overrides);
+  if (*format == SceneFormat::PovRay) return load_povray_text(text, path, overrides);
   return load_scene_text(text, path, overrides);
 }
 

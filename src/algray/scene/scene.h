@@ -161,7 +161,7 @@ struct Scene {
   Antialias antialias;
   RenderSettings render;
   // What the scene's reader could not render as written (a .jsurf feature algray draws differently, an unknown
-  // key it ignored); commands print them as warnings.
+  // key it ignored, a surf statement outside the subset); commands print them as warnings.
   std::vector<std::string> warnings;
 
   // The first surface: the one single-surface tools (the reference solver, the solver benchmarks) work on.
@@ -177,12 +177,20 @@ struct Override {
   std::string origin = {};
 };
 
-// A .toml scene, or a SURFER/jsurf .jsurf file (by extension, any case), translated with jsurf's framing.
+// A scene file by its extension (any case, scene_formats.h): a .toml scene (also a path without an extension),
+// a SURFER/jsurf .jsurf file translated with jsurf's framing, a surf script (.pic) with surf's, or a POV-Ray
+// scene (.pov) as POV-Ray shows it. Any other
+// extension is a SceneError listing the types algray reads, before the file is opened. (PNGs that carry a
+// scene are read a layer up, where the PNG reader is: api's SceneLoader.)
 Scene load_scene_file(const std::string& path, const std::vector<Override>& overrides = {});
 Scene load_scene_text(const std::string& text, const std::string& source_name,
                       const std::vector<Override>& overrides = {});
 Scene load_jsurf_text(const std::string& text, const std::string& source_name,
                       const std::vector<Override>& overrides = {});
+Scene load_surf_script_text(const std::string& text, const std::string& source_name,
+                            const std::vector<Override>& overrides = {});
+Scene load_povray_text(const std::string& text, const std::string& source_name,
+                       const std::vector<Override>& overrides = {});
 Scene default_scene(const std::vector<Override>& overrides = {});
 // An equation alone as a scene (`algray render -e`): "[surface] equation" and algray's defaults for the rest, as a
 // TOML file holding only that table gets. Errors in the equation name "--equation:1:COLUMN".

@@ -1,0 +1,279 @@
+#!/usr/bin/env python3
+"""POV-Ray comparison (issue 47): .pov scenes rendered by Debian's povray and by algray from the same file; how
+well the silhouettes agree (intersection over union of the pixels that show a surface) and how far the depths
+are apart where both show one. Writes its line of bench/RESULTS.md ("surf's and POV-Ray's own scenes",
+under "Against the peers"); every scene's row is printed as it goes.
+
+The scenes: the twelve of tests/data/pov (poly, polynomial, quartic, cubic, sphere and torus objects with their
+transforms and clips, a right-handed, an orthographic and a tilted camera, an area light), and the paper's seven
+surfaces as bench/peers.py writes them for POV-Ray. Silhouettes: povray with +UA (the background transparent)
+against algray's PNG alpha over a transparent background, one ray per pixel in both. Depth: povray once more with
+every object's texture replaced at its `//@depth` line (the end of its modifiers, so in world coordinates) by
+one whose colour is the distance from the camera over --far, written as a 16-bit PNG with File_Gamma 1, against
+algray's EXR Z (the distance from the eye along the unit ray); compared at pixels whose 3x3 neighbourhood both
+programs cover, as a relative difference.
+
+Needs `apt-get install povray` (installed here when missing and run as root); POVRAY names another binary.
+"""
+import argparse
+import datetime
+import glob
+import os
+import re
+import shutil
+import statistics
+import struct
+import subprocess
+import sys
+import tempfile
+import zlib
+from pathlib import Path
+
+from bench_common import ROOT, command_line, commit, machine, replace_bullet
+
+AREA = "## Against the peers"
+HEADING = "### surf's and POV-Ray's own scenes"  # one section, a line per script (surf_compare.py writes the other)
+SHOWN_BELOW = 0.99  # scenes whose IoU is under this are named on the page
+SCENES = ROOT / "tests/data/pov"
+
+
+def ensure_povray():
+    povray = os.environ.get("POVRAY") or shutil.which("povray")
+    if not povray and os.geteuid() == 0:
+        subprocess.run(["apt-get", "install", "-y", "--no-install-recommends", "povray"], check=True,
+                       stdout=subprocess.DEVNULL)
+        povray = shutil.which("povray")
+    if not povray:
+        sys.exit("needs povray: apt-get install povray")
+    return povray
+
+
+def read_png(path):
+    """(width, height, rows of channel tuples) of a non-interlaced 8- or 16-bit grey, RGB or RGBA PNG."""
+    data = Path(path).read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", path
+    pos, idat, header = 8, b"", None
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        if kind == b"IHDR":
+            header = struct.unpack(">IIBBBBB", data[pos + 8:pos + 8 + length])
+        elif kind == b"IDAT":
+            idat += data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+    width, height, depth, colour, _, _, interlace = header
+    channels = {0: 1, 2: 3, 4: 2, 6: 4}[colour]
+    assert depth in (8, 16) and interlace == 0, f"{path}: unsupported PNG layout"
+    bpp = channels * depth // 8
+    stride = width * bpp
+    raw = zlib.decompress(idat)
+    rows, previous, i = [], bytearray(stride), 0
+    for _ in range(height):
+        kind, line = raw[i], bytearray(raw[i + 1:i + 1 + stride])
+        i += 1 + stride
+        for x in range(stride):
+            a = line[x - bpp] if x >= bpp else 0
+            b = previous[x]
+            c = previous[x - bpp] if x >= bpp else 0
+            if kind == 1:
+                line[x] = (line[x] + a) & 255
+            elif kind == 2:
+                line[x] = (line[x] + b) & 255
+            elif kind == 3:
+                line[x] = (line[x] + (a + b) // 2) & 255
+            elif kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        if depth == 8:
+            values = list(line)
+        else:
+            values = [line[k] << 8 | line[k + 1] for k in range(0, stride, 2)]
+        rows.append([tuple(values[x * channels:(x + 1) * channels]) for x in range(width)])
+        previous = line
+    return width, height, rows
+
+
+def read_exr_depth(path):
+    """The Z channel of a scanline EXR (no, ZIPS or ZIP compression) as rows of floats."""
+    data = Path(path).read_bytes()
+    assert data[:4] == b"\x76\x2f\x31\x01", path
+    pos, channels, compression, window = 8, [], 0, None
+    while data[pos] != 0:
+        end = data.index(b"\0", pos)
+        name = data[pos:end].decode()
+        end2 = data.index(b"\0", end + 1)
+        kind = data[end + 1:end2].decode()
+        size = struct.unpack("<i", data[end2 + 1:end2 + 5])[0]
+        value = data[end2 + 5:end2 + 5 + size]
+        if name == "channels":
+            k = 0
+            while value[k] != 0:
+                e = value.index(b"\0", k)
+                channels.append((value[k:e].decode(), struct.unpack("<i", value[e + 1:e + 5])[0]))
+                k = e + 17
+        elif name == "compression":
+            compression = value[0]
+        elif name == "dataWindow":
+            window = struct.unpack("<4i", value)
+        pos = end2 + 5 + size
+    pos += 1
+    assert compression in (0, 2, 3), f"{path}: EXR compression {compression} is not read here"
+    x0, y0, x1, y1 = window
+    width, height = x1 - x0 + 1, y1 - y0 + 1
+    lines_per_chunk = {0: 1, 2: 1, 3: 16}[compression]
+    chunks = (height + lines_per_chunk - 1) // lines_per_chunk
+    offsets = struct.unpack(f"<{chunks}Q", data[pos:pos + 8 * chunks])
+    sizes = {0: 4, 1: 2, 2: 4}  # uint, half, float
+    rows = {}
+    for offset in offsets:
+        y, size = struct.unpack("<ii", data[offset:offset + 8])
+        block = data[offset + 8:offset + 8 + size]
+        n = min(lines_per_chunk, y1 - y + 1)
+        expected = n * width * sum(sizes[t] for _, t in channels)
+        if compression and size < expected:
+            t = bytearray(zlib.decompress(block))
+            for k in range(1, len(t)):
+                t[k] = (t[k - 1] + t[k] - 128) & 255
+            half = (len(t) + 1) // 2
+            out = bytearray(len(t))
+            out[0::2] = t[:half]
+            out[1::2] = t[half:]
+            block = bytes(out)
+        k = 0
+        for line in range(n):
+            for name, kind in channels:
+                length = width * sizes[kind]
+                if name == "Z":
+                    assert kind == 2, "Z is a float channel"
+                    rows[y + line - y0] = list(struct.unpack(f"<{width}f", block[k:k + length]))
+                k += length
+    return [rows[y] for y in range(height)]
+
+
+def camera_location(text):
+    found = re.search(r"location\s*<\s*([-0-9.eE+]+)\s*,\s*([-0-9.eE+]+)\s*,\s*([-0-9.eE+]+)\s*>", text)
+    assert found, "the scene's camera location must be three numbers here"
+    return [float(v) for v in found.groups()]
+
+
+def look_at(text):
+    found = re.search(r"look_at\s*<\s*([-0-9.eE+]+)\s*,\s*([-0-9.eE+]+)\s*,\s*([-0-9.eE+]+)\s*>", text)
+    assert found, "the scene's look_at must be three numbers here"
+    return [float(v) for v in found.groups()]
+
+
+def paper_scenes(tmp):
+    """The paper's surfaces as bench/peers.py writes them for POV-Ray, each object ending in a //@depth line."""
+    sys.path.insert(0, str(ROOT / "bench"))
+    import peers
+    out = []
+    for name in peers.SURFACES:
+        scene = peers.read_scene(ROOT / "scenes" / f"{name}.toml")
+        path = Path(tmp) / f"paper_{name}.pov"
+        peers.write_pov(scene, path, 4, 3, full=False)
+        text = path.read_text()
+        cut = text.rstrip().rindex("}")
+        path.write_text(text[:cut] + "  //@depth\n}\n")
+        out.append(path)
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--binary", default=ROOT / "build/apps/algray/algray")
+    ap.add_argument("--width", type=int, default=320)
+    ap.add_argument("--height", type=int, default=240)
+    ap.add_argument("--far", type=float, default=40.0, help="the distance the depth image's white stands for")
+    ap.add_argument("--output", default=ROOT / "bench/RESULTS.md")
+    args = ap.parse_args()
+    povray = ensure_povray()
+    w, h = args.width, args.height
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        files = sorted(Path(f) for f in glob.glob(str(SCENES / "*.pov"))) + paper_scenes(tmp)
+        for f in files:
+            name = f.stem
+            work = Path(tmp) / name
+            work.mkdir()
+            text = f.read_text()
+            plain, deep = work / "plain.pov", work / "depth.pov"
+            # Without a background POV-Ray's +UA leaves the background transparent.
+            plain.write_text(re.sub(r"background\s*\{[^}]*\}", "", text).replace("//@depth", ""))
+            eye = camera_location(text)
+            if "orthographic" in text:  # algray's Z is then the distance from the eye's plane
+                look = look_at(text)
+                f = [look[i] - eye[i] for i in range(3)]
+                n = sum(c * c for c in f) ** 0.5
+                distance = "(" + "+".join(f"({v}-({eye[i]}))*{f[i] / n}" for i, v in enumerate("xyz")) + \
+                    f")/{args.far}"
+            else:
+                distance = f"sqrt(pow(x-({eye[0]}),2)+pow(y-({eye[1]}),2)+pow(z-({eye[2]}),2))/{args.far}"
+            depth_texture = (f"texture {{ pigment {{ function {{ {distance} }} color_map {{ [0 rgb 0] [1 rgb 1] }} }} "
+                             "finish { ambient 1 diffuse 0 } }")
+            deep.write_text(text.replace("//@depth", depth_texture + " interior_texture { " +
+                                         depth_texture[len("texture { "):]))
+            pov = ["+W%d" % w, "+H%d" % h, "-D", "-GA", "+L/usr/share/povray-3.7/include"]
+            subprocess.run([povray, f"+I{plain}", f"+O{work}/pov.png", "+UA"] + pov, cwd=work, check=True,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=600)
+            subprocess.run([povray, f"+I{deep}", f"+O{work}/pov_depth.png", "+FN16", "File_Gamma=1.0"] + pov,
+                           cwd=work, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=600)
+            result = subprocess.run([str(args.binary), "render", str(plain), "-o", str(work / "algray.png"), "-o",
+                                     str(work / "algray.exr"), "--width", str(w), "--height", str(h), "--set",
+                                     "antialias.samples=1", "--set", "antialias.adaptive=false", "--set",
+                                     "image.background=[0, 0, 0, 0]"], capture_output=True, text=True, timeout=600)
+            if result.returncode != 0:
+                errors = [l for l in result.stderr.splitlines() if ": error: " in l] or ["no message"]
+                note = errors[0].replace(str(plain), name + ".pov")
+                rows.append((name, None, None, None, note))
+                print(f"{name:28s} FAILED: {note}", flush=True)
+                continue
+            _, _, mine = read_png(work / "algray.png")
+            _, _, theirs = read_png(work / "pov.png")
+            _, _, pov_depth = read_png(work / "pov_depth.png")
+            z = read_exr_depth(work / "algray.exr")
+            ma = [[mine[y][x][3] > 0 for x in range(w)] for y in range(h)]
+            mb = [[theirs[y][x][3] > 0 for x in range(w)] for y in range(h)]
+            both = sum(ma[y][x] and mb[y][x] for y in range(h) for x in range(w))
+            either = sum(ma[y][x] or mb[y][x] for y in range(h) for x in range(w))
+            iou = both / either if either else 1.0
+            errors = []
+            for y in range(1, h - 1):
+                for x in range(1, w - 1):
+                    if all(ma[y + dy][x + dx] and mb[y + dy][x + dx] for dy in (-1, 0, 1) for dx in (-1, 0, 1)):
+                        d = pov_depth[y][x][0] / 65535 * args.far
+                        if d > 0:
+                            errors.append(abs(z[y][x] - d) / d)
+            errors.sort()
+            median = statistics.median(errors) if errors else None
+            p99 = errors[int(0.99 * (len(errors) - 1))] if errors else None
+            rows.append((name, iou, median, p99, f"{either} px"))
+            print(f"{name:28s} IoU {iou:.4f}  depth |rel. diff| median {median:.2e} p99 {p99:.2e}  {either} px",
+                  flush=True)
+
+    ok = [r for r in rows if r[1] is not None]
+    if not ok:
+        sys.exit("no scene rendered: nothing to compare")
+    ious = [r[1] for r in ok]
+    version = subprocess.run([povray, "--version"], capture_output=True, text=True)
+    found = re.search(r"POV-Ray (\S+)", version.stdout + version.stderr)
+    low = sorted((r for r in ok if r[1] < SHOWN_BELOW), key=lambda r: r[1])
+    failed = [r for r in rows if r[1] is None]
+    medians = [r[2] for r in ok if r[2] is not None]
+    p99s = [r[3] for r in ok if r[3] is not None]
+    # One line: RESULTS.md is kept short; every scene's row is in this script's output.
+    bullet = (
+        f"- POV-Ray: {datetime.date.today()}, {machine()}, commit {commit(args.binary)}, POV-Ray "
+        f"{found.group(1) if found else '?'}, `{command_line()}`: tests/data/pov's twelve scenes and the paper's "
+        f"seven surfaces as bench/peers.py writes them, {w}x{h}, one ray per pixel. {len(ok)} of {len(rows)} render; "
+        f"silhouette IoU median {statistics.median(ious):.4f}, lowest {min(ious):.4f} "
+        f"({min(ok, key=lambda r: r[1])[0]}); depth against POV-Ray's 16-bit distance image (step "
+        f"{args.far / 65535:.1e}), away from silhouettes: relative difference median per scene at most "
+        f"{max(medians):.1e}, 99th percentile at most {max(p99s):.1e}" +
+        (f"; IoU under {SHOWN_BELOW}: " + ", ".join(f"{r[0]} {r[1]:.4f}" for r in low) if low else "") +
+        ("; failed: " + ", ".join(f"{r[0]} ({r[4]})" for r in failed) if failed else "") + ".")
+    replace_bullet(args.output, HEADING, "- POV-Ray:", bullet, under=AREA)
+    print(f"wrote {args.output}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1186 @@
+// The POV-Ray scene reader: a tokenizer and parser for the part of POV-Ray's scene language that describes
+// algebraic surfaces and how they are seen, and the algray scene made from it.
+//
+// Facts about POV-Ray 3.7 (Debian's povray) this file relies on, checked by rendering with it (bench/pov_compare.py):
+// - The world is left-handed: x right, y up, z into the screen, for the default camera. A camera whose right, up
+//   and direction form a right-handed set (right = -x, say) shows the mirror image. algray's world is
+//   right-handed, so a left-handed scene is read with z negated, which shows the same picture.
+// - rotate <a, b, c> turns about x by a, then y by b, then z by c degrees, each by the usual rotation matrix of
+//   the numbers (in the left-handed world that is clockwise seen from the axis' tip). matrix <m00, m01, m02, m10,
+//   ..., m32> maps a point p to p.x*row0 + p.y*row1 + p.z*row2 + row3.
+// - poly { n, <a...> } lists the coefficients of x^i y^j z^k for i from n down to 0, j from n - i down to 0, k from
+//   n - i - j down to 0; quartic and cubic are poly 4 and 3; polynomial lists xyz(i, j, k): a terms. Inside is
+//   P < 0. torus { R, r } lies around the y axis.
+// - The camera: direction <0, 0, 1>, right <1.33, 0, 0>, up and sky <0, 1, 0> by default; angle is the horizontal
+//   field of view and sets direction's length to |right| / 2 / tan(angle / 2). The view spans |right| across and
+//   |up| down at distance |direction|, whatever the image's size.
+#include "algray/scene/povray.h"
+
+#include <algorithm>
+#include <cmath>
+#include <glm/glm.hpp>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "algray/scene/scene.h"
+#include "algray/scene/sparse_poly.h"
+#include "algray/scene/toml_reader.h"
+
+namespace algray {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Token {
+  enum Kind { Name, Number, String, Directive, Op, End } kind = End;
+  std::string text;
+  double number = 0;
+  int line = 1, column = 1;
+};
+
+using Vec = std::vector<double>;  // a float is one component
+
+struct Clip {
+  bool sphere = true;
+  glm::dvec3 centre{0}, min{0}, max{0};
+  double radius = 0;
+};
+
+struct Object {
+  SparsePoly poly;          // in the object's own coordinates
+  glm::dmat4 transform{1};  // object to world (POV-Ray's coordinates)
+  std::vector<std::pair<Clip, glm::dmat4>> clips;  // each with its own object-to-world transform
+  std::optional<Clip> natural;                     // the bound of a sphere or torus, in object coordinates
+  std::optional<glm::dvec3> front, back;
+  bool inverse = false;
+  double ambient = 0.1, diffuse = 0.6, specular = 0, exponent = 40;  // POV-Ray's default finish
+  bool finished = false;  // a finish was given
+  Token at;
+  std::string kind;
+};
+
+struct Camera {
+  bool orthographic = false;
+  glm::dvec3 location{0, 0, 0}, direction{0, 0, 1}, right{1.33, 0, 0}, up{0, 1, 0}, sky{0, 1, 0};
+  std::optional<glm::dvec3> look_at;
+  std::optional<double> angle;
+};
+
+struct PovLight {
+  glm::dvec3 position{0}, colour{1}, edge_u{0}, edge_v{0};
+  int samples = 1;
+  bool area = false, shadows = true;
+};
+
+class PovReader {
+ public:
+  PovReader(const std::string& text, std::string source, std::vector<std::string>& warnings, int width, int height)
+      : source_(std::move(source)), warnings_(warnings), width_(width), height_(height) {
+    std::istringstream in(text);
+    for (std::string l; std::getline(in, l);) {
+      if (!l.empty() && l.back() == '\r') l.pop_back();
+      lines_.push_back(l);
+    }
+    tokenize(text);
+  }
+
+  PovTranslation run();
+
+ private:
+  // --- messages ---
+  std::string where(const Token& t) const {
+    return source_ + ":" + std::to_string(t.line) + ":" + std::to_string(t.column);
+  }
+  std::string excerpt(const Token& t) const {
+    const std::string line =
+        t.line >= 1 && static_cast<std::size_t>(t.line) <= lines_.size() ? lines_[static_cast<std::size_t>(t.line - 1)]
+                                                                         : std::string();
+    return line + "\n" + std::string(static_cast<std::size_t>(std::max(t.column - 1, 0)), ' ') + "^";
+  }
+  [[noreturn]] void fail(const Token& t, const std::string& message) const {
+    throw SceneError(where(t), message, excerpt(t));
+  }
+  void warn(const Token& t, const std::string& message) { warnings_.push_back(where(t) + ": " + message); }
+
+  // --- tokens ---
+  void tokenize(const std::string& text) {
+    int line = 1, column = 1;
+    std::size_t i = 0;
+    auto advance = [&](std::size_t n) {
+      for (std::size_t k = 0; k < n && i < text.size(); ++k, ++i) {
+        if (text[i] == '\n') {
+          ++line;
+          column = 1;
+        } else {
+          ++column;
+        }
+      }
+    };
+    while (i < text.size()) {
+      const char c = text[i];
+      if (std::isspace(static_cast<unsigned char>(c))) {
+        advance(1);
+        continue;
+      }
+      if (c == '/' && i + 1 < text.size() && text[i + 1] == '/') {
+        while (i < text.size() && text[i] != '\n') advance(1);
+        continue;
+      }
+      Token t{Token::Op, "", 0, line, column};
+      if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
+        const std::size_t end = text.find("*/", i + 2);
+        if (end == std::string::npos) fail(t, "this comment never ends (no */)");
+        advance(end + 2 - i);
+        continue;
+      }
+      if (std::isalpha(static_cast<unsigned char>(c)) || c == '_' || (c == '#' && i + 1 < text.size())) {
+        std::size_t j = i + (c == '#' ? 1 : 0);
+        while (j < text.size() && (std::isalnum(static_cast<unsigned char>(text[j])) || text[j] == '_')) ++j;
+        t.kind = c == '#' ? Token::Directive : Token::Name;
+        t.text = text.substr(i + (c == '#' ? 1 : 0), j - i - (c == '#' ? 1 : 0));
+        if (c == '#' && t.text.empty()) fail(t, "expected a directive after '#'");
+        advance(j - i);
+      } else if (std::isdigit(static_cast<unsigned char>(c)) ||
+                 (c == '.' && i + 1 < text.size() && std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
+        std::size_t j = i;
+        while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
+        if (j < text.size() && text[j] == '.') {
+          ++j;
+          while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
+        }
+        if (j < text.size() && (text[j] == 'e' || text[j] == 'E')) {
+          std::size_t k = j + 1;
+          if (k < text.size() && (text[k] == '+' || text[k] == '-')) ++k;
+          if (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) {
+            j = k;
+            while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
+          }
+        }
+        t.kind = Token::Number;
+        t.text = text.substr(i, j - i);
+        std::istringstream in(t.text);
+        in.imbue(std::locale::classic());
+        in >> t.number;
+        if (in.fail() || !std::isfinite(t.number)) fail(t, "the number " + t.text + " is too large");
+        advance(j - i);
+      } else if (c == '"') {
+        std::size_t j = i + 1;
+        while (j < text.size() && text[j] != '"' && text[j] != '\n') ++j;
+        if (j >= text.size() || text[j] != '"') fail(t, "this string never ends (no closing \")");
+        t.kind = Token::String;
+        t.text = text.substr(i + 1, j - i - 1);
+        advance(j + 1 - i);
+      } else {
+        if (std::string("{}<>,()+-*/:;.=[]").find(c) == std::string::npos) {
+          const unsigned char u = static_cast<unsigned char>(c);
+          fail(t, u >= 0x20 && u < 0x7f ? std::string("unexpected character '") + c + "'"
+                                         : "unexpected byte " + std::to_string(u) +
+                                               " (outside strings, scenes are ASCII)");
+        }
+        t.text = std::string(1, c);
+        advance(1);
+      }
+      tokens_.push_back(t);
+    }
+    tokens_.push_back({Token::End, "", 0, line, column});
+  }
+
+  const Token& peek(std::size_t ahead = 0) const { return tokens_[std::min(pos_ + ahead, tokens_.size() - 1)]; }
+  bool at_op(const char* op, std::size_t ahead = 0) const {
+    return peek(ahead).kind == Token::Op && peek(ahead).text == op;
+  }
+  bool at_name(const char* name) const { return peek().kind == Token::Name && peek().text == name; }
+  const Token& next() {
+    const Token& t = tokens_[pos_];
+    if (pos_ + 1 < tokens_.size()) ++pos_;
+    return t;
+  }
+  static std::string describe(const Token& t) {
+    switch (t.kind) {
+      case Token::End:
+        return "the end of the file";
+      case Token::String:
+        return "a string";
+      case Token::Directive:
+        return "'#" + t.text + "'";
+      default:
+        return "'" + t.text + "'";
+    }
+  }
+  void expect(const char* op, const char* what) {
+    if (!at_op(op)) fail(peek(), std::string("expected ") + what + ", found " + describe(peek()));
+    next();
+  }
+  void optional_comma() {
+    if (at_op(",")) next();
+  }
+  // Skips a { ... } block, the opening brace next.
+  void skip_block() {
+    const Token open = peek();
+    expect("{", "'{'");
+    int depth = 1;
+    while (depth > 0) {
+      const Token& t = next();
+      if (t.kind == Token::End) fail(open, "this '{' is never closed");
+      if (t.kind == Token::Op && t.text == "{") ++depth;
+      if (t.kind == Token::Op && t.text == "}") --depth;
+    }
+  }
+  // Skips what follows an item this reader does not read: its block, or its values up to the next word or '}'.
+  void skip_item() {
+    if (at_op("{")) return skip_block();
+    while (peek().kind != Token::End && !at_op("}") && peek().kind != Token::Name && peek().kind != Token::Directive) {
+      if (at_op("{")) {
+        skip_block();
+        continue;
+      }
+      next();
+    }
+  }
+
+  // --- expressions: floats and vectors ---
+  Vec expression(int depth = 0) {
+    if (depth > 200) fail(peek(), "the expression is nested too deeply");
+    Vec left = term(depth);
+    while (at_op("+") || at_op("-")) {
+      const Token op = next();
+      left = combine(left, term(depth), op);
+    }
+    return left;
+  }
+  Vec term(int depth) {
+    Vec left = unary(depth);
+    while (at_op("*") || at_op("/")) {
+      const Token op = next();
+      left = combine(left, unary(depth), op);
+    }
+    return left;
+  }
+  Vec unary(int depth) {
+    if (depth > 200) fail(peek(), "the expression is nested too deeply");
+    if (at_op("-")) {
+      next();
+      Vec v = unary(depth + 1);
+      for (double& c : v) c = -c;
+      return v;
+    }
+    if (at_op("+")) {
+      next();
+      return unary(depth + 1);
+    }
+    return postfix(primary(depth), depth);
+  }
+  Vec postfix(Vec v, int depth) {
+    (void)depth;
+    while (at_op(".")) {
+      const Token dot = next();
+      const Token member = next();
+      static const std::map<std::string, std::size_t> members = {{"x", 0},     {"u", 0},     {"red", 0},
+                                                                 {"y", 1},     {"v", 1},     {"green", 1},
+                                                                 {"z", 2},     {"blue", 2},  {"filter", 3},
+                                                                 {"t", 3},     {"transmit", 4}};
+      const auto m = members.find(member.text);
+      if (m == members.end()) fail(member, "expected x, y, z, red, green, blue, filter or transmit after '.'");
+      const Vec w = widen(v, std::max<std::size_t>(3, m->second + 1), dot);
+      v = {w[m->second]};
+    }
+    return v;
+  }
+  Vec combine(const Vec& a, const Vec& b, const Token& op) {
+    const std::size_t n = std::max(a.size(), b.size());
+    const Vec x = widen(a, n, op), y = widen(b, n, op);
+    Vec out(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (op.text == "+") out[i] = x[i] + y[i];
+      if (op.text == "-") out[i] = x[i] - y[i];
+      if (op.text == "*") out[i] = x[i] * y[i];
+      if (op.text == "/") {
+        if (y[i] == 0) fail(op, "division by zero");
+        out[i] = x[i] / y[i];
+      }
+      if (!std::isfinite(out[i])) fail(op, "this gives an infinity");
+    }
+    return out;
+  }
+  // A float stands for the vector of that float in every component, as in POV-Ray.
+  Vec widen(const Vec& v, std::size_t n, const Token& at) const {
+    if (v.size() == n) return v;
+    if (v.size() == 1) return Vec(n, v[0]);
+    if (v.size() < n) {
+      Vec out = v;
+      out.resize(n, 0);
+      return out;
+    }
+    fail(at, "expected " + std::to_string(n) + " components, found a vector of " + std::to_string(v.size()));
+  }
+  Vec primary(int depth) {
+    const Token t = next();
+    if (t.kind == Token::Number) return {t.number};
+    if (t.kind == Token::Op && t.text == "(") {
+      Vec v = expression(depth + 1);
+      expect(")", "')'");
+      return v;
+    }
+    if (t.kind == Token::Op && t.text == "<") {
+      Vec v;
+      for (;;) {
+        const Vec c = expression(depth + 1);
+        if (c.size() != 1) fail(t, "a vector's components are floats");
+        v.push_back(c[0]);
+        if (v.size() > 8192) fail(t, "a vector of more than 8192 components");  // poly 32 has 6545
+        if (at_op(",")) {
+          next();
+          continue;
+        }
+        break;
+      }
+      expect(">", "'>' or ','");
+      return v;
+    }
+    if (t.kind != Token::Name) fail(t, "expected a number or vector, found " + describe(t));
+    if (at_op("(")) return call(t, depth);
+    static const std::map<std::string, Vec> constants = {
+        {"x", {1, 0, 0}}, {"y", {0, 1, 0}}, {"z", {0, 0, 1}}, {"u", {1, 0}},   {"v", {0, 1}},  {"t", {0, 0, 0, 1}},
+        {"pi", {kPi}},    {"clock", {0}},   {"true", {1}},    {"yes", {1}},    {"on", {1}},    {"false", {0}},
+        {"no", {0}},      {"off", {0}},     {"clock_delta", {1}}, {"frame_number", {0}}};
+    if (const auto c = constants.find(t.text); c != constants.end()) return c->second;
+    if (t.text == "image_width") return {static_cast<double>(image_width())};
+    if (t.text == "image_height") return {static_cast<double>(image_height())};
+    if (const auto d = declared_.find(t.text); d != declared_.end()) return d->second;
+    fail(t, "'" + t.text + "' is not declared" +
+                (ignored_include_ ? " (#include files are not read, so their names are unknown here)" : ""));
+  }
+  Vec call(const Token& name, int depth) {
+    expect("(", "'('");
+    std::vector<Vec> args;
+    if (!at_op(")"))
+      for (;;) {
+        args.push_back(expression(depth + 1));
+        if (!at_op(",")) break;
+        next();
+      }
+    expect(")", "')' or ','");
+    const std::string& f = name.text;
+    auto scalar = [&](std::size_t i) {
+      if (args[i].size() != 1) fail(name, f + " takes floats");
+      return args[i][0];
+    };
+    auto want = [&](std::size_t n) {
+      if (args.size() != n) fail(name, f + " takes " + std::to_string(n) + " argument" + (n == 1 ? "" : "s"));
+    };
+    auto result = [&](double v) -> Vec {
+      if (!std::isfinite(v)) fail(name, f + " gives no finite number here");
+      return {v};
+    };
+    static const std::map<std::string, double (*)(double)> one = {
+        {"sqrt", [](double v) { return std::sqrt(v); }},     {"sin", [](double v) { return std::sin(v); }},
+        {"cos", [](double v) { return std::cos(v); }},       {"tan", [](double v) { return std::tan(v); }},
+        {"asin", [](double v) { return std::asin(v); }},     {"acos", [](double v) { return std::acos(v); }},
+        {"atan", [](double v) { return std::atan(v); }},     {"abs", [](double v) { return std::fabs(v); }},
+        {"exp", [](double v) { return std::exp(v); }},       {"log", [](double v) { return std::log10(v); }},
+        {"ln", [](double v) { return std::log(v); }},        {"floor", [](double v) { return std::floor(v); }},
+        {"ceil", [](double v) { return std::ceil(v); }},     {"int", [](double v) { return std::trunc(v); }},
+        {"radians", [](double v) { return v * kPi / 180; }}, {"degrees", [](double v) { return v * 180 / kPi; }}};
+    if (const auto g = one.find(f); g != one.end()) {
+      want(1);
+      return result(g->second(scalar(0)));
+    }
+    if (f == "pow" || f == "atan2" || f == "mod") {
+      want(2);
+      const double a = scalar(0), b = scalar(1);
+      return result(f == "pow" ? std::pow(a, b) : f == "atan2" ? std::atan2(a, b) : std::fmod(a, b));
+    }
+    if (f == "min" || f == "max") {
+      if (args.empty()) fail(name, f + " takes at least one float");
+      double v = scalar(0);
+      for (std::size_t i = 1; i < args.size(); ++i) v = f == "min" ? std::min(v, scalar(i)) : std::max(v, scalar(i));
+      return {v};
+    }
+    if (f == "vlength") {
+      want(1);
+      double s = 0;
+      for (double c : args[0]) s += c * c;
+      return result(std::sqrt(s));
+    }
+    if (f == "vnormalize") {
+      want(1);
+      double s = 0;
+      for (double c : args[0]) s += c * c;
+      if (s == 0) fail(name, "vnormalize of a zero vector");
+      Vec v = args[0];
+      for (double& c : v) c /= std::sqrt(s);
+      return v;
+    }
+    fail(name, "'" + f + "' is not a function this reader knows");
+  }
+  double number() {
+    const Token at = peek();
+    const Vec v = expression();
+    if (v.size() != 1) fail(at, "expected a float, found a vector");
+    return v[0];
+  }
+  glm::dvec3 vector3() {
+    const Token at = peek();
+    const Vec v = widen(expression(), 3, at);
+    if (v.size() != 3) fail(at, "expected a vector of 3 components");
+    return {v[0], v[1], v[2]};
+  }
+
+  int image_width() const {
+    return width_ > 0 ? width_ : 800;
+  }
+  int image_height() const {
+    return height_ > 0 ? height_ : 600;
+  }
+
+  // --- colours ---
+  glm::dvec3 colour(const Token& at) {
+    if (at_name("color") || at_name("colour")) next();
+    static const std::map<std::string, std::size_t> forms = {{"rgb", 3}, {"rgbf", 4}, {"rgbt", 4}, {"rgbft", 5},
+                                                              {"srgb", 3}, {"srgbf", 4}, {"srgbt", 4}, {"srgbft", 5}};
+    glm::dvec3 c(0);
+    bool any = false;
+    for (;;) {
+      const Token& t = peek();
+      if (t.kind == Token::Name && forms.count(t.text)) {
+        const Token form = next();
+        const Token vat = peek();
+        const Vec v = widen(expression(), forms.at(form.text), vat);
+        if (v.size() > 3 && (v[3] != 0 || (v.size() > 4 && v[4] != 0)))
+          warn(form, "the colour's filter and transmit are ignored: algray's surfaces are opaque here");
+        c = {v[0], v[1], v[2]};
+        if (form.text[0] == 's')
+          for (int i = 0; i < 3; ++i) c[i] = c[i] <= 0.04045 ? c[i] / 12.92 : std::pow((c[i] + 0.055) / 1.055, 2.4);
+        any = true;
+        continue;
+      }
+      if (t.kind == Token::Name && (t.text == "red" || t.text == "green" || t.text == "blue")) {
+        const std::string channel = next().text;
+        c[channel == "red" ? 0 : channel == "green" ? 1 : 2] = number();
+        any = true;
+        continue;
+      }
+      if (t.kind == Token::Name && (t.text == "filter" || t.text == "transmit")) {
+        next();
+        if (number() != 0) warn(t, "the colour's " + t.text + " is ignored: algray's surfaces are opaque here");
+        continue;
+      }
+      break;
+    }
+    if (!any) {
+      const Token vat = peek();
+      const Vec v = widen(expression(), 3, vat);
+      c = {v[0], v[1], v[2]};
+    }
+    for (int i = 0; i < 3; ++i)
+      if (!(c[i] >= 0) || !std::isfinite(c[i])) fail(at, "colour components must not be negative");
+    return c;
+  }
+  // pigment { colour }: a pattern or map is skipped with a warning.
+  glm::dvec3 pigment(const Token& at) {
+    expect("{", "'{' after pigment");
+    glm::dvec3 c(0);
+    bool coloured = false;
+    while (!at_op("}")) {
+      if (peek().kind == Token::End) fail(at, "this pigment is never closed");
+      const Token& t = peek();
+      if (t.kind == Token::Name && (t.text == "color" || t.text == "colour" || t.text == "rgb" || t.text == "rgbf" ||
+                                    t.text == "rgbt" || t.text == "rgbft" || t.text == "srgb" || t.text == "red" ||
+                                    t.text == "green" || t.text == "blue")) {
+        c = colour(t);
+        coloured = true;
+      } else if (!coloured && (t.kind == Token::Op || declared_.count(t.text))) {
+        c = colour(t);
+        coloured = true;
+      } else {
+        const Token skipped = next();
+        warn(skipped, "pigment '" + skipped.text + "' is ignored: algray reads plain colours");
+        skip_item();
+      }
+    }
+    next();
+    return c;
+  }
+  void finish(Object& o) {
+    o.finished = true;
+    const Token open = peek();
+    expect("{", "'{' after finish");
+    while (!at_op("}")) {
+      if (peek().kind == Token::End) fail(open, "this finish is never closed");
+      const Token t = next();
+      if (t.kind == Token::Name && t.text == "ambient") {
+        const Vec v = expression();
+        o.ambient = std::clamp(v.size() == 1 ? v[0] : (v[0] + v[1] + v[2]) / 3, 0.0, 1.0);
+      } else if (t.kind == Token::Name && t.text == "diffuse") {
+        o.diffuse = std::clamp(number(), 0.0, 1.0);
+      } else if (t.kind == Token::Name && t.text == "phong") {
+        o.specular = std::clamp(number(), 0.0, 1.0);
+      } else if (t.kind == Token::Name && t.text == "phong_size") {
+        o.exponent = std::clamp(number(), 1.0, 10000.0);
+      } else {
+        warn(t, "finish '" + t.text + "' is ignored (algray reads ambient, diffuse, phong and phong_size)");
+        skip_item();
+      }
+    }
+    next();
+  }
+  static void take_finish(Object& o, const Object& from) {
+    o.ambient = from.ambient;
+    o.diffuse = from.diffuse;
+    o.specular = from.specular;
+    o.exponent = from.exponent;
+    o.finished = true;
+  }
+  // texture { pigment {...} finish {...} ... }; interior_texture likewise for the inside (its finish is skipped).
+  void texture(Object& o, bool inside) {
+    const Token open = peek();
+    expect("{", "'{' after texture");
+    while (!at_op("}")) {
+      if (peek().kind == Token::End) fail(open, "this texture is never closed");
+      const Token t = next();
+      if (t.kind == Token::Name && t.text == "pigment") {
+        (inside ? o.back : o.front) = pigment(t);
+      } else if (t.kind == Token::Name && t.text == "finish" && !inside) {
+        finish(o);
+      } else {
+        warn(t, "texture '" + t.text + "' is ignored (algray reads a texture's pigment colour and finish)");
+        skip_item();
+      }
+    }
+    next();
+  }
+
+  // --- transforms ---
+  static glm::dmat4 rotation(const glm::dvec3& degrees) {
+    glm::dmat4 m(1);
+    for (int axis = 0; axis < 3; ++axis) {
+      const double a = degrees[axis] * kPi / 180, c = std::cos(a), s = std::sin(a);
+      const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+      glm::dmat4 r(1);
+      r[i][i] = c;  // glm: [column][row]; the usual matrix's (i, j) entry -s is column j, row i
+      r[j][i] = -s;
+      r[i][j] = s;
+      r[j][j] = c;
+      m = r * m;
+    }
+    return m;
+  }
+  // A transform statement at the cursor, or nullopt when the next word is none.
+  std::optional<glm::dmat4> transform_step() {
+    if (peek().kind != Token::Name) return std::nullopt;
+    const std::string w = peek().text;
+    if (w == "scale") {
+      const Token at = next();
+      const glm::dvec3 s = vector3();
+      if (s.x == 0 || s.y == 0 || s.z == 0) fail(at, "scale by zero");
+      glm::dmat4 m(1);
+      m[0][0] = s.x;
+      m[1][1] = s.y;
+      m[2][2] = s.z;
+      return m;
+    }
+    if (w == "rotate") {
+      next();
+      return rotation(vector3());
+    }
+    if (w == "translate") {
+      next();
+      glm::dmat4 m(1);
+      m[3] = glm::dvec4(vector3(), 1);
+      return m;
+    }
+    if (w == "matrix") {
+      const Token at = next();
+      const Token vat = peek();
+      const Vec v = expression();
+      if (v.size() != 12) fail(vat, "matrix takes 12 numbers, found " + std::to_string(v.size()));
+      glm::dmat4 m(1);
+      for (int row = 0; row < 4; ++row)
+        for (int col = 0; col < 3; ++col) m[row][col] = v[static_cast<std::size_t>(row * 3 + col)];
+      if (std::fabs(glm::determinant(m)) < 1e-300) fail(at, "this matrix is singular");
+      return m;
+    }
+    return std::nullopt;
+  }
+
+  // --- objects ---
+  Clip clip_shape(const Token& at, glm::dmat4& own) {
+    const Token shape = next();
+    if (shape.kind != Token::Name || (shape.text != "sphere" && shape.text != "box"))
+      fail(shape, std::string(at.text) + " takes a sphere or a box here; algray clips to one of those");
+    expect("{", "'{'");
+    Clip c;
+    if (shape.text == "sphere") {
+      c.centre = vector3();
+      optional_comma();
+      c.radius = number();
+      if (!(c.radius > 0)) fail(shape, "the sphere's radius must be positive");
+    } else {
+      c.sphere = false;
+      const glm::dvec3 a = vector3();
+      optional_comma();
+      const glm::dvec3 b = vector3();
+      c.min = glm::min(a, b);
+      c.max = glm::max(a, b);
+      if (!(c.min.x < c.max.x && c.min.y < c.max.y && c.min.z < c.max.z)) fail(shape, "the box has no volume");
+    }
+    while (!at_op("}")) {
+      if (auto m = transform_step()) {
+        own = *m * own;
+        continue;
+      }
+      const Token t = next();
+      if (t.kind == Token::End) fail(shape, "this " + shape.text + " is never closed");
+      warn(t, "'" + t.text + "' in a clipping shape is ignored");
+      skip_item();
+    }
+    next();
+    return c;
+  }
+  void clip_block(Object& o, const Token& at) {
+    expect("{", "'{'");
+    // bounded_by { clipped_by } and clipped_by { bounded_by }: the same region, already recorded.
+    if ((at.text == "bounded_by" && at_name("clipped_by")) || (at.text == "clipped_by" && at_name("bounded_by"))) {
+      if (o.clips.empty()) fail(peek(), peek().text + " names no region yet: give the other one first");
+      next();
+    } else {
+      while (!at_op("}")) {
+        glm::dmat4 own(1);
+        const Clip c = clip_shape(at, own);
+        o.clips.push_back({c, own});
+      }
+    }
+    expect("}", "'}'");
+  }
+  void modifiers(std::vector<Object*> objects, const Token& open) {
+    while (!at_op("}")) {
+      if (peek().kind == Token::End) fail(open, "this '{' is never closed");
+      if (auto m = transform_step()) {
+        for (Object* o : objects) {
+          o->transform = *m * o->transform;
+          for (auto& [clip, t] : o->clips) t = *m * t;
+        }
+        continue;
+      }
+      const Token t = next();
+      if (t.kind != Token::Name) fail(t, "expected an object modifier, found " + describe(t));
+      if (t.text == "pigment") {
+        const glm::dvec3 c = pigment(t);
+        for (Object* o : objects)
+          if (!o->front) o->front = c;
+      } else if (t.text == "texture" || t.text == "interior_texture") {
+        Object scratch;
+        texture(scratch, t.text == "interior_texture");
+        for (Object* o : objects) {
+          if (scratch.front && !o->front) o->front = scratch.front;
+          if (scratch.back && !o->back) o->back = scratch.back;
+          if (scratch.finished) take_finish(*o, scratch);
+        }
+      } else if (t.text == "finish") {
+        Object scratch;
+        finish(scratch);
+        for (Object* o : objects) take_finish(*o, scratch);
+      } else if (t.text == "clipped_by" || t.text == "bounded_by") {
+        if (objects.size() != 1) fail(t, t.text + " on a union: give it to each object inside");
+        clip_block(*objects.front(), t);
+      } else if (t.text == "inverse") {
+        for (Object* o : objects) o->inverse = !o->inverse;
+      } else if (t.text == "sturm" || t.text == "hollow" || t.text == "double_illuminate") {
+        // What changes nothing algray draws: its solver is exact enough without sturm.
+      } else if (t.text == "no_shadow" || t.text == "no_image" || t.text == "no_reflection" ||
+                 t.text == "no_radiosity") {
+        warn(t, t.text + " is ignored");
+      } else if (at_op("{")) {
+        warn(t, "'" + t.text + "' is ignored (algray reads pigment, texture, finish, transforms and clips)");
+        skip_block();
+      } else {
+        fail(t, "'" + t.text + "' is no object modifier this reader knows");
+      }
+    }
+    next();
+  }
+  static SparsePoly sphere_poly(const glm::dvec3& c, double r) {
+    SparsePoly p = SparsePoly::constant(c.x * c.x + c.y * c.y + c.z * c.z - r * r);
+    for (int a = 0; a < 3; ++a) {
+      SparsePoly::Exponents e{0, 0, 0};
+      e[static_cast<std::size_t>(a)] = 2;
+      p.add(e, 1);
+      e[static_cast<std::size_t>(a)] = 1;
+      p.add(e, -2 * c[a]);
+    }
+    return p;
+  }
+  // poly's coefficient order (see the top of the file).
+  SparsePoly listed_poly(int order, const Vec& coefficients, const Token& at) const {
+    const std::size_t count = static_cast<std::size_t>((order + 1) * (order + 2) * (order + 3) / 6);
+    if (coefficients.size() != count)
+      fail(at, "a poly of order " + std::to_string(order) + " has " + std::to_string(count) + " coefficients, found " +
+                   std::to_string(coefficients.size()));
+    SparsePoly p;
+    std::size_t n = 0;
+    for (int i = order; i >= 0; --i)
+      for (int j = order - i; j >= 0; --j)
+        for (int k = order - i - j; k >= 0; --k) p.add({i, j, k}, coefficients[n++]);
+    return p;
+  }
+  int order_of(const Token& at) {
+    const double o = number();
+    if (o != std::floor(o) || o < 1 || o > kMaxDegree)
+      fail(at, "the order must be a whole number from 1 to " + std::to_string(kMaxDegree) + " (algray's degrees)");
+    optional_comma();
+    return static_cast<int>(o);
+  }
+  void object(const Token& kind, std::vector<Object>& out) {
+    expect("{", "'{'");
+    if (kind.text == "union" || kind.text == "merge") {
+      const std::size_t first = out.size();
+      while (peek().kind == Token::Name && is_object(peek().text) && at_op("{", 1)) object(next(), out);
+      std::vector<Object*> members;
+      for (std::size_t i = first; i < out.size(); ++i) members.push_back(&out[i]);
+      if (members.empty()) fail(kind, "this " + kind.text + " holds no object algray reads");
+      modifiers(members, kind);
+      return;
+    }
+    Object o;
+    o.at = kind;
+    o.kind = kind.text;
+    if (kind.text == "sphere") {
+      const glm::dvec3 c = vector3();
+      optional_comma();
+      const double r = number();
+      if (!(r > 0)) fail(kind, "the sphere's radius must be positive");
+      o.poly = sphere_poly(c, r);
+      o.natural = Clip{true, c, {}, {}, r * 1.001};
+    } else if (kind.text == "torus") {
+      const double big = number();
+      optional_comma();
+      const double small = number();
+      if (!(big > 0 && small > 0)) fail(kind, "a torus' radii must be positive");
+      // (x^2 + y^2 + z^2 + R^2 - r^2)^2 - 4 R^2 (x^2 + z^2), about the y axis.
+      SparsePoly q = SparsePoly::constant(big * big - small * small);
+      for (int a = 0; a < 3; ++a) {
+        SparsePoly::Exponents e{0, 0, 0};
+        e[static_cast<std::size_t>(a)] = 2;
+        q.add(e, 1);
+      }
+      PolyBudget budget;
+      o.poly = multiply(q, q, budget);
+      o.poly.add({2, 0, 0}, -4 * big * big);
+      o.poly.add({0, 0, 2}, -4 * big * big);
+      o.natural = Clip{true, {0, 0, 0}, {}, {}, (big + small) * 1.001};
+    } else if (kind.text == "poly" || kind.text == "quartic" || kind.text == "cubic") {
+      const int order = kind.text == "poly" ? order_of(kind) : kind.text == "quartic" ? 4 : 3;
+      const Token vat = peek();
+      o.poly = listed_poly(order, expression(), vat);
+    } else {  // polynomial
+      const int order = order_of(kind);
+      while (at_name("xyz")) {
+        const Token term = next();
+        expect("(", "'('");
+        int e[3];
+        for (int i = 0; i < 3; ++i) {
+          const double v = number();
+          if (v != std::floor(v) || v < 0 || v > order) fail(term, "exponents are whole numbers from 0 to the order");
+          e[i] = static_cast<int>(v);
+          if (i < 2) expect(",", "','");
+        }
+        expect(")", "')'");
+        expect(":", "':'");
+        if (e[0] + e[1] + e[2] > order) fail(term, "this term's degree is above the polynomial's order");
+        o.poly.add({e[0], e[1], e[2]}, number());
+        optional_comma();
+      }
+    }
+    if (o.poly.degree() < 1) fail(kind, "this " + kind.text + " is constant: there is no surface");
+    out.push_back(o);
+    Object* self = &out.back();
+    modifiers({self}, kind);
+  }
+  static bool is_object(const std::string& w) {
+    return w == "sphere" || w == "torus" || w == "poly" || w == "polynomial" || w == "quartic" || w == "cubic" ||
+           w == "union" || w == "merge";
+  }
+
+  // --- scene items ---
+  void camera() {
+    const Token open = peek();
+    expect("{", "'{' after camera");
+    while (!at_op("}")) {
+      const Token t = next();
+      if (t.kind == Token::End) fail(open, "this camera is never closed");
+      if (t.kind != Token::Name) fail(t, "expected a camera item, found " + describe(t));
+      if (t.text == "perspective") camera_.orthographic = false;
+      else if (t.text == "orthographic") camera_.orthographic = true;
+      else if (t.text == "location") camera_.location = vector3();
+      else if (t.text == "look_at") camera_.look_at = vector3();
+      else if (t.text == "direction") camera_.direction = vector3();
+      else if (t.text == "right") camera_.right = vector3();
+      else if (t.text == "up") camera_.up = vector3();
+      else if (t.text == "sky") camera_.sky = vector3();
+      else if (t.text == "angle") {
+        camera_.angle = number();
+        if (!(*camera_.angle > 0 && *camera_.angle < 180)) fail(t, "angle must be between 0 and 180 degrees");
+      } else if (t.text == "fisheye" || t.text == "panoramic" || t.text == "cylinder" || t.text == "spherical" ||
+                 t.text == "omnimax" || t.text == "ultra_wide_angle" || t.text == "mesh_camera")
+        fail(t, "a " + t.text + " camera: algray's cameras are perspective or orthographic");
+      else if (t.text == "rotate" || t.text == "translate" || t.text == "scale" || t.text == "matrix")
+        fail(t, "camera transforms are not read; give location and look_at instead");
+      else {
+        warn(t, "camera '" + t.text + "' is ignored");
+        skip_item();
+      }
+      camera_at_ = open;
+    }
+    next();
+  }
+  void light() {
+    const Token open = peek();
+    expect("{", "'{' after light_source");
+    PovLight l;
+    l.position = vector3();
+    optional_comma();
+    l.colour = colour(open);
+    while (!at_op("}")) {
+      if (auto m = transform_step()) {
+        l.position = glm::dvec3(*m * glm::dvec4(l.position, 1));
+        l.edge_u = glm::dvec3(*m * glm::dvec4(l.edge_u, 0));
+        l.edge_v = glm::dvec3(*m * glm::dvec4(l.edge_v, 0));
+        continue;
+      }
+      const Token t = next();
+      if (t.kind == Token::End) fail(open, "this light_source is never closed");
+      if (t.text == "area_light") {
+        l.area = true;
+        l.edge_u = vector3();
+        optional_comma();
+        l.edge_v = vector3();
+        optional_comma();
+        const double n1 = number();
+        optional_comma();
+        const double n2 = number();
+        l.samples = static_cast<int>(std::clamp(std::max(n1, n2), 1.0, static_cast<double>(kMaxLightSamplesPerSide)));
+      } else if (t.text == "shadowless") {
+        l.shadows = false;
+      } else if (t.text == "adaptive" || t.text == "jitter" || t.text == "orient" || t.text == "circular") {
+        if (t.text == "adaptive") number();  // algray samples the area light's grid evenly
+      } else {
+        warn(t, "light_source '" + t.text + "' is ignored: algray's lights are points and rectangles");
+        skip_item();
+      }
+    }
+    next();
+    lights_.push_back(l);
+  }
+  void background() {
+    const Token open = peek();
+    expect("{", "'{' after background");
+    background_ = colour(open);
+    expect("}", "'}'");
+  }
+  void directive(const Token& d) {
+    if (d.text == "version") {
+      number();
+      if (at_op(";")) next();
+    } else if (d.text == "include") {
+      const Token file = next();
+      if (file.kind != Token::String) fail(file, "expected a file name after #include");
+      warn(d, "#include \"" + file.text + "\" is ignored: algray reads this file alone");
+      ignored_include_ = true;
+    } else if (d.text == "declare" || d.text == "local") {
+      const Token name = next();
+      if (name.kind != Token::Name) fail(name, "expected a name after #" + d.text);
+      expect("=", "'='");
+      static const std::set<std::string> colour_words = {"color", "colour", "rgb", "rgbf", "rgbt", "rgbft", "srgb",
+                                                          "srgbf", "srgbt", "srgbft", "red", "green", "blue"};
+      if (peek().kind == Token::Name && colour_words.count(peek().text)) {
+        const glm::dvec3 c = colour(name);
+        declared_[name.text] = {c.x, c.y, c.z};
+      } else if (peek().kind == Token::Name && at_op("{", 1)) {
+        warn(name, "#" + d.text + " " + name.text + " = " + peek().text + " { ... } is ignored: only floats and " +
+                       "vectors are declared here");
+        next();
+        skip_block();
+      } else {
+        declared_[name.text] = expression();
+      }
+      if (at_op(";")) next();
+    } else {
+      fail(d, "#" + d.text + " is not read: algray reads declarations of floats and vectors, #version and #include");
+    }
+  }
+  void item() {
+    const Token t = next();
+    if (t.kind == Token::Directive) return directive(t);
+    if (t.kind != Token::Name) fail(t, "expected a scene item, found " + describe(t));
+    if (t.text == "camera") return camera();
+    if (t.text == "light_source") return light();
+    if (t.text == "background") return background();
+    if (t.text == "global_settings") {
+      const Token open = peek();
+      expect("{", "'{'");
+      while (!at_op("}")) {
+        const Token s = next();
+        if (s.kind == Token::End) fail(open, "global_settings is never closed");
+        if (s.text == "assumed_gamma") {
+          if (number() != 1) warn(s, "assumed_gamma other than 1 is ignored: algray's colours are linear");
+        } else {
+          warn(s, "global_settings '" + s.text + "' is ignored");
+          skip_item();
+        }
+      }
+      next();
+      return;
+    }
+    if (is_object(t.text)) return object(t, objects_);
+    if (t.text == "object") fail(t, "object { NAME }: declared objects are not read; write the object out");
+    if (at_op("{")) {
+      warn(t, "'" + t.text + "' is ignored: algray reads poly, polynomial, quartic, cubic, sphere and torus objects");
+      skip_block();
+      return;
+    }
+    fail(t, "'" + t.text + "' is no scene item this reader knows");
+  }
+
+  // --- the scene ---
+  // The region an object is drawn in, in POV-Ray's world.
+  Clip region(const Object& o) const {
+    std::optional<Clip> best;
+    auto place = [&](const Clip& c, const glm::dmat4& t, bool loose) {
+      const glm::dmat3 l(t);
+      Clip w = c;
+      if (c.sphere && loose) {  // a sphere or torus' own bound need only enclose it: the largest stretch will do
+        const glm::dmat3 g = glm::transpose(l) * l;
+        glm::dvec3 v(1, 0.7, 0.3);
+        double stretch2 = 0;
+        for (int k = 0; k < 60; ++k) {  // power iteration: the largest eigenvalue of L^T L
+          const glm::dvec3 next = g * v;
+          stretch2 = glm::length(next) / glm::length(v);
+          v = next / glm::length(next);
+        }
+        w.centre = glm::dvec3(t * glm::dvec4(c.centre, 1));
+        w.radius = c.radius * std::sqrt(stretch2) * 1.001;
+      } else if (c.sphere) {
+        const glm::dmat3 g = glm::transpose(l) * l;
+        const double s2 = g[0][0];
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            if (std::fabs(g[i][j] - (i == j ? s2 : 0)) > 1e-9 * s2)
+              fail(o.at, "a clipping sphere scaled unevenly is an ellipsoid; algray clips to spheres and boxes");
+        w.centre = glm::dvec3(t * glm::dvec4(c.centre, 1));
+        w.radius = c.radius * std::sqrt(s2);
+      } else {
+        for (int col = 0; col < 3; ++col) {
+          int nonzero = 0;
+          const double norm = glm::length(l[col]);
+          for (int row = 0; row < 3; ++row) nonzero += std::fabs(l[col][row]) > 1e-9 * norm;
+          if (nonzero != 1) fail(o.at, "a clipping box turned off the axes; algray's boxes are axis-aligned");
+        }
+        const glm::dvec3 a(t * glm::dvec4(c.min, 1)), b(t * glm::dvec4(c.max, 1));
+        w.min = glm::min(a, b);
+        w.max = glm::max(a, b);
+      }
+      return w;
+    };
+    for (const auto& [c, t] : o.clips) {
+      const Clip w = place(c, t, false);
+      if (!best || inside(w, *best)) best = w;
+      else if (!inside(*best, w))
+        fail(o.at, "this object is clipped by two regions that overlap; algray clips to one sphere or box");
+    }
+    if (!best && o.natural) best = place(*o.natural, o.transform, true);
+    if (!best)
+      fail(o.at, "this " + o.kind + " has no clipped_by or bounded_by: POV-Ray draws it without end, algray "
+                                   "within a sphere or box; add clipped_by { sphere { ... } }");
+    return *best;
+  }
+  static bool same(const Clip& a, const Clip& b) {
+    if (a.sphere != b.sphere) return false;
+    const double tolerance = 1e-9 * (1 + a.radius);
+    if (a.sphere)
+      return glm::length(a.centre - b.centre) < tolerance && std::fabs(a.radius - b.radius) < tolerance;
+    return glm::length(a.min - b.min) + glm::length(a.max - b.max) < 1e-9 * (1 + glm::length(a.max - a.min));
+  }
+  // Whether a lies within b.
+  static bool inside(const Clip& a, const Clip& b) {
+    const glm::dvec3 lo = a.sphere ? a.centre - glm::dvec3(a.radius) : a.min;
+    const glm::dvec3 hi = a.sphere ? a.centre + glm::dvec3(a.radius) : a.max;
+    if (b.sphere) {
+      if (a.sphere) return glm::length(a.centre - b.centre) + a.radius <= b.radius * (1 + 1e-9);
+      for (int i = 0; i < 8; ++i) {
+        const glm::dvec3 p(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+        if (glm::length(p - b.centre) > b.radius * (1 + 1e-9)) return false;
+      }
+      return true;
+    }
+    for (int i = 0; i < 3; ++i)
+      if (lo[i] < b.min[i] - 1e-9 * (1 + std::fabs(b.min[i])) || hi[i] > b.max[i] + 1e-9 * (1 + std::fabs(b.max[i])))
+        return false;
+    return true;
+  }
+  static Clip enclosing(const Clip& a, const Clip& b) {
+    Clip out;
+    out.sphere = false;
+    auto lo = [](const Clip& c) { return c.sphere ? c.centre - glm::dvec3(c.radius) : c.min; };
+    auto hi = [](const Clip& c) { return c.sphere ? c.centre + glm::dvec3(c.radius) : c.max; };
+    out.min = glm::min(lo(a), lo(b));
+    out.max = glm::max(hi(a), hi(b));
+    return out;
+  }
+
+  std::string source_;
+  std::vector<std::string>& warnings_;
+  int width_, height_;
+  std::vector<std::string> lines_;
+  std::vector<Token> tokens_;
+  std::size_t pos_ = 0;
+  std::map<std::string, Vec> declared_;
+  bool ignored_include_ = false;
+  std::vector<Object> objects_;
+  Camera camera_;
+  std::optional<Token> camera_at_;
+  std::vector<PovLight> lights_;
+  std::optional<glm::dvec3> background_;
+};
+
+PovTranslation PovReader::run() {
+  while (peek().kind != Token::End) item();
+  if (objects_.empty())
+    fail(peek(), "the scene holds no object algray reads (poly, polynomial, quartic, cubic, sphere, torus)");
+  if (objects_.size() > kMaxSurfaces)
+    fail(objects_[kMaxSurfaces].at, std::to_string(objects_.size()) + " objects: algray draws up to " +
+                                        std::to_string(kMaxSurfaces) + " surfaces in one scene");
+
+  // One region for the scene: the clipped objects' common clip, holding every self-bounded one (spheres, tori),
+  // or, with none clipped, a box around them all.
+  std::optional<Clip> extent;
+  const Object* clipped_by = nullptr;
+  for (const Object& o : objects_)
+    if (!o.clips.empty() || !o.natural) {
+      const Clip r = region(o);
+      if (extent && !same(*extent, r))
+        fail(o.at, "this object is clipped differently from the " + clipped_by->kind + " at line " +
+                       std::to_string(clipped_by->at.line) + "; algray clips every surface of a scene to one region");
+      extent = r;
+      clipped_by = &o;
+    }
+  for (const Object& o : objects_)
+    if (o.clips.empty() && o.natural) {
+      const Clip r = region(o);
+      if (!extent) extent = r;
+      else if (clipped_by && !inside(r, *extent))
+        fail(o.at, "this " + o.kind + " reaches outside the clip of the " + clipped_by->kind + " at line " +
+                       std::to_string(clipped_by->at.line) + "; algray clips every surface of a scene to one region");
+      else if (!clipped_by && !inside(r, *extent)) extent = enclosing(*extent, r);
+    }
+
+  // Handedness: a left-handed camera (the default) is read with z negated; a right-handed one as written.
+  const Camera& cam = camera_;
+  if (glm::length(cam.right) == 0 || glm::length(cam.up) == 0 || glm::length(cam.direction) == 0)
+    fail(camera_at_ ? *camera_at_ : objects_.front().at, "the camera's right, up and direction must not be zero");
+  const bool left_handed = glm::dot(glm::cross(cam.right, cam.up), cam.direction) > 0;
+  const glm::dvec3 mirror(1, 1, left_handed ? -1 : 1);
+  glm::dmat4 flip(1);
+  flip[2][2] = mirror.z;
+
+  std::ostringstream toml;
+  const std::size_t slash = source_.find_last_of('/');
+  const std::string file = source_.substr(slash == std::string::npos ? 0 : slash + 1);
+  toml << "# Translated from " << source_ << " (POV-Ray)\n";
+  int n = 0;
+  for (const Object& o : objects_) {
+    ++n;
+    // algray's point q is POV-Ray's flip(q); the object's own point is transform^-1 of that.
+    const glm::dmat4 a = glm::inverse(o.transform) * flip;
+    std::array<std::array<double, 4>, 3> m{};
+    for (std::size_t r = 0; r < 3; ++r) {
+      for (std::size_t c = 0; c < 3; ++c) m[r][c] = a[static_cast<int>(c)][static_cast<int>(r)];
+      m[r][3] = a[3][static_cast<int>(r)];
+    }
+    SparsePoly p;
+    try {
+      PolyBudget budget;
+      p = substitute(o.poly, m, budget);
+    } catch (const PolyTooLarge& e) {
+      fail(o.at, e.what());
+    }
+    if (o.inverse)
+      for (auto& [e, c] : p.terms) c = -c;
+    toml << "\n[[surface]]\nname = " << toml_quoted(file + " " + std::to_string(n) + " (" + o.kind + ")")
+         << "\nterms = [";
+    const char* sep = "";
+    for (const auto& [e, c] : p.terms) {
+      if (!std::isfinite(c)) fail(o.at, "the coefficients overflow after the transforms");
+      toml << sep << "[" << e[0] << ", " << e[1] << ", " << e[2] << ", " << toml_number(c) << "]";
+      sep = ", ";
+    }
+    toml << "]\n";
+    // POV-Ray's inside is P < 0, algray's back; without an interior texture both sides look alike.
+    const glm::dvec3 front = o.front.value_or(glm::dvec3(0));
+    const glm::dvec3 back = o.back.value_or(front);
+    for (const auto& [side, colour] : {std::pair{"front", front}, std::pair{"back", back}})
+      toml << "\n[surface.material." << side << "]\ncolour = " << toml_vector(glm::min(colour, glm::dvec3(1)))
+           << "\nambient = " << toml_number(o.ambient) << "\ndiffuse = " << toml_number(o.diffuse)
+           << "\nspecular = " << toml_number(o.specular) << "\nexponent = " << toml_number(o.exponent) << "\n";
+  }
+
+  const Clip& e = *extent;
+  if (e.sphere)
+    toml << "\n[extent]\ntype = \"sphere\"\ncentre = " << toml_vector(e.centre * mirror)
+         << "\nradius = " << toml_number(e.radius) << "\n";
+  else
+    toml << "\n[extent]\ntype = \"box\"\nmin = " << toml_vector(glm::min(e.min * mirror, e.max * mirror))
+         << "\nmax = " << toml_vector(glm::max(e.min * mirror, e.max * mirror)) << "\n";
+
+  // The camera: angle sets direction's length from right's; the view is |up| tall at |direction|.
+  double distance = glm::length(cam.direction);
+  if (cam.angle && !cam.orthographic) distance = 0.5 * glm::length(cam.right) / std::tan(*cam.angle * kPi / 360);
+  const glm::dvec3 forward =
+      cam.look_at ? *cam.look_at - cam.location : glm::normalize(cam.direction);
+  if (glm::length(forward) == 0)
+    fail(camera_at_ ? *camera_at_ : objects_.front().at, "look_at is the camera's location");
+  const glm::dvec3 up = cam.look_at ? cam.sky : cam.up;
+  if (glm::length(glm::cross(glm::normalize(forward), glm::normalize(up))) < 1e-9)
+    fail(camera_at_ ? *camera_at_ : objects_.front().at, "the camera looks along its sky (or up) vector");
+  toml << "\n[camera]\neye = " << toml_vector(cam.location * mirror)
+       << "\nlook_at = " << toml_vector((cam.location + glm::normalize(forward)) * mirror)
+       << "\nup = " << toml_vector(up * mirror) << "\n";
+  if (cam.orthographic)
+    toml << "projection = \"orthographic\"\nheight = " << toml_number(glm::length(cam.up)) << "\n";
+  else
+    toml << "projection = \"perspective\"\nfov_y = "
+         << toml_number(2 * std::atan(0.5 * glm::length(cam.up) / distance) * 180 / kPi) << "\n";
+
+  // POV-Ray stretches right x up over whatever image it renders; algray's images keep that shape by default.
+  const int width = image_width();
+  const int height = height_ > 0 ? height_
+                                 : std::max(1, static_cast<int>(std::lround(width * glm::length(cam.up) /
+                                                                            glm::length(cam.right))));
+  toml << "\n[image]\nwidth = " << width << "\nheight = " << std::min(height, 32768)
+       << "\nbackground = " << toml_vector(glm::min(background_.value_or(glm::dvec3(0)), glm::dvec3(1))) << "\n";
+
+  for (const PovLight& l : lights_) {
+    const double strength = std::max({l.colour.x, l.colour.y, l.colour.z});
+    toml << "\n[[light]]\ntype = \"" << (l.area ? "rectangle" : "point") << "\"\nposition = "
+         << toml_vector(l.position * mirror) << "\n";
+    if (l.area)
+      toml << "edge_u = " << toml_vector(l.edge_u * mirror) << "\nedge_v = " << toml_vector(l.edge_v * mirror)
+           << "\nsamples = " << l.samples << "\n";
+    toml << "colour = " << toml_vector(strength > 0 ? l.colour / strength : glm::dvec3(1))
+         << "\nintensity = " << toml_number(strength) << "\nshadows = " << (l.shadows ? "true" : "false") << "\n";
+  }
+  if (lights_.empty())
+    toml << "\n[[light]]  # POV-Ray lights nothing without a light_source\ntype = \"point\"\nposition = "
+         << toml_vector(cam.location * mirror) << "\nintensity = 0.0\nshadows = false\n";
+  return {toml.str(), where(objects_.front().at), excerpt(objects_.front().at)};
+}
+
+}  // namespace
+
+PovTranslation povray_to_toml(const std::string& text, const std::string& source, std::vector<std::string>& warnings,
+                              int width, int height) {
+  return PovReader(text, source, warnings, width, height).run();
+}
+
+}  // namespace algray

@@ -1,0 +1,18 @@
+// Cayley's nodal cubic as poly { 3, ... }, moved: written for algray's POV-Ray comparison (bench/pov_compare.py, tests/test_povray.cpp)
+#version 3.7;
+global_settings { assumed_gamma 1.0 }
+background { color rgb <0.1, 0.1, 0.12> }
+camera { location <0, 1.5, -7> look_at <0, 0, 0> right x*image_width/image_height angle 50 }
+light_source { <30, 40, -50> color rgb 1 }
+light_source { <-40, 10, -30> color rgb <0.4, 0.4, 0.5> }
+poly { 3,
+  <
+    0, 0, 0, 4, 0, 16, 0, 0, 0, 0,
+    0, 0, 4, 0, 0, 0, 0, 4, 0, -1 >
+  pigment { color rgb <0.9, 0.5, 0.6> }
+  clipped_by { sphere { <0, 0, 0>, 1.2 } }
+  scale 1.8
+  rotate <10, 35, 0>
+  translate <0, -0.3, 0.5>
+  //@depth
+}

@@ -1,0 +1,12 @@
+// a torus turned about two axes: written for algray's POV-Ray comparison (bench/pov_compare.py, tests/test_povray.cpp)
+#version 3.7;
+global_settings { assumed_gamma 1.0 }
+background { color rgb <0.1, 0.1, 0.12> }
+camera { location <0, 1.5, -7> look_at <0, 0, 0> right x*image_width/image_height angle 50 }
+light_source { <30, 40, -50> color rgb 1 }
+light_source { <-40, 10, -30> color rgb <0.4, 0.4, 0.5> }
+torus { 2, 0.6
+  pigment { color rgb <0.9, 0.6, 0.2> }
+  rotate <60, 20, 0>
+  //@depth
+}

@@ -1,0 +1,242 @@
+// POV-Ray scenes (.pov): handedness, transforms, objects, clips, camera, lights and colours as POV-Ray shows them,
+// located errors and warnings, and every scene of tests/data/pov.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+
+#include "cli_sandbox.h"
+#include "algray/render/render_plan.h"
+#include "algray/render/renderer.h"
+#include "algray/scene/scene.h"
+#include "test_support.h"
+
+using namespace algray;
+using algray::testing::device_session;
+
+namespace {
+
+// POV-Ray's default right (1.33) over up (1): an image of this shape is what POV-Ray stretches the view over.
+constexpr int kWidth = 100, kHeight = 75;
+
+Scene pov_scene(const std::string& body) {
+  return load_povray_text("camera { location <0, 0, -10> look_at <0, 0, 0> angle 60 }\n"
+                          "light_source { <0, 0, -100> color rgb 1 }\n" +
+                              body,
+                          "test.pov",
+                          {{"image.width", std::to_string(kWidth)},
+                           {"image.height", std::to_string(kHeight)},
+                           {"antialias.samples", "1"}});
+}
+
+struct Coverage {
+  long count = 0;
+  double x = 0, y = 0;  // the centroid in POV-Ray's units on the plane z = 0, x right and y up
+};
+Coverage coverage(const Scene& scene) {
+  static ProgramCache cache(true, algray::testing::shared_cache_dir());
+  Renderer renderer(device_session(), cache);
+  const HitBuffer hits = renderer.render_with_records(scene).hits;
+  const double unit = (hits.width / 2.0) / (10 * std::tan(30 * 3.14159265358979 / 180));  // pixels per unit
+  Coverage c;
+  for (int y = 0; y < hits.height; ++y)
+    for (int x = 0; x < hits.width; ++x)
+      if (hits.at(x, y).flags & ALGRAY_HIT_FOUND) {
+        ++c.count;
+        c.x += (x + 0.5 - hits.width / 2.0) / unit;
+        c.y += (hits.height / 2.0 - y - 0.5) / unit;
+      }
+  if (c.count) {
+    c.x /= static_cast<double>(c.count);
+    c.y /= static_cast<double>(c.count);
+  }
+  return c;
+}
+
+SceneError error_of(const std::string& text) {
+  try {
+    load_povray_text(text, "bad.pov");
+  } catch (const SceneError& e) {
+    return e;
+  }
+  FAIL("no error for:\n" << text);
+  return SceneError("", "");
+}
+
+bool any_contains(const std::vector<std::string>& list, const std::string& part) {
+  for (const std::string& s : list)
+    if (s.find(part) != std::string::npos) return true;
+  return false;
+}
+
+const std::string kBall = "sphere { <3, 0, 0>, 1 pigment { color rgb 1 } ";
+
+}  // namespace
+
+TEST_CASE("POV-Ray's left-handed world and a right-handed camera show what POV-Ray shows", "[povray]") {
+  // Measured with POV-Ray 3.7: the ball at x = 3 is seen on the right, at 3 units.
+  const Coverage left = coverage(pov_scene(kBall + "}"));
+  CHECK(left.x == Approx(3).margin(0.1));
+  CHECK(left.y == Approx(0).margin(0.05));
+  CHECK(left.count > 200);
+  // A right-handed camera (right = -x) shows the mirror image.
+  const Scene mirrored = load_povray_text(
+      "camera { location <0, 0, -10> right -1.33*x look_at <0, 0, 0> angle 60 }\n" + kBall + "}", "m.pov",
+      {{"image.width", std::to_string(kWidth)}, {"image.height", std::to_string(kHeight)}});
+  CHECK(coverage(mirrored).x == Approx(-3).margin(0.1));
+  // rotate <0, 30, 0> brings (3, 0, 0) nearer (POV-Ray: 466 pixels against 330, seen at x = 3.06);
+  // rotate <0, 0, 30> lifts it to (2.6, 1.5).
+  const Coverage turned_y = coverage(pov_scene(kBall + "rotate <0, 30, 0> }"));
+  CHECK(static_cast<double>(turned_y.count) / static_cast<double>(left.count) == Approx(466.0 / 330).epsilon(0.08));
+  CHECK(turned_y.x == Approx(2.6 * 10 / 8.5).margin(0.12));
+  const Coverage turned_z = coverage(pov_scene(kBall + "rotate z*30 }"));
+  CHECK(turned_z.x == Approx(2.6).margin(0.1));
+  CHECK(turned_z.y == Approx(1.5).margin(0.1));
+  // rotate x: (0, 3, 0) goes away from the camera (POV-Ray: 246 pixels against 330).
+  const Coverage turned_x = coverage(pov_scene("sphere { <0, 3, 0>, 1 rotate <30, 0, 0> }"));
+  CHECK(static_cast<double>(turned_x.count) < static_cast<double>(left.count) * 0.85);
+  // matrix rows: x' = x + 0.5 y + 2, then translate y: the ball's centre at (2, 1).
+  const Coverage sheared = coverage(
+      pov_scene("sphere { <0, 0, 0>, 1 matrix <1, 0, 0, 0.5, 1, 0, 0, 0, 1, 2, 0, 0> translate <0, 1, 0> }"));
+  CHECK(sheared.x == Approx(2).margin(0.1));
+  CHECK(sheared.y == Approx(1).margin(0.1));
+}
+
+TEST_CASE("POV-Ray's objects are the polynomials POV-Ray draws", "[povray]") {
+  // poly 2's coefficients, in POV-Ray's order, of (x - 3)^2 + y^2 + z^2 - 1: the same ball as sphere { }.
+  const Scene poly = pov_scene("poly { 2, <1, 0, 0, -6, 1, 0, 0, 1, 0, 8> clipped_by { sphere { <3, 0, 0>, 2 } } }");
+  const Polynomial& p = poly.surfaces[0].polynomial;
+  // Read with z negated: POV-Ray's (3, 0, 0) is algray's (3, 0, 0); (0, 0, 1) is (0, 0, -1).
+  CHECK(p.evaluate(3, 0, 0) == Approx(-1));
+  CHECK(p.evaluate(4, 0, 0) == Approx(0).margin(1e-12));
+  const Scene quartic = pov_scene(
+      "quartic { <0,0,0,0,0,0,0,0,0,0, 0,0,0,0,1,0,0,0,0,0, 0,0,0,0,0,0,0,0,0,0, 0,0,0,0,-1> "
+      "bounded_by { box { <-2, -2, -2>, <2, 2, 2> } } }");
+  CHECK(quartic.surfaces[0].polynomial.evaluate(1, 2, -3) == Approx(1 * 2 * 3 - 1));  // xyz - 1 at z = 3
+  const Scene polynomial =
+      pov_scene("polynomial { 3, xyz(3,0,0):1, xyz(0,1,1):-2, xyz(0,0,0):0.5 clipped_by { sphere { 0, 3 } } }");
+  CHECK(polynomial.surfaces[0].polynomial.evaluate(1, 1, 1) == Approx(1 + 2 + 0.5));
+  // torus { R, r } about the y axis.
+  const Scene torus = pov_scene("torus { 2, 0.5 }");
+  CHECK(torus.surfaces[0].polynomial.evaluate(2, 0, 0) < 0);
+  CHECK(torus.surfaces[0].polynomial.evaluate(0, 2, 0) > 0);
+  CHECK(torus.surfaces[0].polynomial.evaluate(0, 0, 2) < 0);
+  // inverse swaps the sides; a union's transforms move every member.
+  CHECK(pov_scene("sphere { 0, 1 inverse }").surfaces[0].polynomial.evaluate(0, 0, 0) > 0);
+  const Scene group = pov_scene("union { sphere { <1, 0, 0>, 0.5 } sphere { <-1, 0, 0>, 0.5 } translate y*2 }");
+  REQUIRE(group.surfaces.size() == 2);
+  CHECK(group.surfaces[1].polynomial.evaluate(-1, 2, 0) == Approx(-0.25));
+}
+
+TEST_CASE("clips: a sphere or box, moved by the transforms after them, one region per scene", "[povray]") {
+  const Scene boxed = pov_scene("sphere { 0, 2 clipped_by { box { <-1, -3, -3>, <3, 3, 3> } } translate x*2 }");
+  REQUIRE(boxed.extent.kind == ExtentKind::Box);
+  CHECK(boxed.extent.min.x == Approx(1));  // measured with POV-Ray: the box moves with the later translate
+  CHECK(boxed.extent.max.z == Approx(3));
+  const Scene after = pov_scene("sphere { 0, 2 translate x*2 clipped_by { box { <-1, -3, -3>, <3, 3, 3> } } }");
+  CHECK(after.extent.min.x == Approx(-1));
+  const Scene scaled = pov_scene("poly { 2, <1,0,0,0,1,0,0,1,0,-1> bounded_by { sphere { <1, 0, 0>, 2 } } scale 2 }");
+  REQUIRE(scaled.extent.kind == ExtentKind::Sphere);
+  CHECK(scaled.extent.radius == Approx(4));
+  CHECK(scaled.extent.centre.x == Approx(2));
+  // Self-bounded objects inside a clipped one's region share it; a second region is an error.
+  CHECK(pov_scene("sphere { 0, 0.5 } poly { 2, <1,0,0,0,1,0,0,1,0,-4> clipped_by { sphere { 0, 3 } } }")
+            .extent.radius == Approx(3));
+  CHECK(error_of("poly { 2, <1,0,0,0,1,0,0,1,0,-4> clipped_by { sphere { 0, 3 } } }\n"
+                 "poly { 2, <1,0,0,0,1,0,0,1,0,-1> clipped_by { sphere { 0, 2 } } }\n")
+            .where == "bad.pov:2:1");
+  CHECK_THAT(error_of("poly { 2, <1,0,0,0,1,0,0,1,0,-4> }").message, Catch::Contains("clipped_by"));
+  CHECK_THAT(error_of("sphere { 0, 1 clipped_by { box { -1, 1 } } rotate y*30 }").message,
+             Catch::Contains("axis-aligned"));
+  CHECK_THAT(error_of("sphere { 0, 1 clipped_by { sphere { 0, 1 } } scale <1, 2, 1> }").message,
+             Catch::Contains("ellipsoid"));
+}
+
+TEST_CASE("camera, lights, colours and background map to algray's scene", "[povray]") {
+  const Scene s = load_povray_text(
+      "#declare Gold = rgb <1, 0.8, 0.2>;\n"
+      "camera { location <0, 2, -10> look_at <0, 0, 0> right x*image_width/image_height angle 50 sky <0, 1, 0> }\n"
+      "light_source { <10, 20, -30> color rgb <2, 1, 0.5> area_light <4, 0, 0>, <0, 0, 4>, 5, 3 adaptive 1 }\n"
+      "light_source { <0, 5, 0> color rgb 0.5 shadowless }\n"
+      "background { color rgb <0.1, 0.2, 0.3> }\n"
+      "sphere { 0, 1 texture { pigment { color Gold } finish { ambient 0.2 diffuse 0.7 phong 0.5 phong_size 60 } }\n"
+      "  interior_texture { pigment { color red 0.1 green 0.9 } } }\n",
+      "values.pov", {});
+  CHECK(s.image.width == 800);
+  CHECK(s.image.height == 600);
+  CHECK(s.camera.eye == glm::dvec3(0, 2, 10));  // z negated
+  // angle is horizontal: 50 degrees across a right of 4/3 make fov_y 2 atan(tan(25 deg) * 3/4).
+  CHECK(s.camera.fov_y_degrees == Approx(2 * std::atan(std::tan(25 * 3.14159265358979 / 180) * 0.75) * 180 /
+                                         3.14159265358979));
+  REQUIRE(s.lights.size() == 2);
+  CHECK(s.lights[0].kind == LightKind::Rectangle);
+  CHECK(s.lights[0].samples == 5);
+  CHECK(s.lights[0].position == glm::dvec3(10, 20, 30));
+  CHECK(s.lights[0].edge_v == glm::dvec3(0, 0, -4));
+  CHECK(s.lights[0].intensity == 2);
+  CHECK(s.lights[0].colour == glm::dvec3(1, 0.5, 0.25));
+  CHECK_FALSE(s.lights[1].shadows);
+  CHECK(s.image.background.b == Approx(0.3));
+  const Material& front = s.surfaces[0].materials.front;
+  CHECK(front.colour == glm::dvec3(1, 0.8, 0.2));
+  CHECK(front.ambient == 0.2);
+  CHECK(front.diffuse == 0.7);
+  CHECK(front.specular == 0.5);
+  CHECK(front.exponent == 60);
+  CHECK(s.surfaces[0].materials.back.colour == glm::dvec3(0.1, 0.9, 0));
+  const Scene ortho = load_povray_text(
+      "camera { orthographic location <0, 0, -10> look_at 0 right 8*x up 6*y }\nsphere { 0, 1 }\n", "o.pov");
+  CHECK(ortho.camera.projection == Projection::Orthographic);
+  CHECK(ortho.camera.ortho_height == 6);
+}
+
+TEST_CASE("bad POV-Ray scenes get located errors; what is skipped, located warnings", "[povray][errors]") {
+  const SceneError open = error_of("sphere { 0, 1\n");
+  CHECK(open.where == "bad.pov:1:1");
+  CHECK_THAT(open.message, Catch::Contains("never closed"));
+  CHECK(error_of("poly { 2, <1, 2, 3> }\n").where == "bad.pov:1:11");
+  CHECK(error_of("poly { 40, <1> }\n").where == "bad.pov:1:1");
+  CHECK(error_of("camera { fisheye }\nsphere { 0, 1 }\n").where == "bad.pov:1:10");
+  CHECK(error_of("#macro M() #end\n").where == "bad.pov:1:1");
+  CHECK(error_of("sphere { 0, Radius }\n").where == "bad.pov:1:13");
+  CHECK(error_of("object { Thing }\n").where == "bad.pov:1:1");
+  CHECK(error_of("camera { location 0 }\n").message.find("no object") != std::string::npos);
+  CHECK(error_of("sphere { 0, 1 } /* open\n").where == "bad.pov:1:17");
+  // A dense poly of degree 32 moved by a transform is refused at the budget, where it is, in well under a second.
+  std::string dense = "\n poly { 32, <1";
+  for (int i = 1; i < 6545; ++i) dense += ",1";
+  const SceneError big = error_of(dense + "> clipped_by { sphere { 0, 1 } } rotate <10, 20, 30> translate x }\n");
+  CHECK(big.where == "bad.pov:2:2");
+  CHECK_THAT(big.message, Catch::Contains("too large to expand"));
+  const auto w = load_povray_text(
+                     "#include \"colors.inc\"\nplane { y, -1 }\nsphere { 0, 1 finish { reflection 0.3 } }\n"
+                     "media { }\n",
+                     "w.pov")
+                     .warnings;
+  CHECK(any_contains(w, "w.pov:1:1: #include \"colors.inc\" is ignored"));
+  CHECK(any_contains(w, "w.pov:2:1: 'plane' is ignored"));
+  CHECK(any_contains(w, "w.pov:3:24: finish 'reflection' is ignored"));
+  CHECK(any_contains(w, "w.pov:4:1: 'media' is ignored"));
+}
+
+TEST_CASE("every scene of tests/data/pov reads, and one renders from the command line", "[povray][cli]") {
+  int scenes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(ALGRAY_SOURCE_DIR "/tests/data/pov")) {
+    CAPTURE(entry.path().string());
+    const Scene s = load_scene_file(entry.path().string());
+    CHECK_FALSE(s.surfaces.empty());
+    CHECK(s.warnings.empty());
+    ++scenes;
+  }
+  CHECK(scenes >= 12);
+  algray::testing::require_device();
+  algray::testing::Sandbox box;
+  const auto r = box.run("render " + algray::testing::quoted(ALGRAY_SOURCE_DIR "/tests/data/pov/torus.pov") +
+                         " --preview --width 64 --height 48 -o out.png");
+  CHECK(r.exit_code == 0);
+  CHECK(std::filesystem::exists(box.work / "out.png"));
+  const auto bad = box.scene("bad.pov", "sphere { 0, 1 }\ntorus { 1 }\n");
+  const auto b = box.run("render " + algray::testing::quoted(bad.string()) + " -o bad.png");
+  CHECK(b.exit_code == 2);
+  CHECK_THAT(b.err, Catch::Contains("bad.pov:2:"));
+  CHECK_FALSE(std::filesystem::exists(box.work / "bad.png"));
+}
