@@ -24,6 +24,7 @@
 #include <set>
 #include <sstream>
 
+#include "algray/scene/located_text.h"
 #include "algray/scene/scene.h"
 #include "algray/scene/sparse_poly.h"
 #include "algray/scene/toml_reader.h"
@@ -77,12 +78,7 @@ struct PovLight {
 class PovReader {
  public:
   PovReader(const std::string& text, std::string source, std::vector<std::string>& warnings, int width, int height)
-      : source_(std::move(source)), warnings_(warnings), width_(width), height_(height) {
-    std::istringstream in(text);
-    for (std::string l; std::getline(in, l);) {
-      if (!l.empty() && l.back() == '\r') l.pop_back();
-      lines_.push_back(l);
-    }
+      : text_(text, std::move(source)), source_(text_.source()), warnings_(warnings), width_(width), height_(height) {
     tokenize(text);
   }
 
@@ -90,18 +86,9 @@ class PovReader {
 
  private:
   // --- messages ---
-  std::string where(const Token& t) const {
-    return source_ + ":" + std::to_string(t.line) + ":" + std::to_string(t.column);
-  }
-  std::string excerpt(const Token& t) const {
-    const std::string line =
-        t.line >= 1 && static_cast<std::size_t>(t.line) <= lines_.size() ? lines_[static_cast<std::size_t>(t.line - 1)]
-                                                                         : std::string();
-    return line + "\n" + std::string(static_cast<std::size_t>(std::max(t.column - 1, 0)), ' ') + "^";
-  }
-  [[noreturn]] void fail(const Token& t, const std::string& message) const {
-    throw SceneError(where(t), message, excerpt(t));
-  }
+  std::string where(const Token& t) const { return text_.where(t.line, t.column); }
+  std::string excerpt(const Token& t) const { return text_.excerpt(t.line, t.column); }
+  [[noreturn]] void fail(const Token& t, const std::string& message) const { text_.fail(t.line, t.column, message); }
   void warn(const Token& t, const std::string& message) { warnings_.push_back(where(t) + ": " + message); }
 
   // --- tokens ---
@@ -1029,10 +1016,10 @@ class PovReader {
     return out;
   }
 
-  std::string source_;
+  LocatedText text_;
+  const std::string& source_;
   std::vector<std::string>& warnings_;
   int width_, height_;
-  std::vector<std::string> lines_;
   std::vector<Token> tokens_;
   std::size_t pos_ = 0;
   std::map<std::string, Vec> declared_;

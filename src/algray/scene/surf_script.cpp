@@ -24,6 +24,7 @@
 #include <sstream>
 
 #include "algray/math/colour.h"
+#include "algray/scene/located_text.h"
 #include "algray/scene/scene.h"
 #include "algray/scene/solver_options.h"
 #include "algray/scene/sparse_poly.h"
@@ -185,12 +186,7 @@ bool is_known_unsupported(const std::string& name) {
 class Script {
  public:
   Script(const std::string& text, std::string source, std::vector<std::string>& warnings)
-      : source_(std::move(source)), warnings_(warnings) {
-    std::istringstream in(text);
-    for (std::string l; std::getline(in, l);) {
-      if (!l.empty() && l.back() == '\r') l.pop_back();
-      lines_.push_back(l);
-    }
+      : text_(text, std::move(source)), source_(text_.source()), warnings_(warnings) {
     tokenize(text);
     globals_ = reserved_defaults();
   }
@@ -204,18 +200,9 @@ class Script {
   };
 
   // --- messages ---
-  std::string where(const Token& t) const {
-    return source_ + ":" + std::to_string(t.line) + ":" + std::to_string(t.column);
-  }
-  std::string excerpt(const Token& t) const {
-    const std::string line =
-        t.line >= 1 && static_cast<std::size_t>(t.line) <= lines_.size() ? lines_[static_cast<std::size_t>(t.line - 1)]
-                                                                         : std::string();
-    return line + "\n" + std::string(static_cast<std::size_t>(std::max(t.column - 1, 0)), ' ') + "^";
-  }
-  [[noreturn]] void fail(const Token& t, const std::string& message) const {
-    throw SceneError(where(t), message, excerpt(t));
-  }
+  std::string where(const Token& t) const { return text_.where(t.line, t.column); }
+  std::string excerpt(const Token& t) const { return text_.excerpt(t.line, t.column); }
+  [[noreturn]] void fail(const Token& t, const std::string& message) const { text_.fail(t.line, t.column, message); }
   void warn(const Token& t, const std::string& message) { warnings_.push_back(where(t) + ": " + message); }
   void warn_once(const Token& t, const std::string& key, const std::string& message) {
     if (warned_.insert(key).second) warn(t, message);
@@ -761,9 +748,9 @@ class Script {
   }
   std::string translate(const Snapshot& s);
 
-  std::string source_;
+  LocatedText text_;
+  const std::string& source_;
   std::vector<std::string>& warnings_;
-  std::vector<std::string> lines_;
   std::vector<Token> tokens_;
   std::size_t pos_ = 0;
   long statements_ = 0;
@@ -777,7 +764,6 @@ class Script {
   long draws_ = 0, saves_ = 0;
   std::optional<Token> curve_at_;
   int rendered_width_ = 0, rendered_height_ = 0;  // overrides of width and height, 0 where none
-
 };
 
 std::string Script::translate(const Snapshot& s) {
