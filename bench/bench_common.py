@@ -6,9 +6,11 @@ import os
 import platform
 import re
 import shlex
+import struct
 import subprocess
 import sys
 import time
+import zlib
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -140,3 +142,49 @@ def replace_bullet(path, heading, prefix, bullet, under=None):
     lines = sorted([l for l in lines if not l.startswith(prefix)] + [bullet])
     replace_section(path, heading, heading + "\n\n" + "\n".join(lines) + "\n", under=under)
 
+
+def read_png(path, rgb=False):
+    """(width, height, rows of channel tuples) of a non-interlaced 8- or 16-bit grey, RGB or RGBA PNG; with rgb,
+    each pixel's first three channels (an RGB or RGBA picture's colour)."""
+    data = Path(path).read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", path
+    pos, idat, header = 8, b"", None
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        if kind == b"IHDR":
+            header = struct.unpack(">IIBBBBB", data[pos + 8:pos + 8 + length])
+        elif kind == b"IDAT":
+            idat += data[pos + 8:pos + 8 + length]
+        pos += 12 + length
+    width, height, depth, colour, _, _, interlace = header
+    channels = {0: 1, 2: 3, 4: 2, 6: 4}[colour]
+    assert depth in (8, 16) and interlace == 0, f"{path}: unsupported PNG layout"
+    bpp = channels * depth // 8
+    stride = width * bpp
+    raw = zlib.decompress(idat)
+    rows, previous, i = [], bytearray(stride), 0
+    for _ in range(height):
+        kind, line = raw[i], bytearray(raw[i + 1:i + 1 + stride])
+        i += 1 + stride
+        for x in range(stride):
+            a = line[x - bpp] if x >= bpp else 0
+            b = previous[x]
+            c = previous[x - bpp] if x >= bpp else 0
+            if kind == 1:
+                line[x] = (line[x] + a) & 255
+            elif kind == 2:
+                line[x] = (line[x] + b) & 255
+            elif kind == 3:
+                line[x] = (line[x] + (a + b) // 2) & 255
+            elif kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[x] = (line[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        if depth == 8:
+            values = list(line)
+        else:
+            values = [line[k] << 8 | line[k + 1] for k in range(0, stride, 2)]
+        kept = min(channels, 3) if rgb else channels
+        rows.append([tuple(values[x * channels:x * channels + kept]) for x in range(width)])
+        previous = line
+    return width, height, rows
