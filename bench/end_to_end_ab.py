@@ -21,29 +21,38 @@ def main():
     ap.add_argument("--full", action="store_true", help="the scenes as shipped, not the preview")
     ap.add_argument("--width", type=int, default=1024)
     ap.add_argument("--height", type=int, default=768)
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a scene key for both binaries, as `algray render --set` takes it (render.lanes=1, say)")
     a = ap.parse_args()
     args = ["--width", str(a.width), "--height", str(a.height)]
+    for kv in a.set:
+        args += ["--set", kv]
     if not a.full:
         args += ["--preview", "--set", "antialias.samples=1"]
     binaries = [a.baseline, a.algray]
     print(f"Machine: {machine()}. Baseline `{a.baseline}`, current `{a.algray}`; `render {' '.join(args)}` to EXR, "
           f"wall ms of the whole process, median of {a.repeat} interleaved runs each after one warm-up; "
-          f"ratio = current/baseline per pair (median, min-max).\n")
-    print("| surface | baseline ms | current ms | ratio (median) | min-max |")
-    print("|---|---|---|---|---|")
+          f"ratio = current/baseline per pair (median, min-max); kernel ms: every pass's device time from --stats.\n")
+    print("| surface | baseline ms | current ms | ratio (median) | min-max | kernel ms ratio (median) | min-max |")
+    print("|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         for name in a.scenes:
             scene = ROOT / "scenes" / f"{name}.toml"
             for b in binaries:
                 run_render(b, scene, args, None, work)
-            times = [[], []]
+            times, kernels = [[], []], [[], []]
             for _ in range(a.repeat):
                 for k, b in enumerate(binaries):
-                    times[k].append(run_render(b, scene, args, None, work)[0])
+                    wall, stats = run_render(b, scene, args, None, work)
+                    times[k].append(wall)
+                    kernels[k].append(sum(p["kernel_ms"] for p in stats["passes"]))  # every pass's device time
             ratios = [new / old for old, new in zip(times[0], times[1])]
+            kernel_ratios = [new / old for old, new in zip(kernels[0], kernels[1])]
             print(f"| {name} | {statistics.median(times[0]):.0f} | {statistics.median(times[1]):.0f} | "
-                  f"{statistics.median(ratios):.3f} | {min(ratios):.3f}-{max(ratios):.3f} |", flush=True)
+                  f"{statistics.median(ratios):.3f} | {min(ratios):.3f}-{max(ratios):.3f} | "
+                  f"{statistics.median(kernel_ratios):.3f} | {min(kernel_ratios):.3f}-{max(kernel_ratios):.3f} |",
+                  flush=True)
 
 
 if __name__ == "__main__":
