@@ -108,14 +108,14 @@ def main():
             subprocess.run(["tar", "-x", "-C", tmp], input=archive, check=True)
             before = figures(tmp)
         after = figures(HERE.parent)
-        lines = ["### Code shape", "",
+        lines = ["### Issue 43's figures", "",
                  f"- Date: {datetime.date.today().isoformat()}; machine: {machine()}; commit: {commit()}",
                  f"- Command: `{command_line()}`; the rules: the script's docstring and issue 43's figures", "",
                  f"| figure | {base[:7]} | now | goal |", "|---|---|---|---|"]
         goals = ["at most 120", "0", "0", "0", "0"]
         for (name, old, _), (_, new, detail), goal in zip(before, after, goals):
             lines.append(f"| {name} | {old} | {new} | {goal} |")
-        replace_section(RESULTS_MD, "### Code shape", "\n".join(lines) + "\n", under="## Code shape")
+        replace_section(RESULTS_MD, "### Issue 43's figures", "\n".join(lines) + "\n", under="## Code shape")
         print(f"wrote {RESULTS_MD}")
         return
     root = sys.argv[1] if len(sys.argv) > 1 else HERE.parent
