@@ -56,9 +56,9 @@ const char* status_name(int status) {
                                            : "none";
 }
 
-// The scene's solver first, then, when asked, every other valid isolation x refinement.
-std::vector<KernelConfig> solver_configs(const Scene& scene, Precision precision, std::size_t surface, bool all) {
-  const KernelConfig own = primary_config(scene, precision, surface);
+// The render's own kernel for the surface first (`own`, from its plan), then, when asked, every other valid
+// isolation x refinement in its place.
+std::vector<KernelConfig> solver_configs(const Scene& scene, const KernelConfig& own, bool all) {
   std::vector<KernelConfig> configs{own};
   if (!all) return configs;
   for (const NamedChoice<Isolation>& isolation : kIsolations) {
@@ -464,22 +464,25 @@ std::vector<SurfaceProbe> probe_scene(const Scene& scene, const ProbeTarget& tar
                                       RenderContext& context) {
   ClSession& session = context.session();
   const Precision precision = resolve_precision(scene, session.info, context.cache());
-  // The float kernels settle more of their doubts where the render's second pass runs in float-float (the plan's
-  // settle_doubts).
-  const Precision second_pass = escalation_precision(session.info, context.cache());
+  // The render's plan on this device decides the probe's kernels as it decides the render's: the solver, the ray
+  // origin, whether the float kernels settle their doubts, and the second pass's precision.
+  const RenderPlan plan = make_render_plan(
+      scene, precision,
+      {PlanDevice{session.info, precision == Precision::Adaptive ? escalation_precision(session.info, context.cache())
+                                                                 : Precision::Mixed}});
+  const PlannedPass& primary = *plan.find(PassKind::Primary);
   std::vector<SurfaceProbe> probes;
   for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
     SurfaceProbe p;
     p.surface = s;
-    for (KernelConfig& c : solver_configs(scene, precision, s, all_solvers)) {
-      c.settle_doubts = precision == Precision::Adaptive && second_pass == Precision::Mixed;
+    for (const KernelConfig& c : solver_configs(scene, primary.kernels.at(s), all_solvers)) {
       p.traces.push_back(trace_probe(session, context.cache(), scene, s, c, target));
       // A ray adaptive precision doubts is traced again as the render does, the float ray as it was traced, in
-      // the precision of the second pass: that trace follows it.
+      // the precision of the second pass (the plan's escalation kernel): that trace follows it.
       if (p.traces.back().hit.flags & ALGRAY_HIT_DOUBT) {
         KernelConfig again = c;
-        again.precision = second_pass;
-        again.settle_doubts = false;
+        again.precision = primary.escalation.at(s).precision;
+        again.settle_doubts = primary.escalation.at(s).settle_doubts;
         ProbeTarget same_ray;
         same_ray.given_ray = true;
         same_ray.origin = p.traces.back().ray.origin;
