@@ -382,7 +382,10 @@ RenderedFrame render_frame(const Scene& scene, const FrameRequest& request, Rend
     // makes its own), after the film on the same thread: both overlap the device's start, which needs no memory.
     std::future<PopulatedPages> tile_memory;
     if (ahead) {
-      const std::size_t tile_bytes = tile_memory_bytes(make_render_plan(scene, Precision::Double));
+      DeviceInfo cpu;
+      cpu.type = "CPU";
+      const std::size_t tile_bytes =
+          tile_memory_bytes(make_render_plan(scene, Precision::Double, std::vector<PlanDevice>{{cpu}}));
       auto pages = std::make_shared<std::promise<PopulatedPages>>();
       tile_memory = pages->get_future();
       film = std::async(std::launch::async, [=] {

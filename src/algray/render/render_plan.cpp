@@ -245,11 +245,15 @@ std::uint64_t host_bytes_per_tile(const RenderPlan& plan, const Scene& scene, st
 
 }  // namespace
 
+int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 256 : 1024; }
+
 RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size, int lanes) {
   RenderPlan plan;
   plan.width = scene.image.width;
   plan.height = scene.image.height;
-  plan.tile_size = tile_size > 0 ? tile_size : scene.render.tile_size > 0 ? scene.render.tile_size : 1024;
+  plan.tile_size = tile_size > 0                  ? tile_size
+                   : scene.render.tile_size > 0 ? scene.render.tile_size
+                                                : default_tile_size(DeviceInfo{});  // a device of no kind: a CPU's
   // Preview mode is the paper's quick look: one camera ray per pixel, whatever the scene's antialiasing.
   const int samples = scene.render.preview ? 1 : scene.antialias.samples;
   const bool adaptive = scene.antialias.adaptive && samples > 1;
@@ -283,8 +287,6 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
   plan.tile_host_bytes = host_bytes_per_tile(plan, scene, rays);
   return plan;
 }
-
-int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 256 : 1024; }
 
 RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::vector<PlanDevice>& devices) {
   if (devices.empty()) throw std::invalid_argument("a render plan needs at least one device");

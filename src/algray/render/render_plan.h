@@ -89,9 +89,10 @@ struct RenderPlan {
 // is allocated, so that a 32768 x 32768 render with antialiasing is refused at once rather than killed later.
 void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device);
 
-// The passes and buffers `scene` calls for in `precision`. The primary pass is always there; the shadow pass
-// only when a light casts shadows and the scene is not a preview.
-// tile_size: the tile side in traced rays; 0 takes the scene's render.tile_size, or 1024 when it has none.
+// The passes and buffers `scene` calls for in `precision`, for a given tile size and lanes: the building block of
+// the devices' plan below, and what tests pin down. The primary pass is always there; the shadow pass only when a
+// light casts shadows and the scene is not a preview.
+// tile_size: the tile side in traced rays; 0 takes the scene's render.tile_size, or a CPU's default_tile_size.
 // lanes: rays per work-item of the primary and trace kernels where lanes_apply (kernel_config.h); the scene's
 // render.lanes, when set, comes first.
 RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size = 0, int lanes = 1);
