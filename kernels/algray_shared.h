@@ -35,6 +35,7 @@ typedef cl_int algray_i32;
 #define ALGRAY_ISOLATION_POWER 2       /* the paper: power basis mapped to (0, inf), Descartes' rule, left half first */
 #define ALGRAY_ISOLATION_STURM 3       /* Sturm sequence of P* in the power basis, bisection by root counts */
 #define ALGRAY_ISOLATION_DERIVATIVE_CHAIN 4 /* roots of P*', P*'', ... cut [0, 1] into monotone pieces */
+#define ALGRAY_ISOLATION_LAST 4        /* the largest id: a new method's id goes above, and here */
 #define ALGRAY_REFINEMENT_BRENT 1      /* Dekker-Brent with the paper's acceptance and stopping rules */
 #define ALGRAY_REFINEMENT_BISECTION 2  /* plain bisection of the bracket */
 #define ALGRAY_REFINEMENT_REGULA_FALSI 3 /* the paper's plain regula falsi (false position) */
