@@ -33,7 +33,8 @@ std::string format_what(const std::string& where, const std::string& message, co
 }
 
 const std::set<std::string> kTopKeys{"surface",  "parameters", "extent",    "camera", "image",
-                                     "material", "light",      "antialias", "render"};
+                                     "material", "light",      "antialias", "render", "section"};
+const std::set<std::string> kSectionKeys{"plane", "colour"};
 const std::set<std::string> kSurfaceKeys{"name", "equation", "terms", "material"};
 const std::set<std::string> kExtentKeys = [] {
   std::set<std::string> keys{"type"};
@@ -669,6 +670,30 @@ void read_lights(const TomlReader& r, const toml::table& root, const CameraSpec&
   for (const toml::node& node : *list) out.push_back(read_light(r, *node.as_table(), camera));
 }
 
+// [[section]] tables: plane = [a, b, c, d] (a plane: (a, b, c) not zero) and an optional colour.
+void read_sections(const TomlReader& r, const toml::table& root, std::vector<Section>& out) {
+  const toml::node* sections = root.get("section");
+  if (!sections) return;
+  const toml::array* list = sections->as_array();
+  if (!list || !list->is_array_of_tables())
+    r.fail(sections->source(), "plane sections are written as [[section]] tables, one per plane");
+  for (const toml::node& node : *list) {
+    const toml::table& t = *node.as_table();
+    r.check_keys(t, "section", kSectionKeys);
+    Section s;
+    const toml::node* plane = t.get("plane");
+    if (!plane) r.fail(t.source(), "a section needs plane = [a, b, c, d] (the plane a*x + b*y + c*z + d = 0)");
+    const toml::array* a = plane->as_array();
+    if (!a || a->size() != 4) r.fail(plane->source(), "section.plane must be an array of 4 numbers [a, b, c, d]");
+    for (int i = 0; i < 4; ++i)
+      s.plane[i] = r.coordinate(*a->get(static_cast<std::size_t>(i)), "section.plane[" + std::to_string(i) + "]");
+    if (s.plane.x == 0 && s.plane.y == 0 && s.plane.z == 0)
+      r.fail(plane->source(), "section.plane is no plane: a, b and c are all 0");
+    if (const toml::node* c = t.get("colour")) s.colour = glm::dvec3(r.colour(*c, "section.colour", false));
+    out.push_back(s);
+  }
+}
+
 void read_antialias(const TomlReader& r, const toml::table& root, Antialias& out) {
   const toml::table* aa = r.subtable(root, "antialias");
   if (!aa) return;
@@ -754,6 +779,7 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
   read_image(r, root, scene.image);
   read_surface_materials(r, root, surface_tables, scene.surfaces);
   read_lights(r, root, scene.camera, scene.lights);
+  read_sections(r, root, scene.sections);
   if (framed && !root.get("light")) scene.lights = framing_lights(scene.extent.unit_scale(), scene.camera);
   if (framed && !root.get("antialias")) scene.antialias.samples = 2;
   read_antialias(r, root, scene.antialias);
@@ -1026,6 +1052,10 @@ std::string scene_to_toml(const Scene& scene) {
     out << "colour = " << toml_vector(world.colour) << "\nintensity = " << toml_number(world.intensity)
         << "\nshadows = " << (world.shadows ? "true" : "false") << "\n";
   }
+  for (const Section& sec : scene.sections)
+    out << "\n[[section]]\nplane = [" << toml_number(sec.plane.x) << ", " << toml_number(sec.plane.y) << ", "
+        << toml_number(sec.plane.z) << ", " << toml_number(sec.plane.w) << "]\ncolour = " << toml_vector(sec.colour)
+        << "\n";
   const Antialias& aa = scene.antialias;
   out << "\n[antialias]\nsamples = " << aa.samples << "\nadaptive = " << (aa.adaptive ? "true" : "false")
       << "\nthreshold = " << toml_number(aa.threshold) << "\n";

@@ -59,6 +59,13 @@ struct Extent {
   glm::dvec3 unit_box_half() const;
 };
 
+// A plane section, surf's cut_with_plane: the curve where the plane a*x + b*y + c*z + d = 0 meets the surface,
+// drawn over the shading in `colour` as a line one pixel wide (shade.cpp).
+struct Section {
+  glm::dvec4 plane{0, 0, 1, 0};  // a, b, c, d
+  glm::dvec3 colour{0.05, 0.05, 0.05};
+};
+
 struct ImageSpec {
   int width = 800;
   int height = 600;
@@ -165,6 +172,7 @@ struct Scene {
   CameraSpec camera;
   ImageSpec image;
   std::vector<Light> lights;  // none: a headlight at the eye shades the surface, without shadows
+  std::vector<Section> sections;  // plane sections drawn on the surface ([[section]])
   Antialias antialias;
   RenderSettings render;
   // What the scene's reader could not render as written (a .jsurf feature algray draws differently, an unknown
