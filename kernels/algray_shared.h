@@ -29,6 +29,9 @@ typedef cl_int algray_i32;
 /* Extent kinds (kernel argument extent_kind). */
 #define ALGRAY_EXTENT_SPHERE 0
 #define ALGRAY_EXTENT_BOX 1
+/* A cylinder about axis a (0 x, 1 y, 2 z) is kind ALGRAY_EXTENT_CYLINDER + a: the axis is chosen with the kind, not
+ * an argument of its own, and extent_box_half is the box around it (its radius across, half-height along a). */
+#define ALGRAY_EXTENT_CYLINDER 2
 
 /* Compile-time solver choices, passed as -D ISOLATION=... -D REFINEMENT=... */
 #define ALGRAY_ISOLATION_BERNSTEIN 1   /* Descartes' rule on Bernstein coefficients over [t_in, t_out], de Casteljau halving */

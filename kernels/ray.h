@@ -31,7 +31,9 @@ Ray camera_ray(uint px, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4
 }
 
 /* [t_in, t_out] of rays o + t*d inside the extent, given in unit coordinates u = (p - centre)/scale, where the
- * sphere is the unit sphere and the box is |u_i| <= half_i; returns where they enter it. Written once over a real
+ * sphere is the unit sphere, the box is |u_i| <= half_i and the cylinder about axis a (kind
+ * ALGRAY_EXTENT_CYLINDER + a) is the part of the infinite one of radius half_(across a) between its caps at
+ * u_a = +-half_a; returns where they enter it. Written once over a real
  * type T and its comparisons' type M (REAL and int, or LREAL and LMASK of lanes.h), so that every lane of the
  * vector instance is the scalar one's result bit for bit. A ray that misses leaves t_in, t_out undefined. ANY(m):
  * whether any lane of m is set. Where no ray meets the sphere, its square root and divisions are skipped (more
@@ -57,6 +59,29 @@ Ray camera_ray(uint px, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4
         const T t0 = q / a, t1 = c / q;                                                                              \
         lo = fmax(fmin(t0, t1), (T)0);                                                                               \
         hi = fmax(t0, t1);                                                                                           \
+      }                                                                                                              \
+    } else if (kind >= ALGRAY_EXTENT_CYLINDER) {                                                                     \
+      _Pragma("OPENCL FP_CONTRACT OFF") const int axis = kind - ALGRAY_EXTENT_CYLINDER;                              \
+      /* (p1, p2) across the axis, pa along it */                                                                    \
+      const T p1 = axis == 0 ? oy : ox, p2 = axis == 2 ? oy : oz, pa = axis == 0 ? ox : axis == 1 ? oy : oz;         \
+      const T q1 = axis == 0 ? dy : dx, q2 = axis == 2 ? dy : dz, qa = axis == 0 ? dx : axis == 1 ? dy : dz;         \
+      const REAL rho = axis == 0 ? box_half.y : box_half.x;                                                          \
+      const REAL eta = axis == 0 ? box_half.x : axis == 1 ? box_half.y : box_half.z;                                 \
+      /* the caps as a box's slab: +-inf for rays across the axis */                                                 \
+      const T ia = (REAL)1 / qa;                                                                                     \
+      const T s0 = (-eta - pa) * ia, s1 = (eta - pa) * ia;                                                           \
+      lo = fmax(lo, fmin(s0, s1));                                                                                   \
+      hi = fmin((T)REAL_MAX, fmax(s0, s1));                                                                          \
+      /* the side, as the sphere's quadratic across the axis; a ray along the axis meets it everywhere or nowhere */ \
+      const T a = q1 * q1 + q2 * q2, b = p1 * q1 + p2 * q2, c = (p1 * p1 + p2 * p2) - rho * rho;                     \
+      const T disc = b * b - a * c;                                                                                  \
+      const M side = a > 0 && disc > 0;                                                                              \
+      hit = side || (a == 0 && c <= 0);                                                                              \
+      if (ANY(side)) {                                                                                               \
+        const T q = -(b + copysign(sqrt(disc), b));                                                                  \
+        const T t0 = q / a, t1 = c / q;                                                                              \
+        lo = side ? fmax(lo, fmin(t0, t1)) : lo;                                                                     \
+        hi = side ? fmin(hi, fmax(t0, t1)) : hi;                                                                     \
       }                                                                                                              \
     } else {                                                                                                         \
       hi = REAL_MAX;                                                                                                 \

@@ -377,6 +377,11 @@ TEST_CASE("scene_to_toml reads back to the same scene, for every shipped scene a
                                                            "[image]",
                                                            "background = [0, 0, 0, 0.5]"}),
                                               "variants.toml", {{"image.width", "123"}}));
+  scenes.emplace_back("cylinder", algray::load_scene_text(sphere_with({{5,
+                                                                        "type = \"cylinder\"\ncentre = [0.5, 0, "
+                                                                        "-0.25]\nradius = 1.5\naxis = \"y\"\n"
+                                                                        "half_height = 0.7"}}),
+                                                          "cylinder.toml"));
   REQUIRE(scenes.size() >= 12);
   const auto body = [](const std::string& toml) { return toml.substr(toml.find('\n') + 1); };  // past the comment
   for (const auto& [name, scene] : scenes) {
@@ -553,7 +558,61 @@ TEST_CASE("--set extent.type switches the kind, dropping the other kind's keys w
   CHECK(given.extent.max == glm::dvec3(3));
   // In a file, keys of another kind are still a located error.
   check_error(sphere_with({{5, "type = \"box\"\nradius = 2"}}), "t.toml:6:10", "belongs to a sphere extent");
-  check_error(sphere_with({{5, "type = \"cone\""}}), "t.toml:5:8", "\"sphere\" or \"box\"");
+  check_error(sphere_with({{5, "type = \"cone\""}}), "t.toml:5:8", "\"sphere\", \"box\" or \"cylinder\"");
+}
+
+TEST_CASE("a cylinder extent reads, round-trips, refuses other kinds' keys and is switched to and from",
+          "[scene][extent]") {
+  const Scene c = algray::load_scene_text(
+      sphere_with({{5, "type = \"cylinder\"\ncentre = [1, 0, 0]\nradius = 0.6\naxis = \"x\"\nhalf_height = 0.8"}}),
+      "t.toml");
+  REQUIRE(c.extent.kind == algray::ExtentKind::Cylinder);
+  CHECK(c.extent.axis == 0);
+  CHECK(c.extent.half_height == 0.8);
+  // It fits in the unit sphere by its cap's rim: radius 0.6 across, 0.8 along x, so a scale of exactly 1.
+  CHECK(c.extent.unit_scale() == Approx(1.0).epsilon(1e-15));
+  CHECK(c.extent.unit_box_half() == glm::dvec3(c.extent.unit_box_half().x, 0.6, 0.6));
+  CHECK(c.extent.unit_box_half().x == Approx(0.8).epsilon(1e-15));
+  const Scene again = algray::load_scene_text(algray::scene_to_toml(c), "again.toml");
+  CHECK(again.extent.kind == algray::ExtentKind::Cylinder);
+  CHECK(again.extent.centre == c.extent.centre);
+  CHECK(again.extent.radius == c.extent.radius);
+  CHECK(again.extent.axis == c.extent.axis);
+  CHECK(again.extent.half_height == c.extent.half_height);
+  // The axis is z unless given.
+  CHECK(algray::load_scene_text(sphere_with({{5, "type = \"cylinder\"\nradius = 1\nhalf_height = 2"}}), "t.toml")
+            .extent.axis == 2);
+  check_error(sphere_with({{5, "type = \"cylinder\"\nradius = 1\nhalf_height = 1\nmin = [0, 0, 0]"}}), "t.toml:8:7",
+              "extent.min belongs to a box extent");
+  check_error(sphere_with({{5, "type = \"cylinder\"\nradius = 1\nhalf_height = 1\naxis = \"w\""}}), "t.toml:8:8",
+              "extent.axis must be");
+  check_error(sphere_with({{5, "type = \"cylinder\"\nradius = 1"}}), "t.toml:4:1", "needs a half_height");
+  check_error(sphere_with({{5, "type = \"sphere\"\nradius = 1\nhalf_height = 1"}}), "t.toml:7:15",
+              "extent.half_height belongs to a cylinder extent");
+  // --set extent.type=cylinder: from a sphere, the same radius and half_height R about z, with a note.
+  const Scene from_sphere = algray::load_scene_text(sphere_with({}), "t.toml", {{"extent.type", "cylinder"}});
+  CHECK(from_sphere.extent.kind == algray::ExtentKind::Cylinder);
+  CHECK(from_sphere.extent.radius == 2);
+  CHECK(from_sphere.extent.half_height == 2);
+  CHECK(from_sphere.extent.axis == 2);
+  REQUIRE(from_sphere.warnings.size() == 1);
+  CHECK_THAT(from_sphere.warnings[0], Catch::Contains("half_height = 2"));
+  // From a box: inscribed in its x and y sides, its caps on the box's.
+  const Scene from_box =
+      algray::load_scene_text(sphere_with({{5, "type = \"box\"\nmin = [-1, -3, -1]\nmax = [1, 1, 3]"}}), "t.toml",
+                              {{"extent.type", "cylinder"}});
+  CHECK(from_box.extent.centre == glm::dvec3(0, -1, 1));
+  CHECK(from_box.extent.radius == 2);
+  CHECK(from_box.extent.half_height == 2);
+  REQUIRE(from_box.warnings.size() == 1);
+  CHECK_THAT(from_box.warnings[0], Catch::Contains("extent.min and extent.max") && Catch::Contains("cylinder is"));
+  // And to a box: the box around the cylinder.
+  const Scene to_box = algray::load_scene_text(algray::scene_to_toml(c), "t.toml", {{"extent.type", "box"}});
+  const glm::dvec3 min{0.2, -0.6, -0.6}, max{1.8, 0.6, 0.6};
+  for (int i = 0; i < 3; ++i) {
+    CHECK(to_box.extent.min[i] == Approx(min[i]).epsilon(1e-15));
+    CHECK(to_box.extent.max[i] == Approx(max[i]).epsilon(1e-15));
+  }
 }
 
 TEST_CASE("an error in -e's equation names its column in the equation", "[scene][errors]") {

@@ -1,4 +1,5 @@
-// The film's colours against Phong written out one ray and one light point at a time, bit for bit.
+// The film's colours against Phong written out one ray and one light point at a time, bit for bit, and the
+// plane sections drawn over them.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
@@ -122,4 +123,62 @@ TEST_CASE("every hit's colour is Phong over the light points the shadow pass lef
       CHECK(highlights > 5);
     }
   }
+}
+
+TEST_CASE("a section plane through the unit sphere marks the ring where it cuts the sphere, closed and one pixel wide",
+          "[shading][section]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  // The plane z = 0.5, seen from +z: a circle of radius sqrt(0.75) on the near half of the sphere.
+  const std::string base =
+      "[surface]\nequation = \"x^2+y^2+z^2-1\"\n[extent]\nradius = 1.5\n"
+      "[camera]\neye = [0, 0, 4.5]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nfov_y = 45\n"
+      "[image]\nwidth = 96\nheight = 96\n[antialias]\nsamples = 1\n[render]\nprecision = \"double\"\npreview = true\n";
+  const std::string section = "[[section]]\nplane = [0, 0, 2, -1]\ncolour = [0, 1, 0]\n";
+  const auto marked = [](const RenderResult& r, std::size_t k) {
+    return r.image.rgba[4 * k] == 0.0f && r.image.rgba[4 * k + 1] == 1.0f && r.image.rgba[4 * k + 2] == 0.0f;
+  };
+  const RenderResult plain = renderer.render_with_records(load_scene_text(base, "plain.toml"));
+  const RenderResult cut = renderer.render_with_records(load_scene_text(base + section, "cut.toml"));
+  const double ring = std::sqrt(0.75);
+  std::size_t count = 0, unmarked_elsewhere = 0;
+  bool sectors[16] = {};
+  for (int y = 0; y < cut.hits.height; ++y)
+    for (int x = 0; x < cut.hits.width; ++x) {
+      const std::size_t k = static_cast<std::size_t>(y) * cut.hits.width + x;
+      INFO("pixel " << x << "," << y);
+      CHECK_FALSE(marked(plain, k));
+      if (!marked(cut, k)) {
+        // Elsewhere the colour is the plain render's.
+        for (int c = 0; c < 4; ++c) unmarked_elsewhere += cut.image.rgba[4 * k + c] != plain.image.rgba[4 * k + c];
+        continue;
+      }
+      const HitRecord& h = cut.hits.records[k];
+      REQUIRE((h.flags & ALGRAY_HIT_FOUND) != 0);
+      const PixelRay ray = pixel_ray(cut.basis, false, x, y);
+      const glm::dvec3 p = ray.origin + (static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo)) * ray.direction;
+      // There the rays meet the sphere 72 degrees off its normal, so one pixel outwards moves the hit by about
+      // 0.096 in z and 0.055 in sqrt(x^2 + y^2): the ring's pixels lie within half a pixel of the circle, and a
+      // little more for the sphere's curving away over that pixel.
+      CHECK(std::fabs(p.z - 0.5) < 0.065);
+      CHECK(std::fabs(std::hypot(p.x, p.y) - ring) < 0.037);
+      ++count;
+      const double angle = std::atan2(y + 0.5 - 48, x + 0.5 - 48);
+      sectors[static_cast<int>(std::floor((angle + M_PI) / (2 * M_PI) * 16)) & 15] = true;
+    }
+  CHECK(unmarked_elsewhere == 0);
+  // Closed: some of it in each of 16 sectors about the image centre; and one pixel wide: a digital circle of
+  // radius 22.3 pixels (the projected ring) has about 4 sqrt(2) 22.3 = 126 pixels.
+  for (int i = 0; i < 16; ++i) {
+    INFO("sector " << i);
+    CHECK(sectors[i]);
+  }
+  CHECK(count >= 100);
+  CHECK(count <= 160);
+  // And it reads back from the scene's TOML.
+  const Scene again = load_scene_text(scene_to_toml(load_scene_text(base + section, "cut.toml")), "again.toml");
+  REQUIRE(again.sections.size() == 1);
+  CHECK(again.sections[0].plane == glm::dvec4(0, 0, 2, -1));
+  CHECK(again.sections[0].colour == glm::dvec3(0, 1, 0));
 }

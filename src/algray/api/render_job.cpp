@@ -73,7 +73,10 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
       {"algray/extent",
        scene.extent.kind == ExtentKind::Sphere
            ? "sphere centre " + vec_text(scene.extent.centre) + " radius " + std::to_string(scene.extent.radius)
-           : "box min " + vec_text(scene.extent.min) + " max " + vec_text(scene.extent.max)},
+       : scene.extent.kind == ExtentKind::Box
+           ? "box min " + vec_text(scene.extent.min) + " max " + vec_text(scene.extent.max)
+           : "cylinder centre " + vec_text(scene.extent.centre) + " radius " + std::to_string(scene.extent.radius) +
+                 " axis " + "xyz"[scene.extent.axis] + " half_height " + std::to_string(scene.extent.half_height)},
   };
   double kernel_ms = 0;
   for (const PassStats& p : r.passes) kernel_ms += p.kernel_ms;

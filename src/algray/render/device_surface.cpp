@@ -121,8 +121,11 @@ void DeviceSurface::set_extent_args(KernelBinder& args) const {
   args.real_vec("extent_centre", extent_.unit_centre());
   args.real("extent_inv_scale", 1 / extent_.unit_scale());
   args.real_vec("extent_box_half", extent_.unit_box_half());
-  args.plain("extent_kind",
-             static_cast<cl_int>(extent_.kind == ExtentKind::Sphere ? ALGRAY_EXTENT_SPHERE : ALGRAY_EXTENT_BOX));
+  // A cylinder's axis rides on its kind (kernels/algray_shared.h).
+  const cl_int kind = extent_.kind == ExtentKind::Sphere ? ALGRAY_EXTENT_SPHERE
+                      : extent_.kind == ExtentKind::Box  ? ALGRAY_EXTENT_BOX
+                                                         : ALGRAY_EXTENT_CYLINDER + extent_.axis;
+  args.plain("extent_kind", kind);
 }
 
 void DeviceSurface::set_surface_args(KernelBinder& args) const {

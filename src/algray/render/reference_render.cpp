@@ -92,6 +92,24 @@ bool extent_interval(const Extent& e, const PixelRay& ray, long double& t_in, lo
     if (!(disc > 0)) return false;
     t_in = std::max<R>(0, (-b - std::sqrt(disc)) / a);
     t_out = (-b + std::sqrt(disc)) / a;
+  } else if (e.kind == ExtentKind::Cylinder) {
+    // The slab between the caps, then the infinite cylinder's quadratic across the axis.
+    const int a = e.axis, i = a == 0 ? 1 : 0, j = a == 2 ? 1 : 2;
+    const R t0 = (R(e.centre[a]) - R(e.half_height) - o[a]) / d[a],
+            t1 = (R(e.centre[a]) + R(e.half_height) - o[a]) / d[a];
+    t_in = std::max<R>(0, std::min(t0, t1));
+    t_out = std::min(std::numeric_limits<R>::max(), std::max(t0, t1));
+    const R pi = o[i] - R(e.centre[i]), pj = o[j] - R(e.centre[j]);
+    const R qa = d[i] * d[i] + d[j] * d[j], qb = pi * d[i] + pj * d[j];
+    const R qc = pi * pi + pj * pj - R(e.radius) * R(e.radius);
+    if (qa == 0) {
+      if (qc > 0) return false;  // along the axis, outside it
+    } else {
+      const R disc = qb * qb - qa * qc;
+      if (!(disc > 0)) return false;
+      t_in = std::max(t_in, (-qb - std::sqrt(disc)) / qa);
+      t_out = std::min(t_out, (-qb + std::sqrt(disc)) / qa);
+    }
   } else {
     t_in = 0;
     t_out = std::numeric_limits<R>::max();

@@ -60,6 +60,10 @@ void multiply(Trivariate& p, const Coordinate& f, int times, Trivariate& scratch
 bool inside_extent(const glm::dvec3& u, const Extent& extent) {
   if (extent.kind == ExtentKind::Sphere) return glm::dot(u, u) <= 1;
   const glm::dvec3 half = extent.unit_box_half();
+  if (extent.kind == ExtentKind::Cylinder) {
+    const int a = extent.axis, i = a == 0 ? 1 : 0, j = a == 2 ? 1 : 2;
+    return u[i] * u[i] + u[j] * u[j] <= half[i] * half[i] && std::abs(u[a]) <= half[a];
+  }
   return std::abs(u.x) <= half.x && std::abs(u.y) <= half.y && std::abs(u.z) <= half.z;
 }
 

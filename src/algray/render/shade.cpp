@@ -71,6 +71,40 @@ const Material& Shader::material_of(const HitToShade& h) const {
 }
 
 void Shader::shade_hits(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const {
+  shade_lit(hits, count, shadows, out);
+  if (!scene_.sections.empty()) draw_sections(hits, count, out);
+}
+
+// A hit whose pixel the section's curve passes through takes the section's colour: |s(p)| within half the change
+// of s(p) = n.p + d from one pixel to the next along x or y (whichever is larger), which draws the curve as an
+// unbroken line one pixel wide, as a digital line is. Moving to the next pixel moves the ray by e = ou + t*du
+// (or ov + t*dv) times the samples per pixel at parameter t (docs/outputs.md), and its hit along the tangent
+// plane by e - d (N.e)/(N.d).
+void Shader::draw_sections(const HitToShade* hits, std::size_t count, glm::dvec3* out) const {
+  for (std::size_t i = 0; i < count; ++i) {
+    const HitRecord& h = *hits[i].hit;
+    const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
+    const glm::dvec3 d = hits[i].ray.direction, p = hits[i].ray.origin + t * d;
+    const glm::dvec3 normal(h.normal_x, h.normal_y, h.normal_z);
+    glm::dvec3 ex = double(samples_) * (basis_.ou + t * basis_.du), ey = double(samples_) * (basis_.ov + t * basis_.dv);
+    const double facing = glm::dot(normal, d);
+    // At the silhouette the hit runs off along the ray; the move across the image stands for it there.
+    if (std::fabs(facing) > 1e-3 * glm::length(d)) {
+      ex -= d * (glm::dot(normal, ex) / facing);
+      ey -= d * (glm::dot(normal, ey) / facing);
+    }
+    for (const Section& sec : scene_.sections) {
+      const glm::dvec3 n(sec.plane);
+      const double band = 0.5 * std::max(std::fabs(glm::dot(n, ex)), std::fabs(glm::dot(n, ey)));
+      if (std::fabs(glm::dot(n, p) + sec.plane.w) <= band) {
+        out[i] = sec.colour;
+        break;
+      }
+    }
+  }
+}
+
+void Shader::shade_lit(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const {
   if (lights_.empty()) {
     // The headlight: no lights, nothing to hide, the colour by how squarely the surface faces the eye.
     for (std::size_t i = 0; i < count; ++i) {

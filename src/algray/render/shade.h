@@ -76,6 +76,9 @@ class Shader {
   void shade_hits(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const;
 
  private:
+  // shade_hits' two steps: the lit colour, then the plane sections drawn over it.
+  void shade_lit(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const;
+  void draw_sections(const HitToShade* hits, std::size_t count, glm::dvec3* out) const;
   struct LightSamples {
     const Light* light;
     std::vector<glm::dvec3> points;

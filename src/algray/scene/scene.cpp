@@ -33,7 +33,8 @@ std::string format_what(const std::string& where, const std::string& message, co
 }
 
 const std::set<std::string> kTopKeys{"surface",  "parameters", "extent",    "camera", "image",
-                                     "material", "light",      "antialias", "render"};
+                                     "material", "light",      "antialias", "render", "section"};
+const std::set<std::string> kSectionKeys{"plane", "colour"};
 const std::set<std::string> kSurfaceKeys{"name", "equation", "terms", "material"};
 const std::set<std::string> kExtentKeys = [] {
   std::set<std::string> keys{"type"};
@@ -123,7 +124,9 @@ void exchange_camera_keys(toml::table& root, const std::string& key) {
 
 // --set extent.type=KIND: the keys of the other kinds are dropped, with a note, and the new kind's keys that are
 // missing are made from the old ones so that the same part of space stays in view: a sphere of radius R becomes
-// the cube of side 2R about its centre, and a box the sphere inscribed in its largest side.
+// the cube of side 2R about its centre, a box the sphere inscribed in its largest side, a sphere the cylinder
+// about z of the same radius and half_height R, a box the cylinder about z inscribed in its x and y sides with its
+// caps on the box's, and a cylinder the box around it.
 void switch_extent_kind(toml::table& root, const std::string& label, std::vector<std::string>& notes) {
   toml::table* extent = root["extent"].as_table();
   if (!extent) return;
@@ -136,16 +139,22 @@ void switch_extent_kind(toml::table& root, const std::string& label, std::vector
     for (const std::string& key : k.keys)
       if (std::find(to->keys.begin(), to->keys.end(), key) == to->keys.end() && extent->get(key))
         dropped.push_back(key);
-  if (dropped.empty()) return;
   std::string made;
   const auto centre = loose_vec3(extent->get("centre")).value_or(glm::dvec3(0));
   const auto radius = extent->get("radius") ? extent->get("radius")->value<double>() : std::nullopt;
+  const auto half_height = extent->get("half_height") ? extent->get("half_height")->value<double>() : std::nullopt;
+  const auto axis_name = extent->get("axis") ? extent->get("axis")->value<std::string>() : std::nullopt;
   const auto mn = loose_vec3(extent->get("min")), mx = loose_vec3(extent->get("max"));
   if (to->kind == ExtentKind::Box && radius && !extent->get("min") && !extent->get("max")) {
-    extent->insert("min", toml_array(centre - *radius));
-    extent->insert("max", toml_array(centre + *radius));
-    made = "; the box is the cube about the sphere, min = " + toml_vector(centre - *radius) +
-           ", max = " + toml_vector(centre + *radius);
+    glm::dvec3 half(*radius);
+    const int axis = axis_name && axis_name->size() == 1 && (*axis_name)[0] >= 'x' && (*axis_name)[0] <= 'z'
+                         ? (*axis_name)[0] - 'x'
+                         : 2;
+    if (half_height) half[axis] = *half_height;
+    extent->insert("min", toml_array(centre - half));
+    extent->insert("max", toml_array(centre + half));
+    made = std::string("; the box is the ") + (half_height ? "box around the cylinder" : "cube about the sphere") +
+           ", min = " + toml_vector(centre - half) + ", max = " + toml_vector(centre + half);
   } else if (to->kind == ExtentKind::Sphere && mn && mx && !extent->get("radius")) {
     const glm::dvec3 half = (*mx - *mn) * 0.5;
     const double r = std::max({half.x, half.y, half.z});
@@ -153,6 +162,25 @@ void switch_extent_kind(toml::table& root, const std::string& label, std::vector
     extent->insert("radius", r);
     made = "; the sphere is centre = " + toml_vector((*mn + *mx) * 0.5) + ", radius = " + toml_number(r);
     dropped.erase(std::remove(dropped.begin(), dropped.end(), "centre"), dropped.end());
+  } else if (to->kind == ExtentKind::Cylinder && !extent->get("half_height")) {
+    if (mn && mx && !extent->get("radius")) {
+      const glm::dvec3 half = (*mx - *mn) * 0.5;
+      extent->insert_or_assign("centre", toml_array((*mn + *mx) * 0.5));
+      extent->insert("radius", std::max(half.x, half.y));
+      extent->insert("half_height", half.z);
+      made = "; the cylinder is centre = " + toml_vector((*mn + *mx) * 0.5) +
+             ", radius = " + toml_number(std::max(half.x, half.y)) +
+             ", axis = \"z\", half_height = " + toml_number(half.z);
+      dropped.erase(std::remove(dropped.begin(), dropped.end(), "centre"), dropped.end());
+    } else if (radius) {
+      extent->insert("half_height", *radius);
+      made = "; the cylinder is about " + std::string(axis_name ? *axis_name : "z") +
+             " with half_height = " + toml_number(*radius);
+    }
+  }
+  if (dropped.empty()) {
+    if (!made.empty()) notes.push_back(label + ": " + made.substr(2));
+    return;
   }
   std::string names;
   for (const std::string& key : dropped) {
@@ -430,25 +458,57 @@ std::vector<const toml::table*> read_surfaces(const TomlReader& r, const toml::t
   return surface_tables;
 }
 
-void read_sphere_extent(const TomlReader& r, const toml::table& extent, Extent& out) {
-  out.kind = ExtentKind::Sphere;
-  for (const char* k : {"min", "max"})
-    if (const toml::node* n = extent.get(k))
-      r.fail(n->source(), std::string("extent.") + k + " belongs to a box extent");
+// A key of another kind (extent_kinds()) is refused, naming the first kind it belongs to.
+void refuse_other_kinds_keys(const TomlReader& r, const toml::table& extent, ExtentKind kind) {
+  const auto own = std::find_if(extent_kinds().begin(), extent_kinds().end(),
+                                [&](const ExtentKindInfo& k) { return k.kind == kind; });
+  for (const ExtentKindInfo& k : extent_kinds())
+    for (const std::string& key : k.keys)
+      if (const toml::node* n = extent.get(key);
+          n && std::find(own->keys.begin(), own->keys.end(), key) == own->keys.end())
+        r.fail(n->source(), "extent." + key + " belongs to a " + k.name + " extent");
+}
+
+// The centre and radius a sphere and a cylinder share.
+void read_round_extent(const TomlReader& r, const toml::table& extent, Extent& out) {
+  refuse_other_kinds_keys(r, extent, out.kind);
   if (const toml::node* n = extent.get("centre")) out.centre = r.vec3(*n, "extent.centre");
   const toml::node* radius = extent.get("radius");
-  if (!radius) r.fail(extent.source(), "a sphere extent needs a radius");
+  if (!radius)
+    r.fail(extent.source(),
+           std::string("a ") + (out.kind == ExtentKind::Sphere ? "sphere" : "cylinder") + " extent needs a radius");
   out.radius = r.coordinate(*radius, "extent.radius");
   if (out.radius <= 0) r.fail(radius->source(), "the extent is empty: radius must be positive");
   if (out.radius < 1 / kMaxCoordinate)
     r.fail(radius->source(), "the extent is too small to render: its radius must be at least 1e-18");
 }
 
+void read_sphere_extent(const TomlReader& r, const toml::table& extent, Extent& out) {
+  out.kind = ExtentKind::Sphere;
+  read_round_extent(r, extent, out);
+}
+
+// A cylinder: a sphere's centre and radius, an axis "x", "y" or "z" (z unless given) and the caps' half_height.
+void read_cylinder_extent(const TomlReader& r, const toml::table& extent, Extent& out) {
+  out.kind = ExtentKind::Cylinder;
+  read_round_extent(r, extent, out);
+  out.axis = 2;
+  if (const toml::node* n = extent.get("axis")) {
+    const std::string axis = r.string(*n, "extent.axis");
+    if (axis != "x" && axis != "y" && axis != "z") r.fail(n->source(), "extent.axis must be \"x\", \"y\" or \"z\"");
+    out.axis = axis[0] - 'x';
+  }
+  const toml::node* half = extent.get("half_height");
+  if (!half) r.fail(extent.source(), "a cylinder extent needs a half_height");
+  out.half_height = r.coordinate(*half, "extent.half_height");
+  if (out.half_height <= 0) r.fail(half->source(), "the extent is empty: half_height must be positive");
+  if (out.half_height < 1 / kMaxCoordinate)
+    r.fail(half->source(), "the extent is too small to render: its half_height must be at least 1e-18");
+}
+
 void read_box_extent(const TomlReader& r, const toml::table& extent, Extent& out) {
   out.kind = ExtentKind::Box;
-  for (const char* k : {"centre", "radius"})
-    if (const toml::node* n = extent.get(k))
-      r.fail(n->source(), std::string("extent.") + k + " belongs to a sphere extent");
+  refuse_other_kinds_keys(r, extent, out.kind);
   const toml::node* mn = extent.get("min");
   const toml::node* mx = extent.get("max");
   if (!mn || !mx) r.fail(extent.source(), "a box extent needs min and max");
@@ -483,6 +543,8 @@ void read_extent(const TomlReader& r, const toml::table& root, Extent& out) {
     read_sphere_extent(r, *extent, out);
   else if (type == "box")
     read_box_extent(r, *extent, out);
+  else if (type == "cylinder")
+    read_cylinder_extent(r, *extent, out);
   else
     r.fail(extent->get("type")->source(), "extent.type must be " + extent_kind_choices());
 }
@@ -608,6 +670,30 @@ void read_lights(const TomlReader& r, const toml::table& root, const CameraSpec&
   for (const toml::node& node : *list) out.push_back(read_light(r, *node.as_table(), camera));
 }
 
+// [[section]] tables: plane = [a, b, c, d] (a plane: (a, b, c) not zero) and an optional colour.
+void read_sections(const TomlReader& r, const toml::table& root, std::vector<Section>& out) {
+  const toml::node* sections = root.get("section");
+  if (!sections) return;
+  const toml::array* list = sections->as_array();
+  if (!list || !list->is_array_of_tables())
+    r.fail(sections->source(), "plane sections are written as [[section]] tables, one per plane");
+  for (const toml::node& node : *list) {
+    const toml::table& t = *node.as_table();
+    r.check_keys(t, "section", kSectionKeys);
+    Section s;
+    const toml::node* plane = t.get("plane");
+    if (!plane) r.fail(t.source(), "a section needs plane = [a, b, c, d] (the plane a*x + b*y + c*z + d = 0)");
+    const toml::array* a = plane->as_array();
+    if (!a || a->size() != 4) r.fail(plane->source(), "section.plane must be an array of 4 numbers [a, b, c, d]");
+    for (int i = 0; i < 4; ++i)
+      s.plane[i] = r.coordinate(*a->get(static_cast<std::size_t>(i)), "section.plane[" + std::to_string(i) + "]");
+    if (s.plane.x == 0 && s.plane.y == 0 && s.plane.z == 0)
+      r.fail(plane->source(), "section.plane is no plane: a, b and c are all 0");
+    if (const toml::node* c = t.get("colour")) s.colour = glm::dvec3(r.colour(*c, "section.colour", false));
+    out.push_back(s);
+  }
+}
+
 void read_antialias(const TomlReader& r, const toml::table& root, Antialias& out) {
   const toml::table* aa = r.subtable(root, "antialias");
   if (!aa) return;
@@ -693,6 +779,7 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
   read_image(r, root, scene.image);
   read_surface_materials(r, root, surface_tables, scene.surfaces);
   read_lights(r, root, scene.camera, scene.lights);
+  read_sections(r, root, scene.sections);
   if (framed && !root.get("light")) scene.lights = framing_lights(scene.extent.unit_scale(), scene.camera);
   if (framed && !root.get("antialias")) scene.antialias.samples = 2;
   read_antialias(r, root, scene.antialias);
@@ -708,12 +795,27 @@ SceneError::SceneError(std::string where_, std::string message_, std::string exc
       message(std::move(message_)),
       excerpt(std::move(excerpt_)) {}
 
-glm::dvec3 Extent::unit_centre() const { return kind == ExtentKind::Sphere ? centre : (min + max) * 0.5; }
+glm::dvec3 Extent::unit_centre() const { return kind == ExtentKind::Box ? (min + max) * 0.5 : centre; }
 
-double Extent::unit_scale() const { return kind == ExtentKind::Sphere ? radius : glm::length(max - min) * 0.5; }
+// A cylinder's scale is the distance from its centre to a cap's rim, so that it fits in |u| <= 1.
+double Extent::unit_scale() const {
+  switch (kind) {
+    case ExtentKind::Sphere:
+      return radius;
+    case ExtentKind::Box:
+      return glm::length(max - min) * 0.5;
+    case ExtentKind::Cylinder:
+      break;
+  }
+  return std::hypot(radius, half_height);
+}
 
 glm::dvec3 Extent::unit_box_half() const {
-  return kind == ExtentKind::Box ? (max - min) * 0.5 / unit_scale() : glm::dvec3(1);
+  if (kind == ExtentKind::Box) return (max - min) * 0.5 / unit_scale();
+  if (kind == ExtentKind::Sphere) return glm::dvec3(1);
+  glm::dvec3 half(radius / unit_scale());
+  half[axis] = half_height / unit_scale();
+  return half;
 }
 
 std::vector<glm::dvec3> Light::sample_points() const {
@@ -914,8 +1016,12 @@ std::string scene_to_toml(const Scene& scene) {
   if (e.kind == ExtentKind::Sphere)
     out << "\n[extent]\ntype = \"sphere\"\ncentre = " << toml_vector(e.centre) << "\nradius = " << toml_number(e.radius)
         << "\n";
-  else
+  else if (e.kind == ExtentKind::Box)
     out << "\n[extent]\ntype = \"box\"\nmin = " << toml_vector(e.min) << "\nmax = " << toml_vector(e.max) << "\n";
+  else
+    out << "\n[extent]\ntype = \"cylinder\"\ncentre = " << toml_vector(e.centre)
+        << "\nradius = " << toml_number(e.radius) << "\naxis = \""
+        << "xyz"[e.axis] << "\"\nhalf_height = " << toml_number(e.half_height) << "\n";
   const CameraSpec& c = scene.camera;
   const bool perspective = c.projection == Projection::Perspective;
   out << "\n[camera]\n";
@@ -946,6 +1052,10 @@ std::string scene_to_toml(const Scene& scene) {
     out << "colour = " << toml_vector(world.colour) << "\nintensity = " << toml_number(world.intensity)
         << "\nshadows = " << (world.shadows ? "true" : "false") << "\n";
   }
+  for (const Section& sec : scene.sections)
+    out << "\n[[section]]\nplane = [" << toml_number(sec.plane.x) << ", " << toml_number(sec.plane.y) << ", "
+        << toml_number(sec.plane.z) << ", " << toml_number(sec.plane.w) << "]\ncolour = " << toml_vector(sec.colour)
+        << "\n";
   const Antialias& aa = scene.antialias;
   out << "\n[antialias]\nsamples = " << aa.samples << "\nadaptive = " << (aa.adaptive ? "true" : "false")
       << "\nthreshold = " << toml_number(aa.threshold) << "\n";

@@ -21,19 +21,20 @@ struct SceneError : std::runtime_error {
   std::string where, message, excerpt;
 };
 
-enum class ExtentKind { Sphere, Box };
+enum class ExtentKind { Sphere, Box, Cylinder };
 
 // The extent kinds: the name extent.type takes and the keys that belong to each, besides type. One row per kind,
-// read by the scene reader and by --set extent.type, which drops the keys of the other kinds (with a note). A
-// cylinder is a row here, its fields in Extent, its reading in scene.cpp, and its clipping in the kernels.
+// read by the scene reader and by --set extent.type, which drops the keys of the other kinds (with a note).
 struct ExtentKindInfo {
   ExtentKind kind;
   const char* name;
   std::vector<std::string> keys;
 };
 inline const std::vector<ExtentKindInfo>& extent_kinds() {
-  static const std::vector<ExtentKindInfo> kinds{{ExtentKind::Sphere, "sphere", {"centre", "radius"}},
-                                                 {ExtentKind::Box, "box", {"min", "max"}}};
+  static const std::vector<ExtentKindInfo> kinds{
+      {ExtentKind::Sphere, "sphere", {"centre", "radius"}},
+      {ExtentKind::Box, "box", {"min", "max"}},
+      {ExtentKind::Cylinder, "cylinder", {"centre", "radius", "axis", "half_height"}}};
   return kinds;
 }
 
@@ -45,11 +46,24 @@ struct Extent {
   glm::dvec3 centre{0};  // sphere
   double radius = 1;
   glm::dvec3 min{-1}, max{1};  // box
+  // cylinder: centre and radius as a sphere's, about the coordinate axis `axis` (0 x, 1 y, 2 z; "z" unless given),
+  // its caps half_height either side of the centre along that axis
+  int axis = 2;
+  double half_height = 1;
 
   // The kernels work in u = (p - unit_centre()) / unit_scale(), where the extent fits in |u| <= 1.
   glm::dvec3 unit_centre() const;
   double unit_scale() const;
-  glm::dvec3 unit_box_half() const;  // box half-sizes in unit coordinates
+  // Box half-sizes in unit coordinates; for a cylinder, those of the box around it (radius across, half_height
+  // along its axis), from which the kernels take the cylinder (kernels/ray.h).
+  glm::dvec3 unit_box_half() const;
+};
+
+// A plane section, surf's cut_with_plane: the curve where the plane a*x + b*y + c*z + d = 0 meets the surface,
+// drawn over the shading in `colour` as a line one pixel wide (shade.cpp).
+struct Section {
+  glm::dvec4 plane{0, 0, 1, 0};  // a, b, c, d
+  glm::dvec3 colour{0.05, 0.05, 0.05};
 };
 
 struct ImageSpec {
@@ -158,6 +172,7 @@ struct Scene {
   CameraSpec camera;
   ImageSpec image;
   std::vector<Light> lights;  // none: a headlight at the eye shades the surface, without shadows
+  std::vector<Section> sections;  // plane sections drawn on the surface ([[section]])
   Antialias antialias;
   RenderSettings render;
   // What the scene's reader could not render as written (a .jsurf feature algray draws differently, an unknown
