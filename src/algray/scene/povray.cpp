@@ -645,11 +645,20 @@ class PovReader {
   // --- objects ---
   Clip clip_shape(const Token& at, glm::dmat4& own) {
     const Token shape = next();
-    if (shape.kind != Token::Name || (shape.text != "sphere" && shape.text != "box"))
+    if (shape.kind != Token::Name || (shape.text != "sphere" && shape.text != "box" && shape.text != "object"))
       fail(shape, std::string(at.text) + " takes a sphere or a box here; algray clips to one of those");
     expect("{", "'{'");
     Clip c;
-    if (shape.text == "sphere") {
+    if (shape.text == "object") {  // object { NAME ... } of a declared box or sphere
+      const Token name = next();
+      const auto d = declared_clips_.find(name.text);
+      if (d == declared_clips_.end()) {
+        if (name.kind == Token::Name && !declared_objects_.count(name.text)) unusable(name);
+        fail(name, std::string(at.text) + " takes a sphere or a box here; algray clips to one of those");
+      }
+      c = d->second.first;
+      own = d->second.second;
+    } else if (shape.text == "sphere") {
       c.centre = vector3();
       optional_comma();
       c.radius = number();
@@ -787,6 +796,34 @@ class PovReader {
       modifiers(members, kind);
       return;
     }
+    if (kind.text == "intersection") {
+      // POV-Ray's samples cut a surface with a Clear sphere or box: read as the surface clipped to that region.
+      warn(kind, "intersection is read as its algebraic objects clipped by its spheres and boxes; the cut faces "
+                 "are not drawn (POV-Ray's samples make them Clear)");
+      const std::size_t first = out.size();
+      std::vector<std::pair<Clip, glm::dmat4>> clips;
+      while (peek().kind == Token::Name && at_op("{", 1)) {
+        const std::string w = peek().text;
+        if (w == "sphere" || w == "box" || (w == "object" && declared_clips_.count(peek(2).text))) {
+          glm::dmat4 own(1);
+          const Clip c = clip_shape(kind, own);
+          clips.push_back({c, own});
+        } else if (is_object(w)) {
+          object(next(), out);
+        } else {
+          break;
+        }
+      }
+      if (out.size() == first) fail(kind, "this intersection holds no algebraic object algray reads");
+      if (clips.empty()) fail(kind, "this intersection has no sphere or box to cut its objects with");
+      std::vector<Object*> members;
+      for (std::size_t i = first; i < out.size(); ++i) {
+        out[i].clips.insert(out[i].clips.end(), clips.begin(), clips.end());
+        members.push_back(&out[i]);
+      }
+      modifiers(members, kind);
+      return;
+    }
     if (kind.text == "object") {  // object { NAME modifiers } or object { OBJECT modifiers }
       const std::size_t first = out.size();
       const Token name = next();
@@ -861,7 +898,7 @@ class PovReader {
   }
   static bool is_object(const std::string& w) {
     return w == "sphere" || w == "torus" || w == "poly" || w == "polynomial" || w == "quartic" || w == "cubic" ||
-           w == "union" || w == "merge" || w == "object";
+           w == "union" || w == "merge" || w == "object" || w == "intersection";
   }
 
   // --- scene items ---
@@ -1006,9 +1043,10 @@ class PovReader {
     if (at_op(";")) next();
   }
   bool is_declared(const std::string& name) const {
-    return declared_.count(name) || declared_objects_.count(name) || unread_.count(name);
+    return declared_.count(name) || declared_objects_.count(name) || unread_.count(name) || declared_clips_.count(name);
   }
   void forget(const std::string& name) {
+    declared_clips_.erase(name);
     declared_.erase(name);
     declared_objects_.erase(name);
     unread_.erase(name);
@@ -1024,6 +1062,20 @@ class PovReader {
     if (value.kind == Token::Name && colour_words.count(value.text)) {
       const glm::dvec3 c = colour(name);
       declared_[name.text] = {c.x, c.y, c.z};
+    } else if (value.kind == Token::Name && value.text == "box" && at_op("{", 1)) {
+      // A box is no surface here, but clips one: intersection { OBJECT object { NAME } } and bounded_by use it.
+      const std::size_t start = pos_;
+      try {
+        glm::dmat4 own(1);
+        const Clip c = clip_shape(name, own);
+        declared_clips_[name.text] = {c, own};
+      } catch (const SceneError& e) {
+        if (d.file == 0) throw;
+        pos_ = start;
+        unread_[name.text] = {name, "a box algray cannot read (" + e.where + ": " + e.message + ")"};
+        skip_value();
+        return;
+      }
     } else if (value.kind == Token::Name && is_object(value.text) && at_op("{", 1) && d.file != 0) {
       // An include file's object this reader cannot read is an error only where the scene uses it.
       const std::size_t start = pos_;
@@ -1257,6 +1309,7 @@ class PovReader {
   std::size_t pos_ = 0;
   std::map<std::string, Vec> declared_;
   std::map<std::string, std::vector<Object>> declared_objects_;
+  std::map<std::string, std::pair<Clip, glm::dmat4>> declared_clips_;  // declared boxes, with their transforms
   std::map<std::string, std::pair<Token, std::string>> unread_;  // name: where declared, and what it is
   bool missing_include_ = false;
   bool quiet_ = false;  // warnings are dropped (reading an include file's declarations)
