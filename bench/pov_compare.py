@@ -233,7 +233,10 @@ def summary(rows, what, w, h, far, every=False):
         elif low:
             text += f"; IoU under {SHOWN_BELOW}: " + ", ".join(f"{r[0]} {r[1]:.4f}" for r in low)
     if failed:
-        text += "; algray refuses: " + ", ".join(f"{r[0]} ({r[4]})" for r in failed)
+        def short(note):  # the message without its place (the scene is named) and at most 90 characters
+            note = note.split(": error: ", 1)[-1]
+            return note if len(note) <= 90 else note[:87] + "..."
+        text += "; refused: " + ", ".join(f"{r[0]} ({short(r[4])})" for r in failed)
     return text + "."
 
 

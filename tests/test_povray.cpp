@@ -318,3 +318,19 @@ TEST_CASE("#include's errors are located in the include file, and it reads only 
   CHECK(error_of("#end\n").where == "bad.pov:1:1");
   CHECK_THAT(error_of("sphere { 0, 1 }\n#fopen F \"x\" read\n").message, Catch::Contains("#fopen is not read"));
 }
+
+TEST_CASE("intersection with a sphere or a box reads as the object clipped to it, with a warning", "[povray]") {
+  // POV-Ray's samples cut a quartic with a Clear sphere; algray draws the surface within it, not the cut face.
+  const Scene cut = pov_scene("intersection { torus { 1, 0.4 } sphere { 0, 1.2 pigment { rgbf 1 } }\n"
+                              "  pigment { rgb 1 } rotate -90*x }\n");
+  REQUIRE(cut.surfaces.size() == 1);
+  CHECK(any_contains(cut.warnings, "test.pov:3:1: intersection is read as its algebraic objects clipped"));
+  const Scene clipped = pov_scene("torus { 1, 0.4 clipped_by { sphere { 0, 1.2 } } pigment { rgb 1 } rotate -90*x }\n");
+  CHECK(coverage(cut).count == coverage(clipped).count);
+  CHECK(error_of("intersection { torus { 1, 0.4 } }\n").message.find("no sphere or box") != std::string::npos);
+  // A declared box turned off the axes: located at the object it would clip.
+  const SceneError turned =
+      error_of("#declare B = box { -1, 1 }\nintersection { torus { 1, 0.4 } object { B rotate 30*y } }\n");
+  CHECK(turned.where == "bad.pov:2:16");
+  CHECK_THAT(turned.message, Catch::Contains("turned off the axes"));
+}
