@@ -284,7 +284,7 @@ def main():
                              "finish { ambient 1 diffuse 0 } }")
             depth_text = text
             if sample:
-                depth_text = remove_blocks(depth_text, r"\btexture\s*\{(?![^{}]*\{\s*Clear\s*\})")
+                depth_text = remove_blocks(depth_text, r"\btexture(?=\s*\{(?![^{}]*\{\s*Clear\s*\}))")
                 depth_text = remove_blocks(depth_text, r"\b(pigment(?!\s*\{\s*Clear\s*\})|finish)")
             deep.write_text(re.sub(r"background\s*\{[^}]*\}", "", depth_text).replace(
                 "//@depth", depth_texture + " interior_texture { " + depth_texture[len("texture { "):]))
