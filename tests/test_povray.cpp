@@ -52,6 +52,16 @@ Coverage coverage(const Scene& scene) {
   return c;
 }
 
+SceneError error_of_at(const std::string& text, const std::string& source) {
+  try {
+    load_povray_text(text, source);
+  } catch (const SceneError& e) {
+    return e;
+  }
+  FAIL("no error for:\n" << text);
+  return SceneError("", "");
+}
+
 SceneError error_of(const std::string& text) {
   try {
     load_povray_text(text, "bad.pov");
@@ -196,9 +206,11 @@ TEST_CASE("bad POV-Ray scenes get located errors; what is skipped, located warni
   CHECK(error_of("poly { 2, <1, 2, 3> }\n").where == "bad.pov:1:11");
   CHECK(error_of("poly { 40, <1> }\n").where == "bad.pov:1:1");
   CHECK(error_of("camera { fisheye }\nsphere { 0, 1 }\n").where == "bad.pov:1:10");
-  CHECK(error_of("#macro M() #end\n").where == "bad.pov:1:1");
+  CHECK(error_of("#fopen F \"x\" read\n").where == "bad.pov:1:1");
+  CHECK(error_of("#macro M() #end\nsphere { 0, M() }\n").where == "bad.pov:2:13");  // skipped, then named
   CHECK(error_of("sphere { 0, Radius }\n").where == "bad.pov:1:13");
-  CHECK(error_of("object { Thing }\n").where == "bad.pov:1:1");
+  CHECK(error_of("object { Thing }\n").where == "bad.pov:1:10");
+  CHECK_THAT(error_of("object { Thing }\n").message, Catch::Contains("'Thing' is not declared"));
   CHECK(error_of("camera { location 0 }\n").message.find("no object") != std::string::npos);
   CHECK(error_of("sphere { 0, 1 } /* open\n").where == "bad.pov:1:17");
   // A dense poly of degree 32 moved by a transform is refused at the budget, where it is, in well under a second.
@@ -208,11 +220,11 @@ TEST_CASE("bad POV-Ray scenes get located errors; what is skipped, located warni
   CHECK(big.where == "bad.pov:2:2");
   CHECK_THAT(big.message, Catch::Contains("too large to expand"));
   const auto w = load_povray_text(
-                     "#include \"colors.inc\"\nplane { y, -1 }\nsphere { 0, 1 finish { reflection 0.3 } }\n"
+                     "#include \"nowhere47.inc\"\nplane { y, -1 }\nsphere { 0, 1 finish { reflection 0.3 } }\n"
                      "media { }\n",
                      "w.pov")
                      .warnings;
-  CHECK(any_contains(w, "w.pov:1:1: #include \"colors.inc\" is ignored"));
+  CHECK(any_contains(w, "w.pov:1:1: #include \"nowhere47.inc\" is not found"));
   CHECK(any_contains(w, "w.pov:2:1: 'plane' is ignored"));
   CHECK(any_contains(w, "w.pov:3:24: finish 'reflection' is ignored"));
   CHECK(any_contains(w, "w.pov:4:1: 'media' is ignored"));
@@ -222,6 +234,7 @@ TEST_CASE("every scene of tests/data/pov reads, and one renders from the command
   int scenes = 0;
   for (const auto& entry : std::filesystem::directory_iterator(ALGRAY_SOURCE_DIR "/tests/data/pov")) {
     CAPTURE(entry.path().string());
+    if (entry.path().extension() != ".pov") continue;  // include/ holds the scenes' .inc files
     const Scene s = load_scene_file(entry.path().string());
     CHECK_FALSE(s.surfaces.empty());
     CHECK(s.warnings.empty());
@@ -239,4 +252,85 @@ TEST_CASE("every scene of tests/data/pov reads, and one renders from the command
   CHECK(b.exit_code == 2);
   CHECK_THAT(b.err, Catch::Contains("bad.pov:2:"));
   CHECK_FALSE(std::filesystem::exists(box.work / "bad.png"));
+}
+
+TEST_CASE("#include reads a .inc file in place: its colours, floats and declared objects", "[povray]") {
+  // The scene's directory is searched first: the include is tests/data/pov/include/shapes47.inc.
+  const std::string scene_path = ALGRAY_SOURCE_DIR "/tests/data/pov/inline.pov";
+  auto scene = [&](const std::string& body) {
+    return load_povray_text("camera { location <0, 0, -10> look_at <0, 0, 0> angle 60 }\n"
+                            "light_source { <0, 0, -100> color rgb 1 }\n#include \"include/shapes47.inc\"\n" + body,
+                            scene_path,
+                            {{"image.width", std::to_string(kWidth)},
+                             {"image.height", std::to_string(kHeight)},
+                             {"antialias.samples", "1"}});
+  };
+  // Ring47 is torus { 1, 0.4 } written as a quartic: declared, then placed twice by object { }.
+  const Scene declared = scene("object { Ring47 pigment { Gold47 } rotate -90*x translate 2*x }\n");
+  REQUIRE(declared.surfaces.size() == 1);
+  CHECK(declared.warnings.empty());
+  const Coverage ring = coverage(declared);
+  const Coverage torus = coverage(pov_scene("torus { 1, 0.4 rotate -90*x translate 2*x pigment { rgb 1 } }\n"));
+  CHECK(ring.count > 300);
+  CHECK(ring.count == Approx(torus.count).epsilon(0.01));
+  CHECK(ring.x == Approx(2).margin(0.05));
+  // A declared object in a union, and a declared object declared again with its own transform.
+  // (Turned about y, so that both keep the one bounding sphere algray clips a scene to.)
+  const Scene two = scene("#declare Turned = object { Ring47 rotate 90*y }\n"
+                          "union { object { Turned } object { Ring47 } pigment { Gold47 } }\n");
+  CHECK(two.surfaces.size() == 2);
+  // The include's float is a float here; its macro and texture are named for what they are.
+  CHECK(scene("sphere { 0, Radius47 pigment { Gold47 } }\n").surfaces.size() == 1);
+  const SceneError macro = error_of_at("#include \"include/shapes47.inc\"\nsphere { 0, Twice47(1) }\n", scene_path);
+  CHECK(macro.where == scene_path + ":2:13");
+  CHECK_THAT(macro.message, Catch::Contains("'Twice47' is a macro (declared at " ALGRAY_SOURCE_DIR
+                                            "/tests/data/pov/include/shapes47.inc:14:8)"));
+  const SceneError texture = error_of_at("#include \"include/shapes47.inc\"\nobject { Skin47 }\n", scene_path);
+  CHECK(texture.where == scene_path + ":2:10");
+  CHECK_THAT(texture.message, Catch::Contains("'Skin47' is a texture"));
+}
+
+TEST_CASE("#include's errors are located in the include file, and it reads only .inc files, never forever",
+          "[povray]") {
+  const std::string scene_path = ALGRAY_SOURCE_DIR "/tests/data/pov/inline.pov";
+  const std::string include_dir = ALGRAY_SOURCE_DIR "/tests/data/pov/include/";
+  // broken47.inc's fourth line declares a negative colour.
+  const SceneError broken = error_of_at("#include \"include/broken47.inc\"\n", scene_path);
+  CHECK(broken.where == include_dir + "broken47.inc:4:10");
+  CHECK_THAT(broken.message, Catch::Contains("colour components must not be negative"));
+  CHECK_THAT(broken.excerpt, Catch::Contains("#declare Bad47"));
+  // loop47.inc includes itself: stopped at the depth limit, in the include.
+  const SceneError loop = error_of_at("#include \"include/loop47.inc\"\n", scene_path);
+  CHECK(loop.where.rfind(include_dir + "loop47.inc:2:1", 0) == 0);
+  CHECK_THAT(loop.message, Catch::Contains("nested more than 16 deep"));
+  // Other files and other directories are not read.
+  const SceneError pov = error_of_at("#include \"torus.pov\"\n", scene_path);
+  CHECK(pov.where == scene_path + ":1:10");
+  CHECK_THAT(pov.message, Catch::Contains("reads .inc files"));
+  const SceneError up = error_of_at("#include \"../pov/include/shapes47.inc\"\n", scene_path);
+  CHECK(up.where == scene_path + ":1:10");
+  const SceneError absolute = error_of_at("#include \"" + include_dir + "shapes47.inc\"\n", scene_path);
+  CHECK(absolute.where == scene_path + ":1:10");
+  // A scene given as text alone has no directory: its includes come from POV-Ray's directory only.
+  const auto w = load_povray_text("#include \"include/shapes47.inc\"\nsphere { 0, 1 }\n", "w.pov").warnings;
+  CHECK(any_contains(w, "w.pov:1:1: #include \"include/shapes47.inc\" is not found"));
+  // An unmatched #end and an unknown directive are located too.
+  CHECK(error_of("#end\n").where == "bad.pov:1:1");
+  CHECK_THAT(error_of("sphere { 0, 1 }\n#fopen F \"x\" read\n").message, Catch::Contains("#fopen is not read"));
+}
+
+TEST_CASE("intersection with a sphere or a box reads as the object clipped to it, with a warning", "[povray]") {
+  // POV-Ray's samples cut a quartic with a Clear sphere; algray draws the surface within it, not the cut face.
+  const Scene cut = pov_scene("intersection { torus { 1, 0.4 } sphere { 0, 1.2 pigment { rgbf 1 } }\n"
+                              "  pigment { rgb 1 } rotate -90*x }\n");
+  REQUIRE(cut.surfaces.size() == 1);
+  CHECK(any_contains(cut.warnings, "test.pov:3:1: intersection is read as its algebraic objects clipped"));
+  const Scene clipped = pov_scene("torus { 1, 0.4 clipped_by { sphere { 0, 1.2 } } pigment { rgb 1 } rotate -90*x }\n");
+  CHECK(coverage(cut).count == coverage(clipped).count);
+  CHECK(error_of("intersection { torus { 1, 0.4 } }\n").message.find("no sphere or box") != std::string::npos);
+  // A declared box turned off the axes: located at the object it would clip.
+  const SceneError turned =
+      error_of("#declare B = box { -1, 1 }\nintersection { torus { 1, 0.4 } object { B rotate 30*y } }\n");
+  CHECK(turned.where == "bad.pov:2:16");
+  CHECK_THAT(turned.message, Catch::Contains("turned off the axes"));
 }

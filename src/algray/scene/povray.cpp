@@ -14,12 +14,25 @@
 // - The camera: direction <0, 0, 1>, right <1.33, 0, 0>, up and sky <0, 1, 0> by default; angle is the horizontal
 //   field of view and sets direction's length to |right| / 2 / tan(angle / 2). The view spans |right| across and
 //   |up| down at distance |direction|, whatever the image's size.
+// - #include "name.inc" reads the file in place; POV-Ray's own includes (colors.inc, shapesq.inc, ...) declare
+//   colours, objects and macros with #declare, #macro and #ifndef guards.
+//
+// Where #include looks, in order: the scene's own directory (when the scene is a file), each directory of the
+// ALGRAY_POV_INCLUDE environment variable (':'-separated, like povray's +L), then POV-Ray's include directory
+// (/usr/share/povray-3.7/include, Debian's povray-includes). Only names ending in .inc, relative and without '..',
+// are looked up, at most kMaxIncludeDepth deep and kMaxIncludes files in all: a scene cannot read other files or
+// include itself forever. Inside included files, declarations the reader cannot use (textures, macros, other
+// objects) are skipped silently; using one of their names is a located error naming where it was declared.
 #include "algray/scene/povray.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <glm/glm.hpp>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -33,12 +46,16 @@ namespace algray {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr int kMaxIncludeDepth = 16;         // POV-Ray's own includes nest 3 deep
+constexpr int kMaxIncludes = 256;            // files read in all, repeats counted
+constexpr std::size_t kMaxTokens = 1 << 22;  // tokens of all files together
 
 struct Token {
   enum Kind { Name, Number, String, Directive, Op, End } kind = End;
   std::string text;
   double number = 0;
   int line = 1, column = 1;
+  int file = 0;  // index into the reader's files: 0 the scene, then each #include as read
 };
 
 using Vec = std::vector<double>;  // a float is one component
@@ -78,21 +95,39 @@ struct PovLight {
 class PovReader {
  public:
   PovReader(const std::string& text, std::string source, std::vector<std::string>& warnings, int width, int height)
-      : text_(text, std::move(source)), source_(text_.source()), warnings_(warnings), width_(width), height_(height) {
-    tokenize(text);
+      : warnings_(warnings), width_(width), height_(height) {
+    const std::filesystem::path dir = std::filesystem::path(source).parent_path();
+    if (!dir.empty()) include_dirs_.push_back(dir);
+    if (const char* extra = std::getenv("ALGRAY_POV_INCLUDE")) {
+      std::string list = extra;
+      for (std::size_t start = 0; start <= list.size();) {
+        const std::size_t end = std::min(list.find(':', start), list.size());
+        if (end > start) include_dirs_.emplace_back(list.substr(start, end - start));
+        start = end + 1;
+      }
+    }
+    include_dirs_.emplace_back("/usr/share/povray-3.7/include");
+    files_.push_back({std::make_unique<LocatedText>(text, std::move(source)), 0});
+    tokens_ = tokenize(text, 0);
   }
 
   PovTranslation run();
 
  private:
   // --- messages ---
-  std::string where(const Token& t) const { return text_.where(t.line, t.column); }
-  std::string excerpt(const Token& t) const { return text_.excerpt(t.line, t.column); }
-  [[noreturn]] void fail(const Token& t, const std::string& message) const { text_.fail(t.line, t.column, message); }
-  void warn(const Token& t, const std::string& message) { warnings_.push_back(where(t) + ": " + message); }
+  const LocatedText& text_of(const Token& t) const { return *files_[static_cast<std::size_t>(t.file)].text; }
+  std::string where(const Token& t) const { return text_of(t).where(t.line, t.column); }
+  std::string excerpt(const Token& t) const { return text_of(t).excerpt(t.line, t.column); }
+  [[noreturn]] void fail(const Token& t, const std::string& message) const {
+    text_of(t).fail(t.line, t.column, message);
+  }
+  void warn(const Token& t, const std::string& message) {
+    if (!quiet_) warnings_.push_back(where(t) + ": " + message);
+  }
 
   // --- tokens ---
-  void tokenize(const std::string& text) {
+  std::vector<Token> tokenize(const std::string& text, int file) {
+    std::vector<Token> tokens;
     int line = 1, column = 1;
     std::size_t i = 0;
     auto advance = [&](std::size_t n) {
@@ -115,7 +150,7 @@ class PovReader {
         while (i < text.size() && text[i] != '\n') advance(1);
         continue;
       }
-      Token t{Token::Op, "", 0, line, column};
+      Token t{Token::Op, "", 0, line, column, file};
       if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
         const std::size_t end = text.find("*/", i + 2);
         if (end == std::string::npos) fail(t, "this comment never ends (no */)");
@@ -123,10 +158,12 @@ class PovReader {
         continue;
       }
       if (std::isalpha(static_cast<unsigned char>(c)) || c == '_' || (c == '#' && i + 1 < text.size())) {
-        std::size_t j = i + (c == '#' ? 1 : 0);
+        std::size_t start = i + (c == '#' ? 1 : 0);
+        while (c == '#' && start < text.size() && (text[start] == ' ' || text[start] == '\t')) ++start;  // "#  debug"
+        std::size_t j = start;
         while (j < text.size() && (std::isalnum(static_cast<unsigned char>(text[j])) || text[j] == '_')) ++j;
         t.kind = c == '#' ? Token::Directive : Token::Name;
-        t.text = text.substr(i + (c == '#' ? 1 : 0), j - i - (c == '#' ? 1 : 0));
+        t.text = text.substr(start, j - start);
         if (c == '#' && t.text.empty()) fail(t, "expected a directive after '#'");
         advance(j - i);
       } else if (std::isdigit(static_cast<unsigned char>(c)) ||
@@ -154,13 +191,14 @@ class PovReader {
         advance(j - i);
       } else if (c == '"') {
         std::size_t j = i + 1;
-        while (j < text.size() && text[j] != '"' && text[j] != '\n') ++j;
+        while (j < text.size() && text[j] != '"' && text[j] != '\n') j += text[j] == '\\' && j + 1 < text.size() ? 2 : 1;
         if (j >= text.size() || text[j] != '"') fail(t, "this string never ends (no closing \")");
         t.kind = Token::String;
         t.text = text.substr(i + 1, j - i - 1);
         advance(j + 1 - i);
       } else {
-        if (std::string("{}<>,()+-*/:;.=[]").find(c) == std::string::npos) {
+        // ! & | ? are POV-Ray's logic operators, met in its include files; this reader evaluates none of them.
+        if (std::string("{}<>,()+-*/:;.=[]!&|?").find(c) == std::string::npos) {
           const unsigned char u = static_cast<unsigned char>(c);
           fail(t, u >= 0x20 && u < 0x7f ? std::string("unexpected character '") + c + "'"
                                          : "unexpected byte " + std::to_string(u) +
@@ -169,9 +207,11 @@ class PovReader {
         t.text = std::string(1, c);
         advance(1);
       }
-      tokens_.push_back(t);
+      tokens.push_back(t);
+      if (tokens.size() > kMaxTokens) fail(t, "more than " + std::to_string(kMaxTokens) + " tokens");
     }
-    tokens_.push_back({Token::End, "", 0, line, column});
+    tokens.push_back({Token::End, "", 0, line, column, file});
+    return tokens;
   }
 
   const Token& peek(std::size_t ahead = 0) const { return tokens_[std::min(pos_ + ahead, tokens_.size() - 1)]; }
@@ -321,6 +361,7 @@ class PovReader {
           next();
           continue;
         }
+        if (peek().kind == Token::Number) continue;  // POV-Ray reads <1 2> as <1, 2>; its samples rely on it
         break;
       }
       expect(">", "'>' or ','");
@@ -331,15 +372,24 @@ class PovReader {
     static const std::map<std::string, Vec> constants = {
         {"x", {1, 0, 0}}, {"y", {0, 1, 0}}, {"z", {0, 0, 1}}, {"u", {1, 0}},   {"v", {0, 1}},  {"t", {0, 0, 0, 1}},
         {"pi", {kPi}},    {"clock", {0}},   {"true", {1}},    {"yes", {1}},    {"on", {1}},    {"false", {0}},
-        {"no", {0}},      {"off", {0}},     {"clock_delta", {1}}, {"frame_number", {0}}};
+        {"no", {0}},      {"off", {0}},     {"clock_delta", {1}}, {"frame_number", {0}}, {"version", {3.7}}};
     if (const auto c = constants.find(t.text); c != constants.end()) return c->second;
     if (t.text == "image_width") return {static_cast<double>(image_width())};
     if (t.text == "image_height") return {static_cast<double>(image_height())};
     if (const auto d = declared_.find(t.text); d != declared_.end()) return d->second;
+    unusable(t);
+  }
+  // A name that is no float or vector here: declared as something else, or not at all.
+  [[noreturn]] void unusable(const Token& t) const {
+    if (const auto u = unread_.find(t.text); u != unread_.end())
+      fail(t, "'" + t.text + "' is " + u->second.second + " (declared at " + where(u->second.first) +
+                  "), which this reader does not read");
+    if (declared_objects_.count(t.text)) fail(t, "'" + t.text + "' is an object: use it as object { " + t.text + " }");
     fail(t, "'" + t.text + "' is not declared" +
-                (ignored_include_ ? " (#include files are not read, so their names are unknown here)" : ""));
+                (missing_include_ ? " (an #include file was not found, so its names are unknown here)" : ""));
   }
   Vec call(const Token& name, int depth) {
+    if (unread_.count(name.text)) unusable(name);  // a macro from an include, say
     expect("(", "'('");
     std::vector<Vec> args;
     if (!at_op(")"))
@@ -595,11 +645,20 @@ class PovReader {
   // --- objects ---
   Clip clip_shape(const Token& at, glm::dmat4& own) {
     const Token shape = next();
-    if (shape.kind != Token::Name || (shape.text != "sphere" && shape.text != "box"))
+    if (shape.kind != Token::Name || (shape.text != "sphere" && shape.text != "box" && shape.text != "object"))
       fail(shape, std::string(at.text) + " takes a sphere or a box here; algray clips to one of those");
     expect("{", "'{'");
     Clip c;
-    if (shape.text == "sphere") {
+    if (shape.text == "object") {  // object { NAME ... } of a declared box or sphere
+      const Token name = next();
+      const auto d = declared_clips_.find(name.text);
+      if (d == declared_clips_.end()) {
+        if (name.kind == Token::Name && !declared_objects_.count(name.text)) unusable(name);
+        fail(name, std::string(at.text) + " takes a sphere or a box here; algray clips to one of those");
+      }
+      c = d->second.first;
+      own = d->second.second;
+    } else if (shape.text == "sphere") {
       c.centre = vector3();
       optional_comma();
       c.radius = number();
@@ -676,8 +735,10 @@ class PovReader {
         for (Object* o : objects) o->inverse = !o->inverse;
       } else if (t.text == "sturm" || t.text == "hollow" || t.text == "double_illuminate") {
         // What changes nothing algray draws: its solver is exact enough without sturm.
+        switch_value();
       } else if (t.text == "no_shadow" || t.text == "no_image" || t.text == "no_reflection" ||
                  t.text == "no_radiosity") {
+        switch_value();
         warn(t, t.text + " is ignored");
       } else if (at_op("{")) {
         warn(t, "'" + t.text + "' is ignored (algray reads pigment, texture, finish, transforms and clips)");
@@ -687,6 +748,11 @@ class PovReader {
       }
     }
     next();
+  }
+  // The optional on/off after a flag such as hollow.
+  void switch_value() {
+    static const std::set<std::string> words = {"on", "off", "true", "false", "yes", "no"};
+    if (peek().kind == Token::Number || (peek().kind == Token::Name && words.count(peek().text))) next();
   }
   static SparsePoly sphere_poly(const glm::dvec3& c, double r) {
     SparsePoly p = SparsePoly::constant(c.x * c.x + c.y * c.y + c.z * c.z - r * r);
@@ -727,6 +793,51 @@ class PovReader {
       std::vector<Object*> members;
       for (std::size_t i = first; i < out.size(); ++i) members.push_back(&out[i]);
       if (members.empty()) fail(kind, "this " + kind.text + " holds no object algray reads");
+      modifiers(members, kind);
+      return;
+    }
+    if (kind.text == "intersection") {
+      // POV-Ray's samples cut a surface with a Clear sphere or box: read as the surface clipped to that region.
+      warn(kind, "intersection is read as its algebraic objects clipped by its spheres and boxes; the cut faces "
+                 "are not drawn (POV-Ray's samples make them Clear)");
+      const std::size_t first = out.size();
+      std::vector<std::pair<Clip, glm::dmat4>> clips;
+      while (peek().kind == Token::Name && at_op("{", 1)) {
+        const std::string w = peek().text;
+        if (w == "sphere" || w == "box" || (w == "object" && declared_clips_.count(peek(2).text))) {
+          glm::dmat4 own(1);
+          const Clip c = clip_shape(kind, own);
+          clips.push_back({c, own});
+        } else if (is_object(w)) {
+          object(next(), out);
+        } else {
+          break;
+        }
+      }
+      if (out.size() == first) fail(kind, "this intersection holds no algebraic object algray reads");
+      if (clips.empty()) fail(kind, "this intersection has no sphere or box to cut its objects with");
+      std::vector<Object*> members;
+      for (std::size_t i = first; i < out.size(); ++i) {
+        out[i].clips.insert(out[i].clips.end(), clips.begin(), clips.end());
+        members.push_back(&out[i]);
+      }
+      modifiers(members, kind);
+      return;
+    }
+    if (kind.text == "object") {  // object { NAME modifiers } or object { OBJECT modifiers }
+      const std::size_t first = out.size();
+      const Token name = next();
+      if (name.kind == Token::Name && is_object(name.text) && at_op("{")) {
+        object(name, out);
+      } else if (name.kind == Token::Name && declared_objects_.count(name.text)) {
+        for (const Object& o : declared_objects_.at(name.text)) out.push_back(o);
+      } else if (name.kind == Token::Name) {
+        unusable(name);
+      } else {
+        fail(name, "expected a declared object's name, found " + describe(name));
+      }
+      std::vector<Object*> members;
+      for (std::size_t i = first; i < out.size(); ++i) members.push_back(&out[i]);
       modifiers(members, kind);
       return;
     }
@@ -787,7 +898,7 @@ class PovReader {
   }
   static bool is_object(const std::string& w) {
     return w == "sphere" || w == "torus" || w == "poly" || w == "polynomial" || w == "quartic" || w == "cubic" ||
-           w == "union" || w == "merge";
+           w == "union" || w == "merge" || w == "object" || w == "intersection";
   }
 
   // --- scene items ---
@@ -866,35 +977,206 @@ class PovReader {
     background_ = colour(open);
     expect("}", "'}'");
   }
+  // --- directives ---
+  // The file #include names, read and its tokens put in place of the directive.
+  void include(const Token& d) {
+    const Token file = next();
+    if (file.kind != Token::String) fail(file, "expected a file name after #include");
+    const std::filesystem::path name(file.text);
+    bool plain = name.extension() == ".inc" && name.is_relative();
+    for (const auto& part : name) plain = plain && part != "..";
+    if (!plain) fail(file, "#include reads .inc files by a relative name without '..' (see algray's POV-Ray notes)");
+    const int depth = files_[static_cast<std::size_t>(d.file)].depth + 1;
+    if (depth > kMaxIncludeDepth) fail(d, "#include nested more than " + std::to_string(kMaxIncludeDepth) + " deep");
+    if (files_.size() > static_cast<std::size_t>(kMaxIncludes))
+      fail(d, "more than " + std::to_string(kMaxIncludes) + " #include files read");
+    std::string looked;
+    for (const auto& dir : include_dirs_) {
+      const std::filesystem::path path = dir / name;
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(path, ec)) {
+        looked += (looked.empty() ? "" : ", ") + dir.string();
+        continue;
+      }
+      std::ifstream in(path, std::ios::binary);
+      std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      if (!in && !in.eof()) fail(file, "cannot read " + path.string());
+      const int index = static_cast<int>(files_.size());
+      files_.push_back({std::make_unique<LocatedText>(text, path.string()), depth});
+      std::vector<Token> tokens = tokenize(text, index);
+      tokens.pop_back();  // its End
+      if (tokens_.size() + tokens.size() > kMaxTokens) fail(d, "the #include files hold too many tokens");
+      tokens_.insert(tokens_.begin() + static_cast<std::ptrdiff_t>(pos_), tokens.begin(), tokens.end());
+      return;
+    }
+    // As before includes were read: a scene that only takes colours from a missing colors.inc still renders.
+    warn(d, "#include \"" + file.text + "\" is not found (looked in " + looked + "); it is ignored");
+    missing_include_ = true;
+  }
+  // Skips to the #end that closes the block opened before the cursor; with stop_at_else, to its #else instead
+  // when there is one. Returns whether it stopped at an #else.
+  bool skip_to_end(const Token& open, bool stop_at_else) {
+    static const std::set<std::string> openers = {"if", "ifdef", "ifndef", "while", "for", "switch", "macro"};
+    int depth = 0;
+    for (;;) {
+      const Token t = next();
+      if (t.kind == Token::End) fail(open, "this #" + open.text + " has no #end");
+      if (t.kind != Token::Directive) continue;
+      if (openers.count(t.text)) ++depth;
+      else if (t.text == "end" && depth-- == 0) return false;
+      else if (t.text == "else" && depth == 0 && stop_at_else) return true;
+    }
+  }
+  // Skips a value this reader does not read: NAME { ... }, or tokens up to ';' or the next directive.
+  void skip_value() {
+    if (peek().kind == Token::Name && at_op("{", 1)) {
+      next();
+      skip_block();
+    } else {
+      int depth = 0;
+      while (peek().kind != Token::End && !(depth == 0 && (at_op(";") || peek().kind == Token::Directive))) {
+        const Token t = next();
+        if (t.kind == Token::Op && (t.text == "(" || t.text == "{" || t.text == "[")) ++depth;
+        if (t.kind == Token::Op && (t.text == ")" || t.text == "}" || t.text == "]")) --depth;
+      }
+    }
+    if (at_op(";")) next();
+  }
+  bool is_declared(const std::string& name) const {
+    return declared_.count(name) || declared_objects_.count(name) || unread_.count(name) || declared_clips_.count(name);
+  }
+  void forget(const std::string& name) {
+    declared_clips_.erase(name);
+    declared_.erase(name);
+    declared_objects_.erase(name);
+    unread_.erase(name);
+  }
+  void declaration(const Token& d) {
+    const Token name = next();
+    if (name.kind != Token::Name) fail(name, "expected a name after #" + d.text);
+    expect("=", "'='");
+    forget(name.text);
+    static const std::set<std::string> colour_words = {"color", "colour", "rgb", "rgbf", "rgbt", "rgbft", "srgb",
+                                                        "srgbf", "srgbt", "srgbft", "red", "green", "blue"};
+    const Token value = peek();
+    if (value.kind == Token::Name && colour_words.count(value.text)) {
+      const glm::dvec3 c = colour(name);
+      declared_[name.text] = {c.x, c.y, c.z};
+    } else if (value.kind == Token::Name && value.text == "box" && at_op("{", 1)) {
+      // A box is no surface here, but clips one: intersection { OBJECT object { NAME } } and bounded_by use it.
+      const std::size_t start = pos_;
+      try {
+        glm::dmat4 own(1);
+        const Clip c = clip_shape(name, own);
+        declared_clips_[name.text] = {c, own};
+      } catch (const SceneError& e) {
+        if (d.file == 0) throw;
+        pos_ = start;
+        unread_[name.text] = {name, "a box algray cannot read (" + e.where + ": " + e.message + ")"};
+        skip_value();
+        return;
+      }
+    } else if (value.kind == Token::Name && is_object(value.text) && at_op("{", 1) && d.file != 0) {
+      // An include file's object this reader cannot read is an error only where the scene uses it.
+      const std::size_t start = pos_;
+      std::vector<Object> objects;
+      try {
+        object(next(), objects);
+        declared_objects_[name.text] = std::move(objects);
+      } catch (const SceneError& e) {
+        pos_ = start;
+        unread_[name.text] = {name, "a " + value.text + " algray cannot draw (" + e.where + ": " + e.message + ")"};
+        skip_value();
+        return;
+      }
+    } else if (value.kind == Token::Name && is_object(value.text) && at_op("{", 1)) {
+      std::vector<Object> objects;
+      object(next(), objects);
+      declared_objects_[name.text] = std::move(objects);
+    } else if (value.kind == Token::Name && declared_objects_.count(value.text)) {
+      next();
+      declared_objects_[name.text] = declared_objects_.at(value.text);
+    } else if (value.kind == Token::Name && at_op("{", 1)) {
+      // A texture, pigment, finish or another object: its name is remembered so that a use can say what it is.
+      if (d.file == 0)
+        warn(name, "#" + d.text + " " + name.text + " = " + value.text + " { ... } is ignored: algray declares " +
+                       "floats, vectors, colours and the objects it reads");
+      unread_[name.text] = {name, "a " + value.text};
+      skip_value();
+      return;
+    } else if (d.file != 0) {
+      // In an include file a value this reader cannot evaluate (a macro's result, a string) is skipped.
+      const std::size_t start = pos_;
+      try {
+        declared_[name.text] = expression();
+      } catch (const SceneError&) {
+        pos_ = start;
+        unread_[name.text] = {name, "a value"};
+        skip_value();
+        return;
+      }
+    } else {
+      declared_[name.text] = expression();
+    }
+    if (at_op(";")) next();
+  }
   void directive(const Token& d) {
     if (d.text == "version") {
       number();
       if (at_op(";")) next();
     } else if (d.text == "include") {
-      const Token file = next();
-      if (file.kind != Token::String) fail(file, "expected a file name after #include");
-      warn(d, "#include \"" + file.text + "\" is ignored: algray reads this file alone");
-      ignored_include_ = true;
+      include(d);
     } else if (d.text == "declare" || d.text == "local") {
-      const Token name = next();
-      if (name.kind != Token::Name) fail(name, "expected a name after #" + d.text);
-      expect("=", "'='");
-      static const std::set<std::string> colour_words = {"color", "colour", "rgb", "rgbf", "rgbt", "rgbft", "srgb",
-                                                          "srgbf", "srgbt", "srgbft", "red", "green", "blue"};
-      if (peek().kind == Token::Name && colour_words.count(peek().text)) {
-        const glm::dvec3 c = colour(name);
-        declared_[name.text] = {c.x, c.y, c.z};
-      } else if (peek().kind == Token::Name && at_op("{", 1)) {
-        warn(name, "#" + d.text + " " + name.text + " = " + peek().text + " { ... } is ignored: only floats and " +
-                       "vectors are declared here");
-        next();
-        skip_block();
-      } else {
-        declared_[name.text] = expression();
+      // An include file's declarations warn about nothing: only what the scene uses of them matters.
+      const bool was = quiet_;
+      quiet_ = quiet_ || d.file != 0;
+      try {
+        declaration(d);
+      } catch (...) {
+        quiet_ = was;
+        throw;
       }
-      if (at_op(";")) next();
+      quiet_ = was;
+    } else if (d.text == "undef") {
+      const Token name = next();
+      if (name.kind != Token::Name) fail(name, "expected a name after #undef");
+      forget(name.text);
+    } else if (d.text == "macro") {
+      const Token name = next();
+      if (name.kind != Token::Name) fail(name, "expected a name after #macro");
+      if (d.file == 0) warn(d, "#macro " + name.text + " is skipped: this reader does not expand macros");
+      unread_[name.text] = {name, "a macro"};
+      skip_to_end(d, false);
+    } else if (d.text == "ifdef" || d.text == "ifndef" || d.text == "if") {
+      bool holds;
+      if (d.text == "if") {
+        holds = number() != 0;
+      } else {
+        expect("(", "'('");
+        const Token name = next();
+        if (name.kind != Token::Name) fail(name, "expected a name");
+        expect(")", "')'");
+        holds = is_declared(name.text) == (d.text == "ifdef");
+      }
+      if (holds || skip_to_end(d, true)) open_ifs_.push_back(d);
+    } else if (d.text == "else") {
+      if (open_ifs_.empty()) fail(d, "#else without #if, #ifdef or #ifndef");
+      skip_to_end(open_ifs_.back(), false);  // the branch that was read ends here
+      open_ifs_.pop_back();
+    } else if (d.text == "end") {
+      if (open_ifs_.empty()) fail(d, "#end without #if, #ifdef or #ifndef");
+      open_ifs_.pop_back();
+    } else if (d.text == "debug" || d.text == "warning") {
+      skip_value();
+    } else if (d.text == "default") {
+      warn(d, "#default is ignored: algray's objects take POV-Ray's default finish unless they give their own");
+      skip_block();
+    } else if (d.text == "while" || d.text == "for" || d.text == "switch") {
+      warn(d, "#" + d.text + " ... #end is skipped: this reader does not run loops or switches");
+      skip_to_end(d, false);
     } else {
-      fail(d, "#" + d.text + " is not read: algray reads declarations of floats and vectors, #version and #include");
+      fail(d, "#" + d.text + " is not read: algray reads #declare, #local, #undef, #include, #if, #ifdef, " +
+                  "#ifndef, #else, #end, #version (and skips #macro, #while, #for, #switch, #debug, #warning)");
     }
   }
   void item() {
@@ -921,7 +1203,6 @@ class PovReader {
       return;
     }
     if (is_object(t.text)) return object(t, objects_);
-    if (t.text == "object") fail(t, "object { NAME }: declared objects are not read; write the object out");
     if (at_op("{")) {
       warn(t, "'" + t.text + "' is ignored: algray reads poly, polynomial, quartic, cubic, sphere and torus objects");
       skip_block();
@@ -1016,14 +1297,23 @@ class PovReader {
     return out;
   }
 
-  LocatedText text_;
-  const std::string& source_;
+  struct File {
+    std::unique_ptr<LocatedText> text;
+    int depth = 0;  // how many #includes deep
+  };
+  std::vector<File> files_;
+  std::vector<std::filesystem::path> include_dirs_;
   std::vector<std::string>& warnings_;
   int width_, height_;
   std::vector<Token> tokens_;
   std::size_t pos_ = 0;
   std::map<std::string, Vec> declared_;
-  bool ignored_include_ = false;
+  std::map<std::string, std::vector<Object>> declared_objects_;
+  std::map<std::string, std::pair<Clip, glm::dmat4>> declared_clips_;  // declared boxes, with their transforms
+  std::map<std::string, std::pair<Token, std::string>> unread_;  // name: where declared, and what it is
+  bool missing_include_ = false;
+  bool quiet_ = false;  // warnings are dropped (reading an include file's declarations)
+  std::vector<Token> open_ifs_;                                    // #if, #ifdef, #ifndef being read
   std::vector<Object> objects_;
   Camera camera_;
   std::optional<Token> camera_at_;
@@ -1072,9 +1362,9 @@ PovTranslation PovReader::run() {
   flip[2][2] = mirror.z;
 
   std::ostringstream toml;
-  const std::size_t slash = source_.find_last_of('/');
-  const std::string file = source_.substr(slash == std::string::npos ? 0 : slash + 1);
-  toml << "# Translated from " << source_ << " (POV-Ray)\n";
+  const std::size_t slash = files_[0].text->source().find_last_of('/');
+  const std::string file = files_[0].text->source().substr(slash == std::string::npos ? 0 : slash + 1);
+  toml << "# Translated from " << files_[0].text->source() << " (POV-Ray)\n";
   int n = 0;
   for (const Object& o : objects_) {
     ++n;
