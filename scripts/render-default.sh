@@ -12,4 +12,3 @@ cmake -S . -B build ${gen:+-G "$gen"} -DCMAKE_BUILD_TYPE=Release -DBUILD_TESTING
 cmake --build build -j"$(nproc)" --target algray
 mkdir -p out
 ./build/apps/algray/algray render -o out/barth_sextic.exr -o out/barth_sextic.png --stats out/barth_sextic.json
-echo "wrote out/barth_sextic.exr, out/barth_sextic.png and out/barth_sextic.json"
