@@ -2,6 +2,7 @@
 #include "algray/scene/located_text.h"
 
 #include <algorithm>
+#include <cctype>
 #include <sstream>
 
 #include "algray/scene/scene.h"
@@ -29,6 +30,52 @@ std::string LocatedText::excerpt(int line, int column) const {
 
 void LocatedText::fail(int line, int column, const std::string& message) const {
   throw SceneError(where(line, column), message, excerpt(line, column));
+}
+
+void TextCursor::advance(std::size_t n) {
+  for (std::size_t k = 0; k < n && i < text.size(); ++k, ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+}
+
+int TextCursor::skip_comment() {
+  if (at() != '/') return 0;
+  if (at(1) == '/') {
+    while (!done() && at() != '\n') advance(1);
+    return 1;
+  }
+  if (at(1) != '*') return 0;
+  const std::size_t end = text.find("*/", i + 2);
+  if (end == std::string::npos) return -1;
+  advance(end + 2 - i);
+  return 1;
+}
+
+std::size_t TextCursor::number_end(bool* real) const {
+  auto digit = [&](std::size_t k) { return k < text.size() && std::isdigit(static_cast<unsigned char>(text[k])); };
+  std::size_t j = i;
+  *real = false;
+  while (digit(j)) ++j;
+  if (j < text.size() && text[j] == '.') {
+    *real = true;
+    ++j;
+    while (digit(j)) ++j;
+  }
+  if (j < text.size() && (text[j] == 'e' || text[j] == 'E')) {
+    std::size_t k = j + 1;
+    if (k < text.size() && (text[k] == '+' || text[k] == '-')) ++k;
+    if (digit(k)) {
+      *real = true;
+      j = k;
+      while (digit(j)) ++j;
+    }
+  }
+  return j;
 }
 
 }  // namespace algray

@@ -128,33 +128,19 @@ class PovReader {
   // --- tokens ---
   std::vector<Token> tokenize(const std::string& text, int file) {
     std::vector<Token> tokens;
-    int line = 1, column = 1;
-    std::size_t i = 0;
-    auto advance = [&](std::size_t n) {
-      for (std::size_t k = 0; k < n && i < text.size(); ++k, ++i) {
-        if (text[i] == '\n') {
-          ++line;
-          column = 1;
-        } else {
-          ++column;
-        }
-      }
-    };
+    TextCursor cursor(text);
+    std::size_t& i = cursor.i;
+    const int &line = cursor.line, &column = cursor.column;
+    auto advance = [&](std::size_t n) { cursor.advance(n); };
     while (i < text.size()) {
       const char c = text[i];
       if (std::isspace(static_cast<unsigned char>(c))) {
         advance(1);
         continue;
       }
-      if (c == '/' && i + 1 < text.size() && text[i + 1] == '/') {
-        while (i < text.size() && text[i] != '\n') advance(1);
-        continue;
-      }
       Token t{Token::Op, "", 0, line, column, file};
-      if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
-        const std::size_t end = text.find("*/", i + 2);
-        if (end == std::string::npos) fail(t, "this comment never ends (no */)");
-        advance(end + 2 - i);
+      if (const int comment = cursor.skip_comment()) {
+        if (comment < 0) fail(t, "this comment never ends (no */)");
         continue;
       }
       if (std::isalpha(static_cast<unsigned char>(c)) || c == '_' || (c == '#' && i + 1 < text.size())) {
@@ -168,20 +154,8 @@ class PovReader {
         advance(j - i);
       } else if (std::isdigit(static_cast<unsigned char>(c)) ||
                  (c == '.' && i + 1 < text.size() && std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
-        std::size_t j = i;
-        while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
-        if (j < text.size() && text[j] == '.') {
-          ++j;
-          while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
-        }
-        if (j < text.size() && (text[j] == 'e' || text[j] == 'E')) {
-          std::size_t k = j + 1;
-          if (k < text.size() && (text[k] == '+' || text[k] == '-')) ++k;
-          if (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) {
-            j = k;
-            while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
-          }
-        }
+        bool real = false;
+        const std::size_t j = cursor.number_end(&real);
         t.kind = Token::Number;
         t.text = text.substr(i, j - i);
         std::istringstream in(t.text);

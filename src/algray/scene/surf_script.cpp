@@ -210,33 +210,18 @@ class Script {
 
   // --- tokens ---
   void tokenize(const std::string& text) {
-    int line = 1, column = 1;
-    std::size_t i = 0;
-    auto advance = [&](std::size_t n) {
-      for (std::size_t k = 0; k < n && i < text.size(); ++k, ++i) {
-        if (text[i] == '\n') {
-          ++line;
-          column = 1;
-        } else {
-          ++column;
-        }
-      }
-    };
+    TextCursor cursor(text);
+    std::size_t& i = cursor.i;
+    const int &line = cursor.line, &column = cursor.column;
+    auto advance = [&](std::size_t n) { cursor.advance(n); };
     while (i < text.size()) {
       const char c = text[i];
       if (c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v') {
         advance(1);
         continue;
       }
-      if (c == '/' && i + 1 < text.size() && text[i + 1] == '/') {
-        while (i < text.size() && text[i] != '\n') advance(1);
-        continue;
-      }
-      if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
-        Token open{Token::Op, "/*", 0, line, column};
-        const std::size_t end = text.find("*/", i + 2);
-        if (end == std::string::npos) fail(open, "this comment never ends (no */)");
-        advance(end + 2 - i);
+      if (const int comment = cursor.skip_comment()) {
+        if (comment < 0) fail(Token{Token::Op, "/*", 0, line, column}, "this comment never ends (no */)");
         continue;
       }
       Token t{Token::Op, "", 0, line, column};
@@ -248,23 +233,8 @@ class Script {
         advance(j - i);
       } else if (std::isdigit(static_cast<unsigned char>(c)) ||
                  (c == '.' && i + 1 < text.size() && std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
-        std::size_t j = i;
         bool real = false;
-        while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
-        if (j < text.size() && text[j] == '.') {
-          real = true;
-          ++j;
-          while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
-        }
-        if (j < text.size() && (text[j] == 'e' || text[j] == 'E')) {
-          std::size_t k = j + 1;
-          if (k < text.size() && (text[k] == '+' || text[k] == '-')) ++k;
-          if (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) {
-            real = true;
-            j = k;
-            while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) ++j;
-          }
-        }
+        const std::size_t j = cursor.number_end(&real);
         t.kind = real ? Token::Real : Token::Int;
         t.text = text.substr(i, j - i);
         std::istringstream in(t.text);
