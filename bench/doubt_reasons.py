@@ -36,7 +36,7 @@ def main():
             continue
         reason = solver["doubt"]["reason"]
         if "confirmed" in solver["doubt"]:
-            # surface.h confirm_flat_root kept the float root, or methods/bernstein.h bracket_settled the bracket
+            # surface.h confirm_flat_roots kept the float root, or methods/bernstein.h settle_brackets the bracket
             reason += ", settled (no second pass)"
         reasons[reason] += 1
         print(f"seed {a.seed} case {case} pixel {x},{y}: {reason}", flush=True)

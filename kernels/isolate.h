@@ -25,7 +25,7 @@ Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL*
 LREAL isolated_start(const LREAL* c);
 void prepare_isolated(LREAL* c, __constant const REAL* binomials);
 LREAL isolated_value(const LREAL* c, LREAL y);
-REAL isolated_value_slope(const REAL* c, REAL y, REAL* slope);
+LREAL isolated_value_slope(const LREAL* c, LREAL y, LREAL* slope);
 LREAL isolated_magnitude(const LREAL* c, LREAL y);
 
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN

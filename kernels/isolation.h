@@ -23,9 +23,9 @@ typedef struct {
   REAL f_lo, f_hi;
 } Isolation;
 
-#if LANES > 1
-/* The isolations of LANES rays side by side (isolate_bernstein_lanes): each field Isolation's, lane j ray j's, in
- * vectors, so that the refinement and the records take them without a trip through memory. */
+/* The isolations of LANES rays side by side (the Bernstein search): each field Isolation's, lane j ray j's, in
+ * vectors, so that the refinement and the records take them without a trip through memory; with LANES = 1, one
+ * ray's. */
 typedef struct {
   LREAL status, steps, lo, hi, f_lo, f_hi;
   LMASK budget, cluster;
@@ -59,7 +59,6 @@ void set_lane_isolation(LaneIsolation* lanes, uint j, Isolation iso) {
   lane_set(&lanes->f_lo, j, iso.f_lo);
   lane_set(&lanes->f_hi, j, iso.f_hi);
 }
-#endif
 
 Isolation isolation_none(void) {
   Isolation iso;
@@ -160,7 +159,7 @@ ALGRAY_INLINE SearchNoise search_noise(const REAL* c, RayTerms* terms) {
 REAL noise_bound(REAL terms) { return DOUBT_NOISE(terms, terms); }
 
 /* The noise with the ray's terms summed: what a value within the upper bound's noise, and the refined root's
- * check (doubt_flat_root), compare against. */
+ * check (refine_rays), compare against. */
 REAL exact_noise(SearchNoise* n) {
   if (!n->terms->exact) n->noise = DOUBT_NOISE(n->scale, ray_terms_exact(n->terms));
   return n->noise;
@@ -248,7 +247,7 @@ int doubted(Isolation* iso, uint reason, REAL value, SearchNoise* noise, int lev
 }
 
 /* A root to refine takes the search's noise with the terms summed, for the refined root's check
- * (doubt_flat_root); shadow rays refine nothing. */
+ * (refine_rays); shadow rays refine nothing. */
 Isolation isolation_found(Isolation iso, SearchNoise* noise) {
   if (!ALGRAY_SHADOW_RAYS && iso.status == ISOLATION_BRACKET) iso.noise = exact_noise(noise);
   return iso;

@@ -19,6 +19,8 @@ typedef REAL LREAL;
 typedef int LMASK;
 typedef int LANE_INT;     /* one lane's integer */
 typedef int LANE_INT_VEC; /* integers per lane */
+#define LANE_TO_INT(x) ((LANE_INT)(x))
+#define LANE_TO_REAL(x) ((REAL)(x))
 #define LANE_SEL(a, b, m) ((m) ? (b) : (a))
 #define LANE_ANY(m) (m)
 #define LANE_ALL(m) (m)
@@ -129,7 +131,7 @@ ALGRAY_INLINE LMASK lanes_of_bits(uint bits) {
 
 /* The lanes of v into a[0 .. LANES), in one store: reading many lanes of a vector one by one (lane_get) stored
  * the whole vector again for each, and the loads waited on the stores (measured: a fifth of
- * isolate_bernstein_lanes in the Barth sextic's double preview). */
+ * the lanes' Bernstein search in the Barth sextic's double preview). */
 #if LANES == 1
 #define LANES_STORE(v, a) ((a)[0] = (v))
 #define LANES_LOAD(a) ((a)[0])

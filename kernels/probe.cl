@@ -8,7 +8,7 @@
 #include "restrict.h"
 #include "surface.h"
 
-/* A single work-item. The ray is pixel (px, py) of the camera, built by camera_ray() exactly as the primary
+/* A single work-item. The ray is pixel (px, py) of the camera, built by camera_rays() exactly as the primary
  * kernel builds it, or, with use_given_ray, given_o + t * given_d (world coordinates, as the trace kernel takes
  * rays). out gets the hit record the render would write; ray_out the ray (origin, direction) that was traced;
  * events and values the log (see ALGRAY_EVENT_* in algray_shared.h); event_count[0] how many events were
@@ -23,29 +23,20 @@ __kernel void probe(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, RE
                     __global HitRecord* out, __global REAL4* ray_out, __global ProbeEvent* events,
                     __global REAL* values, uint capacity, __global uint* event_count) {
   if (get_global_id(0) != 0) return;
-  Ray ray;
-  if (use_given_ray) {
-    ray.o = given_o.xyz;
-    ray.d = given_d.xyz;
-  } else {
-    ray = camera_ray(px, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
-  }
+  const LaneRays ray = use_given_ray ? one_lane_rays(given_o.xyz, given_d.xyz)
+                                     : camera_rays(px, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
   ProbeLog log;
   log.events = events;
   log.values = values;
   log.capacity = capacity;
   log.count = 0;
-  ProbeLog* probe_log = &log;
   /* Camera rays only: the host probes a given ray with the trace kernel's construction (RAY_ORIGIN=extent). */
-  REAL taylor[NCOEF], taylor_t = 0;
-#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
-  taylor_t = screen_ray_taylor(px, py, screen_rows, screen_row0, screen_t, xi_scale, xi_offset, taylor);
-#endif
-  const SurfaceHit hit = trace_surface(ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                       mono_exps, mono_coefs, mono_count, binomials, even_axes, taylor, taylor_t,
-                                       probe_log);
-  out[0] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
-  ray_out[0] = (REAL4)(ray.o, 0);
-  ray_out[1] = (REAL4)(ray.d, 0);
+  HitRecord record;
+  const int entered = trace_rays(1, &ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
+                                 mono_exps, mono_coefs, mono_count, binomials, even_axes, &record, px, py, screen_rows,
+                                 screen_row0, screen_t, xi_scale, xi_offset, &log);
+  out[0] = entered ? record : missed_record();
+  ray_out[0] = (REAL4)(ray.ox, ray.oy, ray.oz, 0);
+  ray_out[1] = (REAL4)(ray.dx, ray.dy, ray.dz, 0);
   event_count[0] = log.count;
 }

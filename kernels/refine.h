@@ -6,11 +6,13 @@
 #include "probe_log.h"
 #include "real.h"
 
-/* Needs isolated_value(c, y) from the isolation method: the polynomial at y in [0,1] of the isolating interval.
- * f0 and f1 are its values at 0 and 1, of opposite signs. tol_y is the stopping width in y; scale is the size
- * of the polynomial's coefficients on the isolating interval; start is the isolation's estimate of the root in
- * (0, 1) (isolated_start), or anything outside it for none. Returns the root's y and counts the iterations
- * (function evaluations) in *iterations. */
+/* refine_root(c, f0, f1, tol_y, scale, start, running, iterations, probe_log), one per method below, needs
+ * isolated_value(c, y) from the isolation method: the polynomial at y in [0,1] of the isolating interval. f0 and f1
+ * are its values at 0 and 1, of opposite signs. tol_y is the stopping width in y; scale is the size of the
+ * polynomial's coefficients on the isolating interval; start is the isolation's estimate of the root in (0, 1)
+ * (isolated_start), or anything outside it for none. Returns the root's y and counts the iterations (function
+ * evaluations) in *iterations, for the lanes in `running` (Brent, the one method built for lanes), or for one ray
+ * (the others). */
 
 /* Degree 1: P* on the isolating interval is the line f0 (1 - y) + f1 y, and its root f0 / (f0 - f1) is within 1.5
  * ulps: f0 and f1 have opposite signs, so f0 - f1 does not cancel. That is far inside any stopping width, where
@@ -47,8 +49,8 @@ int value_within_rounding(const REAL* c, REAL y, REAL fy, REAL scale) {
  * A lane with a start in (0, 1) (isolated_start: degree 2's formula) evaluates it first: it becomes b, the
  * bracket's end of the other sign c, and the other end a; the stopping rule then decides as always. Without a
  * start, the secant of the ends is the first step, as the paper has it. */
-LREAL refine_root_lanes(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL scale, LREAL start, LMASK running,
-                        LMASK* iterations, ProbeLog* probe_log) {
+LREAL refine_root(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL scale, LREAL start, LMASK running,
+                  LMASK* iterations, ProbeLog* probe_log) {
   /* b: best estimate; c_: contrapoint, f(c_) of the other sign; a: the previous b. */
   LREAL a = 0, fa = f0, b = 1, fb = f1, cp = 0, fc = f0;
   LMASK done = !running;
@@ -116,19 +118,11 @@ LREAL refine_root_lanes(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL s
   return b;
 }
 
-#if LANES == 1
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations,
-                 ProbeLog* probe_log) {
-  LMASK it;
-  const REAL y = refine_root_lanes(c, f0, f1, tol_y, scale, start, 1, &it, probe_log);
-  *iterations = (uint)it;
-  return y;
-}
-#endif
 #elif REFINEMENT == ALGRAY_REFINEMENT_BISECTION
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations,
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, int running, int* iterations,
                  ProbeLog* probe_log) {
   (void)start; /* the paper's start */
+  (void)running; /* one ray */
   REAL lo = 0, hi = 1, flo = f0;
   (void)f1;
   (void)scale;
@@ -150,7 +144,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL s
     }
     PROBE_ITERATE(it, mid, fm, lo, hi);
   }
-  *iterations = it;
+  *iterations = (int)it;
   return (REAL)0.5 * (lo + hi);
 }
 #elif REFINEMENT == ALGRAY_REFINEMENT_REGULA_FALSI || REFINEMENT == ALGRAY_REFINEMENT_ILLINOIS
@@ -158,9 +152,10 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL s
  * good, so the bracket never shrinks below the stopping width and only |P*| <= eps_m or the iteration cap
  * stops it (the paper's Barth decic defects). The Illinois variant halves the value kept at an end that has
  * survived twice in a row, which breaks that one-sidedness. */
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations,
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, int running, int* iterations,
                  ProbeLog* probe_log) {
   (void)start; /* the paper's start */
+  (void)running; /* one ray */
   REAL a = 0, fa = f0, b = 1, fb = f1, x = fabs(f0) < fabs(f1) ? (REAL)0 : (REAL)1;
   int kept = 0; /* +1: a survived the last step(s), -1: b did */
   uint it = 0;
@@ -191,16 +186,17 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL s
     PROBE_ITERATE(it, x, fx, a, b);
   }
   (void)kept;
-  *iterations = it;
+  *iterations = (int)it;
   return x;
 }
 #elif REFINEMENT == ALGRAY_REFINEMENT_NEWTON
 /* Newton's method inside the bracket: a step that would leave it, or that fails to halve |P*|, is replaced by
  * bisection, so it converges like bisection at worst and quadratically near a simple root. Needs
  * isolated_value_slope(c, y, &slope) from the isolation method. */
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, uint* iterations,
+REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, int running, int* iterations,
                  ProbeLog* probe_log) {
   (void)start; /* the paper's start */
+  (void)running; /* one ray */
   REAL a = 0, b = 1, fa = f0;
   REAL x = fabs(f0) < fabs(f1) ? (REAL)0 : (REAL)1, slope;
   REAL fx = isolated_value_slope(c, x, &slope);
@@ -221,7 +217,7 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL s
     }
     PROBE_ITERATE(it, x, fx, a, b);
   }
-  *iterations = it;
+  *iterations = (int)it;
   return x;
 }
 #else

@@ -3,6 +3,7 @@
 #define ALGRAY_RESTRICT_H
 
 #include "algray_shared.h"
+#include "lanes.h"
 #include "real.h"
 
 /* Which basis the restriction builds: Bernstein for Bernstein isolation, the power basis for the others. */
@@ -148,36 +149,39 @@ ALGRAY_INLINE void axis_powers(REAL3 q, REAL* px, REAL* py, REAL* pz) {
   }
 }
 
-/* sum_m |a_m| x^i y^j z^k over the monomials. Four partial sums: one would be a chain of dependent additions,
- * each waiting for the last (measured on the Barth decic's adaptive render: 1.5% of its kernel time less). Power
- * tables measured faster than a nested Horner scheme in scalars (like restrict_to_rays'). Defined for REALs and
- * for lanes of them (surface.h), each lane with the operations a REAL would get. */
-#define DEFINE_TERMS_SUM(name, T)                                                                               \
-  T name(__global const uint* exps, __global const REAL* coefs, uint count, T x, T y, T z) {                    \
-    T px[NCOEF], py[NCOEF], pz[NCOEF];                                                                          \
-    px[0] = py[0] = pz[0] = (T)1;                                                                               \
-    ALGRAY_UNROLL                                                                                               \
-    for (int n = 1; n <= DEGREE; ++n) {                                                                         \
-      px[n] = px[n - 1] * x;                                                                                    \
-      py[n] = py[n - 1] * y;                                                                                    \
-      pz[n] = pz[n - 1] * z;                                                                                    \
-    }                                                                                                           \
-    T sum[4] = {(T)0, (T)0, (T)0, (T)0};                                                                        \
-    uint m = 0;                                                                                                 \
-    for (; m + 4 <= count; m += 4) {                                                                            \
-      sum[0] += TERMS_SUM_TERM(m);                                                                              \
-      sum[1] += TERMS_SUM_TERM(m + 1);                                                                          \
-      sum[2] += TERMS_SUM_TERM(m + 2);                                                                          \
-      sum[3] += TERMS_SUM_TERM(m + 3);                                                                          \
-    }                                                                                                           \
-    for (; m < count; ++m) sum[0] += TERMS_SUM_TERM(m);                                                         \
-    return (sum[0] + sum[1]) + (sum[2] + sum[3]);                                                               \
+/* sum_m |a_m| x^i y^j z^k over the monomials, of one ray or of lanes (each lane with one ray's operations). Four
+ * partial sums: one would be a chain of dependent additions, each waiting for the last (measured on the Barth
+ * decic's adaptive render: 1.5% of its kernel time less). Power tables measured faster than a nested Horner scheme
+ * in scalars (like restrict_to_rays'). Over lanes, every lane's ray terms are summed at once: summed one lane at a
+ * time, they were a tenth of the Endrass octic's adaptive camera pass. */
+LREAL terms_sum(__global const uint* exps, __global const REAL* coefs, uint count, LREAL x, LREAL y, LREAL z) {
+  LREAL px[NCOEF], py[NCOEF], pz[NCOEF];
+  px[0] = py[0] = pz[0] = 1;
+  ALGRAY_UNROLL
+  for (int n = 1; n <= DEGREE; ++n) {
+    px[n] = px[n - 1] * x;
+    py[n] = py[n - 1] * y;
+    pz[n] = pz[n - 1] * z;
   }
+  LREAL sum[4] = {(LREAL)0, (LREAL)0, (LREAL)0, (LREAL)0};
+  uint m = 0;
 #define TERMS_SUM_TERM(m) \
   (fabs(coefs[m]) * px[exps[m] & 0xffu] * py[(exps[m] >> 8) & 0xffu] * pz[(exps[m] >> 16) & 0xffu])
-DEFINE_TERMS_SUM(terms_sum, REAL)
+  for (; m + 4 <= count; m += 4) {
+    sum[0] += TERMS_SUM_TERM(m);
+    sum[1] += TERMS_SUM_TERM(m + 1);
+    sum[2] += TERMS_SUM_TERM(m + 2);
+    sum[3] += TERMS_SUM_TERM(m + 3);
+  }
+  for (; m < count; ++m) sum[0] += TERMS_SUM_TERM(m);
+#undef TERMS_SUM_TERM
+  return (sum[0] + sum[1]) + (sum[2] + sum[3]);
+}
 
-REAL terms_at(const RayTerms* t, REAL3 q) { return terms_sum(t->exps, t->coefs, t->count, q.x, q.y, q.z); }
+/* One ray's terms at q: terms_sum with the ray in every lane, lane 0 read (in one-ray builds, the only lane). */
+REAL terms_at(const RayTerms* t, REAL3 q) {
+  return lane_get(terms_sum(t->exps, t->coefs, t->count, (LREAL)q.x, (LREAL)q.y, (LREAL)q.z), 0);
+}
 
 /* The ray's terms summed (terms_at its largest coordinates), computed once. */
 REAL ray_terms_exact(RayTerms* t) {

@@ -189,7 +189,8 @@ LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials) {
     ALGRAY_UNROLL
     for (int p = (1 << level) - 1; p >= 0; --p) {
       LREAL left[NCOEF], right[NCOEF];
-      casteljau_halve_lanes(piece[p], left, right);
+      coefs_copy(left, (LREAL*)0, piece[p], (LREAL*)0); /* the point form has no mixed precision: no low parts */
+      casteljau_halve(left, (LREAL*)0, right, (LREAL*)0);
       ALGRAY_UNROLL
       for (int k = 0; k <= DEGREE; ++k) {
         piece[2 * p][k] = left[k];
@@ -233,18 +234,13 @@ typedef struct {
 ulong search_queued(SearchQueue* queue) {
   ulong found = 0;
   LREAL cur[NCOEF];
-#if LANES > 1
-  LMASK running = lanes_of_bits((1u << queue->count) - 1);
+  const LMASK running = lanes_of_bits((1u << queue->count) - 1);
   LaneIsolation iso;
-  isolate_bernstein_lanes(running, queue->b, queue->t_in, queue->t_out, &iso, cur, (const LaneTerms*)0);
+  isolate_bernstein_search(running, queue->b, queue->b, queue->t_in, queue->t_out, &iso, cur, (LaneTerms*)0,
+                           NO_PROBE);
   const uint found_bits = lane_mask_bits(running && iso.status != (REAL)ISOLATION_NONE);
   for (uint j = 0; j < queue->count; ++j)
     if ((found_bits >> j) & 1u) found |= (ulong)1 << queue->sample[j];
-#else
-  if (isolate_bernstein(queue->b, queue->b, queue->t_in, queue->t_out, cur, (RayTerms*)0, NO_PROBE).status !=
-      ISOLATION_NONE)
-    found = (ulong)1 << queue->sample[0];
-#endif
   queue->count = 0;
   return found;
 }

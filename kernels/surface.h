@@ -1,4 +1,5 @@
-/* One ray against one surface: clip, restrict, isolate the smallest root, refine it; then its normal and side. */
+/* Rays against one surface: clip, restrict, isolate the smallest root, refine it; then the normal and side. One ray, or
+ * LANES rays side by side (lanes.h), through the same code. */
 #ifndef ALGRAY_SURFACE_H
 #define ALGRAY_SURFACE_H
 
@@ -7,6 +8,7 @@
 #include "lanes.h"
 #include "ray.h"
 #include "real.h"
+#include "restrict.h"
 
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EYE && ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
 #error "RAY_ORIGIN=eye needs a power-basis isolation method"
@@ -27,7 +29,7 @@
  * expanded about t = screen_t; a pixel's xi = (px + 1/2) * xi_scale + xi_offset. */
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
 
-/* The xi of a pixel column whose centre is `centre` ((REAL)px + 0.5, as camera_ray's), where its row's polynomials
+/* The xi of a pixel column whose centre is `centre` ((REAL)px + 0.5, as camera_rays'), where its row's polynomials
  * are evaluated; of one column or of lanes (lane_pixel_centres). */
 #define SCREEN_COLUMN(centre, xi_scale, xi_offset) ((centre) * (xi_scale) + (xi_offset))
 
@@ -48,26 +50,15 @@ REAL screen_ray_taylor(uint px, uint py, __global const REAL* rows, uint row0, R
 }
 #endif
 
-/* The outcome of isolating and refining the smallest root of P*(t) on [t_in, t_out]. */
+/* The outcome of isolating and refining the smallest root of P*(t) on [t_in, t_out], for LANES rays side by side
+ * (lane j ray j's; with LANES = 1, one ray's). */
 typedef struct {
-  REAL t;          /* the root; meaningful with ALGRAY_HIT_FOUND */
-  REAL f_before;   /* P at the left end of the isolating interval */
-  uint flags;      /* ALGRAY_HIT_FOUND, ALGRAY_HIT_BUDGET */
-  uint steps;      /* isolation intervals examined */
-  uint iterations; /* refinement iterations */
-} SegmentRoot;
-
-/* SegmentRoot for LANES rays side by side (trace_lanes), lane j ray j's; with LANES = 1, one ray's (hit_record). */
-typedef struct {
-  LREAL t, f_before;
-  LANE_INT_VEC flags, steps, iterations;
+  LREAL t;        /* the root; meaningful with ALGRAY_HIT_FOUND */
+  LREAL f_before; /* P at the left end of the isolating interval */
+  LANE_INT_VEC flags;      /* ALGRAY_HIT_FOUND, ALGRAY_HIT_BUDGET, ALGRAY_HIT_IN_EXTENT, ... */
+  LANE_INT_VEC steps;      /* isolation intervals examined */
+  LANE_INT_VEC iterations; /* refinement iterations */
 } LaneRoots;
-
-typedef struct {
-  SegmentRoot root; /* root.t: the ray parameter of the hit; root.flags also carries ALGRAY_HIT_IN_EXTENT */
-  REAL3 u;          /* hit point in unit coordinates */
-  REAL3 d_unit;     /* ray direction in unit coordinates */
-} SurfaceHit;
 
 /* The probe records the coefficients the isolation starts from, in its basis; a render build has no such call. */
 #if ALGRAY_PROBE
@@ -85,18 +76,7 @@ void probe_coefficients(const REAL* c, const REAL* c_lo, uint basis, ProbeLog* p
 #define ISOLATED_TOL_Y(lo, hi, t_in, t_out) \
   (STOP_WIDTH((t_in) + (lo) * ((t_out) - (t_in))) / (((hi) - (lo)) * ((t_out) - (t_in))))
 
-/* The record of a ray that misses the extent, as enter_surface starts it. */
-ALGRAY_INLINE SegmentRoot missed_root(void) {
-  SegmentRoot r;
-  r.t = INFINITY;
-  r.f_before = 0;
-  r.flags = 0;
-  r.steps = 0;
-  r.iterations = 0;
-  return r;
-}
-
-/* The hit record of a ray that misses the extent: hit_records_lanes starts every record from it. */
+/* The hit record of a ray that misses the extent: hit_records starts every record from it. */
 ALGRAY_INLINE HitRecord missed_record(void) {
   HitRecord r;
   r.flags = 0;
@@ -105,18 +85,6 @@ ALGRAY_INLINE HitRecord missed_record(void) {
   r.t_lo = 0;
   r.depth = INFINITY;
   r.normal_x = r.normal_y = r.normal_z = 0;
-  return r;
-}
-
-/* The record of what the isolation found, before refinement; a bracket (ISOLATION_BRACKET) is refined next. */
-SegmentRoot isolated_root(Isolation iso, ProbeLog* probe_log) {
-  SegmentRoot r = missed_root();
-  r.flags = iso.budget ? ALGRAY_HIT_BUDGET : 0u;
-  r.steps = iso.steps;
-  PROBE(ALGRAY_EVENT_ISOLATED, iso.budget, (uint)iso.status, 0u, iso.lo, iso.hi, iso.f_lo, iso.f_hi);
-  if (iso.doubt) r.flags |= ALGRAY_HIT_DOUBT;
-  if (iso.status == ISOLATION_EXACT) r.flags |= ALGRAY_HIT_EXACT;
-  if (iso.status != ISOLATION_NONE && iso.cluster) r.flags |= ALGRAY_HIT_CLUSTER;
   return r;
 }
 
@@ -131,71 +99,23 @@ LREAL coefficient_scale(const LREAL* c) {
  * of lanes. */
 #define PLACED_ROOT_T(lo, hi, y, t_in, t_out) ((t_in) + ((lo) + (y) * ((hi) - (lo))) * ((t_out) - (t_in)))
 
-/* The root at y of the isolating interval (0 when the isolation settled it at the interval's left end). */
-void place_root(SegmentRoot* r, Isolation iso, REAL y, REAL t_in, REAL t_out) {
-  r->t = PLACED_ROOT_T(iso.lo, iso.hi, y, t_in, t_out);
-  r->f_before = iso.f_lo;
-  r->flags |= ALGRAY_HIT_FOUND;
-}
-
-/* Adaptive builds: whether the root at y of the isolating interval (prepared coefficients c) could move by more
- * than ALGRAY_DOUBT_POSITION of its t under the coefficients' noise, read off P's slope there: the secant of the
- * isolating interval can be many times steeper than P at the root (a Kummer shell ray: 60 times, with the root
- * 1e-3 off). Then r is marked doubted. */
 /* How far the root at t may move, read off P's slope on the isolating interval [lo, hi]: for one ray and for lanes
  * alike, so that both take the same operations. */
 #define FLAT_ROOT_MARGIN(slope, t, lo, hi, t_in, t_out) \
   (fabs(slope) * ALGRAY_DOUBT_POSITION * fabs(t) / (((hi) - (lo)) * ((t_out) - (t_in))))
-void doubt_flat_root(SegmentRoot* r, Isolation iso, const REAL* c, REAL y, REAL t_in, REAL t_out, ProbeLog* probe_log) {
-#if ALGRAY_ESCALATE
-  REAL slope;
-  (void)isolated_value_slope(c, y, &slope);
-  const REAL margin = FLAT_ROOT_MARGIN(slope, r->t, iso.lo, iso.hi, t_in, t_out);
-  if (!(margin <= iso.noise)) return;
-  PROBE(ALGRAY_EVENT_DOUBT, 0, ALGRAY_DOUBT_FLAT, 0u, iso.lo, iso.hi, margin, iso.noise);
-  r->flags |= ALGRAY_HIT_DOUBT;
-#else
-  (void)r;
-  (void)iso;
-  (void)c;
-  (void)y;
-  (void)t_in;
-  (void)t_out;
-#endif
-}
 
-#if LANES == 1
-/* Refines what the isolation found; iso_c holds the polynomial on the isolating interval (consumed). */
-SegmentRoot refine_isolated(Isolation iso, REAL* iso_c, REAL t_in, REAL t_out,
-                            __constant const REAL* binomials, ProbeLog* probe_log) {
-  SegmentRoot r = isolated_root(iso, probe_log);
-  if (iso.status == ISOLATION_NONE) return r;
-  REAL y = 0;
-  const int refine = iso.status == ISOLATION_BRACKET;
-  if (refine) {
-    const REAL tol_y = ISOLATED_TOL_Y(iso.lo, iso.hi, t_in, t_out);
-    const REAL scale = coefficient_scale(iso_c), start = isolated_start(iso_c);
-    prepare_isolated(iso_c, binomials);
-#if REFINE_IN_CLOSED_FORM
-    (void)scale;
-    (void)start;
-    y = line_root(iso.f_lo, iso.f_hi);
-#else
-    y = refine_root(iso_c, iso.f_lo, iso.f_hi, tol_y, scale, start, &r.iterations, probe_log);
-#endif
-  }
-  place_root(&r, iso, y, t_in, t_out);
-  if (refine) doubt_flat_root(&r, iso, iso_c, y, t_in, t_out, probe_log);
-  return r;
-}
-#else
-/* The roots of LANES rays' isolations, refined together in lanes (lanes.h), in vectors throughout: c holds each
- * lane's polynomial on its isolating interval (consumed); t_in, t_out each lane's segment. Lanes that missed the
- * extent (not in `entered`) get missed_root()'s fields; every other lane isolated_root's, then place_root's where
- * a root was found, with ALGRAY_HIT_IN_EXTENT. */
-void refine_lanes(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in, LREAL t_out,
-                  __constant const REAL* binomials, LaneRoots* roots) {
-  /* isolated_root's flags */
+/* The roots of the rays' isolations, refined (refine.h): c holds each lane's polynomial on its isolating interval
+ * (consumed); t_in, t_out each lane's segment. Lanes that missed the extent (not in `entered`) get no root and no
+ * flags; every other lane the isolation's flags with ALGRAY_HIT_IN_EXTENT, and where the isolation found a root (a
+ * bracket refined, or one settled at an end: y = 0) its t, with ALGRAY_HIT_FOUND. Adaptive builds doubt a root
+ * that lies where P is so flat that the coefficients' noise could move it by more than ALGRAY_DOUBT_POSITION of
+ * its t, read off P's slope there: the secant of the isolating interval can be many times steeper than P at the
+ * root (a Kummer shell ray: 60 times, with the root 1e-3 off). */
+void refine_rays(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in, LREAL t_out,
+                 __constant const REAL* binomials, LaneRoots* roots, ProbeLog* probe_log) {
+  if (LANE_ANY(entered))
+    PROBE(ALGRAY_EVENT_ISOLATED, iso->budget, (uint)iso->status, 0u, iso->lo, iso->hi, iso->f_lo, iso->f_hi);
+  /* the isolation's flags */
 #define FLAG_WHERE(flag, mask) LANE_SEL((LANE_INT_VEC)0, (LANE_INT_VEC)(flag), (mask))
   LANE_INT_VEC flags = FLAG_WHERE(ALGRAY_HIT_IN_EXTENT, entered) | FLAG_WHERE(ALGRAY_HIT_BUDGET, entered && iso->budget) |
                        FLAG_WHERE(ALGRAY_HIT_DOUBT, entered && iso->doubt != 0) |
@@ -218,29 +138,26 @@ void refine_lanes(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in,
     (void)start;
     y = LANE_SEL((LREAL)0, line_root(f0, f1), running);
 #else
-    y = LANE_SEL((LREAL)0, refine_root_lanes(c, f0, f1, tol_y, scale, start, running, &iterations, NO_PROBE), running);
+    y = LANE_SEL((LREAL)0, refine_root(c, f0, f1, tol_y, scale, start, running, &iterations, probe_log), running);
 #endif
   }
-  /* place_root, where the isolation found a root (a bracket refined, or one settled at an end: y = 0) */
   roots->t = LANE_SEL((LREAL)INFINITY, PLACED_ROOT_T(iso->lo, iso->hi, y, t_in, t_out), found);
   roots->f_before = LANE_SEL((LREAL)0, iso->f_lo, found);
   roots->flags = flags | FLAG_WHERE(ALGRAY_HIT_FOUND, found);
 #undef FLAG_WHERE
   roots->steps = LANE_SEL((LANE_INT_VEC)0, LANE_TO_INT(iso->steps), entered);
   roots->iterations = LANE_SEL((LANE_INT_VEC)0, iterations, running);
-#if ALGRAY_ESCALATE
-  /* doubt_flat_root over lanes, each lane with its operations (taken lane by lane, the coefficients' trip through
-   * memory and the scalar slopes were 60% of what adaptive added to the cusp catastrophe's camera pass) */
-  if (LANE_ANY(running)) {
+  /* the flat check, each lane with its operations (taken lane by lane, the coefficients' trip through memory and
+   * the scalar slopes were 60% of what adaptive added to the cusp catastrophe's camera pass) */
+  if (ALGRAY_ESCALATE && LANE_ANY(running)) {
     LREAL slope;
-    (void)isolated_value_slope_lanes(c, y, &slope);
+    (void)isolated_value_slope(c, y, &slope);
     const LREAL margin = FLAT_ROOT_MARGIN(slope, roots->t, iso->lo, iso->hi, t_in, t_out);
-    roots->flags |= LANE_SEL((LANE_INT_VEC)0, (LANE_INT_VEC)ALGRAY_HIT_DOUBT, running && margin <= iso->noise);
+    const LMASK flat = running && margin <= iso->noise;
+    if (LANE_ANY(flat)) PROBE(ALGRAY_EVENT_DOUBT, 0, ALGRAY_DOUBT_FLAT, 0u, iso->lo, iso->hi, margin, iso->noise);
+    roots->flags |= LANE_SEL((LANE_INT_VEC)0, (LANE_INT_VEC)ALGRAY_HIT_DOUBT, flat);
   }
-#endif
 }
-#endif
-
 #if RAY_ORIGIN == ALGRAY_ORIGIN_EXTENT || RAY_ORIGIN == ALGRAY_ORIGIN_POINT
 /* The coordinates' factors of the ray o + t*d restricted to [t_in, t_out] as s in [0, 1], in the isolation's
  * basis: entry and exit points for the Bernstein form, entry point and chord for the power basis. */
@@ -335,26 +252,12 @@ Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, _
 }
 #endif
 
-/* The start of trace_surface: the ray in unit coordinates (h->u, h->d_unit), clipped to the extent. Returns 0
- * when the ray misses the extent; *h is then the whole answer. */
-int enter_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, SurfaceHit* h, REAL* t_in,
-                  REAL* t_out, ProbeLog* probe_log) {
-  h->root = missed_root();
-  /* Unit coordinates keep every point of the extent within |u| <= 1: the conditioning step that makes float usable. */
-  h->u = (ray.o - centre) * inv_scale;
-  h->d_unit = ray.d * inv_scale;
-  if (!clip_to_extent(h->u, h->d_unit, extent_kind, box_half, t_in, t_out)) return 0;
-  PROBE(ALGRAY_EVENT_SEGMENT, 0, 0u, 0u, *t_in, *t_out, (REAL)0, (REAL)0);
-  h->root.flags = ALGRAY_HIT_IN_EXTENT;
-  return 1;
-}
-
-#if LANES > 1
-/* enter_surface for LANES rays at once: unit gets each lane's ray in unit coordinates (as enter_surface's h->u and
- * h->d_unit, bit for bit), and *lane_t_in, *lane_t_out each lane's segment (0 and 1 where it misses). Returns the
- * lanes that enter the extent (none from `count` on). */
-LMASK enter_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
-                  LaneRays* unit, LREAL* lane_t_in, LREAL* lane_t_out) {
+/* The first `count` (<= LANES) of the rays, in unit coordinates (unit) and clipped to the extent: *lane_t_in,
+ * *lane_t_out get each lane's segment (0 and 1 where it misses). Returns the lanes that enter the extent (none from
+ * `count` on). Unit coordinates keep every point of the extent within |u| <= 1: the conditioning step that makes
+ * float usable. */
+LMASK enter_extent(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
+                   LaneRays* unit, LREAL* lane_t_in, LREAL* lane_t_out, ProbeLog* probe_log) {
   unit->ox = (rays->ox - centre.x) * inv_scale;
   unit->oy = (rays->oy - centre.y) * inv_scale;
   unit->oz = (rays->oz - centre.z) * inv_scale;
@@ -367,6 +270,7 @@ LMASK enter_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale
                                             box_half, &lo, &hi);
   *lane_t_in = LANE_SEL((LREAL)0, lo, inside);
   *lane_t_out = LANE_SEL((LREAL)1, hi, inside);
+  if (LANE_ANY(inside)) PROBE(ALGRAY_EVENT_SEGMENT, 0, 0u, 0u, *lane_t_in, *lane_t_out, (REAL)0, (REAL)0);
   return inside;
 }
 
@@ -377,103 +281,27 @@ ALGRAY_INLINE REAL3 lane_origin(const LaneRays* rays, uint j) {
 ALGRAY_INLINE REAL3 lane_direction(const LaneRays* rays, uint j) {
   return (REAL3)(lane_get(rays->dx, j), lane_get(rays->dy, j), lane_get(rays->dz, j));
 }
-#endif
 
-/* The part of trace_surface before the refinement: enter_surface, then the isolation of P*(t)'s smallest root
- * on the segment (iso_c: the polynomial on the isolating interval). Returns 0 when the ray misses the extent. */
-int isolate_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind, __global const uint* exps,
-                    __global const REAL* coefs, uint count, __constant const REAL* binomials, uint even_axes,
-                    SurfaceHit* h, Isolation* iso, REAL* t_in, REAL* t_out, REAL* iso_c, const REAL* taylor,
-                    REAL taylor_t, ProbeLog* probe_log) {
-  if (!enter_surface(ray, centre, inv_scale, box_half, extent_kind, h, t_in, t_out, probe_log)) return 0;
-  *iso = isolate_on_segment(h->u, h->d_unit, *t_in, *t_out, exps, coefs, count, binomials, even_axes,
-                            iso_c, taylor, taylor_t, probe_log);
-  return 1;
-}
-
+/* The isolations of the rays from their segment_coefficients (root, root_lo are consumed): one ray by its method
+ * (isolate_method); lanes together, in the Bernstein search, the one method built for lanes (refine.h). c gets each
+ * lane's polynomial on its isolating interval, for refine_rays. Lanes from `count` on, and those whose ray missed the
+ * extent (in_extent[j] == 0), are left alone. rays: the lanes' rays in unit coordinates, where adaptive builds'
+ * search evaluates P in float-float (bracket_ends_in_float_float). */
+void isolate_rays(uint count, const int* in_extent, const LaneRays* rays, REAL (*root)[NCOEF], REAL (*root_lo)[NCOEF],
+                  const REAL* t_in, const REAL* t_out, LaneIsolation* iso, LREAL* c, RayTerms* terms,
+                  ProbeLog* probe_log) {
 #if LANES > 1
-#if ALGRAY_ESCALATE && !ALGRAY_COMPENSATED
-/* terms_sum over lanes (restrict.h): every lane's ray terms summed at once, each the value ray_terms_exact would
- * give it. Summed one lane at a time, they were a tenth of the Endrass octic's adaptive camera pass. */
-DEFINE_TERMS_SUM(terms_sum_lanes, LREAL)
-#endif
-
-/* The isolations of LANES rays from their segment_coefficients (root, root_lo are consumed): together in lanes
- * (isolate_bernstein_lanes), or one lane at a time in mixed precision. c gets each lane's polynomial on its
- * isolating interval, for refine_lanes. Lanes from `count` on, and those whose ray missed the extent
- * (in_extent[j] == 0), are left alone. rays: the lanes' rays in unit coordinates, where adaptive builds' search
- * evaluates P in float-float (bracket_ends_in_float_float). */
-void isolate_lanes(uint count, const int* in_extent, const LaneRays* rays, REAL (*root)[NCOEF], REAL (*root_lo)[NCOEF],
-                   const REAL* t_in, const REAL* t_out, LaneIsolation* iso, LREAL* c, RayTerms* terms) {
-  (void)rays; /* adaptive builds' search checks its accept doubts on them */
-  for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
-#if ALGRAY_COMPENSATED
-  for (uint j = 0; j < LANES; ++j) set_lane_isolation(iso, j, isolation_none());
-  for (uint j = 0; j < count; ++j) {
-    if (!in_extent[j]) continue;
-    REAL iso_c[NCOEF];
-    set_lane_isolation(iso, j,
-                       isolate_method(root[j], root_lo[j], t_in[j], t_out[j], iso_c, &terms[j], NO_PROBE));
-    for (int k = 0; k <= DEGREE; ++k) lane_set(&c[k], j, iso_c[k]);
-  }
+  isolate_rays_together(count, in_extent, rays, root, root_lo, t_in, t_out, iso, c, terms, probe_log);
 #else
-  (void)root_lo;
-  LREAL lane_root[NCOEF], lane_t_in = 0, lane_t_out = 1, lane_terms = 0;
-  for (int k = 0; k <= DEGREE; ++k) lane_root[k] = 0;
-  LMASK running = 0;
-#if ALGRAY_ESCALATE
-  LREAL x = 0, y = 0, z = 0; /* each ray's largest coordinates, where its terms are summed */
-  uint first = LANES; /* the first ray in the extent: its terms name the monomials */
-#endif
-  for (uint j = 0; j < count; ++j) {
-    if (!in_extent[j]) continue;
-    lane_set_mask(&running, j, 1);
-    for (int k = 0; k <= DEGREE; ++k) lane_set(&lane_root[k], j, root[j][k]);
-    lane_set(&lane_t_in, j, t_in[j]);
-    lane_set(&lane_t_out, j, t_out[j]);
-#if ALGRAY_ESCALATE
-    if (first == LANES) first = j;
-    lane_set(&x, j, terms[j].x);
-    lane_set(&y, j, terms[j].y);
-    lane_set(&z, j, terms[j].z);
-#endif
-  }
-#if ALGRAY_ESCALATE
-  if (LANE_ANY(running)) {
-    lane_terms = terms_sum_lanes(terms[first].exps, terms[first].coefs, terms[first].count, x, y, z);
-    REAL terms_of[LANES];
-    LANES_STORE(lane_terms, terms_of);
-    for (uint j = 0; j < count; ++j) {
-      if (!in_extent[j]) continue;
-      terms[j].value = terms_of[j];
-      terms[j].exact = 1;
-    }
-  }
-#endif
-  (void)lane_terms;
-  if (LANE_ANY(running)) {
-    LaneTerms search_terms;
-#if ALGRAY_ESCALATE
-    search_terms.value = lane_terms;
-    search_terms.rays = rays;
-    search_terms.exps = terms[first].exps;
-    search_terms.coefs = terms[first].coefs;
-    search_terms.count = terms[first].count;
-#endif
-    isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, iso, c, &search_terms);
-  }
+  (void)rays;
+  (void)count;
+  for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
+  if (!in_extent[0]) return;
+  set_lane_isolation(iso, 0, isolate_method(root[0], root_lo[0], t_in[0], t_out[0], c, &terms[0], probe_log));
 #endif
 }
-#endif
 
-/* The hit of a ray that entered the extent, from its refined root. */
-void finish_surface(SurfaceHit* h, SegmentRoot root) {
-  h->root = root;
-  h->root.flags |= ALGRAY_HIT_IN_EXTENT;
-  if (h->root.flags & ALGRAY_HIT_FOUND) h->u = h->u + h->root.t * h->d_unit;
-}
-
-/* Adaptive builds: a root doubted as flat (doubt_flat_root) is kept after all where P, evaluated from the
+/* Adaptive builds: a root doubted as flat (refine_rays) is kept after all where P, evaluated from the
  * monomials at t -+ ALGRAY_DOUBT_POSITION |t| on the ray, has opposite signs beyond that evaluation's rounding:
  * then a root lies within what the flat check allows. The check held the root to the coefficients' noise, which
  * sums the terms over the whole segment, out to the extent's sphere; at a root inside, the terms are far smaller
@@ -505,7 +333,7 @@ REAL direct_value(REAL3 q, __global const uint* exps, __global const REAL* coefs
 #define CERTAIN_SIGN_CHANGE(v0, rounding0, v1, rounding1) \
   (fabs(v0) > (rounding0) && fabs(v1) > (rounding1) && ((v0) > 0) != ((v1) > 0))
 
-/* The float-float check of confirm_flat_root for the lanes in `doubted` (roots at t, rays r from their starts),
+/* The float-float check of confirm_flat_roots for the lanes in `doubted` (roots at t, rays r from their starts),
  * at t -+ delta with delta shrunk by 2^-10, so that their own rounding keeps the points within
  * ALGRAY_DOUBT_POSITION |t| of t; the lanes it confirms. *v0 ... *rounding1: the values and their bounds. */
 LMASK confirmed_in_float_float(LMASK doubted, const LaneRays* r, LREAL t, __global const uint* exps,
@@ -517,54 +345,38 @@ LMASK confirmed_in_float_float(LMASK doubted, const LaneRays* r, LREAL t, __glob
   return doubted && CERTAIN_SIGN_CHANGE(*v0, *rounding0, *v1, *rounding1);
 }
 
-/* h: a found root (h->u its point), u the ray's start; clears the doubt when P's values confirm it, in float or
- * else in float-float (the probe's event says which: decision 0 or 1). */
-void confirm_flat_root(SurfaceHit* h, REAL3 u, __global const uint* exps, __global const REAL* coefs,
-                       uint count, ProbeLog* probe_log) {
-  if ((h->root.flags & (ALGRAY_HIT_FOUND | ALGRAY_HIT_DOUBT)) != (ALGRAY_HIT_FOUND | ALGRAY_HIT_DOUBT)) return;
-  const REAL delta = (REAL)ALGRAY_DOUBT_POSITION * fabs(h->root.t);
-  REAL rounding0, rounding1;
-  REAL v0 = direct_value(h->u - delta * h->d_unit, exps, coefs, count, &rounding0);
-  REAL v1 = direct_value(h->u + delta * h->d_unit, exps, coefs, count, &rounding1);
-  uint arithmetic = 0;
-  if (!CERTAIN_SIGN_CHANGE(v0, rounding0, v1, rounding1)) {
-#if LANES == 1
-    const LaneRays r = one_lane_rays(u, h->d_unit);
-    if (!confirmed_in_float_float(1, &r, h->root.t, exps, coefs, count, &v0, &rounding0, &v1, &rounding1)) return;
-    arithmetic = 1;
-#else
-    (void)u; /* the lanes' caller checks its lanes in float-float together */
-    return;
-#endif
+/* Adaptive builds: clears the doubt of the found roots (roots, at: each root's point as its ray's origin, in unit
+ * coordinates) that P's values confirm, in float lane by lane, and then in float-float for the lanes still in
+ * doubt, together (unit: the rays from their starts). The probe sees which arithmetic confirmed it (decision 0 or
+ * 1). */
+void confirm_flat_roots(uint count, LaneRoots* roots, const LaneRays* at, const LaneRays* unit,
+                        __global const uint* exps, __global const REAL* coefs, uint mono_count, ProbeLog* probe_log) {
+  const LMASK found = (roots->flags & (LANE_INT_VEC)ALGRAY_HIT_FOUND) != 0;
+  const uint doubted_bits = lane_mask_bits(found && (roots->flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0);
+  for (uint j = 0; j < count; ++j) {
+    if (!((doubted_bits >> j) & 1u)) continue;
+    const REAL delta = (REAL)ALGRAY_DOUBT_POSITION * fabs(lane_get(roots->t, j));
+    const REAL3 u = lane_origin(at, j), d = lane_direction(at, j);
+    REAL rounding0, rounding1;
+    const REAL v0 = direct_value(u - delta * d, exps, coefs, mono_count, &rounding0);
+    const REAL v1 = direct_value(u + delta * d, exps, coefs, mono_count, &rounding1);
+    if (!CERTAIN_SIGN_CHANGE(v0, rounding0, v1, rounding1)) continue;
+    PROBE(ALGRAY_EVENT_CONFIRMED, 0, 0u, 0u, v0, rounding0, v1, rounding1);
+    ((LANE_INT*)&roots->flags)[j] &= ~ALGRAY_HIT_DOUBT;
   }
-  PROBE(ALGRAY_EVENT_CONFIRMED, 0, arithmetic, 0u, v0, rounding0, v1, rounding1);
-  h->root.flags &= ~ALGRAY_HIT_DOUBT;
-}
-#else
-#define confirm_flat_root(h, u, exps, coefs, count, probe_log) ((void)(u))
-#endif
-
-#if LANES == 1
-SurfaceHit trace_surface(Ray ray, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
-                         __global const uint* exps, __global const REAL* coefs, uint count,
-                         __constant const REAL* binomials, uint even_axes, const REAL* taylor, REAL taylor_t,
-                         ProbeLog* probe_log) {
-  SurfaceHit h;
-  Isolation iso;
-  REAL t_in, t_out, iso_c[NCOEF];
-  if (isolate_surface(ray, centre, inv_scale, box_half, extent_kind, exps, coefs, count, binomials, even_axes, &h, &iso,
-                      &t_in, &t_out, iso_c, taylor, taylor_t, probe_log)) {
-    const REAL3 start = h.u; /* finish_surface moves h.u to the root */
-    finish_surface(&h, refine_isolated(iso, iso_c, t_in, t_out, binomials, probe_log));
-    confirm_flat_root(&h, start, exps, coefs, count, probe_log);
-  }
-  return h;
+  const LMASK still = found && (roots->flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0;
+  if (!LANE_ANY(still)) return;
+  LREAL v0, rounding0, v1, rounding1;
+  const LMASK confirmed = confirmed_in_float_float(still, unit, LANE_SEL((LREAL)0, roots->t, still), exps, coefs,
+                                                   mono_count, &v0, &rounding0, &v1, &rounding1);
+  if (LANE_ANY(confirmed)) PROBE(ALGRAY_EVENT_CONFIRMED, 0, 1u, 0u, v0, rounding0, v1, rounding1);
+  roots->flags &= LANE_SEL((LANE_INT_VEC)(-1), (LANE_INT_VEC)(~ALGRAY_HIT_DOUBT), confirmed);
 }
 #endif
 
 /* grad P at (x, y, z), from the monomials, with a table of powers per axis; over lanes, each lane's point. */
-void surface_gradient_lanes(LREAL x, LREAL y, LREAL z, __global const uint* exps, __global const REAL* coefs,
-                            uint count, LREAL* gx, LREAL* gy, LREAL* gz) {
+void surface_gradient(LREAL x, LREAL y, LREAL z, __global const uint* exps, __global const REAL* coefs,
+                      uint count, LREAL* gx, LREAL* gy, LREAL* gz) {
   LREAL px[NCOEF], py[NCOEF], pz[NCOEF];
   px[0] = py[0] = pz[0] = 1;
   for (int n = 1; n <= DEGREE; ++n) {
@@ -588,10 +400,9 @@ void surface_gradient_lanes(LREAL x, LREAL y, LREAL z, __global const uint* exps
 
 /* The hit records of the first `count` (<= LANES) of the lanes' rays: lane j of roots holds ray j's root, `at` the
  * rays in unit coordinates with each found root's point as the origin, `rays` the rays as traced. Depth, the normal
- * from grad P (taken together in lanes) facing the ray, and the side. With LANES = 1, one ray's record
- * (hit_record). */
-void hit_records_lanes(uint count, const LaneRays* rays, const LaneRays* at, const LaneRoots* roots,
-                       __global const uint* exps, __global const REAL* coefs, uint mono_count, HitRecord* out) {
+ * from grad P (taken together in lanes) facing the ray, and the side. */
+void hit_records(uint count, const LaneRays* rays, const LaneRays* at, const LaneRoots* roots,
+                 __global const uint* exps, __global const REAL* coefs, uint mono_count, HitRecord* out) {
   const LMASK found = (roots->flags & (LANE_INT_VEC)ALGRAY_HIT_FOUND) != 0;
   const uint found_bits = lane_mask_bits(found);
   REAL depth_of[LANES], nx_of[LANES], ny_of[LANES], nz_of[LANES];
@@ -603,7 +414,7 @@ void hit_records_lanes(uint count, const LaneRays* rays, const LaneRays* at, con
     const LREAL dux = at->dx, duy = at->dy, duz = at->dz;
     const LREAL t = LANE_SEL((LREAL)0, roots->t, found);
     LREAL gx, gy, gz;
-    surface_gradient_lanes(x, y, z, exps, coefs, mono_count, &gx, &gy, &gz);
+    surface_gradient(x, y, z, exps, coefs, mono_count, &gx, &gy, &gz);
     LREAL glen, dlen, g_dot_du;
     {
       /* length() and dot() as PoCL computes them: three products, added left to right */
@@ -659,22 +470,6 @@ void hit_records_lanes(uint count, const LaneRays* rays, const LaneRays* at, con
   }
 }
 
-#if LANES == 1
-HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global const REAL* coefs, uint count) {
-  /* the ray as traced, and in unit coordinates from its hit point (as trace_lanes' `at`) */
-  const LaneRays r = one_lane_rays(ray.o, ray.d), at = one_lane_rays(h.u, h.d_unit);
-  LaneRoots root;
-  root.t = h.root.t;
-  root.f_before = h.root.f_before;
-  root.flags = (LANE_INT_VEC)h.root.flags;
-  root.steps = (LANE_INT_VEC)h.root.steps;
-  root.iterations = (LANE_INT_VEC)h.root.iterations;
-  HitRecord record;
-  hit_records_lanes(1, &r, &at, &root, exps, coefs, count, &record);
-  return record;
-}
-#endif
-
 #if LANES > 1 && RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && DEGREE <= 15
 #define SCREEN_LANES 1
 /* The screen form's coefficients for a group of lanes at once: screen_ray_taylor, restrict_from_taylor and
@@ -683,8 +478,8 @@ HitRecord hit_record(Ray ray, SurfaceHit h, __global const uint* exps, __global 
  * One ray's steps are chains of dependent vector operations; over lanes the D + 1 coefficients' chains run side
  * by side. row: the image row's polynomials (screen_rows); xi: each lane's column; tau_in, tau_out: each lane's
  * segment about the row's t0. */
-ALGRAY_INLINE void screen_coefficients_lanes(__global const REAL* row, LREAL xi, LREAL tau_in, LREAL tau_out,
-                               __constant const REAL* binomials, LREAL* out) {
+ALGRAY_INLINE void screen_coefficients(__global const REAL* row, LREAL xi, LREAL tau_in, LREAL tau_out,
+                                       __constant const REAL* binomials, LREAL* out) {
   LREAL taylor[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) taylor[k] = (LREAL)row[DEGREE * NCOEF + k];
@@ -721,35 +516,35 @@ ALGRAY_INLINE void screen_coefficients_lanes(__global const REAL* row, LREAL xi,
 #define SCREEN_LANES 0
 #endif
 
-#if LANES > 1
-/* trace_surface and hit_record for the first `count` (<= LANES) of the lanes' rays, or 0 when none enters the
- * extent (records then left alone: each is missed_record()). They are clipped together, each
- * is restricted on its own (the screen form: together), then all are isolated, refined and their normals taken
- * together in vector lanes (lanes.h), with the one-ray kernel's records bit for bit (tests/test_lanes). Camera
- * and secondary rays share it. */
-int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
-                 __global const uint* exps, __global const REAL* coefs, uint mono_count,
-                 __constant const REAL* binomials, uint even_axes, HitRecord* records, uint px0, uint py,
-                 __global const REAL* screen_rows, uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset) {
+/* The hit records of the first `count` (<= LANES) of the rays, or 0 when none enters the extent (records then left
+ * alone: each is missed_record()). They are clipped together, each is restricted on its own (the screen form's
+ * lanes: together), then all are isolated, refined and their normals taken together, in vector lanes (lanes.h)
+ * where LANES > 1, with the one-ray build's records bit for bit (tests/test_lanes). Camera and secondary rays, and
+ * the probe, share it. px0, py: the first ray's pixel, and screen_rows .. xi_offset the image rows' polynomials, for
+ * the screen form (other builds never read them). */
+int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
+               __global const uint* exps, __global const REAL* coefs, uint mono_count, __constant const REAL* binomials,
+               uint even_axes, HitRecord* records, uint px0, uint py, __global const REAL* screen_rows,
+               uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset, ProbeLog* probe_log) {
   LaneIsolation iso;
   LaneRoots roots;
   LREAL iso_c[NCOEF], lane_t_in, lane_t_out;
   LaneRays unit;
   const LMASK running =
-      enter_lanes(count, rays, centre, inv_scale, box_half, extent_kind, &unit, &lane_t_in, &lane_t_out);
+      enter_extent(count, rays, centre, inv_scale, box_half, extent_kind, &unit, &lane_t_in, &lane_t_out, probe_log);
   /* no ray enters the extent (whole groups of most views): the caller writes missed_record() for each */
   if (!LANE_ANY(running)) return 0;
 #if SCREEN_LANES
   /* screen_ray_taylor's column and segment_coefficients' segment about t0 */
   const LREAL xi = LANE_SEL((LREAL)0, SCREEN_COLUMN(lane_pixel_centres(px0), xi_scale, xi_offset), running);
   LREAL lane_root[NCOEF];
-  screen_coefficients_lanes(screen_row(screen_rows, py, screen_row0), xi,
-                            LANE_SEL((LREAL)0, lane_t_in - screen_t, running),
-                            LANE_SEL((LREAL)1, lane_t_out - screen_t, running), binomials, lane_root);
-  /* lanes outside the extent start from zeros, as isolate_lanes gives them */
+  screen_coefficients(screen_row(screen_rows, py, screen_row0), xi, LANE_SEL((LREAL)0, lane_t_in - screen_t, running),
+                      LANE_SEL((LREAL)1, lane_t_out - screen_t, running), binomials, lane_root);
+  /* lanes outside the extent start from zeros, as isolate_rays gives them */
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) lane_root[k] = LANE_SEL((LREAL)0, lane_root[k], running);
-  isolate_bernstein_lanes(running, lane_root, lane_t_in, lane_t_out, &iso, iso_c, (const LaneTerms*)0);
+  isolate_bernstein_search(running, lane_root, lane_root, lane_t_in, lane_t_out, &iso, iso_c, (LaneTerms*)0,
+                           probe_log);
 #else
   /* one ray at a time: each lane's segment and whether it entered */
   REAL t_in[LANES], t_out[LANES];
@@ -767,12 +562,12 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
     taylor_t = screen_ray_taylor(px0 + j, py, screen_rows, screen_row0, screen_t, xi_scale, xi_offset, taylor);
 #endif
     segment_coefficients(lane_origin(&unit, j), lane_direction(&unit, j), t_in[j], t_out[j], exps, coefs, mono_count,
-                         binomials, even_axes, root[j], root_lo[j], &terms[j], taylor, taylor_t, NO_PROBE);
+                         binomials, even_axes, root[j], root_lo[j], &terms[j], taylor, taylor_t, probe_log);
   }
-  isolate_lanes(count, in_extent, &unit, root, root_lo, t_in, t_out, &iso, iso_c, terms);
+  isolate_rays(count, in_extent, &unit, root, root_lo, t_in, t_out, &iso, iso_c, terms, probe_log);
 #endif
-  refine_lanes(running, &iso, iso_c, lane_t_in, lane_t_out, binomials, &roots);
-  /* finish_surface over lanes: `at` moves each found root's ray to its point */
+  refine_rays(running, &iso, iso_c, lane_t_in, lane_t_out, binomials, &roots, probe_log);
+  /* `at` moves each found root's ray to its point */
   const LMASK found = (roots.flags & (LANE_INT_VEC)ALGRAY_HIT_FOUND) != 0;
   LaneRays at = unit;
   if (LANE_ANY(found)) {
@@ -782,29 +577,10 @@ int trace_lanes(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, 
     at.oz = LANE_SEL(unit.oz, unit.oz + t * unit.dz, found);
   }
 #if ALGRAY_ESCALATE
-  /* confirm_flat_root lane by lane in float, then in float-float for the lanes still doubted, together */
-  const uint doubted_bits = lane_mask_bits(found && (roots.flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0);
-  for (uint j = 0; j < count; ++j) {
-    if (!((doubted_bits >> j) & 1u)) continue;
-    SurfaceHit h;
-    h.root.t = lane_get(roots.t, j);
-    h.root.flags = (uint)((LANE_INT*)&roots.flags)[j];
-    h.u = lane_origin(&at, j);
-    h.d_unit = lane_direction(&at, j);
-    confirm_flat_root(&h, lane_origin(&unit, j), exps, coefs, mono_count, NO_PROBE);
-    ((LANE_INT*)&roots.flags)[j] = (LANE_INT)h.root.flags;
-  }
-  const LMASK still = found && (roots.flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0;
-  if (LANE_ANY(still)) {
-    LREAL v0, rounding0, v1, rounding1;
-    const LMASK confirmed = confirmed_in_float_float(still, &unit, LANE_SEL((LREAL)0, roots.t, still), exps, coefs,
-                                                     mono_count, &v0, &rounding0, &v1, &rounding1);
-    roots.flags &= LANE_SEL((LANE_INT_VEC)(-1), (LANE_INT_VEC)(~ALGRAY_HIT_DOUBT), confirmed);
-  }
+  confirm_flat_roots(count, &roots, &at, &unit, exps, coefs, mono_count, probe_log);
 #endif
-  hit_records_lanes(count, rays, &at, &roots, exps, coefs, mono_count, records);
+  hit_records(count, rays, &at, &roots, exps, coefs, mono_count, records);
   return 1;
 }
-#endif
 
 #endif /* ALGRAY_SURFACE_H */

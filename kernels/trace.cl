@@ -1,4 +1,4 @@
-/* The secondary-ray kernel: given rays (reflection, transmission) against the surface, one work-item per ray. */
+/* The secondary-ray kernel: given rays (reflection, transmission) against the surface, LANES rays per work-item. */
 #include "algray_shared.h"
 #include "isolate.h"
 #include "lanes.h"
@@ -12,26 +12,16 @@
 #endif
 
 /* Ray i is origins[i].xyz + t * directions[i].xyz, t >= 0, in world coordinates; its hit goes to out[i] as the
- * primary kernel writes it (t, depth, normal facing the ray, side, work). With LANES > 1, global size
- * ceil(count / LANES) and LANES consecutive rays per work-item (trace_lanes), with the same records. */
+ * primary kernel writes it (t, depth, normal facing the ray, side, work). Global size ceil(count / LANES), LANES
+ * consecutive rays per work-item (trace_rays). */
 __kernel void trace(__global const REAL4* origins, __global const REAL4* directions, uint count, REAL4 extent_centre,
                     REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind, __global const uint* mono_exps,
                     __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials, uint even_axes,
                     __global HitRecord* out) {
-#if LANES == 1
-  const uint i = get_global_id(0);
-  if (i >= count) return;
-  Ray ray;
-  ray.o = origins[i].xyz;
-  ray.d = directions[i].xyz;
-  const SurfaceHit hit = trace_surface(ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                       mono_exps, mono_coefs, mono_count, binomials, even_axes, 0, 0, NO_PROBE);
-  out[i] = hit_record(ray, hit, mono_exps, mono_coefs, mono_count);
-#else
   const uint first = get_global_id(0) * LANES;
   if (first >= count) return;
   const uint group = min((uint)LANES, count - first);
-  /* lanes from `group` on repeat the last ray; trace_lanes leaves them alone */
+  /* lanes from `group` on repeat the last ray; trace_rays leaves them alone */
 #define RAY_AXIS(array, axis, j) array[first + min((uint)(j), group - 1)].axis
 #define ORIGIN_X(j) RAY_AXIS(origins, x, j)
 #define ORIGIN_Y(j) RAY_AXIS(origins, y, j)
@@ -54,9 +44,8 @@ __kernel void trace(__global const REAL4* origins, __global const REAL4* directi
 #undef DIRECTION_Y
 #undef DIRECTION_Z
   HitRecord records[LANES];
-  const int entered = trace_lanes(group, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                  mono_exps, mono_coefs, mono_count, binomials, even_axes, records, 0, 0, 0, 0, 0,
-                                  0, 0);
+  const int entered = trace_rays(group, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
+                                 mono_exps, mono_coefs, mono_count, binomials, even_axes, records, 0, 0, 0, 0, 0, 0, 0,
+                                 NO_PROBE);
   for (uint j = 0; j < group; ++j) out[first + j] = entered ? records[j] : missed_record();
-#endif
 }

@@ -27,14 +27,17 @@ __kernel void univariate(__global const REAL* polys, uint count, __constant cons
   /* The coefficients are given, rounded once: their own size is their noise's. */
   terms = known_terms(0);
 #endif
-  const Isolation iso = isolate_method(root, root_lo, (REAL)0, (REAL)1, iso_c, &terms, NO_PROBE);
-  const SegmentRoot sr = refine_isolated(iso, iso_c, (REAL)0, (REAL)1, binomials, NO_PROBE);
+  LaneIsolation iso;
+  set_lane_isolation(&iso, 0, isolate_method(root, root_lo, (REAL)0, (REAL)1, iso_c, &terms, NO_PROBE));
+  LaneRoots roots;
+  refine_rays(1, &iso, iso_c, (REAL)0, (REAL)1, binomials, &roots, NO_PROBE);
+  const uint flags = (uint)roots.flags & ~ALGRAY_HIT_IN_EXTENT; /* a polynomial on [0, 1] has no extent */
   HitRecord r;
-  r.t_hi = (float)sr.t;
-  r.t_lo = (sr.flags & ALGRAY_HIT_FOUND) ? (float)(sr.t - (REAL)r.t_hi) : 0.0f;
+  r.t_hi = (float)roots.t;
+  r.t_lo = (flags & ALGRAY_HIT_FOUND) ? (float)(roots.t - (REAL)r.t_hi) : 0.0f;
   r.depth = r.t_hi;
   r.normal_x = r.normal_y = r.normal_z = 0;
-  r.flags = sr.flags;
-  r.work = ALGRAY_WORK_PACK(min(sr.steps, ALGRAY_WORK_MAX), min(sr.iterations, ALGRAY_WORK_MAX));
+  r.flags = flags;
+  r.work = ALGRAY_WORK_PACK(min((uint)roots.steps, ALGRAY_WORK_MAX), min((uint)roots.iterations, ALGRAY_WORK_MAX));
   out[i] = r;
 }

@@ -1,5 +1,6 @@
-// The primary and trace kernels in vector lanes (render.lanes, kernels/lanes.h) against one ray per work-item: the
-// same hit records bit for bit, on seeded random surfaces, in every precision and with partial lane groups.
+// The primary and trace kernels at lane widths 2 to 16 (render.lanes, kernels/lanes.h) against width 1, the one-ray
+// build of the same code: the same hit records bit for bit, on seeded random surfaces, in every precision and with
+// partial lane groups.
 #include <catch2/catch.hpp>
 #include <cstring>
 #include <string>
@@ -57,7 +58,7 @@ TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") 
   }
   cases.push_back({6, Precision::Double, "extent", {2, 4, 8, 16}});
   cases.push_back({10, Precision::Float, "auto", {2, 4, 16}});
-  cases.push_back({9, Precision::Double, "auto", {2, 4, 16}});  // the screen form's lanes (screen_coefficients_lanes)
+  cases.push_back({9, Precision::Double, "auto", {2, 4, 16}});  // the screen form's lanes (screen_coefficients)
   std::size_t hits = 0;
   for (std::size_t index = 0; index < cases.size(); ++index) {
     const Case& c = cases[index];

@@ -10,19 +10,23 @@
  * *_lo arrays below hold the low parts (other builds never touch them). Rounding the coefficients to float
  * before isolating was not enough: on the Endrass octic, rays that pass a node come within 1e-9 of the
  * coefficients' size of zero, so float noise faked sign changes there and hid thin pairs of roots (measured:
- * one hit on the wrong sheet, depth error 0.17). Sign variations read the hi parts, which carry the sign. */
+ * one hit on the wrong sheet, depth error 0.17). Sign variations read the hi parts, which carry the sign.
+ *
+ * Everything from here to the search is written over LREAL (lanes.h): one ray where LANES = 1, LANES rays side by
+ * side otherwise, each lane with one ray's operations, so that a lane's result is the one-ray build's bit for bit
+ * (tests/test_lanes compares the widths). */
 #if ALGRAY_COMPENSATED
 /* hi + lo = x1 a + x b, for float-float a, b and weights x1, x given as float-float too (lo 0 when exact). */
-ALGRAY_INLINE void ff_combine(REAL a, REAL a_lo, REAL x1, REAL x1_lo, REAL b, REAL b_lo, REAL x, REAL x_lo, REAL* hi,
-                              REAL* lo) {
-  const REAL p = x1 * a, q = x * b;
-  const REAL s = p + q, bb = s - p;
+ALGRAY_INLINE void ff_combine(LREAL a, LREAL a_lo, LREAL x1, LREAL x1_lo, LREAL b, LREAL b_lo, LREAL x, LREAL x_lo,
+                              LREAL* hi, LREAL* lo) {
+  const LREAL p = x1 * a, q = x * b;
+  const LREAL s = p + q, bb = s - p;
   /* The rounding errors and the low parts' products summed apart from the two-sum's chain, then added to it
    * once: each row of de Casteljau's triangle waits on the one before, so the chain's latency sets the pace.
    * Summed left to right in one chain, the Endrass octic's mixed render (512x384, with shadows) took 10% longer;
    * the images came out bit-identical. */
-  const REAL lows = (fma(x1, a, -p) + fma(x, b, -q)) + ((x1 * a_lo + x * b_lo) + (x1_lo * a + x_lo * b));
-  const REAL e = ((p - (s - bb)) + (q - bb)) + lows;
+  const LREAL lows = (fma(x1, a, -p) + fma(x, b, -q)) + ((x1 * a_lo + x * b_lo) + (x1_lo * a + x_lo * b));
+  const LREAL e = ((p - (s - bb)) + (q - bb)) + lows;
   *hi = s + e;
   *lo = e - (*hi - s);
 }
@@ -44,11 +48,12 @@ void bernstein_from_scaled(REAL* c, REAL* c_lo, __constant const REAL* binomials
   }
 }
 
-/* x1 a + x b: de Casteljau's recurrence in plain arithmetic, for REALs and for lanes of them alike. */
+/* x1 a + x b: de Casteljau's recurrence in plain arithmetic. */
 #define CASTELJAU_COMBINE(x1, a, x, b) ((x1) * (a) + (x) * (b))
 
-/* c = x1 a + x b: one step of de Casteljau's recurrence, in the build's arithmetic. */
-ALGRAY_INLINE void casteljau_step(REAL* c, REAL* c_lo, int k, int a, int b, REAL x1, REAL x1_lo, REAL x, REAL x_lo) {
+/* c[k] = x1 c[a] + x c[b]: one step of de Casteljau's recurrence, in the build's arithmetic. */
+ALGRAY_INLINE void casteljau_step(LREAL* c, LREAL* c_lo, int k, int a, int b, LREAL x1, LREAL x1_lo, LREAL x,
+                                  LREAL x_lo) {
 #if ALGRAY_COMPENSATED
   ff_combine(c[a], c_lo[a], x1, x1_lo, c[b], c_lo[b], x, x_lo, &c[k], &c_lo[k]);
 #else
@@ -59,14 +64,22 @@ ALGRAY_INLINE void casteljau_step(REAL* c, REAL* c_lo, int k, int a, int b, REAL
 #endif
 }
 
-ALGRAY_INLINE void coefs_copy(REAL* dst, REAL* dst_lo, const REAL* src, const REAL* src_lo) {
-  poly_copy(dst, src);
-#if ALGRAY_COMPENSATED
-  poly_copy(dst_lo, src_lo);
-#else
-  (void)dst_lo;
-  (void)src_lo;
-#endif
+/* dst = src, and dst_lo = src_lo in mixed precision. */
+ALGRAY_INLINE void coefs_copy(LREAL* dst, LREAL* dst_lo, const LREAL* src, const LREAL* src_lo) {
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) {
+    dst[k] = src[k];
+    if (ALGRAY_COMPENSATED) dst_lo[k] = src_lo[k];
+  }
+}
+
+/* dst = src in the lanes of `take`. */
+ALGRAY_INLINE void coefs_select(LREAL* dst, LREAL* dst_lo, const LREAL* src, const LREAL* src_lo, LMASK take) {
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) {
+    dst[k] = LANE_SEL(dst[k], src[k], take);
+    if (ALGRAY_COMPENSATED) dst_lo[k] = LANE_SEL(dst_lo[k], src_lo[k], take);
+  }
 }
 
 /* The triangles below run every inner loop to a constant bound and test the row's end inside: a bound that
@@ -75,8 +88,8 @@ ALGRAY_INLINE void coefs_copy(REAL* dst, REAL* dst_lo, const REAL* src, const RE
 
 /* Keeps the part of the curve on [0, x], x dyadic (so 1 - x is exact). In place: after pass r, c[r] is the
  * r-th left coefficient. */
-void casteljau_keep_left(REAL* c, REAL* c_lo, REAL x) {
-  const REAL x1 = (REAL)1 - x;
+ALGRAY_INLINE void casteljau_keep_left(LREAL* c, LREAL* c_lo, LREAL x) {
+  const LREAL x1 = (REAL)1 - x;
   ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
   for (int k = DEGREE; k >= 1; --k)
@@ -84,8 +97,8 @@ void casteljau_keep_left(REAL* c, REAL* c_lo, REAL x) {
 }
 
 /* Keeps the part on [x + x_lo, 1], for x >= 1/2 (so 1 - x is exact). */
-void casteljau_keep_right(REAL* c, REAL* c_lo, REAL x, REAL x_lo) {
-  const REAL x1 = (REAL)1 - x;
+ALGRAY_INLINE void casteljau_keep_right(LREAL* c, LREAL* c_lo, LREAL x, LREAL x_lo) {
+  const LREAL x1 = (REAL)1 - x;
   ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
   for (int k = 0; k < DEGREE; ++k)
@@ -93,11 +106,11 @@ void casteljau_keep_right(REAL* c, REAL* c_lo, REAL x, REAL x_lo) {
 }
 
 /* Halves c at 1/2 in one de Casteljau triangle: c becomes the left half, right the right half. */
-#if DEGREE <= 15 && !ALGRAY_COMPENSATED
-/* Each row of the triangle as one vector operation on a register, instead of a row of scalars through memory
- * (measured: casteljau_halve was a fifth of the Barth decic's shadow kernel). The same products and sums as
- * the scalar rows below: 0.5 t_k + 0.5 t_(k+1) per lane. Lanes past the row's end are never read. */
-void casteljau_halve(REAL* c, REAL* c_lo, REAL* right, REAL* right_lo) {
+#if LANES == 1 && DEGREE <= 15 && !ALGRAY_COMPENSATED
+/* One ray: each row of the triangle as one vector operation on a register, instead of a row of scalars through
+ * memory (measured: casteljau_halve was a fifth of the Barth decic's shadow kernel). The same products and sums
+ * as the rows below: 0.5 t_k + 0.5 t_(k+1) per lane. Lanes past the row's end are never read. */
+ALGRAY_INLINE void casteljau_halve(LREAL* c, LREAL* c_lo, LREAL* right, LREAL* right_lo) {
   (void)c_lo;
   (void)right_lo;
   REAL row[ACC_WIDTH];
@@ -114,13 +127,11 @@ void casteljau_halve(REAL* c, REAL* c_lo, REAL* right, REAL* right_lo) {
   }
 }
 #else
-void casteljau_halve(REAL* c, REAL* c_lo, REAL* right, REAL* right_lo) {
-  REAL t[NCOEF], t_lo[NCOEF];
+ALGRAY_INLINE void casteljau_halve(LREAL* c, LREAL* c_lo, LREAL* right, LREAL* right_lo) {
+  LREAL t[NCOEF], t_lo[NCOEF];
   coefs_copy(t, t_lo, c, c_lo);
   right[DEGREE] = t[DEGREE];
-#if ALGRAY_COMPENSATED
-  right_lo[DEGREE] = t_lo[DEGREE];
-#endif
+  if (ALGRAY_COMPENSATED) right_lo[DEGREE] = t_lo[DEGREE];
   ALGRAY_UNROLL
   for (int r = 1; r <= DEGREE; ++r) {
     ALGRAY_UNROLL
@@ -128,230 +139,13 @@ void casteljau_halve(REAL* c, REAL* c_lo, REAL* right, REAL* right_lo) {
       if (k <= DEGREE - r) casteljau_step(t, t_lo, k, k, k + 1, (REAL)0.5, 0, (REAL)0.5, 0);
     c[r] = t[0];
     right[DEGREE - r] = t[DEGREE - r];
-#if ALGRAY_COMPENSATED
-    c_lo[r] = t_lo[0];
-    right_lo[DEGREE - r] = t_lo[DEGREE - r];
-#else
-    (void)right_lo;
-#endif
+    if (ALGRAY_COMPENSATED) {
+      c_lo[r] = t_lo[0];
+      right_lo[DEGREE - r] = t_lo[DEGREE - r];
+    }
   }
 }
 #endif
-
-/* Coefficients on the dyadic interval [idx/2^level, (idx+1)/2^level], recomputed from the whole interval's. */
-void bernstein_restrict(const REAL* root, const REAL* root_lo, int level, ulong idx, REAL* out, REAL* out_lo) {
-  coefs_copy(out, out_lo, root, root_lo);
-  const REAL width = ldexp((REAL)1, -level);
-  const REAL lo = (REAL)idx * width, hi = lo + width;
-  if (hi < (REAL)1) casteljau_keep_left(out, out_lo, hi);
-  if (lo > (REAL)0) {
-    /* lo / hi = idx / (idx + 1) >= 1/2, and its rounding error recovered exactly by fma */
-    const REAL x = lo / hi;
-    casteljau_keep_right(out, out_lo, x, fma(-x, hi, lo) / hi);
-  }
-}
-
-/* Whether float refinement can find the root bracketed by cur's end values. Always in plain builds. In mixed
- * precision the rounded coefficients are only good to eps of their largest, so an end value below that noise
- * could stop the refinement at the wrong end (measured: an Endrass octic hit 0.19 from its root); the
- * interval is halved further instead, in float-float, until its ends stand clear of the noise. */
-int refinable_in_float(const REAL* c) {
-#if ALGRAY_COMPENSATED
-  REAL scale = 0;
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(c[k]));
-  return fmin(fabs(c[0]), fabs(c[DEGREE])) > (REAL)(4 * DEGREE) * REAL_EPS * scale;
-#else
-  (void)c;
-  return 1;
-#endif
-}
-
-/* Adaptive builds, one ray per work-item (camera and secondary rays): whether an isolated bracket [iso.lo, iso.hi]
- * whose end values are within the noise (an accept doubt) is settled after all by P's values at its ends in
- * float-float (float_float.h, bracket_ends_in_float_float). The probe sees the doubt, then what settled it
- * (ALGRAY_EVENT_CONFIRMED, decision 2). Other builds and shadow rays never settle one so. */
-#if ALGRAY_ESCALATE && LANES == 1 && !ALGRAY_SHADOW_RAYS
-int bracket_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise, int level, ProbeLog* probe_log) {
-  const RayTerms* terms = noise->terms;
-  const REAL end = smaller_end(cur, iso->lo);
-  if (!terms->has_ray || !within_noise_at(noise, end, iso->lo, iso->hi)) return 0;
-  const LaneRays r = one_lane_rays(terms->o, terms->d);
-  REAL v_lo, rounding_lo, v_hi, rounding_hi;
-  if (!bracket_ends_in_float_float(1, &r, terms->t_in, terms->t_out, iso->lo, iso->hi, cur[0], cur[DEGREE],
-                                   terms->exps, terms->coefs, terms->count, &v_lo, &rounding_lo, &v_hi, &rounding_hi))
-    return 0;
-  PROBE(ALGRAY_EVENT_DOUBT, 0, ALGRAY_DOUBT_ACCEPT, (uint)level, iso->lo, iso->hi, end, noise->noise);
-  PROBE(ALGRAY_EVENT_CONFIRMED, 0, 2u, 0u, v_lo, rounding_lo, v_hi, rounding_hi);
-  return 1;
-}
-#else
-#define bracket_settled(iso, cur, noise, level, probe_log) 0
-#endif
-
-/* Camera and secondary rays of adaptive builds that settle doubts (ALGRAY_SETTLE_DOUBTS: where the second pass runs
- * in float-float; in double, tracing the ray again costs less than these checks) settle discard doubts by P's signs
- * in float-float (discard_settled). */
-#define ALGRAY_SETTLES_DISCARDS (ALGRAY_ESCALATE && !ALGRAY_SHADOW_RAYS && ALGRAY_SETTLE_DOUBTS)
-#if ALGRAY_SETTLES_DISCARDS && LANES == 1
-
-/* The end value of an interval at fraction s as the probe shows a settled discard doubt: P in float-float and its
- * rounding where that end was within the noise (in proven), else float's value c and the noise it stood clear of. */
-void settled_end(const ProvenEnds* proven, REAL s, REAL c, REAL noise, REAL* value, REAL* bound) {
-  *value = c;
-  *bound = noise;
-  for (int e = 0; e < 2; ++e)
-    if (proven->at[e] == s) {
-      *value = proven->value[e];
-      *bound = proven->rounding[e];
-    }
-}
-
-/* One ray per work-item (camera and secondary rays): whether an interval without sign variations doubted for an
- * end value within the noise (a discard doubt) is root-free after all: every coefficient inside stands clear of the
- * noise, and P in float-float at each end within it (proven, evaluated where not there yet) has the sign float
- * gave there, beyond its rounding. Then every Bernstein coefficient has that one sign for certain. (Where one
- * inside is within the noise too, P itself is, and halving down to the stopping width measured no better than
- * tracing the ray again.) The probe sees the doubt, then what settled it (ALGRAY_EVENT_CONFIRMED, decision 3). */
-int discard_settled(const Isolation* iso, const REAL* cur, SearchNoise* noise, ProvenEnds* proven,
-                    int level, ProbeLog* probe_log) {
-  const RayTerms* terms = noise->terms;
-  if (!terms->has_ray || within_noise_at(noise, inner_smallest_magnitude(cur), iso->lo, iso->hi)) return 0;
-  const int lo_doubted = within_noise_at(noise, cur[0], iso->lo, iso->hi);
-  const int hi_doubted = within_noise_at(noise, cur[DEGREE], iso->lo, iso->hi);
-  const LaneRays r = one_lane_rays(terms->o, terms->d);
-  if (lo_doubted && !proven_at(proven, iso->lo))
-    prove_end(1, &r, terms->t_in, terms->t_out, iso->lo, iso->hi, terms->exps, terms->coefs, terms->count, proven);
-  if (hi_doubted && !proven_at(proven, iso->hi))
-    prove_end(1, &r, terms->t_in, terms->t_out, iso->hi, iso->lo, terms->exps, terms->coefs, terms->count, proven);
-  if ((lo_doubted && !proven_sign_of(proven, iso->lo, cur[0])) ||
-      (hi_doubted && !proven_sign_of(proven, iso->hi, cur[DEGREE])))
-    return 0;
-#if ALGRAY_PROBE
-  REAL v_lo, bound_lo, v_hi, bound_hi;
-  settled_end(proven, iso->lo, cur[0], noise->noise, &v_lo, &bound_lo);
-  settled_end(proven, iso->hi, cur[DEGREE], noise->noise, &v_hi, &bound_hi);
-  PROBE(ALGRAY_EVENT_DOUBT, 0, ALGRAY_DOUBT_DISCARD, (uint)level, iso->lo, iso->hi, smaller_end(cur, iso->lo),
-        noise->noise);
-  PROBE(ALGRAY_EVENT_CONFIRMED, 0, 3u, 0u, v_lo, bound_lo, v_hi, bound_hi);
-#else
-  (void)level;
-#endif
-  return 1;
-}
-#else
-#define discard_settled(iso, cur, noise, proven, level, probe_log) 0
-#endif
-
-/* Finds the leftmost subinterval of [0,1] that isolates the smallest root of the polynomial with Bernstein
- * coefficients `root` (+ `root_lo` in mixed precision). Depth-first, left half first; the path is the pair
- * (level, idx), so no stack is kept. The right half of the latest split is cached, as the left half is usually
- * rejected at once. On return `cur` holds the Bernstein coefficients on [iso.lo, iso.hi] (rounded to float in
- * mixed precision, where they are accurate relative to their own size). */
-Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out,
-                            REAL* cur, RayTerms* terms, ProbeLog* probe_log) {
-  Isolation iso = isolation_none();
-  REAL cur_lo[NCOEF], sib[NCOEF], sib_lo[NCOEF];
-  int sib_level = -1;
-  ulong sib_idx = 0;
-  int level = 0;
-  ulong idx = 0;
-  const REAL len = t_out - t_in;
-  const int start_sign = (root[0] > 0) - (root[0] < 0);
-  coefs_copy(cur, cur_lo, root, root_lo);
-#if ALGRAY_ESCALATE
-  SearchNoise noise_of_search = search_noise(root, terms);
-  SearchNoise* noise = &noise_of_search;
-#endif
-#if ALGRAY_SETTLES_DISCARDS
-  ProvenEnds proven;
-  no_proven_ends(&proven);
-#endif
-
-  for (;;) {
-    ++iso.steps;
-    const REAL width = ldexp((REAL)1, -level);
-    iso.lo = (REAL)idx * width;
-    iso.hi = iso.lo + width;
-    iso.f_lo = cur[0];
-    iso.f_hi = cur[DEGREE];
-    if (settled_at_left_end(&iso, start_sign, level, probe_log)) {
-      doubted(&iso, ALGRAY_DOUBT_ACCEPT, iso.f_lo, noise, level, probe_log);
-      return isolation_found(iso, noise);
-    }
-    const int v = sign_variations(cur);
-    if (v == 1 && cur[DEGREE] != 0 && refinable_in_float(cur)) {
-      PROBE_STEP(iso, v, ALGRAY_STEP_ISOLATED, level);
-      iso.status = ISOLATION_BRACKET;
-      if (!bracket_settled(&iso, cur, noise, level, probe_log))
-        doubted(&iso, ALGRAY_DOUBT_ACCEPT, smaller_end(cur, iso.lo), noise, level, probe_log);
-      return isolation_found(iso, noise);
-    }
-#if ALGRAY_ESCALATE
-    /* No sign variation, but a coefficient within the noise of zero: the interval is not yet shown root-free.
-     * Its end coefficients are P's values: near zero there, float cannot tell; an inner one is halved until it
-     * stands clear, as de Casteljau's coefficients close in on P's values (fewer rays doubted: on the Barth
-     * decic's shadow rays, 10% of them doubted without this), unless P's signs there are proven in float-float
-     * (discard_settled). */
-    int near_zero = v == 0 && within_noise_at(noise, smallest_magnitude(cur, iso.lo), iso.lo, iso.hi);
-    if (near_zero && within_noise_at(noise, smaller_end(cur, iso.lo), iso.lo, iso.hi)) {
-      if (!discard_settled(&iso, cur, noise, &proven, level, probe_log)) {
-        doubted(&iso, ALGRAY_DOUBT_DISCARD, smaller_end(cur, iso.lo), noise, level, probe_log);
-        return iso;
-      }
-      near_zero = 0; /* root-free */
-    }
-#else
-    const int near_zero = 0;
-#endif
-    if (v >= 1 || near_zero) {
-      const int next = halve_or_settle(&iso, v, level, width, t_in, len, probe_log);
-      if (next == INTERVAL_HALVE) {
-        casteljau_halve(cur, cur_lo, sib, sib_lo);
-        ++level;
-        idx *= 2;
-        sib_level = level;
-        sib_idx = idx + 1;
-        continue;
-      }
-      /* A cluster is always in doubt: float cannot tell a close pair from a complex one there. */
-      if (doubted(&iso, ALGRAY_DOUBT_CLUSTER, 0, noise, level, probe_log)) return iso;
-      if (next == INTERVAL_SETTLED) return isolation_found(iso, noise);
-    } else {
-      PROBE_STEP(iso, v, ALGRAY_STEP_NO_ROOT, level);
-    }
-    if (!next_interval(&level, &idx)) return isolation_at_far_end(iso, root[DEGREE] == 0, root[DEGREE], probe_log);
-    if (sib_level == level && sib_idx == idx)
-      coefs_copy(cur, cur_lo, sib, sib_lo);
-    else
-      bernstein_restrict(root, root_lo, level, idx, cur, cur_lo);
-  }
-}
-
-/* The method's entry (isolate.h). */
-Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
-                         ProbeLog* probe_log) {
-  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c, terms, probe_log);
-}
-
-#if !ALGRAY_COMPENSATED
-/* casteljau_halve over lanes: c's halves at 1/2 into left and right, by the same rows of the triangle (the same
- * products and sums per lane). */
-ALGRAY_INLINE void casteljau_halve_lanes(const LREAL* c, LREAL* left, LREAL* right) {
-  LREAL t[NCOEF];
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) t[k] = c[k];
-  left[0] = t[0];
-  right[DEGREE] = t[DEGREE];
-  ALGRAY_UNROLL
-  for (int r = 1; r <= DEGREE; ++r) {
-    ALGRAY_UNROLL
-    for (int k = 0; k < DEGREE; ++k)
-      if (k <= DEGREE - r) t[k] = CASTELJAU_COMBINE((REAL)0.5, t[k], (REAL)0.5, t[k + 1]);
-    left[r] = t[0];
-    right[DEGREE - r] = t[DEGREE - r];
-  }
-}
 
 /* Whether every coefficient of c has one strict sign, lane by lane: then the polynomial has no root on the
  * interval (and de Casteljau's pieces of it keep the sign). */
@@ -364,35 +158,51 @@ ALGRAY_INLINE LMASK one_strict_sign(const LREAL* c) {
   }
   return positive || negative;
 }
-#endif
 
-#if LANES > 1 && !ALGRAY_COMPENSATED
-/* isolation.h's PICK_LARGER and PICK_SMALLER, lane by lane */
-#define LANE_LARGER(a, b) LANE_SEL((a), (b), (b) > (a))
-#define LANE_SMALLER(a, b) LANE_SEL((a), (b), (b) < (a))
-/* What the lanes' search of an adaptive build needs of its rays: their terms (the noise), and the rays in unit
- * coordinates with the monomials, for bracket_ends_in_float_float as bracket_settled uses it. Other builds never
- * read it. */
-typedef struct {
-  LREAL value;
-  const LaneRays* rays;
-  __global const uint* exps;
-  __global const REAL* coefs;
-  uint count;
-} LaneTerms;
-/* isolate_bernstein for LANES polynomials at once (lanes.h), lanes where `running` is clear left alone: each
- * lane takes the scalar search's decisions in its order, with the same arithmetic, so it ends with the scalar
- * result bit for bit (tests/test_lanes). The search's position is kept as the interval's left end and width,
- * REALs that are exact for these dyadic numbers, so that all the state is in vector registers: (level, idx) is
- * (-log2 width, left end / width).
- * A halving, a recomputation from `root` and a copy of the cached sibling each cost every lane, so this pays
- * where neighbouring rays take similar searches (bench/history/2026-12.md, "Lock-step lanes"). Mixed precision keeps
- * the scalar search per lane. */
+/* The coefficients on [lo, lo + width] (dyadic fractions of the segment), recomputed from the whole segment's
+ * (root, root_lo), into out and out_lo for the lanes in `take`. */
+ALGRAY_INLINE void bernstein_restrict(const LREAL* root, const LREAL* root_lo, LREAL lo, LREAL width, LMASK take,
+                                      LREAL* out, LREAL* out_lo) {
+  LREAL o[NCOEF], o_lo[NCOEF];
+  coefs_copy(o, o_lo, root, root_lo);
+  const LREAL hi = lo + width;
+  const LMASK left = take && hi < (REAL)1;
+  if (LANE_ANY(left)) {
+    LREAL t[NCOEF], t_lo[NCOEF];
+    coefs_copy(t, t_lo, o, o_lo);
+    casteljau_keep_left(t, t_lo, hi);
+    coefs_select(o, o_lo, t, t_lo, left);
+  }
+  const LMASK right = take && lo > (REAL)0;
+  if (LANE_ANY(right)) {
+    /* lo / hi = idx / (idx + 1) >= 1/2, and its rounding error recovered exactly by fma */
+    const LREAL x = lo / hi;
+    LREAL t[NCOEF], t_lo[NCOEF];
+    coefs_copy(t, t_lo, o, o_lo);
+    casteljau_keep_right(t, t_lo, x, fma(-x, hi, lo) / hi);
+    coefs_select(o, o_lo, t, t_lo, right);
+  }
+  coefs_select(out, out_lo, o, o_lo, take);
+}
 
-/* Sign changes between consecutive nonzero coefficients, per lane, as sign_variations counts them (a NaN counts
- * as a zero). The last sign seen is carried by selections alone, and the changes are summed as a tree: added one
- * after another, each waiting on the last, they were the longest chain of the search's step. */
-ALGRAY_INLINE LREAL sign_variations_lanes(const LREAL* c) {
+/* Whether float refinement can find the root bracketed by c's end values. Always in plain builds. In mixed
+ * precision the rounded coefficients are only good to eps of their largest, so an end value below that noise
+ * could stop the refinement at the wrong end (measured: an Endrass octic hit 0.19 from its root); the
+ * interval is halved further instead, in float-float, until its ends stand clear of the noise. */
+ALGRAY_INLINE LMASK refinable_in_float(const LREAL* c) {
+  LREAL scale = 0;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(c[k]));
+  return !ALGRAY_COMPENSATED || fmin(fabs(c[0]), fabs(c[DEGREE])) > (REAL)(4 * DEGREE) * REAL_EPS * scale;
+}
+
+/* sign_variations (isolation.h) of each lane's coefficients. One ray counts by bit masks; lanes carry the last
+ * sign seen by selections alone and sum the changes as a tree (added one after another, each waiting on the last,
+ * they were the longest chain of the search's step). The same counts: a NaN counts as a zero. */
+ALGRAY_INLINE LREAL bernstein_sign_variations(const LREAL* c) {
+#if LANES == 1
+  return (REAL)sign_variations(c);
+#else
   LREAL change[NCOEF];
   LMASK seen = c[0] > 0 || c[0] < 0, prev_negative = c[0] < 0;
   ALGRAY_UNROLL
@@ -407,215 +217,520 @@ ALGRAY_INLINE LREAL sign_variations_lanes(const LREAL* c) {
   for (int span = 1; span <= DEGREE; span *= 2) ALGRAY_UNROLL
   for (int k = 0; k + span <= DEGREE; k += 2 * span) change[k] += change[k + span];
   return change[0];
-}
-
-/* bernstein_restrict per lane: the coefficients on [lo, lo + width] from the whole interval's, into out for the
- * lanes in `take`. */
-void bernstein_restrict_lanes(const LREAL* root, LREAL lo, LREAL width, LMASK take, LREAL* out) {
-  LREAL o[NCOEF];
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) o[k] = root[k];
-  const LREAL hi = lo + width;
-  const LMASK left = take && hi < (REAL)1;
-  if (LANE_ANY(left)) {
-    const LREAL x1 = (REAL)1 - hi;
-    LREAL t[NCOEF];
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE; ++k) t[k] = o[k];
-    ALGRAY_UNROLL
-    for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-    for (int k = DEGREE; k >= 1; --k)
-      if (k >= r) t[k] = CASTELJAU_COMBINE(x1, t[k - 1], hi, t[k]);
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE; ++k) o[k] = LANE_SEL(o[k], t[k], left);
-  }
-  const LMASK right = take && lo > (REAL)0;
-  if (LANE_ANY(right)) {
-    const LREAL x = lo / hi, x1 = (REAL)1 - x;
-    LREAL t[NCOEF];
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE; ++k) t[k] = o[k];
-    ALGRAY_UNROLL
-    for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-    for (int k = 0; k < DEGREE; ++k)
-      if (k <= DEGREE - r) t[k] = CASTELJAU_COMBINE(x1, t[k], x, t[k + 1]);
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE; ++k) o[k] = LANE_SEL(o[k], t[k], right);
-  }
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) out[k] = LANE_SEL(out[k], o[k], take);
-}
-
-/* root: each lane's Bernstein coefficients on [t_in, t_out]. On return each running lane of iso is that lane's
- * Isolation (the others mean nothing), and cur_out holds each lane's coefficients on its isolating interval. */
-void isolate_bernstein_lanes(LMASK running, const LREAL* root, LREAL t_in, LREAL t_out, LaneIsolation* iso,
-                             LREAL* cur_out, const LaneTerms* terms) {
-  LREAL cur[NCOEF], sib[NCOEF];
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) cur[k] = sib[k] = root[k];
-  const LREAL len = t_out - t_in;
-  const LREAL start_sign = LANE_SEL((LREAL)0, (LREAL)1, root[0] > 0) - LANE_SEL((LREAL)0, (LREAL)1, root[0] < 0);
-  /* the interval searched, [at, at + width], and the cached right half of the latest split (none yet) */
-  LREAL at = 0, width = 1, sib_at = 0, sib_width = 0;
-  LREAL status = ISOLATION_NONE, steps = 0;
-  /* A lane that stops keeps its interval [at, at + width] and its coefficients cur, which are what it reports,
-   * unless it ended past the far end (searched_all). */
-  LMASK budget = 0, cluster = 0, searched_all = 0, done = !running;
-#if ALGRAY_ESCALATE
-  /* doubt_noise and doubted per lane: a doubted lane stops with status NONE and its ALGRAY_DOUBT_* */
-  LREAL magnitude[NCOEF], doubt = 0;
-  LMASK brackets_doubted = 0; /* the lanes doubted at an isolated bracket */
-#if ALGRAY_SETTLES_DISCARDS
-  ProvenEnds proven;
-  no_proven_ends(&proven);
 #endif
+}
+
+/* The search's next interval after the one ending at next_at: next_interval (isolation.h) without its loop. It
+ * climbs while the interval is a right child, then steps right, so the next interval is as wide as the largest
+ * power of two that divides next_at (its lowest set bit in units of the finest intervals). */
+ALGRAY_INLINE LREAL next_interval_width(LREAL next_at) {
+#if LANES == 1
+  const long units = (long)(next_at * (REAL)FINEST_UNITS);
+  return (REAL)(units & -units) * ((REAL)1 / (REAL)FINEST_UNITS);
+#else
+  const LANE_INT_VEC units = LANE_TO_INT(next_at * (REAL)FINEST_UNITS);
+  return LANE_TO_REAL(units & -units) * ((REAL)1 / (REAL)FINEST_UNITS);
+#endif
+}
+
+/* isolation.h's PICK_LARGER and PICK_SMALLER, lane by lane */
+#define LANE_LARGER(a, b) LANE_SEL((a), (b), (b) > (a))
+#define LANE_SMALLER(a, b) LANE_SEL((a), (b), (b) < (a))
+
+/* The smallest |c_k| that counts (first_counted), the smaller end that counts (smaller_end) and the smallest
+ * inner |c_k| (inner_smallest_magnitude), lane by lane; lo: the interval's left end. */
+ALGRAY_INLINE LREAL lanes_smallest_magnitude(const LREAL* c, LREAL lo, int ends) {
+  LREAL t[NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]);
+  t[0] = LANE_SEL(t[0], (LREAL)INFINITY, !ends || (ALGRAY_SHADOW_RAYS && lo == 0));
+  if (!ends) t[DEGREE] = INFINITY;
+  MAGNITUDE_TREE(t, LANE_SMALLER);
+  return t[0];
+}
+ALGRAY_INLINE LREAL lanes_smaller_end(const LREAL* c, LREAL lo) {
+  return LANE_SEL(fmin(fabs(c[0]), fabs(c[DEGREE])), fabs(c[DEGREE]), ALGRAY_SHADOW_RAYS && lo == 0);
+}
+
+/* What the search of an adaptive build needs of its rays: their terms, which it measures its noise by, and the
+ * rays in unit coordinates with the monomials, where it evaluates P in float-float (float_float.h). One ray takes
+ * RayTerms (restrict.h) and sums its terms only when a value falls within their upper bound's noise; lanes take
+ * every lane's terms summed. Other builds never read it. */
+#if LANES == 1
+typedef RayTerms LaneTerms;
+#else
+typedef struct {
+  LREAL value;
+  const LaneRays* rays;
+  __global const uint* exps;
+  __global const REAL* coefs;
+  uint count;
+} LaneTerms;
+#endif
+
+/* The search's noise (isolation.h, DOUBT_NOISE), and P's signs proven in float-float at interval ends
+ * (discards_settled): one ray's SearchNoise, with the local noise of shadow rays, or every lane's noise on its
+ * summed terms. Builds without adaptive precision doubt nothing: no value is within their noise. */
+#if ALGRAY_ESCALATE
+typedef struct {
+#if LANES == 1
+  SearchNoise one;
+#endif
+  LREAL noise;
+  ProvenEnds proven;
+} LaneNoise;
+
+LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
+  LaneNoise n;
+  no_proven_ends(&n.proven);
+#if LANES == 1
+  n.one = search_noise(root, terms);
+  n.noise = n.one.noise;
+#else
+  LREAL magnitude[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(root[k]);
   MAGNITUDE_TREE(magnitude, LANE_LARGER);
-  const LREAL noise = DOUBT_NOISE(magnitude[0], terms->value);
-#define DOUBT_LANES(mask, reason)                               \
-  do {                                                          \
-    const LMASK doubted_ = (mask);                              \
-    doubt = LANE_SEL(doubt, (LREAL)(reason), doubted_);         \
-    status = LANE_SEL(status, (LREAL)ISOLATION_NONE, doubted_); \
-    done = done || doubted_;                                    \
-  } while (0)
-#else
-#define DOUBT_LANES(mask, reason) ((void)0)
+  n.noise = DOUBT_NOISE(magnitude[0], terms->value);
 #endif
-  for (;;) {
-    const LMASK active = !done;
-    steps += LANE_SEL((LREAL)0, (LREAL)1, active);
-    const LREAL f_lo = cur[0], f_hi = cur[DEGREE];
-    /* settled_at_left_end: an exact zero, or the other sign than at t_in */
-    const LREAL s = LANE_SEL((LREAL)0, (LREAL)1, f_lo > 0) - LANE_SEL((LREAL)0, (LREAL)1, f_lo < 0);
-    const LMASK exact = active && (f_lo == 0 || (s != 0 && s != start_sign));
-    status = LANE_SEL(status, (LREAL)ISOLATION_EXACT, exact);
-    done = done || exact;
-    DOUBT_LANES(exact && fabs(f_lo) <= noise, ALGRAY_DOUBT_ACCEPT);
-    const LREAL v = sign_variations_lanes(cur);
-    const LMASK isolated = !done && v == 1 && cur[DEGREE] != 0;
-    status = LANE_SEL(status, (LREAL)ISOLATION_BRACKET, isolated);
-    done = done || isolated;
-#if ALGRAY_ESCALATE
-    /* doubted for now; bracket_settled's check comes once for all such lanes, after the search */
-    const LMASK bracket_doubt = isolated && fmin(fabs(cur[0]), fabs(cur[DEGREE])) <= noise;
-    brackets_doubted = brackets_doubted || bracket_doubt;
-    DOUBT_LANES(bracket_doubt, ALGRAY_DOUBT_ACCEPT);
-    /* isolate_bernstein's near_zero: doubted at an end unless discard_settled's float-float signs settle it,
-     * halved inside */
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(cur[k]);
-    MAGNITUDE_TREE(magnitude, LANE_SMALLER);
-    LMASK near_zero = !done && v == 0 && magnitude[0] <= noise;
-    const LMASK lo_doubted = fabs(cur[0]) <= noise, hi_doubted = fabs(cur[DEGREE]) <= noise;
-    const LMASK end_doubted = near_zero && (lo_doubted || hi_doubted);
-#if ALGRAY_SETTLES_DISCARDS
-    if (LANE_ANY(end_doubted)) {
-      /* inner_smallest_magnitude first: where it is within the noise, nothing is evaluated */
-      ALGRAY_UNROLL
-      for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(cur[k]);
-      magnitude[0] = magnitude[DEGREE] = INFINITY;
-      MAGNITUDE_TREE(magnitude, LANE_SMALLER);
-      const LMASK inner_clear = end_doubted && magnitude[0] > noise;
-      /* one evaluation for the lanes that need either end, a second for those that need both */
-      const LREAL hi = at + width;
-      const LMASK lo_needed = inner_clear && lo_doubted && !proven_at(&proven, at);
-      const LMASK hi_needed = inner_clear && hi_doubted && !proven_at(&proven, hi);
-      if (LANE_ANY(lo_needed || hi_needed))
-        prove_end(lo_needed || hi_needed, terms->rays, t_in, t_out, LANE_SEL(hi, at, lo_needed),
-                  LANE_SEL(at, hi, lo_needed), terms->exps, terms->coefs, terms->count, &proven);
-      if (LANE_ANY(lo_needed && hi_needed))
-        prove_end(lo_needed && hi_needed, terms->rays, t_in, t_out, hi, at, terms->exps, terms->coefs, terms->count,
-                  &proven);
-      const LMASK settled = inner_clear && (!lo_doubted || proven_sign_of(&proven, at, cur[0])) &&
-                            (!hi_doubted || proven_sign_of(&proven, hi, cur[DEGREE]));
-      DOUBT_LANES(end_doubted && !settled, ALGRAY_DOUBT_DISCARD);
-      near_zero = near_zero && !settled; /* root-free */
-    }
-#else
-    DOUBT_LANES(end_doubted, ALGRAY_DOUBT_DISCARD);
-#endif
-    /* halve_or_settle for the lanes that may hold several roots */
-    const LMASK several = !done && (v >= 1 || near_zero);
-#else
-    /* halve_or_settle for the lanes that may hold several roots */
-    const LMASK several = !done && v >= 1;
-#endif
-    const LMASK located = width * len <= STOP_WIDTH(t_in + at * len);
-    const LMASK halve = several && !located && width > (REAL)1 / (REAL)FINEST_UNITS; /* level < REAL_MAX_HALVINGS */
-    const LMASK settle = several && !halve;
-    budget = budget || (settle && !located);
-    const LMASK cluster_root = settle && ((f_lo < 0) != (f_hi < 0));
-    status = LANE_SEL(status, (LREAL)ISOLATION_BRACKET, cluster_root);
-    cluster = cluster || cluster_root;
-    done = done || cluster_root;
-    DOUBT_LANES(settle, ALGRAY_DOUBT_CLUSTER);
-    if (LANE_ALL(done)) break;
-    if (LANE_ANY(halve)) {
-      LREAL left[NCOEF], right[NCOEF];
-      casteljau_halve_lanes(cur, left, right);
-      ALGRAY_UNROLL
-      for (int k = 0; k <= DEGREE; ++k) {
-        cur[k] = LANE_SEL(cur[k], left[k], halve);
-        sib[k] = LANE_SEL(sib[k], right[k], halve);
-      }
-      width = LANE_SEL(width, width * (REAL)0.5, halve);
-      sib_width = LANE_SEL(sib_width, width, halve);
-      sib_at = LANE_SEL(sib_at, at + width, halve);
-    }
-    /* next_interval for the lanes moving on, without its loop: it climbs while the interval is a right child
-     * (idx odd), then steps right, so the next interval starts where this one ends, and is as wide as the
-     * largest power of two that divides that end (idx + 1's lowest set bit, in units of width). */
-    LMASK move = !done && !halve;
-    if (!LANE_ANY(move)) continue;
-    const LREAL next_at = at + width;
-    const LANE_INT_VEC units = LANE_TO_INT(next_at * (REAL)FINEST_UNITS);
-    width = LANE_SEL(width, LANE_TO_REAL(units & -units) * ((REAL)1 / (REAL)FINEST_UNITS), move);
-    /* isolation_at_far_end: the whole interval searched; its far end is a root only where P is zero there */
-    const LMASK finished = move && next_at == 1;
-    status = LANE_SEL(status, LANE_SEL((LREAL)ISOLATION_NONE, (LREAL)ISOLATION_EXACT, root[DEGREE] == 0), finished);
-    searched_all = searched_all || finished;
-    done = done || finished;
-    move = move && !finished;
-    at = LANE_SEL(at, next_at, move);
-    const LMASK from_sib = move && sib_width == width && sib_at == at;
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE; ++k) cur[k] = LANE_SEL(cur[k], sib[k], from_sib);
-    const LMASK from_root = move && !from_sib;
-    if (LANE_ANY(from_root)) bernstein_restrict_lanes(root, at, width, from_root, cur);
-  }
-#if ALGRAY_ESCALATE && !ALGRAY_SHADOW_RAYS
-  /* bracket_settled: a stopped lane keeps its interval and coefficients, so the brackets doubted in any step are
-   * checked here together, in one evaluation for the lanes rather than one per step that doubted some */
-  if (LANE_ANY(brackets_doubted)) {
-    LREAL v_lo, rounding_lo, v_hi, rounding_hi;
-    const LMASK settled =
-        bracket_ends_in_float_float(brackets_doubted, terms->rays, t_in, t_out, at, at + width, cur[0], cur[DEGREE],
-                                    terms->exps, terms->coefs, terms->count, &v_lo, &rounding_lo, &v_hi, &rounding_hi);
-    status = LANE_SEL(status, (LREAL)ISOLATION_BRACKET, settled);
-    doubt = LANE_SEL(doubt, (LREAL)0, settled);
-  }
-#endif
-  iso->status = status;
-  iso->steps = steps;
-  /* isolation_at_far_end reports [1, 1] with zero values */
-  iso->lo = LANE_SEL(at, (LREAL)1, searched_all);
-  iso->hi = LANE_SEL(at + width, (LREAL)1, searched_all);
-  iso->f_lo = LANE_SEL(cur[0], (LREAL)0, searched_all);
-  iso->f_hi = LANE_SEL(cur[DEGREE], (LREAL)0, searched_all);
-  iso->budget = budget;
-  iso->cluster = cluster;
-#if ALGRAY_ESCALATE
-  iso->doubt = doubt;
-  iso->noise = noise;
-#else
-  iso->doubt = iso->noise = 0;
-#endif
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) cur_out[k] = cur[k];
+  return n;
 }
-#undef DOUBT_LANES
+
+/* Whether |value| on the part [lo, hi] of the segment is within the noise (within_noise_at). */
+ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREAL hi) {
+#if LANES == 1
+  const int within = within_noise_at(&n->one, value, lo, hi);
+  n->noise = n->one.noise;
+  return within;
+#else
+  (void)lo;
+  (void)hi;
+  return fabs(value) <= n->noise;
+#endif
+}
+
+/* The noise a found root's refinement checks against (isolation_found), where `found`. */
+ALGRAY_INLINE LREAL found_noise(LaneNoise* n, LMASK found) {
+#if LANES == 1
+  return found ? exact_noise(&n->one) : (REAL)0;
+#else
+  return LANE_SEL((LREAL)0, n->noise, found);
+#endif
+}
+
+/* The rays of the terms, and whether there are any (one ray's terms may come without). */
+ALGRAY_INLINE LaneRays terms_rays(const LaneTerms* t) {
+#if LANES == 1
+  return one_lane_rays(t->o, t->d);
+#else
+  return *t->rays;
+#endif
+}
+ALGRAY_INLINE LMASK terms_have_rays(const LaneTerms* t) {
+#if LANES == 1
+  return t->has_ray;
+#else
+  (void)t;
+  return (LMASK)(-1); /* every lane */
+#endif
+}
+#else
+typedef struct {
+  LREAL noise;
+} LaneNoise;
+ALGRAY_INLINE LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
+  (void)root;
+  (void)terms;
+  LaneNoise n;
+  n.noise = 0;
+  return n;
+}
+ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREAL hi) {
+  (void)lo;
+  (void)hi;
+  (void)n;
+  (void)value;
+  return (LMASK)0; /* no lane */
+}
+ALGRAY_INLINE LREAL found_noise(LaneNoise* n, LMASK found) {
+  (void)found;
+  return n->noise;
+}
+#endif
+
+/* The search's state for each lane: the interval [at, at + width] and its coefficients cur (cur_lo), the cached
+ * right half of the latest split [sib_at, sib_at + sib_width] (none: width 0), and the Isolation's fields so far.
+ * A lane that stops (done) keeps its interval and coefficients, which are what it reports, unless it ended past
+ * the far end (searched_all). */
+typedef struct {
+  LREAL cur[NCOEF], cur_lo[NCOEF], sib[NCOEF], sib_lo[NCOEF];
+  LREAL at, width, sib_at, sib_width;
+  LREAL status, steps, doubt, start_sign;
+  LMASK budget, cluster, searched_all, done, brackets_doubted;
+} BernsteinSearch;
+
+/* The halving level of the search's interval (the probe's events name it). */
+#define SEARCH_LEVEL(s) ((uint)(-ilogb((s)->width)))
+/* A probe event of the search's interval: a step that saw `count` sign variations, or a doubt for `value` within
+ * the noise. Only one-ray builds record. */
+#define PROBE_SEARCH_STEP(s, count, decision) \
+  PROBE(ALGRAY_EVENT_STEP, count, decision, SEARCH_LEVEL(s), (s)->at, (s)->at + (s)->width, (s)->cur[0], (s)->cur[DEGREE])
+#define PROBE_SEARCH_DOUBT(s, reason, value, noise)                                                           \
+  PROBE(ALGRAY_EVENT_DOUBT, 0, reason, SEARCH_LEVEL(s), (s)->at, (s)->at + (s)->width, value, (noise)->noise)
+#if ALGRAY_PROBE && LANES != 1
+#error "the probe records one ray: LANES=1"
+#endif
+
+/* Ends the search undecided for `reason` in the lanes of `doubted`. */
+ALGRAY_INLINE void mark_doubted(BernsteinSearch* s, LMASK doubted, uint reason) {
+  s->doubt = LANE_SEL(s->doubt, (LREAL)reason, doubted);
+  s->status = LANE_SEL(s->status, (LREAL)ISOLATION_NONE, doubted);
+  s->done = s->done || doubted;
+}
+
+/* settled_at_left_end (isolation.h): P exactly zero at the interval's left end, or of the other sign there than at
+ * t_in, is a root there; in doubt where P there is within the noise. */
+ALGRAY_INLINE void settle_at_left_end(BernsteinSearch* s, LaneNoise* noise, ProbeLog* probe_log) {
+  const LREAL f_lo = s->cur[0];
+  const LREAL sign = LANE_SEL((LREAL)0, (LREAL)1, f_lo > 0) - LANE_SEL((LREAL)0, (LREAL)1, f_lo < 0);
+  const LMASK exact = !s->done && (f_lo == 0 || (sign != 0 && sign != s->start_sign));
+  if (!LANE_ANY(exact)) return;
+  PROBE_SEARCH_STEP(s, -1, f_lo == 0 ? ALGRAY_STEP_EXACT_ZERO : ALGRAY_STEP_CROSSED);
+  s->status = LANE_SEL(s->status, (LREAL)ISOLATION_EXACT, exact);
+  s->done = s->done || exact;
+  const LMASK doubted = exact && within_lanes_noise(noise, f_lo, s->at, s->at + s->width);
+  if (LANE_ANY(doubted)) PROBE_SEARCH_DOUBT(s, ALGRAY_DOUBT_ACCEPT, f_lo, noise);
+  mark_doubted(s, doubted, ALGRAY_DOUBT_ACCEPT);
+}
+
+/* One sign variation (and P not zero at the right end): the isolating interval. In doubt where an end value is
+ * within the noise, unless P's values there in float-float settle it after the search (brackets_settled). */
+ALGRAY_INLINE void settle_isolated(BernsteinSearch* s, LREAL v, LaneNoise* noise, ProbeLog* probe_log) {
+  const LMASK isolated = !s->done && v == 1 && s->cur[DEGREE] != 0 && refinable_in_float(s->cur);
+  if (!LANE_ANY(isolated)) return;
+  PROBE_SEARCH_STEP(s, (int)v, ALGRAY_STEP_ISOLATED);
+  s->status = LANE_SEL(s->status, (LREAL)ISOLATION_BRACKET, isolated);
+  s->done = s->done || isolated;
+  const LREAL end = lanes_smaller_end(s->cur, s->at);
+  const LMASK doubted = isolated && within_lanes_noise(noise, end, s->at, s->at + s->width);
+  if (LANE_ANY(doubted)) PROBE_SEARCH_DOUBT(s, ALGRAY_DOUBT_ACCEPT, end, noise);
+  s->brackets_doubted = s->brackets_doubted || doubted;
+  mark_doubted(s, doubted, ALGRAY_DOUBT_ACCEPT);
+}
+
+/* Camera and secondary rays of adaptive builds that settle doubts (ALGRAY_SETTLE_DOUBTS: where the second pass runs
+ * in float-float; in double, tracing the ray again costs less than these checks) settle discard doubts by P's signs
+ * in float-float. */
+#define ALGRAY_SETTLES_DISCARDS (ALGRAY_ESCALATE && !ALGRAY_SHADOW_RAYS && ALGRAY_SETTLE_DOUBTS)
+
+#if ALGRAY_SETTLES_DISCARDS
+#if ALGRAY_PROBE
+/* The end value of an interval at fraction `end` as the probe shows a settled discard doubt: P in float-float and
+ * its rounding where that end was within the noise (in proven), else float's value c and the noise it stood clear
+ * of. */
+void settled_end(const ProvenEnds* proven, REAL end, REAL c, REAL noise, REAL* value, REAL* bound) {
+  *value = c;
+  *bound = noise;
+  for (int e = 0; e < 2; ++e)
+    if (proven->at[e] == end) {
+      *value = proven->value[e];
+      *bound = proven->rounding[e];
+    }
+}
+#endif
+
+/* discards_settled: whether intervals without sign variations, in doubt for an end value within the noise, are
+ * root-free after all (the lanes of end_doubted): every coefficient inside stands clear of the noise, and P in
+ * float-float at each end within it (proven, evaluated where not there yet) has the sign float gave there, beyond
+ * its rounding. Then every Bernstein coefficient has that one sign for certain. (Where one inside is within the
+ * noise too, P itself is, and halving down to the stopping width measured no better than tracing the ray again.)
+ * The probe sees what settled it (ALGRAY_EVENT_CONFIRMED, decision 3). */
+ALGRAY_INLINE LMASK discards_settled(const BernsteinSearch* s, LMASK end_doubted, LaneNoise* noise, LaneTerms* terms, LREAL t_in,
+                       LREAL t_out, ProbeLog* probe_log) {
+  const LREAL at = s->at, hi = s->at + s->width;
+  const LMASK inner_clear = end_doubted && terms_have_rays(terms) &&
+                            !within_lanes_noise(noise, lanes_smallest_magnitude(s->cur, at, 0), at, hi);
+  if (!LANE_ANY(inner_clear)) return inner_clear;
+  const LMASK lo_doubted = within_lanes_noise(noise, s->cur[0], at, hi);
+  const LMASK hi_doubted = within_lanes_noise(noise, s->cur[DEGREE], at, hi);
+  /* one evaluation for the lanes that need either end, a second for those that need both */
+  const LaneRays rays = terms_rays(terms);
+  ProvenEnds* proven = &noise->proven;
+  const LMASK lo_needed = inner_clear && lo_doubted && !proven_at(proven, at);
+  const LMASK hi_needed = inner_clear && hi_doubted && !proven_at(proven, hi);
+  if (LANE_ANY(lo_needed || hi_needed))
+    prove_end(lo_needed || hi_needed, &rays, t_in, t_out, LANE_SEL(hi, at, lo_needed), LANE_SEL(at, hi, lo_needed),
+              terms->exps, terms->coefs, terms->count, proven);
+  if (LANE_ANY(lo_needed && hi_needed))
+    prove_end(lo_needed && hi_needed, &rays, t_in, t_out, hi, at, terms->exps, terms->coefs, terms->count, proven);
+  const LMASK settled = inner_clear && (!lo_doubted || proven_sign_of(proven, at, s->cur[0])) &&
+                        (!hi_doubted || proven_sign_of(proven, hi, s->cur[DEGREE]));
+#if ALGRAY_PROBE
+  if (settled) {
+    REAL v_lo, bound_lo, v_hi, bound_hi;
+    settled_end(proven, at, s->cur[0], noise->noise, &v_lo, &bound_lo);
+    settled_end(proven, hi, s->cur[DEGREE], noise->noise, &v_hi, &bound_hi);
+    PROBE(ALGRAY_EVENT_CONFIRMED, 0, 3u, 0u, v_lo, bound_lo, v_hi, bound_hi);
+  }
+#endif
+  return settled;
+}
+#else
+#define discards_settled(s, end_doubted, noise, terms, t_in, t_out, probe_log) ((end_doubted) && !(end_doubted))
+#endif
+
+/* Adaptive builds: no sign variation, but a coefficient within the noise of zero: the interval is not yet shown
+ * root-free. Its end coefficients are P's values: near zero there, float cannot tell, and the search ends in doubt
+ * unless P's signs there are proven in float-float (discards_settled); an inner one is halved until it stands clear,
+ * as de Casteljau's coefficients close in on P's values (fewer rays doubted: on the Barth decic's shadow rays, 10%
+ * of them doubted without this). Returns the lanes to halve. */
+ALGRAY_INLINE LMASK halve_near_zero(BernsteinSearch* s, LREAL v, LaneNoise* noise, LaneTerms* terms, LREAL t_in,
+                                    LREAL t_out, ProbeLog* probe_log) {
+  const LREAL at = s->at, hi = s->at + s->width;
+  const LMASK near_zero = !s->done && v == 0 &&
+                          within_lanes_noise(noise, lanes_smallest_magnitude(s->cur, at, 1), at, hi);
+  if (!LANE_ANY(near_zero)) return near_zero;
+  const LREAL end = lanes_smaller_end(s->cur, at);
+  const LMASK end_doubted = near_zero && within_lanes_noise(noise, end, at, hi);
+  if (!LANE_ANY(end_doubted)) return near_zero;
+  PROBE_SEARCH_DOUBT(s, ALGRAY_DOUBT_DISCARD, end, noise);
+  const LMASK settled = discards_settled(s, end_doubted, noise, terms, t_in, t_out, probe_log);
+  mark_doubted(s, end_doubted && !settled, ALGRAY_DOUBT_DISCARD);
+  return near_zero && !end_doubted; /* the settled ones are root-free */
+}
+
+/* halve_or_settle (isolation.h) for the lanes that may hold several roots: halved until located at the stopping
+ * width or at the halving limit; then a sign change between the ends is a root (a cluster), and none is skipped.
+ * A cluster is always in doubt: float cannot tell a close pair from a complex one there. Returns the lanes to
+ * halve. */
+ALGRAY_INLINE LMASK halve_or_settle_several(BernsteinSearch* s, LMASK several, LREAL v, LREAL t_in, LREAL len,
+                                          LaneNoise* noise, ProbeLog* probe_log) {
+  const LMASK located = s->width * len <= STOP_WIDTH(t_in + s->at * len);
+  const LMASK halve = several && !located && s->width > (REAL)1 / (REAL)FINEST_UNITS; /* level < REAL_MAX_HALVINGS */
+  const LMASK settle = several && !halve;
+  s->budget = s->budget || (settle && !located);
+  const LMASK cluster_root = settle && ((s->cur[0] < 0) != (s->cur[DEGREE] < 0));
+  s->status = LANE_SEL(s->status, (LREAL)ISOLATION_BRACKET, cluster_root);
+  s->cluster = s->cluster || cluster_root;
+  s->done = s->done || cluster_root;
+  if (LANE_ANY(several))
+    PROBE_SEARCH_STEP(s, (int)v, halve ? ALGRAY_STEP_SPLIT : cluster_root ? ALGRAY_STEP_CLUSTER_ROOT
+                                                                          : ALGRAY_STEP_CLUSTER_SKIP);
+  const LMASK doubted = settle && within_lanes_noise(noise, (LREAL)0, s->at, s->at + s->width);
+  if (LANE_ANY(doubted)) PROBE_SEARCH_DOUBT(s, ALGRAY_DOUBT_CLUSTER, (REAL)0, noise);
+  mark_doubted(s, doubted, ALGRAY_DOUBT_CLUSTER);
+  return halve;
+}
+
+/* The lanes of `halve` go one level down, left half first; the right half is kept for later. */
+ALGRAY_INLINE void halve_intervals(BernsteinSearch* s, LMASK halve) {
+  LREAL left[NCOEF], left_lo[NCOEF], right[NCOEF], right_lo[NCOEF];
+  coefs_copy(left, left_lo, s->cur, s->cur_lo);
+  casteljau_halve(left, left_lo, right, right_lo);
+  coefs_select(s->cur, s->cur_lo, left, left_lo, halve);
+  coefs_select(s->sib, s->sib_lo, right, right_lo, halve);
+  s->width = LANE_SEL(s->width, s->width * (REAL)0.5, halve);
+  s->sib_width = LANE_SEL(s->sib_width, s->width, halve);
+  s->sib_at = LANE_SEL(s->sib_at, s->at + s->width, halve);
+}
+
+/* The lanes of `move` go on to the next interval: the cached right half where it is that one, else recomputed from
+ * the segment's coefficients. Past the far end the whole segment is searched (isolation_at_far_end): its far end is
+ * a root only where P is zero there. */
+ALGRAY_INLINE void move_on(BernsteinSearch* s, LMASK move, const LREAL* root, const LREAL* root_lo,
+                           ProbeLog* probe_log) {
+  const LREAL next_at = s->at + s->width;
+  s->width = LANE_SEL(s->width, next_interval_width(next_at), move);
+  const LMASK finished = move && next_at == 1;
+  if (LANE_ANY(finished))
+    PROBE(ALGRAY_EVENT_STEP, -1, root[DEGREE] == 0 ? ALGRAY_STEP_END_ZERO : ALGRAY_STEP_END_NONE, 0u, (REAL)1,
+          (REAL)1, root[DEGREE], root[DEGREE]);
+  s->status = LANE_SEL(s->status, LANE_SEL((LREAL)ISOLATION_NONE, (LREAL)ISOLATION_EXACT, root[DEGREE] == 0), finished);
+  s->searched_all = s->searched_all || finished;
+  s->done = s->done || finished;
+  move = move && !finished;
+  s->at = LANE_SEL(s->at, next_at, move);
+  const LMASK from_sib = move && s->sib_width == s->width && s->sib_at == s->at;
+  coefs_select(s->cur, s->cur_lo, s->sib, s->sib_lo, from_sib);
+  const LMASK from_root = move && !from_sib;
+  if (LANE_ANY(from_root)) bernstein_restrict(root, root_lo, s->at, s->width, from_root, s->cur, s->cur_lo);
+}
+
+/* Adaptive camera and secondary rays: the brackets doubted for an end value within the noise (brackets_doubted) are
+ * settled after all where P's values at their ends in float-float have float's signs beyond their rounding
+ * (bracket_ends_in_float_float). A stopped lane keeps its interval and coefficients, so they are checked here
+ * together, in one evaluation for the lanes rather than one per step that doubted some. The probe sees what
+ * settled it (ALGRAY_EVENT_CONFIRMED, decision 2). */
+ALGRAY_INLINE void settle_brackets(BernsteinSearch* s, LaneTerms* terms, LREAL t_in, LREAL t_out,
+                                   ProbeLog* probe_log) {
+#if ALGRAY_ESCALATE && !ALGRAY_SHADOW_RAYS
+  const LMASK doubted = s->brackets_doubted && terms_have_rays(terms);
+  if (!LANE_ANY(doubted)) return;
+  const LaneRays rays = terms_rays(terms);
+  LREAL v_lo, rounding_lo, v_hi, rounding_hi;
+  const LMASK settled =
+      bracket_ends_in_float_float(doubted, &rays, t_in, t_out, s->at, s->at + s->width, s->cur[0], s->cur[DEGREE],
+                                  terms->exps, terms->coefs, terms->count, &v_lo, &rounding_lo, &v_hi, &rounding_hi);
+  if (LANE_ANY(settled)) PROBE(ALGRAY_EVENT_CONFIRMED, 0, 2u, 0u, v_lo, rounding_lo, v_hi, rounding_hi);
+  s->status = LANE_SEL(s->status, (LREAL)ISOLATION_BRACKET, settled);
+  s->doubt = LANE_SEL(s->doubt, (LREAL)0, settled);
+#else
+  (void)s;
+  (void)terms;
+  (void)t_in;
+  (void)t_out;
+  (void)probe_log;
+#endif
+}
+
+/* Finds the leftmost subinterval of [0,1] that isolates the smallest root of the polynomial with Bernstein
+ * coefficients `root` (+ `root_lo` in mixed precision), for the lanes in `running` (the others are left alone).
+ * Depth-first, left half first. The right half of the latest split is cached, as the left half is usually rejected
+ * at once. The position is kept as the interval's left end and width, REALs that are exact for these dyadic
+ * numbers, so that all the state is in registers: the path (level, idx) of a depth-first search is (-log2 width,
+ * left end / width). On return each running lane of iso is that lane's Isolation, and cur_out holds its
+ * coefficients on [iso.lo, iso.hi] (rounded to float in mixed precision, where they are accurate relative to their
+ * own size). Over lanes, a halving, a recomputation from `root` and a copy of the cached sibling each cost every
+ * lane, so this pays where neighbouring rays take similar searches (bench/history/2026-12.md, "Lock-step lanes"). */
+void isolate_bernstein_search(LMASK running, const LREAL* root, const LREAL* root_lo, LREAL t_in, LREAL t_out,
+                              LaneIsolation* iso, LREAL* cur_out, LaneTerms* terms, ProbeLog* probe_log) {
+  BernsteinSearch s;
+  coefs_copy(s.cur, s.cur_lo, root, root_lo);
+  coefs_copy(s.sib, s.sib_lo, root, root_lo);
+  s.at = s.sib_at = s.sib_width = 0;
+  s.width = 1;
+  s.status = ISOLATION_NONE;
+  s.steps = s.doubt = 0;
+  s.start_sign = LANE_SEL((LREAL)0, (LREAL)1, root[0] > 0) - LANE_SEL((LREAL)0, (LREAL)1, root[0] < 0);
+  s.budget = s.cluster = s.searched_all = s.brackets_doubted = 0;
+  s.done = !running;
+  const LREAL len = t_out - t_in;
+  LaneNoise noise = lanes_noise(root, terms);
+  for (;;) {
+    s.steps += LANE_SEL((LREAL)0, (LREAL)1, !s.done);
+    settle_at_left_end(&s, &noise, probe_log);
+    const LREAL v = bernstein_sign_variations(s.cur);
+    settle_isolated(&s, v, &noise, probe_log);
+    const LMASK near_zero = ALGRAY_ESCALATE && halve_near_zero(&s, v, &noise, terms, t_in, t_out, probe_log);
+    const LMASK several = !s.done && (v >= 1 || near_zero);
+    const LMASK root_free = !s.done && !several;
+    if (LANE_ANY(root_free)) PROBE_SEARCH_STEP(&s, (int)v, ALGRAY_STEP_NO_ROOT);
+    const LMASK halve = halve_or_settle_several(&s, several, v, t_in, len, &noise, probe_log);
+    if (LANE_ALL(s.done)) break;
+    if (LANE_ANY(halve)) halve_intervals(&s, halve);
+    const LMASK move = !s.done && !halve;
+    if (LANE_ANY(move)) move_on(&s, move, root, root_lo, probe_log);
+  }
+  settle_brackets(&s, terms, t_in, t_out, probe_log);
+  iso->status = s.status;
+  iso->steps = s.steps;
+  /* isolation_at_far_end reports [1, 1] with zero values */
+  iso->lo = LANE_SEL(s.at, (LREAL)1, s.searched_all);
+  iso->hi = LANE_SEL(s.at + s.width, (LREAL)1, s.searched_all);
+  iso->f_lo = LANE_SEL(s.cur[0], (LREAL)0, s.searched_all);
+  iso->f_hi = LANE_SEL(s.cur[DEGREE], (LREAL)0, s.searched_all);
+  iso->budget = s.budget;
+  iso->cluster = s.cluster;
+  iso->doubt = s.doubt;
+  iso->noise = found_noise(&noise, !ALGRAY_SHADOW_RAYS && s.status == (REAL)ISOLATION_BRACKET);
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) cur_out[k] = s.cur[k];
+}
+
+/* The search for one ray (the method's entry, isolate.h; shadow rays): its coefficients in lane 0. */
+Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out, REAL* cur,
+                            RayTerms* terms, ProbeLog* probe_log) {
+  LREAL r[NCOEF], r_lo[NCOEF], c[NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) {
+    r[k] = root[k];
+    r_lo[k] = ALGRAY_COMPENSATED ? root_lo[k] : (REAL)0;
+  }
+  LaneIsolation iso;
+#if LANES == 1
+  LaneTerms* lane_terms = terms;
+#elif ALGRAY_ESCALATE
+  /* lanes builds search their rays together (surface.h); one ray in lane 0 measures its noise as lanes do */
+  const LaneRays rays = one_lane_rays(terms->o, terms->d);
+  LaneTerms ray_lanes;
+  ray_lanes.value = ray_terms_exact(terms);
+  ray_lanes.rays = &rays;
+  ray_lanes.exps = terms->exps;
+  ray_lanes.coefs = terms->coefs;
+  ray_lanes.count = terms->count;
+  LaneTerms* lane_terms = &ray_lanes;
+#else
+  (void)terms;
+  LaneTerms* lane_terms = (LaneTerms*)0; /* read by adaptive builds only */
+#endif
+  isolate_bernstein_search(lanes_of_bits(1u), r, r_lo, t_in, t_out, &iso, c, lane_terms, probe_log);
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) cur[k] = lane_get(c[k], 0);
+  return lane_isolation(&iso, 0);
+}
+
+/* The method's entry (isolate.h). */
+Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
+                         ProbeLog* probe_log) {
+  return isolate_bernstein(root, root_lo, t_in, t_out, iso_c, terms, probe_log);
+}
+#if LANES > 1
+/* isolate_rays (surface.h) for lanes: the rays' segment coefficients root[j], root_lo[j] (consumed) and segments
+ * gathered into lanes, with adaptive builds' terms summed together, then searched together. */
+void isolate_rays_together(uint count, const int* in_extent, const LaneRays* rays, REAL (*root)[NCOEF],
+                           REAL (*root_lo)[NCOEF], const REAL* t_in, const REAL* t_out, LaneIsolation* iso, LREAL* c,
+                           RayTerms* terms, ProbeLog* probe_log) {
+  for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
+  (void)rays; /* adaptive builds' search checks its accept doubts on them */
+  LREAL lane_root[NCOEF], lane_root_lo[NCOEF], lane_t_in = 0, lane_t_out = 1, lane_terms = 0;
+  for (int k = 0; k <= DEGREE; ++k) lane_root[k] = lane_root_lo[k] = 0;
+  LMASK running = 0;
+#if ALGRAY_ESCALATE
+  LREAL x = 0, y = 0, z = 0; /* each ray's largest coordinates, where its terms are summed */
+  uint first = LANES; /* the first ray in the extent: its terms name the monomials */
+#endif
+  for (uint j = 0; j < count; ++j) {
+    if (!in_extent[j]) continue;
+    lane_set_mask(&running, j, 1);
+    for (int k = 0; k <= DEGREE; ++k) {
+      lane_set(&lane_root[k], j, root[j][k]);
+      if (ALGRAY_COMPENSATED) lane_set(&lane_root_lo[k], j, root_lo[j][k]);
+    }
+    lane_set(&lane_t_in, j, t_in[j]);
+    lane_set(&lane_t_out, j, t_out[j]);
+#if ALGRAY_ESCALATE
+    if (first == LANES) first = j;
+    lane_set(&x, j, terms[j].x);
+    lane_set(&y, j, terms[j].y);
+    lane_set(&z, j, terms[j].z);
+#endif
+  }
+#if ALGRAY_ESCALATE
+  if (LANE_ANY(running)) {
+    lane_terms = terms_sum(terms[first].exps, terms[first].coefs, terms[first].count, x, y, z);
+    REAL terms_of[LANES];
+    LANES_STORE(lane_terms, terms_of);
+    for (uint j = 0; j < count; ++j) {
+      if (!in_extent[j]) continue;
+      terms[j].value = terms_of[j];
+      terms[j].exact = 1;
+    }
+  }
+#endif
+  (void)lane_terms;
+  if (LANE_ANY(running)) {
+    LaneTerms search_terms;
+#if ALGRAY_ESCALATE
+    search_terms.value = lane_terms;
+    search_terms.rays = rays;
+    search_terms.exps = terms[first].exps;
+    search_terms.coefs = terms[first].coefs;
+    search_terms.count = terms[first].count;
+#endif
+    isolate_bernstein_search(running, lane_root, lane_root_lo, lane_t_in, lane_t_out, iso, c, &search_terms,
+                             probe_log);
+  }
+}
 #endif
 
 /* Whether isolate_bernstein would find a root at all, read off the signs of the scaled coefficients c (as the
@@ -704,39 +819,27 @@ LREAL isolated_magnitude(const LREAL* c, LREAL y) {
 
 /* Value and slope at y in [0,1] of a prepared polynomial, for Newton's method and adaptive builds' flat check. With
  * r = y/(1-y) and H(r) = sum c_k r^k, P = (1-y)^n H and P' = (1-y)^(n-2) (H' - n (1-y) H); mirrored past 1/2 like
- * the value. Defined for one ray and, in lane builds, for lanes (each lane with one ray's operations, the sides
- * picked by `pick`). */
-#if DEGREE == 1
-#define DEFINE_VALUE_SLOPE(name, T, M, pick) \
-  T name(const T* c, T y, T* slope) {        \
-    *slope = c[1] - c[0];                    \
-    return c[0] * ((REAL)1 - y) + c[1] * y;  \
+ * the value; over lanes, each lane's. */
+LREAL isolated_value_slope(const LREAL* c, LREAL y, LREAL* slope) {
+  if (DEGREE == 1) {
+    *slope = c[1] - c[0];
+    return c[0] * ((REAL)1 - y) + c[1] * y;
   }
-#else
-#define DEFINE_VALUE_SLOPE(name, T, M, pick)                                                                   \
-  T name(const T* c, T y, T* slope) {                                                                          \
-    const M mirrored = y > (REAL)0.5;                                                                          \
-    const T u = pick(mirrored, y, (REAL)1 - y); /* the factor raised to the power n */                        \
-    const T r = pick(mirrored, (REAL)1 - y, y) / u;                                                            \
-    T h = 0, d = 0;                                                                                            \
-    ALGRAY_UNROLL                                                                                              \
-    for (int k = DEGREE; k >= 0; --k) {                                                                        \
-      d = d * r + h;                                                                                           \
-      h = h * r + pick(mirrored, c[DEGREE - k], c[k]);                                                         \
-    }                                                                                                          \
-    T un2 = 1; /* u^(n-2) */                                                                                   \
-    ALGRAY_UNROLL                                                                                              \
-    for (int k = 0; k < DEGREE - 2; ++k) un2 *= u;                                                             \
-    /* dr/dy = 1/(1-y)^2 unmirrored, -1/y^2 mirrored */                                                        \
-    *slope = pick(mirrored, un2 * ((REAL)DEGREE * u * h - d), un2 * (d - (REAL)DEGREE * u * h));              \
-    return h * un2 * u * u;                                                                                    \
+  const LMASK mirrored = y > (REAL)0.5;
+  const LREAL u = LANE_SEL((REAL)1 - y, y, mirrored); /* the factor raised to the power n */
+  const LREAL r = LANE_SEL(y, (REAL)1 - y, mirrored) / u;
+  LREAL h = 0, d = 0;
+  ALGRAY_UNROLL
+  for (int k = DEGREE; k >= 0; --k) {
+    d = d * r + h;
+    h = h * r + LANE_SEL(c[k], c[DEGREE - k], mirrored);
   }
-#endif
-#define PICK_OF_ONE(m, a, b) ((m) ? (a) : (b))
-DEFINE_VALUE_SLOPE(isolated_value_slope, REAL, int, PICK_OF_ONE)
-#if LANES > 1
-#define PICK_OF_LANES(m, a, b) LANE_SEL((b), (a), (m))
-DEFINE_VALUE_SLOPE(isolated_value_slope_lanes, LREAL, LMASK, PICK_OF_LANES)
-#endif
+  LREAL un2 = 1; /* u^(n-2) */
+  ALGRAY_UNROLL
+  for (int k = 0; k < DEGREE - 2; ++k) un2 *= u;
+  /* dr/dy = 1/(1-y)^2 unmirrored, -1/y^2 mirrored */
+  *slope = LANE_SEL(un2 * (d - (REAL)DEGREE * u * h), un2 * ((REAL)DEGREE * u * h - d), mirrored);
+  return h * un2 * u * u;
+}
 
 #endif /* ALGRAY_BERNSTEIN_H */

@@ -28,7 +28,7 @@ class KernelBinder {
   }
   void real(const std::string& name, double value);
   void real_vec(const std::string& name, const glm::dvec3& value);
-  // ray_o00 .. ray_dv, as camera_ray() takes them (kernels/ray.h).
+  // ray_o00 .. ray_dv, as camera_rays() takes them (kernels/ray.h).
   void ray_basis(const RayBasis& basis);
   // A __global or __constant pointer the build never reads (the screen form's rows elsewhere, `undecided` outside
   // adaptive builds): NULL, as OpenCL allows for such arguments.

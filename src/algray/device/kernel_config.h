@@ -40,7 +40,7 @@ struct KernelConfig {
   // segment's noise is held to the noise of its own interval too (isolation.h, within_noise_at), and before a
   // doubted ray goes to the second pass, two values of P* of opposite signs beyond the noise at 16 points settle it
   // as hidden (shadow.h, sampled_sign_change). In camera and secondary ray kernels an interval doubted for an end
-  // value within the noise is settled by P's signs there in float-float (discard_settled). These pay
+  // value within the noise is settled by P's signs there in float-float (discards_settled). These pay
   // where the second pass runs in float-float, not where it runs in double (bench/RESULTS.md), so the plan sets it
   // for the former only.
   bool settle_doubts = false;

@@ -18,7 +18,7 @@
 namespace algray {
 
 // The ray to probe: a pixel's, through its centre exactly as a render without antialiasing traces it (the
-// primary kernel's camera_ray()), or one given in world coordinates, as the secondary-ray kernel takes rays.
+// primary kernel's camera_rays()), or one given in world coordinates, as the secondary-ray kernel takes rays.
 struct ProbeTarget {
   bool given_ray = false;
   int px = 0, py = 0;
@@ -52,9 +52,9 @@ struct ProbeDoubt {
   double noise = 0;       // the noise bound it was held to
 };
 
-// A doubt settled after all (ALGRAY_EVENT_CONFIRMED): a flat-doubted root (kernels/surface.h confirm_flat_root),
+// A doubt settled after all (ALGRAY_EVENT_CONFIRMED): a flat-doubted root (kernels/surface.h confirm_flat_roots),
 // P from the monomials at t - delta and t + delta, delta = ALGRAY_DOUBT_POSITION |t|; or an accept-doubted bracket
-// (kernels/methods/bernstein.h bracket_settled), P at its ends; or a discard-doubted interval (discard_settled),
+// (kernels/methods/bernstein.h settle_brackets), P at its ends; or a discard-doubted interval (discards_settled),
 // P at its ends. Each value beyond its rounding bound. A search may settle several doubts: this is the last.
 struct ProbeConfirmed {
   double before = 0, before_rounding = 0;
