@@ -519,3 +519,31 @@ TEST_CASE("-e's errors name the equation's column; --set of a missing parameter 
   CHECK_THAT(typo.err, Catch::Contains("did you mean 'fov_y'"));
   CHECK_FALSE(fs::exists(box.work / "out.png"));
 }
+
+TEST_CASE("--section draws a plane's curve, --radius comes before --set, and bad planes exit 2 writing nothing",
+          "[cli][section]") {
+  require_device();
+  Sandbox box;
+  const std::string torus = (fs::path(ALGRAY_SOURCE_DIR) / "scenes" / "torus.toml").string();
+  REQUIRE(box.run("render " + torus + " --preview -o plain.exr -q " + kTiny).exit_code == 0);
+  const Result cut = box.run("render " + torus + " --preview --section z=0.5 --set section.0.colour=[1,0,0] "
+                             "--stats s.json -o cut.exr " + kTiny);
+  INFO(cut.err);
+  REQUIRE(cut.exit_code == 0);
+  CHECK_THAT(read_text(box.work / "s.json"), Catch::Contains("plane = [0.0, 0.0, 1.0, -0.5]"));
+  CHECK(algray::read_exr(box.work / "cut.exr").rgba != algray::read_exr(box.work / "plain.exr").rgba);
+  // --radius makes the sphere that --set extent.type then turns into a cylinder.
+  const Result cylinder = box.run("render -e 'x^2+y^2+z^2-1' --radius 1.5 --set extent.type=cylinder --preview "
+                                  "--stats c.json -o c.exr " + kTiny);
+  INFO(cylinder.err);
+  REQUIRE(cylinder.exit_code == 0);
+  CHECK_THAT(cylinder.err, Catch::Contains("half_height = 1.5"));
+  CHECK_THAT(read_text(box.work / "c.json"), Catch::Contains("type = \\\"cylinder\\\""));
+  const Result bad = box.run("render " + torus + " --section 'x+*y=1' -o bad.png " + kTiny);
+  CHECK(bad.exit_code == 2);
+  CHECK_THAT(bad.err, Catch::StartsWith("--section x+*y=1: error: ") && Catch::Contains("  x+*y=1\n    ^"));
+  const Result missing = box.run("render " + torus + " --set section.1.plane=[0,0,1,0] -o bad.png " + kTiny);
+  CHECK(missing.exit_code == 2);
+  CHECK_THAT(missing.err, Catch::Contains("no [[section]] tables"));
+  CHECK_FALSE(fs::exists(box.work / "bad.png"));
+}

@@ -625,3 +625,96 @@ TEST_CASE("an error in -e's equation names its column in the equation", "[scene]
     CHECK(e.excerpt == "  x^2+*y\n      ^");
   }
 }
+
+TEST_CASE("--set extent.* and --set light.N.* reach the defaults of a scene that leaves them to algray",
+          "[scene][defaults]") {
+  const std::string eq = "[surface]\nequation = \"x^2+y^2+z^2-1\"\n";
+  // No [extent]: the default sphere of radius 2 is what extent.type switches from.
+  const Scene box = algray::load_scene_text(eq, "eq.toml", {{"extent.type", "box"}});
+  CHECK(box.extent.kind == algray::ExtentKind::Box);
+  CHECK(box.extent.min == glm::dvec3(-2));
+  CHECK(box.extent.max == glm::dvec3(2));
+  const Scene moved = algray::load_scene_text(eq, "eq.toml", {{"extent.centre", "[1, 0, 0]"}});
+  CHECK(moved.extent.radius == algray::kDefaultExtentRadius);
+  CHECK(moved.extent.centre == glm::dvec3(1, 0, 0));
+  // The default key and fill lights are there to change, sized by the extent as overridden after them.
+  const Scene plain = algray::load_scene_text(eq, "eq.toml", {{"extent.radius", "3"}});
+  const Scene dimmed =
+      algray::load_scene_text(eq, "eq.toml", {{"light.1.intensity", "0.5"}, {"extent.radius", "3"}});
+  REQUIRE(dimmed.lights.size() == 2);
+  CHECK(dimmed.lights[1].intensity == 0.5);
+  CHECK(dimmed.lights[0].intensity == plain.lights[0].intensity);
+  for (int i = 0; i < 2; ++i) {
+    CHECK(dimmed.lights[i].position == plain.lights[i].position);
+    CHECK(dimmed.lights[i].edge_u == plain.lights[i].edge_u);
+    CHECK(dimmed.lights[i].samples == plain.lights[i].samples);
+    CHECK(dimmed.lights[i].in_camera.has_value());
+  }
+  try {
+    algray::load_scene_text(eq, "eq.toml", {{"light.0.intensty", "2"}});
+    FAIL("light.0.intensty was accepted");
+  } catch (const SceneError& e) {
+    CHECK(e.where == "--set light.0.intensty=2");
+    CHECK_THAT(e.message, Catch::Contains("unknown key 'light.0.intensty' (did you mean 'intensity'?)"));
+  }
+  // antialias.adaptive alone keeps the default 2x2.
+  CHECK(algray::load_scene_text(eq, "eq.toml", {{"antialias.adaptive", "true"}}).antialias.samples == 2);
+  // A sphere and a cylinder share centre and radius: a switch names each dropped key once.
+  const Scene cylinder = algray::load_scene_text(
+      sphere_with({{5, "type = \"cylinder\"\nradius = 1\nhalf_height = 2"}}), "t.toml", {{"extent.type", "box"}});
+  REQUIRE(cylinder.warnings.size() == 1);
+  CHECK_THAT(cylinder.warnings[0],
+             Catch::StartsWith("--set extent.type=box: extent.radius and extent.half_height do not apply"));
+}
+
+TEST_CASE("--section adds a plane section from a linear equation; --set changes or drops sections",
+          "[scene][section]") {
+  const std::string s = sphere_with({});
+  const Override z{algray::kSectionOverrideKey, "z=0.5"};
+  const Scene one = algray::load_scene_text(s, "t.toml", {z, {"section.0.colour", "[1, 0, 0]"}});
+  REQUIRE(one.sections.size() == 1);
+  CHECK(one.sections[0].plane == glm::dvec4(0, 0, 1, -0.5));
+  CHECK(one.sections[0].colour == glm::dvec3(1, 0, 0));
+  const Scene two =
+      algray::load_scene_text("[parameters]\nh = 0.25\n" + s, "t.toml",
+                              {z, {algray::kSectionOverrideKey, "x + 2*y = h"}, {algray::kSectionOverrideKey, "-z"}});
+  REQUIRE(two.sections.size() == 3);
+  CHECK(two.sections[1].plane == glm::dvec4(1, 2, 0, -0.25));
+  CHECK(two.sections[2].plane == glm::dvec4(0, 0, -1, 0));
+  // The list as a whole: replaced, or emptied.
+  CHECK(algray::load_scene_text(s, "t.toml", {z, {"section", "[]"}}).sections.empty());
+  const Scene listed = algray::load_scene_text(s, "t.toml", {z, {"section", "[{plane = [1, 0, 0, 0]}]"}});
+  REQUIRE(listed.sections.size() == 1);
+  CHECK(listed.sections[0].plane == glm::dvec4(1, 0, 0, 0));
+  CHECK(algray::load_scene_text(algray::scene_to_toml(two), "again.toml").sections.size() == 3);
+  // Errors name the flag and the character of the plane.
+  const auto section_error = [&](const std::string& plane) {
+    try {
+      algray::load_scene_text(s, "t.toml", {{algray::kSectionOverrideKey, plane}});
+    } catch (const SceneError& e) {
+      CHECK(e.where == "--section " + plane);
+      return e;
+    }
+    FAIL("--section " << plane << " was accepted");
+    throw std::logic_error("unreachable");
+  };
+  CHECK_THAT(section_error("x^2=1").message, Catch::Contains("degree 2"));
+  const SceneError star = section_error("x+*y=1");
+  CHECK_THAT(star.message, Catch::Contains("at character 3 of the plane"));
+  CHECK(star.excerpt == "  x+*y=1\n    ^");
+  CHECK_THAT(section_error("2=3").message, Catch::Contains("no x, y or z"));
+  CHECK_THAT(section_error("z=1=2").message, Catch::Contains("at character 4"));
+  CHECK_THAT(section_error("=1").message, Catch::Contains("left side of the plane is empty"));
+  CHECK_THAT(section_error("").message, Catch::Contains("--section takes a plane"));
+  // A section that is not there is named, with what adds one.
+  try {
+    algray::load_scene_text(s, "t.toml", {{"section.0.colour", "[1, 0, 0]"}});
+    FAIL("section.0.colour without sections was accepted");
+  } catch (const SceneError& e) {
+    CHECK_THAT(e.message, Catch::Contains("no [[section]] tables") && Catch::Contains("--section"));
+  }
+  // A parameter named as a table is still the parameter.
+  const Scene param = algray::load_scene_text("[parameters]\nsection = 1\n[surface]\nequation = \"x^2+y^2+z^2-section\"\n",
+                                              "t.toml", {{"section", "2"}});
+  CHECK(param.parameters.at("section") == 2);
+}

@@ -36,6 +36,7 @@ struct SceneOptions {
   std::string equation;  // -e: an equation alone, with algray's defaults for the rest
   double radius = 0;     // --radius: extent.radius
   std::vector<std::string> sets;
+  std::vector<std::string> sections;  // --section: plane sections added, each a linear equation
   int width = 0, height = 0;
   std::string precision, isolation, refinement, tolerance, max_iterations;
   std::string device_spec;
@@ -63,7 +64,9 @@ void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = t
                     "antialiasing")
         ->excludes(scene);
   }
-  cmd->add_option("--radius", o.radius, "the sphere extent's radius (overrides extent.radius)");
+  cmd->add_option("--radius", o.radius,
+                  "the sphere extent's radius (overrides extent.radius, before any --set: --set extent.type=box then "
+                  "makes the cube about that sphere)");
   cmd->add_option("--width", o.width, "image width in pixels (overrides image.width)");
   cmd->add_option("--height", o.height, "image height in pixels (overrides image.height)");
   cmd->add_option("--device", o.device_spec,
@@ -77,16 +80,26 @@ void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = t
   cmd->add_option("--tolerance", o.tolerance, "the stopping tolerance eps (overrides render.tolerance)");
   cmd->add_option("--max-iterations", o.max_iterations,
                   "the refinement's iteration cap (overrides render.max_iterations)");
-  cmd->add_option("--set", o.sets, "override a scene key: name=value (a bare name is a parameter)");
+  cmd->add_option("--set", o.sets,
+                  "override a scene key: name=value (a bare name is a parameter); repeatable, e.g. --set a=2 --set "
+                  "camera.azimuth=60 --set extent.type=box --set section.0.colour=[1,0,0] --set 'section=[]'");
+  cmd->add_option("--section", o.sections,
+                  "draw the curve where this plane meets the surface (surf's cut_with_plane), a linear equation in "
+                  "x, y, z such as z=0.5 or x+y=1; repeatable, appended to the scene's [[section]] list before any "
+                  "--set");
   cmd->add_flag("--preview", o.preview,
                 "the paper's preview mode: primary rays only (no shadows); sets render.preview");
   cmd->add_flag("--no-cache", o.no_cache, "compile kernels from source; neither read nor write the program cache");
   add_no_fp64_flag(cmd);
 }
 
-// --set first, then the flags, which are overrides like any --set applied last so that they win. Returns false
+// --radius and --section, then --set, then the other flags, which are overrides like any --set applied last so
+// that they win. Returns false
 // (after saying why) on a malformed --set.
 bool collect_overrides(const CLI::App* cmd, const SceneOptions& o, std::vector<Override>& out) {
+  // --radius and --section first: they make the sphere and the sections that a --set may then change.
+  if (cmd->count("--radius")) out.push_back({"extent.radius", cmd->get_option("--radius")->as<std::string>()});
+  for (const std::string& s : o.sections) out.push_back({kSectionOverrideKey, s});
   for (const std::string& s : o.sets) {
     const auto eq = s.find('=');
     if (eq == std::string::npos || eq == 0) {
@@ -95,8 +108,6 @@ bool collect_overrides(const CLI::App* cmd, const SceneOptions& o, std::vector<O
     }
     out.push_back({s.substr(0, eq), s.substr(eq + 1)});
   }
-  // Written back as the shortest text that reads to the same double, so that the scene records what was given.
-  if (cmd->count("--radius")) out.push_back({"extent.radius", cmd->get_option("--radius")->as<std::string>()});
   if (cmd->count("--width")) out.push_back({"image.width", std::to_string(o.width)});
   if (cmd->count("--height")) out.push_back({"image.height", std::to_string(o.height)});
   if (!o.precision.empty()) out.push_back({"render.precision", "\"" + o.precision + "\""});

@@ -152,6 +152,19 @@ json scene_summary(const api::Scene& scene, const std::string& device) {
   if (const toml::array* list = t["light"].as_array())
     for (const toml::node& l : *list) lights.push_back(l.as_table()->get("intensity")->value_or(1.0));
   const std::array<double, 3> angles = scene.camera_angles();
+  // The extent as its kind has it, and the plane sections, for the page's clip and section controls.
+  const toml::node_view<const toml::node> e = t["extent"];
+  json extent{{"type", e["type"].value_or(std::string("sphere"))}};
+  for (const char* key : {"centre", "min", "max"})
+    if (e[key]) extent[key] = numbers(e[key].node());
+  for (const char* key : {"radius", "half_height"})
+    if (e[key]) extent[key] = e[key].value_or(1.0);
+  if (e["axis"]) extent["axis"] = e["axis"].value_or(std::string("z"));
+  json sections = json::array();
+  if (const toml::array* list = t["section"].as_array())
+    for (const toml::node& section : *list)
+      sections.push_back({{"plane", numbers(section.as_table()->get("plane"))},
+                          {"colour", numbers(section.as_table()->get("colour"))}});
   json parameters = json::object();
   for (const auto& [name, value] : scene.parameters()) parameters[name] = value;
   json precisions = choice_names(kPrecisions);
@@ -174,6 +187,8 @@ json scene_summary(const api::Scene& scene, const std::string& device) {
           {"background", numbers(t["image"]["background"].node())},
           {"light_intensities", lights},
           {"extent_radius", t["extent"]["radius"].value_or(1.0)},
+          {"extent", extent},
+          {"sections", sections},
           {"precision", t["render"]["precision"].value_or(std::string("auto"))},
           {"isolation", t["render"]["isolation"].value_or(std::string("bernstein"))},
           {"refinement", t["render"]["refinement"].value_or(std::string("brent"))},

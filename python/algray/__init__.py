@@ -24,8 +24,9 @@ __all__ = ["Scene", "Renderer", "Image", "Animation", "SceneError", "DeviceError
 
 def _scene_set(self, key, value):
     """Changes this scene in place, and returns it for chaining: sets a dotted scene key, or a parameter by its
-    bare name, as `algray render --set key=value` does. The value may be a Python number, bool, string or list
-    (written as TOML). Use copy.copy(scene) first to keep the original.
+    bare name, as `algray render --set key=value` does; a bare name that is no parameter but a table sets the table
+    or list whole ("section", []), and the key "--section" adds a plane section, as the flag. The value may be a
+    Python number, bool, string or list (written as TOML). Use copy.copy(scene) first to keep the original.
 
     >>> scene = algray.Scene.from_equation("x^2+y^2+z^2-r^2", parameters={"r": 1})
     >>> scene.set("r", 0.5).set("camera.azimuth", 90) is scene
@@ -37,6 +38,10 @@ def _scene_set(self, key, value):
     ... except algray.SceneError as e:
     ...     print(e.message)
     the scene has no parameter 'q'; its parameters: r (--set parameters.q=VALUE adds one)
+    >>> scene.set("section", [{"plane": [0, 0, 1, -0.5]}]).to_dict()["section"][0]["plane"]
+    [0.0, 0.0, 1.0, -0.5]
+    >>> scene.set("--section", "x=0").set("section.1.colour", [1, 0, 0]).to_dict()["section"][1]["plane"]
+    [1.0, 0.0, 0.0, 0.0]
     """
     self._set(key, _toml.value(value))
     return self

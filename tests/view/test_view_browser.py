@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """`algray view` in a real browser: headless Chromium driven by Selenium loads the page and its first frame, a drag
-turns the camera, a slider moves a parameter, a bad equation shows its error at the command line's column and
-keeps the image, and the saved scene renders to the view's last full-size frame.
+turns the camera, a slider moves a parameter, each control of the panel (colours, light, background,
+transparency, axis views, clip shape and radius, plane sections, reset, saved image) changes what the server
+renders, a bad equation shows its error at the command line's column and keeps the image, and the saved scene
+renders to the view's last full-size frame.
 
 Usage: test_view_browser.py ALGRAY_BINARY WORK_DIR. Needs chromium, chromium-driver and python3-selenium
 (scripts/install-deps.sh installs them) and an OpenCL device; fails loudly without any of them."""
@@ -9,6 +11,7 @@ import base64
 import os
 import subprocess
 import sys
+import tomllib
 import urllib.request
 
 from png_data import idat
@@ -45,6 +48,7 @@ fetch(document.getElementById("frame").src).then(r => r.arrayBuffer()).then(b =>
 
 server = subprocess.Popen([BINARY, "view", "--port", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 driver = None
+other = None  # a second server, for an equation alone with a box extent
 try:
     url = server.stdout.readline().strip()
     if not url.startswith("http://127.0.0.1:"):
@@ -84,8 +88,12 @@ try:
         fail("the solver selectors are not in a closed Advanced fold")
 
     original = driver.execute_script("return view.equation")
-    # A drag turns the camera about the look-at point, and the image changes.
+    # A drag turns the camera about the look-at point, and the image changes; the info line shows the frame rate
+    # while the frames come from moving input, and drops it at rest.
     camera = driver.execute_script("return Object.assign({}, view.camera)")
+    driver.execute_script("""window.infoTexts = [];
+      new MutationObserver(() => infoTexts.push(document.getElementById('info').textContent))
+        .observe(document.getElementById('info'), {childList: true, characterData: true, subtree: true});""")
     n = frames()
     ActionChains(driver).move_to_element(driver.find_element(By.ID, "frame")).click_and_hold() \
         .move_by_offset(40, 0).move_by_offset(40, 15).release().perform()
@@ -96,6 +104,9 @@ try:
         fail(f"the drag changed the camera from {camera} to {turned}, not its angles about the look-at point")
     if dragged == first:
         fail("the image did not change with the drag")
+    texts = driver.execute_script("return infoTexts")
+    if not any("fps" in t for t in texts) or "fps" in texts[-1]:
+        fail(f"the info line while moving and at rest: {texts}")
 
     # A slider moves the parameter, and the image changes.
     n = frames()
@@ -166,12 +177,49 @@ try:
     picture = control("document.getElementById('view-x').click()")
     if driver.execute_script("return [view.camera.azimuth, view.camera.elevation]") != [90, 0] or picture == shown:
         fail("the x axis button does not look along the x axis")
-    # Reset: the scene's own view and colours again, and its first frame's pixels.
+    # Clip shape and radius, and plane sections: the server's scene (scene.toml from the page's settings) has what
+    # the controls say, and the image changes with each.
+    def server_scene():
+        path = driver.execute_script("return '/scene.toml?' + query(view.width, view.height, false)")
+        with urllib.request.urlopen(url.rstrip("/") + path, timeout=60) as r:
+            return tomllib.loads(r.read().decode())
+
+    def close(a, b):
+        return len(a) == len(b) and all(abs(x - y) < 1e-9 for x, y in zip(a, b))
+
+    for kind in ("box", "cylinder"):
+        picture = control("""const e = document.getElementById('extent-type'); e.value = arguments[0];
+                             e.dispatchEvent(new Event('change'));""", kind)
+        if server_scene()["extent"]["type"] != kind or picture == shown:
+            fail(f"the clip shape {kind}: the server's extent is {server_scene()['extent']}")
+        shown = picture
+    picture = control("""const e = document.getElementById('radius'); e.value = '0.7';
+                         e.dispatchEvent(new Event('change'));""")
+    extent = server_scene()["extent"]
+    if extent["radius"] != 0.7 or picture == shown:
+        fail(f"the clip radius 0.7: the server's extent is {extent}")
+    shown = picture
+    for axis, offset in (("z", "0.3"), ("x", "0")):
+        picture = control("""document.getElementById('section-axis').value = arguments[0];
+                             document.getElementById('section-offset').value = arguments[1];
+                             document.getElementById('section-add').click();""", axis, offset)
+        if picture == shown:
+            fail(f"the image did not change with the section {axis} = {offset}")
+        shown = picture
+    planes = [x["plane"] for x in server_scene()["section"]]
+    if len(planes) != 2 or not close(planes[0], [0, 0, 1, -0.3]) or not close(planes[1], [1, 0, 0, 0]):
+        fail(f"two sections added, z = 0.3 and x = 0: the server has {planes}")
+    picture = control("document.querySelector('#sections .section-remove').click()")
+    planes = [x["plane"] for x in server_scene().get("section", [])]
+    if len(planes) != 1 or not close(planes[0], [1, 0, 0, 0]) or picture == shown:
+        fail(f"the first section removed: the server has {planes}")
+    # Reset: the scene's own view, colours, clip and sections again, and its first frame's pixels.
     n = frames()
     driver.execute_script("document.getElementById('reset').click()")
     reset = settle(n)
-    if driver.execute_script("return [view.camera.azimuth, view.light, view.transparency]") != \
-            [camera["azimuth"], 1, 0] or idat(reset) != idat(first):
+    if driver.execute_script("return [view.camera.azimuth, view.light, view.transparency, view.sections.length]") != \
+            [camera["azimuth"], 1, 0, 0] or idat(reset) != idat(first) or \
+            driver.execute_script("return document.getElementById('extent-type').value") != "sphere":
         fail("Reset does not bring back the scene's own view")
     # Save image: the server renders the size and quality asked for, not the frame on screen.
     driver.execute_script("""document.getElementById('save-width').value = '50';
@@ -184,6 +232,14 @@ try:
         saved_png = r.read()
     if saved_png[16:24] != (50).to_bytes(4, "big") + (30).to_bytes(4, "big"):
         fail("the saved image is not 50x30")
+    # At full quality (antialiasing and shadows) the server renders another picture of that size.
+    driver.execute_script("""document.getElementById('save-quality').value = 'full';
+                             document.getElementById('save-png').click();""")
+    wait.until(lambda d: d.find_element(By.ID, "save-png").get_attribute("data-saved") == "50x30 full")
+    with urllib.request.urlopen(url.rstrip("/") + driver.execute_script("return '/frame.png?' + query(50, 30, true)"),
+                                timeout=60) as r:
+        if idat(r.read()) == idat(saved_png):
+            fail("the full-quality saved image is the preview's")
 
     # A bad equation: the error under the column the command line reports, and the last good image stays.
     n = frames()
@@ -216,10 +272,31 @@ try:
     with open(out, "rb") as f:
         if idat(f.read()) != idat(last):
             fail("the saved scene does not render to the view's last full-size frame")
+
+    # An equation alone, clipped by a box: the page keeps the box (it sends a box's keys, not a radius) and its
+    # light slider reaches algray's default key and fill lights.
+    other = subprocess.Popen([BINARY, "view", "--port", "0", "-e", "x^2+y^2-z^2-0.25", "--set", "extent.type=box",
+                              "--width", "96", "--height", "72"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+    other_url = other.stdout.readline().strip()
+    if not other_url.startswith("http://127.0.0.1:"):
+        fail(f"expected the second server's URL, got {other_url!r}")
+    driver.get(other_url)
+    boxed = settle(0)
+    if driver.find_element(By.ID, "error").text != "" or \
+            driver.execute_script("return document.getElementById('extent-type').value") != "box":
+        fail(f"an equation in a box: error {driver.find_element(By.ID, 'error').text!r}")
+    picture = control("""const e = document.getElementById('light'); e.value = '0.3';
+                         e.dispatchEvent(new Event('input'));""")
+    if driver.find_element(By.ID, "error").text != "" or picture == boxed:
+        fail(f"the light slider on an equation's default lights: error {driver.find_element(By.ID, 'error').text!r}")
 finally:
     if driver is not None:
         driver.quit()
-    server.terminate()
-    server.wait(timeout=30)
-print("test_view_browser: first frame, hint, drag, slider, zoom, colours, lights, transparency, axis views, reset, "
-      "saved image, located error and saved scene all hold in Chromium")
+    for process in (server, other):
+        if process is not None:
+            process.terminate()
+            process.wait(timeout=30)
+print("test_view_browser: first frame, hint, fps while moving, drag, slider, zoom, colours, lights, transparency, "
+      "axis views, clip shape and radius, sections, reset, saved image at both qualities, located error, saved scene "
+      "and an equation in a box all hold in Chromium")

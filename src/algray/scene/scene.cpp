@@ -134,10 +134,11 @@ void switch_extent_kind(toml::table& root, const std::string& label, std::vector
   const auto to = std::find_if(extent_kinds().begin(), extent_kinds().end(),
                                [&](const ExtentKindInfo& k) { return type && *type == k.name; });
   if (to == extent_kinds().end()) return;  // the reader names the kinds
-  std::vector<std::string> dropped;
+  std::vector<std::string> dropped;  // each once: a sphere and a cylinder share centre and radius
   for (const ExtentKindInfo& k : extent_kinds())
     for (const std::string& key : k.keys)
-      if (std::find(to->keys.begin(), to->keys.end(), key) == to->keys.end() && extent->get(key))
+      if (std::find(to->keys.begin(), to->keys.end(), key) == to->keys.end() && extent->get(key) &&
+          std::find(dropped.begin(), dropped.end(), key) == dropped.end())
         dropped.push_back(key);
   std::string made;
   const auto centre = loose_vec3(extent->get("centre")).value_or(glm::dvec3(0));
@@ -191,17 +192,95 @@ void switch_extent_kind(toml::table& root, const std::string& label, std::vector
                   " extent and " + (dropped.size() == 1 ? "was" : "were") + " dropped" + made);
 }
 
+// The [[section]] list's table for a new section, appended (the list made where there is none).
+toml::array& section_list(toml::table& root) {
+  toml::node* at = root.get("section");
+  if (!at || !at->is_array()) {
+    root.insert_or_assign("section", toml::array{});
+    at = root.get("section");
+  }
+  return *at->as_array();
+}
+
+// --section EQUATION: a plane as a linear equation in x, y and z ("z=0.5", "x+y=1", "x-2*z", the last = 0), with
+// the scene's parameters, appended as a [[section]] table. Errors name the character of the equation.
+void add_section(toml::table& root, const std::string& text, const std::string& label) {
+  const auto fail_at = [&](std::size_t offset, const std::string& message) {
+    throw SceneError(label, message + " (at character " + std::to_string(offset + 1) + " of the plane)",
+                     "  " + text + "\n  " + std::string(std::min(offset, text.size()), ' ') + "^");
+  };
+  std::map<std::string, double> parameters;
+  if (const toml::table* p = root["parameters"].as_table())
+    for (auto&& [name, node] : *p)
+      if (const auto v = node.value<double>()) parameters[std::string(name.str())] = *v;
+  const std::size_t eq = text.find('=');
+  if (eq != std::string::npos && text.find('=', eq + 1) != std::string::npos)
+    fail_at(text.find('=', eq + 1), "a plane is one equation, as z=0.5 or x+y=1: it has one '='");
+  const auto side = [&](std::size_t from, std::size_t length) {
+    const std::string part = text.substr(from, length);
+    if (part.find_first_not_of(" \t") == std::string::npos) {
+      if (eq == std::string::npos) fail_at(from, "--section takes a plane, as z=0.5 or x+y=1");
+      fail_at(from, std::string("the ") + (from == 0 ? "left" : "right") + " side of the plane is empty");
+    }
+    try {
+      return parse_equation(part, parameters);
+    } catch (const EquationError& e) {
+      fail_at(from + e.position, e.what());
+    }
+    return Polynomial();
+  };
+  const Polynomial p = eq == std::string::npos ? side(0, std::string::npos)
+                                               : side(0, eq) - side(eq + 1, std::string::npos);
+  if (p.degree() != 1)
+    fail_at(0, p.degree() < 1 ? "the plane has no x, y or z: a section is a plane such as z=0.5"
+                              : "a section is a plane, of degree 1 in x, y and z; this equation has degree " +
+                                    std::to_string(p.degree()));
+  double plane[4] = {0, 0, 0, 0};
+  for (const auto& [e, c] : p.terms()) plane[e[0] ? 0 : e[1] ? 1 : e[2] ? 2 : 3] = nearest_double(c);
+  for (const double c : plane)
+    if (!std::isfinite(c)) fail_at(0, "the plane's coefficients do not fit a double");
+  toml::table section;
+  section.insert("plane", toml::array{plane[0], plane[1], plane[2], plane[3]});
+  section_list(root).push_back(std::move(section));
+}
+
+// Why LIST.INDEX names nothing: the scene has no [[LIST]] tables, and what adds one.
+std::string no_list_message(const std::string& list, const std::string& index) {
+  std::string m = "the scene has no [[" + list + "]] tables, so there is no " + list + "." + index;
+  if (list == "section") m += "; --section adds one, as --section z=0.5";
+  if (list == "light")
+    m += "; it is lit by a headlight at the eye (a scene that places camera.eye); [[light]] tables give it lights";
+  return m;
+}
+
 void apply_override(toml::table& root, const Override& o, std::vector<std::string>& notes) {
   // A hostile key or value may be megabytes long: messages show its start.
   const auto shown = [](const std::string& t) {
     return t.size() <= 120 ? t : t.substr(0, 100) + "...(" + std::to_string(t.size()) + " characters)";
   };
+  // A scene without [extent] has algray's sphere of radius kDefaultExtentRadius: extent.KEY changes that one.
+  if (o.key.rfind("extent.", 0) == 0 && !root.get("extent"))
+    root.insert("extent", toml::table{{"radius", kDefaultExtentRadius}});
+  if (o.key == kSectionOverrideKey) {
+    // The plane as written, or as a TOML string (Python's Scene.set and a job's set table quote it).
+    std::string plane = o.value;
+    if (!plane.empty() && (plane.front() == '"' || plane.front() == '\'')) try {
+        plane = toml::parse("v = " + plane)["v"].value_or(plane);
+      } catch (const toml::parse_error&) {
+        // not a TOML string after all: the plane's own reading says what is wrong
+      }
+    add_section(root, plane, (o.origin.empty() ? "--section " : o.origin + ": section ") + shown(plane));
+    return;
+  }
   const std::string label = (o.origin.empty() ? "--set " : o.origin + ": set ") + shown(o.key) + "=" + shown(o.value);
   // A bare name is a parameter; any other key is a dotted path into the scene. A bare name must be one of the
-  // scene's parameters, so that a typo is not a new parameter nothing uses; parameters.NAME adds one.
+  // scene's parameters, so that a typo is not a new parameter nothing uses; parameters.NAME adds one. A bare name
+  // that is no parameter but a top-level table of the scene is that table: --set 'section=[]' drops the sections.
   const bool bare = o.key.find('.') == std::string::npos;
-  if (bare && is_identifier(o.key)) {
-    const toml::table* params = root["parameters"].as_table();
+  const toml::table* params = root["parameters"].as_table();
+  const bool top_table =
+      bare && (!params || !params->get(o.key)) && kTopKeys.count(o.key) && o.key != "parameters";
+  if (bare && is_identifier(o.key) && !top_table) {
     if (!params || !params->get(o.key)) {
       std::string names;
       if (params)
@@ -211,7 +290,7 @@ void apply_override(toml::table& root, const Override& o, std::vector<std::strin
                                   " (--set parameters." + o.key + "=VALUE adds one)");
     }
   }
-  const std::string key = bare ? "parameters." + o.key : o.key;
+  const std::string key = bare && !top_table ? "parameters." + o.key : o.key;
   std::vector<std::string> parts;
   for (std::size_t start = 0;;) {
     const std::size_t dot = key.find('.', start);
@@ -243,7 +322,11 @@ void apply_override(toml::table& root, const Override& o, std::vector<std::strin
       ++i;
       continue;
     }
-    if (!at || !at->is_array_of_tables()) break;
+    if (!at || !at->is_array_of_tables()) {
+      if (is_index(parts[i + 1]) && (!at || (at->is_array() && at->as_array()->empty())))
+        throw SceneError(label, no_list_message(parts[i], parts[i + 1]));
+      break;
+    }
     const std::string& list_name = parts[i];
     const toml::array& list = *at->as_array();
     if (!is_index(parts[i + 1]))
@@ -259,7 +342,7 @@ void apply_override(toml::table& root, const Override& o, std::vector<std::strin
     target = at->as_array()->get(index)->as_table();
     i += 2;
   }
-  if (i + 1 == parts.size() && target->get(parts[i]) && target->get(parts[i])->is_array_of_tables())
+  if (!top_table && i + 1 == parts.size() && target->get(parts[i]) && target->get(parts[i])->is_array_of_tables())
     throw SceneError(label, "'" + parts[i] + "' is a list of [[" + parts[i] +
                                 "]] tables: name one by its index from 0, as in " + parts[i] + ".0.KEY");
   std::string rest;
@@ -359,8 +442,9 @@ SceneSurface read_surface(const TomlReader& r, const toml::table& surface,
   return out;
 }
 
-Light read_light(const TomlReader& r, const toml::table& t, const CameraSpec& camera) {
-  r.check_keys(t, "light", kLightKeys);
+// `index`: the light's place in the [[light]] list, as --set light.N.KEY names it in an unknown key's message.
+Light read_light(const TomlReader& r, const toml::table& t, const CameraSpec& camera, std::size_t index) {
+  r.check_keys(t, "light." + std::to_string(index), kLightKeys);
   Light light;
   const std::string type = t.get("type") ? r.string(*t.get("type"), "light.type") : "point";
   if (type == "point")
@@ -661,13 +745,36 @@ std::vector<Light> framing_lights(double radius, const CameraSpec& camera) {
   return out;
 }
 
+// The framing lights as [[light]] tables of `root`, sized by its extent as read now: for a --set light.N.KEY on a
+// scene that leaves its lights to algray (load_scene_text), which then changes one of them. They read back to
+// framing_lights' own values.
+void write_framing_lights(const TomlReader& r, toml::table& root) {
+  Extent extent;
+  read_extent(r, root, extent);
+  const double radius = extent.unit_scale();
+  toml::array lights;
+  for (const FramingLight& f : kFramingLights) {
+    toml::table t;
+    t.insert("type", "rectangle");
+    t.insert("frame", "camera");
+    t.insert("position", toml_array(f.position * radius));
+    t.insert("edge_u", toml_array(f.edge_u * radius));
+    t.insert("edge_v", toml_array(f.edge_v * radius));
+    t.insert("samples", 5);
+    t.insert("intensity", f.intensity);
+    lights.push_back(std::move(t));
+  }
+  root.insert_or_assign("light", std::move(lights));
+}
+
 void read_lights(const TomlReader& r, const toml::table& root, const CameraSpec& camera, std::vector<Light>& out) {
   const toml::node* lights = root.get("light");
   if (!lights) return;
   const toml::array* list = lights->as_array();
+  if (list && list->empty()) return;  // light = []: the headlight
   if (!list || !list->is_array_of_tables())
     r.fail(lights->source(), "lights are written as [[light]] tables, one per light");
-  for (const toml::node& node : *list) out.push_back(read_light(r, *node.as_table(), camera));
+  for (const toml::node& node : *list) out.push_back(read_light(r, *node.as_table(), camera, out.size()));
 }
 
 // [[section]] tables: plane = [a, b, c, d] (a plane: (a, b, c) not zero) and an optional colour.
@@ -675,11 +782,12 @@ void read_sections(const TomlReader& r, const toml::table& root, std::vector<Sec
   const toml::node* sections = root.get("section");
   if (!sections) return;
   const toml::array* list = sections->as_array();
+  if (list && list->empty()) return;  // section = []: none
   if (!list || !list->is_array_of_tables())
     r.fail(sections->source(), "plane sections are written as [[section]] tables, one per plane");
   for (const toml::node& node : *list) {
     const toml::table& t = *node.as_table();
-    r.check_keys(t, "section", kSectionKeys);
+    r.check_keys(t, "section." + std::to_string(out.size()), kSectionKeys);
     Section s;
     const toml::node* plane = t.get("plane");
     if (!plane) r.fail(t.source(), "a section needs plane = [a, b, c, d] (the plane a*x + b*y + c*z + d = 0)");
@@ -781,7 +889,9 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
   read_lights(r, root, scene.camera, scene.lights);
   read_sections(r, root, scene.sections);
   if (framed && !root.get("light")) scene.lights = framing_lights(scene.extent.unit_scale(), scene.camera);
-  if (framed && !root.get("antialias")) scene.antialias.samples = 2;
+  // 2x2 unless the scene gives antialias.samples (a --set antialias.adaptive=true alone keeps the 2x2).
+  const toml::table* aa = root["antialias"].as_table();
+  if (framed && (!aa || !aa->get("samples"))) scene.antialias.samples = 2;
   read_antialias(r, root, scene.antialias);
   read_render(r, root, degree, scene.render);
   return scene;
@@ -871,7 +981,20 @@ Scene load_scene_text(const std::string& text, const std::string& source_name, c
   const toml::table* written_camera = root["camera"].as_table();
   const bool framed = !written_camera || !written_camera->get("eye");
   std::vector<std::string> notes;
-  for (const Override& o : overrides) apply_override(root, o, notes);
+  // A scene that leaves its lights to algray gets them from its camera and extent as it is read: a --set
+  // light.N.KEY there waits for the other overrides (--radius, extent.*), then the default lights are written in
+  // as [[light]] tables, and it changes one of them.
+  std::vector<const Override*> to_default_lights;
+  for (const Override& o : overrides) {
+    if (framed && !root.get("light") && o.key.rfind("light.", 0) == 0)
+      to_default_lights.push_back(&o);
+    else
+      apply_override(root, o, notes);
+  }
+  if (!to_default_lights.empty()) {
+    if (!root.get("light")) write_framing_lights(reader, root);
+    for (const Override* o : to_default_lights) apply_override(root, *o, notes);
+  }
   Scene scene = interpret(reader, root, source_name, framed);
   scene.warnings.insert(scene.warnings.end(), notes.begin(), notes.end());
   if (scene.name.empty()) {

@@ -184,7 +184,10 @@ struct Scene {
 };
 
 // "key=value" from --set (or a flag such as --width): key is a dotted scene key; a key without a dot names a
-// parameter. The value is read as TOML, or as a string when it is not valid TOML.
+// parameter, or else a top-level table (--set 'section=[]'). The value is read as TOML, or as a string when it is
+// not valid TOML. The key kSectionOverrideKey is --section: its value, a plane as a linear equation in x, y, z
+// ("z=0.5", "x+y=1"), is appended as a [[section]] table.
+inline constexpr const char* kSectionOverrideKey = "--section";
 struct Override {
   std::string key;
   std::string value;
