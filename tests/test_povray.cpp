@@ -158,6 +158,10 @@ TEST_CASE("clips: a sphere or box, moved by the transforms after them, one regio
   CHECK_THAT(
       error_of("camera { location <0, 0, -10> look_at 0 }\npoly { 2, <1,0,0,0,1,0,0,1,0,-4> translate -z*50 }").message,
       Catch::Contains("clipped_by"));
+  // Clipping planes (POV-Ray's grafbic sample) do not exist in algray: located at the plane.
+  const SceneError plane = error_of("poly { 2, <1,0,0,0,1,0,0,1,0,-4>\n  clipped_by { plane { x, 0.5 } } }");
+  CHECK(plane.where == "bad.pov:2:16");
+  CHECK_THAT(plane.message, Catch::Contains("no clipping planes"));
   // Two boxes turned differently (or one sheared) have no common frame.
   CHECK_THAT(error_of("sphere { 0, 1 clipped_by { box { -1, 1 rotate y*30 } } clipped_by { box { -2, 2 } } }").message,
              Catch::Contains("axis-aligned"));

@@ -627,6 +627,9 @@ class PovReader {
   // --- objects ---
   Clip clip_shape(const Token& at, glm::dmat4& own) {
     const Token shape = next();
+    if (shape.kind == Token::Name && shape.text == "plane")
+      fail(shape, std::string(at.text) + " { plane }: algray has no clipping planes yet; it clips to one sphere, box "
+                                         "or cylinder");
     if (shape.kind != Token::Name || (shape.text != "sphere" && shape.text != "box" && shape.text != "object"))
       fail(shape, std::string(at.text) + " takes a sphere or a box here; algray clips to one of those");
     expect("{", "'{'");
