@@ -14,6 +14,10 @@
 // - The camera: direction <0, 0, 1>, right <1.33, 0, 0>, up and sky <0, 1, 0> by default; angle is the horizontal
 //   field of view and sets direction's length to |right| / 2 / tan(angle / 2). The view spans |right| across and
 //   |up| down at distance |direction|, whatever the image's size.
+// - bounded_by alone is no clip: a ray that misses the bound skips the object, one that meets it sees all of the
+//   surface along it, inside the bound or not (the hyptorus sample shows its arms beyond its bounding sphere, cut
+//   off only along the sphere's outline). No sphere or box does that for every ray, so run() picks the one that
+//   agrees best on rays traced here; an object with no region at all gets a sphere about what the camera sees.
 // - #include "name.inc" reads the file in place; POV-Ray's own includes (colors.inc, shapesq.inc, ...) declare
 //   colours, objects and macros with #declare, #macro and #ifndef guards.
 //
@@ -31,13 +35,16 @@
 #include <filesystem>
 #include <fstream>
 #include <glm/glm.hpp>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
 
+#include "algray/scene/camera.h"
 #include "algray/scene/located_text.h"
+#include "algray/scene/ray_roots.h"
 #include "algray/scene/scene.h"
 #include "algray/scene/sparse_poly.h"
 #include "algray/scene/toml_reader.h"
@@ -64,6 +71,7 @@ struct Clip {
   bool sphere = true;
   glm::dvec3 centre{0}, min{0}, max{0};
   double radius = 0;
+  bool bound = false;  // from bounded_by alone: POV-Ray's hint, not a clip (see the top of the file)
 };
 
 struct Object {
@@ -619,6 +627,9 @@ class PovReader {
   // --- objects ---
   Clip clip_shape(const Token& at, glm::dmat4& own) {
     const Token shape = next();
+    if (shape.kind == Token::Name && shape.text == "plane")
+      fail(shape, std::string(at.text) + " { plane }: algray has no clipping planes yet; it clips to one sphere, box "
+                                         "or cylinder");
     if (shape.kind != Token::Name || (shape.text != "sphere" && shape.text != "box" && shape.text != "object"))
       fail(shape, std::string(at.text) + " takes a sphere or a box here; algray clips to one of those");
     expect("{", "'{'");
@@ -665,10 +676,12 @@ class PovReader {
     if ((at.text == "bounded_by" && at_name("clipped_by")) || (at.text == "clipped_by" && at_name("bounded_by"))) {
       if (o.clips.empty()) fail(peek(), peek().text + " names no region yet: give the other one first");
       next();
+      for (auto& [c, t] : o.clips) c.bound = false;  // clipped_by { bounded_by }: the bound clips too
     } else {
       while (!at_op("}")) {
         glm::dmat4 own(1);
-        const Clip c = clip_shape(at, own);
+        Clip c = clip_shape(at, own);
+        c.bound = at.text == "bounded_by";
         o.clips.push_back({c, own});
       }
     }
@@ -1186,8 +1199,9 @@ class PovReader {
   }
 
   // --- the scene ---
-  // The region an object is drawn in, in POV-Ray's world.
-  Clip region(const Object& o) const {
+  // The region an object is drawn in, in POV-Ray's world (or the box frame's, see run()); nullopt for an object
+  // without one. A region from bounded_by alone is marked `bound`.
+  std::optional<Clip> region(const Object& o) const {
     std::optional<Clip> best;
     auto place = [&](const Clip& c, const glm::dmat4& t, bool loose) {
       const glm::dmat3 l(t);
@@ -1217,7 +1231,10 @@ class PovReader {
           int nonzero = 0;
           const double norm = glm::length(l[col]);
           for (int row = 0; row < 3; ++row) nonzero += std::fabs(l[col][row]) > 1e-9 * norm;
-          if (nonzero != 1) fail(o.at, "a clipping box turned off the axes; algray's boxes are axis-aligned");
+          if (nonzero != 1)
+            fail(o.at,
+                 "a clipping box sheared, or turned differently from another box of the scene; algray's boxes "
+                 "are axis-aligned (a scene with one turned box is written in that box's frame)");
         }
         const glm::dvec3 a(t * glm::dvec4(c.min, 1)), b(t * glm::dvec4(c.max, 1));
         w.min = glm::min(a, b);
@@ -1225,18 +1242,19 @@ class PovReader {
       }
       return w;
     };
+    bool bound_only = !o.clips.empty();
     for (const auto& [c, t] : o.clips) {
       const Clip w = place(c, t, false);
+      bound_only = bound_only && c.bound;
       if (!best || inside(w, *best)) best = w;
       else if (!inside(*best, w))
         fail(o.at, "this object is clipped by two regions that overlap; algray clips to one sphere or box");
     }
+    if (best) best->bound = bound_only;
     if (!best && o.natural) best = place(*o.natural, o.transform, true);
-    if (!best)
-      fail(o.at, "this " + o.kind + " has no clipped_by or bounded_by: POV-Ray draws it without end, algray "
-                                   "within a sphere or box; add clipped_by { sphere { ... } }");
-    return *best;
+    return best;
   }
+  glm::dmat4 box_frame(const Token*& at) const;
   static bool same(const Clip& a, const Clip& b) {
     if (a.sphere != b.sphere) return false;
     const double tolerance = 1e-9 * (1 + a.radius);
@@ -1295,6 +1313,120 @@ class PovReader {
   std::optional<glm::dvec3> background_;
 };
 
+// The rigid frame of the first clipping box turned off the axes: the map from POV-Ray's world to that frame, in
+// which the box is axis-aligned; the identity where every box is axis-aligned already. A box stays a box under a
+// transform whose columns are orthogonal (rotations, translations, scales in any order); a sheared one is left
+// to region()'s message.
+glm::dmat4 PovReader::box_frame(const Token*& at) const {
+  for (const Object& o : objects_)
+    for (const auto& [c, t] : o.clips) {
+      if (c.sphere) continue;
+      const glm::dmat3 l(t);
+      bool aligned = true, orthogonal = true;
+      for (int col = 0; col < 3; ++col) {
+        int nonzero = 0;
+        const double norm = glm::length(l[col]);
+        for (int row = 0; row < 3; ++row) nonzero += std::fabs(l[col][row]) > 1e-9 * norm;
+        aligned = aligned && nonzero == 1;
+        for (int other = col + 1; other < 3; ++other)
+          orthogonal = orthogonal && std::fabs(glm::dot(l[col], l[other])) <= 1e-9 * norm * glm::length(l[other]);
+      }
+      if (aligned || !orthogonal) continue;
+      glm::dmat3 q(glm::normalize(l[0]), glm::normalize(l[1]), glm::normalize(l[2]));
+      if (glm::determinant(q) < 0) q[2] = -q[2];  // a rotation: the frame keeps the camera's handedness
+      glm::dmat4 to_world(q);
+      to_world[3] = glm::dvec4(glm::dvec3(t[3]), 1);
+      at = &o.at;
+      return glm::inverse(to_world);
+    }
+  return glm::dmat4(1);
+}
+
+namespace {
+
+// Where a ray o + t d (t >= 0) is inside a sphere or box: [a, b], or nullopt where it misses.
+std::optional<std::pair<double, double>> span(const Clip& c, const glm::dvec3& o, const glm::dvec3& d) {
+  double a = 0, b = std::numeric_limits<double>::infinity();
+  if (c.sphere) {
+    const glm::dvec3 oc = o - c.centre;
+    const double half_b = glm::dot(oc, d), cc = glm::dot(oc, oc) - c.radius * c.radius;
+    const double disc = half_b * half_b - cc;
+    if (disc < 0) return std::nullopt;
+    a = std::max(a, -half_b - std::sqrt(disc));
+    b = std::min(b, -half_b + std::sqrt(disc));
+  } else {
+    for (int i = 0; i < 3; ++i) {
+      if (d[i] == 0) {
+        if (o[i] < c.min[i] || o[i] > c.max[i]) return std::nullopt;
+        continue;
+      }
+      const double t0 = (c.min[i] - o[i]) / d[i], t1 = (c.max[i] - o[i]) / d[i];
+      a = std::max(a, std::min(t0, t1));
+      b = std::min(b, std::max(t0, t1));
+    }
+  }
+  if (a > b) return std::nullopt;
+  return std::pair{a, b};
+}
+
+// What a grid of camera rays sees of the surfaces: each ray (unit direction) and its roots, all surfaces together.
+struct Sight {
+  struct Ray {
+    glm::dvec3 o, d;
+    std::vector<double> roots;
+  };
+  std::vector<Ray> rays;
+  static constexpr int kColumns = 64, kRows = 48;
+};
+Sight look(const CameraSpec& camera, int width, int height, const std::vector<SparsePoly>& polys, double scale) {
+  Sight sight;
+  const RayBasis basis = make_ray_basis(camera, width, height);
+  for (int j = 0; j < Sight::kRows; ++j)
+    for (int i = 0; i < Sight::kColumns; ++i) {
+      const PixelRay ray = pixel_ray(basis, false, i * width / Sight::kColumns, j * height / Sight::kRows);
+      Sight::Ray r{ray.origin, glm::normalize(ray.direction), {}};
+      for (const SparsePoly& p : polys) {
+        const std::vector<double> roots = ray_roots(p, r.o, r.d, 1e-5 * scale, 1e5 * scale);
+        r.roots.insert(r.roots.end(), roots.begin(), roots.end());
+      }
+      std::sort(r.roots.begin(), r.roots.end());
+      sight.rays.push_back(std::move(r));
+    }
+  return sight;
+}
+// How well drawing within `region` agrees with what `shown` says each ray shows: intersection over union.
+double agreement(const Sight& sight, const std::vector<bool>& shown, const Clip& region) {
+  long both = 0, either = 0;
+  for (std::size_t k = 0; k < sight.rays.size(); ++k) {
+    const Sight::Ray& r = sight.rays[k];
+    bool drawn = false;
+    if (const auto s = span(region, r.o, r.d))
+      for (double t : r.roots) drawn = drawn || (t >= s->first && t <= s->second);
+    both += drawn && shown[k];
+    either += drawn || shown[k];
+  }
+  return either ? static_cast<double>(both) / static_cast<double>(either) : 1.0;
+}
+// A sphere about the first points the rays see, `margin` times as large as needed.
+std::optional<Clip> seen_sphere(const Sight& sight, const std::vector<bool>& shown, double margin) {
+  glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi = -lo;
+  std::vector<glm::dvec3> points;
+  for (std::size_t k = 0; k < sight.rays.size(); ++k)
+    if (shown[k] && !sight.rays[k].roots.empty()) {
+      points.push_back(sight.rays[k].o + sight.rays[k].roots.front() * sight.rays[k].d);
+      lo = glm::min(lo, points.back());
+      hi = glm::max(hi, points.back());
+    }
+  if (points.empty()) return std::nullopt;
+  Clip c;
+  c.centre = 0.5 * (lo + hi);
+  for (const glm::dvec3& p : points) c.radius = std::max(c.radius, glm::length(p - c.centre));
+  c.radius = std::max(c.radius * margin, 1e-3 * glm::length(hi - lo) + 1e-9);
+  return c;
+}
+
+}  // namespace
+
 PovTranslation PovReader::run() {
   while (peek().kind != Token::End) item();
   if (objects_.empty())
@@ -1303,22 +1435,59 @@ PovTranslation PovReader::run() {
     fail(objects_[kMaxSurfaces].at, std::to_string(objects_.size()) + " objects: algray draws up to " +
                                         std::to_string(kMaxSurfaces) + " surfaces in one scene");
 
+  // A clipping box turned off the axes: the whole scene (objects, clips, camera, lights) is written in the box's
+  // own frame, turned and moved from POV-Ray's, in which algray's axis-aligned box is that box. The picture is
+  // the same, since the camera moves with everything else.
+  Camera cam = camera_;
+  std::vector<PovLight> lights = lights_;
+  const Token* framed_by = nullptr;
+  const glm::dmat4 to_frame = box_frame(framed_by);
+  if (framed_by) {
+    const glm::dmat3 turn(to_frame);
+    auto point = [&](const glm::dvec3& p) { return glm::dvec3(to_frame * glm::dvec4(p, 1)); };
+    for (Object& o : objects_) {
+      o.transform = to_frame * o.transform;
+      for (auto& [c, t] : o.clips) t = to_frame * t;
+    }
+    cam.location = point(cam.location);
+    if (cam.look_at) cam.look_at = point(*cam.look_at);
+    cam.direction = turn * cam.direction;
+    cam.right = turn * cam.right;
+    cam.up = turn * cam.up;
+    cam.sky = turn * cam.sky;
+    for (PovLight& l : lights) {
+      l.position = point(l.position);
+      l.edge_u = turn * l.edge_u;
+      l.edge_v = turn * l.edge_v;
+    }
+  }
+
   // One region for the scene: the clipped objects' common clip, holding every self-bounded one (spheres, tori),
-  // or, with none clipped, a box around them all.
+  // or, with none clipped, a box around them all. Objects with no region at all are `open`.
   std::optional<Clip> extent;
   const Object* clipped_by = nullptr;
+  std::vector<const Object*> open;
   for (const Object& o : objects_)
     if (!o.clips.empty() || !o.natural) {
-      const Clip r = region(o);
-      if (extent && !same(*extent, r))
+      std::optional<Clip> r = region(o);
+      if (!r) {
+        open.push_back(&o);
+        continue;
+      }
+      if (extent && !same(*extent, *r))
         fail(o.at, "this object is clipped differently from the " + clipped_by->kind + " at line " +
                        std::to_string(clipped_by->at.line) + "; algray clips every surface of a scene to one region");
+      if (extent) r->bound = r->bound && extent->bound;
       extent = r;
       clipped_by = &o;
     }
+  if (!open.empty() && clipped_by)
+    fail(open.front()->at, "this " + open.front()->kind + " has no clipped_by or bounded_by, but the " +
+                               clipped_by->kind + " at line " + std::to_string(clipped_by->at.line) +
+                               " has; algray clips every surface of a scene to one region");
   for (const Object& o : objects_)
     if (o.clips.empty() && o.natural) {
-      const Clip r = region(o);
+      const Clip r = *region(o);
       if (!extent) extent = r;
       else if (clipped_by && !inside(r, *extent))
         fail(o.at, "this " + o.kind + " reaches outside the clip of the " + clipped_by->kind + " at line " +
@@ -1327,7 +1496,6 @@ PovTranslation PovReader::run() {
     }
 
   // Handedness: a left-handed camera (the default) is read with z negated; a right-handed one as written.
-  const Camera& cam = camera_;
   if (glm::length(cam.right) == 0 || glm::length(cam.up) == 0 || glm::length(cam.direction) == 0)
     fail(camera_at_ ? *camera_at_ : objects_.front().at, "the camera's right, up and direction must not be zero");
   const bool left_handed = glm::dot(glm::cross(cam.right, cam.up), cam.direction) > 0;
@@ -1335,14 +1503,10 @@ PovTranslation PovReader::run() {
   glm::dmat4 flip(1);
   flip[2][2] = mirror.z;
 
-  std::ostringstream toml;
-  const std::size_t slash = files_[0].text->source().find_last_of('/');
-  const std::string file = files_[0].text->source().substr(slash == std::string::npos ? 0 : slash + 1);
-  toml << "# Translated from " << files_[0].text->source() << " (POV-Ray)\n";
-  int n = 0;
+  // The surfaces in algray's coordinates: algray's point q is POV-Ray's flip(q); the object's own point is
+  // transform^-1 of that.
+  std::vector<SparsePoly> polys;
   for (const Object& o : objects_) {
-    ++n;
-    // algray's point q is POV-Ray's flip(q); the object's own point is transform^-1 of that.
     const glm::dmat4 a = glm::inverse(o.transform) * flip;
     std::array<std::array<double, 4>, 3> m{};
     for (std::size_t r = 0; r < 3; ++r) {
@@ -1358,11 +1522,123 @@ PovTranslation PovReader::run() {
     }
     if (o.inverse)
       for (auto& [e, c] : p.terms) c = -c;
-    toml << "\n[[surface]]\nname = " << toml_quoted(file + " " + std::to_string(n) + " (" + o.kind + ")")
+    for (const auto& [e, c] : p.terms)
+      if (!std::isfinite(c)) fail(o.at, "the coefficients overflow after the transforms");
+    polys.push_back(std::move(p));
+  }
+
+  // The camera: angle sets direction's length from right's; the view is |up| tall at |direction|.
+  double distance = glm::length(cam.direction);
+  if (cam.angle && !cam.orthographic) distance = 0.5 * glm::length(cam.right) / std::tan(*cam.angle * kPi / 360);
+  const glm::dvec3 forward = cam.look_at ? *cam.look_at - cam.location : glm::normalize(cam.direction);
+  if (glm::length(forward) == 0)
+    fail(camera_at_ ? *camera_at_ : objects_.front().at, "look_at is the camera's location");
+  const glm::dvec3 up = cam.look_at ? cam.sky : cam.up;
+  if (glm::length(glm::cross(glm::normalize(forward), glm::normalize(up))) < 1e-9)
+    fail(camera_at_ ? *camera_at_ : objects_.front().at, "the camera looks along its sky (or up) vector");
+  CameraSpec view;
+  view.eye = cam.location * mirror;
+  view.look_at = (cam.location + glm::normalize(forward)) * mirror;
+  view.up = up * mirror;
+  view.projection = cam.orthographic ? Projection::Orthographic : Projection::Perspective;
+  view.ortho_height = glm::length(cam.up);
+  view.fov_y_degrees = 2 * std::atan(0.5 * glm::length(cam.up) / distance) * 180 / kPi;
+  // POV-Ray stretches right x up over whatever image it renders; algray's images keep that shape by default.
+  const int width = image_width();
+  const int height = std::min(
+      height_ > 0 ? height_
+                  : std::max(1, static_cast<int>(std::lround(width * glm::length(cam.up) / glm::length(cam.right)))),
+      32768);
+
+  // The extent in algray's coordinates.
+  std::optional<Clip> drawn;
+  if (extent) {
+    drawn = *extent;
+    drawn->centre *= mirror;
+    const glm::dvec3 a = extent->min * mirror, b = extent->max * mirror;
+    drawn->min = glm::min(a, b);
+    drawn->max = glm::max(a, b);
+  }
+  std::string extent_note;
+  // Objects without a region, or with bounded_by alone: POV-Ray draws all of the surface that the rays meet (that
+  // pass the bound), which no sphere or box holds in general. algray draws within the sphere or box that agrees
+  // best with that on a grid of rays traced here.
+  if (!open.empty() || (drawn && drawn->bound)) {
+    const double scale =
+        std::max({1.0, glm::length(view.eye), drawn ? glm::length(drawn->centre - view.eye) : 0.0});
+    const Sight sight = look(view, width, height, polys, scale);
+    std::vector<bool> shown;
+    for (const Sight::Ray& r : sight.rays)
+      shown.push_back(!r.roots.empty() && (!drawn || span(*drawn, r.o, r.d).has_value()));
+    std::vector<Clip> candidates;
+    if (drawn && !cam.orthographic) {
+      // The bound moved k times as far from the eye: the same rays meet it, each over k times its stretch.
+      std::vector<double> ks = {1};
+      for (int i = 1; i <= 40; ++i) {
+        ks.push_back(std::pow(16.0, i / 40.0));
+        ks.push_back(std::pow(0.5, i / 40.0));
+      }
+      std::sort(ks.begin(), ks.end(),
+                [](double a, double b) { return std::fabs(std::log(a)) < std::fabs(std::log(b)); });
+      for (double k : ks) {
+        Clip c = *drawn;
+        c.centre = view.eye + k * (c.centre - view.eye);
+        c.radius *= k;
+        c.min = view.eye + k * (c.min - view.eye);
+        c.max = view.eye + k * (c.max - view.eye);
+        candidates.push_back(c);
+      }
+    } else if (drawn) {
+      candidates.push_back(*drawn);
+    }
+    for (double margin : {1.25, 1.1, 1.5, 2.0, 3.0})
+      if (const auto c = seen_sphere(sight, shown, margin)) candidates.push_back(*c);
+    if (candidates.empty()) {
+      const Object& o = *open.front();
+      fail(o.at, "this " + o.kind +
+                     " has no clipped_by or bounded_by, and no ray of the camera meets it; POV-Ray draws it without "
+                     "end, algray within a sphere or box: add clipped_by { sphere { ... } }");
+    }
+    double best = -1;
+    bool first = true, kept = false;  // kept: the bound itself (the first candidate where there is a bound)
+    for (const Clip& c : candidates) {
+      const double iou = agreement(sight, shown, c);
+      if (iou > best + 1e-9) {
+        best = iou;
+        drawn = c;
+        kept = first && open.empty();
+      }
+      first = false;
+    }
+    drawn->bound = false;
+    if (!(kept && best == 1)) {  // a bound that holds all that the rays see is what POV-Ray shows: nothing to say
+      std::ostringstream note;
+      note.precision(4);
+      const Object& o = open.empty() ? *clipped_by : *open.front();
+      note << (open.empty() ? "bounded_by alone does not clip in POV-Ray: the rays that pass the bound see all of "
+                              "the surface"
+                            : "no clipped_by or bounded_by: POV-Ray draws this " + o.kind + " without end")
+           << "; algray draws it within the " << (drawn->sphere ? "sphere" : "box")
+           << " that agrees best with that on a " << Sight::kColumns << " x " << Sight::kRows
+           << " grid of rays traced here (IoU " << best << ")";
+      extent_note = note.str();
+      warn(o.at, extent_note);
+    }
+  }
+
+  std::ostringstream toml;
+  const std::size_t slash = files_[0].text->source().find_last_of('/');
+  const std::string file = files_[0].text->source().substr(slash == std::string::npos ? 0 : slash + 1);
+  toml << "# Translated from " << files_[0].text->source() << " (POV-Ray)\n";
+  if (framed_by)
+    toml << "# Written in the frame of the clipping box of the " << framed_by->text << " at " << where(*framed_by)
+         << " (turned and moved from POV-Ray's world: the same picture)\n";
+  for (std::size_t n = 0; n < objects_.size(); ++n) {
+    const Object& o = objects_[n];
+    toml << "\n[[surface]]\nname = " << toml_quoted(file + " " + std::to_string(n + 1) + " (" + o.kind + ")")
          << "\nterms = [";
     const char* sep = "";
-    for (const auto& [e, c] : p.terms) {
-      if (!std::isfinite(c)) fail(o.at, "the coefficients overflow after the transforms");
+    for (const auto& [e, c] : polys[n].terms) {
       toml << sep << "[" << e[0] << ", " << e[1] << ", " << e[2] << ", " << toml_number(c) << "]";
       sep = ", ";
     }
@@ -1376,42 +1652,24 @@ PovTranslation PovReader::run() {
            << "\nspecular = " << toml_number(o.specular) << "\nexponent = " << toml_number(o.exponent) << "\n";
   }
 
-  const Clip& e = *extent;
+  const Clip& e = *drawn;
+  toml << "\n[extent]" << (extent_note.empty() ? "" : "  # " + extent_note) << "\n";
   if (e.sphere)
-    toml << "\n[extent]\ntype = \"sphere\"\ncentre = " << toml_vector(e.centre * mirror)
-         << "\nradius = " << toml_number(e.radius) << "\n";
+    toml << "type = \"sphere\"\ncentre = " << toml_vector(e.centre) << "\nradius = " << toml_number(e.radius) << "\n";
   else
-    toml << "\n[extent]\ntype = \"box\"\nmin = " << toml_vector(glm::min(e.min * mirror, e.max * mirror))
-         << "\nmax = " << toml_vector(glm::max(e.min * mirror, e.max * mirror)) << "\n";
+    toml << "type = \"box\"\nmin = " << toml_vector(e.min) << "\nmax = " << toml_vector(e.max) << "\n";
 
-  // The camera: angle sets direction's length from right's; the view is |up| tall at |direction|.
-  double distance = glm::length(cam.direction);
-  if (cam.angle && !cam.orthographic) distance = 0.5 * glm::length(cam.right) / std::tan(*cam.angle * kPi / 360);
-  const glm::dvec3 forward =
-      cam.look_at ? *cam.look_at - cam.location : glm::normalize(cam.direction);
-  if (glm::length(forward) == 0)
-    fail(camera_at_ ? *camera_at_ : objects_.front().at, "look_at is the camera's location");
-  const glm::dvec3 up = cam.look_at ? cam.sky : cam.up;
-  if (glm::length(glm::cross(glm::normalize(forward), glm::normalize(up))) < 1e-9)
-    fail(camera_at_ ? *camera_at_ : objects_.front().at, "the camera looks along its sky (or up) vector");
-  toml << "\n[camera]\neye = " << toml_vector(cam.location * mirror)
-       << "\nlook_at = " << toml_vector((cam.location + glm::normalize(forward)) * mirror)
-       << "\nup = " << toml_vector(up * mirror) << "\n";
+  toml << "\n[camera]\neye = " << toml_vector(view.eye) << "\nlook_at = " << toml_vector(view.look_at)
+       << "\nup = " << toml_vector(view.up) << "\n";
   if (cam.orthographic)
-    toml << "projection = \"orthographic\"\nheight = " << toml_number(glm::length(cam.up)) << "\n";
+    toml << "projection = \"orthographic\"\nheight = " << toml_number(view.ortho_height) << "\n";
   else
-    toml << "projection = \"perspective\"\nfov_y = "
-         << toml_number(2 * std::atan(0.5 * glm::length(cam.up) / distance) * 180 / kPi) << "\n";
+    toml << "projection = \"perspective\"\nfov_y = " << toml_number(view.fov_y_degrees) << "\n";
 
-  // POV-Ray stretches right x up over whatever image it renders; algray's images keep that shape by default.
-  const int width = image_width();
-  const int height = height_ > 0 ? height_
-                                 : std::max(1, static_cast<int>(std::lround(width * glm::length(cam.up) /
-                                                                            glm::length(cam.right))));
-  toml << "\n[image]\nwidth = " << width << "\nheight = " << std::min(height, 32768)
+  toml << "\n[image]\nwidth = " << width << "\nheight = " << height
        << "\nbackground = " << toml_vector(glm::min(background_.value_or(glm::dvec3(0)), glm::dvec3(1))) << "\n";
 
-  for (const PovLight& l : lights_) {
+  for (const PovLight& l : lights) {
     const double strength = std::max({l.colour.x, l.colour.y, l.colour.z});
     toml << "\n[[light]]\ntype = \"" << (l.area ? "rectangle" : "point") << "\"\nposition = "
          << toml_vector(l.position * mirror) << "\n";
@@ -1421,7 +1679,7 @@ PovTranslation PovReader::run() {
     toml << "colour = " << toml_vector(strength > 0 ? l.colour / strength : glm::dvec3(1))
          << "\nintensity = " << toml_number(strength) << "\nshadows = " << (l.shadows ? "true" : "false") << "\n";
   }
-  if (lights_.empty())
+  if (lights.empty())
     toml << "\n[[light]]  # POV-Ray lights nothing without a light_source\ntype = \"point\"\nposition = "
          << toml_vector(cam.location * mirror) << "\nintensity = 0.0\nshadows = false\n";
   return {toml.str(), where(objects_.front().at), excerpt(objects_.front().at)};
