@@ -41,6 +41,18 @@
 #error "ISOLATION must be one of ALGRAY_ISOLATION_*"
 #endif
 
+/* What the isolation method can do, 0/1 each, from its row of the host's one table of abilities
+ * (kIsolationAbilities, src/algray/scene/solver_options.h), so that the kernels name abilities and never a method.
+ * Required, like DEGREE: a default here would be a second copy of that table.
+ * ISOLATION_POWER_BASIS: it isolates in the power basis (else Bernstein's, on the segment).
+ * ISOLATION_ADAPTIVE: it doubts what float cannot decide (adaptive precision).
+ * ISOLATION_POINT_FORM: shadow rays can be built in the point form.
+ * SOLVER_LANES: the isolation and the refinement have lane builds (LANES > 1). */
+#if !defined(ISOLATION_POWER_BASIS) || !defined(ISOLATION_ADAPTIVE) || !defined(ISOLATION_POINT_FORM) || \
+    !defined(SOLVER_LANES)
+#error "ISOLATION_POWER_BASIS, ISOLATION_ADAPTIVE, ISOLATION_POINT_FORM and SOLVER_LANES must be defined (-D ...=0/1)"
+#endif
+
 /* The root refinement method, one of ALGRAY_REFINEMENT_* (algray_shared.h). */
 #ifndef REFINEMENT
 #define REFINEMENT ALGRAY_REFINEMENT_BRENT

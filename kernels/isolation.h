@@ -350,7 +350,7 @@ typedef uint SignBits;
 #else
 typedef ulong SignBits;
 #endif
-int sign_variations(const REAL* c) {
+ALGRAY_INLINE int sign_variations(const REAL* c) {
   SignBits negative = 0, signless = 0;
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) {

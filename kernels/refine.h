@@ -18,12 +18,7 @@
  * ulps: f0 and f1 have opposite signs, so f0 - f1 does not cancel. That is far inside any stopping width, where
  * every method would only converge to it, so at degree 1 none runs and no evaluation is counted. Over lanes, each
  * lane's root. */
-#if DEGREE == 1
-#define REFINE_IN_CLOSED_FORM 1
 ALGRAY_INLINE LREAL line_root(LREAL f0, LREAL f1) { return f0 / (f0 - f1); }
-#else
-#define REFINE_IN_CLOSED_FORM 0
-#endif
 
 /* The paper's value stop, |P*(y)| <= eps_m, made independent of how P is scaled: the value is within the
  * rounding error of evaluating it at y, so its sign carries no more information. The error is measured at y
@@ -38,8 +33,8 @@ int value_within_rounding(const REAL* c, REAL y, REAL fy, REAL scale) {
 }
 #endif
 
-#if LANES > 1 && (REFINEMENT != ALGRAY_REFINEMENT_BRENT || ISOLATION != ALGRAY_ISOLATION_BERNSTEIN)
-#error "LANES > 1 is built for Bernstein isolation with Brent refinement"
+#if LANES > 1 && !SOLVER_LANES
+#error "LANES > 1 needs an isolation and a refinement with lane builds (SOLVER_LANES)"
 #endif
 
 #if REFINEMENT == ALGRAY_REFINEMENT_BRENT

@@ -7,7 +7,7 @@
 #include "real.h"
 
 /* Which basis the restriction builds: Bernstein for Bernstein isolation, the power basis for the others. */
-#define RESTRICT_BERNSTEIN (ISOLATION == ALGRAY_ISOLATION_BERNSTEIN)
+#define RESTRICT_BERNSTEIN (!ISOLATION_POWER_BASIS)
 
 /* Every coordinate along the ray is a linear polynomial in s. Multiplying by linear factors and adding
  * constants builds P*(s) from the monomial list by a sparse, homogeneous Horner scheme.

@@ -140,8 +140,8 @@ Isolation shadow_isolation(const REAL* b, const REAL* b_lo, REAL t_in, REAL t_ou
 #include "methods/bernstein.h"
 #include "point_form.h"
 
-#if ALGRAY_ESCALATE || ALGRAY_COMPENSATED || ISOLATION != ALGRAY_ISOLATION_BERNSTEIN
-#error "the point form is built in plain float or double with Bernstein isolation"
+#if ALGRAY_ESCALATE || ALGRAY_COMPENSATED || !ISOLATION_POINT_FORM
+#error "the point form is built in plain float or double, for isolation methods with ISOLATION_POINT_FORM"
 #endif
 
 /* shadow_segment for LANES light samples (lx, ly, lz), each lane its result bit for bit: *self where the sample is

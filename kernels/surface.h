@@ -10,11 +10,11 @@
 #include "real.h"
 #include "restrict.h"
 
-#if RAY_ORIGIN == ALGRAY_ORIGIN_EYE && ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+#if RAY_ORIGIN == ALGRAY_ORIGIN_EYE && !ISOLATION_POWER_BASIS
 #error "RAY_ORIGIN=eye needs a power-basis isolation method"
 #endif
-#if ALGRAY_ESCALATE && ISOLATION != ALGRAY_ISOLATION_BERNSTEIN
-#error "adaptive precision doubts rays in the Bernstein isolation only"
+#if ALGRAY_ESCALATE && !ISOLATION_ADAPTIVE
+#error "adaptive precision needs an isolation method that doubts (ISOLATION_ADAPTIVE)"
 #endif
 #if RAY_ORIGIN != ALGRAY_ORIGIN_EXTENT && ALGRAY_ESCALATE
 #error "adaptive precision builds P*(t) on the segment (RAY_ORIGIN=extent), whose terms it measures its noise by"
@@ -60,15 +60,11 @@ typedef struct {
   LANE_INT_VEC iterations; /* refinement iterations */
 } LaneRoots;
 
-/* The probe records the coefficients the isolation starts from, in its basis; a render build has no such call. */
-#if ALGRAY_PROBE
-void probe_coefficients(const REAL* c, const REAL* c_lo, uint basis, ProbeLog* probe_log) {
+/* The probe records the coefficients the isolation starts from, in its basis; in a render build this is empty. */
+ALGRAY_INLINE void probe_coefficients(const REAL* c, const REAL* c_lo, uint basis, ProbeLog* probe_log) {
   for (int k = 0; k <= DEGREE; ++k)
     PROBE(ALGRAY_EVENT_COEFFICIENT, k, basis, 0u, c[k], ALGRAY_COMPENSATED ? c_lo[k] : (REAL)0, (REAL)0, (REAL)0);
 }
-#else
-#define probe_coefficients(c, c_lo, basis, probe_log) ((void)0)
-#endif
 
 /* The refinement's stopping width in y on the isolating interval [lo, hi] of the segment [t_in, t_out] (lo and hi
  * fractions of it): the stopping width at the interval's left end over the interval's width in t. Of one ray or
@@ -132,14 +128,11 @@ void refine_rays(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in, 
     const LREAL tol_y = LANE_SEL((LREAL)0, ISOLATED_TOL_Y(lo, hi, t_in, t_out), running);
     const LREAL scale = coefficient_scale(c), start = isolated_start(c);
     prepare_isolated(c, binomials);
-#if REFINE_IN_CLOSED_FORM
-    (void)scale;
-    (void)tol_y;
-    (void)start;
-    y = LANE_SEL((LREAL)0, line_root(f0, f1), running);
-#else
-    y = LANE_SEL((LREAL)0, refine_root(c, f0, f1, tol_y, scale, start, running, &iterations, probe_log), running);
-#endif
+    /* degree 1 in closed form (refine.h, line_root) */
+    y = LANE_SEL((LREAL)0,
+                 DEGREE == 1 ? line_root(f0, f1)
+                             : refine_root(c, f0, f1, tol_y, scale, start, running, &iterations, probe_log),
+                 running);
   }
   roots->t = LANE_SEL((LREAL)INFINITY, PLACED_ROOT_T(iso->lo, iso->hi, y, t_in, t_out), found);
   roots->f_before = LANE_SEL((LREAL)0, iso->f_lo, found);
@@ -164,11 +157,7 @@ void refine_rays(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in, 
 void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, AxisFactor* fx, AxisFactor* fy,
                      AxisFactor* fz) {
   const REAL3 pa = o + t_in * d, pb = o + t_out * d;
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
-  const REAL3 l1 = pb;
-#else
-  const REAL3 l1 = pb - pa;
-#endif
+  const REAL3 l1 = ISOLATION_POWER_BASIS ? pb - pa : pb;
   *fx = axis_factor(pa.x, l1.x, even_axes & 1);
   *fy = axis_factor(pa.y, l1.y, even_axes & 2);
   *fz = axis_factor(pa.z, l1.z, even_axes & 4);
@@ -178,7 +167,7 @@ void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, Ax
 
 /* The restriction's result (scaled Bernstein coefficients, or a power basis) as the isolation method takes it. */
 void restricted_to_isolation_basis(REAL* root, REAL* root_lo, __constant const REAL* binomials, ProbeLog* probe_log) {
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+#if !ISOLATION_POWER_BASIS
   bernstein_from_scaled(root, root_lo, binomials);
   probe_coefficients(root, root_lo, ALGRAY_BASIS_BERNSTEIN, probe_log);
 #elif RAY_ORIGIN == ALGRAY_ORIGIN_EYE
@@ -297,7 +286,13 @@ void isolate_rays(uint count, const int* in_extent, const LaneRays* rays, REAL (
   (void)count;
   for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
   if (!in_extent[0]) return;
+#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+  /* straight into the lanes' isolation: isolate_method's round trip through an Isolation measured 2% of the
+   * lemniscate's one-ray kernel */
+  isolate_bernstein_search(1, root[0], root_lo[0], t_in[0], t_out[0], iso, c, &terms[0], probe_log);
+#else
   set_lane_isolation(iso, 0, isolate_method(root[0], root_lo[0], t_in[0], t_out[0], c, &terms[0], probe_log));
+#endif
 #endif
 }
 
@@ -353,7 +348,7 @@ void confirm_flat_roots(uint count, LaneRoots* roots, const LaneRays* at, const 
                         __global const uint* exps, __global const REAL* coefs, uint mono_count, ProbeLog* probe_log) {
   const LMASK found = (roots->flags & (LANE_INT_VEC)ALGRAY_HIT_FOUND) != 0;
   const uint doubted_bits = lane_mask_bits(found && (roots->flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0);
-  for (uint j = 0; j < count; ++j) {
+  for (uint j = 0; j < min(count, (uint)LANES); ++j) {
     if (!((doubted_bits >> j) & 1u)) continue;
     const REAL delta = (REAL)ALGRAY_DOUBT_POSITION * fabs(lane_get(roots->t, j));
     const REAL3 u = lane_origin(at, j), d = lane_direction(at, j);
@@ -445,7 +440,7 @@ void hit_records(uint count, const LaneRays* rays, const LaneRays* at, const Lan
   LANES_STORE(roots->steps, steps_of);
   LANES_STORE(roots->iterations, iterations_of);
   /* Front is the side where P > 0; at an exact root use the direction in which P grows instead. */
-  for (uint j = 0; j < count; ++j) {
+  for (uint j = 0; j < min(count, (uint)LANES); ++j) {
     HitRecord r = missed_record();
     r.flags = (uint)flags_of[j];
     r.work = ALGRAY_WORK_PACK(min((uint)steps_of[j], ALGRAY_WORK_MAX), min((uint)iterations_of[j], ALGRAY_WORK_MAX));
@@ -546,7 +541,9 @@ int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, R
   isolate_bernstein_search(running, lane_root, lane_root, lane_t_in, lane_t_out, &iso, iso_c, (LaneTerms*)0,
                            probe_log);
 #else
-  /* one ray at a time: each lane's segment and whether it entered */
+  /* one ray at a time: each lane's segment and whether it entered. The loops over lanes run to min(count, LANES),
+   * never to count alone: a bound the compiler cannot see is at most 1 kept one-ray builds' arrays in memory (8%
+   * of the lemniscate's one-ray kernel). */
   REAL t_in[LANES], t_out[LANES];
   LANES_STORE(lane_t_in, t_in);
   LANES_STORE(lane_t_out, t_out);
@@ -555,7 +552,7 @@ int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, R
   for (uint j = 0; j < LANES; ++j) in_extent[j] = (entered_bits >> j) & 1u;
   REAL root[LANES][NCOEF], root_lo[LANES][NCOEF];
   RayTerms terms[LANES];
-  for (uint j = 0; j < count; ++j) {
+  for (uint j = 0; j < min(count, (uint)LANES); ++j) {
     if (!in_extent[j]) continue;
     REAL taylor[NCOEF], taylor_t = 0;
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN

@@ -234,9 +234,13 @@ TEST_CASE("every build switch is declared once, and the host writes each one it 
   std::set<std::string> host_declared;
   for (auto it = std::sregex_iterator(header.begin(), header.end(), default_of); it != std::sregex_iterator(); ++it)
     if (static_cast<std::size_t>(it->position()) < host_end) host_declared.insert((*it)[1]);
-  // DEGREE has no default, only a required value.
+  // DEGREE and the method's abilities have no default, only a required value.
   CHECK(header.find("#ifndef DEGREE\n#error") != std::string::npos);
   host_declared.insert("DEGREE");
+  for (const char* ability : {"ISOLATION_POWER_BASIS", "ISOLATION_ADAPTIVE", "ISOLATION_POINT_FORM", "SOLVER_LANES"}) {
+    CHECK(header.find(std::string("!defined(") + ability + ")") != std::string::npos);
+    host_declared.insert(ability);
+  }
   const std::vector<std::string> written = build_switch_names();
   CHECK(std::set<std::string>(written.begin(), written.end()) == host_declared);
   KernelConfig config;

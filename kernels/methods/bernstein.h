@@ -15,7 +15,6 @@
  * Everything from here to the search is written over LREAL (lanes.h): one ray where LANES = 1, LANES rays side by
  * side otherwise, each lane with one ray's operations, so that a lane's result is the one-ray build's bit for bit
  * (tests/test_lanes compares the widths). */
-#if ALGRAY_COMPENSATED
 /* hi + lo = x1 a + x b, for float-float a, b and weights x1, x given as float-float too (lo 0 when exact). */
 ALGRAY_INLINE void ff_combine(LREAL a, LREAL a_lo, LREAL x1, LREAL x1_lo, LREAL b, LREAL b_lo, LREAL x, LREAL x_lo,
                               LREAL* hi, LREAL* lo) {
@@ -30,21 +29,15 @@ ALGRAY_INLINE void ff_combine(LREAL a, LREAL a_lo, LREAL x1, LREAL x1_lo, LREAL 
   *hi = s + e;
   *lo = e - (*hi - s);
 }
-#endif
 
 /* The restriction produced scaled coefficients c_k = C(n,k) b_k; Descartes' rule and de Casteljau want b_k. */
 void bernstein_from_scaled(REAL* c, REAL* c_lo, __constant const REAL* binomials) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) {
-#if ALGRAY_COMPENSATED
     const REAL q = c[k] / row[k];
-    c_lo[k] = (fma(-q, row[k], c[k]) + c_lo[k]) / row[k]; /* the division's remainder is exact */
+    if (ALGRAY_COMPENSATED) c_lo[k] = (fma(-q, row[k], c[k]) + c_lo[k]) / row[k]; /* the division's remainder is exact */
     c[k] = q;
-#else
-    (void)c_lo;
-    c[k] /= row[k];
-#endif
   }
 }
 
@@ -54,14 +47,10 @@ void bernstein_from_scaled(REAL* c, REAL* c_lo, __constant const REAL* binomials
 /* c[k] = x1 c[a] + x c[b]: one step of de Casteljau's recurrence, in the build's arithmetic. */
 ALGRAY_INLINE void casteljau_step(LREAL* c, LREAL* c_lo, int k, int a, int b, LREAL x1, LREAL x1_lo, LREAL x,
                                   LREAL x_lo) {
-#if ALGRAY_COMPENSATED
-  ff_combine(c[a], c_lo[a], x1, x1_lo, c[b], c_lo[b], x, x_lo, &c[k], &c_lo[k]);
-#else
-  (void)c_lo;
-  (void)x1_lo;
-  (void)x_lo;
-  c[k] = CASTELJAU_COMBINE(x1, c[a], x, c[b]);
-#endif
+  if (ALGRAY_COMPENSATED)
+    ff_combine(c[a], c_lo[a], x1, x1_lo, c[b], c_lo[b], x, x_lo, &c[k], &c_lo[k]);
+  else
+    c[k] = CASTELJAU_COMBINE(x1, c[a], x, c[b]);
 }
 
 /* dst = src, and dst_lo = src_lo in mixed precision. */
@@ -269,13 +258,15 @@ typedef struct {
 #endif
 
 /* The search's noise (isolation.h, DOUBT_NOISE), and P's signs proven in float-float at interval ends
- * (discards_settled): one ray's SearchNoise, with the local noise of shadow rays, or every lane's noise on its
- * summed terms. Builds without adaptive precision doubt nothing: no value is within their noise. */
-#if ALGRAY_ESCALATE
+ * (discards_settled): lanes_noise starts it, within_lanes_noise asks whether a value on the part [lo, hi] of the
+ * segment is within it, and found_noise gives the noise a found root's refinement checks against (isolation_found),
+ * where `found`. terms_rays and terms_have_rays: the rays of the terms, and whether there are any (one ray's terms
+ * may come without). Builds without adaptive precision doubt nothing: no value is within their noise. */
+#if ALGRAY_ESCALATE && LANES == 1
+/* One ray: its SearchNoise, on the terms' upper bound until a value falls within it, and for shadow rays local to
+ * each interval (within_noise_at). */
 typedef struct {
-#if LANES == 1
   SearchNoise one;
-#endif
   LREAL noise;
   ProvenEnds proven;
 } LaneNoise;
@@ -283,56 +274,45 @@ typedef struct {
 LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
   LaneNoise n;
   no_proven_ends(&n.proven);
-#if LANES == 1
   n.one = search_noise(root, terms);
   n.noise = n.one.noise;
-#else
+  return n;
+}
+ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREAL hi) {
+  const int within = within_noise_at(&n->one, value, lo, hi);
+  n->noise = n->one.noise;
+  return within;
+}
+ALGRAY_INLINE LREAL found_noise(LaneNoise* n, LMASK found) { return found ? exact_noise(&n->one) : (REAL)0; }
+ALGRAY_INLINE LaneRays terms_rays(const LaneTerms* t) { return one_lane_rays(t->o, t->d); }
+ALGRAY_INLINE LMASK terms_have_rays(const LaneTerms* t) { return t->has_ray; }
+#elif ALGRAY_ESCALATE
+/* Lanes: every lane's noise on its terms summed. */
+typedef struct {
+  LREAL noise;
+  ProvenEnds proven;
+} LaneNoise;
+
+LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
+  LaneNoise n;
+  no_proven_ends(&n.proven);
   LREAL magnitude[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(root[k]);
   MAGNITUDE_TREE(magnitude, LANE_LARGER);
   n.noise = DOUBT_NOISE(magnitude[0], terms->value);
-#endif
   return n;
 }
-
-/* Whether |value| on the part [lo, hi] of the segment is within the noise (within_noise_at). */
 ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREAL hi) {
-#if LANES == 1
-  const int within = within_noise_at(&n->one, value, lo, hi);
-  n->noise = n->one.noise;
-  return within;
-#else
   (void)lo;
   (void)hi;
   return fabs(value) <= n->noise;
-#endif
 }
-
-/* The noise a found root's refinement checks against (isolation_found), where `found`. */
-ALGRAY_INLINE LREAL found_noise(LaneNoise* n, LMASK found) {
-#if LANES == 1
-  return found ? exact_noise(&n->one) : (REAL)0;
-#else
-  return LANE_SEL((LREAL)0, n->noise, found);
-#endif
-}
-
-/* The rays of the terms, and whether there are any (one ray's terms may come without). */
-ALGRAY_INLINE LaneRays terms_rays(const LaneTerms* t) {
-#if LANES == 1
-  return one_lane_rays(t->o, t->d);
-#else
-  return *t->rays;
-#endif
-}
+ALGRAY_INLINE LREAL found_noise(LaneNoise* n, LMASK found) { return LANE_SEL((LREAL)0, n->noise, found); }
+ALGRAY_INLINE LaneRays terms_rays(const LaneTerms* t) { return *t->rays; }
 ALGRAY_INLINE LMASK terms_have_rays(const LaneTerms* t) {
-#if LANES == 1
-  return t->has_ray;
-#else
   (void)t;
   return (LMASK)(-1); /* every lane */
-#endif
 }
 #else
 typedef struct {
@@ -424,20 +404,17 @@ ALGRAY_INLINE void settle_isolated(BernsteinSearch* s, LREAL v, LaneNoise* noise
 #define ALGRAY_SETTLES_DISCARDS (ALGRAY_ESCALATE && !ALGRAY_SHADOW_RAYS && ALGRAY_SETTLE_DOUBTS)
 
 #if ALGRAY_SETTLES_DISCARDS
-#if ALGRAY_PROBE
 /* The end value of an interval at fraction `end` as the probe shows a settled discard doubt: P in float-float and
  * its rounding where that end was within the noise (in proven), else float's value c and the noise it stood clear
  * of. */
-void settled_end(const ProvenEnds* proven, REAL end, REAL c, REAL noise, REAL* value, REAL* bound) {
+ALGRAY_INLINE void settled_end(const ProvenEnds* proven, LREAL end, LREAL c, LREAL noise, LREAL* value, LREAL* bound) {
   *value = c;
   *bound = noise;
-  for (int e = 0; e < 2; ++e)
-    if (proven->at[e] == end) {
-      *value = proven->value[e];
-      *bound = proven->rounding[e];
-    }
+  for (int e = 0; e < 2; ++e) {
+    *value = LANE_SEL(*value, proven->value[e], proven->at[e] == end);
+    *bound = LANE_SEL(*bound, proven->rounding[e], proven->at[e] == end);
+  }
 }
-#endif
 
 /* discards_settled: whether intervals without sign variations, in doubt for an end value within the noise, are
  * root-free after all (the lanes of end_doubted): every coefficient inside stands clear of the noise, and P in
@@ -465,14 +442,12 @@ ALGRAY_INLINE LMASK discards_settled(const BernsteinSearch* s, LMASK end_doubted
     prove_end(lo_needed && hi_needed, &rays, t_in, t_out, hi, at, terms->exps, terms->coefs, terms->count, proven);
   const LMASK settled = inner_clear && (!lo_doubted || proven_sign_of(proven, at, s->cur[0])) &&
                         (!hi_doubted || proven_sign_of(proven, hi, s->cur[DEGREE]));
-#if ALGRAY_PROBE
-  if (settled) {
-    REAL v_lo, bound_lo, v_hi, bound_hi;
+  if (LANE_ANY(settled)) {
+    LREAL v_lo, bound_lo, v_hi, bound_hi;
     settled_end(proven, at, s->cur[0], noise->noise, &v_lo, &bound_lo);
     settled_end(proven, hi, s->cur[DEGREE], noise->noise, &v_hi, &bound_hi);
     PROBE(ALGRAY_EVENT_CONFIRMED, 0, 3u, 0u, v_lo, bound_lo, v_hi, bound_hi);
   }
-#endif
   return settled;
 }
 #else
@@ -505,7 +480,7 @@ ALGRAY_INLINE LMASK halve_near_zero(BernsteinSearch* s, LREAL v, LaneNoise* nois
  * halve. */
 ALGRAY_INLINE LMASK halve_or_settle_several(BernsteinSearch* s, LMASK several, LREAL v, LREAL t_in, LREAL len,
                                           LaneNoise* noise, ProbeLog* probe_log) {
-  const LMASK located = s->width * len <= STOP_WIDTH(t_in + s->at * len);
+  const LMASK located = several && s->width * len <= STOP_WIDTH(t_in + s->at * len);
   const LMASK halve = several && !located && s->width > (REAL)1 / (REAL)FINEST_UNITS; /* level < REAL_MAX_HALVINGS */
   const LMASK settle = several && !halve;
   s->budget = s->budget || (settle && !located);
@@ -608,9 +583,12 @@ void isolate_bernstein_search(LMASK running, const LREAL* root, const LREAL* roo
   LaneNoise noise = lanes_noise(root, terms);
   for (;;) {
     s.steps += LANE_SEL((LREAL)0, (LREAL)1, !s.done);
+    /* One ray stops at its first decision, as the steps after it would change nothing (lanes go on together). */
     settle_at_left_end(&s, &noise, probe_log);
+    if (LANES == 1 && LANE_ALL(s.done)) break;
     const LREAL v = bernstein_sign_variations(s.cur);
     settle_isolated(&s, v, &noise, probe_log);
+    if (LANES == 1 && LANE_ALL(s.done)) break;
     const LMASK near_zero = ALGRAY_ESCALATE && halve_near_zero(&s, v, &noise, terms, t_in, t_out, probe_log);
     const LMASK several = !s.done && (v >= 1 || near_zero);
     const LMASK root_free = !s.done && !several;
@@ -618,6 +596,7 @@ void isolate_bernstein_search(LMASK running, const LREAL* root, const LREAL* roo
     const LMASK halve = halve_or_settle_several(&s, several, v, t_in, len, &noise, probe_log);
     if (LANE_ALL(s.done)) break;
     if (LANE_ANY(halve)) halve_intervals(&s, halve);
+    if (LANES == 1 && LANE_ALL(halve)) continue;
     const LMASK move = !s.done && !halve;
     if (LANE_ANY(move)) move_on(&s, move, root, root_lo, probe_log);
   }
@@ -762,20 +741,14 @@ int bernstein_root_by_signs(const REAL* c) {
  * rule holds, as from any start (near a double root the formula loses digits, and the search then finds them). A
  * start moves where in the stopping width a root lands, so other degrees keep the paper's start (bench/RESULTS.md:
  * the control polygon's crossing as a start, measured and not kept). Over lanes, each lane's. */
-#if DEGREE == 2
 LREAL isolated_start(const LREAL* c) {
+  if (DEGREE != 2) return -1;
   /* c0 (1 - y)^2 + 2 c1 y (1 - y) + c2 y^2 = a y^2 + b y + c0 */
-  const LREAL a = (c[0] - (REAL)2 * c[1]) + c[2], b = (REAL)2 * (c[1] - c[0]);
+  const LREAL a = (c[0] - (REAL)2 * c[1]) + c[DEGREE], b = (REAL)2 * (c[1] - c[0]);
   const LREAL q = (REAL)-0.5 * (b + copysign(sqrt(b * b - (REAL)4 * a * c[0]), b));
   const LREAL near = c[0] / q, far = q / a;
   return LANE_SEL(LANE_SEL((LREAL)-1, far, far > 0 && far < 1), near, near > 0 && near < 1);
 }
-#else
-LREAL isolated_start(const LREAL* c) {
-  (void)c;
-  return -1;
-}
-#endif
 
 /* Turns Bernstein coefficients into the form isolated_value() expects: c_k * C(n,k); over lanes, each lane's. */
 void prepare_isolated(LREAL* c, __constant const REAL* binomials) {

@@ -58,6 +58,10 @@ const BuildSwitch kBuildSwitches[] = {
     {"ALGRAY_COMPENSATED", [](const KernelConfig& c) { return flag(c.precision == Precision::Mixed); }},
     {"ALGRAY_ESCALATE", [](const KernelConfig& c) { return flag(c.precision == Precision::Adaptive); }},
     {"ISOLATION", [](const KernelConfig& c) { return std::to_string(kernel_id(kIsolationIds, c.isolation)); }},
+    {"ISOLATION_POWER_BASIS", [](const KernelConfig& c) { return flag(abilities(c.isolation).power_basis); }},
+    {"ISOLATION_ADAPTIVE", [](const KernelConfig& c) { return flag(abilities(c.isolation).adaptive); }},
+    {"ISOLATION_POINT_FORM", [](const KernelConfig& c) { return flag(abilities(c.isolation).point_form); }},
+    {"SOLVER_LANES", [](const KernelConfig& c) { return flag(lanes_supported(c.isolation, c.refinement)); }},
     {"REFINEMENT", [](const KernelConfig& c) { return std::to_string(kernel_id(kRefinementIds, c.refinement)); }},
     {"RAY_ORIGIN", [](const KernelConfig& c) { return std::to_string(kernel_id(kOriginIds, c.ray_origin)); }},
     // Hexadecimal literals carry the tolerance bit for bit; float builds get a float literal, as devices without
