@@ -100,27 +100,6 @@ ALGRAY_INLINE REAL largest_magnitude(const REAL* c) {
   return t[0];
 }
 
-/* The smallest |c_k| that counts (first_counted): an interval whose coefficients all stand clear of the noise
- * keeps its sign variations. */
-ALGRAY_INLINE REAL smallest_magnitude(const REAL* c, REAL lo) {
-  REAL t[NCOEF];
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]);
-  if (first_counted(lo)) t[0] = INFINITY;
-  MAGNITUDE_TREE(t, PICK_SMALLER);
-  return t[0];
-}
-
-/* The smallest |c_k| inside, the ends left out. */
-ALGRAY_INLINE REAL inner_smallest_magnitude(const REAL* c) {
-  REAL t[NCOEF];
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]);
-  t[0] = t[DEGREE] = INFINITY;
-  MAGNITUDE_TREE(t, PICK_SMALLER);
-  return t[0];
-}
-
 /* Adaptive precision (ALGRAY_ESCALATE): the float search stops where a decision rests on values within the
  * rounding noise of the coefficients it started from, and the host redoes the ray in float-float or double. The
  * noise is REAL_EPS * max(ALGRAY_DOUBT_FACTOR * DEGREE * max |b_k|, ALGRAY_TERMS_FACTOR * terms), b the segment's
@@ -229,34 +208,6 @@ int within_noise_at(SearchNoise* n, REAL value, REAL lo, REAL hi) {
 
 /* Every isolation takes the ray's terms (RayTerms in restrict.h), which adaptive builds measure their noise by and
  * others never read: callers outside adaptive builds may pass a RayTerms they never filled. */
-
-/* The smaller |P| at the interval's ends that counts (c_0 and c_n are P's values there). */
-REAL smaller_end(const REAL* c, REAL lo) {
-  return first_counted(lo) ? fabs(c[DEGREE]) : fmin(fabs(c[0]), fabs(c[DEGREE]));
-}
-
-/* Ends the search undecided for `reason` when |value| is within the noise on the current interval
- * (within_noise_at); returns 1 then. Other builds compute none of its arguments. */
-#if ALGRAY_ESCALATE
-int doubted(Isolation* iso, uint reason, REAL value, SearchNoise* noise, int level, ProbeLog* probe_log) {
-  if (!within_noise_at(noise, value, iso->lo, iso->hi)) return 0;
-  PROBE(ALGRAY_EVENT_DOUBT, 0, reason, (uint)level, iso->lo, iso->hi, value, noise->noise);
-  iso->doubt = reason;
-  iso->status = ISOLATION_NONE;
-  return 1;
-}
-
-/* A root to refine takes the search's noise with the terms summed, for the refined root's check
- * (refine_rays); shadow rays refine nothing. */
-Isolation isolation_found(Isolation iso, SearchNoise* noise) {
-  if (!ALGRAY_SHADOW_RAYS && iso.status == ISOLATION_BRACKET) iso.noise = exact_noise(noise);
-  return iso;
-}
-#else
-/* Named parameters: OpenCL C before 3.0 has no variadic macros (NVIDIA's compiler refuses them). */
-#define doubted(iso, reason, value, noise, level, probe_log) 0
-#define isolation_found(iso, noise) (iso)
-#endif
 
 /* Whether an interval `width` (a fraction of [t_in, t_out], starting at fraction lo) is down to the stopping
  * width: then it is located, however many roots Descartes' rule still allows in it. */

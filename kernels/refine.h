@@ -26,12 +26,9 @@ ALGRAY_INLINE LREAL line_root(LREAL f0, LREAL f1) { return f0 / (f0 - f1); }
  * orders of magnitude larger than the terms near the root, and a coefficient-sized threshold stopped early
  * there: 726 of 4096 pixels more than 1e-6 deep on (z + x/10)^21 = a (derivative chain, double). It is at most
  * (DEGREE + 1) * scale, which skips computing it far from the root. */
-#if LANES == 1
-int value_within_rounding(const REAL* c, REAL y, REAL fy, REAL scale) {
-  if (fabs(fy) > REAL_EPS * (REAL)(DEGREE + 1) * scale) return 0;
-  return fabs(fy) <= REAL_EPS * isolated_magnitude(c, y);
+LMASK value_within_rounding(const LREAL* c, LREAL y, LREAL fy, LREAL scale) {
+  return !(fabs(fy) > REAL_EPS * (REAL)(DEGREE + 1) * scale) && fabs(fy) <= REAL_EPS * isolated_magnitude(c, y);
 }
-#endif
 
 #if LANES > 1 && !SOLVER_LANES
 #error "LANES > 1 needs an isolation and a refinement with lane builds (SOLVER_LANES)"
@@ -166,16 +163,12 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL s
     if ((fx < 0) == (fa < 0)) {
       a = x;
       fa = fx;
-#if REFINEMENT == ALGRAY_REFINEMENT_ILLINOIS
-      if (kept < 0) fb *= (REAL)0.5;
-#endif
+      if (REFINEMENT == ALGRAY_REFINEMENT_ILLINOIS && kept < 0) fb *= (REAL)0.5;
       kept = kept < 0 ? kept - 1 : -1;
     } else {
       b = x;
       fb = fx;
-#if REFINEMENT == ALGRAY_REFINEMENT_ILLINOIS
-      if (kept > 0) fa *= (REAL)0.5;
-#endif
+      if (REFINEMENT == ALGRAY_REFINEMENT_ILLINOIS && kept > 0) fa *= (REAL)0.5;
       kept = kept > 0 ? kept + 1 : 1;
     }
     PROBE_ITERATE(it, x, fx, a, b);

@@ -190,7 +190,7 @@ LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials) {
     for (int p = (1 << level) - 1; p >= 0; --p) {
       LREAL left[NCOEF], right[NCOEF];
       coefs_copy(left, (LREAL*)0, piece[p], (LREAL*)0); /* the point form has no mixed precision: no low parts */
-      casteljau_halve(left, (LREAL*)0, right, (LREAL*)0);
+      casteljau_halve_rows(left, (LREAL*)0, right, (LREAL*)0);
       ALGRAY_UNROLL
       for (int k = 0; k <= DEGREE; ++k) {
         piece[2 * p][k] = left[k];

@@ -94,29 +94,9 @@ ALGRAY_INLINE void casteljau_keep_right(LREAL* c, LREAL* c_lo, LREAL x, LREAL x_
     if (k <= DEGREE - r) casteljau_step(c, c_lo, k, k, k + 1, x1, -x_lo, x, x_lo);
 }
 
-/* Halves c at 1/2 in one de Casteljau triangle: c becomes the left half, right the right half. */
-#if LANES == 1 && DEGREE <= 15 && !ALGRAY_COMPENSATED
-/* One ray: each row of the triangle as one vector operation on a register, instead of a row of scalars through
- * memory (measured: casteljau_halve was a fifth of the Barth decic's shadow kernel). The same products and sums
- * as the rows below: 0.5 t_k + 0.5 t_(k+1) per lane. Lanes past the row's end are never read. */
-ALGRAY_INLINE void casteljau_halve(LREAL* c, LREAL* c_lo, LREAL* right, LREAL* right_lo) {
-  (void)c_lo;
-  (void)right_lo;
-  REAL row[ACC_WIDTH];
-  ALGRAY_UNROLL
-  for (int k = 0; k < ACC_WIDTH; ++k) row[k] = k <= DEGREE ? c[k] : (REAL)0;
-  PolyVec t = VEC_LOAD(row);
-  right[DEGREE] = c[DEGREE];
-  ALGRAY_UNROLL
-  for (int r = 1; r <= DEGREE; ++r) {
-    t = CASTELJAU_COMBINE((REAL)0.5, t, (REAL)0.5, VEC_SHIFT_DOWN(t));
-    VEC_STORE(t, row);
-    c[r] = row[0];
-    right[DEGREE - r] = row[DEGREE - r];
-  }
-}
-#else
-ALGRAY_INLINE void casteljau_halve(LREAL* c, LREAL* c_lo, LREAL* right, LREAL* right_lo) {
+/* Halves c at 1/2 in one de Casteljau triangle: c becomes the left half, right the right half; row by row, over
+ * lanes or one ray. */
+ALGRAY_INLINE void casteljau_halve_rows(LREAL* c, LREAL* c_lo, LREAL* right, LREAL* right_lo) {
   LREAL t[NCOEF], t_lo[NCOEF];
   coefs_copy(t, t_lo, c, c_lo);
   right[DEGREE] = t[DEGREE];
@@ -134,6 +114,30 @@ ALGRAY_INLINE void casteljau_halve(LREAL* c, LREAL* c_lo, LREAL* right, LREAL* r
     }
   }
 }
+
+/* casteljau_halve_rows for the search. One ray's search takes each row of the triangle as one vector operation on a
+ * register, instead of a row of scalars through memory (measured: the halving was a fifth of the Barth decic's
+ * shadow kernel). The same products and sums as the rows: 0.5 t_k + 0.5 t_(k+1) per lane. Lanes past the row's end
+ * are never read. */
+#if LANES == 1 && DEGREE <= 15 && !ALGRAY_COMPENSATED
+ALGRAY_INLINE void casteljau_halve(LREAL* c, LREAL* c_lo, LREAL* right, LREAL* right_lo) {
+  (void)c_lo;
+  (void)right_lo;
+  REAL row[ACC_WIDTH];
+  ALGRAY_UNROLL
+  for (int k = 0; k < ACC_WIDTH; ++k) row[k] = k <= DEGREE ? c[k] : (REAL)0;
+  PolyVec t = VEC_LOAD(row);
+  right[DEGREE] = c[DEGREE];
+  ALGRAY_UNROLL
+  for (int r = 1; r <= DEGREE; ++r) {
+    t = CASTELJAU_COMBINE((REAL)0.5, t, (REAL)0.5, VEC_SHIFT_DOWN(t));
+    VEC_STORE(t, row);
+    c[r] = row[0];
+    right[DEGREE - r] = row[DEGREE - r];
+  }
+}
+#else
+#define casteljau_halve casteljau_halve_rows
 #endif
 
 /* Whether every coefficient of c has one strict sign, lane by lane: then the polynomial has no root on the
@@ -226,8 +230,9 @@ ALGRAY_INLINE LREAL next_interval_width(LREAL next_at) {
 #define LANE_LARGER(a, b) LANE_SEL((a), (b), (b) > (a))
 #define LANE_SMALLER(a, b) LANE_SEL((a), (b), (b) < (a))
 
-/* The smallest |c_k| that counts (first_counted), the smaller end that counts (smaller_end) and the smallest
- * inner |c_k| (inner_smallest_magnitude), lane by lane; lo: the interval's left end. */
+/* The smallest |c_k| that counts (first_counted, isolation.h: an interval whose coefficients all stand clear of the
+ * noise keeps its sign variations), or the smallest inner one (ends = 0); and the smaller |P| at the interval's
+ * ends that counts (c_0 and c_n are P's values there). Lane by lane; lo: the interval's left end. */
 ALGRAY_INLINE LREAL lanes_smallest_magnitude(const LREAL* c, LREAL lo, int ends) {
   LREAL t[NCOEF];
   ALGRAY_UNROLL
