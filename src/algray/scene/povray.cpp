@@ -1255,11 +1255,31 @@ class PovReader {
     return best;
   }
   glm::dmat4 box_frame(const Token*& at) const;
+  // --- the stages of run(): what they settle, in order ---
+  struct Translated {
+    Camera camera;
+    std::vector<PovLight> lights;
+    const Token* framed_by = nullptr;  // the turned clipping box whose frame the scene is written in
+    std::optional<Clip> extent;        // the objects' common region, in POV-Ray's coordinates
+    const Object* clipped_by = nullptr;
+    std::vector<const Object*> open;  // objects with no region at all
+    glm::dvec3 mirror{1, 1, 1};       // algray's point q is POV-Ray's q * mirror
+    std::vector<SparsePoly> polys;    // the objects in algray's coordinates
+    CameraSpec view;
+    int width = 0, height = 0;
+    std::optional<Clip> drawn;  // the extent in algray's coordinates
+    std::string extent_note;    // why it differs from POV-Ray's region, if it does
+  };
+  void frame(Translated& scene);
+  void common_region(Translated& scene);
+  std::vector<SparsePoly> algray_polys(const glm::dmat4& flip);
+  void algray_view(Translated& scene);
+  void fit_extent(Translated& scene);
+  PovTranslation write_toml(const Translated& scene) const;
   static bool same(const Clip& a, const Clip& b) {
     if (a.sphere != b.sphere) return false;
     const double tolerance = 1e-9 * (1 + a.radius);
-    if (a.sphere)
-      return glm::length(a.centre - b.centre) < tolerance && std::fabs(a.radius - b.radius) < tolerance;
+    if (a.sphere) return glm::length(a.centre - b.centre) < tolerance && std::fabs(a.radius - b.radius) < tolerance;
     return glm::length(a.min - b.min) + glm::length(a.max - b.max) < 1e-9 * (1 + glm::length(a.max - a.min));
   }
   // Whether a lies within b.
@@ -1427,6 +1447,9 @@ std::optional<Clip> seen_sphere(const Sight& sight, const std::vector<bool>& sho
 
 }  // namespace
 
+// The scene as algray's TOML: its objects, turned into the frame of a turned clipping box if there is one (frame),
+// clipped to one region (common_region), mirrored where POV-Ray's camera is left-handed, the camera and image
+// (algray_view), an extent fitted where POV-Ray's own region is not a clip (fit_extent), then written out.
 PovTranslation PovReader::run() {
   while (peek().kind != Token::End) item();
   if (objects_.empty())
@@ -1434,39 +1457,57 @@ PovTranslation PovReader::run() {
   if (objects_.size() > kMaxSurfaces)
     fail(objects_[kMaxSurfaces].at, std::to_string(objects_.size()) + " objects: algray draws up to " +
                                         std::to_string(kMaxSurfaces) + " surfaces in one scene");
+  Translated scene;
+  scene.camera = camera_;
+  scene.lights = lights_;
+  frame(scene);
+  common_region(scene);
+  // Handedness: a left-handed camera (the default) is read with z negated; a right-handed one as written.
+  const Camera& cam = scene.camera;
+  if (glm::length(cam.right) == 0 || glm::length(cam.up) == 0 || glm::length(cam.direction) == 0)
+    fail(camera_at_ ? *camera_at_ : objects_.front().at, "the camera's right, up and direction must not be zero");
+  const bool left_handed = glm::dot(glm::cross(cam.right, cam.up), cam.direction) > 0;
+  scene.mirror = glm::dvec3(1, 1, left_handed ? -1 : 1);
+  glm::dmat4 flip(1);
+  flip[2][2] = scene.mirror.z;
 
+  scene.polys = algray_polys(flip);
+  algray_view(scene);
+  fit_extent(scene);
+  return write_toml(scene);
+}
+
+void PovReader::frame(Translated& scene) {
   // A clipping box turned off the axes: the whole scene (objects, clips, camera, lights) is written in the box's
   // own frame, turned and moved from POV-Ray's, in which algray's axis-aligned box is that box. The picture is
   // the same, since the camera moves with everything else.
-  Camera cam = camera_;
-  std::vector<PovLight> lights = lights_;
-  const Token* framed_by = nullptr;
-  const glm::dmat4 to_frame = box_frame(framed_by);
-  if (framed_by) {
-    const glm::dmat3 turn(to_frame);
-    auto point = [&](const glm::dvec3& p) { return glm::dvec3(to_frame * glm::dvec4(p, 1)); };
-    for (Object& o : objects_) {
-      o.transform = to_frame * o.transform;
-      for (auto& [c, t] : o.clips) t = to_frame * t;
-    }
-    cam.location = point(cam.location);
-    if (cam.look_at) cam.look_at = point(*cam.look_at);
-    cam.direction = turn * cam.direction;
-    cam.right = turn * cam.right;
-    cam.up = turn * cam.up;
-    cam.sky = turn * cam.sky;
-    for (PovLight& l : lights) {
-      l.position = point(l.position);
-      l.edge_u = turn * l.edge_u;
-      l.edge_v = turn * l.edge_v;
-    }
+  const glm::dmat4 to_frame = box_frame(scene.framed_by);
+  if (!scene.framed_by) return;
+  const glm::dmat3 turn(to_frame);
+  auto point = [&](const glm::dvec3& p) { return glm::dvec3(to_frame * glm::dvec4(p, 1)); };
+  for (Object& o : objects_) {
+    o.transform = to_frame * o.transform;
+    for (auto& [c, t] : o.clips) t = to_frame * t;
   }
+  scene.camera.location = point(scene.camera.location);
+  if (scene.camera.look_at) scene.camera.look_at = point(*scene.camera.look_at);
+  scene.camera.direction = turn * scene.camera.direction;
+  scene.camera.right = turn * scene.camera.right;
+  scene.camera.up = turn * scene.camera.up;
+  scene.camera.sky = turn * scene.camera.sky;
+  for (PovLight& l : scene.lights) {
+    l.position = point(l.position);
+    l.edge_u = turn * l.edge_u;
+    l.edge_v = turn * l.edge_v;
+  }
+}
 
+void PovReader::common_region(Translated& scene) {
   // One region for the scene: the clipped objects' common clip, holding every self-bounded one (spheres, tori),
   // or, with none clipped, a box around them all. Objects with no region at all are `open`.
-  std::optional<Clip> extent;
-  const Object* clipped_by = nullptr;
-  std::vector<const Object*> open;
+  std::optional<Clip>& extent = scene.extent;
+  const Object*& clipped_by = scene.clipped_by;
+  std::vector<const Object*>& open = scene.open;
   for (const Object& o : objects_)
     if (!o.clips.empty() || !o.natural) {
       std::optional<Clip> r = region(o);
@@ -1488,21 +1529,17 @@ PovTranslation PovReader::run() {
   for (const Object& o : objects_)
     if (o.clips.empty() && o.natural) {
       const Clip r = *region(o);
-      if (!extent) extent = r;
+      if (!extent)
+        extent = r;
       else if (clipped_by && !inside(r, *extent))
         fail(o.at, "this " + o.kind + " reaches outside the clip of the " + clipped_by->kind + " at line " +
                        std::to_string(clipped_by->at.line) + "; algray clips every surface of a scene to one region");
-      else if (!clipped_by && !inside(r, *extent)) extent = enclosing(*extent, r);
+      else if (!clipped_by && !inside(r, *extent))
+        extent = enclosing(*extent, r);
     }
+}
 
-  // Handedness: a left-handed camera (the default) is read with z negated; a right-handed one as written.
-  if (glm::length(cam.right) == 0 || glm::length(cam.up) == 0 || glm::length(cam.direction) == 0)
-    fail(camera_at_ ? *camera_at_ : objects_.front().at, "the camera's right, up and direction must not be zero");
-  const bool left_handed = glm::dot(glm::cross(cam.right, cam.up), cam.direction) > 0;
-  const glm::dvec3 mirror(1, 1, left_handed ? -1 : 1);
-  glm::dmat4 flip(1);
-  flip[2][2] = mirror.z;
-
+std::vector<SparsePoly> PovReader::algray_polys(const glm::dmat4& flip) {
   // The surfaces in algray's coordinates: algray's point q is POV-Ray's flip(q); the object's own point is
   // transform^-1 of that.
   std::vector<SparsePoly> polys;
@@ -1527,31 +1564,44 @@ PovTranslation PovReader::run() {
     polys.push_back(std::move(p));
   }
 
+  return polys;
+}
+
+void PovReader::algray_view(Translated& scene) {
   // The camera: angle sets direction's length from right's; the view is |up| tall at |direction|.
-  double distance = glm::length(cam.direction);
-  if (cam.angle && !cam.orthographic) distance = 0.5 * glm::length(cam.right) / std::tan(*cam.angle * kPi / 360);
-  const glm::dvec3 forward = cam.look_at ? *cam.look_at - cam.location : glm::normalize(cam.direction);
+  double distance = glm::length(scene.camera.direction);
+  if (scene.camera.angle && !scene.camera.orthographic)
+    distance = 0.5 * glm::length(scene.camera.right) / std::tan(*scene.camera.angle * kPi / 360);
+  const glm::dvec3 forward =
+      scene.camera.look_at ? *scene.camera.look_at - scene.camera.location : glm::normalize(scene.camera.direction);
   if (glm::length(forward) == 0)
     fail(camera_at_ ? *camera_at_ : objects_.front().at, "look_at is the camera's location");
-  const glm::dvec3 up = cam.look_at ? cam.sky : cam.up;
+  const glm::dvec3 up = scene.camera.look_at ? scene.camera.sky : scene.camera.up;
   if (glm::length(glm::cross(glm::normalize(forward), glm::normalize(up))) < 1e-9)
     fail(camera_at_ ? *camera_at_ : objects_.front().at, "the camera looks along its sky (or up) vector");
-  CameraSpec view;
-  view.eye = cam.location * mirror;
-  view.look_at = (cam.location + glm::normalize(forward)) * mirror;
-  view.up = up * mirror;
-  view.projection = cam.orthographic ? Projection::Orthographic : Projection::Perspective;
-  view.ortho_height = glm::length(cam.up);
-  view.fov_y_degrees = 2 * std::atan(0.5 * glm::length(cam.up) / distance) * 180 / kPi;
+  CameraSpec& view = scene.view;
+  view.eye = scene.camera.location * scene.mirror;
+  view.look_at = (scene.camera.location + glm::normalize(forward)) * scene.mirror;
+  view.up = up * scene.mirror;
+  view.projection = scene.camera.orthographic ? Projection::Orthographic : Projection::Perspective;
+  view.ortho_height = glm::length(scene.camera.up);
+  view.fov_y_degrees = 2 * std::atan(0.5 * glm::length(scene.camera.up) / distance) * 180 / kPi;
   // POV-Ray stretches right x up over whatever image it renders; algray's images keep that shape by default.
-  const int width = image_width();
-  const int height = std::min(
-      height_ > 0 ? height_
-                  : std::max(1, static_cast<int>(std::lround(width * glm::length(cam.up) / glm::length(cam.right)))),
-      32768);
+  scene.width = image_width();
+  scene.height =
+      std::min(height_ > 0 ? height_
+                           : std::max(1, static_cast<int>(std::lround(scene.width * glm::length(scene.camera.up) /
+                                                                      glm::length(scene.camera.right)))),
+               32768);
+}
 
+void PovReader::fit_extent(Translated& scene) {
   // The extent in algray's coordinates.
-  std::optional<Clip> drawn;
+  const glm::dvec3 mirror = scene.mirror;
+  const std::optional<Clip>& extent = scene.extent;
+  const std::vector<const Object*>& open = scene.open;
+  const CameraSpec& view = scene.view;
+  std::optional<Clip>& drawn = scene.drawn;
   if (extent) {
     drawn = *extent;
     drawn->centre *= mirror;
@@ -1559,19 +1609,17 @@ PovTranslation PovReader::run() {
     drawn->min = glm::min(a, b);
     drawn->max = glm::max(a, b);
   }
-  std::string extent_note;
   // Objects without a region, or with bounded_by alone: POV-Ray draws all of the surface that the rays meet (that
   // pass the bound), which no sphere or box holds in general. algray draws within the sphere or box that agrees
   // best with that on a grid of rays traced here.
   if (!open.empty() || (drawn && drawn->bound)) {
-    const double scale =
-        std::max({1.0, glm::length(view.eye), drawn ? glm::length(drawn->centre - view.eye) : 0.0});
-    const Sight sight = look(view, width, height, polys, scale);
+    const double scale = std::max({1.0, glm::length(view.eye), drawn ? glm::length(drawn->centre - view.eye) : 0.0});
+    const Sight sight = look(view, scene.width, scene.height, scene.polys, scale);
     std::vector<bool> shown;
     for (const Sight::Ray& r : sight.rays)
       shown.push_back(!r.roots.empty() && (!drawn || span(*drawn, r.o, r.d).has_value()));
     std::vector<Clip> candidates;
-    if (drawn && !cam.orthographic) {
+    if (drawn && !scene.camera.orthographic) {
       // The bound moved k times as far from the eye: the same rays meet it, each over k times its stretch.
       std::vector<double> ks = {1};
       for (int i = 1; i <= 40; ++i) {
@@ -1614,31 +1662,33 @@ PovTranslation PovReader::run() {
     if (!(kept && best == 1)) {  // a bound that holds all that the rays see is what POV-Ray shows: nothing to say
       std::ostringstream note;
       note.precision(4);
-      const Object& o = open.empty() ? *clipped_by : *open.front();
+      const Object& o = open.empty() ? *scene.clipped_by : *open.front();
       note << (open.empty() ? "bounded_by alone does not clip in POV-Ray: the rays that pass the bound see all of "
                               "the surface"
                             : "no clipped_by or bounded_by: POV-Ray draws this " + o.kind + " without end")
            << "; algray draws it within the " << (drawn->sphere ? "sphere" : "box")
            << " that agrees best with that on a " << Sight::kColumns << " x " << Sight::kRows
            << " grid of rays traced here (IoU " << best << ")";
-      extent_note = note.str();
-      warn(o.at, extent_note);
+      scene.extent_note = note.str();
+      warn(o.at, scene.extent_note);
     }
   }
+}
 
+PovTranslation PovReader::write_toml(const Translated& scene) const {
   std::ostringstream toml;
   const std::size_t slash = files_[0].text->source().find_last_of('/');
   const std::string file = files_[0].text->source().substr(slash == std::string::npos ? 0 : slash + 1);
   toml << "# Translated from " << files_[0].text->source() << " (POV-Ray)\n";
-  if (framed_by)
-    toml << "# Written in the frame of the clipping box of the " << framed_by->text << " at " << where(*framed_by)
-         << " (turned and moved from POV-Ray's world: the same picture)\n";
+  if (scene.framed_by)
+    toml << "# Written in the frame of the clipping box of the " << scene.framed_by->text << " at "
+         << where(*scene.framed_by) << " (turned and moved from POV-Ray's world: the same picture)\n";
   for (std::size_t n = 0; n < objects_.size(); ++n) {
     const Object& o = objects_[n];
     toml << "\n[[surface]]\nname = " << toml_quoted(file + " " + std::to_string(n + 1) + " (" + o.kind + ")")
          << "\nterms = [";
     const char* sep = "";
-    for (const auto& [e, c] : polys[n].terms) {
+    for (const auto& [e, c] : scene.polys[n].terms) {
       toml << sep << "[" << e[0] << ", " << e[1] << ", " << e[2] << ", " << toml_number(c) << "]";
       sep = ", ";
     }
@@ -1652,36 +1702,36 @@ PovTranslation PovReader::run() {
            << "\nspecular = " << toml_number(o.specular) << "\nexponent = " << toml_number(o.exponent) << "\n";
   }
 
-  const Clip& e = *drawn;
-  toml << "\n[extent]" << (extent_note.empty() ? "" : "  # " + extent_note) << "\n";
+  const Clip& e = *scene.drawn;
+  toml << "\n[extent]" << (scene.extent_note.empty() ? "" : "  # " + scene.extent_note) << "\n";
   if (e.sphere)
     toml << "type = \"sphere\"\ncentre = " << toml_vector(e.centre) << "\nradius = " << toml_number(e.radius) << "\n";
   else
     toml << "type = \"box\"\nmin = " << toml_vector(e.min) << "\nmax = " << toml_vector(e.max) << "\n";
 
-  toml << "\n[camera]\neye = " << toml_vector(view.eye) << "\nlook_at = " << toml_vector(view.look_at)
-       << "\nup = " << toml_vector(view.up) << "\n";
-  if (cam.orthographic)
-    toml << "projection = \"orthographic\"\nheight = " << toml_number(view.ortho_height) << "\n";
+  toml << "\n[camera]\neye = " << toml_vector(scene.view.eye) << "\nlook_at = " << toml_vector(scene.view.look_at)
+       << "\nup = " << toml_vector(scene.view.up) << "\n";
+  if (scene.camera.orthographic)
+    toml << "projection = \"orthographic\"\nheight = " << toml_number(scene.view.ortho_height) << "\n";
   else
-    toml << "projection = \"perspective\"\nfov_y = " << toml_number(view.fov_y_degrees) << "\n";
+    toml << "projection = \"perspective\"\nfov_y = " << toml_number(scene.view.fov_y_degrees) << "\n";
 
-  toml << "\n[image]\nwidth = " << width << "\nheight = " << height
+  toml << "\n[image]\nwidth = " << scene.width << "\nheight = " << scene.height
        << "\nbackground = " << toml_vector(glm::min(background_.value_or(glm::dvec3(0)), glm::dvec3(1))) << "\n";
 
-  for (const PovLight& l : lights) {
+  for (const PovLight& l : scene.lights) {
     const double strength = std::max({l.colour.x, l.colour.y, l.colour.z});
-    toml << "\n[[light]]\ntype = \"" << (l.area ? "rectangle" : "point") << "\"\nposition = "
-         << toml_vector(l.position * mirror) << "\n";
+    toml << "\n[[light]]\ntype = \"" << (l.area ? "rectangle" : "point")
+         << "\"\nposition = " << toml_vector(l.position * scene.mirror) << "\n";
     if (l.area)
-      toml << "edge_u = " << toml_vector(l.edge_u * mirror) << "\nedge_v = " << toml_vector(l.edge_v * mirror)
-           << "\nsamples = " << l.samples << "\n";
+      toml << "edge_u = " << toml_vector(l.edge_u * scene.mirror)
+           << "\nedge_v = " << toml_vector(l.edge_v * scene.mirror) << "\nsamples = " << l.samples << "\n";
     toml << "colour = " << toml_vector(strength > 0 ? l.colour / strength : glm::dvec3(1))
          << "\nintensity = " << toml_number(strength) << "\nshadows = " << (l.shadows ? "true" : "false") << "\n";
   }
-  if (lights.empty())
+  if (scene.lights.empty())
     toml << "\n[[light]]  # POV-Ray lights nothing without a light_source\ntype = \"point\"\nposition = "
-         << toml_vector(cam.location * mirror) << "\nintensity = 0.0\nshadows = false\n";
+         << toml_vector(scene.camera.location * scene.mirror) << "\nintensity = 0.0\nshadows = false\n";
   return {toml.str(), where(objects_.front().at), excerpt(objects_.front().at)};
 }
 
