@@ -21,6 +21,9 @@
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
 #error "the screen form is for camera rays; the host builds this kernel with RAY_ORIGIN=extent or point"
 #endif
+#if ALGRAY_ESCALATE && ISOLATION_POWER_BASIS
+#error "adaptive shadow rays settle what the signs of Bernstein coefficients show (bernstein_root_by_signs)"
+#endif
 
 #if RAY_ORIGIN != ALGRAY_ORIGIN_POINT
 
@@ -100,7 +103,7 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
 #else
   (void)clear_limit;
 #endif
-#if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
+#if !ISOLATION_POWER_BASIS
   const int by_signs = bernstein_root_by_signs(root);
 #if ALGRAY_ESCALATE
   const REAL scale = by_signs == ISOLATION_NONE ? search_scale_bound(root) : 0;
