@@ -202,8 +202,8 @@ TEST_CASE("every kernel configuration compiles as strict OpenCL C 1.2") {
 
 TEST_CASE("a build log's locations in the assembled program point back into the kernel files") {
   const std::string source = assemble_kernel_source("primary.cl");
-  // The line of the assembled text that holds isolation.h's no-escalation `doubted`, and that line in the file.
-  const std::string marker = "#define doubted(iso, reason, value, noise, level, probe_log) 0";
+  // The line of the assembled text that holds isolation.h's ISOLATION_NONE, and that line in the file.
+  const std::string marker = "#define ISOLATION_NONE ALGRAY_ISOLATED_NONE";
   const auto at = source.find(marker);
   REQUIRE(at != std::string::npos);
   const long assembled_line = std::count(source.begin(), source.begin() + static_cast<long>(at), '\n') + 1;
