@@ -126,7 +126,7 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
     devices.push_back(std::make_unique<Passes>(*session, shared, scene, options, precision, result));
     Passes& passes = *devices.back();
     for (std::size_t i = 0; i < scene.surfaces.size(); ++i)
-      passes.surfaces.push_back(std::make_unique<DeviceSurface>(session->context, scene, precision, i));
+      passes.kernels.surfaces.push_back(std::make_unique<DeviceSurface>(session->context, scene, precision, i));
     prepare_passes(passes, devices.size() == 1);
     passes.shader = &shader;
   }
@@ -168,7 +168,7 @@ FrameImage Renderer::render_rows(std::vector<std::unique_ptr<Passes>>& devices, 
     passes->film_y0 = traced_first;
     passes->first_row = first_row;
     passes->end_row = end_row;
-    passes->band_y0 = -1;  // a band's first tile row may start where the last band's did, but be shorter
+    passes->kernels.band_y0 = -1;  // a band's first tile row may start where the last band's did, but be shorter
   }
   const int film_height = traced_end - traced_first;
   FrameImage film;
@@ -190,13 +190,13 @@ FrameImage Renderer::render_rows(std::vector<std::unique_ptr<Passes>>& devices, 
   shared.tiles_done = 0;
   shared.tiles_total = static_cast<int>(tiles.size()) * (adaptive ? 2 : 1);
   sweep(devices, tiles, [this](Passes& passes, const Tile& tile) {
-    if (tile.y0 != passes.band_y0) {
+    if (tile.y0 != passes.kernels.band_y0) {
       set_band_args(passes, tile);
-      passes.band_y0 = tile.y0;
+      passes.kernels.band_y0 = tile.y0;
     }
     trace_primary(passes, tile);
     finish_tile(passes, tile);
-    ++passes.tiles;
+    ++passes.tally.tiles;
   });
   if (adaptive) {
     // Every device's first colours are in the film before any pixel is chosen: a tile's choice at its border
@@ -210,7 +210,7 @@ FrameImage Renderer::render_rows(std::vector<std::unique_ptr<Passes>>& devices, 
     const std::size_t width = static_cast<std::size_t>(plan.width);
     std::fill(refine.begin(), refine.begin() + static_cast<std::ptrdiff_t>((first_row - traced_first) * width), 0);
     std::fill(refine.end() - static_cast<std::ptrdiff_t>((traced_end - end_row) * width), refine.end(), 0);
-    devices.front()->shade_ms += ms_since(start);
+    devices.front()->tally.shade_ms += ms_since(start);
     sweep(devices, tiles, [this, &refine](Passes& passes, const Tile& tile) { refine_tile(passes, tile, refine); });
     if (any.options.keep_records) result.refined = refine;
   }

@@ -168,6 +168,9 @@ class Renderer {
 
  private:
   struct Shared;
+  struct DeviceKernels;
+  struct TileWork;
+  struct DeviceTally;
   struct Passes;
   struct Bounce;
   struct Tile;

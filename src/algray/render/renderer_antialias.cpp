@@ -14,8 +14,8 @@ void Renderer::refine_tile(Passes& passes, const Tile& tile, const std::vector<s
   for (std::size_t k = 0; k < tile.pixels(); ++k)
     if (refine[passes.film_pixel(tile.pixel_in_image(k, plan.width))]) pixels.push_back(static_cast<std::uint32_t>(k));
   if (pixels.empty()) return;
-  passes.refined_colour.assign(tile.pixels(), glm::dvec3(0));
-  passes.refined_alpha.assign(tile.pixels(), 0.0);
+  passes.work.refined_colour.assign(tile.pixels(), glm::dvec3(0));
+  passes.work.refined_alpha.assign(tile.pixels(), 0.0);
   const bool single = passes.single();
   // Whole pixels per batch, each with the n x n rays of the n-times finer grid, so that a refined pixel gets
   // exactly the rays uniform n x n antialiasing would trace.
@@ -37,8 +37,8 @@ void Renderer::refine_tile(Passes& passes, const Tile& tile, const std::vector<s
     }
     trace_batch(passes, batch);
     const auto start = std::chrono::steady_clock::now();
-    passes.shader->add_batch(batch, passes.refined_colour, passes.refined_alpha);
-    passes.shade_ms += ms_since(start);
+    passes.shader->add_batch(batch, passes.work.refined_colour, passes.work.refined_alpha);
+    passes.tally.shade_ms += ms_since(start);
     std::vector<Bounce> first;
     for (std::size_t i = 0; i < batch.rays.size(); ++i)
       if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
@@ -54,9 +54,9 @@ void Renderer::refine_tile(Passes& passes, const Tile& tile, const std::vector<s
   }
   const auto start = std::chrono::steady_clock::now();
   for (std::uint32_t k : pixels)
-    passes.shader->resolve_refined(passes.film_pixel(tile.pixel_in_image(k, plan.width)), passes.refined_colour[k],
-                                   passes.refined_alpha[k], result.image);
-  passes.shade_ms += ms_since(start);
+    passes.shader->resolve_refined(passes.film_pixel(tile.pixel_in_image(k, plan.width)), passes.work.refined_colour[k],
+                                   passes.work.refined_alpha[k], result.image);
+  passes.tally.shade_ms += ms_since(start);
 }
 
 }  // namespace algray

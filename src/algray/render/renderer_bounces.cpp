@@ -48,9 +48,9 @@ void Renderer::run_bounces(Passes& passes, const Tile& tile, std::vector<Bounce>
     if (batch.rays.empty()) continue;
     trace_batch(passes, batch);
     const auto start = std::chrono::steady_clock::now();
-    passes.shader->add_batch(batch, refinement ? passes.refined_colour : passes.secondary, passes.refined_alpha);
-    passes.any_secondary = true;
-    passes.shade_ms += ms_since(start);
+    passes.shader->add_batch(batch, refinement ? passes.work.refined_colour : passes.work.secondary, passes.work.refined_alpha);
+    passes.work.any_secondary = true;
+    passes.tally.shade_ms += ms_since(start);
     for (std::size_t i = 0; i < batch.rays.size(); ++i)
       if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
         next.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i],

@@ -31,60 +31,60 @@ void Renderer::prepare_passes(Passes& passes, bool first_device) {
       });
   for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
     ProgramRecord record;
-    passes.primary.push_back(cache_.kernel(passes.session, plan.find(PassKind::Primary)->kernels[s], &record));
-    passes.primary_lanes.push_back(plan.find(PassKind::Primary)->kernels[s].lanes);
-    passes.screen_rows.emplace_back();
-    passes.programs.push_back(record);
+    passes.kernels.primary.push_back(cache_.kernel(passes.session, plan.find(PassKind::Primary)->kernels[s], &record));
+    passes.kernels.primary_lanes.push_back(plan.find(PassKind::Primary)->kernels[s].lanes);
+    passes.kernels.screen_rows.emplace_back();
+    passes.tally.programs.push_back(record);
     primary.program_keys.push_back(record.key);
     primary.program_ms.push_back(0);
   }
-  passes.primary_out =
+  passes.work.primary_out =
       std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays, hit_memory.get());
   if (scene.surfaces.size() > 1)
-    passes.other_out =
+    passes.work.other_out =
         std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays, PopulatedPages(bytes));
 
   if (PassStats* stats = passes.stats_of(PassKind::Shadow)) {
     const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
     for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-      passes.shadows.push_back(std::make_unique<ShadowTracer>(
-          passes.session, cache_, plan.find(PassKind::Shadow)->kernels[i], *passes.surfaces[i], offset));
-      passes.programs.push_back(passes.shadows.back()->program());
-      stats->program_keys.push_back(passes.shadows.back()->program().key);
+      passes.kernels.shadows.push_back(std::make_unique<ShadowTracer>(
+          passes.session, cache_, plan.find(PassKind::Shadow)->kernels[i], *passes.kernels.surfaces[i], offset));
+      passes.tally.programs.push_back(passes.kernels.shadows.back()->program());
+      stats->program_keys.push_back(passes.kernels.shadows.back()->program().key);
       stats->program_ms.push_back(0);
     }
-    passes.shadow_points = std::make_unique<ShadowPoints>(passes.session, passes.precision);
+    passes.kernels.shadow_points = std::make_unique<ShadowPoints>(passes.session, passes.precision);
     std::vector<std::vector<glm::dvec3>> light_points;  // per shadow-casting light of the plan
     for (int light : plan.shadow_lights)
       light_points.push_back(scene.lights[static_cast<std::size_t>(light)].sample_points());
-    passes.light_groups = group_lights(light_points);
+    passes.kernels.light_groups = group_lights(light_points);
   }
   // Adaptive precision: every ray pass escalates to the same mixed trace kernels.
   if (const PlannedPass* primary_pass = plan.find(PassKind::Primary); !primary_pass->escalation.empty()) {
     for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-      passes.escalate_rays.push_back(
+      passes.kernels.escalate_rays.push_back(
           std::make_unique<RayEscalation>(passes.session, cache_, primary_pass->escalation[i], scene, i));
-      passes.programs.push_back(passes.escalate_rays.back()->program());
+      passes.tally.programs.push_back(passes.kernels.escalate_rays.back()->program());
     }
     if (const PlannedPass* shadow_pass = plan.find(PassKind::Shadow)) {
       const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
       for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-        passes.escalate_shadows.push_back(
+        passes.kernels.escalate_shadows.push_back(
             std::make_unique<ShadowEscalation>(passes.session, cache_, shadow_pass->escalation[i], scene, i, offset));
-        passes.programs.push_back(passes.escalate_shadows.back()->program());
+        passes.tally.programs.push_back(passes.kernels.escalate_shadows.back()->program());
       }
     }
   }
   // Every secondary pass launches the same trace kernels.
   for (PassKind kind : {PassKind::Reflection, PassKind::Transmission, PassKind::Antialias})
     if (PassStats* stats = passes.stats_of(kind)) {
-      if (passes.rays.empty())
+      if (passes.kernels.rays.empty())
         for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-          passes.rays.push_back(
-              std::make_unique<RayTracer>(passes.session, cache_, plan.find(kind)->kernels[i], *passes.surfaces[i]));
-          passes.programs.push_back(passes.rays.back()->program());
+          passes.kernels.rays.push_back(
+              std::make_unique<RayTracer>(passes.session, cache_, plan.find(kind)->kernels[i], *passes.kernels.surfaces[i]));
+          passes.tally.programs.push_back(passes.kernels.rays.back()->program());
         }
-      for (const auto& tracer : passes.rays) {
+      for (const auto& tracer : passes.kernels.rays) {
         stats->program_keys.push_back(tracer->program().key);
         stats->program_ms.push_back(0);
       }
@@ -92,8 +92,8 @@ void Renderer::prepare_passes(Passes& passes, bool first_device) {
   // The pass's stats list its escalation kernels after its own.
   for (std::size_t i = 0; i < plan.passes.size(); ++i)
     for (const KernelConfig& config : plan.passes[i].escalation) {
-      passes.stats[i].program_keys.push_back(config.key());
-      passes.stats[i].program_ms.push_back(0);
+      passes.tally.stats[i].program_keys.push_back(config.key());
+      passes.tally.stats[i].program_ms.push_back(0);
     }
 }
 
@@ -101,18 +101,18 @@ void Renderer::set_band_args(Passes& passes, const Tile& first) {
   RenderResult& result = passes.result;
   const RenderPlan& plan = result.plan;
   const auto start = std::chrono::steady_clock::now();
-  for (std::size_t s = 0; s < passes.surfaces.size(); ++s) {
-    const DeviceSurface& surface = *passes.surfaces[s];
-    KernelBinder args(passes.primary[s], "primary", surface.precision());
+  for (std::size_t s = 0; s < passes.kernels.surfaces.size(); ++s) {
+    const DeviceSurface& surface = *passes.kernels.surfaces[s];
+    KernelBinder args(passes.kernels.primary[s], "primary", surface.precision());
     args.ray_basis(result.basis);
     surface.set_extent_args(args);
     surface.set_surface_args(args);
     // The screen form's polynomials of the band's rows; the kernel must answer each camera ray alike whatever
     // tile and band it is in (test_secondary_rays compares renders in small and large tiles bit for bit).
-    passes.screen_rows[s] =
+    passes.kernels.screen_rows[s] =
         surface.set_screen_args(args, passes.session.context, plan.find(PassKind::Primary)->kernels[s], result.basis,
                                 plan.trace_width(), plan.trace_height(), first.trace_y0, first.trace_h);
-    args.plain("out", (s == 0 ? passes.primary_out : passes.other_out)->buffer());  // the tile: per launch
+    args.plain("out", (s == 0 ? passes.work.primary_out : passes.work.other_out)->buffer());  // the tile: per launch
   }
   passes.stats_of(PassKind::Primary)->wall_ms += ms_since(start);
 }
@@ -120,20 +120,20 @@ void Renderer::set_band_args(Passes& passes, const Tile& first) {
 void Renderer::trace_primary(Passes& passes, const Tile& tile) {
   PassStats& pass = *passes.stats_of(PassKind::Primary);
   const std::size_t rays = tile.rays();
-  passes.primary_out->release();  // the last tile's records: the kernel writes them again
-  passes.hit_surface.clear();
-  for (std::size_t s = 0; s < passes.surfaces.size(); ++s) {
+  passes.work.primary_out->release();  // the last tile's records: the kernel writes them again
+  passes.work.hit_surface.clear();
+  for (std::size_t s = 0; s < passes.kernels.surfaces.size(); ++s) {
     const auto start = std::chrono::steady_clock::now();
-    cl::Kernel& kernel = passes.primary[s];
-    KernelBinder args(kernel, "primary", passes.surfaces[s]->precision());
+    cl::Kernel& kernel = passes.kernels.primary[s];
+    KernelBinder args(kernel, "primary", passes.kernels.surfaces[s]->precision());
     args.plain("tile_x0", static_cast<cl_uint>(tile.trace_x0));
     args.plain("tile_y0", static_cast<cl_uint>(tile.trace_y0));
     args.plain("tile_w", static_cast<cl_uint>(tile.trace_w));
     args.plain("tile_h", static_cast<cl_uint>(tile.trace_h));
     cl::Event done;
     passes.session.queue.enqueueNDRangeKernel(kernel, cl::NullRange,
-                                              primary_global_size(passes.primary_lanes[s], tile.trace_w, tile.trace_h),
-                                              primary_local_size(passes.primary_lanes[s]), nullptr, &done);
+                                              primary_global_size(passes.kernels.primary_lanes[s], tile.trace_w, tile.trace_h),
+                                              primary_local_size(passes.kernels.primary_lanes[s]), nullptr, &done);
     // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
     done.wait();
     pass.kernel_ms += ms_between(done);
@@ -142,13 +142,13 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
     if (s == 0) pass.rays += rays;  // each camera ray once, however many surfaces it is tested against
     auto camera_ray = [&](std::size_t k) { return passes.camera_ray(tile, k); };
     if (s == 0) {
-      passes.hits = passes.primary_out->map(rays);
-      escalate_doubted(passes, pass, s, passes.hits, rays, camera_ray);
+      passes.work.hits = passes.work.primary_out->map(rays);
+      escalate_doubted(passes, pass, s, passes.work.hits, rays, camera_ray);
     } else {
-      HitRecord* other = passes.other_out->map(rays);
+      HitRecord* other = passes.work.other_out->map(rays);
       escalate_doubted(passes, pass, s, other, rays, camera_ray);
-      keep_nearest(passes.hits, rays, passes.hit_surface, other, static_cast<std::uint8_t>(s));
-      passes.other_out->release();
+      keep_nearest(passes.work.hits, rays, passes.work.hit_surface, other, static_cast<std::uint8_t>(s));
+      passes.work.other_out->release();
     }
     pass.wall_ms += ms_since(start);
   }
@@ -158,8 +158,8 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
 void Renderer::trace_batch(Passes& passes, SecondaryBatch& batch) {
   const auto start = std::chrono::steady_clock::now();
   PassStats& stats = *passes.stats_of(batch.pass);
-  for (std::size_t s = 0; s < passes.rays.size(); ++s) {
-    TracedBatch traced = passes.rays[s]->trace(batch.rays);
+  for (std::size_t s = 0; s < passes.kernels.rays.size(); ++s) {
+    TracedBatch traced = passes.kernels.rays[s]->trace(batch.rays);
     escalate_doubted(passes, stats, s, traced.hits.data(), traced.hits.size(),
                      [&](std::size_t i) { return batch.rays[i]; });
     if (s == 0)
@@ -173,7 +173,7 @@ void Renderer::trace_batch(Passes& passes, SecondaryBatch& batch) {
     ++stats.launches;
   }
   stats.wall_ms += ms_since(start);
-  if (!passes.shadows.empty())
+  if (!passes.kernels.shadows.empty())
     batch.shadows =
         trace_shadows(passes, batch.hits.data(), batch.hits.size(), [&](std::size_t i) { return batch.rays[i]; });
 }
@@ -187,18 +187,18 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
   if (passes.options.on_primary_tile) {
     const std::lock_guard<std::mutex> hold(passes.shared.lock);
     passes.options.on_primary_tile(
-        {tile.trace_x0, tile.trace_y0, tile.trace_w, tile.trace_h, plan.samples, passes.hits});
+        {tile.trace_x0, tile.trace_y0, tile.trace_w, tile.trace_h, plan.samples, passes.work.hits});
   }
   if (passes.options.keep_records)
     for (std::size_t k = 0; k < rays; ++k) {
       const std::uint32_t at = tile.ray_in_image(k, grid_width);
-      result.hits.records[at] = passes.hits[k];
-      if (!passes.hit_surface.empty()) result.hits.surface[at] = passes.hit_surface[k];
+      result.hits.records[at] = passes.work.hits[k];
+      if (!passes.work.hit_surface.empty()) result.hits.surface[at] = passes.work.hit_surface[k];
     }
 
   ShadowData shadows;
-  if (!passes.shadows.empty()) {
-    shadows = trace_shadows(passes, passes.hits, rays, camera_ray);
+  if (!passes.kernels.shadows.empty()) {
+    shadows = trace_shadows(passes, passes.work.hits, rays, camera_ray);
     if (passes.options.keep_records) {
       const std::lock_guard<std::mutex> hold(passes.shared.lock);
       for (std::uint32_t k : shadows.points) result.shadows.points.push_back(tile.ray_in_image(k, grid_width));
@@ -210,15 +210,15 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
   }
 
   // Reflection and transmission from the camera rays' hits, batch_rays camera rays at a time.
-  passes.any_secondary = false;
+  passes.work.any_secondary = false;
   if (passes.stats_of(PassKind::Reflection) || passes.stats_of(PassKind::Transmission)) {
-    passes.secondary.assign(rays, glm::dvec3(0));
+    passes.work.secondary.assign(rays, glm::dvec3(0));
     std::vector<Bounce> first;
     for (std::size_t k = 0; k < rays; ++k) {
-      const HitRecord& h = passes.hits[k];
+      const HitRecord& h = passes.work.hits[k];
       if (!(h.flags & ALGRAY_HIT_FOUND)) continue;
       first.push_back({static_cast<std::uint32_t>(k), 1.0, camera_ray(k), h,
-                       passes.hit_surface.empty() ? std::uint8_t{0} : passes.hit_surface[k]});
+                       passes.work.hit_surface.empty() ? std::uint8_t{0} : passes.work.hit_surface[k]});
       if (first.size() == passes.options.batch_rays) {
         run_bounces(passes, tile, std::move(first), 1, false);
         first.clear();
@@ -234,10 +234,10 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
   block.y0 = tile.trace_y0;
   block.width = tile.trace_w;
   block.height = tile.trace_h;
-  block.hits = passes.hits;
-  block.surface = passes.hit_surface.empty() ? nullptr : passes.hit_surface.data();
+  block.hits = passes.work.hits;
+  block.surface = passes.work.hit_surface.empty() ? nullptr : passes.work.hit_surface.data();
   block.shadows = &lookup;
-  block.secondary = passes.any_secondary ? passes.secondary.data() : nullptr;
+  block.secondary = passes.work.any_secondary ? passes.work.secondary.data() : nullptr;
   block.film_y0 = passes.film_y0;
   // The camera rays' totals, counted as the shading threads finish their rows, while the records are in cache
   // (a pass of its own over a 1024^2 preview's 32 MB of records took 4 ms). Only the rows the film keeps: a
@@ -249,14 +249,14 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
     const int end = std::min(tile.y0 + row_end, passes.end_row);
     if (end <= first) return;
     PrimarySummary rows;
-    rows.add(passes.hits + static_cast<std::size_t>(first - tile.y0) * plan.samples * tile.trace_w, tile.trace_w,
+    rows.add(passes.work.hits + static_cast<std::size_t>(first - tile.y0) * plan.samples * tile.trace_w, tile.trace_w,
              (end - first) * plan.samples, plan.samples);
     const std::lock_guard<std::mutex> hold(summary_lock);
     tile_summary += rows;
   };
   passes.shader->resolve(block, result.image);
-  passes.primary_summary += tile_summary;
-  passes.shade_ms += ms_since(start);
+  passes.tally.primary_summary += tile_summary;
+  passes.tally.shade_ms += ms_since(start);
 }
 
 }  // namespace algray

@@ -177,22 +177,13 @@ struct Renderer::Shared {
 
 // What every tile's passes on one device share while a render runs: kernels, tracers, the device's stats, and
 // one tile's buffers, which the device's next tile reuses.
-struct Renderer::Passes {
-  Passes(ClSession& se, Shared& sh, const Scene& s, const RenderOptions& o, Precision p, RenderResult& r)
-      : session(se), shared(sh), scene(s), options(o), precision(p), result(r), stats(r.plan.passes.size()) {}
-  ClSession& session;
-  Shared& shared;
-  const Scene& scene;
-  const RenderOptions& options;
-  Precision precision;
-  RenderResult& result;  // its plan, basis and film are the render's; the tallies below are this device's
+// One device's kernels and tracers for the render, built once (prepare_passes) and used by every tile.
+struct Renderer::DeviceKernels {
   std::vector<std::unique_ptr<DeviceSurface>> surfaces;  // one per scene surface
-  std::vector<PassStats> stats;                          // one per planned pass, in plan order
   std::vector<cl::Kernel> primary;                       // one per surface
   std::vector<int> primary_lanes;                        // per surface: its kernel's camera rays per work-item
   std::vector<cl::Buffer> screen_rows;                   // per surface: a band's rows for screen-form builds
-  std::unique_ptr<TileHits> primary_out;                 // a tile's hit records, of the first surface
-  std::unique_ptr<TileHits> other_out;                   // several surfaces: those of the next ones
+  int band_y0 = -1;                                      // the band (row of tiles) whose arguments they hold
   std::vector<std::unique_ptr<ShadowTracer>> shadows;    // one per surface, when the plan has a shadow pass
   std::unique_ptr<ShadowPoints> shadow_points;           // a batch's surface points on the device
   std::vector<LightGroup> light_groups;                  // the plan's shadow-casting lights, a launch per group
@@ -201,33 +192,57 @@ struct Renderer::Passes {
   // its shadow kernel for doubted shadow rays (when the plan has a shadow pass).
   std::vector<std::unique_ptr<RayEscalation>> escalate_rays;
   std::vector<std::unique_ptr<ShadowEscalation>> escalate_shadows;
-  const Shader* shader = nullptr;  // the render's: shading is const, so the devices share one
-  RayBasis fine;                   // adaptive antialiasing: the rays of the n-times finer grid
+};
 
-  // This device's share, added into the result when every device is done.
-  PrimarySummary primary_summary;
-  double shade_ms = 0;
-  std::vector<ProgramRecord> programs;
-  int tiles = 0;
-  int band_y0 = -1;  // the band (row of tiles) whose arguments the primary kernels hold
-  int film_y0 = 0;   // the image row of the film's row 0, and the output rows [first_row, end_row) kept
-  int first_row = 0, end_row = 0;
-  // A pixel of the image (its index in the whole image) in the film.
-  std::size_t film_pixel(std::size_t image_pixel) const {
-    return image_pixel - static_cast<std::size_t>(film_y0) * static_cast<std::size_t>(result.plan.width);
-  }
-
-  // One tile's work.
+// One tile's buffers and intermediate results, which the device's next tile reuses.
+struct Renderer::TileWork {
+  std::unique_ptr<TileHits> primary_out;  // a tile's hit records, of the first surface
+  std::unique_ptr<TileHits> other_out;    // several surfaces: those of the next ones
   HitRecord* hits = nullptr;              // camera rays, row-major in the tile: primary_out mapped
   std::vector<std::uint8_t> hit_surface;  // several surfaces: which one each hit
   std::vector<glm::dvec3> secondary;      // per camera ray: what its bounces bring back
   bool any_secondary = false;
   std::vector<glm::dvec3> refined_colour;  // adaptive antialiasing: per pixel of the tile
   std::vector<double> refined_alpha;
+};
+
+// One device's share of the render's tallies, added into the result when every device is done.
+struct Renderer::DeviceTally {
+  std::vector<PassStats> stats;  // one per planned pass, in plan order
+  PrimarySummary primary_summary;
+  double shade_ms = 0;
+  std::vector<ProgramRecord> programs;
+  int tiles = 0;
+};
+
+// What every tile's passes on one device share while a render runs: the render's context, the device's kernels,
+// one tile's work, and the device's tallies.
+struct Renderer::Passes {
+  Passes(ClSession& se, Shared& sh, const Scene& s, const RenderOptions& o, Precision p, RenderResult& r)
+      : session(se), shared(sh), scene(s), options(o), precision(p), result(r) {
+    tally.stats.resize(r.plan.passes.size());
+  }
+  ClSession& session;
+  Shared& shared;
+  const Scene& scene;
+  const RenderOptions& options;
+  Precision precision;
+  RenderResult& result;            // its plan, basis and film are the render's; the tallies below are this device's
+  const Shader* shader = nullptr;  // the render's: shading is const, so the devices share one
+  RayBasis fine;                   // adaptive antialiasing: the rays of the n-times finer grid
+  DeviceKernels kernels;
+  TileWork work;
+  DeviceTally tally;
+  int film_y0 = 0;  // the image row of the film's row 0, and the output rows [first_row, end_row) kept
+  int first_row = 0, end_row = 0;
+  // A pixel of the image (its index in the whole image) in the film.
+  std::size_t film_pixel(std::size_t image_pixel) const {
+    return image_pixel - static_cast<std::size_t>(film_y0) * static_cast<std::size_t>(result.plan.width);
+  }
 
   PassStats* stats_of(PassKind kind) {
-    for (std::size_t i = 0; i < stats.size(); ++i)
-      if (result.plan.passes[i].kind == kind) return &stats[i];
+    for (std::size_t i = 0; i < tally.stats.size(); ++i)
+      if (result.plan.passes[i].kind == kind) return &tally.stats[i];
     return nullptr;
   }
   bool single() const { return precision != Precision::Double; }
@@ -265,9 +280,9 @@ inline void count_escalation(PassStats& stats, std::size_t program, const Escala
 template <typename Passes, typename RayOf>
 inline void escalate_doubted(Passes& p, PassStats& stats, std::size_t surface, HitRecord* records, std::size_t count,
                       RayOf ray_of) {
-  if (p.escalate_rays.empty()) return;
-  const EscalationCount done = p.escalate_rays[surface]->redo(records, count, ray_of, p.options.batch_rays);
-  count_escalation(stats, p.surfaces.size() + surface, done);
+  if (p.kernels.escalate_rays.empty()) return;
+  const EscalationCount done = p.kernels.escalate_rays[surface]->redo(records, count, ray_of, p.options.batch_rays);
+  count_escalation(stats, p.kernels.surfaces.size() + surface, done);
 }
 
 // Shadow rays from every hit of one batch, in groups of at most batch_rays surface points; ray(i) is the ray of hit i
@@ -294,20 +309,20 @@ inline ShadowData trace_shadows(Passes& p, const HitRecord* hits, std::size_t co
       points.push_back(hit_point(ray(data.points[k]), h));
       normals.emplace_back(h.normal_x, h.normal_y, h.normal_z);
     }
-    p.shadow_points->upload(points, normals);
-    for (const LightGroup& group : p.light_groups) {
+    p.kernels.shadow_points->upload(points, normals);
+    for (const LightGroup& group : p.kernels.light_groups) {
       // Each surface's kernel in turn; a light point one surface hides is not traced against the next. A ray
       // counts once, from the first surface's kernel, which traces every light point in front of the surface.
       std::vector<std::uint64_t> hidden;
-      for (std::size_t s = 0; s < p.shadows.size(); ++s) {
-        ShadowAnswer answer = p.shadows[s]->trace(*p.shadow_points, group.points, hidden);
+      for (std::size_t s = 0; s < p.kernels.shadows.size(); ++s) {
+        ShadowAnswer answer = p.kernels.shadows[s]->trace(*p.kernels.shadow_points, group.points, hidden);
         stats.kernel_ms += answer.kernel_ms;
         stats.program_ms[s] += answer.kernel_ms;
         ++stats.launches;
         if (s == 0) stats.rays += answer.rays_traced;
-        if (!p.escalate_shadows.empty()) {
-          count_escalation(stats, p.shadows.size() + s,
-                           p.escalate_shadows[s]->redo(points, normals, group.points, answer.undecided, answer.masks));
+        if (!p.kernels.escalate_shadows.empty()) {
+          count_escalation(stats, p.kernels.shadows.size() + s,
+                           p.kernels.escalate_shadows[s]->redo(points, normals, group.points, answer.undecided, answer.masks));
         }
         hidden = std::move(answer.masks);
       }

@@ -25,26 +25,26 @@ void add_counts(DeviceShare& into, const DeviceShare& more) {
 void Renderer::add_device_tallies(const std::vector<std::unique_ptr<Passes>>& devices, RenderResult& result) {
   const RenderPlan& plan = result.plan;
   for (std::size_t i = 0; i < plan.passes.size(); ++i) {
-    PassStats total = devices.front()->stats[i];
-    for (std::size_t d = 1; d < devices.size(); ++d) add_counts(total, devices[d]->stats[i]);
+    PassStats total = devices.front()->tally.stats[i];
+    for (std::size_t d = 1; d < devices.size(); ++d) add_counts(total, devices[d]->tally.stats[i]);
     total.name = to_string(plan.passes[i].kind);
     result.passes.push_back(total);
   }
   // Every device loads the same programs; the first device's records stand for them, each device's load time
   // is in its share.
-  result.programs = devices.front()->programs;
+  result.programs = devices.front()->tally.programs;
   for (const auto& passes : devices) {
-    result.primary += passes->primary_summary;
-    result.shade_ms += passes->shade_ms;
+    result.primary += passes->tally.primary_summary;
+    result.shade_ms += passes->tally.shade_ms;
     DeviceShare share;
     share.index = passes->session.info.index;
     share.name = passes->session.info.name;
-    share.tiles = passes->tiles;
-    for (const PassStats& pass : passes->stats) {
+    share.tiles = passes->tally.tiles;
+    for (const PassStats& pass : passes->tally.stats) {
       share.rays += pass.rays;
       share.kernel_ms += pass.kernel_ms;
     }
-    for (const ProgramRecord& program : passes->programs) share.programs_ms += program.build_ms;
+    for (const ProgramRecord& program : passes->tally.programs) share.programs_ms += program.build_ms;
     result.devices.push_back(share);
   }
 }
