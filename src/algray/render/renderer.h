@@ -188,6 +188,10 @@ class Renderer {
                          const std::function<FrameImage()>& film);
   static void add_device_tallies(const std::vector<std::unique_ptr<Passes>>& devices, RenderResult& result);
   void prepare_passes(Passes& passes, bool first_device);
+  void prepare_primary(Passes& passes, bool first_device);
+  void prepare_shadows(Passes& passes, PassStats& stats);
+  void prepare_escalation(Passes& passes);
+  void prepare_secondary(Passes& passes);
   // The primary kernels' arguments for a band of tiles (a row of them), but the tile's own.
   void set_band_args(Passes& passes, const Tile& first);
   void trace_primary(Passes& passes, const Tile& tile);

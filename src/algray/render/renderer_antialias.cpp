@@ -1,6 +1,7 @@
 // Adaptive antialiasing: the pixels of a tile whose colour differs from a neighbour's, traced again on the finer
 // grid.
 #include <utility>
+
 #include "algray/render/renderer_parts.h"
 
 namespace algray {

@@ -1,5 +1,6 @@
 // A tile's reflected and transmitted rays, bounce by bounce, up to the plan's depth.
 #include <utility>
+
 #include "algray/render/renderer_parts.h"
 
 namespace algray {
@@ -48,7 +49,8 @@ void Renderer::run_bounces(Passes& passes, const Tile& tile, std::vector<Bounce>
     if (batch.rays.empty()) continue;
     trace_batch(passes, batch);
     const auto start = std::chrono::steady_clock::now();
-    passes.shader->add_batch(batch, refinement ? passes.work.refined_colour : passes.work.secondary, passes.work.refined_alpha);
+    passes.shader->add_batch(batch, refinement ? passes.work.refined_colour : passes.work.secondary,
+                             passes.work.refined_alpha);
     passes.work.any_secondary = true;
     passes.tally.shade_ms += ms_since(start);
     for (std::size_t i = 0; i < batch.rays.size(); ++i)

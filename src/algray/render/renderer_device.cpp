@@ -3,15 +3,15 @@
 #include <cstdio>
 #include <future>
 #include <utility>
+
 #include "algray/render/renderer_parts.h"
 
 namespace algray {
 using namespace renderer_parts;
 
-void Renderer::prepare_passes(Passes& passes, bool first_device) {
-  const Scene& scene = passes.scene;
-  RenderResult& result = passes.result;
-  const RenderPlan& plan = result.plan;
+// The device's camera-ray kernels, one per surface, and a tile's hit-record buffers.
+void Renderer::prepare_primary(Passes& passes, bool first_device) {
+  const RenderPlan& plan = passes.result.plan;
   PassStats& primary = *passes.stats_of(PassKind::Primary);
   // The largest tile: a tile's hit records are all the device holds for the camera rays. Their memory (32 MB
   // at 1024^2) is populated on another thread while this one loads the programs, a core's work either way.
@@ -29,67 +29,93 @@ void Renderer::prepare_passes(Passes& passes, bool first_device) {
         }
         return PopulatedPages(bytes);
       });
-  for (std::size_t s = 0; s < scene.surfaces.size(); ++s) {
+  DeviceKernels& kernels = passes.kernels;
+  for (const KernelConfig& config : plan.find(PassKind::Primary)->kernels) {
     ProgramRecord record;
-    passes.kernels.primary.push_back(cache_.kernel(passes.session, plan.find(PassKind::Primary)->kernels[s], &record));
-    passes.kernels.primary_lanes.push_back(plan.find(PassKind::Primary)->kernels[s].lanes);
-    passes.kernels.screen_rows.emplace_back();
+    kernels.primary.push_back(cache_.kernel(passes.session, config, &record));
+    kernels.primary_lanes.push_back(config.lanes);
+    kernels.screen_rows.emplace_back();
     passes.tally.programs.push_back(record);
     primary.program_keys.push_back(record.key);
     primary.program_ms.push_back(0);
   }
   passes.work.primary_out =
       std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays, hit_memory.get());
-  if (scene.surfaces.size() > 1)
+  if (passes.scene.surfaces.size() > 1)
     passes.work.other_out =
         std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays, PopulatedPages(bytes));
+}
 
-  if (PassStats* stats = passes.stats_of(PassKind::Shadow)) {
-    const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
-    for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-      passes.kernels.shadows.push_back(std::make_unique<ShadowTracer>(
-          passes.session, cache_, plan.find(PassKind::Shadow)->kernels[i], *passes.kernels.surfaces[i], offset));
-      passes.tally.programs.push_back(passes.kernels.shadows.back()->program());
-      stats->program_keys.push_back(passes.kernels.shadows.back()->program().key);
-      stats->program_ms.push_back(0);
-    }
-    passes.kernels.shadow_points = std::make_unique<ShadowPoints>(passes.session, passes.precision);
-    std::vector<std::vector<glm::dvec3>> light_points;  // per shadow-casting light of the plan
-    for (int light : plan.shadow_lights)
-      light_points.push_back(scene.lights[static_cast<std::size_t>(light)].sample_points());
-    passes.kernels.light_groups = group_lights(light_points);
+// The device's shadow tracers, one per surface, and the plan's shadow-casting lights in launch groups.
+void Renderer::prepare_shadows(Passes& passes, PassStats& stats) {
+  const Scene& scene = passes.scene;
+  const RenderPlan& plan = passes.result.plan;
+  DeviceKernels& kernels = passes.kernels;
+  const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
+  for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+    kernels.shadows.push_back(std::make_unique<ShadowTracer>(
+        passes.session, cache_, plan.find(PassKind::Shadow)->kernels[i], *kernels.surfaces[i], offset));
+    passes.tally.programs.push_back(kernels.shadows.back()->program());
+    stats.program_keys.push_back(kernels.shadows.back()->program().key);
+    stats.program_ms.push_back(0);
   }
-  // Adaptive precision: every ray pass escalates to the same mixed trace kernels.
+  kernels.shadow_points = std::make_unique<ShadowPoints>(passes.session, passes.precision);
+  std::vector<std::vector<glm::dvec3>> light_points;  // per shadow-casting light of the plan
+  for (int light : plan.shadow_lights)
+    light_points.push_back(scene.lights[static_cast<std::size_t>(light)].sample_points());
+  kernels.light_groups = group_lights(light_points);
+}
+
+// Adaptive precision: every ray pass escalates to the same mixed trace kernels, and shadow rays to the second
+// pass's shadow kernels.
+void Renderer::prepare_escalation(Passes& passes) {
+  const Scene& scene = passes.scene;
+  const RenderPlan& plan = passes.result.plan;
+  DeviceKernels& kernels = passes.kernels;
   if (const PlannedPass* primary_pass = plan.find(PassKind::Primary); !primary_pass->escalation.empty()) {
     for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-      passes.kernels.escalate_rays.push_back(
+      kernels.escalate_rays.push_back(
           std::make_unique<RayEscalation>(passes.session, cache_, primary_pass->escalation[i], scene, i));
-      passes.tally.programs.push_back(passes.kernels.escalate_rays.back()->program());
+      passes.tally.programs.push_back(kernels.escalate_rays.back()->program());
     }
     if (const PlannedPass* shadow_pass = plan.find(PassKind::Shadow)) {
       const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
       for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-        passes.kernels.escalate_shadows.push_back(
+        kernels.escalate_shadows.push_back(
             std::make_unique<ShadowEscalation>(passes.session, cache_, shadow_pass->escalation[i], scene, i, offset));
-        passes.tally.programs.push_back(passes.kernels.escalate_shadows.back()->program());
+        passes.tally.programs.push_back(kernels.escalate_shadows.back()->program());
       }
     }
   }
-  // Every secondary pass launches the same trace kernels.
+}
+
+// Every secondary pass (reflection, transmission, adaptive antialiasing) launches the same trace kernels.
+void Renderer::prepare_secondary(Passes& passes) {
+  const RenderPlan& plan = passes.result.plan;
+  DeviceKernels& kernels = passes.kernels;
   for (PassKind kind : {PassKind::Reflection, PassKind::Transmission, PassKind::Antialias})
     if (PassStats* stats = passes.stats_of(kind)) {
-      if (passes.kernels.rays.empty())
-        for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-          passes.kernels.rays.push_back(
-              std::make_unique<RayTracer>(passes.session, cache_, plan.find(kind)->kernels[i], *passes.kernels.surfaces[i]));
-          passes.tally.programs.push_back(passes.kernels.rays.back()->program());
+      if (kernels.rays.empty())
+        for (std::size_t i = 0; i < passes.scene.surfaces.size(); ++i) {
+          kernels.rays.push_back(
+              std::make_unique<RayTracer>(passes.session, cache_, plan.find(kind)->kernels[i], *kernels.surfaces[i]));
+          passes.tally.programs.push_back(kernels.rays.back()->program());
         }
-      for (const auto& tracer : passes.kernels.rays) {
+      for (const auto& tracer : kernels.rays) {
         stats->program_keys.push_back(tracer->program().key);
         stats->program_ms.push_back(0);
       }
     }
+}
+
+// The device's kernels, tracers and tile buffers for the plan's passes, with their programs in the tallies.
+void Renderer::prepare_passes(Passes& passes, bool first_device) {
+  prepare_primary(passes, first_device);
+  if (PassStats* stats = passes.stats_of(PassKind::Shadow)) prepare_shadows(passes, *stats);
+  prepare_escalation(passes);
+  prepare_secondary(passes);
   // The pass's stats list its escalation kernels after its own.
+  const RenderPlan& plan = passes.result.plan;
   for (std::size_t i = 0; i < plan.passes.size(); ++i)
     for (const KernelConfig& config : plan.passes[i].escalation) {
       passes.tally.stats[i].program_keys.push_back(config.key());
@@ -131,9 +157,9 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
     args.plain("tile_w", static_cast<cl_uint>(tile.trace_w));
     args.plain("tile_h", static_cast<cl_uint>(tile.trace_h));
     cl::Event done;
-    passes.session.queue.enqueueNDRangeKernel(kernel, cl::NullRange,
-                                              primary_global_size(passes.kernels.primary_lanes[s], tile.trace_w, tile.trace_h),
-                                              primary_local_size(passes.kernels.primary_lanes[s]), nullptr, &done);
+    passes.session.queue.enqueueNDRangeKernel(
+        kernel, cl::NullRange, primary_global_size(passes.kernels.primary_lanes[s], tile.trace_w, tile.trace_h),
+        primary_local_size(passes.kernels.primary_lanes[s]), nullptr, &done);
     // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
     done.wait();
     pass.kernel_ms += ms_between(done);
