@@ -113,7 +113,7 @@ ALGRAY_INLINE REAL largest_magnitude(const REAL* c) {
   (REAL_EPS * fmax((REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * (scale), (REAL)ALGRAY_TERMS_FACTOR * (terms)))
 
 #if ALGRAY_ESCALATE
-/* The noise of one scalar search: DOUBT_NOISE of its coefficients' size and its ray's terms, on the terms' upper
+/* The noise of one ray's search (the Bernstein search's at LANES = 1): DOUBT_NOISE of its coefficients' size and its ray's terms, on the terms' upper
  * bound until a value falls within it (RayTerms in restrict.h). */
 typedef struct {
   REAL scale;       /* max |b_k| of the coefficients the search starts from */

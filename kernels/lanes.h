@@ -7,10 +7,9 @@
 /* PoCL runs a CPU work-group's work-items one after another, and the solver's loops keep its vectoriser from
  * merging them, so each ray's divisions and Horner chains wait on one another. Code written over LREAL runs
  * LANES rays at once instead: every lane takes the same steps, a lane that has finished keeps its state
- * through LANE_SEL, and a loop ends when every lane has. Each lane's arithmetic is the scalar code's,
- * operation for operation, so a lane's result is the scalar build's bit for bit (bench/lockstep_lanes checks
- * this on 2^20 polynomials per degree). With LANES = 1 the same code is the scalar build: GPUs, the probe,
- * and the other kernels.
+ * through LANE_SEL, and a loop ends when every lane has. Each lane's arithmetic is one ray's, operation for
+ * operation, so a lane's result is the LANES = 1 build's bit for bit (tests/test_lanes). With LANES = 1 the same
+ * code is the one-ray build: GPUs, the probe, and the other kernels.
  *
  * LMASK is what a comparison of LREALs gives: 0 or 1 for scalars, 0 or -1 (all bits) per lane for vectors. So
  * masks combine with !, && and ||, never ~, and count with LANE_SEL((LMASK)0, (LMASK)1, m). */

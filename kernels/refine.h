@@ -36,7 +36,7 @@ LMASK value_within_rounding(const LREAL* c, LREAL y, LREAL fy, LREAL scale) {
 
 #if REFINEMENT == ALGRAY_REFINEMENT_BRENT
 /* Dekker-Brent over lanes (lanes.h): each lane where `running` is set refines its own polynomial, and a lane
- * that has stopped keeps its state, so every lane ends as the scalar loop would, bit for bit. *iterations gets
+ * that has stopped keeps its state, so every lane ends as one ray alone would, bit for bit. *iterations gets
  * each lane's count of function evaluations.
  * A lane with a start in (0, 1) (isolated_start: degree 2's formula) evaluates it first: it becomes b, the
  * bracket's end of the other sign c, and the other end a; the stopping rule then decides as always. Without a

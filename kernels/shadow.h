@@ -230,7 +230,8 @@ typedef struct {
   uint count;
 } SearchQueue;
 
-/* The samples whose queued segments hold a root, by isolate_bernstein's search; the queue is emptied. */
+/* The samples whose queued segments hold a root, by the Bernstein search over the queue's lanes; the queue is
+ * emptied. */
 ulong search_queued(SearchQueue* queue) {
   ulong found = 0;
   LREAL cur[NCOEF];

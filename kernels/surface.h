@@ -469,7 +469,7 @@ void hit_records(uint count, const LaneRays* rays, const LaneRays* at, const Lan
 #define SCREEN_LANES 1
 /* The screen form's coefficients for a group of lanes at once: screen_ray_taylor, restrict_from_taylor and
  * bernstein_from_scaled over lanes, each lane with the operations of the vector Horner steps that those run one
- * ray at a time (restrict.h), so every lane's coefficients are the one-ray kernel's bit for bit (tests/test_lanes).
+ * ray at a time (restrict.h), so every lane's coefficients are the one-ray build's bit for bit (tests/test_lanes).
  * One ray's steps are chains of dependent vector operations; over lanes the D + 1 coefficients' chains run side
  * by side. row: the image row's polynomials (screen_rows); xi: each lane's column; tau_in, tau_out: each lane's
  * segment about the row's t0. */
