@@ -6,7 +6,8 @@
 #include "ray.h"
 #include "real.h"
 
-#if ALGRAY_ESCALATE
+/* Adaptive precision's evaluations in float-float; compiled in every build and called by adaptive ones. */
+
 /* Float-float numbers hi + lo, |lo| within half an ulp of hi, of one ray or of lanes: each product and sum below
  * keeps its rounding error (fma, Knuth's two-sum), so its relative error is a few REAL_EPS^2, not REAL_EPS. */
 typedef struct {
@@ -151,6 +152,5 @@ void prove_end(LMASK take, const LaneRays* r, LREAL t_in, LREAL t_out, LREAL s, 
   p->value[1] = LANE_SEL(p->value[1], v, second);
   p->rounding[1] = LANE_SEL(p->rounding[1], rounding, second);
 }
-#endif
 
 #endif /* ALGRAY_FLOAT_FLOAT_H */

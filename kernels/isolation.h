@@ -112,9 +112,8 @@ ALGRAY_INLINE REAL largest_magnitude(const REAL* c) {
 #define DOUBT_NOISE(scale, terms) \
   (REAL_EPS * fmax((REAL)(ALGRAY_DOUBT_FACTOR * DEGREE) * (scale), (REAL)ALGRAY_TERMS_FACTOR * (terms)))
 
-#if ALGRAY_ESCALATE
-/* The noise of one ray's search (the Bernstein search's at LANES = 1): DOUBT_NOISE of its coefficients' size and its ray's terms, on the terms' upper
- * bound until a value falls within it (RayTerms in restrict.h). */
+/* The noise of one ray's search (the Bernstein search's at LANES = 1): DOUBT_NOISE of its coefficients' size
+ * and its ray's terms, on the terms' upper bound until a value falls within it (RayTerms in restrict.h). */
 typedef struct {
   REAL scale;       /* max |b_k| of the coefficients the search starts from */
   const REAL* root; /* those coefficients, for the noise local to an interval */
@@ -204,7 +203,6 @@ int within_noise_at(SearchNoise* n, REAL value, REAL lo, REAL hi) {
   }
   return fabs(value) <= n->part_noise;
 }
-#endif
 
 /* Every isolation takes the ray's terms (RayTerms in restrict.h), which adaptive builds measure their noise by and
  * others never read: callers outside adaptive builds may pass a RayTerms they never filled. */

@@ -80,8 +80,6 @@ typedef struct {
   REAL t_in, t_out;
 } RayTerms;
 
-#if ALGRAY_ESCALATE
-
 /* Terms of a known size (exact from the start): coefficients given as they are. */
 RayTerms known_terms(REAL value) {
   RayTerms t;
@@ -211,7 +209,6 @@ REAL ray_terms_within_part(const RayTerms* t, REAL lo, REAL hi) {
   const REAL3 q = part_coordinates(t, lo, hi);
   return terms_within(t->coefs, t->count, fmax(q.x, fmax(q.y, q.z)));
 }
-#endif
 
 /* c (degree n) plus a * one^n. binomials[n * NCOEF + k] = C(n, k), zero for k > n. */
 ALGRAY_INLINE void poly_add_constant(REAL* c, int n, REAL a, __constant const REAL* binomials) {

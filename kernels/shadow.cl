@@ -27,7 +27,9 @@
 
 #if RAY_ORIGIN != ALGRAY_ORIGIN_POINT
 
-#if ALGRAY_ESCALATE
+/* Adaptive builds' checks of the signs against the noise (the helpers below compile everywhere, adaptive builds
+ * call them). */
+
 /* C(DEGREE, k): a constant wherever k is one (the loops below unroll), so no division is left at run time. */
 ALGRAY_INLINE REAL degree_binomial(int k) {
   ulong c = 1;
@@ -83,7 +85,6 @@ ALGRAY_INLINE int signs_clear_of(const REAL* c, int by_signs, REAL scale, REAL t
   for (int k = 1; k <= DEGREE; ++k) clear &= fabs(c[k]) > noise * degree_binomial(k);
   return clear;
 }
-#endif
 
 /* Whether the segment, restricted to root (and root_lo, both consumed), holds a root: what shadow_isolation (or,
  * where it is not built, isolate_restricted) reports, without it when the coefficients' signs already settle it
@@ -98,36 +99,22 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
                                    AxisFactor fx, AxisFactor fy, AxisFactor fz, REAL extent_terms,
                                    const REAL* clear_limit) {
   *doubt = 0;
-#if ALGRAY_ESCALATE
-  if (one_sign_beyond(root, clear_limit)) return 0;
-#else
-  (void)clear_limit;
-#endif
+  if (ALGRAY_ESCALATE && one_sign_beyond(root, clear_limit)) return 0;
+  int by_signs = -1; /* bernstein_root_by_signs' answer, -1 for none */
+  REAL scale = 0;
 #if !ISOLATION_POWER_BASIS
-  const int by_signs = bernstein_root_by_signs(root);
-#if ALGRAY_ESCALATE
-  const REAL scale = by_signs == ISOLATION_NONE ? search_scale_bound(root) : 0;
-  if (by_signs >= 0 && signs_clear_of(root, by_signs, scale, extent_terms))
+  by_signs = bernstein_root_by_signs(root);
+  if (ALGRAY_ESCALATE && by_signs == ISOLATION_NONE) scale = search_scale_bound(root);
+  if (by_signs >= 0 && (!ALGRAY_ESCALATE || signs_clear_of(root, by_signs, scale, extent_terms)))
     return by_signs != ISOLATION_NONE;
-#else
-  if (by_signs >= 0) return by_signs != ISOLATION_NONE;
-#endif
 #endif
   RayTerms terms;
-#if ALGRAY_ESCALATE
-  terms = ray_terms(exps, coefs, count, fx, fy, fz);
-  if (by_signs >= 0 && (signs_clear_of(root, by_signs, scale, terms.value) ||
-                        signs_clear_of(root, by_signs, scale, ray_terms_exact(&terms))))
-    return by_signs != ISOLATION_NONE;
-#else
-  (void)exps;
-  (void)coefs;
-  (void)count;
-  (void)fx;
-  (void)fy;
-  (void)fz;
-  (void)extent_terms;
-#endif
+  if (ALGRAY_ESCALATE) {
+    terms = ray_terms(exps, coefs, count, fx, fy, fz);
+    if (by_signs >= 0 && (signs_clear_of(root, by_signs, scale, terms.value) ||
+                          signs_clear_of(root, by_signs, scale, ray_terms_exact(&terms))))
+      return by_signs != ISOLATION_NONE;
+  }
   REAL iso_c[NCOEF];
 #if SHADOW_SAMPLED
   restricted_to_isolation_basis(root, root_lo, binomials, NO_PROBE);
@@ -172,18 +159,14 @@ __kernel void shadow(__global const REAL4* points, __global const float4* normal
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
   ulong mask = occluded[i], unsure = 0;
   uint traced = 0;
-#if ALGRAY_ESCALATE
-  const REAL extent_terms = terms_within(mono_coefs, mono_count, 1); /* unit coordinates are at most 1 */
-  /* Every Bernstein coefficient of a segment in the extent is at most its terms, which extent_terms bounds with
-   * room to spare, so no coefficients' scale makes the search's noise larger than noise_bound's. */
+  /* Adaptive builds: every Bernstein coefficient of a segment in the extent is at most its terms, which
+   * extent_terms bounds with room to spare, so no coefficients' scale makes the search's noise larger than
+   * noise_bound's. */
+  const REAL extent_terms = ALGRAY_ESCALATE ? terms_within(mono_coefs, mono_count, 1) : 0; /* |u| <= 1 */
   REAL clear_limit[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k)
-    clear_limit[k] = noise_bound(extent_terms) * (REAL)(1 + 8 * REAL_EPS) * degree_binomial(k);
-#else
-  const REAL extent_terms = 0;
-  const REAL* clear_limit = 0;
-#endif
+    clear_limit[k] = ALGRAY_ESCALATE ? noise_bound(extent_terms) * (REAL)(1 + 8 * REAL_EPS) * degree_binomial(k) : 0;
   /* The batch waiting for its restriction: ray r is light sample sample[r] on [t_in[r], t_out[r]]. */
   AxisFactor fx[RESTRICT_RAYS], fy[RESTRICT_RAYS], fz[RESTRICT_RAYS];
   REAL t_in[RESTRICT_RAYS], t_out[RESTRICT_RAYS];

@@ -94,7 +94,7 @@ ALGRAY_INLINE int sampled_sign_change(const REAL* b, int pieces, __constant cons
     negative |= sure[j] < 0;
   }
   if (!(positive && negative)) return 0;
-#if ALGRAY_ESCALATE
+  if (!ALGRAY_ESCALATE) return 1;
   /* The noise only where the signs change at all: it may need the ray's terms summed. The value at the start,
    * P at the shadow ray's origin, counts with the sign it has, as the search takes it (first_counted): measured
    * on the Barth decic (1024x768, no fp64), its noise check cost 20 ms of the shadow pass and moved no ray to
@@ -110,9 +110,6 @@ ALGRAY_INLINE int sampled_sign_change(const REAL* b, int pieces, __constant cons
     seen = sign;
   }
   return 0;
-#else
-  return 1;
-#endif
 }
 
 /* A shadow ray's answer from its segment's Bernstein coefficients b (and b_lo): a root where

@@ -151,7 +151,7 @@ void refine_rays(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in, 
     roots->flags |= LANE_SEL((LANE_INT_VEC)0, (LANE_INT_VEC)ALGRAY_HIT_DOUBT, flat);
   }
 }
-#if RAY_ORIGIN == ALGRAY_ORIGIN_EXTENT || RAY_ORIGIN == ALGRAY_ORIGIN_POINT
+
 /* The coordinates' factors of the ray o + t*d restricted to [t_in, t_out] as s in [0, 1], in the isolation's
  * basis: entry and exit points for the Bernstein form, entry point and chord for the power basis. */
 void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, AxisFactor* fx, AxisFactor* fy,
@@ -162,8 +162,6 @@ void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, Ax
   *fy = axis_factor(pa.y, l1.y, even_axes & 2);
   *fz = axis_factor(pa.z, l1.z, even_axes & 4);
 }
-
-#endif
 
 /* The restriction's result (scaled Bernstein coefficients, or a power basis) as the isolation method takes it. */
 void restricted_to_isolation_basis(REAL* root, REAL* root_lo, __constant const REAL* binomials, ProbeLog* probe_log) {
@@ -205,14 +203,14 @@ ALGRAY_INLINE void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out,
   AxisFactor fx, fy, fz;
   segment_factors(o, d, t_in, t_out, even_axes, &fx, &fy, &fz);
   restrict_to_ray(exps, coefs, count, binomials, fx, fy, fz, root, root_lo);
-#if ALGRAY_ESCALATE
-  *terms = ray_terms(exps, coefs, count, fx, fy, fz);
-  terms->has_ray = 1;
-  terms->o = o;
-  terms->d = d;
-  terms->t_in = t_in;
-  terms->t_out = t_out;
-#endif
+  if (ALGRAY_ESCALATE) {
+    *terms = ray_terms(exps, coefs, count, fx, fy, fz);
+    terms->has_ray = 1;
+    terms->o = o;
+    terms->d = d;
+    terms->t_in = t_in;
+    terms->t_out = t_out;
+  }
 #endif
   restricted_to_isolation_basis(root, root_lo, binomials, probe_log);
 }
@@ -230,7 +228,6 @@ Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global c
   return isolate_method(root, root_lo, t_in, t_out, iso_c, &terms, probe_log);
 }
 
-#if RAY_ORIGIN == ALGRAY_ORIGIN_EXTENT
 /* Isolates the smallest root on [t_in, t_out] from the coefficients restrict_to_rays made of segment_factors'
  * factors (root, root_lo are consumed), as isolate_on_segment would; iso_c gets the polynomial on the isolating
  * interval. */
@@ -239,7 +236,6 @@ Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, _
   restricted_to_isolation_basis(root, root_lo, binomials, probe_log);
   return isolate_method(root, root_lo, t_in, t_out, iso_c, terms, probe_log);
 }
-#endif
 
 /* The first `count` (<= LANES) of the rays, in unit coordinates (unit) and clipped to the extent: *lane_t_in,
  * *lane_t_out get each lane's segment (0 and 1 where it misses). Returns the lanes that enter the extent (none from
@@ -305,7 +301,6 @@ void isolate_rays(uint count, const int* in_extent, const LaneRays* rays, REAL (
  * rounding is still too large (surfaces whose monomials cancel by orders of magnitude, such as Chebyshev sums),
  * P is evaluated again in float-float, whose rounding is float's squared: over the lanes together, that costs less
  * than the second pass even in double (bench/history/2026-12.md, "Flat roots confirmed in float-float"). */
-#if ALGRAY_ESCALATE
 /* P at q from the monomials (the power tables of axis_powers, restrict.h), and a bound on its rounding: the
  * products, the sum, and the rounding of q's coordinates and of the coefficients, each of at most REAL_EPS / 2
  * per operation to first order, with room. */
@@ -367,7 +362,6 @@ void confirm_flat_roots(uint count, LaneRoots* roots, const LaneRays* at, const 
   if (LANE_ANY(confirmed)) PROBE(ALGRAY_EVENT_CONFIRMED, 0, 1u, 0u, v0, rounding0, v1, rounding1);
   roots->flags &= LANE_SEL((LANE_INT_VEC)(-1), (LANE_INT_VEC)(~ALGRAY_HIT_DOUBT), confirmed);
 }
-#endif
 
 /* grad P at (x, y, z), from the monomials, with a table of powers per axis; over lanes, each lane's point. */
 void surface_gradient(LREAL x, LREAL y, LREAL z, __global const uint* exps, __global const REAL* coefs,
@@ -573,9 +567,7 @@ int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, R
     at.oy = LANE_SEL(unit.oy, unit.oy + t * unit.dy, found);
     at.oz = LANE_SEL(unit.oz, unit.oz + t * unit.dz, found);
   }
-#if ALGRAY_ESCALATE
-  confirm_flat_roots(count, &roots, &at, &unit, exps, coefs, mono_count, probe_log);
-#endif
+  if (ALGRAY_ESCALATE) confirm_flat_roots(count, &roots, &at, &unit, exps, coefs, mono_count, probe_log);
   hit_records(count, rays, &at, &roots, exps, coefs, mono_count, records);
   return 1;
 }

@@ -665,14 +665,13 @@ void isolate_rays_together(uint count, const int* in_extent, const LaneRays* ray
                            REAL (*root_lo)[NCOEF], const REAL* t_in, const REAL* t_out, LaneIsolation* iso, LREAL* c,
                            RayTerms* terms, ProbeLog* probe_log) {
   for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
-  (void)rays; /* adaptive builds' search checks its accept doubts on them */
   LREAL lane_root[NCOEF], lane_root_lo[NCOEF], lane_t_in = 0, lane_t_out = 1, lane_terms = 0;
   for (int k = 0; k <= DEGREE; ++k) lane_root[k] = lane_root_lo[k] = 0;
   LMASK running = 0;
-#if ALGRAY_ESCALATE
-  LREAL x = 0, y = 0, z = 0; /* each ray's largest coordinates, where its terms are summed */
-  uint first = LANES; /* the first ray in the extent: its terms name the monomials */
-#endif
+  /* adaptive builds: each ray's largest coordinates, where its terms are summed, and the first ray in the extent,
+   * whose terms name the monomials */
+  LREAL x = 0, y = 0, z = 0;
+  uint first = LANES;
   for (uint j = 0; j < count; ++j) {
     if (!in_extent[j]) continue;
     lane_set_mask(&running, j, 1);
@@ -682,15 +681,14 @@ void isolate_rays_together(uint count, const int* in_extent, const LaneRays* ray
     }
     lane_set(&lane_t_in, j, t_in[j]);
     lane_set(&lane_t_out, j, t_out[j]);
-#if ALGRAY_ESCALATE
-    if (first == LANES) first = j;
-    lane_set(&x, j, terms[j].x);
-    lane_set(&y, j, terms[j].y);
-    lane_set(&z, j, terms[j].z);
-#endif
+    if (ALGRAY_ESCALATE) {
+      if (first == LANES) first = j;
+      lane_set(&x, j, terms[j].x);
+      lane_set(&y, j, terms[j].y);
+      lane_set(&z, j, terms[j].z);
+    }
   }
-#if ALGRAY_ESCALATE
-  if (LANE_ANY(running)) {
+  if (ALGRAY_ESCALATE && LANE_ANY(running)) {
     lane_terms = terms_sum(terms[first].exps, terms[first].coefs, terms[first].count, x, y, z);
     REAL terms_of[LANES];
     LANES_STORE(lane_terms, terms_of);
@@ -700,17 +698,15 @@ void isolate_rays_together(uint count, const int* in_extent, const LaneRays* ray
       terms[j].exact = 1;
     }
   }
-#endif
-  (void)lane_terms;
   if (LANE_ANY(running)) {
-    LaneTerms search_terms;
-#if ALGRAY_ESCALATE
-    search_terms.value = lane_terms;
-    search_terms.rays = rays;
-    search_terms.exps = terms[first].exps;
-    search_terms.coefs = terms[first].coefs;
-    search_terms.count = terms[first].count;
-#endif
+    LaneTerms search_terms; /* read by adaptive builds only */
+    if (ALGRAY_ESCALATE) {
+      search_terms.value = lane_terms;
+      search_terms.rays = rays;
+      search_terms.exps = terms[first].exps;
+      search_terms.coefs = terms[first].coefs;
+      search_terms.count = terms[first].count;
+    }
     isolate_bernstein_search(running, lane_root, lane_root_lo, lane_t_in, lane_t_out, iso, c, &search_terms,
                              probe_log);
   }
