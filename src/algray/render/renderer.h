@@ -196,6 +196,10 @@ class Renderer {
   void set_band_args(Passes& passes, const Tile& first);
   void trace_primary(Passes& passes, const Tile& tile);
   void trace_batch(Passes& passes, SecondaryBatch& batch);
+  // A traced batch shaded into `colour`, its hits as the next bounces, and the batch kept in the result where the
+  // caller keeps records (its samples as image positions: pixels for a refinement, rays otherwise).
+  std::vector<Bounce> shade_batch(Passes& passes, const Tile& tile, SecondaryBatch& batch,
+                                  std::vector<glm::dvec3>& colour);
   // The camera rays' shadows and bounces of one tile, and its pixels in the film.
   void finish_tile(Passes& passes, const Tile& tile);
   // Reflection and transmission rays, bounce by bounce from `depth`, from the hits in `current`.

@@ -37,21 +37,7 @@ void Renderer::refine_tile(Passes& passes, const Tile& tile, const std::vector<s
         }
     }
     trace_batch(passes, batch);
-    const auto start = std::chrono::steady_clock::now();
-    passes.shader->add_batch(batch, passes.work.refined_colour, passes.work.refined_alpha);
-    passes.tally.shade_ms += ms_since(start);
-    std::vector<Bounce> first;
-    for (std::size_t i = 0; i < batch.rays.size(); ++i)
-      if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
-        first.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i],
-                         batch.hit_surface.empty() ? std::uint8_t{0} : batch.hit_surface[i]});
-    if (passes.options.keep_records) {
-      const std::lock_guard<std::mutex> hold(passes.shared.lock);
-      for (std::uint32_t& sample : batch.sample)
-        sample = static_cast<std::uint32_t>(tile.pixel_in_image(sample, plan.width));
-      result.secondary.push_back(std::move(batch));
-    }
-    run_bounces(passes, tile, std::move(first), 1, true);
+    run_bounces(passes, tile, shade_batch(passes, tile, batch, passes.work.refined_colour), 1, true);
   }
   const auto start = std::chrono::steady_clock::now();
   for (std::uint32_t k : pixels)

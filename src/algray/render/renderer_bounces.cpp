@@ -48,27 +48,36 @@ void Renderer::run_bounces(Passes& passes, const Tile& tile, std::vector<Bounce>
     }
     if (batch.rays.empty()) continue;
     trace_batch(passes, batch);
-    const auto start = std::chrono::steady_clock::now();
-    passes.shader->add_batch(batch, refinement ? passes.work.refined_colour : passes.work.secondary,
-                             passes.work.refined_alpha);
+    std::vector<Bounce> found =
+        shade_batch(passes, tile, batch, refinement ? passes.work.refined_colour : passes.work.secondary);
     passes.work.any_secondary = true;
-    passes.tally.shade_ms += ms_since(start);
-    for (std::size_t i = 0; i < batch.rays.size(); ++i)
-      if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
-        next.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i],
-                        batch.hit_surface.empty() ? std::uint8_t{0} : batch.hit_surface[i]});
-    if (passes.options.keep_records) {
-      const std::lock_guard<std::mutex> hold(passes.shared.lock);
-      for (std::uint32_t& sample : batch.sample)
-        sample = refinement ? static_cast<std::uint32_t>(tile.pixel_in_image(sample, result.plan.width))
-                            : tile.ray_in_image(sample, result.plan.trace_width());
-      result.secondary.push_back(std::move(batch));
-    }
+    next.insert(next.end(), found.begin(), found.end());
   }
   // This bounce's rays are done with before the next bounce's are traced.
   current.clear();
   current.shrink_to_fit();
   run_bounces(passes, tile, std::move(next), depth + 1, refinement);
+}
+
+std::vector<Renderer::Bounce> Renderer::shade_batch(Passes& passes, const Tile& tile, SecondaryBatch& batch,
+                                                    std::vector<glm::dvec3>& colour) {
+  const auto start = std::chrono::steady_clock::now();
+  passes.shader->add_batch(batch, colour, passes.work.refined_alpha);
+  passes.tally.shade_ms += ms_since(start);
+  std::vector<Bounce> found;
+  for (std::size_t i = 0; i < batch.rays.size(); ++i)
+    if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
+      found.push_back({batch.sample[i], batch.weight[i], batch.rays[i], batch.hits[i],
+                       batch.hit_surface.empty() ? std::uint8_t{0} : batch.hit_surface[i]});
+  if (passes.options.keep_records) {
+    const RenderPlan& plan = passes.result.plan;
+    const std::lock_guard<std::mutex> hold(passes.shared.lock);
+    for (std::uint32_t& sample : batch.sample)
+      sample = batch.refinement ? static_cast<std::uint32_t>(tile.pixel_in_image(sample, plan.width))
+                                : tile.ray_in_image(sample, plan.trace_width());
+    passes.result.secondary.push_back(std::move(batch));
+  }
+  return found;
 }
 
 }  // namespace algray

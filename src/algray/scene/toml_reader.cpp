@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "algray/scene/located_text.h"
+
 namespace algray {
 
 std::string toml_quoted(const std::string& s) {
@@ -81,7 +83,9 @@ void check_toml_shape(const std::string& text, const std::string& source) {
   // A light lexer, not a parser: it skips strings and comments and counts the segments of each dotted chain
   // (a.b.c, also 1.5, which counts 2) and the depth of [ and {. toml++ recurses once per segment, so a key of
   // 50,000 parts overflowed the stack; nothing real comes near these limits.
-  std::size_t line = 1, column = 1;
+  TextCursor cursor(text);
+  const std::size_t& i = cursor.i;
+  const auto advance = [&](std::size_t n) { cursor.advance(n); };
   std::size_t chain = 0, chain_line = 0, chain_column = 0;
   bool after_dot = false;  // the chain's last token was a dot, so the next segment continues it
   int depth = 0;
@@ -99,19 +103,9 @@ void check_toml_shape(const std::string& text, const std::string& source) {
       fail(chain_line, chain_column,
            "a dotted key (or value) with more than " + std::to_string(kMaxTomlKeyParts) + " parts");
   };
-  for (std::size_t i = 0; i < text.size();) {
+  while (!cursor.done()) {
     const char c = text[i];
-    const std::size_t l = line, col = column;
-    const auto advance = [&](std::size_t n) {
-      for (std::size_t k = 0; k < n && i < text.size(); ++k, ++i) {
-        if (text[i] == '\n') {
-          ++line;
-          column = 1;
-        } else {
-          ++column;
-        }
-      }
-    };
+    const std::size_t l = static_cast<std::size_t>(cursor.line), col = static_cast<std::size_t>(cursor.column);
     if (c == '#') {
       while (i < text.size() && text[i] != '\n') advance(1);
       continue;
