@@ -34,15 +34,22 @@ SparsePoly SparsePoly::variable(int axis) {
   return p;
 }
 
+namespace {
+
+[[noreturn]] void throw_over_budget(const PolyBudget& budget) {
+  throw PolyTooLarge("the polynomial arithmetic is too large to expand here (more than " +
+                     std::to_string(static_cast<long long>(budget.limit)) + " coefficient products)");
+}
+
+}  // namespace
+
 SparsePoly multiply(const SparsePoly& a, const SparsePoly& b, PolyBudget& budget) {
   if (a.terms.empty() || b.terms.empty()) return {};
   if (a.degree() + b.degree() > budget.max_degree)
     throw PolyTooLarge("this product has degree " + std::to_string(a.degree() + b.degree()) +
                        "; algray draws degrees up to " + std::to_string(budget.max_degree));
   budget.work += static_cast<double>(a.terms.size()) * static_cast<double>(b.terms.size());
-  if (budget.work > budget.limit)
-    throw PolyTooLarge("the polynomial arithmetic is too large to expand here (more than " +
-                       std::to_string(static_cast<long long>(budget.limit)) + " coefficient products)");
+  if (budget.work > budget.limit) throw_over_budget(budget);
   // Products are summed in a dense table of the result's degree, far cheaper per product than map inserts.
   const int d = a.degree() + b.degree(), side = d + 1;
   thread_local std::vector<double> table;
@@ -75,7 +82,64 @@ SparsePoly power(const SparsePoly& p, long e, PolyBudget& budget) {
   return out;
 }
 
+namespace {
+
+long long binomial(int n, int k) {
+  long long b = 1;
+  for (int i = 1; i <= k; ++i) b = b * (n - k + i) / i;
+  return b;
+}
+
+// Which of x, y, z and the constant an affine form uses.
+struct FormSupport {
+  std::array<bool, 3> variables{};
+  bool constant = false;
+  int entries() const { return variables[0] + variables[1] + variables[2] + constant; }
+};
+
+// Terms of the power e of a form with k entries: one per way to share e among them, all nonzero.
+double power_terms(const FormSupport& f, int e) { return static_cast<double>(binomial(e + f.entries() - 1, f.entries() - 1)); }
+
+// At most how many terms the product of powers a and b of two forms has: the monomials in their variables whose
+// degree the products can reach (exact for forms in general position, an upper bound otherwise).
+double product_terms(const FormSupport& f, int a, const FormSupport& g, int b) {
+  const int variables = (f.variables[0] || g.variables[0]) + (f.variables[1] || g.variables[1]) +
+                        (f.variables[2] || g.variables[2]);
+  const int high = a + b, low = (f.constant ? 0 : a) + (g.constant ? 0 : b);
+  // Monomials of degree low..high in `variables` variables: those of degree <= high less those of degree < low.
+  const long long count = binomial(high + variables, variables) - (low > 0 ? binomial(low - 1 + variables, variables) : 0);
+  return std::min(static_cast<double>(count), power_terms(f, a) * power_terms(g, b));
+}
+
+// The coefficient products `substitute` will count, found from the term counts alone, so that a substitution past
+// the budget is refused before any of its work is done rather than when the work reaches the limit.
+double substitution_products(const SparsePoly& p, const std::array<FormSupport, 3>& forms) {
+  double products = 0;
+  std::array<int, 3> highest{};
+  std::map<std::pair<int, int>, double> xy_terms;
+  for (const auto& [e, c] : p.terms) {
+    for (std::size_t axis = 0; axis < 3; ++axis) highest[axis] = std::max(highest[axis], e[axis]);
+    auto [it, inserted] = xy_terms.emplace(std::make_pair(e[0], e[1]), 0.0);
+    if (inserted) {
+      products += power_terms(forms[0], e[0]) * power_terms(forms[1], e[1]);
+      it->second = product_terms(forms[0], e[0], forms[1], e[1]);
+    }
+    products += it->second * power_terms(forms[2], e[2]);
+  }
+  for (std::size_t axis = 0; axis < 3; ++axis)
+    for (int e = 1; e <= highest[axis]; ++e) products += power_terms(forms[axis], e - 1) * forms[axis].entries();
+  return products;
+}
+
+}  // namespace
+
 SparsePoly substitute(const SparsePoly& p, const std::array<std::array<double, 4>, 3>& m, PolyBudget& budget) {
+  std::array<FormSupport, 3> supports;
+  for (std::size_t r = 0; r < 3; ++r) {
+    for (std::size_t c = 0; c < 3; ++c) supports[r].variables[c] = m[r][c] != 0;
+    supports[r].constant = m[r][3] != 0;
+  }
+  if (budget.work + substitution_products(p, supports) > budget.limit) throw_over_budget(budget);
   std::array<SparsePoly, 3> forms;
   for (std::size_t r = 0; r < 3; ++r) {
     for (std::size_t c = 0; c < 3; ++c)

@@ -29,6 +29,7 @@ struct PolyTooLarge : std::runtime_error {
 struct PolyBudget {
   double work = 0;
   double limit = 1e8;  // under a second in Release; a dense poly of degree 32 moved by a transform needs more
+                       // (substitute refuses such a move before it starts, from the term counts)
   int max_degree = kMaxDegree;
 };
 
