@@ -184,6 +184,7 @@ TEST_CASE("lanes give the one-ray kernel's hit records where groups settle witho
 
 // Reflection and transmission rays of a random surface, traced by the trace kernel: its lanes against one ray
 // per work-item, in every precision. In adaptive precision the camera rays' doubts go to the trace kernel too.
+// No light casts shadows (the headlight shades): the shadow kernel's lanes are test_shadows_batched's.
 TEST_CASE("secondary rays in lanes give the one-ray kernel's hit records bit for bit", "[lanes]") {
   ClSession& session = testing::device_session();
   ProgramCache cache(false);
@@ -195,7 +196,7 @@ TEST_CASE("secondary rays in lanes give the one-ray kernel's hit records bit for
       if (choice.value == Precision::Mixed && degree > kMaxMixedDegree) continue;
       const auto render = [&](int lanes) {
         return renderer.render_with_records(load_scene_text(
-            testing::random_scene(degree, seed, choice.value) + "[[light]]\nposition = [3, 3, 3]\n", "random",
+            testing::random_scene(degree, seed, choice.value), "random",
             {{"render.preview", "false"},
              {"image.width", "96"},
              {"image.height", "72"},

@@ -35,6 +35,19 @@ RayLaunch ray_launch(std::size_t count, std::size_t largest_group) {
   return {cl::NDRange((count + group - 1) / group * group), cl::NDRange(group)};
 }
 
+RayLaunch primary_launch(int lanes, int width, int height, std::size_t largest_group) {
+  // One ray per work-item: 8 x 8 pixels, as many as ray_launch's group and each one's neighbours' rays alike.
+  // Lanes multiply each work-item's private arrays, and PoCL keeps a work-group's on one thread's stack (its own
+  // choice of up to 4096 items overflowed it): rows of 16 work-items, 128 pixels at 8 lanes.
+  std::size_t group_x = lanes == 1 ? 8 : 16, group_y = lanes == 1 ? 8 : 1;
+  while (group_x * group_y > std::max<std::size_t>(largest_group, 1)) (group_y > 1 ? group_y : group_x) /= 2;
+  const auto whole_groups = [](std::size_t n, std::size_t group) { return (n + group - 1) / group * group; };
+  const std::size_t items = (static_cast<std::size_t>(width) + static_cast<std::size_t>(lanes) - 1) /
+                            static_cast<std::size_t>(lanes);
+  return {cl::NDRange(whole_groups(items, group_x), whole_groups(static_cast<std::size_t>(height), group_y)),
+          cl::NDRange(group_x, group_y)};
+}
+
 std::size_t largest_group(const cl::Kernel& kernel, const cl::Device& device) {
   return kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device);
 }

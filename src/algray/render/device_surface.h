@@ -31,6 +31,10 @@ struct RayLaunch {
   cl::NDRange global, local;
 };
 RayLaunch ray_launch(std::size_t count, std::size_t largest_group);
+// The launch that covers a width x height tile of camera rays, `lanes` pixels of a row per work-item
+// (kernels/primary.cl), in work-groups of a fixed shape for the same reason: tiles at the image's right and
+// bottom edges are narrower and shorter.
+RayLaunch primary_launch(int lanes, int width, int height, std::size_t largest_group);
 std::size_t largest_group(const cl::Kernel& kernel, const cl::Device& device);
 
 // Buffer of REAL values (double, or float for float and mixed precision) from doubles.

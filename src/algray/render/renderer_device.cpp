@@ -34,6 +34,7 @@ void Renderer::prepare_primary(Passes& passes, bool first_device) {
     ProgramRecord record;
     kernels.primary.push_back(cache_.kernel(passes.session, config, &record));
     kernels.primary_lanes.push_back(config.lanes);
+    kernels.primary_largest_group.push_back(largest_group(kernels.primary.back(), passes.session.info.device));
     kernels.screen_rows.emplace_back();
     passes.tally.programs.push_back(record);
     primary.program_keys.push_back(record.key);
@@ -157,9 +158,9 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
     args.plain("tile_w", static_cast<cl_uint>(tile.trace_w));
     args.plain("tile_h", static_cast<cl_uint>(tile.trace_h));
     cl::Event done;
-    passes.session.queue.enqueueNDRangeKernel(
-        kernel, cl::NullRange, primary_global_size(passes.kernels.primary_lanes[s], tile.trace_w, tile.trace_h),
-        primary_local_size(passes.kernels.primary_lanes[s]), nullptr, &done);
+    const RayLaunch launch = primary_launch(passes.kernels.primary_lanes[s], tile.trace_w, tile.trace_h,
+                                            passes.kernels.primary_largest_group[s]);
+    passes.session.queue.enqueueNDRangeKernel(kernel, cl::NullRange, launch.global, launch.local, nullptr, &done);
     // One tile at a time keeps each launch short (no GPU watchdog) and lets progress be shown.
     done.wait();
     pass.kernel_ms += ms_between(done);

@@ -24,18 +24,6 @@ inline double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-// A primary launch covers the tile with one work-item per `lanes` pixels of a row (kernels/primary.cl).
-inline constexpr std::size_t kLaneGroupWidth = 16;
-inline cl::NDRange primary_global_size(int lanes, int width, int height) {
-  const std::size_t w = static_cast<std::size_t>(width), h = static_cast<std::size_t>(height);
-  if (lanes == 1) return cl::NDRange(w, h);
-  const std::size_t items = (w + static_cast<std::size_t>(lanes) - 1) / static_cast<std::size_t>(lanes);
-  return cl::NDRange((items + kLaneGroupWidth - 1) / kLaneGroupWidth * kLaneGroupWidth, h);
-}
-// Lanes multiply each work-item's private arrays; PoCL keeps a work-group's on one thread's stack and picks
-// work-groups of up to 4096 items on its own, which overflows it (bench/lockstep_lanes crashed so). Rows of 16
-// work-items, 128 pixels at 8 lanes, keep it small; one-lane kernels keep the device's choice.
-inline cl::NDRange primary_local_size(int lanes) { return lanes == 1 ? cl::NullRange : cl::NDRange(kLaneGroupWidth, 1); }
 
 // Keeps, per ray, the nearer of the hits found so far (surface `best`) and `other`'s hits (surface `index`).
 // The solver work of both is added up, and a depth-limited isolation on either is kept, so the statistics
@@ -182,6 +170,7 @@ struct Renderer::DeviceKernels {
   std::vector<std::unique_ptr<DeviceSurface>> surfaces;  // one per scene surface
   std::vector<cl::Kernel> primary;                       // one per surface
   std::vector<int> primary_lanes;                        // per surface: its kernel's camera rays per work-item
+  std::vector<std::size_t> primary_largest_group;        // per surface: its kernel's work-group limit
   std::vector<cl::Buffer> screen_rows;                   // per surface: a band's rows for screen-form builds
   int band_y0 = -1;                                      // the band (row of tiles) whose arguments they hold
   std::vector<std::unique_ptr<ShadowTracer>> shadows;    // one per surface, when the plan has a shadow pass
