@@ -1142,21 +1142,9 @@ const char* light_type(LightKind k) {
   return "point";
 }
 
-}  // namespace
-
-std::string scene_to_toml(const Scene& scene) {
-  std::ostringstream out;
-  std::string origin = scene.name + ", as algray rendered it (from " + scene.source + ")";
-  for (char& ch : origin)
-    // A comment ends at the line's end, and TOML text must be UTF-8, which a file name need not be.
-    if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) >= 0x7f) ch = '?';
-  out << "# " << origin << "\n";
-  if (!scene.parameters.empty()) {
-    out << "\n[parameters]\n";
-    for (const auto& [name, value] : scene.parameters) out << name << " = " << toml_number(value) << "\n";
-  }
-  const bool several = scene.surfaces.size() > 1;
-  for (const SceneSurface& s : scene.surfaces) {
+void write_surfaces(std::ostringstream& out, const std::vector<SceneSurface>& surfaces) {
+  const bool several = surfaces.size() > 1;
+  for (const SceneSurface& s : surfaces) {
     out << (several ? "\n[[surface]]\n" : "\n[surface]\n");
     if (!s.name.empty()) out << "name = " << toml_quoted(s.name) << "\n";
     if (s.from_terms) {
@@ -1174,7 +1162,9 @@ std::string scene_to_toml(const Scene& scene) {
     write_material(out, "surface.material.front", s.materials.front);
     write_material(out, "surface.material.back", s.materials.back);
   }
-  const Extent& e = scene.extent;
+}
+
+void write_extent(std::ostringstream& out, const Extent& e) {
   if (e.kind == ExtentKind::Sphere)
     out << "\n[extent]\ntype = \"sphere\"\ncentre = " << toml_vector(e.centre) << "\nradius = " << toml_number(e.radius)
         << "\n";
@@ -1184,7 +1174,9 @@ std::string scene_to_toml(const Scene& scene) {
     out << "\n[extent]\ntype = \"cylinder\"\ncentre = " << toml_vector(e.centre)
         << "\nradius = " << toml_number(e.radius) << "\naxis = \""
         << "xyz"[e.axis] << "\"\nhalf_height = " << toml_number(e.half_height) << "\n";
-  const CameraSpec& c = scene.camera;
+}
+
+void write_camera(std::ostringstream& out, const CameraSpec& c) {
   const bool perspective = c.projection == Projection::Perspective;
   out << "\n[camera]\n";
   // The eye as placed, which reads back to the same rays; the angles it was placed by, for people.
@@ -1196,11 +1188,10 @@ std::string scene_to_toml(const Scene& scene) {
       << "\"\neye = " << toml_vector(c.eye) << "\nlook_at = " << toml_vector(c.look_at)
       << "\nup = " << toml_vector(c.up) << "\n"
       << (perspective ? "fov_y = " + toml_number(c.fov_y_degrees) : "height = " + toml_number(c.ortho_height)) << "\n";
-  const glm::dvec4& bg = scene.image.background;
-  out << "\n[image]\nwidth = " << scene.image.width << "\nheight = " << scene.image.height << "\nbackground = ["
-      << toml_number(bg.r) << ", " << toml_number(bg.g) << ", " << toml_number(bg.b) << ", " << toml_number(bg.a)
-      << "]\n";
-  for (const Light& world : scene.lights) {
+}
+
+void write_lights(std::ostringstream& out, const std::vector<Light>& lights) {
+  for (const Light& world : lights) {
     // A light attached to the camera is written in the camera's frame, as it was given, so that it still follows.
     const Light::CameraFrame l = world.in_camera.value_or(
         Light::CameraFrame{world.position, world.edge_u, world.edge_v, world.normal});
@@ -1214,14 +1205,9 @@ std::string scene_to_toml(const Scene& scene) {
     out << "colour = " << toml_vector(world.colour) << "\nintensity = " << toml_number(world.intensity)
         << "\nshadows = " << (world.shadows ? "true" : "false") << "\n";
   }
-  for (const Section& sec : scene.sections)
-    out << "\n[[section]]\nplane = [" << toml_number(sec.plane.x) << ", " << toml_number(sec.plane.y) << ", "
-        << toml_number(sec.plane.z) << ", " << toml_number(sec.plane.w) << "]\ncolour = " << toml_vector(sec.colour)
-        << "\n";
-  const Antialias& aa = scene.antialias;
-  out << "\n[antialias]\nsamples = " << aa.samples << "\nadaptive = " << (aa.adaptive ? "true" : "false")
-      << "\nthreshold = " << toml_number(aa.threshold) << "\n";
-  const RenderSettings& rs = scene.render;
+}
+
+void write_render(std::ostringstream& out, const RenderSettings& rs) {
   out << "\n[render]\nprecision = \"" << (rs.precision ? to_string(*rs.precision) : std::string("auto"))
       << "\"\ntolerance = " << toml_number(rs.tolerance) << "\nisolation = \"" << to_string(rs.isolation)
       << "\"\nrefinement = \"" << to_string(rs.refinement) << "\"\nray_origin = \"" << to_string(rs.ray_origin)
@@ -1229,6 +1215,37 @@ std::string scene_to_toml(const Scene& scene) {
   if (rs.max_iterations) out << "max_iterations = " << rs.max_iterations << "\n";
   if (rs.tile_size) out << "tile_size = " << rs.tile_size << "\n";
   if (rs.lanes) out << "lanes = " << rs.lanes << "\n";
+}
+
+}  // namespace
+
+std::string scene_to_toml(const Scene& scene) {
+  std::ostringstream out;
+  std::string origin = scene.name + ", as algray rendered it (from " + scene.source + ")";
+  for (char& ch : origin)
+    // A comment ends at the line's end, and TOML text must be UTF-8, which a file name need not be.
+    if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) >= 0x7f) ch = '?';
+  out << "# " << origin << "\n";
+  if (!scene.parameters.empty()) {
+    out << "\n[parameters]\n";
+    for (const auto& [name, value] : scene.parameters) out << name << " = " << toml_number(value) << "\n";
+  }
+  write_surfaces(out, scene.surfaces);
+  write_extent(out, scene.extent);
+  write_camera(out, scene.camera);
+  const glm::dvec4& bg = scene.image.background;
+  out << "\n[image]\nwidth = " << scene.image.width << "\nheight = " << scene.image.height << "\nbackground = ["
+      << toml_number(bg.r) << ", " << toml_number(bg.g) << ", " << toml_number(bg.b) << ", " << toml_number(bg.a)
+      << "]\n";
+  write_lights(out, scene.lights);
+  for (const Section& sec : scene.sections)
+    out << "\n[[section]]\nplane = [" << toml_number(sec.plane.x) << ", " << toml_number(sec.plane.y) << ", "
+        << toml_number(sec.plane.z) << ", " << toml_number(sec.plane.w) << "]\ncolour = " << toml_vector(sec.colour)
+        << "\n";
+  const Antialias& aa = scene.antialias;
+  out << "\n[antialias]\nsamples = " << aa.samples << "\nadaptive = " << (aa.adaptive ? "true" : "false")
+      << "\nthreshold = " << toml_number(aa.threshold) << "\n";
+  write_render(out, scene.render);
   return out.str();
 }
 
