@@ -72,6 +72,100 @@ std::vector<std::string> wrap(const std::string& text, std::size_t columns) {
   return lines;
 }
 
+void check_heatmap_input(int width, int height, const std::vector<std::uint32_t>& work,
+                         const std::vector<std::uint8_t>& in_extent) {
+  if (width < 0 || height < 0)
+    throw OutputError("invalid heat map size " + std::to_string(width) + "x" + std::to_string(height));
+  const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  if (work.size() != n)
+    throw OutputError("heat map work holds " + std::to_string(work.size()) + " values, expected " + std::to_string(n));
+  if (!in_extent.empty() && in_extent.size() != n)
+    throw OutputError("heat map extent mask holds " + std::to_string(in_extent.size()) + " values, expected " +
+                      std::to_string(n));
+}
+
+// Layout: the map at the origin, the bar to its right with the scale's name above it, the caption below.
+constexpr int kScale = 2, kBarWidth = 20, kGap = 16, kBarTop = 38, kMinBody = 220, kLine = 20;
+
+struct HeatmapLayout {
+  int body;  // the height of the map and bar, above the caption
+  int bar_x, bar_top, bar_bottom;
+  double bar_h;
+
+  HeatmapLayout(int width, int height)
+      : body(std::max(height, kMinBody)),
+        bar_x(width + kGap),
+        bar_top(kBarTop),
+        bar_bottom(body - 12),
+        bar_h(bar_bottom - bar_top) {}
+};
+
+struct Tick {
+  double value;
+  std::string label;
+};
+
+// The scale's ends, and round values between them where their labels keep clear of each other.
+std::vector<Tick> bar_ticks(const HeatmapScale& scale, const HeatmapLayout& layout) {
+  std::vector<Tick> ticks;
+  auto label = [](double v) { return format("%.0f", v); };
+  if (scale.pixels == 0) return ticks;
+  ticks.push_back({scale.min, label(scale.min)});
+  if (!(scale.max > scale.min)) return ticks;
+  std::vector<double> inner;
+  if (scale.logarithmic) {
+    for (double p = 1; p < scale.max; p *= 10)
+      if (p > scale.min) inner.push_back(p);
+  } else {
+    const double step = std::max(1.0, nice_step((scale.max - scale.min) / 5));
+    for (double v = std::ceil(scale.min / step) * step; v < scale.max; v += step)
+      if (v > scale.min) inner.push_back(v);
+  }
+  auto y_of = [&](double v) { return layout.bar_bottom - ramp_position(v, scale) * layout.bar_h; };
+  const int text_h = kGlyphH * kScale;
+  const double y_max = y_of(scale.max);
+  double last_y = y_of(scale.min);
+  for (double v : inner) {
+    const double y = y_of(v);
+    if (last_y - y >= text_h + 4 && y - y_max >= text_h + 4) {
+      ticks.push_back({v, label(v)});
+      last_y = y;
+    }
+  }
+  ticks.push_back({scale.max, label(scale.max)});
+  return ticks;
+}
+
+void paint_map(Canvas& canvas, int width, int height, const std::vector<std::uint32_t>& work,
+               const std::vector<std::uint8_t>& in_extent, const HeatmapScale& scale) {
+  const auto grey = unit(kOutOfExtent);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+      const bool inside = in_extent.empty() || in_extent[i];
+      canvas.set(x, y, inside ? work_colour(ramp_position(work[i], scale)) : grey);
+    }
+}
+
+// The bar: bright at the top like "more"; a single colour when every pixel did the same work.
+void paint_bar(Canvas& canvas, const HeatmapScale& scale, const HeatmapLayout& layout, const std::string& kind,
+               const std::vector<Tick>& ticks) {
+  const int bar_x = layout.bar_x, bar_top = layout.bar_top, bar_bottom = layout.bar_bottom;
+  for (int y = bar_top; y < bar_bottom; ++y) {
+    const bool single = scale.pixels > 0 && scale.max == scale.min;
+    const double u = single ? 0.5 : 1.0 - (y - bar_top + 0.5) / layout.bar_h;
+    for (int x = bar_x; x < bar_x + kBarWidth; ++x) canvas.set(x, y, work_colour(u));
+  }
+  canvas.text(bar_x, kBarTop / 2.0, kind, kScale, Anchor::Start, kInk);
+  for (const Tick& t : ticks) {
+    const double y = scale.max > scale.min ? bar_bottom - ramp_position(t.value, scale) * layout.bar_h
+                                           : (bar_top + bar_bottom) / 2.0;
+    const int yi = std::clamp(static_cast<int>(std::lround(y)), bar_top, bar_bottom - 1);
+    for (int x = bar_x + kBarWidth; x < bar_x + kBarWidth + 6; ++x) canvas.blend(x, yi, kInk, 1);
+    canvas.text(bar_x + kBarWidth + 10, yi, t.label, kScale, Anchor::Start, kInk);
+  }
+}
+
 }  // namespace
 
 HeatmapScale heatmap_scale(const std::vector<std::uint32_t>& work, const std::vector<std::uint8_t>& in_extent) {
@@ -92,57 +186,14 @@ HeatmapScale heatmap_scale(const std::vector<std::uint32_t>& work, const std::ve
 
 FrameImage work_heatmap(int width, int height, const std::vector<std::uint32_t>& work,
                         const std::vector<std::uint8_t>& in_extent, const std::string& caption) {
-  if (width < 0 || height < 0)
-    throw OutputError("invalid heat map size " + std::to_string(width) + "x" + std::to_string(height));
-  const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  if (work.size() != n)
-    throw OutputError("heat map work holds " + std::to_string(work.size()) + " values, expected " + std::to_string(n));
-  if (!in_extent.empty() && in_extent.size() != n)
-    throw OutputError("heat map extent mask holds " + std::to_string(in_extent.size()) + " values, expected " +
-                      std::to_string(n));
+  check_heatmap_input(width, height, work, in_extent);
   const HeatmapScale scale = heatmap_scale(work, in_extent);
-
-  // Layout: the map at the origin, the bar to its right with the scale's name above it, the caption below.
-  constexpr int kScale = 2, kBarWidth = 20, kGap = 16, kBarTop = 38, kMinBody = 220, kLine = 20;
-  const int text_h = kGlyphH * kScale;
-  const int body = std::max(height, kMinBody);
-  const int bar_x = width + kGap, bar_top = kBarTop, bar_bottom = body - 12;
-  const double bar_h = bar_bottom - bar_top;
-
-  struct Tick {
-    double value;
-    std::string label;
-  };
-  std::vector<Tick> ticks;
-  auto label = [](double v) { return format("%.0f", v); };
-  if (scale.pixels > 0) {
-    ticks.push_back({scale.min, label(scale.min)});
-    if (scale.max > scale.min) {
-      std::vector<double> inner;
-      if (scale.logarithmic) {
-        for (double p = 1; p < scale.max; p *= 10)
-          if (p > scale.min) inner.push_back(p);
-      } else {
-        const double step = std::max(1.0, nice_step((scale.max - scale.min) / 5));
-        for (double v = std::ceil(scale.min / step) * step; v < scale.max; v += step)
-          if (v > scale.min) inner.push_back(v);
-      }
-      auto y_of = [&](double v) { return bar_bottom - ramp_position(v, scale) * bar_h; };
-      const double y_max = y_of(scale.max);
-      double last_y = y_of(scale.min);
-      for (double v : inner) {
-        const double y = y_of(v);
-        if (last_y - y >= text_h + 4 && y - y_max >= text_h + 4) {
-          ticks.push_back({v, label(v)});
-          last_y = y;
-        }
-      }
-      ticks.push_back({scale.max, label(scale.max)});
-    }
-  }
+  const HeatmapLayout layout(width, height);
+  const std::vector<Tick> ticks = bar_ticks(scale, layout);
   std::size_t widest = 0;
   for (const Tick& t : ticks) widest = std::max(widest, t.label.size());
   const std::string kind = scale.pixels == 0 ? "no data" : scale.logarithmic ? "log scale" : "linear scale";
+  const int bar_x = layout.bar_x;
   const int panel_right =
       std::max(bar_x + kBarWidth + 10 + text_width(widest, kScale), bar_x + text_width(kind.size(), kScale)) + 12;
 
@@ -152,33 +203,13 @@ FrameImage work_heatmap(int width, int height, const std::vector<std::uint32_t>&
   full_caption += scale.pixels == 0 ? " (no pixel in the extent)"
                                     : " (" + kind + ", " + std::to_string(scale.pixels) + " pixels in the extent)";
   const std::vector<std::string> lines = wrap(full_caption, columns);
-  const int canvas_h = body + 8 + static_cast<int>(lines.size()) * kLine + 6;
+  const int canvas_h = layout.body + 8 + static_cast<int>(lines.size()) * kLine + 6;
 
   Canvas canvas(canvas_w, canvas_h, kPanel);
-  const auto grey = unit(kOutOfExtent);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
-      const bool inside = in_extent.empty() || in_extent[i];
-      canvas.set(x, y, inside ? work_colour(ramp_position(work[i], scale)) : grey);
-    }
-
-  // The bar: bright at the top like "more"; a single colour when every pixel did the same work.
-  for (int y = bar_top; y < bar_bottom; ++y) {
-    const bool single = scale.pixels > 0 && scale.max == scale.min;
-    const double u = single ? 0.5 : 1.0 - (y - bar_top + 0.5) / bar_h;
-    for (int x = bar_x; x < bar_x + kBarWidth; ++x) canvas.set(x, y, work_colour(u));
-  }
-  canvas.text(bar_x, kBarTop / 2.0, kind, kScale, Anchor::Start, kInk);
-  for (const Tick& t : ticks) {
-    const double y =
-        scale.max > scale.min ? bar_bottom - ramp_position(t.value, scale) * bar_h : (bar_top + bar_bottom) / 2.0;
-    const int yi = std::clamp(static_cast<int>(std::lround(y)), bar_top, bar_bottom - 1);
-    for (int x = bar_x + kBarWidth; x < bar_x + kBarWidth + 6; ++x) canvas.blend(x, yi, kInk, 1);
-    canvas.text(bar_x + kBarWidth + 10, yi, t.label, kScale, Anchor::Start, kInk);
-  }
+  paint_map(canvas, width, height, work, in_extent, scale);
+  paint_bar(canvas, scale, layout, kind, ticks);
   for (std::size_t i = 0; i < lines.size(); ++i)
-    canvas.text(8, body + 8 + (static_cast<double>(i) + 0.5) * kLine, lines[i], kScale, Anchor::Start, kInk);
+    canvas.text(8, layout.body + 8 + (static_cast<double>(i) + 0.5) * kLine, lines[i], kScale, Anchor::Start, kInk);
   return canvas.to_frame();
 }
 

@@ -96,26 +96,14 @@ void write_chunk(std::FILE* fp, const char type[4], const std::vector<unsigned c
   write_bytes(fp, suffix, sizeof suffix);
 }
 
-}  // namespace
+// How the image's rows fall into bands, and the bytes each band's filtered rows start from.
+struct BandPlan {
+  std::size_t height, row_bytes, band_rows, bands;
+  const PngRowSource& rows;
+  int level;
 
-void write_png_image_data(std::FILE* fp, std::size_t height, std::size_t row_bytes, const PngRowSource& rows, int level,
-                          std::size_t band_bytes, unsigned threads) {
-  const std::size_t band_rows =
-      std::clamp<std::size_t>(band_bytes / (row_bytes + 1), 1, std::max<std::size_t>(height, 1));
-  const std::size_t bands = (height + band_rows - 1) / band_rows;
-  if (threads == 0) threads = std::clamp(std::thread::hardware_concurrency(), 1u, 16u);
-  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(bands, 1)));
-  // Two bands per thread: one being deflated while the last one waits its turn to be written.
-  const std::size_t window = 2 * static_cast<std::size_t>(threads);
-  std::vector<Band> slots(window);
-
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::size_t next = 0, written = 0;  // the next band to deflate; bands written so far
-  bool stop = false;                  // a failure, here or in a worker: everyone stops
-  std::exception_ptr failure;
-
-  auto deflate_band = [&](std::size_t i, Band& band) {
+  // Reads band i's rows (and the row above it), Up-filters them and deflates them alone.
+  void deflate_band(std::size_t i, Band& band) const {
     const std::size_t y0 = i * band_rows, count = std::min(band_rows, height - y0);
     band.bytes.resize((count + 1) * row_bytes);
     if (y0 == 0)
@@ -134,92 +122,132 @@ void write_png_image_data(std::FILE* fp, std::size_t height, std::size_t row_byt
     }
     band.adler = adler32_z(adler32(0L, nullptr, 0), band.filtered.data(), band.filtered_size);
     deflate_alone(band.filtered.data(), band.filtered_size, i + 1 == bands, level, band.deflated);
-  };
-  auto work = [&] {
+  }
+};
+
+// Worker threads deflating bands into a ring of slots while one caller takes them in order to write them.
+class BandPipeline {
+ public:
+  BandPipeline(const BandPlan& plan, unsigned threads)
+      : plan_(plan), window_(2 * static_cast<std::size_t>(threads)), slots_(window_) {
+    try {
+      for (unsigned t = 0; t < threads; ++t) workers_.emplace_back([this] { work(); });
+    } catch (...) {
+      stop_and_join();  // no destructor runs for a constructor that throws
+      throw;
+    }
+  }
+  // Joined on every way out: a thread still running would use the slots.
+  ~BandPipeline() { stop_and_join(); }
+
+  // Band i once deflated; null when a worker failed.
+  Band* wait_for(std::size_t i) {
+    Band& band = slots_[i % window_];
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [&] { return stop_ || band.ready; });
+    return band.ready ? &band : nullptr;
+  }
+  // The band is written: its slot may take the band `window` later.
+  void written(Band& band) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    band.ready = false;
+    ++written_;
+    changed_.notify_all();
+  }
+  // The first failure is the one reported; every thread stops.
+  void fail(std::exception_ptr e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!failure_) failure_ = e;
+    stop_ = true;
+  }
+  void stop_and_join() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    changed_.notify_all();
+    for (std::thread& t : workers_) t.join();
+    workers_.clear();
+  }
+  std::exception_ptr failure() const { return failure_; }
+
+ private:
+  void work() {
     for (;;) {
       std::size_t i;
       {
-        std::unique_lock<std::mutex> lock(mutex);
-        changed.wait(lock, [&] { return stop || next >= bands || next < written + window; });
-        if (stop || next >= bands) return;
-        i = next++;
+        std::unique_lock<std::mutex> lock(mutex_);
+        changed_.wait(lock, [&] { return stop_ || next_ >= plan_.bands || next_ < written_ + window_; });
+        if (stop_ || next_ >= plan_.bands) return;
+        i = next_++;
       }
-      Band& band = slots[i % window];
+      Band& band = slots_[i % window_];
       try {
-        deflate_band(i, band);
+        plan_.deflate_band(i, band);
       } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-        stop = true;
-        changed.notify_all();
+        fail(std::current_exception());
+        changed_.notify_all();
         return;
       }
-      std::lock_guard<std::mutex> lock(mutex);
+      std::lock_guard<std::mutex> lock(mutex_);
       band.ready = true;
-      changed.notify_all();
+      changed_.notify_all();
     }
-  };
+  }
 
-  std::vector<std::thread> workers;
-  // Joined on every way out: a thread still running would use this frame's buffers.
-  struct Join {
-    std::vector<std::thread>& workers;
-    std::mutex& mutex;
-    std::condition_variable& changed;
-    bool& stop;
-    ~Join() {
-      {
-        std::lock_guard<std::mutex> lock(mutex);
-        stop = true;
-      }
-      changed.notify_all();
-      for (std::thread& t : workers) t.join();
-    }
-  } join{workers, mutex, changed, stop};
-  for (unsigned t = 0; t < threads; ++t) workers.emplace_back(work);
+  const BandPlan& plan_;
+  // Two bands per thread: one being deflated while the last one waits its turn to be written.
+  const std::size_t window_;
+  std::vector<Band> slots_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::size_t next_ = 0, written_ = 0;  // the next band to deflate; bands written so far
+  bool stop_ = false;                   // a failure, here or in a worker: everyone stops
+  std::exception_ptr failure_;
+  std::vector<std::thread> workers_;
+};
 
-  // The zlib header: deflate with a 32 KB window (0x78), and FLEVEL 0 (fastest) for level 1, else 2 (default);
-  // FCHECK makes the pair a multiple of 31.
+// The zlib header: deflate with a 32 KB window (0x78), and FLEVEL 0 (fastest) for level 1, else 2 (default);
+// FCHECK makes the pair a multiple of 31.
+std::vector<unsigned char> zlib_header(int level) {
   const unsigned flevel = level <= 1 ? 0 : 2;
   const unsigned cmf = 0x78, flg0 = flevel << 6;
-  const std::vector<unsigned char> zlib_head{static_cast<unsigned char>(cmf),
-                                             static_cast<unsigned char>(flg0 + (31 - (cmf * 256 + flg0) % 31) % 31)};
+  return {static_cast<unsigned char>(cmf), static_cast<unsigned char>(flg0 + (31 - (cmf * 256 + flg0) % 31) % 31)};
+}
+
+}  // namespace
+
+void write_png_image_data(std::FILE* fp, std::size_t height, std::size_t row_bytes, const PngRowSource& rows, int level,
+                          std::size_t band_bytes, unsigned threads) {
+  const std::size_t band_rows =
+      std::clamp<std::size_t>(band_bytes / (row_bytes + 1), 1, std::max<std::size_t>(height, 1));
+  const BandPlan plan{height, row_bytes, band_rows, (height + band_rows - 1) / band_rows, rows, level};
+  if (threads == 0) threads = std::clamp(std::thread::hardware_concurrency(), 1u, 16u);
+  threads = static_cast<unsigned>(std::min<std::size_t>(threads, std::max<std::size_t>(plan.bands, 1)));
+  BandPipeline pipeline(plan, threads);
+
+  const std::vector<unsigned char> zlib_head = zlib_header(level);
   const std::vector<unsigned char> none;
   uLong adler = adler32(0L, nullptr, 0);
-  for (std::size_t i = 0; i < bands; ++i) {
-    Band& band = slots[i % window];
-    {
-      std::unique_lock<std::mutex> lock(mutex);
-      changed.wait(lock, [&] { return stop || band.ready; });
-      if (!band.ready) break;  // a worker failed
-    }
-    adler = adler32_combine(adler, band.adler, static_cast<z_off_t>(band.filtered_size));
+  for (std::size_t i = 0; i < plan.bands; ++i) {
+    Band* band = pipeline.wait_for(i);
+    if (!band) break;  // a worker failed
+    adler = adler32_combine(adler, band->adler, static_cast<z_off_t>(band->filtered_size));
     std::vector<unsigned char> tail;
-    if (i + 1 == bands) {
+    if (i + 1 == plan.bands) {
       tail.resize(4);
       put_be32(tail.data(), static_cast<std::uint32_t>(adler));
     }
     try {
-      write_chunk(fp, "IDAT", i == 0 ? zlib_head : none, band.deflated, tail);
+      write_chunk(fp, "IDAT", i == 0 ? zlib_head : none, band->deflated, tail);
     } catch (...) {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (!failure) failure = std::current_exception();
-      stop = true;
+      pipeline.fail(std::current_exception());
       break;
     }
-    std::lock_guard<std::mutex> lock(mutex);
-    band.ready = false;
-    ++written;
-    changed.notify_all();
+    pipeline.written(*band);
   }
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    stop = true;
-  }
-  changed.notify_all();
-  for (std::thread& t : workers) t.join();
-  workers.clear();
-  if (failure) std::rethrow_exception(failure);
+  pipeline.stop_and_join();
+  if (pipeline.failure()) std::rethrow_exception(pipeline.failure());
   write_chunk(fp, "IEND", none, none, none);
 }
 

@@ -229,12 +229,7 @@ void add_marker_shapes(Drawing& d, PlotMarker::Kind kind, double x, double y_top
   }
 }
 
-Drawing draw_probe_plot(const ProbePlot& plot, const ProbePlotGeometry& g) {
-  Drawing d;
-  d.width = g.width;
-  d.height = g.height;
-  d.clip = {g.left, g.top, g.right, g.bottom};
-  d.title = plot.title;
+void add_headings(Drawing& d, const ProbePlot& plot, const ProbePlotGeometry& g) {
   const double text_room = g.width - 24;
   d.shapes.push_back(TextShape{g.width / 2.0, 20, plot.title, 2, text_room, Anchor::Middle});
   const CheckedPlot range{g.t_in, g.t_out};
@@ -242,9 +237,10 @@ Drawing draw_probe_plot(const ProbePlot& plot, const ProbePlotGeometry& g) {
                                "y = sign(P) log10(1+|P|/f), f = " + format("%.3g", g.floor) + " (" +
                                    floor_origin(visible_values(plot, range), g.floor) + ")",
                                2, g.right - g.left});
+}
 
-  // Shaded intervals first, so everything else stays visible on top; at least 2 px wide, or a tight
-  // interval around a root would vanish.
+// At least 2 px wide, or a tight interval around a root would vanish.
+void add_intervals(Drawing& d, const ProbePlot& plot, const ProbePlotGeometry& g) {
   for (const auto& [a, b] : plot.intervals) {
     if (!std::isfinite(a) || !std::isfinite(b) || std::max(a, b) < g.t_in || std::min(a, b) > g.t_out) continue;
     double x0 = g.x_of(std::max(std::min(a, b), g.t_in)), x1 = g.x_of(std::min(std::max(a, b), g.t_out));
@@ -255,13 +251,10 @@ Drawing draw_probe_plot(const ProbePlot& plot, const ProbePlotGeometry& g) {
     }
     d.shapes.push_back(RectShape{{x0, g.top, x1, g.bottom}, kInterval, kIntervalOpacity, true});
   }
+}
 
-  add_y_ticks(d, g);
-  add_t_ticks(d, g);
-  const double y0 = g.y_of(0);
-  d.shapes.push_back(LineShape{g.left, y0, g.right, y0, kZeroLine, 1.5, false, true});
-
-  // The curve, broken at non-finite values.
+// The curve, broken at non-finite values.
+void add_curve(Drawing& d, const ProbePlot& plot, const ProbePlotGeometry& g) {
   PolylineShape piece{{}, kCurve, 2, true};
   auto flush = [&] {
     if (!piece.points.empty()) d.shapes.push_back(piece);
@@ -275,19 +268,18 @@ Drawing draw_probe_plot(const ProbePlot& plot, const ProbePlotGeometry& g) {
     piece.points.emplace_back(g.x_of(plot.t[i]), g.y_of(plot.value[i]));
   }
   flush();
+}
 
-  // Markers by kind, so reference roots (open circles) stay visible over the roots found.
-  for (auto kind : {PlotMarker::Kind::IsolationEnd, PlotMarker::Kind::Root, PlotMarker::Kind::ReferenceRoot})
-    for (const PlotMarker& m : plot.markers)
-      if (m.kind == kind && in_range(m.t, g)) add_marker_shapes(d, kind, g.x_of(m.t), g.top, g.bottom, y0, true);
-
+void add_frame(Drawing& d, const ProbePlotGeometry& g) {
   d.shapes.push_back(RectShape{{g.left, g.top, g.right, g.top + 1}, kInk});
   d.shapes.push_back(RectShape{{g.left, g.bottom - 1, g.right, g.bottom}, kInk});
   d.shapes.push_back(RectShape{{g.left, g.top, g.left + 1, g.bottom}, kInk});
   d.shapes.push_back(RectShape{{g.right - 1, g.top, g.right, g.bottom}, kInk});
   d.shapes.push_back(TextShape{g.right, g.bottom + 42, "t", 2, 0, Anchor::End});
+}
 
-  // Legend: one row per curve, interval and marker, each with its swatch and its exact t.
+// Legend: one row per curve, interval and marker, each with its swatch and its exact t.
+void add_legend(Drawing& d, const ProbePlot& plot, const ProbePlotGeometry& g) {
   const double sx0 = g.left, sx1 = g.left + 36, tx = g.left + 48, room = g.width - tx - 12;
   double row = g.bottom + kLegendGap;
   std::size_t visible_samples = 0;
@@ -326,6 +318,28 @@ Drawing draw_probe_plot(const ProbePlot& plot, const ProbePlotGeometry& g) {
     d.shapes.push_back(
         TextShape{tx, row, label + ": t = " + t_text(m.t) + (in_range(m.t, g) ? "" : " (outside the plot)"), 2, room});
   }
+}
+
+Drawing draw_probe_plot(const ProbePlot& plot, const ProbePlotGeometry& g) {
+  Drawing d;
+  d.width = g.width;
+  d.height = g.height;
+  d.clip = {g.left, g.top, g.right, g.bottom};
+  d.title = plot.title;
+  add_headings(d, plot, g);
+  // Shaded intervals first, so everything else stays visible on top.
+  add_intervals(d, plot, g);
+  add_y_ticks(d, g);
+  add_t_ticks(d, g);
+  const double y0 = g.y_of(0);
+  d.shapes.push_back(LineShape{g.left, y0, g.right, y0, kZeroLine, 1.5, false, true});
+  add_curve(d, plot, g);
+  // Markers by kind, so reference roots (open circles) stay visible over the roots found.
+  for (auto kind : {PlotMarker::Kind::IsolationEnd, PlotMarker::Kind::Root, PlotMarker::Kind::ReferenceRoot})
+    for (const PlotMarker& m : plot.markers)
+      if (m.kind == kind && in_range(m.t, g)) add_marker_shapes(d, kind, g.x_of(m.t), g.top, g.bottom, y0, true);
+  add_frame(d, g);
+  add_legend(d, plot, g);
   return d;
 }
 

@@ -253,44 +253,35 @@ std::string no_list_message(const std::string& list, const std::string& index) {
   return m;
 }
 
-void apply_override(toml::table& root, const Override& o, std::vector<std::string>& notes) {
-  // A hostile key or value may be megabytes long: messages show its start.
-  const auto shown = [](const std::string& t) {
-    return t.size() <= 120 ? t : t.substr(0, 100) + "...(" + std::to_string(t.size()) + " characters)";
-  };
-  // A scene without [extent] has algray's sphere of radius kDefaultExtentRadius: extent.KEY changes that one.
-  if (o.key.rfind("extent.", 0) == 0 && !root.get("extent"))
-    root.insert("extent", toml::table{{"radius", kDefaultExtentRadius}});
-  if (o.key == kSectionOverrideKey) {
-    // The plane as written, or as a TOML string (Python's Scene.set and a job's set table quote it).
-    std::string plane = o.value;
-    if (!plane.empty() && (plane.front() == '"' || plane.front() == '\'')) try {
-        plane = toml::parse("v = " + plane)["v"].value_or(plane);
-      } catch (const toml::parse_error&) {
-        // not a TOML string after all: the plane's own reading says what is wrong
-      }
-    add_section(root, plane, (o.origin.empty() ? "--section " : o.origin + ": section ") + shown(plane));
-    return;
-  }
-  const std::string label = (o.origin.empty() ? "--set " : o.origin + ": set ") + shown(o.key) + "=" + shown(o.value);
-  // A bare name is a parameter; any other key is a dotted path into the scene. A bare name must be one of the
-  // scene's parameters, so that a typo is not a new parameter nothing uses; parameters.NAME adds one. A bare name
-  // that is no parameter but a top-level table of the scene is that table: --set 'section=[]' drops the sections.
-  const bool bare = o.key.find('.') == std::string::npos;
-  const toml::table* params = root["parameters"].as_table();
-  const bool top_table =
-      bare && (!params || !params->get(o.key)) && kTopKeys.count(o.key) && o.key != "parameters";
-  if (bare && is_identifier(o.key) && !top_table) {
-    if (!params || !params->get(o.key)) {
-      std::string names;
-      if (params)
-        for (auto&& [name, node] : *params) names += (names.empty() ? "" : ", ") + std::string(name.str());
-      throw SceneError(label, "the scene has no parameter '" + o.key + "'; " +
-                                  (names.empty() ? "it has no parameters" : "its parameters: " + names) +
-                                  " (--set parameters." + o.key + "=VALUE adds one)");
+// A hostile key or value may be megabytes long: messages show its start.
+std::string shown(const std::string& t) {
+  return t.size() <= 120 ? t : t.substr(0, 100) + "...(" + std::to_string(t.size()) + " characters)";
+}
+
+// --section given as an override: the plane as written, or as a TOML string (Python's Scene.set and a job's set
+// table quote it).
+void apply_section_override(toml::table& root, const Override& o) {
+  std::string plane = o.value;
+  if (!plane.empty() && (plane.front() == '"' || plane.front() == '\'')) try {
+      plane = toml::parse("v = " + plane)["v"].value_or(plane);
+    } catch (const toml::parse_error&) {
+      // not a TOML string after all: the plane's own reading says what is wrong
     }
-  }
-  const std::string key = bare && !top_table ? "parameters." + o.key : o.key;
+  add_section(root, plane, (o.origin.empty() ? "--section " : o.origin + ": section ") + shown(plane));
+}
+
+// A bare name must be one of the scene's parameters, so that a typo is not a new parameter nothing uses.
+void check_parameter_exists(const toml::table* params, const std::string& name, const std::string& label) {
+  if (params && params->get(name)) return;
+  std::string names;
+  if (params)
+    for (auto&& [param, node] : *params) names += (names.empty() ? "" : ", ") + std::string(param.str());
+  throw SceneError(label, "the scene has no parameter '" + name + "'; " +
+                              (names.empty() ? "it has no parameters" : "its parameters: " + names) +
+                              " (--set parameters." + name + "=VALUE adds one)");
+}
+
+std::vector<std::string> key_parts(const std::string& key, const std::string& label) {
   std::vector<std::string> parts;
   for (std::size_t start = 0;;) {
     const std::size_t dot = key.find('.', start);
@@ -301,76 +292,124 @@ void apply_override(toml::table& root, const Override& o, std::vector<std::strin
   if (parts.size() > kMaxTomlKeyParts)
     throw SceneError(label, "the key has " + std::to_string(parts.size()) + " parts; at most " +
                                 std::to_string(kMaxTomlKeyParts) + " are allowed");
-  const auto check_identifier = [&](const std::string& part) {
+  return parts;
+}
+
+// An override's key on its way down the scene's tables, and the override's words for its messages.
+struct KeyWalk {
+  const std::vector<std::string>& parts;
+  const std::string& written_key;
+  const std::string& label;
+  toml::table* target;
+  std::size_t i = 0;  // parts[i] is the first part below target
+
+  void check_identifier(const std::string& part) const {
     if (!is_identifier(part))
-      throw SceneError(label,
-                       "'" + shown(o.key) + "' is not a dotted scene key such as camera.fov_y or light.0.intensity");
-  };
-  // Walk down the existing tables. A list of tables ([[surface]], [[light]]) is reached by index, as in
-  // light.0.intensity, and the override applies inside that one table: merging at the list would replace the
-  // whole list with a single table.
-  toml::table* target = &root;
-  std::size_t i = 0;
-  while (i + 1 < parts.size()) {
-    check_identifier(parts[i]);
-    toml::node* at = target->get(parts[i]);
-    if (at && at->is_table()) {
-      if (is_index(parts[i + 1]))
-        throw SceneError(label, "'" + parts[i] + "' is a single [" + parts[i] + "] table, not a list: leave out the " +
-                                    "index, as in " + parts[i] + "." + (i + 2 < parts.size() ? parts[i + 2] : "KEY"));
-      target = at->as_table();
-      ++i;
-      continue;
-    }
-    if (!at || !at->is_array_of_tables()) {
-      if (is_index(parts[i + 1]) && (!at || (at->is_array() && at->as_array()->empty())))
-        throw SceneError(label, no_list_message(parts[i], parts[i + 1]));
-      break;
-    }
-    const std::string& list_name = parts[i];
-    const toml::array& list = *at->as_array();
-    if (!is_index(parts[i + 1]))
-      throw SceneError(label, "'" + list_name + "' is a list of [[" + list_name +
-                                  "]] tables: name one by its index from 0, as in " + list_name + ".0." + parts[i + 1]);
-    const std::size_t index = std::stoul(parts[i + 1]);
-    if (index >= list.size())
-      throw SceneError(label, "the scene has " + std::to_string(list.size()) + " [[" + list_name + "]] table" +
-                                  (list.size() == 1 ? "" : "s") + ", indexed from 0: there is no " + list_name + "." +
-                                  parts[i + 1]);
-    if (i + 2 == parts.size())
-      throw SceneError(label, "'" + shown(o.key) + "' names a whole [[" + list_name + "]] table; set one of its keys");
-    target = at->as_array()->get(index)->as_table();
-    i += 2;
+      throw SceneError(
+          label, "'" + shown(written_key) + "' is not a dotted scene key such as camera.fov_y or light.0.intensity");
   }
-  if (!top_table && i + 1 == parts.size() && target->get(parts[i]) && target->get(parts[i])->is_array_of_tables())
-    throw SceneError(label, "'" + parts[i] + "' is a list of [[" + parts[i] +
-                                "]] tables: name one by its index from 0, as in " + parts[i] + ".0.KEY");
-  std::string rest;
-  for (std::size_t k = i; k < parts.size(); ++k) {
-    check_identifier(parts[k]);
-    rest += (k > i ? "." : "") + parts[k];
+  // Down the existing tables to the last part's, or to where they end.
+  void descend() {
+    while (i + 1 < parts.size())
+      if (!step()) return;
   }
-  // Parsed as the TOML line `key = value`, every node it creates carries the override as its source, so errors
-  // name it. A value that is not TOML (render.precision=float) is taken as a string.
+  bool step();
+  void step_into_list(toml::node& at);
+};
+
+// One step down: into a table, or into one table of a list by its index; false where the existing tables end.
+bool KeyWalk::step() {
+  check_identifier(parts[i]);
+  toml::node* at = target->get(parts[i]);
+  if (at && at->is_table()) {
+    if (is_index(parts[i + 1]))
+      throw SceneError(label, "'" + parts[i] + "' is a single [" + parts[i] + "] table, not a list: leave out the " +
+                                  "index, as in " + parts[i] + "." + (i + 2 < parts.size() ? parts[i + 2] : "KEY"));
+    target = at->as_table();
+    ++i;
+    return true;
+  }
+  if (!at || !at->is_array_of_tables()) {
+    if (is_index(parts[i + 1]) && (!at || (at->is_array() && at->as_array()->empty())))
+      throw SceneError(label, no_list_message(parts[i], parts[i + 1]));
+    return false;
+  }
+  step_into_list(*at);
+  return true;
+}
+
+void KeyWalk::step_into_list(toml::node& at) {
+  const std::string& list_name = parts[i];
+  toml::array& list = *at.as_array();
+  if (!is_index(parts[i + 1]))
+    throw SceneError(label, "'" + list_name + "' is a list of [[" + list_name +
+                                "]] tables: name one by its index from 0, as in " + list_name + ".0." + parts[i + 1]);
+  const std::size_t index = std::stoul(parts[i + 1]);
+  if (index >= list.size())
+    throw SceneError(label, "the scene has " + std::to_string(list.size()) + " [[" + list_name + "]] table" +
+                                (list.size() == 1 ? "" : "s") + ", indexed from 0: there is no " + list_name + "." +
+                                parts[i + 1]);
+  if (i + 2 == parts.size())
+    throw SceneError(label,
+                     "'" + shown(written_key) + "' names a whole [[" + list_name + "]] table; set one of its keys");
+  target = list.get(index)->as_table();
+  i += 2;
+}
+
+// Parsed as the TOML line `key = value`, every node it creates carries the override as its source, so errors
+// name it. A value that is not TOML (render.precision=float) is taken as a string.
+toml::table parse_override_value(const std::string& rest, const std::string& value, const std::string& label) {
   try {
-    check_toml_shape(rest + " = " + o.value, label);
+    check_toml_shape(rest + " = " + value, label);
   } catch (const SceneError& e) {
     throw SceneError(label, e.message);  // the line and column are of a line the user never wrote
   }
-  toml::table parsed;
   try {
-    parsed = toml::parse(rest + " = " + o.value, label);
+    return toml::parse(rest + " = " + value, label);
   } catch (const toml::parse_error&) {
     // As a literal string it must still be TOML: no quote, no line break, no control character, valid UTF-8.
     try {
-      if (o.value.find_first_of("'\n") != std::string::npos) throw std::invalid_argument("quote or line break");
-      parsed = toml::parse(rest + " = '" + o.value + "'", label);
+      if (value.find_first_of("'\n") != std::string::npos) throw std::invalid_argument("quote or line break");
+      return toml::parse(rest + " = '" + value + "'", label);
     } catch (const std::exception&) {
       throw SceneError(label, "value is neither valid TOML nor a plain string");
     }
   }
+}
+
+void apply_override(toml::table& root, const Override& o, std::vector<std::string>& notes) {
+  // A scene without [extent] has algray's sphere of radius kDefaultExtentRadius: extent.KEY changes that one.
+  if (o.key.rfind("extent.", 0) == 0 && !root.get("extent"))
+    root.insert("extent", toml::table{{"radius", kDefaultExtentRadius}});
+  if (o.key == kSectionOverrideKey) return apply_section_override(root, o);
+  const std::string label = (o.origin.empty() ? "--set " : o.origin + ": set ") + shown(o.key) + "=" + shown(o.value);
+  // A bare name is a parameter; any other key is a dotted path into the scene; parameters.NAME adds a parameter.
+  // A bare name that is no parameter but a top-level table of the scene is that table: --set 'section=[]' drops
+  // the sections.
+  const bool bare = o.key.find('.') == std::string::npos;
+  const toml::table* params = root["parameters"].as_table();
+  const bool top_table = bare && (!params || !params->get(o.key)) && kTopKeys.count(o.key) && o.key != "parameters";
+  if (bare && is_identifier(o.key) && !top_table) check_parameter_exists(params, o.key, label);
+  const std::string key = bare && !top_table ? "parameters." + o.key : o.key;
+  const std::vector<std::string> parts = key_parts(key, label);
+  // Walk down the existing tables. A list of tables ([[surface]], [[light]]) is reached by index, as in
+  // light.0.intensity, and the override applies inside that one table: merging at the list would replace the
+  // whole list with a single table.
+  KeyWalk walk{parts, o.key, label, &root};
+  walk.descend();
+  const std::size_t i = walk.i;
+  if (!top_table && i + 1 == parts.size() && walk.target->get(parts[i]) &&
+      walk.target->get(parts[i])->is_array_of_tables())
+    throw SceneError(label, "'" + parts[i] + "' is a list of [[" + parts[i] +
+                                "]] tables: name one by its index from 0, as in " + parts[i] + ".0.KEY");
+  std::string rest;
+  for (std::size_t k = i; k < parts.size(); ++k) {
+    walk.check_identifier(parts[k]);
+    rest += (k > i ? "." : "") + parts[k];
+  }
+  toml::table parsed = parse_override_value(rest, o.value, label);
   if (parts.size() == 2 && parts[0] == "camera") exchange_camera_keys(root, parts[1]);
-  merge_tables(*target, std::move(parsed));
+  merge_tables(*walk.target, std::move(parsed));
   if (key == "extent.type") switch_extent_kind(root, label, notes);
 }
 
@@ -1103,21 +1142,9 @@ const char* light_type(LightKind k) {
   return "point";
 }
 
-}  // namespace
-
-std::string scene_to_toml(const Scene& scene) {
-  std::ostringstream out;
-  std::string origin = scene.name + ", as algray rendered it (from " + scene.source + ")";
-  for (char& ch : origin)
-    // A comment ends at the line's end, and TOML text must be UTF-8, which a file name need not be.
-    if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) >= 0x7f) ch = '?';
-  out << "# " << origin << "\n";
-  if (!scene.parameters.empty()) {
-    out << "\n[parameters]\n";
-    for (const auto& [name, value] : scene.parameters) out << name << " = " << toml_number(value) << "\n";
-  }
-  const bool several = scene.surfaces.size() > 1;
-  for (const SceneSurface& s : scene.surfaces) {
+void write_surfaces(std::ostringstream& out, const std::vector<SceneSurface>& surfaces) {
+  const bool several = surfaces.size() > 1;
+  for (const SceneSurface& s : surfaces) {
     out << (several ? "\n[[surface]]\n" : "\n[surface]\n");
     if (!s.name.empty()) out << "name = " << toml_quoted(s.name) << "\n";
     if (s.from_terms) {
@@ -1135,7 +1162,9 @@ std::string scene_to_toml(const Scene& scene) {
     write_material(out, "surface.material.front", s.materials.front);
     write_material(out, "surface.material.back", s.materials.back);
   }
-  const Extent& e = scene.extent;
+}
+
+void write_extent(std::ostringstream& out, const Extent& e) {
   if (e.kind == ExtentKind::Sphere)
     out << "\n[extent]\ntype = \"sphere\"\ncentre = " << toml_vector(e.centre) << "\nradius = " << toml_number(e.radius)
         << "\n";
@@ -1145,7 +1174,9 @@ std::string scene_to_toml(const Scene& scene) {
     out << "\n[extent]\ntype = \"cylinder\"\ncentre = " << toml_vector(e.centre)
         << "\nradius = " << toml_number(e.radius) << "\naxis = \""
         << "xyz"[e.axis] << "\"\nhalf_height = " << toml_number(e.half_height) << "\n";
-  const CameraSpec& c = scene.camera;
+}
+
+void write_camera(std::ostringstream& out, const CameraSpec& c) {
   const bool perspective = c.projection == Projection::Perspective;
   out << "\n[camera]\n";
   // The eye as placed, which reads back to the same rays; the angles it was placed by, for people.
@@ -1157,11 +1188,10 @@ std::string scene_to_toml(const Scene& scene) {
       << "\"\neye = " << toml_vector(c.eye) << "\nlook_at = " << toml_vector(c.look_at)
       << "\nup = " << toml_vector(c.up) << "\n"
       << (perspective ? "fov_y = " + toml_number(c.fov_y_degrees) : "height = " + toml_number(c.ortho_height)) << "\n";
-  const glm::dvec4& bg = scene.image.background;
-  out << "\n[image]\nwidth = " << scene.image.width << "\nheight = " << scene.image.height << "\nbackground = ["
-      << toml_number(bg.r) << ", " << toml_number(bg.g) << ", " << toml_number(bg.b) << ", " << toml_number(bg.a)
-      << "]\n";
-  for (const Light& world : scene.lights) {
+}
+
+void write_lights(std::ostringstream& out, const std::vector<Light>& lights) {
+  for (const Light& world : lights) {
     // A light attached to the camera is written in the camera's frame, as it was given, so that it still follows.
     const Light::CameraFrame l = world.in_camera.value_or(
         Light::CameraFrame{world.position, world.edge_u, world.edge_v, world.normal});
@@ -1175,14 +1205,9 @@ std::string scene_to_toml(const Scene& scene) {
     out << "colour = " << toml_vector(world.colour) << "\nintensity = " << toml_number(world.intensity)
         << "\nshadows = " << (world.shadows ? "true" : "false") << "\n";
   }
-  for (const Section& sec : scene.sections)
-    out << "\n[[section]]\nplane = [" << toml_number(sec.plane.x) << ", " << toml_number(sec.plane.y) << ", "
-        << toml_number(sec.plane.z) << ", " << toml_number(sec.plane.w) << "]\ncolour = " << toml_vector(sec.colour)
-        << "\n";
-  const Antialias& aa = scene.antialias;
-  out << "\n[antialias]\nsamples = " << aa.samples << "\nadaptive = " << (aa.adaptive ? "true" : "false")
-      << "\nthreshold = " << toml_number(aa.threshold) << "\n";
-  const RenderSettings& rs = scene.render;
+}
+
+void write_render(std::ostringstream& out, const RenderSettings& rs) {
   out << "\n[render]\nprecision = \"" << (rs.precision ? to_string(*rs.precision) : std::string("auto"))
       << "\"\ntolerance = " << toml_number(rs.tolerance) << "\nisolation = \"" << to_string(rs.isolation)
       << "\"\nrefinement = \"" << to_string(rs.refinement) << "\"\nray_origin = \"" << to_string(rs.ray_origin)
@@ -1190,6 +1215,37 @@ std::string scene_to_toml(const Scene& scene) {
   if (rs.max_iterations) out << "max_iterations = " << rs.max_iterations << "\n";
   if (rs.tile_size) out << "tile_size = " << rs.tile_size << "\n";
   if (rs.lanes) out << "lanes = " << rs.lanes << "\n";
+}
+
+}  // namespace
+
+std::string scene_to_toml(const Scene& scene) {
+  std::ostringstream out;
+  std::string origin = scene.name + ", as algray rendered it (from " + scene.source + ")";
+  for (char& ch : origin)
+    // A comment ends at the line's end, and TOML text must be UTF-8, which a file name need not be.
+    if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) >= 0x7f) ch = '?';
+  out << "# " << origin << "\n";
+  if (!scene.parameters.empty()) {
+    out << "\n[parameters]\n";
+    for (const auto& [name, value] : scene.parameters) out << name << " = " << toml_number(value) << "\n";
+  }
+  write_surfaces(out, scene.surfaces);
+  write_extent(out, scene.extent);
+  write_camera(out, scene.camera);
+  const glm::dvec4& bg = scene.image.background;
+  out << "\n[image]\nwidth = " << scene.image.width << "\nheight = " << scene.image.height << "\nbackground = ["
+      << toml_number(bg.r) << ", " << toml_number(bg.g) << ", " << toml_number(bg.b) << ", " << toml_number(bg.a)
+      << "]\n";
+  write_lights(out, scene.lights);
+  for (const Section& sec : scene.sections)
+    out << "\n[[section]]\nplane = [" << toml_number(sec.plane.x) << ", " << toml_number(sec.plane.y) << ", "
+        << toml_number(sec.plane.z) << ", " << toml_number(sec.plane.w) << "]\ncolour = " << toml_vector(sec.colour)
+        << "\n";
+  const Antialias& aa = scene.antialias;
+  out << "\n[antialias]\nsamples = " << aa.samples << "\nadaptive = " << (aa.adaptive ? "true" : "false")
+      << "\nthreshold = " << toml_number(aa.threshold) << "\n";
+  write_render(out, scene.render);
   return out.str();
 }
 

@@ -716,7 +716,26 @@ class Script {
     if (v < 0 || v > 100) fail(set_at(s, key), key + " must be between 0 and 100");
     return v / 100;
   }
+  using Affine = std::array<std::array<double, 4>, 3>;
+  // The clip region and the framing: the shorter side spans -10..10 on the plane z = 0.
+  struct View {
+    glm::dvec3 centre;
+    double radius, clip;
+    double width, height;  // the script's image size
+    double half_w, half_h;
+    bool central;
+    double spec_z;
+  };
   std::string translate(const Snapshot& s);
+  Affine screen_to_script(const Snapshot& s) const;
+  Affine undone_position_step(const Snapshot& s, const char* order) const;
+  void write_surfaces(std::ostringstream& toml, const Snapshot& s, const Affine& inverse);
+  void write_material(std::ostringstream& toml, const Snapshot& s, const std::string& sfx, const char* side,
+                      bool transmitted) const;
+  View view(const Snapshot& s) const;
+  void write_extent(std::ostringstream& toml, const Snapshot& s, const View& v) const;
+  void write_camera_and_image(std::ostringstream& toml, const Snapshot& s, const View& v) const;
+  void write_lights(std::ostringstream& toml, const Snapshot& s) const;
 
   LocatedText text_;
   const std::string& source_;
@@ -736,16 +755,15 @@ class Script {
   int rendered_width_ = 0, rendered_height_ = 0;  // overrides of width and height, 0 where none
 };
 
-std::string Script::translate(const Snapshot& s) {
-  std::ostringstream toml;
-  const std::size_t slash = source_.find_last_of('/');
-  toml << "# Translated from " << source_ << " (surf script)\n";
-
-  // The surfaces, moved by the position settings in their order.
-  std::array<std::array<double, 4>, 3> inverse{};  // screen point -> the script's own coordinates
+// The position settings in their order, undone: a screen point -> the script's own coordinates. The steps apply
+// first to last to the surface, so their inverses apply last to first to a screen point:
+// inverse = inv(first) o inv(second) o inv(third), which composing in this order builds.
+Script::Affine Script::screen_to_script(const Snapshot& s) const {
+  Affine inverse{};
   for (int i = 0; i < 3; ++i) inverse[i][i] = 1;
-  auto compose = [&](const std::array<std::array<double, 4>, 3>& step) {  // inverse = inverse o step
-    std::array<std::array<double, 4>, 3> out{};
+  for (const char* order : {"first", "second", "third"}) {
+    const Affine step = undone_position_step(s, order);
+    Affine out{};  // inverse o step
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c)
         for (int k = 0; k < 3; ++k) out[r][c] += inverse[r][k] * step[k][c];
@@ -753,39 +771,42 @@ std::string Script::translate(const Snapshot& s) {
       for (int k = 0; k < 3; ++k) out[r][3] += inverse[r][k] * step[k][3];
     }
     inverse = out;
-  };
-  for (const char* order : {"first", "second", "third"}) {
-    const double what = number(s, order);
-    std::array<std::array<double, 4>, 3> step{};
-    if (what == 0) {  // translate by origin: p -> p + o, undone by x - o
-      for (int i = 0; i < 3; ++i) {
-        step[i][i] = 1;
-        step[i][3] = -number(s, std::string("origin_") + "xyz"[i]);
-      }
-    } else if (what == 1) {  // rotate about y, then x, then z: undone by R^T
-      auto product = rotation(1, number(s, "rot_y"));
-      for (std::size_t axis : {std::size_t{0}, std::size_t{2}}) {
-        const auto r = rotation(axis, number(s, axis == 0 ? "rot_x" : "rot_z"));
-        std::array<std::array<double, 3>, 3> next{};
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j)
-            for (int k = 0; k < 3; ++k) next[i][j] += r[i][k] * product[k][j];
-        product = next;
-      }
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) step[i][j] = product[j][i];
-    } else if (what == 2) {  // scale: P(s x)
-      for (int i = 0; i < 3; ++i) step[i][i] = number(s, std::string("scale_") + "xyz"[i]);
-    } else {
-      fail(set_at(s, order), std::string(order) + " is translate, rotate or scale");
-    }
-    compose(step);
   }
-  // The steps apply first to last to the surface, so their inverses apply last to first to a screen point:
-  // inverse = inv(first) o inv(second) o inv(third), which composing in this order builds.
+  return inverse;
+}
 
+Script::Affine Script::undone_position_step(const Snapshot& s, const char* order) const {
+  const double what = number(s, order);
+  Affine step{};
+  if (what == 0) {  // translate by origin: p -> p + o, undone by x - o
+    for (int i = 0; i < 3; ++i) {
+      step[i][i] = 1;
+      step[i][3] = -number(s, std::string("origin_") + "xyz"[i]);
+    }
+  } else if (what == 1) {  // rotate about y, then x, then z: undone by R^T
+    auto product = rotation(1, number(s, "rot_y"));
+    for (std::size_t axis : {std::size_t{0}, std::size_t{2}}) {
+      const auto r = rotation(axis, number(s, axis == 0 ? "rot_x" : "rot_z"));
+      std::array<std::array<double, 3>, 3> next{};
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          for (int k = 0; k < 3; ++k) next[i][j] += r[i][k] * product[k][j];
+      product = next;
+    }
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) step[i][j] = product[j][i];
+  } else if (what == 2) {  // scale: P(s x)
+    for (int i = 0; i < 3; ++i) step[i][i] = number(s, std::string("scale_") + "xyz"[i]);
+  } else {
+    fail(set_at(s, order), std::string(order) + " is translate, rotate or scale");
+  }
+  return step;
+}
+
+void Script::write_surfaces(std::ostringstream& toml, const Snapshot& s, const Affine& inverse) {
   int surfaces = 0;
   const bool transmitted = (static_cast<long>(number(s, "illumination")) & 8) != 0;
+  const std::size_t slash = source_.find_last_of('/');
   for (int n = 1; n <= kSurfaces; ++n) {
     const std::string sfx = surface_suffix(n);
     const Poly& own = s.globals.at("surface" + sfx).poly;
@@ -804,76 +825,92 @@ std::string Script::translate(const Snapshot& s) {
       sep = ", ";
     }
     toml << "]\n";
-    for (const char* side : {"front", "back"}) {
-      const bool front = side[0] == 'f';
-      toml << "\n[surface.material." << side << "]\ncolour = "
-           << toml_vector(colour(s, (front ? "surface" : "inside") + sfx + "_")) << "\n";
-      toml << "ambient = " << toml_number(percent(s, "ambient" + sfx)) << "\n";
-      toml << "diffuse = " << toml_number(percent(s, "diffuse" + sfx)) << "\n";
-      toml << "specular = " << toml_number(percent(s, "reflected" + sfx)) << "\n";
-      const double smooth = number(s, "smoothness" + sfx);
-      if (smooth < 0) fail(set_at(s, "smoothness" + sfx), "smoothness" + sfx + " must not be negative");
-      toml << "exponent = " << toml_number(std::clamp(smooth, 1.0, 10000.0)) << "\n";
-      toml << "transparency = " << toml_number(transmitted ? percent(s, "transparence" + sfx) : 0.0) << "\n";
-    }
+    for (const char* side : {"front", "back"}) write_material(toml, s, sfx, side, transmitted);
   }
   if (surfaces == 0) fail(s.at, "no surface is set when draw_surface runs (surface = ...; first)");
   if (surfaces > static_cast<int>(kMaxSurfaces))
     fail(s.at, std::to_string(surfaces) + " surfaces: algray draws up to " + std::to_string(kMaxSurfaces) +
                    " in one scene");
+}
 
-  // The clip region, in screen space.
-  const glm::dvec3 centre(number(s, "center_x"), number(s, "center_y"), number(s, "center_z"));
-  const double radius = number(s, "radius");
-  if (!(radius > 0)) fail(set_at(s, "radius"), "radius must be positive");
-  const double clip = number(s, "clip");
-  const double w = number(s, "width"), h = number(s, "height");
-  if (w < 1 || w > 32768) fail(set_at(s, "width"), "width must be between 1 and 32768");
-  if (h < 1 || h > 32768) fail(set_at(s, "height"), "height must be between 1 and 32768");
+void Script::write_material(std::ostringstream& toml, const Snapshot& s, const std::string& sfx, const char* side,
+                            bool transmitted) const {
+  const bool front = side[0] == 'f';
+  toml << "\n[surface.material." << side << "]\ncolour = "
+       << toml_vector(colour(s, (front ? "surface" : "inside") + sfx + "_")) << "\n";
+  toml << "ambient = " << toml_number(percent(s, "ambient" + sfx)) << "\n";
+  toml << "diffuse = " << toml_number(percent(s, "diffuse" + sfx)) << "\n";
+  toml << "specular = " << toml_number(percent(s, "reflected" + sfx)) << "\n";
+  const double smooth = number(s, "smoothness" + sfx);
+  if (smooth < 0) fail(set_at(s, "smoothness" + sfx), "smoothness" + sfx + " must not be negative");
+  toml << "exponent = " << toml_number(std::clamp(smooth, 1.0, 10000.0)) << "\n";
+  toml << "transparency = " << toml_number(transmitted ? percent(s, "transparence" + sfx) : 0.0) << "\n";
+}
+
+// Read and checked in this order, which decides what a script with several mistakes is told first.
+Script::View Script::view(const Snapshot& s) const {
+  View v;
+  v.centre = glm::dvec3(number(s, "center_x"), number(s, "center_y"), number(s, "center_z"));
+  v.radius = number(s, "radius");
+  if (!(v.radius > 0)) fail(set_at(s, "radius"), "radius must be positive");
+  v.clip = number(s, "clip");
+  v.width = number(s, "width");
+  v.height = number(s, "height");
+  if (v.width < 1 || v.width > 32768) fail(set_at(s, "width"), "width must be between 1 and 32768");
+  if (v.height < 1 || v.height > 32768) fail(set_at(s, "height"), "height must be between 1 and 32768");
   // The framing follows the size the image is rendered at, which --set or --width may change.
-  const double fw = rendered_width_ > 0 ? rendered_width_ : w, fh = rendered_height_ > 0 ? rendered_height_ : h;
-  const double half_w = 10 * fw / std::min(fw, fh), half_h = 10 * fh / std::min(fw, fh);
-  const bool central = number(s, "perspective") != 0;
-  const double spec_z = number(s, "spec_z");
-  if (central && !(spec_z > 0)) fail(set_at(s, "spec_z"), "spec_z must be positive");
-  if (clip == 5) {
+  const double fw = rendered_width_ > 0 ? rendered_width_ : v.width;
+  const double fh = rendered_height_ > 0 ? rendered_height_ : v.height;
+  v.half_w = 10 * fw / std::min(fw, fh);
+  v.half_h = 10 * fh / std::min(fw, fh);
+  v.central = number(s, "perspective") != 0;
+  v.spec_z = number(s, "spec_z");
+  if (v.central && !(v.spec_z > 0)) fail(set_at(s, "spec_z"), "spec_z must be positive");
+  return v;
+}
+
+void Script::write_extent(std::ostringstream& toml, const Snapshot& s, const View& v) const {
+  if (v.clip == 5) {
     const double front = number(s, "clip_front"), back = number(s, "clip_back");
     if (!(front > back)) fail(set_at(s, "clip_front"), "clip_front must be above clip_back");
-    if (central && front >= spec_z)
+    if (v.central && front >= v.spec_z)
       fail(set_at(s, "clip_front"), "clip_front must be below spec_z, where the eye is");
     // Wide enough for the whole view: the frustum widens towards the back.
-    const double widen = central ? (spec_z - back) / spec_z : 1.0;
+    const double widen = v.central ? (v.spec_z - back) / v.spec_z : 1.0;
     toml << "\n[extent]  # clip = none: the slab clip_back <= z <= clip_front\ntype = \"box\"\nmin = "
-         << toml_vector({-half_w * widen * 1.01, -half_h * widen * 1.01, back})
-         << "\nmax = " << toml_vector({half_w * widen * 1.01, half_h * widen * 1.01, front}) << "\n";
-  } else if (clip == 4) {
-    toml << "\n[extent]  # clip = cube\ntype = \"box\"\nmin = " << toml_vector(centre - glm::dvec3(radius))
-         << "\nmax = " << toml_vector(centre + glm::dvec3(radius)) << "\n";
+         << toml_vector({-v.half_w * widen * 1.01, -v.half_h * widen * 1.01, back})
+         << "\nmax = " << toml_vector({v.half_w * widen * 1.01, v.half_h * widen * 1.01, front}) << "\n";
+  } else if (v.clip == 4) {
+    toml << "\n[extent]  # clip = cube\ntype = \"box\"\nmin = " << toml_vector(v.centre - glm::dvec3(v.radius))
+         << "\nmax = " << toml_vector(v.centre + glm::dvec3(v.radius)) << "\n";
   } else {
-    toml << "\n[extent]  # surf's clip ball\ntype = \"sphere\"\ncentre = " << toml_vector(centre)
-         << "\nradius = " << toml_number(radius) << "\n";
+    toml << "\n[extent]  # surf's clip ball\ntype = \"sphere\"\ncentre = " << toml_vector(v.centre)
+         << "\nradius = " << toml_number(v.radius) << "\n";
   }
+}
 
-  // The camera: the shorter side spans -10..10 on the plane z = 0.
-  toml << "\n[camera]\neye = " << toml_vector({0, 0, central ? spec_z : 1000.0})
+void Script::write_camera_and_image(std::ostringstream& toml, const Snapshot& s, const View& v) const {
+  toml << "\n[camera]\neye = " << toml_vector({0, 0, v.central ? v.spec_z : 1000.0})
        << "\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\n";
-  if (central)
+  if (v.central)
     toml << "projection = \"perspective\"\nfov_y = "
-         << toml_number(2 * std::atan(half_h / spec_z) * 180 / 3.14159265358979323846) << "\n";
+         << toml_number(2 * std::atan(v.half_h / v.spec_z) * 180 / 3.14159265358979323846) << "\n";
   else
-    toml << "projection = \"orthographic\"\nheight = " << toml_number(2 * half_h) << "\n";
+    toml << "projection = \"orthographic\"\nheight = " << toml_number(2 * v.half_h) << "\n";
 
   const glm::dvec3 background = colour(s, "background_");
-  toml << "\n[image]\nwidth = " << static_cast<long>(w) << "\nheight = " << static_cast<long>(h)
+  toml << "\n[image]\nwidth = " << static_cast<long>(v.width) << "\nheight = " << static_cast<long>(v.height)
        << "\nbackground = " << toml_vector(background) << "\n";
   const double aa = number(s, "antialiasing");
   if (aa < 1 || aa > 16) fail(set_at(s, "antialiasing"), "antialiasing must be between 1 and 16");
   const double threshold = number(s, "antialiasing_threshold");
   toml << "\n[antialias]\nsamples = " << static_cast<long>(aa) << "\nadaptive = " << (aa > 1 ? "true" : "false")
        << "\nthreshold = " << toml_number(std::clamp(threshold, 0.0, 1.0)) << "\n";
+}
 
-  // Lights in screen space, without shadows (surf casts none). With none on, surf shows the ambient term alone:
-  // a light of no intensity keeps algray from adding its headlight.
+// Lights in screen space, without shadows (surf casts none). With none on, surf shows the ambient term alone:
+// a light of no intensity keeps algray from adding its headlight.
+void Script::write_lights(std::ostringstream& toml, const Snapshot& s) const {
   int lights = 0;
   for (int n = 1; n <= kLights; ++n) {
     const std::string l = "light" + std::to_string(n) + "_";
@@ -888,6 +925,16 @@ std::string Script::translate(const Snapshot& s) {
   if (lights == 0)
     toml << "\n[[light]]  # no light is on in the script\ntype = \"point\"\nposition = [0.0, 0.0, 100.0]\n"
             "intensity = 0.0\nshadows = false\n";
+}
+
+std::string Script::translate(const Snapshot& s) {
+  std::ostringstream toml;
+  toml << "# Translated from " << source_ << " (surf script)\n";
+  write_surfaces(toml, s, screen_to_script(s));
+  const View v = view(s);
+  write_extent(toml, s, v);
+  write_camera_and_image(toml, s, v);
+  write_lights(toml, s);
   return toml.str();
 }
 
