@@ -85,105 +85,138 @@ std::string resolve(const std::string& base_dir, const std::string& path) {
   return (fs::path(base_dir) / path).lexically_normal().string();
 }
 
-// Reads one [[job]] on top of [defaults].
-BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::table& t, std::size_t index,
-                  const std::string& base_dir) {
-  r.check_keys(t, "job", kJobKeys);
-  const auto get = [&](const char* key) -> const toml::node* {
-    if (const toml::node* n = t.get(key)) return n;
+// A job's tables: its own, and [defaults] for what it leaves out.
+struct JobTables {
+  const toml::table& job;
+  const toml::table* defaults;
+  const toml::node* get(const char* key) const {
+    if (const toml::node* n = job.get(key)) return n;
     return defaults ? defaults->get(key) : nullptr;
-  };
-  BatchJob job;
-  job.line = static_cast<int>(t.source().begin.line);
-  job.origin = origin_of(r, t);
-  const toml::node* scene = get("scene");
-  if (!scene) r.fail(t.source(), "job " + std::to_string(index) + " needs a scene (a .toml or .jsurf path)");
+  }
+};
+
+// The scene, and the name, which defaults to the scene's stem and the job's index.
+void read_job_scene(const TomlReader& r, const JobTables& tables, std::size_t index, const std::string& base_dir,
+                    BatchJob& job) {
+  const toml::node* scene = tables.get("scene");
+  if (!scene) r.fail(tables.job.source(), "job " + std::to_string(index) + " needs a scene (a .toml or .jsurf path)");
   job.scene = r.string(*scene, "job.scene");
   if (job.scene == "-") r.fail(scene->source(), "a batch job cannot read its scene from standard input");
   job.scene = resolve(base_dir, job.scene);
-  job.name = get("name") ? r.string(*get("name"), "job.name")
-                         : fs::path(job.scene).stem().string() + "_" + std::to_string(index);
-  if (defaults)
-    if (const toml::node* n = defaults->get("set")) {
+  job.name = tables.get("name") ? r.string(*tables.get("name"), "job.name")
+                                : fs::path(job.scene).stem().string() + "_" + std::to_string(index);
+}
+
+// [defaults]' set first, then the job's, so that the job's own values win.
+void read_job_sets(const TomlReader& r, const JobTables& tables, BatchJob& job) {
+  for (const toml::table* table : {tables.defaults, &tables.job})
+    if (const toml::node* n = table ? table->get("set") : nullptr) {
       if (!n->is_table()) r.fail(n->source(), "set must be a table of scene keys and values");
       collect_sets(r, *n->as_table(), "", job.overrides);
     }
-  if (const toml::node* n = t.get("set")) {
-    if (!n->is_table()) r.fail(n->source(), "set must be a table of scene keys and values");
-    collect_sets(r, *n->as_table(), "", job.overrides);
-  }
+}
+
+// Returns the output node, which later messages about the patterns point at.
+const toml::node* read_job_outputs(const TomlReader& r, const JobTables& tables, const std::string& base_dir,
+                                   BatchJob& job) {
   // Without an output, the frames go only into the batch's --video (plan_batch checks there is one).
-  const toml::node* output = get("output");
+  const toml::node* output = tables.get("output");
   if (output)
     for (const std::string& o : string_or_list(r, *output, "job.output")) job.outputs.push_back(resolve(base_dir, o));
-  if (const toml::node* n = get("stats")) job.stats = resolve(base_dir, r.string(*n, "job.stats"));
+  if (const toml::node* n = tables.get("stats")) job.stats = resolve(base_dir, r.string(*n, "job.stats"));
+  return output;
+}
 
+// The frame count as the job's frames, seconds x fps, sweeps' steps and orbit frames give it: each that gives
+// one must agree with those before it.
+struct FrameCount {
+  const TomlReader& r;
   std::optional<int> frames;
-  const toml::node* frames_node = t.get("frames");
-  if (frames_node) frames = static_cast<int>(r.integer(*frames_node, "job.frames", 1, 1000000));
-  const auto agree = [&](int n, const toml::node& where, const std::string& what) {
+  void agree(int n, const toml::node& where, const std::string& what) {
     if (frames && *frames != n)
       r.fail(where.source(), what + " gives " + std::to_string(n) + " frames but the job has " +
                                  std::to_string(*frames) + " (all sweeps and the orbit step together)");
     frames = n;
-  };
-  // A duration and a frame rate: seconds x fps frames (a sweep or orbit then needs no steps or frames).
+  }
+};
+
+// A duration and a frame rate: seconds x fps frames (a sweep or orbit then needs no steps or frames).
+void read_job_duration(const TomlReader& r, const toml::table& t, FrameCount& count, BatchJob& job) {
   if (const toml::node* n = t.get("fps")) {
     job.fps = r.number(*n, "job.fps");
     if (!(job.fps > 0 && job.fps <= 1000)) r.fail(n->source(), "job.fps must be above 0 and at most 1000");
   }
   if (const toml::node* n = t.get("seconds")) {
     const double seconds = r.number(*n, "job.seconds");
-    const double count = std::round(seconds * job.fps);
-    if (!(seconds > 0) || !(count >= 1 && count <= 1000000))
+    const double frames = std::round(seconds * job.fps);
+    if (!(seconds > 0) || !(frames >= 1 && frames <= 1000000))
       r.fail(n->source(), "job.seconds x fps must make 1 to 1000000 frames");
-    agree(static_cast<int>(count), *n, "seconds x fps");
+    count.agree(static_cast<int>(frames), *n, "seconds x fps");
   }
-  if (const toml::node* n = t.get("sweep")) {
-    const toml::table* sweeps = n->as_table();
-    if (!sweeps || sweeps->empty())
-      r.fail(n->source(), "sweep must be a table of keys, each { from = ..., to = ..., steps = ... }");
-    for (auto&& [key, node] : *sweeps) {
-      const std::string what = "sweep." + std::string(key.str());
-      const toml::table* s = node.as_table();
-      if (!s) r.fail(node.source(), what + " must be { from = ..., to = ..., steps = ... }");
-      r.check_keys(*s, what, kSweepKeys);
-      for (const char* k : {"from", "to"})
-        if (!s->get(k)) r.fail(node.source(), what + " needs '" + k + "'");
-      if (!s->get("steps") && !frames)
-        r.fail(node.source(), what + " needs 'steps', or the job frames or seconds (and fps)");
-      Sweep sweep;
-      sweep.key = std::string(key.str());
-      sweep.origin = origin_of(r, node);
-      sweep.from = r.number(*s->get("from"), what + ".from");
-      sweep.to = r.number(*s->get("to"), what + ".to");
-      if (const toml::node* steps = s->get("steps"))
-        agree(static_cast<int>(r.integer(*steps, what + ".steps", 1, 1000000)), node, what);
-      job.sweeps.push_back(sweep);
-    }
+}
+
+Sweep read_sweep(const TomlReader& r, const toml::key& key, const toml::node& node, FrameCount& count) {
+  const std::string what = "sweep." + std::string(key.str());
+  const toml::table* s = node.as_table();
+  if (!s) r.fail(node.source(), what + " must be { from = ..., to = ..., steps = ... }");
+  r.check_keys(*s, what, kSweepKeys);
+  for (const char* k : {"from", "to"})
+    if (!s->get(k)) r.fail(node.source(), what + " needs '" + k + "'");
+  if (!s->get("steps") && !count.frames)
+    r.fail(node.source(), what + " needs 'steps', or the job frames or seconds (and fps)");
+  Sweep sweep;
+  sweep.key = std::string(key.str());
+  sweep.origin = origin_of(r, node);
+  sweep.from = r.number(*s->get("from"), what + ".from");
+  sweep.to = r.number(*s->get("to"), what + ".to");
+  if (const toml::node* steps = s->get("steps"))
+    count.agree(static_cast<int>(r.integer(*steps, what + ".steps", 1, 1000000)), node, what);
+  return sweep;
+}
+
+std::vector<Sweep> read_sweeps(const TomlReader& r, const toml::node& n, FrameCount& count) {
+  const toml::table* sweeps = n.as_table();
+  if (!sweeps || sweeps->empty())
+    r.fail(n.source(), "sweep must be a table of keys, each { from = ..., to = ..., steps = ... }");
+  std::vector<Sweep> out;
+  for (auto&& [key, node] : *sweeps) out.push_back(read_sweep(r, key, node, count));
+  return out;
+}
+
+Orbit read_orbit(const TomlReader& r, const toml::node& n, FrameCount& count) {
+  const toml::table* o = n.as_table();
+  if (!o) r.fail(n.source(), "orbit must be a table { frames, degrees, axis, lights }");
+  r.check_keys(*o, "orbit", kOrbitKeys);
+  Orbit orbit;
+  if (const toml::node* d = o->get("degrees")) orbit.degrees = r.number(*d, "orbit.degrees");
+  if (const toml::node* a = o->get("axis")) {
+    orbit.axis = r.vec3(*a, "orbit.axis");
+    if (!(glm::length(*orbit.axis) > 0)) r.fail(a->source(), "orbit.axis must not be zero");
   }
-  if (const toml::node* n = t.get("orbit")) {
-    const toml::table* o = n->as_table();
-    if (!o) r.fail(n->source(), "orbit must be a table { frames, degrees, axis, lights }");
-    r.check_keys(*o, "orbit", kOrbitKeys);
-    Orbit orbit;
-    if (const toml::node* d = o->get("degrees")) orbit.degrees = r.number(*d, "orbit.degrees");
-    if (const toml::node* a = o->get("axis")) {
-      orbit.axis = r.vec3(*a, "orbit.axis");
-      if (!(glm::length(*orbit.axis) > 0)) r.fail(a->source(), "orbit.axis must not be zero");
-    }
-    if (const toml::node* l = o->get("lights")) {
-      const std::string mode = r.string(*l, "orbit.lights");
-      if (mode != "camera" && mode != "world") r.fail(l->source(), "orbit.lights must be \"camera\" or \"world\"");
-      orbit.lights_follow_camera = mode == "camera";
-    }
-    if (const toml::node* f = o->get("frames"))
-      agree(static_cast<int>(r.integer(*f, "orbit.frames", 1, 1000000)), *f, "orbit.frames");
-    else if (!frames)
-      r.fail(n->source(), "orbit needs frames (or a sweep's steps) to know how many views to render");
-    job.orbit = orbit;
+  if (const toml::node* l = o->get("lights")) {
+    const std::string mode = r.string(*l, "orbit.lights");
+    if (mode != "camera" && mode != "world") r.fail(l->source(), "orbit.lights must be \"camera\" or \"world\"");
+    orbit.lights_follow_camera = mode == "camera";
   }
-  job.frames = frames.value_or(1);
+  if (const toml::node* f = o->get("frames"))
+    count.agree(static_cast<int>(r.integer(*f, "orbit.frames", 1, 1000000)), *f, "orbit.frames");
+  else if (!count.frames)
+    r.fail(n.source(), "orbit needs frames (or a sweep's steps) to know how many views to render");
+  return orbit;
+}
+
+// Frames, sweeps and orbits belong to the job alone, never to [defaults].
+void read_job_frames(const TomlReader& r, const toml::table& t, BatchJob& job) {
+  FrameCount count{r, std::nullopt};
+  if (const toml::node* n = t.get("frames")) count.frames = static_cast<int>(r.integer(*n, "job.frames", 1, 1000000));
+  read_job_duration(r, t, count, job);
+  if (const toml::node* n = t.get("sweep")) job.sweeps = read_sweeps(r, *n, count);
+  if (const toml::node* n = t.get("orbit")) job.orbit = read_orbit(r, *n, count);
+  job.frames = count.frames.value_or(1);
+}
+
+// Patterns are checked now, so that a typo fails the whole batch before any rendering.
+void check_job_patterns(const TomlReader& r, const BatchJob& job, const toml::node* output, const toml::node* stats) {
   // Every frame must write its own files: a pattern without {frame}, {value} or {angle} would overwrite itself.
   if (job.frames > 1)
     for (const std::string& o : job.outputs)
@@ -191,7 +224,6 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
           o.find("{angle}") == std::string::npos)
         r.fail(output->source(), "job '" + job.name + "' has " + std::to_string(job.frames) + " frames but output '" +
                                      o + "' has no {frame} (or {value}, {angle}) to tell them apart");
-  // Patterns are checked now, so that a typo fails the whole batch before any rendering.
   for (const std::string& o : job.outputs) {
     try {
       expand_pattern(o, job, 0);
@@ -206,9 +238,24 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
     try {
       expand_pattern(*job.stats, job, 0);
     } catch (const SceneError& e) {
-      r.fail(get("stats")->source(), e.message);
+      r.fail(stats->source(), e.message);
     }
   }
+}
+
+// Reads one [[job]] on top of [defaults].
+BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::table& t, std::size_t index,
+                  const std::string& base_dir) {
+  r.check_keys(t, "job", kJobKeys);
+  const JobTables tables{t, defaults};
+  BatchJob job;
+  job.line = static_cast<int>(t.source().begin.line);
+  job.origin = origin_of(r, t);
+  read_job_scene(r, tables, index, base_dir, job);
+  read_job_sets(r, tables, job);
+  const toml::node* output = read_job_outputs(r, tables, base_dir, job);
+  read_job_frames(r, t, job);
+  check_job_patterns(r, job, output, tables.get("stats"));
   job.output_origin = output ? origin_of(r, *output) : job.origin;
   return job;
 }
