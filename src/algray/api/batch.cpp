@@ -19,6 +19,7 @@
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
+#include <variant>
 
 #include "algray/io/image_io.h"
 #include "algray/io/video_writer.h"
@@ -1021,62 +1022,63 @@ BatchOutcome encode_shards_video(const BatchRequest& req, const BatchPlan& plan,
   }
 }
 
-}  // namespace
-
-BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& callbacks) {
-  const BatchReporter message{callbacks};
+// The batch's plan without the shard, checked for what a merge needs; a refusal is the outcome to return.
+std::variant<BatchPlan, BatchOutcome> plan_merge(const BatchRequest& req, const BatchReporter& message) {
   BatchRequest whole = req;
   whole.shard.reset();
-  BatchPlan plan;
   try {
-    plan = plan_batch(whole);
+    BatchPlan plan = plan_batch(whole);
     if (req.video_path)
       for (const BatchJob& job : plan.jobs)
         if (!frame_image_pattern(job))
           throw SceneError(job.origin, "--merge-logs --video makes the video from the shards' images: job '" +
                                            job.name + "' needs a .png or .exr output");
+    return plan;
   } catch (const std::exception& e) {
     return message.refused(e);
   }
-  // The shard logs beside the batch's log: <stem>.shard-K-of-N<extension>, whatever the shard count.
-  const fs::path log(plan.log_path);
+}
+
+// The shard logs beside the batch's log: <stem>.shard-K-of-N<extension>, whatever the shard count.
+struct ShardLogs {
+  std::vector<fs::path> paths;                               // sorted
+  std::map<std::string, std::vector<std::string>> by_count;  // shard count -> its logs' names
+};
+
+ShardLogs find_shard_logs(const fs::path& log) {
   const fs::path dir = log.parent_path().empty() ? fs::path(".") : log.parent_path();
   const auto literal = [](const std::string& text) {
     return std::regex_replace(text, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)");
   };
   const std::regex shard_name(literal(log.stem().string()) + R"(\.shard-[0-9]+-of-([0-9]+))" +
                               literal(log.extension().string()));
-  std::vector<fs::path> shard_logs;
-  std::map<std::string, std::vector<std::string>> by_count;  // shard count -> its logs' names
+  ShardLogs found;
   std::error_code ec;
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
     std::smatch m;
     if (!std::regex_match(name, m, shard_name)) continue;
-    shard_logs.push_back(log.parent_path() / name);  // named as the batch's log is, without a "./"
-    by_count[m[1].str()].push_back(name);
+    found.paths.push_back(log.parent_path() / name);  // named as the batch's log is, without a "./"
+    found.by_count[m[1].str()].push_back(name);
   }
-  std::sort(shard_logs.begin(), shard_logs.end());
-  if (shard_logs.empty()) {
-    message("algray: no shard logs beside " + plan.log_path + " (" + log.stem().string() + ".shard-K-of-N" +
-            log.extension().string() + "): nothing to merge\n");
-    return BatchOutcome::BadInput;
+  std::sort(found.paths.begin(), found.paths.end());
+  return found;
+}
+
+// "\n  4 shards: a, b\n  8 shards: c": the logs of each shard count, for the message that refuses to mix them.
+std::string shard_counts_text(std::map<std::string, std::vector<std::string>>& by_count) {
+  std::string counts;
+  for (auto& [count, names] : by_count) {
+    std::sort(names.begin(), names.end());
+    counts += "\n  " + count + " shards: ";
+    for (std::size_t i = 0; i < names.size(); ++i) counts += (i ? ", " : "") + names[i];
   }
-  // Two shard counts side by side are two runs, one of them stale: which frames came from which is the user's
-  // call, not ours.
-  if (by_count.size() > 1 && !req.merge_mixed_counts) {
-    std::string counts;
-    for (auto& [count, names] : by_count) {
-      std::sort(names.begin(), names.end());
-      counts += "\n  " + count + " shards: ";
-      for (std::size_t i = 0; i < names.size(); ++i) counts += (i ? ", " : "") + names[i];
-    }
-    message("algray: the shard logs beside " + plan.log_path + " are of different shard counts:" + counts +
-            "\nalgray: remove the stale ones, or pass --mixed-shard-counts to merge them all; nothing merged\n");
-    return BatchOutcome::BadInput;
-  }
-  // Each frame's last entry: a later line of a shard's log is a later attempt (--resume appends). Across logs, a
-  // frame one shard rendered and another failed is a conflict: reported, and the rendered one kept.
+  return counts;
+}
+
+// Each frame's last entry: a later line of a shard's log is a later attempt (--resume appends). Across logs, a
+// frame one shard rendered and another failed is a conflict: reported, and the rendered one kept.
+struct ShardEntries {
   struct Kept {
     nlohmann::json entry;
     std::string where;  // file:line
@@ -1084,6 +1086,25 @@ BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& cal
   };
   std::map<std::pair<std::string, int>, Kept> last;
   std::vector<std::string> conflicts;
+
+  void add(nlohmann::json j, const fs::path& p, const std::string& where) {
+    std::pair<std::string, int> key{j.at("job").get<std::string>(), j.at("frame").get<int>()};
+    const auto it = last.find(key);
+    if (it != last.end() && it->second.file != p.string()) {
+      const std::string was = it->second.entry.value("status", ""), now = j.value("status", "");
+      if ((was == "ok" && now == "failed") || (was == "failed" && now == "ok")) {
+        conflicts.push_back("job " + key.first + " frame " + std::to_string(key.second) + ": " + was + " in " +
+                            it->second.where + ", " + now + " in " + where + "; the ok entry is kept");
+        if (now == "failed") return;
+      }
+    }
+    put_path(j, "merged_from", p.filename());
+    last[std::move(key)] = Kept{std::move(j), where, p.string()};
+  }
+};
+
+ShardEntries read_shard_entries(const std::vector<fs::path>& shard_logs, const BatchReporter& message) {
+  ShardEntries entries;
   for (const fs::path& p : shard_logs) {
     std::ifstream in(p);
     int line_number = 0;
@@ -1091,54 +1112,87 @@ BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& cal
       ++line_number;
       const std::string where = p.string() + ":" + std::to_string(line_number);
       try {
-        nlohmann::json j = nlohmann::json::parse(line);
-        std::pair<std::string, int> key{j.at("job").get<std::string>(), j.at("frame").get<int>()};
-        const auto it = last.find(key);
-        if (it != last.end() && it->second.file != p.string()) {
-          const std::string was = it->second.entry.value("status", ""), now = j.value("status", "");
-          if ((was == "ok" && now == "failed") || (was == "failed" && now == "ok")) {
-            conflicts.push_back("job " + key.first + " frame " + std::to_string(key.second) + ": " + was + " in " +
-                                it->second.where + ", " + now + " in " + where + "; the ok entry is kept");
-            if (now == "failed") continue;
-          }
-        }
-        put_path(j, "merged_from", p.filename());
-        last[std::move(key)] = Kept{std::move(j), where, p.string()};
+        entries.add(nlohmann::json::parse(line), p, where);
       } catch (const std::exception& e) {
         message("algray: warning: " + where + ": not a log entry (" + e.what() + "), ignored\n");
       }
     }
   }
-  for (const std::string& c : conflicts) message("algray: warning: conflicting shard logs: " + c + "\n");
-  std::string merged;
+  return entries;
+}
+
+// The merged log's text, in the batch's frame order, and what it lacks.
+struct MergedLog {
+  std::string text;
   int missing = 0, failed = 0, total = 0;
-  std::string missing_names;
+  std::string missing_names;  // the first 10
+};
+
+MergedLog merge_entries(const BatchPlan& plan, const ShardEntries& entries) {
+  MergedLog merged;
   for (const BatchJob& job : plan.jobs)
-    for (int frame = 0; frame < job.frames; ++frame, ++total) {
-      const auto it = last.find({job.name, frame});
-      if (it == last.end()) {
-        if (missing++ < 10) missing_names += (missing_names.empty() ? "" : ", ") + job.name + "/" + std::to_string(frame);
+    for (int frame = 0; frame < job.frames; ++frame, ++merged.total) {
+      const auto it = entries.last.find({job.name, frame});
+      if (it == entries.last.end()) {
+        if (merged.missing++ < 10)
+          merged.missing_names += (merged.missing_names.empty() ? "" : ", ") + job.name + "/" + std::to_string(frame);
         continue;
       }
-      failed += it->second.entry.value("status", "") == "failed";
-      merged += dump_json(it->second.entry) + "\n";
+      merged.failed += it->second.entry.value("status", "") == "failed";
+      merged.text += dump_json(it->second.entry) + "\n";
     }
+  return merged;
+}
+
+// Writes the merged log over the batch's, keeping aside a log that no merge wrote; false when that failed.
+bool write_merged_log(const BatchPlan& plan, const std::string& text, const BatchReporter& message) {
   std::string kept_as;
   try {
     kept_as = keep_unmerged_log(plan.log_path);
-    write_text_file(plan.log_path, merged);
+    write_text_file(plan.log_path, text);
   } catch (const std::exception& e) {
     message(describe_error(e).text);
-    return BatchOutcome::Stopped;
+    return false;
   }
   if (!kept_as.empty())
     message("algray: " + plan.log_path + " held entries that no merge wrote (a run's log and its --resume " +
             "history); it is kept as " + kept_as + "\n");
-  message("algray: merged " + std::to_string(shard_logs.size()) + " shard logs into " + plan.log_path + ": " +
-          std::to_string(total) + " frames, " + std::to_string(failed) + " failed, " + std::to_string(missing) +
-          " in no log" + (missing ? " (" + missing_names + (missing > 10 ? ", ..." : "") + ")" : "") +
-          (conflicts.empty() ? "" : ", " + std::to_string(conflicts.size()) + " in conflict") + "\n");
-  if (missing || failed) {
+  return true;
+}
+
+}  // namespace
+
+BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& callbacks) {
+  const BatchReporter message{callbacks};
+  std::variant<BatchPlan, BatchOutcome> planned = plan_merge(req, message);
+  if (const BatchOutcome* refused = std::get_if<BatchOutcome>(&planned)) return *refused;
+  const BatchPlan& plan = std::get<BatchPlan>(planned);
+  const fs::path log(plan.log_path);
+  ShardLogs shard_logs = find_shard_logs(log);
+  if (shard_logs.paths.empty()) {
+    message("algray: no shard logs beside " + plan.log_path + " (" + log.stem().string() + ".shard-K-of-N" +
+            log.extension().string() + "): nothing to merge\n");
+    return BatchOutcome::BadInput;
+  }
+  // Two shard counts side by side are two runs, one of them stale: which frames came from which is the user's
+  // call, not ours.
+  if (shard_logs.by_count.size() > 1 && !req.merge_mixed_counts) {
+    message("algray: the shard logs beside " + plan.log_path + " are of different shard counts:" +
+            shard_counts_text(shard_logs.by_count) +
+            "\nalgray: remove the stale ones, or pass --mixed-shard-counts to merge them all; nothing merged\n");
+    return BatchOutcome::BadInput;
+  }
+  const ShardEntries entries = read_shard_entries(shard_logs.paths, message);
+  for (const std::string& c : entries.conflicts) message("algray: warning: conflicting shard logs: " + c + "\n");
+  const MergedLog merged = merge_entries(plan, entries);
+  if (!write_merged_log(plan, merged.text, message)) return BatchOutcome::Stopped;
+  const std::size_t conflicts = entries.conflicts.size();
+  message("algray: merged " + std::to_string(shard_logs.paths.size()) + " shard logs into " + plan.log_path + ": " +
+          std::to_string(merged.total) + " frames, " + std::to_string(merged.failed) + " failed, " +
+          std::to_string(merged.missing) + " in no log" +
+          (merged.missing ? " (" + merged.missing_names + (merged.missing > 10 ? ", ..." : "") + ")" : "") +
+          (conflicts ? ", " + std::to_string(conflicts) + " in conflict" : "") + "\n");
+  if (merged.missing || merged.failed) {
     if (req.video_path) message("algray: the video " + *req.video_path + " was not written: frames are missing\n");
     return BatchOutcome::FramesFailed;
   }
