@@ -243,43 +243,81 @@ std::string target_text(const ProbeTarget& t) {
   return "pixel (" + std::to_string(t.px) + ", " + std::to_string(t.py) + ")";
 }
 
+nlohmann::json step_json(const SolverTrace& tr, const ProbeStep& s) {
+  return {{"decision", step_decision_name(s.decision)},
+          {"decision_code", s.decision},
+          {"count", s.count},
+          {"level", s.level},
+          {"t_lo", tr.t_at(s.lo)},
+          {"t_hi", tr.t_at(s.hi)},
+          {"s_lo", s.lo},
+          {"s_hi", s.hi},
+          {"f_lo", s.f_lo},
+          {"f_hi", s.f_hi}};
+}
+
+nlohmann::json iterates_json(const std::vector<ProbeIterate>& list) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const ProbeIterate& it : list)
+    a.push_back({{"number", it.number},
+                 {"order", it.order},
+                 {"t", it.t},
+                 {"y", it.y},
+                 {"value", it.value},
+                 {"bracket", {it.lo, it.hi}}});
+  return a;
+}
+
+// What was traced, and how: the solver's configuration and the ray.
+nlohmann::json traced_json(const SolverTrace& tr) {
+  return {{"solver", solver_name(tr.config)},
+          {"isolation", to_string(tr.config.isolation)},
+          {"refinement", to_string(tr.config.refinement)},
+          {"precision", to_string(tr.config.precision)},
+          {"tolerance", tr.config.tolerance},
+          {"max_iterations", tr.config.max_iterations},
+          {"ray_origin", to_string(tr.config.ray_origin)},
+          {"program", tr.program_origin},
+          {"ray",
+           {{"origin", {tr.ray.origin.x, tr.ray.origin.y, tr.ray.origin.z}},
+            {"direction", {tr.ray.direction.x, tr.ray.direction.y, tr.ray.direction.z}}}},
+          {"in_extent", tr.in_extent}};
+}
+
+// P at a settled interval's ends, or around a confirmed root, and the rounding bound of each.
+nlohmann::json ends_json(const ProbeConfirmed& ends) {
+  return {{"before", ends.before},
+          {"before_rounding", ends.before_rounding},
+          {"after", ends.after},
+          {"after_rounding", ends.after_rounding}};
+}
+
+nlohmann::json settled_discards_json(const SolverTrace& tr) {
+  nlohmann::json settled = nlohmann::json::array();
+  for (const auto& [doubt, ends] : tr.settled_discards) {
+    nlohmann::json s = ends_json(ends);
+    s["t_lo"] = tr.t_at(doubt.lo);
+    s["t_hi"] = tr.t_at(doubt.hi);
+    settled.push_back(s);
+  }
+  return settled;
+}
+
+nlohmann::json doubt_json(const SolverTrace& tr, const ProbeDoubt& doubt) {
+  const DoubtReason* why = doubt_reason(static_cast<unsigned>(doubt.reason));
+  nlohmann::json j = {{"reason", why ? why->name : "?"}, {"level", doubt.level}, {"t_lo", tr.t_at(doubt.lo)},
+                      {"t_hi", tr.t_at(doubt.hi)},       {"value", doubt.value}, {"noise", doubt.noise}};
+  if (tr.confirmed) {
+    j["confirmed"] = ends_json(*tr.confirmed);
+    j["confirmed"]["float_float"] = tr.confirmed->float_float;
+    j["confirmed"]["bracket"] = tr.confirmed->bracket;
+    j["confirmed"]["discard"] = tr.confirmed->discard;
+  }
+  return j;
+}
+
 nlohmann::json trace_json(const SolverTrace& tr) {
-  using nlohmann::json;
-  json steps = json::array();
-  for (const ProbeStep& s : tr.steps)
-    steps.push_back({{"decision", step_decision_name(s.decision)},
-                     {"decision_code", s.decision},
-                     {"count", s.count},
-                     {"level", s.level},
-                     {"t_lo", tr.t_at(s.lo)},
-                     {"t_hi", tr.t_at(s.hi)},
-                     {"s_lo", s.lo},
-                     {"s_hi", s.hi},
-                     {"f_lo", s.f_lo},
-                     {"f_hi", s.f_hi}});
-  auto iterates = [&](const std::vector<ProbeIterate>& list) {
-    json a = json::array();
-    for (const ProbeIterate& it : list)
-      a.push_back({{"number", it.number},
-                   {"order", it.order},
-                   {"t", it.t},
-                   {"y", it.y},
-                   {"value", it.value},
-                   {"bracket", {it.lo, it.hi}}});
-    return a;
-  };
-  json j = {{"solver", solver_name(tr.config)},
-            {"isolation", to_string(tr.config.isolation)},
-            {"refinement", to_string(tr.config.refinement)},
-            {"precision", to_string(tr.config.precision)},
-            {"tolerance", tr.config.tolerance},
-            {"max_iterations", tr.config.max_iterations},
-            {"ray_origin", to_string(tr.config.ray_origin)},
-            {"program", tr.program_origin},
-            {"ray",
-             {{"origin", {tr.ray.origin.x, tr.ray.origin.y, tr.ray.origin.z}},
-              {"direction", {tr.ray.direction.x, tr.ray.direction.y, tr.ray.direction.z}}}},
-            {"in_extent", tr.in_extent}};
+  nlohmann::json j = traced_json(tr);
   if (!tr.in_extent) return j;
   j["t_in"] = tr.t_in;
   j["t_out"] = tr.t_out;
@@ -287,39 +325,18 @@ nlohmann::json trace_json(const SolverTrace& tr) {
   j["coefficients"] = tr.coefficients;
   if (tr.config.precision == Precision::Mixed) j["coefficients_lo"] = tr.coefficients_lo;
   j["power_coefficients"] = tr.power;
-  j["steps"] = steps;
-  if (!tr.chain_iterates.empty()) j["chain_iterates"] = iterates(tr.chain_iterates);
+  j["steps"] = nlohmann::json::array();
+  for (const ProbeStep& s : tr.steps) j["steps"].push_back(step_json(tr, s));
+  if (!tr.chain_iterates.empty()) j["chain_iterates"] = iterates_json(tr.chain_iterates);
   j["isolation"] = {{"status", status_name(tr.isolation_status)},
                     {"t_lo", tr.t_at(tr.iso_lo)},
                     {"t_hi", tr.t_at(tr.iso_hi)},
                     {"f_lo", tr.iso_f_lo},
                     {"f_hi", tr.iso_f_hi},
                     {"halving_limit", tr.halving_limit}};
-  j["iterates"] = iterates(tr.iterates);
-  if (!tr.settled_discards.empty()) {
-    nlohmann::json settled = nlohmann::json::array();
-    for (const auto& [doubt, ends] : tr.settled_discards)
-      settled.push_back({{"t_lo", tr.t_at(doubt.lo)},
-                         {"t_hi", tr.t_at(doubt.hi)},
-                         {"before", ends.before},
-                         {"before_rounding", ends.before_rounding},
-                         {"after", ends.after},
-                         {"after_rounding", ends.after_rounding}});
-    j["settled_discards"] = settled;
-  }
-  if (tr.doubt) {
-    const DoubtReason* why = doubt_reason(static_cast<unsigned>(tr.doubt->reason));
-    j["doubt"] = {{"reason", why ? why->name : "?"}, {"level", tr.doubt->level}, {"t_lo", tr.t_at(tr.doubt->lo)},
-                  {"t_hi", tr.t_at(tr.doubt->hi)},   {"value", tr.doubt->value}, {"noise", tr.doubt->noise}};
-    if (tr.confirmed)
-      j["doubt"]["confirmed"] = {{"before", tr.confirmed->before},
-                                 {"before_rounding", tr.confirmed->before_rounding},
-                                 {"after", tr.confirmed->after},
-                                 {"after_rounding", tr.confirmed->after_rounding},
-                                 {"float_float", tr.confirmed->float_float},
-                                 {"bracket", tr.confirmed->bracket},
-                                 {"discard", tr.confirmed->discard}};
-  }
+  j["iterates"] = iterates_json(tr.iterates);
+  if (!tr.settled_discards.empty()) j["settled_discards"] = settled_discards_json(tr);
+  if (tr.doubt) j["doubt"] = doubt_json(tr, *tr.doubt);
   j["found"] = tr.found();
   if (tr.found()) j["t"] = tr.t;
   j["back_side"] = (tr.hit.flags & ALGRAY_HIT_BACK) != 0;
