@@ -118,12 +118,84 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
   img.world_to_ndc = world_to_ndc_matrix(cam, b, scene.image.width, scene.image.height);
 }
 
+// Drivers' strings come from outside and need not be UTF-8.
+nlohmann::json device_json(const DeviceInfo& device) {
+  return {{"name", utf8_for_json(device.name)},
+          {"platform", utf8_for_json(device.platform_name)},
+          {"type", device.type},
+          {"fp64", device.fp64},
+          {"driver", utf8_for_json(device.driver_version)}};
+}
+
+nlohmann::json solver_json(const KernelConfig& config) {
+  return {{"isolation", to_string(config.isolation)},
+          {"refinement", to_string(config.refinement)},
+          {"ray_origin", to_string(config.ray_origin)},
+          {"precision", to_string(config.precision)},
+          {"tolerance", config.tolerance},
+          {"max_iterations", config.max_iterations}};
+}
+
+// A program, with the device time of its launches in every pass.
+nlohmann::json program_json(const ProgramRecord& p, const std::vector<PassStats>& passes) {
+  double kernel_ms = 0;
+  for (const PassStats& pass : passes)
+    for (std::size_t k = 0; k < pass.program_keys.size(); ++k)
+      if (pass.program_keys[k] == p.key) kernel_ms += pass.program_ms[k];
+  return {{"key", p.key},
+          {"options", p.options},
+          {"from_cache", p.origin != "built"},
+          {"origin", p.origin},
+          {"build_ms", p.build_ms},
+          {"kernel_ms", kernel_ms}};
+}
+
+// A pass, with where each of its programs came from.
+nlohmann::json pass_json(const PassStats& p, const std::vector<ProgramRecord>& programs) {
+  nlohmann::json kernels = nlohmann::json::array();
+  for (const std::string& key : p.program_keys) {
+    std::string origin;
+    for (const ProgramRecord& program : programs)
+      if (program.key == key) origin = program.origin;
+    kernels.push_back({{"key", key}, {"origin", origin}});
+  }
+  return {{"name", p.name},
+          {"kernels", kernels},
+          {"rays", p.rays},
+          {"launches", p.launches},
+          {"kernel_ms", p.kernel_ms},
+          {"wall_ms", p.wall_ms},
+          {"escalated", p.escalated},
+          {"escalation_ms", p.escalation_ms}};
+}
+
+// Where the render's time went: device time of the launches, the passes' wall time (launches, staging and
+// readback), and the host's shading, which runs tile by tile inside the render.
+nlohmann::json render_ms_json(const RenderResult& r) {
+  double kernel_ms = 0, passes_ms = 0;
+  for (const PassStats& pass : r.passes) {
+    kernel_ms += pass.kernel_ms;
+    passes_ms += pass.wall_ms;
+  }
+  return {{"kernel", kernel_ms}, {"passes_wall", passes_ms}, {"host_shading", r.shade_ms}};
+}
+
+// A device's share of the tiles, of the rays of every pass, and of the device time.
+nlohmann::json device_share_json(const DeviceShare& d) {
+  return {{"rank", d.rank},
+          {"index", d.index},
+          {"name", utf8_for_json(d.name)},
+          {"tiles", d.tiles},
+          {"rays", d.rays},
+          {"kernel_ms", d.kernel_ms},
+          {"programs_ms", d.programs_ms}};
+}
+
 }  // namespace
 
 nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const std::vector<std::string>& images,
                            bool cache_used) {
   const RenderResult& r = frame.result;
-  const DeviceInfo& device = frame.device;
   nlohmann::json j;
   j["version"] = version_string();
   put_path(j, "scene", scene.source);
@@ -132,57 +204,21 @@ nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const
   j["scene_toml"] = utf8_for_json(scene_to_toml(scene));
   put_paths(j, "outputs", images);
   j["image"] = {{"width", scene.image.width}, {"height", scene.image.height}};
-  // Drivers' strings and .jsurf equations come from outside and need not be UTF-8.
-  j["device"] = {{"name", utf8_for_json(device.name)},
-                 {"platform", utf8_for_json(device.platform_name)},
-                 {"type", device.type},
-                 {"fp64", device.fp64},
-                 {"driver", utf8_for_json(device.driver_version)}};
+  j["device"] = device_json(frame.device);
+  // .jsurf equations come from outside and need not be UTF-8.
   j["surface"] = {{"equation", utf8_for_json(scene.surface().equation)}, {"degree", r.config.degree}};
   for (const SceneSurface& s : scene.surfaces)
     j["surfaces"].push_back({{"name", utf8_for_json(s.name)},
                              {"equation", utf8_for_json(s.equation)},
                              {"degree", s.polynomial.degree()}});
-  j["solver"] = {{"isolation", to_string(r.config.isolation)},
-                 {"refinement", to_string(r.config.refinement)},
-                 {"ray_origin", to_string(r.config.ray_origin)},
-                 {"precision", to_string(r.config.precision)},
-                 {"tolerance", r.config.tolerance},
-                 {"max_iterations", r.config.max_iterations}};
+  j["solver"] = solver_json(r.config);
   if (cache_used)
     put_path(j, "cache", ProgramCache::default_directory());
   else
     j["cache"] = "off";
-  for (const ProgramRecord& p : r.programs) {
-    double kernel_ms = 0;
-    for (const PassStats& pass : r.passes)
-      for (std::size_t k = 0; k < pass.program_keys.size(); ++k)
-        if (pass.program_keys[k] == p.key) kernel_ms += pass.program_ms[k];
-    j["programs"].push_back({{"key", p.key},
-                             {"options", p.options},
-                             {"from_cache", p.origin != "built"},
-                             {"origin", p.origin},
-                             {"build_ms", p.build_ms},
-                             {"kernel_ms", kernel_ms}});
-  }
+  for (const ProgramRecord& p : r.programs) j["programs"].push_back(program_json(p, r.passes));
   j["plan"] = r.plan.json();
-  for (const PassStats& p : r.passes) {
-    nlohmann::json kernels = nlohmann::json::array();
-    for (const std::string& key : p.program_keys) {
-      std::string origin;
-      for (const ProgramRecord& program : r.programs)
-        if (program.key == key) origin = program.origin;
-      kernels.push_back({{"key", key}, {"origin", origin}});
-    }
-    j["passes"].push_back({{"name", p.name},
-                           {"kernels", kernels},
-                           {"rays", p.rays},
-                           {"launches", p.launches},
-                           {"kernel_ms", p.kernel_ms},
-                           {"wall_ms", p.wall_ms},
-                           {"escalated", p.escalated},
-                           {"escalation_ms", p.escalation_ms}});
-  }
+  for (const PassStats& p : r.passes) j["passes"].push_back(pass_json(p, r.programs));
   const PrimarySummary& p = r.primary;
   j["primary_rays"] = {{"count", p.rays},
                        {"hits", p.hits},
@@ -191,23 +227,8 @@ nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const
                        {"refine_iterations", p.refine_iterations}};
   // A pixel shows the surface when any of its antialiasing samples hit it.
   j["pixels"] = {{"count", p.pixels}, {"hits", p.pixels_hit}};
-  // Where the render's time went: device time of the launches, the passes' wall time (launches, staging and
-  // readback), and the host's shading, which runs tile by tile inside the render.
-  double kernel_ms = 0, passes_ms = 0;
-  for (const PassStats& pass : r.passes) {
-    kernel_ms += pass.kernel_ms;
-    passes_ms += pass.wall_ms;
-  }
-  j["render_ms"] = {{"kernel", kernel_ms}, {"passes_wall", passes_ms}, {"host_shading", r.shade_ms}};
-  // Each device's share of the tiles, of the rays of every pass, and of the device time.
-  for (const DeviceShare& d : r.devices)
-    j["devices"].push_back({{"rank", d.rank},
-                            {"index", d.index},
-                            {"name", utf8_for_json(d.name)},
-                            {"tiles", d.tiles},
-                            {"rays", d.rays},
-                            {"kernel_ms", d.kernel_ms},
-                            {"programs_ms", d.programs_ms}});
+  j["render_ms"] = render_ms_json(r);
+  for (const DeviceShare& d : r.devices) j["devices"].push_back(device_share_json(d));
   j["phases_ms"] = frame.timer.json();
   j["total_ms"] = frame.timer.total_ms();
   return j;
