@@ -19,6 +19,7 @@
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
+#include <variant>
 
 #include "algray/io/image_io.h"
 #include "algray/io/video_writer.h"
@@ -85,105 +86,138 @@ std::string resolve(const std::string& base_dir, const std::string& path) {
   return (fs::path(base_dir) / path).lexically_normal().string();
 }
 
-// Reads one [[job]] on top of [defaults].
-BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::table& t, std::size_t index,
-                  const std::string& base_dir) {
-  r.check_keys(t, "job", kJobKeys);
-  const auto get = [&](const char* key) -> const toml::node* {
-    if (const toml::node* n = t.get(key)) return n;
+// A job's tables: its own, and [defaults] for what it leaves out.
+struct JobTables {
+  const toml::table& job;
+  const toml::table* defaults;
+  const toml::node* get(const char* key) const {
+    if (const toml::node* n = job.get(key)) return n;
     return defaults ? defaults->get(key) : nullptr;
-  };
-  BatchJob job;
-  job.line = static_cast<int>(t.source().begin.line);
-  job.origin = origin_of(r, t);
-  const toml::node* scene = get("scene");
-  if (!scene) r.fail(t.source(), "job " + std::to_string(index) + " needs a scene (a .toml or .jsurf path)");
+  }
+};
+
+// The scene, and the name, which defaults to the scene's stem and the job's index.
+void read_job_scene(const TomlReader& r, const JobTables& tables, std::size_t index, const std::string& base_dir,
+                    BatchJob& job) {
+  const toml::node* scene = tables.get("scene");
+  if (!scene) r.fail(tables.job.source(), "job " + std::to_string(index) + " needs a scene (a .toml or .jsurf path)");
   job.scene = r.string(*scene, "job.scene");
   if (job.scene == "-") r.fail(scene->source(), "a batch job cannot read its scene from standard input");
   job.scene = resolve(base_dir, job.scene);
-  job.name = get("name") ? r.string(*get("name"), "job.name")
-                         : fs::path(job.scene).stem().string() + "_" + std::to_string(index);
-  if (defaults)
-    if (const toml::node* n = defaults->get("set")) {
+  job.name = tables.get("name") ? r.string(*tables.get("name"), "job.name")
+                                : fs::path(job.scene).stem().string() + "_" + std::to_string(index);
+}
+
+// [defaults]' set first, then the job's, so that the job's own values win.
+void read_job_sets(const TomlReader& r, const JobTables& tables, BatchJob& job) {
+  for (const toml::table* table : {tables.defaults, &tables.job})
+    if (const toml::node* n = table ? table->get("set") : nullptr) {
       if (!n->is_table()) r.fail(n->source(), "set must be a table of scene keys and values");
       collect_sets(r, *n->as_table(), "", job.overrides);
     }
-  if (const toml::node* n = t.get("set")) {
-    if (!n->is_table()) r.fail(n->source(), "set must be a table of scene keys and values");
-    collect_sets(r, *n->as_table(), "", job.overrides);
-  }
+}
+
+// Returns the output node, which later messages about the patterns point at.
+const toml::node* read_job_outputs(const TomlReader& r, const JobTables& tables, const std::string& base_dir,
+                                   BatchJob& job) {
   // Without an output, the frames go only into the batch's --video (plan_batch checks there is one).
-  const toml::node* output = get("output");
+  const toml::node* output = tables.get("output");
   if (output)
     for (const std::string& o : string_or_list(r, *output, "job.output")) job.outputs.push_back(resolve(base_dir, o));
-  if (const toml::node* n = get("stats")) job.stats = resolve(base_dir, r.string(*n, "job.stats"));
+  if (const toml::node* n = tables.get("stats")) job.stats = resolve(base_dir, r.string(*n, "job.stats"));
+  return output;
+}
 
+// The frame count as the job's frames, seconds x fps, sweeps' steps and orbit frames give it: each that gives
+// one must agree with those before it.
+struct FrameCount {
+  const TomlReader& r;
   std::optional<int> frames;
-  const toml::node* frames_node = t.get("frames");
-  if (frames_node) frames = static_cast<int>(r.integer(*frames_node, "job.frames", 1, 1000000));
-  const auto agree = [&](int n, const toml::node& where, const std::string& what) {
+  void agree(int n, const toml::node& where, const std::string& what) {
     if (frames && *frames != n)
       r.fail(where.source(), what + " gives " + std::to_string(n) + " frames but the job has " +
                                  std::to_string(*frames) + " (all sweeps and the orbit step together)");
     frames = n;
-  };
-  // A duration and a frame rate: seconds x fps frames (a sweep or orbit then needs no steps or frames).
+  }
+};
+
+// A duration and a frame rate: seconds x fps frames (a sweep or orbit then needs no steps or frames).
+void read_job_duration(const TomlReader& r, const toml::table& t, FrameCount& count, BatchJob& job) {
   if (const toml::node* n = t.get("fps")) {
     job.fps = r.number(*n, "job.fps");
     if (!(job.fps > 0 && job.fps <= 1000)) r.fail(n->source(), "job.fps must be above 0 and at most 1000");
   }
   if (const toml::node* n = t.get("seconds")) {
     const double seconds = r.number(*n, "job.seconds");
-    const double count = std::round(seconds * job.fps);
-    if (!(seconds > 0) || !(count >= 1 && count <= 1000000))
+    const double frames = std::round(seconds * job.fps);
+    if (!(seconds > 0) || !(frames >= 1 && frames <= 1000000))
       r.fail(n->source(), "job.seconds x fps must make 1 to 1000000 frames");
-    agree(static_cast<int>(count), *n, "seconds x fps");
+    count.agree(static_cast<int>(frames), *n, "seconds x fps");
   }
-  if (const toml::node* n = t.get("sweep")) {
-    const toml::table* sweeps = n->as_table();
-    if (!sweeps || sweeps->empty())
-      r.fail(n->source(), "sweep must be a table of keys, each { from = ..., to = ..., steps = ... }");
-    for (auto&& [key, node] : *sweeps) {
-      const std::string what = "sweep." + std::string(key.str());
-      const toml::table* s = node.as_table();
-      if (!s) r.fail(node.source(), what + " must be { from = ..., to = ..., steps = ... }");
-      r.check_keys(*s, what, kSweepKeys);
-      for (const char* k : {"from", "to"})
-        if (!s->get(k)) r.fail(node.source(), what + " needs '" + k + "'");
-      if (!s->get("steps") && !frames)
-        r.fail(node.source(), what + " needs 'steps', or the job frames or seconds (and fps)");
-      Sweep sweep;
-      sweep.key = std::string(key.str());
-      sweep.origin = origin_of(r, node);
-      sweep.from = r.number(*s->get("from"), what + ".from");
-      sweep.to = r.number(*s->get("to"), what + ".to");
-      if (const toml::node* steps = s->get("steps"))
-        agree(static_cast<int>(r.integer(*steps, what + ".steps", 1, 1000000)), node, what);
-      job.sweeps.push_back(sweep);
-    }
+}
+
+Sweep read_sweep(const TomlReader& r, const toml::key& key, const toml::node& node, FrameCount& count) {
+  const std::string what = "sweep." + std::string(key.str());
+  const toml::table* s = node.as_table();
+  if (!s) r.fail(node.source(), what + " must be { from = ..., to = ..., steps = ... }");
+  r.check_keys(*s, what, kSweepKeys);
+  for (const char* k : {"from", "to"})
+    if (!s->get(k)) r.fail(node.source(), what + " needs '" + k + "'");
+  if (!s->get("steps") && !count.frames)
+    r.fail(node.source(), what + " needs 'steps', or the job frames or seconds (and fps)");
+  Sweep sweep;
+  sweep.key = std::string(key.str());
+  sweep.origin = origin_of(r, node);
+  sweep.from = r.number(*s->get("from"), what + ".from");
+  sweep.to = r.number(*s->get("to"), what + ".to");
+  if (const toml::node* steps = s->get("steps"))
+    count.agree(static_cast<int>(r.integer(*steps, what + ".steps", 1, 1000000)), node, what);
+  return sweep;
+}
+
+std::vector<Sweep> read_sweeps(const TomlReader& r, const toml::node& n, FrameCount& count) {
+  const toml::table* sweeps = n.as_table();
+  if (!sweeps || sweeps->empty())
+    r.fail(n.source(), "sweep must be a table of keys, each { from = ..., to = ..., steps = ... }");
+  std::vector<Sweep> out;
+  for (auto&& [key, node] : *sweeps) out.push_back(read_sweep(r, key, node, count));
+  return out;
+}
+
+Orbit read_orbit(const TomlReader& r, const toml::node& n, FrameCount& count) {
+  const toml::table* o = n.as_table();
+  if (!o) r.fail(n.source(), "orbit must be a table { frames, degrees, axis, lights }");
+  r.check_keys(*o, "orbit", kOrbitKeys);
+  Orbit orbit;
+  if (const toml::node* d = o->get("degrees")) orbit.degrees = r.number(*d, "orbit.degrees");
+  if (const toml::node* a = o->get("axis")) {
+    orbit.axis = r.vec3(*a, "orbit.axis");
+    if (!(glm::length(*orbit.axis) > 0)) r.fail(a->source(), "orbit.axis must not be zero");
   }
-  if (const toml::node* n = t.get("orbit")) {
-    const toml::table* o = n->as_table();
-    if (!o) r.fail(n->source(), "orbit must be a table { frames, degrees, axis, lights }");
-    r.check_keys(*o, "orbit", kOrbitKeys);
-    Orbit orbit;
-    if (const toml::node* d = o->get("degrees")) orbit.degrees = r.number(*d, "orbit.degrees");
-    if (const toml::node* a = o->get("axis")) {
-      orbit.axis = r.vec3(*a, "orbit.axis");
-      if (!(glm::length(*orbit.axis) > 0)) r.fail(a->source(), "orbit.axis must not be zero");
-    }
-    if (const toml::node* l = o->get("lights")) {
-      const std::string mode = r.string(*l, "orbit.lights");
-      if (mode != "camera" && mode != "world") r.fail(l->source(), "orbit.lights must be \"camera\" or \"world\"");
-      orbit.lights_follow_camera = mode == "camera";
-    }
-    if (const toml::node* f = o->get("frames"))
-      agree(static_cast<int>(r.integer(*f, "orbit.frames", 1, 1000000)), *f, "orbit.frames");
-    else if (!frames)
-      r.fail(n->source(), "orbit needs frames (or a sweep's steps) to know how many views to render");
-    job.orbit = orbit;
+  if (const toml::node* l = o->get("lights")) {
+    const std::string mode = r.string(*l, "orbit.lights");
+    if (mode != "camera" && mode != "world") r.fail(l->source(), "orbit.lights must be \"camera\" or \"world\"");
+    orbit.lights_follow_camera = mode == "camera";
   }
-  job.frames = frames.value_or(1);
+  if (const toml::node* f = o->get("frames"))
+    count.agree(static_cast<int>(r.integer(*f, "orbit.frames", 1, 1000000)), *f, "orbit.frames");
+  else if (!count.frames)
+    r.fail(n.source(), "orbit needs frames (or a sweep's steps) to know how many views to render");
+  return orbit;
+}
+
+// Frames, sweeps and orbits belong to the job alone, never to [defaults].
+void read_job_frames(const TomlReader& r, const toml::table& t, BatchJob& job) {
+  FrameCount count{r, std::nullopt};
+  if (const toml::node* n = t.get("frames")) count.frames = static_cast<int>(r.integer(*n, "job.frames", 1, 1000000));
+  read_job_duration(r, t, count, job);
+  if (const toml::node* n = t.get("sweep")) job.sweeps = read_sweeps(r, *n, count);
+  if (const toml::node* n = t.get("orbit")) job.orbit = read_orbit(r, *n, count);
+  job.frames = count.frames.value_or(1);
+}
+
+// Patterns are checked now, so that a typo fails the whole batch before any rendering.
+void check_job_patterns(const TomlReader& r, const BatchJob& job, const toml::node* output, const toml::node* stats) {
   // Every frame must write its own files: a pattern without {frame}, {value} or {angle} would overwrite itself.
   if (job.frames > 1)
     for (const std::string& o : job.outputs)
@@ -191,7 +225,6 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
           o.find("{angle}") == std::string::npos)
         r.fail(output->source(), "job '" + job.name + "' has " + std::to_string(job.frames) + " frames but output '" +
                                      o + "' has no {frame} (or {value}, {angle}) to tell them apart");
-  // Patterns are checked now, so that a typo fails the whole batch before any rendering.
   for (const std::string& o : job.outputs) {
     try {
       expand_pattern(o, job, 0);
@@ -206,9 +239,24 @@ BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::
     try {
       expand_pattern(*job.stats, job, 0);
     } catch (const SceneError& e) {
-      r.fail(get("stats")->source(), e.message);
+      r.fail(stats->source(), e.message);
     }
   }
+}
+
+// Reads one [[job]] on top of [defaults].
+BatchJob read_job(const TomlReader& r, const toml::table* defaults, const toml::table& t, std::size_t index,
+                  const std::string& base_dir) {
+  r.check_keys(t, "job", kJobKeys);
+  const JobTables tables{t, defaults};
+  BatchJob job;
+  job.line = static_cast<int>(t.source().begin.line);
+  job.origin = origin_of(r, t);
+  read_job_scene(r, tables, index, base_dir, job);
+  read_job_sets(r, tables, job);
+  const toml::node* output = read_job_outputs(r, tables, base_dir, job);
+  read_job_frames(r, t, job);
+  check_job_patterns(r, job, output, tables.get("stats"));
   job.output_origin = output ? origin_of(r, *output) : job.origin;
   return job;
 }
@@ -974,62 +1022,63 @@ BatchOutcome encode_shards_video(const BatchRequest& req, const BatchPlan& plan,
   }
 }
 
-}  // namespace
-
-BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& callbacks) {
-  const BatchReporter message{callbacks};
+// The batch's plan without the shard, checked for what a merge needs; a refusal is the outcome to return.
+std::variant<BatchPlan, BatchOutcome> plan_merge(const BatchRequest& req, const BatchReporter& message) {
   BatchRequest whole = req;
   whole.shard.reset();
-  BatchPlan plan;
   try {
-    plan = plan_batch(whole);
+    BatchPlan plan = plan_batch(whole);
     if (req.video_path)
       for (const BatchJob& job : plan.jobs)
         if (!frame_image_pattern(job))
           throw SceneError(job.origin, "--merge-logs --video makes the video from the shards' images: job '" +
                                            job.name + "' needs a .png or .exr output");
+    return plan;
   } catch (const std::exception& e) {
     return message.refused(e);
   }
-  // The shard logs beside the batch's log: <stem>.shard-K-of-N<extension>, whatever the shard count.
-  const fs::path log(plan.log_path);
+}
+
+// The shard logs beside the batch's log: <stem>.shard-K-of-N<extension>, whatever the shard count.
+struct ShardLogs {
+  std::vector<fs::path> paths;                               // sorted
+  std::map<std::string, std::vector<std::string>> by_count;  // shard count -> its logs' names
+};
+
+ShardLogs find_shard_logs(const fs::path& log) {
   const fs::path dir = log.parent_path().empty() ? fs::path(".") : log.parent_path();
   const auto literal = [](const std::string& text) {
     return std::regex_replace(text, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)");
   };
   const std::regex shard_name(literal(log.stem().string()) + R"(\.shard-[0-9]+-of-([0-9]+))" +
                               literal(log.extension().string()));
-  std::vector<fs::path> shard_logs;
-  std::map<std::string, std::vector<std::string>> by_count;  // shard count -> its logs' names
+  ShardLogs found;
   std::error_code ec;
   for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
     std::smatch m;
     if (!std::regex_match(name, m, shard_name)) continue;
-    shard_logs.push_back(log.parent_path() / name);  // named as the batch's log is, without a "./"
-    by_count[m[1].str()].push_back(name);
+    found.paths.push_back(log.parent_path() / name);  // named as the batch's log is, without a "./"
+    found.by_count[m[1].str()].push_back(name);
   }
-  std::sort(shard_logs.begin(), shard_logs.end());
-  if (shard_logs.empty()) {
-    message("algray: no shard logs beside " + plan.log_path + " (" + log.stem().string() + ".shard-K-of-N" +
-            log.extension().string() + "): nothing to merge\n");
-    return BatchOutcome::BadInput;
+  std::sort(found.paths.begin(), found.paths.end());
+  return found;
+}
+
+// "\n  4 shards: a, b\n  8 shards: c": the logs of each shard count, for the message that refuses to mix them.
+std::string shard_counts_text(std::map<std::string, std::vector<std::string>>& by_count) {
+  std::string counts;
+  for (auto& [count, names] : by_count) {
+    std::sort(names.begin(), names.end());
+    counts += "\n  " + count + " shards: ";
+    for (std::size_t i = 0; i < names.size(); ++i) counts += (i ? ", " : "") + names[i];
   }
-  // Two shard counts side by side are two runs, one of them stale: which frames came from which is the user's
-  // call, not ours.
-  if (by_count.size() > 1 && !req.merge_mixed_counts) {
-    std::string counts;
-    for (auto& [count, names] : by_count) {
-      std::sort(names.begin(), names.end());
-      counts += "\n  " + count + " shards: ";
-      for (std::size_t i = 0; i < names.size(); ++i) counts += (i ? ", " : "") + names[i];
-    }
-    message("algray: the shard logs beside " + plan.log_path + " are of different shard counts:" + counts +
-            "\nalgray: remove the stale ones, or pass --mixed-shard-counts to merge them all; nothing merged\n");
-    return BatchOutcome::BadInput;
-  }
-  // Each frame's last entry: a later line of a shard's log is a later attempt (--resume appends). Across logs, a
-  // frame one shard rendered and another failed is a conflict: reported, and the rendered one kept.
+  return counts;
+}
+
+// Each frame's last entry: a later line of a shard's log is a later attempt (--resume appends). Across logs, a
+// frame one shard rendered and another failed is a conflict: reported, and the rendered one kept.
+struct ShardEntries {
   struct Kept {
     nlohmann::json entry;
     std::string where;  // file:line
@@ -1037,6 +1086,25 @@ BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& cal
   };
   std::map<std::pair<std::string, int>, Kept> last;
   std::vector<std::string> conflicts;
+
+  void add(nlohmann::json j, const fs::path& p, const std::string& where) {
+    std::pair<std::string, int> key{j.at("job").get<std::string>(), j.at("frame").get<int>()};
+    const auto it = last.find(key);
+    if (it != last.end() && it->second.file != p.string()) {
+      const std::string was = it->second.entry.value("status", ""), now = j.value("status", "");
+      if ((was == "ok" && now == "failed") || (was == "failed" && now == "ok")) {
+        conflicts.push_back("job " + key.first + " frame " + std::to_string(key.second) + ": " + was + " in " +
+                            it->second.where + ", " + now + " in " + where + "; the ok entry is kept");
+        if (now == "failed") return;
+      }
+    }
+    put_path(j, "merged_from", p.filename());
+    last[std::move(key)] = Kept{std::move(j), where, p.string()};
+  }
+};
+
+ShardEntries read_shard_entries(const std::vector<fs::path>& shard_logs, const BatchReporter& message) {
+  ShardEntries entries;
   for (const fs::path& p : shard_logs) {
     std::ifstream in(p);
     int line_number = 0;
@@ -1044,54 +1112,87 @@ BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& cal
       ++line_number;
       const std::string where = p.string() + ":" + std::to_string(line_number);
       try {
-        nlohmann::json j = nlohmann::json::parse(line);
-        std::pair<std::string, int> key{j.at("job").get<std::string>(), j.at("frame").get<int>()};
-        const auto it = last.find(key);
-        if (it != last.end() && it->second.file != p.string()) {
-          const std::string was = it->second.entry.value("status", ""), now = j.value("status", "");
-          if ((was == "ok" && now == "failed") || (was == "failed" && now == "ok")) {
-            conflicts.push_back("job " + key.first + " frame " + std::to_string(key.second) + ": " + was + " in " +
-                                it->second.where + ", " + now + " in " + where + "; the ok entry is kept");
-            if (now == "failed") continue;
-          }
-        }
-        put_path(j, "merged_from", p.filename());
-        last[std::move(key)] = Kept{std::move(j), where, p.string()};
+        entries.add(nlohmann::json::parse(line), p, where);
       } catch (const std::exception& e) {
         message("algray: warning: " + where + ": not a log entry (" + e.what() + "), ignored\n");
       }
     }
   }
-  for (const std::string& c : conflicts) message("algray: warning: conflicting shard logs: " + c + "\n");
-  std::string merged;
+  return entries;
+}
+
+// The merged log's text, in the batch's frame order, and what it lacks.
+struct MergedLog {
+  std::string text;
   int missing = 0, failed = 0, total = 0;
-  std::string missing_names;
+  std::string missing_names;  // the first 10
+};
+
+MergedLog merge_entries(const BatchPlan& plan, const ShardEntries& entries) {
+  MergedLog merged;
   for (const BatchJob& job : plan.jobs)
-    for (int frame = 0; frame < job.frames; ++frame, ++total) {
-      const auto it = last.find({job.name, frame});
-      if (it == last.end()) {
-        if (missing++ < 10) missing_names += (missing_names.empty() ? "" : ", ") + job.name + "/" + std::to_string(frame);
+    for (int frame = 0; frame < job.frames; ++frame, ++merged.total) {
+      const auto it = entries.last.find({job.name, frame});
+      if (it == entries.last.end()) {
+        if (merged.missing++ < 10)
+          merged.missing_names += (merged.missing_names.empty() ? "" : ", ") + job.name + "/" + std::to_string(frame);
         continue;
       }
-      failed += it->second.entry.value("status", "") == "failed";
-      merged += dump_json(it->second.entry) + "\n";
+      merged.failed += it->second.entry.value("status", "") == "failed";
+      merged.text += dump_json(it->second.entry) + "\n";
     }
+  return merged;
+}
+
+// Writes the merged log over the batch's, keeping aside a log that no merge wrote; false when that failed.
+bool write_merged_log(const BatchPlan& plan, const std::string& text, const BatchReporter& message) {
   std::string kept_as;
   try {
     kept_as = keep_unmerged_log(plan.log_path);
-    write_text_file(plan.log_path, merged);
+    write_text_file(plan.log_path, text);
   } catch (const std::exception& e) {
     message(describe_error(e).text);
-    return BatchOutcome::Stopped;
+    return false;
   }
   if (!kept_as.empty())
     message("algray: " + plan.log_path + " held entries that no merge wrote (a run's log and its --resume " +
             "history); it is kept as " + kept_as + "\n");
-  message("algray: merged " + std::to_string(shard_logs.size()) + " shard logs into " + plan.log_path + ": " +
-          std::to_string(total) + " frames, " + std::to_string(failed) + " failed, " + std::to_string(missing) +
-          " in no log" + (missing ? " (" + missing_names + (missing > 10 ? ", ..." : "") + ")" : "") +
-          (conflicts.empty() ? "" : ", " + std::to_string(conflicts.size()) + " in conflict") + "\n");
-  if (missing || failed) {
+  return true;
+}
+
+}  // namespace
+
+BatchOutcome merge_shard_logs(const BatchRequest& req, const BatchCallbacks& callbacks) {
+  const BatchReporter message{callbacks};
+  std::variant<BatchPlan, BatchOutcome> planned = plan_merge(req, message);
+  if (const BatchOutcome* refused = std::get_if<BatchOutcome>(&planned)) return *refused;
+  const BatchPlan& plan = std::get<BatchPlan>(planned);
+  const fs::path log(plan.log_path);
+  ShardLogs shard_logs = find_shard_logs(log);
+  if (shard_logs.paths.empty()) {
+    message("algray: no shard logs beside " + plan.log_path + " (" + log.stem().string() + ".shard-K-of-N" +
+            log.extension().string() + "): nothing to merge\n");
+    return BatchOutcome::BadInput;
+  }
+  // Two shard counts side by side are two runs, one of them stale: which frames came from which is the user's
+  // call, not ours.
+  if (shard_logs.by_count.size() > 1 && !req.merge_mixed_counts) {
+    message("algray: the shard logs beside " + plan.log_path + " are of different shard counts:" +
+            shard_counts_text(shard_logs.by_count) +
+            "\nalgray: remove the stale ones, or pass --mixed-shard-counts to merge them all; nothing merged\n");
+    return BatchOutcome::BadInput;
+  }
+  const ShardEntries entries = read_shard_entries(shard_logs.paths, message);
+  for (const std::string& c : entries.conflicts) message("algray: warning: conflicting shard logs: " + c + "\n");
+  const MergedLog merged = merge_entries(plan, entries);
+  if (!write_merged_log(plan, merged.text, message)) return BatchOutcome::Stopped;
+  const std::size_t conflicts = entries.conflicts.size();
+  message("algray: merged " + std::to_string(shard_logs.paths.size()) + " shard logs into " + plan.log_path + ": " +
+          std::to_string(merged.total) + " frames, " + std::to_string(merged.failed) + " failed, " +
+          std::to_string(merged.missing) + " in no log" +
+          (merged.missing ? " (" + merged.missing_names + (merged.missing > 10 ? ", ..." : "") + ")" : "") +
+          (conflicts ? ", " + std::to_string(conflicts) + " in conflict" : "") + "\n");
+  if (merged.missing || merged.failed) {
     if (req.video_path) message("algray: the video " + *req.video_path + " was not written: frames are missing\n");
     return BatchOutcome::FramesFailed;
   }

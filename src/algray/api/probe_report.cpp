@@ -88,15 +88,14 @@ std::string reference_summary(const ProbeReference& ref) {
   return s;
 }
 
-void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference& ref) {
+void print_trace_heading(std::ostream& out, const SolverTrace& tr) {
   const KernelConfig& c = tr.config;
   out << "\n== " << solver_name(c) << ", " << to_string(c.precision) << ", tolerance " << num(c.tolerance, 3)
       << ", max " << c.max_iterations << " iterations, ray origin " << to_string(c.ray_origin) << " (program "
       << tr.program_origin << ") ==\n";
-  if (!tr.in_extent) {
-    out << "the ray misses the extent: nothing to solve\n";
-    return;
-  }
+}
+
+void print_polynomial(std::ostream& out, const SolverTrace& tr) {
   out << "P* in the solver's basis: " << basis_name(tr.basis) << "\n";
   for (std::size_t k = 0; k < tr.coefficients.size(); ++k) {
     out << "  c" << k << " = " << num(tr.coefficients[k]);
@@ -107,6 +106,10 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
     out << "P* in the power basis of s (converted on the host in long double):\n";
     for (std::size_t k = 0; k < tr.power.size(); ++k) out << "  a" << k << " = " << num(tr.power[k]) << "\n";
   }
+}
+
+// The steps as a table, the derivative chain's solves, and the interval isolation settled on.
+void print_isolation(std::ostream& out, const SolverTrace& tr) {
   out << "isolation, " << tr.steps.size() << " steps (intervals in t; P* at its ends in the solver's scaling):\n";
   char line[256];
   std::snprintf(line, sizeof line, "  %4s %5s  %-45s %12s %12s %5s  %s\n", "step", "level", "interval [lo, hi]",
@@ -130,17 +133,24 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
     out << " on [" << num(tr.t_at(tr.iso_lo)) << ", " << num(tr.t_at(tr.iso_hi)) << "]";
   if (tr.halving_limit) out << " (an interval reached the halving limit)";
   out << "\n";
-  if (!tr.iterates.empty()) {
-    out << "refinement (" << to_string(c.refinement) << "), " << tr.iterates.size() << " iterates:\n";
-    for (const ProbeIterate& it : tr.iterates) {
-      std::snprintf(line, sizeof line, "  %4d  t = %-24s P*(y) = %12.4e  y = %.17g  bracket y in [%.17g, %.17g]\n",
-                    it.number + 1, num(it.t).c_str(), it.value, it.y, it.lo, it.hi);
-      out << line;
-    }
+}
+
+void print_refinement(std::ostream& out, const SolverTrace& tr) {
+  if (tr.iterates.empty()) return;
+  out << "refinement (" << to_string(tr.config.refinement) << "), " << tr.iterates.size() << " iterates:\n";
+  char line[256];
+  for (const ProbeIterate& it : tr.iterates) {
+    std::snprintf(line, sizeof line, "  %4d  t = %-24s P*(y) = %12.4e  y = %.17g  bracket y in [%.17g, %.17g]\n",
+                  it.number + 1, num(it.t).c_str(), it.value, it.y, it.lo, it.hi);
+    out << line;
   }
+}
+
+bool doubted(const SolverTrace& tr) { return (tr.hit.flags & ALGRAY_HIT_DOUBT) != 0; }
+
+void print_result(std::ostream& out, const SolverTrace& tr) {
   out << "result: ";
-  const bool doubted = (tr.hit.flags & ALGRAY_HIT_DOUBT) != 0;
-  if (doubted) {
+  if (doubted(tr)) {
     out << "undecided, left to the second pass";
   } else if (tr.found()) {
     out << "root t = " << num(tr.t) << " (" << ((tr.hit.flags & ALGRAY_HIT_BACK) ? "back" : "front") << " side";
@@ -153,10 +163,10 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
   out << "; " << tr.isolation_steps() << " isolation steps, " << tr.refine_iterations() << " refinement iterations";
   if (tr.hit.flags & ALGRAY_HIT_BUDGET) out << "; halving limit reached";
   out << "\n";
-  const RayCertificate& cert = ref.certificate;
-  if (doubted) {
-    // The next trace is the answer the render keeps; this one stopped undecided.
-  } else if (tr.found() && cert.answer.kind != ref::Classification::Miss && cert.cls != PixelClass::OutsideExtent) {
+}
+
+void print_reference_comparison(std::ostream& out, const SolverTrace& tr, const RayCertificate& cert) {
+  if (tr.found() && cert.answer.kind != ref::Classification::Miss && cert.cls != PixelClass::OutsideExtent) {
     const double error = std::fabs(tr.t - cert.answer.t_nearest);
     out << "vs solver_ref: |t - t_ref| = " << num(error, 3);
     if (cert.answer.t_nearest != 0) out << " (relative " << num(error / std::fabs(cert.answer.t_nearest), 3) << ")";
@@ -167,6 +177,9 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
     out << "vs solver_ref: DISAGREES (" << (tr.found() ? "kernel hit, reference miss" : "kernel miss, reference root")
         << ")\n";
   }
+}
+
+void print_settled_discards(std::ostream& out, const SolverTrace& tr) {
   // The last settled discard is the doubt line below when nothing was doubted after it.
   const std::size_t shown_below = tr.confirmed && tr.confirmed->discard ? 1 : 0;
   for (std::size_t i = 0; i + shown_below < tr.settled_discards.size(); ++i) {
@@ -175,31 +188,52 @@ void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference&
         << "], P at its ends " << num(ends.before, 4) << " (bound " << num(ends.before_rounding, 3) << ") and "
         << num(ends.after, 4) << " (bound " << num(ends.after_rounding, 3) << ")\n";
   }
-  if (tr.doubt) {
-    const DoubtReason* why = doubt_reason(static_cast<unsigned>(tr.doubt->reason));
-    out << "doubted (" << (why ? why->name : "?") << ": " << (why ? why->meaning : "unknown reason")
-        << "): " << num(tr.doubt->value, 4) << " within the noise " << num(tr.doubt->noise, 4) << " on ["
-        << num(tr.t_at(tr.doubt->lo)) << ", " << num(tr.t_at(tr.doubt->hi)) << "]";
-    if (tr.confirmed && tr.confirmed->bracket)
-      out << "; settled: P from the monomials in float-float is " << num(tr.confirmed->before, 4) << " (rounding "
-          << num(tr.confirmed->before_rounding, 3) << ") at the interval's start and " << num(tr.confirmed->after, 4)
-          << " (rounding " << num(tr.confirmed->after_rounding, 3)
-          << ") at its end, the signs float gave: the render keeps this bracket\n";
-    else if (tr.confirmed && tr.confirmed->discard)
-      out << "; settled: P at the interval's ends is " << num(tr.confirmed->before, 4) << " (bound "
-          << num(tr.confirmed->before_rounding, 3) << ") and " << num(tr.confirmed->after, 4) << " (bound "
-          << num(tr.confirmed->after_rounding, 3)
-          << "), in float-float where float's value was within the noise, of its coefficients' sign: the search "
-             "went on\n";
-    else if (tr.confirmed)
-      out << "; confirmed: P from the monomials" << (tr.confirmed->float_float ? " in float-float" : "") << " is "
-          << num(tr.confirmed->before, 4) << " (rounding "
-          << num(tr.confirmed->before_rounding, 3) << ") before the root and " << num(tr.confirmed->after, 4)
-          << " (rounding " << num(tr.confirmed->after_rounding, 3)
-          << ") after it, within " ALGRAY_DOUBT_POSITION_TEXT " of its t: the render keeps this root\n";
-    else
-      out << "; the render traces the ray again in the next trace's precision, whose answer it keeps\n";
+}
+
+// How the doubt ended: settled in float-float or confirmed (the render keeps the answer), else the next trace.
+void print_doubt_outcome(std::ostream& out, const std::optional<ProbeConfirmed>& confirmed) {
+  if (confirmed && confirmed->bracket)
+    out << "; settled: P from the monomials in float-float is " << num(confirmed->before, 4) << " (rounding "
+        << num(confirmed->before_rounding, 3) << ") at the interval's start and " << num(confirmed->after, 4)
+        << " (rounding " << num(confirmed->after_rounding, 3)
+        << ") at its end, the signs float gave: the render keeps this bracket\n";
+  else if (confirmed && confirmed->discard)
+    out << "; settled: P at the interval's ends is " << num(confirmed->before, 4) << " (bound "
+        << num(confirmed->before_rounding, 3) << ") and " << num(confirmed->after, 4) << " (bound "
+        << num(confirmed->after_rounding, 3)
+        << "), in float-float where float's value was within the noise, of its coefficients' sign: the search "
+           "went on\n";
+  else if (confirmed)
+    out << "; confirmed: P from the monomials" << (confirmed->float_float ? " in float-float" : "") << " is "
+        << num(confirmed->before, 4) << " (rounding " << num(confirmed->before_rounding, 3) << ") before the root and "
+        << num(confirmed->after, 4) << " (rounding " << num(confirmed->after_rounding, 3)
+        << ") after it, within " ALGRAY_DOUBT_POSITION_TEXT " of its t: the render keeps this root\n";
+  else
+    out << "; the render traces the ray again in the next trace's precision, whose answer it keeps\n";
+}
+
+void print_doubt(std::ostream& out, const SolverTrace& tr, const ProbeDoubt& doubt) {
+  const DoubtReason* why = doubt_reason(static_cast<unsigned>(doubt.reason));
+  out << "doubted (" << (why ? why->name : "?") << ": " << (why ? why->meaning : "unknown reason")
+      << "): " << num(doubt.value, 4) << " within the noise " << num(doubt.noise, 4) << " on ["
+      << num(tr.t_at(doubt.lo)) << ", " << num(tr.t_at(doubt.hi)) << "]";
+  print_doubt_outcome(out, tr.confirmed);
+}
+
+void print_trace(std::ostream& out, const SolverTrace& tr, const ProbeReference& ref) {
+  print_trace_heading(out, tr);
+  if (!tr.in_extent) {
+    out << "the ray misses the extent: nothing to solve\n";
+    return;
   }
+  print_polynomial(out, tr);
+  print_isolation(out, tr);
+  print_refinement(out, tr);
+  print_result(out, tr);
+  // A doubted trace has no answer to compare: the next trace's is the one the render keeps.
+  if (!doubted(tr)) print_reference_comparison(out, tr, ref.certificate);
+  print_settled_discards(out, tr);
+  if (tr.doubt) print_doubt(out, tr, *tr.doubt);
   if (tr.events_offered > tr.events_recorded)
     out << "note: the log kept the first " << tr.events_recorded << " of " << tr.events_offered << " events\n";
 }
@@ -209,43 +243,81 @@ std::string target_text(const ProbeTarget& t) {
   return "pixel (" + std::to_string(t.px) + ", " + std::to_string(t.py) + ")";
 }
 
+nlohmann::json step_json(const SolverTrace& tr, const ProbeStep& s) {
+  return {{"decision", step_decision_name(s.decision)},
+          {"decision_code", s.decision},
+          {"count", s.count},
+          {"level", s.level},
+          {"t_lo", tr.t_at(s.lo)},
+          {"t_hi", tr.t_at(s.hi)},
+          {"s_lo", s.lo},
+          {"s_hi", s.hi},
+          {"f_lo", s.f_lo},
+          {"f_hi", s.f_hi}};
+}
+
+nlohmann::json iterates_json(const std::vector<ProbeIterate>& list) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const ProbeIterate& it : list)
+    a.push_back({{"number", it.number},
+                 {"order", it.order},
+                 {"t", it.t},
+                 {"y", it.y},
+                 {"value", it.value},
+                 {"bracket", {it.lo, it.hi}}});
+  return a;
+}
+
+// What was traced, and how: the solver's configuration and the ray.
+nlohmann::json traced_json(const SolverTrace& tr) {
+  return {{"solver", solver_name(tr.config)},
+          {"isolation", to_string(tr.config.isolation)},
+          {"refinement", to_string(tr.config.refinement)},
+          {"precision", to_string(tr.config.precision)},
+          {"tolerance", tr.config.tolerance},
+          {"max_iterations", tr.config.max_iterations},
+          {"ray_origin", to_string(tr.config.ray_origin)},
+          {"program", tr.program_origin},
+          {"ray",
+           {{"origin", {tr.ray.origin.x, tr.ray.origin.y, tr.ray.origin.z}},
+            {"direction", {tr.ray.direction.x, tr.ray.direction.y, tr.ray.direction.z}}}},
+          {"in_extent", tr.in_extent}};
+}
+
+// P at a settled interval's ends, or around a confirmed root, and the rounding bound of each.
+nlohmann::json ends_json(const ProbeConfirmed& ends) {
+  return {{"before", ends.before},
+          {"before_rounding", ends.before_rounding},
+          {"after", ends.after},
+          {"after_rounding", ends.after_rounding}};
+}
+
+nlohmann::json settled_discards_json(const SolverTrace& tr) {
+  nlohmann::json settled = nlohmann::json::array();
+  for (const auto& [doubt, ends] : tr.settled_discards) {
+    nlohmann::json s = ends_json(ends);
+    s["t_lo"] = tr.t_at(doubt.lo);
+    s["t_hi"] = tr.t_at(doubt.hi);
+    settled.push_back(s);
+  }
+  return settled;
+}
+
+nlohmann::json doubt_json(const SolverTrace& tr, const ProbeDoubt& doubt) {
+  const DoubtReason* why = doubt_reason(static_cast<unsigned>(doubt.reason));
+  nlohmann::json j = {{"reason", why ? why->name : "?"}, {"level", doubt.level}, {"t_lo", tr.t_at(doubt.lo)},
+                      {"t_hi", tr.t_at(doubt.hi)},       {"value", doubt.value}, {"noise", doubt.noise}};
+  if (tr.confirmed) {
+    j["confirmed"] = ends_json(*tr.confirmed);
+    j["confirmed"]["float_float"] = tr.confirmed->float_float;
+    j["confirmed"]["bracket"] = tr.confirmed->bracket;
+    j["confirmed"]["discard"] = tr.confirmed->discard;
+  }
+  return j;
+}
+
 nlohmann::json trace_json(const SolverTrace& tr) {
-  using nlohmann::json;
-  json steps = json::array();
-  for (const ProbeStep& s : tr.steps)
-    steps.push_back({{"decision", step_decision_name(s.decision)},
-                     {"decision_code", s.decision},
-                     {"count", s.count},
-                     {"level", s.level},
-                     {"t_lo", tr.t_at(s.lo)},
-                     {"t_hi", tr.t_at(s.hi)},
-                     {"s_lo", s.lo},
-                     {"s_hi", s.hi},
-                     {"f_lo", s.f_lo},
-                     {"f_hi", s.f_hi}});
-  auto iterates = [&](const std::vector<ProbeIterate>& list) {
-    json a = json::array();
-    for (const ProbeIterate& it : list)
-      a.push_back({{"number", it.number},
-                   {"order", it.order},
-                   {"t", it.t},
-                   {"y", it.y},
-                   {"value", it.value},
-                   {"bracket", {it.lo, it.hi}}});
-    return a;
-  };
-  json j = {{"solver", solver_name(tr.config)},
-            {"isolation", to_string(tr.config.isolation)},
-            {"refinement", to_string(tr.config.refinement)},
-            {"precision", to_string(tr.config.precision)},
-            {"tolerance", tr.config.tolerance},
-            {"max_iterations", tr.config.max_iterations},
-            {"ray_origin", to_string(tr.config.ray_origin)},
-            {"program", tr.program_origin},
-            {"ray",
-             {{"origin", {tr.ray.origin.x, tr.ray.origin.y, tr.ray.origin.z}},
-              {"direction", {tr.ray.direction.x, tr.ray.direction.y, tr.ray.direction.z}}}},
-            {"in_extent", tr.in_extent}};
+  nlohmann::json j = traced_json(tr);
   if (!tr.in_extent) return j;
   j["t_in"] = tr.t_in;
   j["t_out"] = tr.t_out;
@@ -253,39 +325,18 @@ nlohmann::json trace_json(const SolverTrace& tr) {
   j["coefficients"] = tr.coefficients;
   if (tr.config.precision == Precision::Mixed) j["coefficients_lo"] = tr.coefficients_lo;
   j["power_coefficients"] = tr.power;
-  j["steps"] = steps;
-  if (!tr.chain_iterates.empty()) j["chain_iterates"] = iterates(tr.chain_iterates);
+  j["steps"] = nlohmann::json::array();
+  for (const ProbeStep& s : tr.steps) j["steps"].push_back(step_json(tr, s));
+  if (!tr.chain_iterates.empty()) j["chain_iterates"] = iterates_json(tr.chain_iterates);
   j["isolation"] = {{"status", status_name(tr.isolation_status)},
                     {"t_lo", tr.t_at(tr.iso_lo)},
                     {"t_hi", tr.t_at(tr.iso_hi)},
                     {"f_lo", tr.iso_f_lo},
                     {"f_hi", tr.iso_f_hi},
                     {"halving_limit", tr.halving_limit}};
-  j["iterates"] = iterates(tr.iterates);
-  if (!tr.settled_discards.empty()) {
-    nlohmann::json settled = nlohmann::json::array();
-    for (const auto& [doubt, ends] : tr.settled_discards)
-      settled.push_back({{"t_lo", tr.t_at(doubt.lo)},
-                         {"t_hi", tr.t_at(doubt.hi)},
-                         {"before", ends.before},
-                         {"before_rounding", ends.before_rounding},
-                         {"after", ends.after},
-                         {"after_rounding", ends.after_rounding}});
-    j["settled_discards"] = settled;
-  }
-  if (tr.doubt) {
-    const DoubtReason* why = doubt_reason(static_cast<unsigned>(tr.doubt->reason));
-    j["doubt"] = {{"reason", why ? why->name : "?"}, {"level", tr.doubt->level}, {"t_lo", tr.t_at(tr.doubt->lo)},
-                  {"t_hi", tr.t_at(tr.doubt->hi)},   {"value", tr.doubt->value}, {"noise", tr.doubt->noise}};
-    if (tr.confirmed)
-      j["doubt"]["confirmed"] = {{"before", tr.confirmed->before},
-                                 {"before_rounding", tr.confirmed->before_rounding},
-                                 {"after", tr.confirmed->after},
-                                 {"after_rounding", tr.confirmed->after_rounding},
-                                 {"float_float", tr.confirmed->float_float},
-                                 {"bracket", tr.confirmed->bracket},
-                                 {"discard", tr.confirmed->discard}};
-  }
+  j["iterates"] = iterates_json(tr.iterates);
+  if (!tr.settled_discards.empty()) j["settled_discards"] = settled_discards_json(tr);
+  if (tr.doubt) j["doubt"] = doubt_json(tr, *tr.doubt);
   j["found"] = tr.found();
   if (tr.found()) j["t"] = tr.t;
   j["back_side"] = (tr.hit.flags & ALGRAY_HIT_BACK) != 0;

@@ -118,12 +118,84 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
   img.world_to_ndc = world_to_ndc_matrix(cam, b, scene.image.width, scene.image.height);
 }
 
+// Drivers' strings come from outside and need not be UTF-8.
+nlohmann::json device_json(const DeviceInfo& device) {
+  return {{"name", utf8_for_json(device.name)},
+          {"platform", utf8_for_json(device.platform_name)},
+          {"type", device.type},
+          {"fp64", device.fp64},
+          {"driver", utf8_for_json(device.driver_version)}};
+}
+
+nlohmann::json solver_json(const KernelConfig& config) {
+  return {{"isolation", to_string(config.isolation)},
+          {"refinement", to_string(config.refinement)},
+          {"ray_origin", to_string(config.ray_origin)},
+          {"precision", to_string(config.precision)},
+          {"tolerance", config.tolerance},
+          {"max_iterations", config.max_iterations}};
+}
+
+// A program, with the device time of its launches in every pass.
+nlohmann::json program_json(const ProgramRecord& p, const std::vector<PassStats>& passes) {
+  double kernel_ms = 0;
+  for (const PassStats& pass : passes)
+    for (std::size_t k = 0; k < pass.program_keys.size(); ++k)
+      if (pass.program_keys[k] == p.key) kernel_ms += pass.program_ms[k];
+  return {{"key", p.key},
+          {"options", p.options},
+          {"from_cache", p.origin != "built"},
+          {"origin", p.origin},
+          {"build_ms", p.build_ms},
+          {"kernel_ms", kernel_ms}};
+}
+
+// A pass, with where each of its programs came from.
+nlohmann::json pass_json(const PassStats& p, const std::vector<ProgramRecord>& programs) {
+  nlohmann::json kernels = nlohmann::json::array();
+  for (const std::string& key : p.program_keys) {
+    std::string origin;
+    for (const ProgramRecord& program : programs)
+      if (program.key == key) origin = program.origin;
+    kernels.push_back({{"key", key}, {"origin", origin}});
+  }
+  return {{"name", p.name},
+          {"kernels", kernels},
+          {"rays", p.rays},
+          {"launches", p.launches},
+          {"kernel_ms", p.kernel_ms},
+          {"wall_ms", p.wall_ms},
+          {"escalated", p.escalated},
+          {"escalation_ms", p.escalation_ms}};
+}
+
+// Where the render's time went: device time of the launches, the passes' wall time (launches, staging and
+// readback), and the host's shading, which runs tile by tile inside the render.
+nlohmann::json render_ms_json(const RenderResult& r) {
+  double kernel_ms = 0, passes_ms = 0;
+  for (const PassStats& pass : r.passes) {
+    kernel_ms += pass.kernel_ms;
+    passes_ms += pass.wall_ms;
+  }
+  return {{"kernel", kernel_ms}, {"passes_wall", passes_ms}, {"host_shading", r.shade_ms}};
+}
+
+// A device's share of the tiles, of the rays of every pass, and of the device time.
+nlohmann::json device_share_json(const DeviceShare& d) {
+  return {{"rank", d.rank},
+          {"index", d.index},
+          {"name", utf8_for_json(d.name)},
+          {"tiles", d.tiles},
+          {"rays", d.rays},
+          {"kernel_ms", d.kernel_ms},
+          {"programs_ms", d.programs_ms}};
+}
+
 }  // namespace
 
 nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const std::vector<std::string>& images,
                            bool cache_used) {
   const RenderResult& r = frame.result;
-  const DeviceInfo& device = frame.device;
   nlohmann::json j;
   j["version"] = version_string();
   put_path(j, "scene", scene.source);
@@ -132,57 +204,21 @@ nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const
   j["scene_toml"] = utf8_for_json(scene_to_toml(scene));
   put_paths(j, "outputs", images);
   j["image"] = {{"width", scene.image.width}, {"height", scene.image.height}};
-  // Drivers' strings and .jsurf equations come from outside and need not be UTF-8.
-  j["device"] = {{"name", utf8_for_json(device.name)},
-                 {"platform", utf8_for_json(device.platform_name)},
-                 {"type", device.type},
-                 {"fp64", device.fp64},
-                 {"driver", utf8_for_json(device.driver_version)}};
+  j["device"] = device_json(frame.device);
+  // .jsurf equations come from outside and need not be UTF-8.
   j["surface"] = {{"equation", utf8_for_json(scene.surface().equation)}, {"degree", r.config.degree}};
   for (const SceneSurface& s : scene.surfaces)
     j["surfaces"].push_back({{"name", utf8_for_json(s.name)},
                              {"equation", utf8_for_json(s.equation)},
                              {"degree", s.polynomial.degree()}});
-  j["solver"] = {{"isolation", to_string(r.config.isolation)},
-                 {"refinement", to_string(r.config.refinement)},
-                 {"ray_origin", to_string(r.config.ray_origin)},
-                 {"precision", to_string(r.config.precision)},
-                 {"tolerance", r.config.tolerance},
-                 {"max_iterations", r.config.max_iterations}};
+  j["solver"] = solver_json(r.config);
   if (cache_used)
     put_path(j, "cache", ProgramCache::default_directory());
   else
     j["cache"] = "off";
-  for (const ProgramRecord& p : r.programs) {
-    double kernel_ms = 0;
-    for (const PassStats& pass : r.passes)
-      for (std::size_t k = 0; k < pass.program_keys.size(); ++k)
-        if (pass.program_keys[k] == p.key) kernel_ms += pass.program_ms[k];
-    j["programs"].push_back({{"key", p.key},
-                             {"options", p.options},
-                             {"from_cache", p.origin != "built"},
-                             {"origin", p.origin},
-                             {"build_ms", p.build_ms},
-                             {"kernel_ms", kernel_ms}});
-  }
+  for (const ProgramRecord& p : r.programs) j["programs"].push_back(program_json(p, r.passes));
   j["plan"] = r.plan.json();
-  for (const PassStats& p : r.passes) {
-    nlohmann::json kernels = nlohmann::json::array();
-    for (const std::string& key : p.program_keys) {
-      std::string origin;
-      for (const ProgramRecord& program : r.programs)
-        if (program.key == key) origin = program.origin;
-      kernels.push_back({{"key", key}, {"origin", origin}});
-    }
-    j["passes"].push_back({{"name", p.name},
-                           {"kernels", kernels},
-                           {"rays", p.rays},
-                           {"launches", p.launches},
-                           {"kernel_ms", p.kernel_ms},
-                           {"wall_ms", p.wall_ms},
-                           {"escalated", p.escalated},
-                           {"escalation_ms", p.escalation_ms}});
-  }
+  for (const PassStats& p : r.passes) j["passes"].push_back(pass_json(p, r.programs));
   const PrimarySummary& p = r.primary;
   j["primary_rays"] = {{"count", p.rays},
                        {"hits", p.hits},
@@ -191,23 +227,8 @@ nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const
                        {"refine_iterations", p.refine_iterations}};
   // A pixel shows the surface when any of its antialiasing samples hit it.
   j["pixels"] = {{"count", p.pixels}, {"hits", p.pixels_hit}};
-  // Where the render's time went: device time of the launches, the passes' wall time (launches, staging and
-  // readback), and the host's shading, which runs tile by tile inside the render.
-  double kernel_ms = 0, passes_ms = 0;
-  for (const PassStats& pass : r.passes) {
-    kernel_ms += pass.kernel_ms;
-    passes_ms += pass.wall_ms;
-  }
-  j["render_ms"] = {{"kernel", kernel_ms}, {"passes_wall", passes_ms}, {"host_shading", r.shade_ms}};
-  // Each device's share of the tiles, of the rays of every pass, and of the device time.
-  for (const DeviceShare& d : r.devices)
-    j["devices"].push_back({{"rank", d.rank},
-                            {"index", d.index},
-                            {"name", utf8_for_json(d.name)},
-                            {"tiles", d.tiles},
-                            {"rays", d.rays},
-                            {"kernel_ms", d.kernel_ms},
-                            {"programs_ms", d.programs_ms}});
+  j["render_ms"] = render_ms_json(r);
+  for (const DeviceShare& d : r.devices) j["devices"].push_back(device_share_json(d));
   j["phases_ms"] = frame.timer.json();
   j["total_ms"] = frame.timer.total_ms();
   return j;
@@ -345,102 +366,127 @@ void check_outputs(const Scene& scene, const RenderOutputs& outputs, const std::
   check_distinct_files({{"scene file", scene_path}}, planned_outputs(outputs));
 }
 
+namespace {
+
+// No device: exact arithmetic on the CPU, rays rebuilt in the precision the kernels would use.
+void render_reference_frame(const Scene& scene, bool diagnostics, RenderedFrame& frame, SolverWork& work) {
+  frame.device.name = "CPU reference (solver_ref, exact arithmetic)";
+  frame.device.type = "CPU";
+  ReferenceResult ref = render_reference(scene, scene.render.precision.value_or(Precision::Double));
+  frame.timer.mark("render");
+  RenderResult& result = frame.result;
+  result = std::move(ref.render);
+  result.primary = summarise_hits(result.hits, result.plan.samples);
+  frame.image = shade_frame(scene, result);
+  frame.image.uint_channels.push_back({"reference.class", std::move(ref.classes)});
+  if (diagnostics) work = solver_work(result);
+  frame.timer.mark("shade");
+}
+
+// Only a film of at most 256 MB (4096^2 RGBA) is made ahead: the render's memory check (check_plan_fits, which
+// needs the device) must refuse a render too large before its film is allocated, and a larger render takes
+// seconds, beside which the overlap is noise.
+bool film_made_ahead(int width, int height, bool depth_and_normal) {
+  return static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) * (depth_and_normal ? 8 : 4) *
+             sizeof(float) <=
+         (std::uint64_t{256} << 20);
+}
+
+// The film (16 to 32 bytes a pixel, zero-filled, every page faulted in) is made on another thread while this one
+// starts the device, which loads the OpenCL driver on one core for tens of milliseconds. Its depth and normal
+// channels are made only for an EXR output, the one format that stores them. For a PNG output the sRGB encoder's
+// table (some 40000 pow() calls, built on first use) is made there too.
+struct FilmAhead {
+  std::future<FrameImage> film;
+  // The camera rays' hit records of the largest tile on a CPU (the plan's default tile; a GPU's is smaller and
+  // makes its own), after the film on the same thread: both overlap the device's start, which needs no memory.
+  std::future<PopulatedPages> tile_memory;
+};
+
+FilmAhead start_film(const Scene& scene, bool png, bool depth_and_normal) {
+  const int film_width = scene.image.width, film_height = scene.image.height;
+  DeviceInfo cpu;
+  cpu.type = "CPU";
+  const std::size_t tile_bytes =
+      tile_memory_bytes(make_render_plan(scene, Precision::Double, std::vector<PlanDevice>{{cpu}}));
+  auto pages = std::make_shared<std::promise<PopulatedPages>>();
+  FilmAhead ahead;
+  ahead.tile_memory = pages->get_future();
+  ahead.film = std::async(std::launch::async, [=] {
+    // The tile first: the render needs it when its programs are loaded, the film only after the first tile.
+    try {
+      pages->set_value(PopulatedPages(tile_bytes));
+    } catch (...) {
+      pages->set_exception(std::current_exception());
+    }
+    if (png) srgb_byte(0.5f);
+    return make_film(film_width, film_height, depth_and_normal);
+  });
+  return ahead;
+}
+
+void render_on_device(const Scene& scene, const FrameRequest& request, RenderContext& context,
+                      const RenderCallbacks& callbacks, bool diagnostics, RenderedFrame& frame, SolverWork& work) {
+  const bool depth_and_normal = request.depth_and_normal;
+  const int film_width = scene.image.width, film_height = scene.image.height;
+  const bool ahead = film_made_ahead(film_width, film_height, depth_and_normal);
+  FilmAhead made;
+  if (ahead) made = start_film(scene, request.png, depth_and_normal);
+  const std::vector<ClSession*> sessions = context.sessions();
+  frame.device = sessions.front()->info;
+  frame.timer.mark("device");
+  Renderer renderer(sessions, context.cache());
+  RenderOptions options;
+  // A larger film is made when the render has checked that it fits, with only the channels the outputs hold.
+  if (ahead) {
+    options.film = [&made] { return made.film.get(); };
+    options.tile_memory = [&made] { return made.tile_memory.get(); };
+  } else
+    options.film = [=] { return make_film(film_width, film_height, depth_and_normal); };
+  options.on_progress = callbacks.on_progress;
+  options.cancelled = callbacks.cancelled;
+  if (diagnostics) {
+    options.on_primary_tile = [&](const PrimaryTile& tile) {
+      if (work.isolation_steps.empty()) work = empty_solver_work(scene.image.width, scene.image.height, tile.samples);
+      add_tile_work(work, tile);
+    };
+  }
+  RenderResult& result = frame.result;
+  result =
+      callbacks.render_pixels ? callbacks.render_pixels(renderer, scene, options) : renderer.render(scene, options);
+  frame.timer.mark("render");
+  frame.timer.move("render", "shade", result.shade_ms);
+  frame.image = std::move(result.image);
+}
+
+// The heat map's colour scale spans the whole image, so it needs every pixel's work before any colour: the
+// work (16 bytes a pixel) and the picture are whole-image, bounded by the pixels, never by the samples.
+void add_diagnostics(const FrameRequest& request, SolverWork& work, RenderedFrame& frame) {
+  if (request.heatmap) {
+    const std::string per =
+        work.samples > 1 ? " (sum over " + std::to_string(work.samples * work.samples) + " samples)" : "";
+    frame.heatmap = work_heatmap(work.width, work.height, work.total(), work.in_extent(),
+                                 "isolation steps + refinement iterations per pixel" + per);
+  }
+  add_solver_aovs(frame.image, std::move(work), request.aovs);
+  frame.timer.mark("diagnostics");
+}
+
+}  // namespace
+
 RenderedFrame render_frame(const Scene& scene, const FrameRequest& request, RenderContext& context,
                            const RenderCallbacks& callbacks, std::chrono::steady_clock::time_point started) {
   RenderedFrame frame{{}, {}, {}, {}, PhaseTimer(started)};
-  PhaseTimer& timer = frame.timer;
-  timer.mark("scene");  // reading and checking it, before this call
-  FrameImage& image = frame.image;
-  RenderResult& result = frame.result;
-  DeviceInfo& device = frame.device;
+  frame.timer.mark("scene");  // reading and checking it, before this call
   const bool diagnostics = !request.aovs.empty() || request.heatmap;
   SolverWork work;  // per output pixel: the solver channels and the heat map are pictures of the whole image
-  if (request.reference) {
-    // No device: exact arithmetic on the CPU, rays rebuilt in the precision the kernels would use.
-    device.name = "CPU reference (solver_ref, exact arithmetic)";
-    device.type = "CPU";
-    ReferenceResult ref = render_reference(scene, scene.render.precision.value_or(Precision::Double));
-    timer.mark("render");
-    result = std::move(ref.render);
-    result.primary = summarise_hits(result.hits, result.plan.samples);
-    image = shade_frame(scene, result);
-    image.uint_channels.push_back({"reference.class", std::move(ref.classes)});
-    if (diagnostics) work = solver_work(result);
-    timer.mark("shade");
-  } else {
-    // The film (16 to 32 bytes a pixel, zero-filled, every page faulted in) is made on another thread while
-    // this one starts the device, which loads the OpenCL driver on one core for tens of milliseconds. Its
-    // depth and normal channels are made only for an EXR output, the one format that stores them. For a PNG
-    // output the sRGB encoder's table (some 40000 pow() calls, built on first use) is made there too.
-    const bool depth_and_normal = request.depth_and_normal, png = request.png;
-    // Only a film of at most 256 MB (4096^2 RGBA) is made ahead: the render's memory check (check_plan_fits,
-    // which needs the device) must refuse a render too large before its film is allocated, and a larger render
-    // takes seconds, beside which the overlap is noise.
-    const int film_width = scene.image.width, film_height = scene.image.height;
-    const bool ahead = static_cast<std::uint64_t>(film_width) * static_cast<std::uint64_t>(film_height) *
-                           (depth_and_normal ? 8 : 4) * sizeof(float) <=
-                       (std::uint64_t{256} << 20);
-    std::future<FrameImage> film;
-    // The camera rays' hit records of the largest tile on a CPU (the plan's default tile; a GPU's is smaller and
-    // makes its own), after the film on the same thread: both overlap the device's start, which needs no memory.
-    std::future<PopulatedPages> tile_memory;
-    if (ahead) {
-      DeviceInfo cpu;
-      cpu.type = "CPU";
-      const std::size_t tile_bytes =
-          tile_memory_bytes(make_render_plan(scene, Precision::Double, std::vector<PlanDevice>{{cpu}}));
-      auto pages = std::make_shared<std::promise<PopulatedPages>>();
-      tile_memory = pages->get_future();
-      film = std::async(std::launch::async, [=] {
-        // The tile first: the render needs it when its programs are loaded, the film only after the first tile.
-        try {
-          pages->set_value(PopulatedPages(tile_bytes));
-        } catch (...) {
-          pages->set_exception(std::current_exception());
-        }
-        if (png) srgb_byte(0.5f);
-        return make_film(film_width, film_height, depth_and_normal);
-      });
-    }
-    const std::vector<ClSession*> sessions = context.sessions();
-    device = sessions.front()->info;
-    timer.mark("device");
-    Renderer renderer(sessions, context.cache());
-    RenderOptions options;
-    // A larger film is made when the render has checked that it fits, with only the channels the outputs hold.
-    if (ahead) {
-      options.film = [&film] { return film.get(); };
-      options.tile_memory = [&tile_memory] { return tile_memory.get(); };
-    } else
-      options.film = [=] { return make_film(film_width, film_height, depth_and_normal); };
-    options.on_progress = callbacks.on_progress;
-    options.cancelled = callbacks.cancelled;
-    if (diagnostics) {
-      options.on_primary_tile = [&](const PrimaryTile& tile) {
-        if (work.isolation_steps.empty()) work = empty_solver_work(scene.image.width, scene.image.height, tile.samples);
-        add_tile_work(work, tile);
-      };
-    }
-    result =
-        callbacks.render_pixels ? callbacks.render_pixels(renderer, scene, options) : renderer.render(scene, options);
-    timer.mark("render");
-    timer.move("render", "shade", result.shade_ms);
-    image = std::move(result.image);
-  }
-  add_metadata(image, scene, result, device);
-  timer.mark("metadata");
-  // The heat map's colour scale spans the whole image, so it needs every pixel's work before any colour: the
-  // work (16 bytes a pixel) and the picture are whole-image, bounded by the pixels, never by the samples.
-  if (diagnostics) {
-    if (request.heatmap) {
-      const std::string per =
-          work.samples > 1 ? " (sum over " + std::to_string(work.samples * work.samples) + " samples)" : "";
-      frame.heatmap = work_heatmap(work.width, work.height, work.total(), work.in_extent(),
-                                   "isolation steps + refinement iterations per pixel" + per);
-    }
-    add_solver_aovs(image, std::move(work), request.aovs);
-    timer.mark("diagnostics");
-  }
+  if (request.reference)
+    render_reference_frame(scene, diagnostics, frame, work);
+  else
+    render_on_device(scene, request, context, callbacks, diagnostics, frame, work);
+  add_metadata(frame.image, scene, frame.result, frame.device);
+  frame.timer.mark("metadata");
+  if (diagnostics) add_diagnostics(request, work, frame);
   return frame;
 }
 

@@ -127,17 +127,28 @@ void Shader::shade_lit(const HitToShade* hits, std::size_t count, const ShadowLo
 // one's (they were most of a preview's shading time). Each lane does the scalar formula's operations in its
 // order (glm's normalize is v * (1 / sqrt(v.v)), its dot ((x + y) + z)); with no contraction into fused
 // multiply-adds (-ffp-contract=off) the colours are the scalar code's bit for bit, whatever the vector width.
-void Shader::shade_lanes(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows,
-                         glm::dvec3* out) const {
-  constexpr std::size_t W = kShadeLanes;
-  using Lanes = double[W];
+struct Shader::HitLanes {
+  using Lanes = double[kShadeLanes];
   Lanes nx, ny, nz, ex, ey, ez, px, py, pz, cr, cg, cb, own, amb, kd, ks, cutoff, mr, mg, mb;
-  const Material* material[W];
-  for (std::size_t j = 0; j < W; ++j) {
+  const Material* material[kShadeLanes];
+  // One light's sums over its points, and a point's reflection term and highlight test. Kept here beside the
+  // rest, where the compiler sees that no two arrays overlap.
+  Lanes diffuse, specular, r_dot_v;
+  bool highlight[kShadeLanes];
+
+  HitLanes(const Shader& shader, const HitToShade* hits, std::size_t count);
+  void start_at_ambient();
+  void add_light(const LightSamples& ls, const std::uint64_t* hidden, std::size_t count);
+  void add_light_point(const glm::dvec3& at, std::size_t s, const std::uint64_t* hidden, std::size_t count);
+  void write(std::size_t count, glm::dvec3* out) const;
+};
+
+Shader::HitLanes::HitLanes(const Shader& shader, const HitToShade* hits, std::size_t count) {
+  for (std::size_t j = 0; j < kShadeLanes; ++j) {
     // Lanes past `count` repeat the first hit, so that every lane computes on ordinary numbers.
     const HitToShade& q = hits[j < count ? j : 0];
     const HitRecord& h = *q.hit;
-    const Material& m = material_of(q);
+    const Material& m = shader.material_of(q);
     material[j] = &m;
     nx[j] = h.normal_x;
     ny[j] = h.normal_y;
@@ -150,16 +161,21 @@ void Shader::shade_lanes(const HitToShade* hits, std::size_t count, const Shadow
     px[j] = point.x;
     py[j] = point.y;
     pz[j] = point.z;
-    own[j] = transmits_ ? 1 - m.transparency : 1.0;
+    own[j] = shader.transmits_ ? 1 - m.transparency : 1.0;
     amb[j] = m.ambient;
     kd[j] = m.diffuse;
     ks[j] = m.specular;
     mr[j] = m.colour.r;
     mg[j] = m.colour.g;
     mb[j] = m.colour.b;
-    cutoff[j] = highlight_cutoff_[static_cast<std::size_t>(2 * q.surface + ((h.flags & ALGRAY_HIT_BACK) ? 1 : 0))];
+    cutoff[j] =
+        shader.highlight_cutoff_[static_cast<std::size_t>(2 * q.surface + ((h.flags & ALGRAY_HIT_BACK) ? 1 : 0))];
   }
-  for (std::size_t j = 0; j < W; ++j) {
+}
+
+// The direction to the eye in place of the ray's, and the colour at the ambient term.
+void Shader::HitLanes::start_at_ambient() {
+  for (std::size_t j = 0; j < kShadeLanes; ++j) {
     const double inv = 1.0 / std::sqrt(ex[j] * ex[j] + ey[j] * ey[j] + ez[j] * ez[j]);
     ex[j] = -(ex[j] * inv);
     ey[j] = -(ey[j] * inv);
@@ -168,52 +184,66 @@ void Shader::shade_lanes(const HitToShade* hits, std::size_t count, const Shadow
     cg[j] = amb[j] * mg[j];
     cb[j] = amb[j] * mb[j];
   }
-  for (std::size_t li = 0; li < lights_.size(); ++li) {
-    const LightSamples& ls = lights_[li];
-    std::uint64_t hidden[W];
-    for (std::size_t j = 0; j < W; ++j) hidden[j] = j < count ? shadows.hidden(li, hits[j].hit_index) : 0;
-    Lanes diffuse = {}, specular = {}, r_dot_v;
-    bool highlight[W];
-    for (std::size_t s = 0; s < ls.points.size(); ++s) {
-      const glm::dvec3 at = ls.points[s];
-      // The square roots and divisions first, in a loop of arithmetic alone (which vectorises), then the tests.
-      Lanes lx, ly, lz, n_dot_l;
-      for (std::size_t j = 0; j < W; ++j) {
-        lx[j] = at.x - px[j];
-        ly[j] = at.y - py[j];
-        lz[j] = at.z - pz[j];
-        const double inv = 1.0 / std::sqrt(lx[j] * lx[j] + ly[j] * ly[j] + lz[j] * lz[j]);
-        lx[j] *= inv;
-        ly[j] *= inv;
-        lz[j] *= inv;
-        n_dot_l[j] = nx[j] * lx[j] + ny[j] * ly[j] + nz[j] * lz[j];
-        const double twice = 2 * n_dot_l[j];
-        r_dot_v[j] =
-            (twice * nx[j] - lx[j]) * ex[j] + (twice * ny[j] - ly[j]) * ey[j] + (twice * nz[j] - lz[j]) * ez[j];
-      }
-      bool any_highlight = false;
-      for (std::size_t j = 0; j < W; ++j) {
-        // Not hidden by the shadow pass, and in front of the tangent plane (the surface hides it from itself).
-        const bool lit = !(hidden[j] >> s & 1u) && !(n_dot_l[j] <= 0);
-        if (lit) diffuse[j] += n_dot_l[j];
-        highlight[j] = lit && r_dot_v[j] > cutoff[j];
-        any_highlight |= highlight[j];
-      }
-      // pow() only where a highlight can show; below the cutoff it is under 1/4096 of full strength.
-      if (any_highlight)
-        for (std::size_t j = 0; j < count; ++j)
-          if (highlight[j]) specular[j] += std::pow(r_dot_v[j], material[j]->exponent);
-    }
-    const double share = 1.0 / static_cast<double>(ls.points.size());
-    const glm::dvec3 light = ls.light->intensity * ls.light->colour;
-    for (std::size_t j = 0; j < W; ++j) {
-      const double d = kd[j] * diffuse[j] * share, sp = ks[j] * specular[j] * share;
-      cr[j] += light.r * (d * mr[j] + sp);
-      cg[j] += light.g * (d * mg[j] + sp);
-      cb[j] += light.b * (d * mb[j] + sp);
-    }
+}
+
+// hidden[j]: the shadow pass's bits of this light's points for lane j.
+void Shader::HitLanes::add_light(const LightSamples& ls, const std::uint64_t* hidden, std::size_t count) {
+  for (std::size_t j = 0; j < kShadeLanes; ++j) diffuse[j] = specular[j] = 0;
+  for (std::size_t s = 0; s < ls.points.size(); ++s) add_light_point(ls.points[s], s, hidden, count);
+  const double share = 1.0 / static_cast<double>(ls.points.size());
+  const glm::dvec3 light = ls.light->intensity * ls.light->colour;
+  for (std::size_t j = 0; j < kShadeLanes; ++j) {
+    const double d = kd[j] * diffuse[j] * share, sp = ks[j] * specular[j] * share;
+    cr[j] += light.r * (d * mr[j] + sp);
+    cg[j] += light.g * (d * mg[j] + sp);
+    cb[j] += light.b * (d * mb[j] + sp);
   }
+}
+
+void Shader::HitLanes::add_light_point(const glm::dvec3& at, std::size_t s, const std::uint64_t* hidden,
+                                       std::size_t count) {
+  // The square roots and divisions first, in a loop of arithmetic alone (which vectorises), then the tests.
+  Lanes lx, ly, lz, n_dot_l;
+  for (std::size_t j = 0; j < kShadeLanes; ++j) {
+    lx[j] = at.x - px[j];
+    ly[j] = at.y - py[j];
+    lz[j] = at.z - pz[j];
+    const double inv = 1.0 / std::sqrt(lx[j] * lx[j] + ly[j] * ly[j] + lz[j] * lz[j]);
+    lx[j] *= inv;
+    ly[j] *= inv;
+    lz[j] *= inv;
+    n_dot_l[j] = nx[j] * lx[j] + ny[j] * ly[j] + nz[j] * lz[j];
+    const double twice = 2 * n_dot_l[j];
+    r_dot_v[j] = (twice * nx[j] - lx[j]) * ex[j] + (twice * ny[j] - ly[j]) * ey[j] + (twice * nz[j] - lz[j]) * ez[j];
+  }
+  bool any_highlight = false;
+  for (std::size_t j = 0; j < kShadeLanes; ++j) {
+    // Not hidden by the shadow pass, and in front of the tangent plane (the surface hides it from itself).
+    const bool lit = !(hidden[j] >> s & 1u) && !(n_dot_l[j] <= 0);
+    if (lit) diffuse[j] += n_dot_l[j];
+    highlight[j] = lit && r_dot_v[j] > cutoff[j];
+    any_highlight |= highlight[j];
+  }
+  // pow() only where a highlight can show; below the cutoff it is under 1/4096 of full strength.
+  if (any_highlight)
+    for (std::size_t j = 0; j < count; ++j)
+      if (highlight[j]) specular[j] += std::pow(r_dot_v[j], material[j]->exponent);
+}
+
+void Shader::HitLanes::write(std::size_t count, glm::dvec3* out) const {
   for (std::size_t j = 0; j < count; ++j) out[j] = glm::dvec3(own[j] * cr[j], own[j] * cg[j], own[j] * cb[j]);
+}
+
+void Shader::shade_lanes(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows,
+                         glm::dvec3* out) const {
+  HitLanes lanes(*this, hits, count);
+  lanes.start_at_ambient();
+  for (std::size_t li = 0; li < lights_.size(); ++li) {
+    std::uint64_t hidden[kShadeLanes];
+    for (std::size_t j = 0; j < kShadeLanes; ++j) hidden[j] = j < count ? shadows.hidden(li, hits[j].hit_index) : 0;
+    lanes.add_light(lights_[li], hidden, count);
+  }
+  lanes.write(count, out);
 }
 
 void Shader::add_batch(const SecondaryBatch& batch, std::vector<glm::dvec3>& colour, std::vector<double>& alpha) const {

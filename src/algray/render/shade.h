@@ -85,6 +85,7 @@ class Shader {
   };
   // At most kShadeLanes of them, side by side (count >= 1).
   void shade_lanes(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const;
+  struct HitLanes;  // shade_lanes' hits as arrays, one element a lane (shade.cpp)
   const Material& material_of(const HitToShade& h) const;
 
   const Scene& scene_;
