@@ -208,8 +208,6 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL s
   *iterations = (int)it;
   return x;
 }
-#else
-#error "REFINEMENT must name a refinement method"
-#endif
+#endif /* build_switches.h holds REFINEMENT to the methods above */
 
 #endif /* ALGRAY_REFINE_H */

@@ -203,6 +203,18 @@ REAL ray_terms_local(const RayTerms* t, REAL lo, REAL hi) {
   return terms_at(t, part_coordinates(t, lo, hi)) * (REAL)(1 + 1.0 / 1024);
 }
 
+/* The restriction produced scaled coefficients c_k = C(n,k) b_k; the Bernstein
+ * methods' Descartes' rule and de Casteljau want b_k. */
+void bernstein_from_scaled(REAL* c, REAL* c_lo, __constant const REAL* binomials) {
+  __constant const REAL* row = binomials + DEGREE * NCOEF;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) {
+    const REAL q = c[k] / row[k];
+    if (ALGRAY_COMPENSATED) c_lo[k] = (fma(-q, row[k], c[k]) + c_lo[k]) / row[k]; /* the division's remainder is exact */
+    c[k] = q;
+  }
+}
+
 /* An upper bound on ray_terms_local from the per-degree sums (terms_within) at the part's largest coordinate. */
 REAL ray_terms_within_part(const RayTerms* t, REAL lo, REAL hi) {
   if (t->coefs == 0) return t->value;
@@ -212,16 +224,14 @@ REAL ray_terms_within_part(const RayTerms* t, REAL lo, REAL hi) {
 
 /* c (degree n) plus a * one^n. binomials[n * NCOEF + k] = C(n, k), zero for k > n. */
 ALGRAY_INLINE void poly_add_constant(REAL* c, int n, REAL a, __constant const REAL* binomials) {
-#if RESTRICT_BERNSTEIN
-  /* one^n = sum C(n,k) (1-s)^(n-k) s^k in the scaled basis. */
-  __constant const REAL* row = binomials + n * NCOEF;
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) c[k] += a * row[k];
-#else
-  (void)n;
-  (void)binomials;
-  c[0] += a;
-#endif
+  if (RESTRICT_BERNSTEIN) {
+    /* one^n = sum C(n,k) (1-s)^(n-k) s^k in the scaled basis. */
+    __constant const REAL* row = binomials + n * NCOEF;
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) c[k] += a * row[k];
+  } else {
+    c[0] += a;
+  }
 }
 
 ALGRAY_INLINE void poly_add(REAL* c, const REAL* other) {
@@ -325,16 +335,14 @@ ALGRAY_INLINE void acc_mul_linear(Acc* c, REAL l0, REAL l1) {
 }
 ALGRAY_INLINE void acc_add_constant(Acc* c, int n, REAL a, REAL a_lo, __constant const REAL* binomials) {
   Acc term;
-#if RESTRICT_BERNSTEIN
-  term.hi = (PolyVec)(a);
-  term.lo = (PolyVec)(a_lo);
-  term = acc_scale(term, VEC_LOAD(binomials + n * NCOEF)); /* binomials are exact in float up to degree 15 */
-#else
-  (void)n;
-  (void)binomials;
-  term.hi = vec_constant(a);
-  term.lo = vec_constant(a_lo);
-#endif
+  if (RESTRICT_BERNSTEIN) {
+    term.hi = (PolyVec)(a);
+    term.lo = (PolyVec)(a_lo);
+    term = acc_scale(term, VEC_LOAD(binomials + n * NCOEF)); /* binomials are exact in float up to degree 15 */
+  } else {
+    term.hi = vec_constant(a);
+    term.lo = vec_constant(a_lo);
+  }
   *c = acc_sum(*c, term);
 }
 ALGRAY_INLINE void acc_add(Acc* c, const Acc* other) { *c = acc_sum(*c, *other); }
@@ -359,13 +367,10 @@ ALGRAY_INLINE void acc_mul_quadratic(Acc* c, REAL q0, REAL q1, REAL q2) {
 }
 ALGRAY_INLINE void acc_add_constant(Acc* c, int n, REAL a, REAL a_lo, __constant const REAL* binomials) {
   (void)a_lo;
-#if RESTRICT_BERNSTEIN
-  *c += a * VEC_LOAD(binomials + n * NCOEF);
-#else
-  (void)n;
-  (void)binomials;
-  (*c).s0 += a;
-#endif
+  if (RESTRICT_BERNSTEIN)
+    *c += a * VEC_LOAD(binomials + n * NCOEF);
+  else
+    (*c).s0 += a;
 }
 ALGRAY_INLINE void acc_add(Acc* c, const Acc* other) { *c += *other; }
 ALGRAY_INLINE void acc_copy(Acc* dst, const Acc* src) { *dst = *src; }
@@ -418,13 +423,9 @@ ALGRAY_INLINE void acc_mul_axis(RayAccs c, const AxisFactor* f, int times) {
 
 /* Every c[r] times one^times: degree elevation in the Bernstein form; nothing to do in the power basis. */
 ALGRAY_INLINE void acc_mul_one(RayAccs c, int times) {
-#if RESTRICT_BERNSTEIN
+  if (!RESTRICT_BERNSTEIN) return;
   for (int q = 0; q < times; ++q) ALGRAY_UNROLL
   for (int r = 0; r < RESTRICT_RAYS; ++r) acc_mul_linear(c[r], (REAL)1, (REAL)1);
-#else
-  (void)c;
-  (void)times;
-#endif
 }
 
 /* The other accumulator operations, ray by ray. The batch loops are unrolled so that the accumulators stay in
@@ -456,9 +457,7 @@ void restrict_to_rays(__global const uint* exps, __global const REAL* coefs, uin
       j = (int)((e >> 8) & 0xffu);
       k = (int)((e >> 16) & 0xffu);
       a = coefs[m];
-#if ALGRAY_COMPENSATED
-      a_lo = coefs[count + m]; /* the coefficient's low part: hi + lo carries ~48 bits */
-#endif
+      if (ALGRAY_COMPENSATED) a_lo = coefs[count + m]; /* the coefficient's low part: hi + lo carries ~48 bits */
     }
     /* Close the z-level group (cur_i, cur_j) when (i, j) changes or the list ends. */
     if (deg_z >= 0 && (i != cur_i || j != cur_j)) {
@@ -521,9 +520,7 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
   });
   restrict_to_rays(exps, coefs, count, binomials, bx, by, bz, c, c_lo);
   poly_copy(out, c[0]);
-#if ALGRAY_COMPENSATED
-  poly_copy(out_lo, c_lo[0]);
-#endif
+  if (ALGRAY_COMPENSATED) poly_copy(out_lo, c_lo[0]);
 }
 
 /* The screen form (RAY_ORIGIN=screen): P*(t) = sum_k taylor[k] (t - t0)^k around a point of the ray near the
@@ -532,11 +529,7 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
  * of one per monomial. */
 void restrict_from_taylor(const REAL* taylor, REAL tau_in, REAL tau_out, __constant const REAL* binomials, REAL* out) {
   Acc acc[ACC_SLOTS];
-#if RESTRICT_BERNSTEIN
-  const REAL l0 = tau_in, l1 = tau_out;
-#else
-  const REAL l0 = tau_in, l1 = tau_out - tau_in;
-#endif
+  const REAL l0 = tau_in, l1 = RESTRICT_BERNSTEIN ? tau_out : tau_out - tau_in;
   acc_set_constant(acc, taylor[DEGREE], 0);
   ALGRAY_UNROLL
   for (int k = DEGREE - 1; k >= 0; --k) {

@@ -5,11 +5,7 @@
 
 /* Shadow rays restrict P in batches (see RESTRICT_RAYS in restrict.h); the width that measured fastest for the
  * vector width the degree takes. */
-#if DEGREE <= 7
-#define RESTRICT_RAYS 4
-#else
-#define RESTRICT_RAYS 2
-#endif
+#define RESTRICT_RAYS (DEGREE <= 7 ? 4 : 2)
 
 #include "isolate.h"
 #include "ray.h"

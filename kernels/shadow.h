@@ -166,11 +166,7 @@ LMASK shadow_segments(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, LREAL lx, LREAL l
 
 /* Measured on the Barth sextic and decic (full mode, 1024x768): 3 levels saved the most at degree 6, 2 at degree
  * 10, where 3 cost more than they saved. */
-#if DEGREE <= 7
-#define SHADOW_PIECE_LEVELS 3
-#else
-#define SHADOW_PIECE_LEVELS 2
-#endif
+#define SHADOW_PIECE_LEVELS (DEGREE <= 7 ? 3 : 2)
 /* Whether every one of the 2^SHADOW_PIECE_LEVELS equal pieces of the segment has Bernstein coefficients of one
  * strict sign (c: scaled coefficients on the whole segment): then no piece, and so no part of the segment, holds
  * a root. De Casteljau's halving keeps a piece of one sign so, so this is what the search concludes after as many

@@ -27,7 +27,6 @@
  * taylor_t, which other builds pass as 0 and never read). Its kernels take the image rows' polynomials:
  * screen_rows[(py - screen_row0) * NCOEF * NCOEF + j * NCOEF + k] is the xi^j coefficient of row py's taylor[k],
  * expanded about t = screen_t; a pixel's xi = (px + 1/2) * xi_scale + xi_offset. */
-#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
 
 /* The xi of a pixel column whose centre is `centre` ((REAL)px + 0.5, as camera_rays'), where its row's polynomials
  * are evaluated; of one column or of lanes (lane_pixel_centres). */
@@ -48,7 +47,6 @@ REAL screen_ray_taylor(uint px, uint py, __global const REAL* rows, uint row0, R
   screen_taylor(screen_row(rows, py, row0), screen_column(px, xi_scale, xi_offset), taylor);
   return t0;
 }
-#endif
 
 /* The outcome of isolating and refining the smallest root of P*(t) on [t_in, t_out], for LANES rays side by side
  * (lane j ray j's; with LANES = 1, one ray's). */
@@ -165,16 +163,12 @@ void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, Ax
 
 /* The restriction's result (scaled Bernstein coefficients, or a power basis) as the isolation method takes it. */
 void restricted_to_isolation_basis(REAL* root, REAL* root_lo, __constant const REAL* binomials, ProbeLog* probe_log) {
-#if !ISOLATION_POWER_BASIS
-  bernstein_from_scaled(root, root_lo, binomials);
-  probe_coefficients(root, root_lo, ALGRAY_BASIS_BERNSTEIN, probe_log);
-#elif RAY_ORIGIN == ALGRAY_ORIGIN_EYE
-  (void)binomials;
-  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_EYE, probe_log);
-#else
-  (void)binomials;
-  probe_coefficients(root, root_lo, ALGRAY_BASIS_POWER_SEGMENT, probe_log);
-#endif
+  if (!ISOLATION_POWER_BASIS) bernstein_from_scaled(root, root_lo, binomials);
+  probe_coefficients(root, root_lo,
+                     !ISOLATION_POWER_BASIS              ? ALGRAY_BASIS_BERNSTEIN
+                     : RAY_ORIGIN == ALGRAY_ORIGIN_EYE ? ALGRAY_BASIS_POWER_EYE
+                                                       : ALGRAY_BASIS_POWER_SEGMENT,
+                     probe_log);
 }
 
 /* P*(t) on [t_in, t_out] for the ray o + t*d in unit coordinates, in the isolation method's basis: Bernstein
@@ -184,34 +178,26 @@ ALGRAY_INLINE void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out,
                                         uint even_axes, REAL* root,
                                         REAL* root_lo, RayTerms* terms, const REAL* taylor, REAL taylor_t,
                                         ProbeLog* probe_log) {
-#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
-  /* The same coefficients the extent construction computes from the monomials, from D + 1 numbers instead. */
-  (void)o;
-  (void)d;
-  (void)exps;
-  (void)coefs;
-  (void)count;
-  (void)even_axes;
-  restrict_from_taylor(taylor, t_in - taylor_t, t_out - taylor_t, binomials, root);
-#elif RAY_ORIGIN == ALGRAY_ORIGIN_EYE
-  /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
-  (void)t_in;
-  (void)t_out;
-  restrict_to_ray(exps, coefs, count, binomials, axis_factor(o.x, d.x, even_axes & 1),
-                  axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root, root_lo);
-#else
-  AxisFactor fx, fy, fz;
-  segment_factors(o, d, t_in, t_out, even_axes, &fx, &fy, &fz);
-  restrict_to_ray(exps, coefs, count, binomials, fx, fy, fz, root, root_lo);
-  if (ALGRAY_ESCALATE) {
-    *terms = ray_terms(exps, coefs, count, fx, fy, fz);
-    terms->has_ray = 1;
-    terms->o = o;
-    terms->d = d;
-    terms->t_in = t_in;
-    terms->t_out = t_out;
+  if (RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN) {
+    /* The same coefficients the extent construction computes from the monomials, from D + 1 numbers instead. */
+    restrict_from_taylor(taylor, t_in - taylor_t, t_out - taylor_t, binomials, root);
+  } else if (RAY_ORIGIN == ALGRAY_ORIGIN_EYE) {
+    /* The paper's construction: P*(t) around the ray origin, then mapped to each subinterval. */
+    restrict_to_ray(exps, coefs, count, binomials, axis_factor(o.x, d.x, even_axes & 1),
+                    axis_factor(o.y, d.y, even_axes & 2), axis_factor(o.z, d.z, even_axes & 4), root, root_lo);
+  } else {
+    AxisFactor fx, fy, fz;
+    segment_factors(o, d, t_in, t_out, even_axes, &fx, &fy, &fz);
+    restrict_to_ray(exps, coefs, count, binomials, fx, fy, fz, root, root_lo);
+    if (ALGRAY_ESCALATE) {
+      *terms = ray_terms(exps, coefs, count, fx, fy, fz);
+      terms->has_ray = 1;
+      terms->o = o;
+      terms->d = d;
+      terms->t_in = t_in;
+      terms->t_out = t_out;
+    }
   }
-#endif
   restricted_to_isolation_basis(root, root_lo, binomials, probe_log);
 }
 
@@ -475,11 +461,7 @@ ALGRAY_INLINE void screen_coefficients(__global const REAL* row, LREAL xi, LREAL
   ALGRAY_UNROLL
   for (int j = DEGREE - 1; j >= 0; --j) ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) taylor[k] = taylor[k] * xi + row[j * NCOEF + k];
-#if RESTRICT_BERNSTEIN
-  const LREAL l0 = tau_in, l1 = tau_out;
-#else
-  const LREAL l0 = tau_in, l1 = tau_out - tau_in;
-#endif
+  const LREAL l0 = tau_in, l1 = RESTRICT_BERNSTEIN ? tau_out : tau_out - tau_in;
   LREAL c[NCOEF];
   c[0] = taylor[DEGREE];
   ALGRAY_UNROLL
@@ -491,12 +473,12 @@ ALGRAY_INLINE void screen_coefficients(__global const REAL* row, LREAL xi, LREAL
     for (int k = DEGREE; k > 0; --k) c[k] = l0 * c[k] + l1 * c[k - 1];
     c[0] = l0 * c[0] + l1 * (LREAL)0;
     /* acc_add_constant */
-#if RESTRICT_BERNSTEIN
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE; ++k) c[k] += taylor[n] * binomials[(DEGREE - n) * NCOEF + k];
-#else
-    c[0] += taylor[n];
-#endif
+    if (RESTRICT_BERNSTEIN) {
+      ALGRAY_UNROLL
+      for (int k = 0; k <= DEGREE; ++k) c[k] += taylor[n] * binomials[(DEGREE - n) * NCOEF + k];
+    } else {
+      c[0] += taylor[n];
+    }
   }
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) out[k] = c[k] / binomials[DEGREE * NCOEF + k]; /* bernstein_from_scaled */
@@ -549,9 +531,8 @@ int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, R
   for (uint j = 0; j < min(count, (uint)LANES); ++j) {
     if (!in_extent[j]) continue;
     REAL taylor[NCOEF], taylor_t = 0;
-#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
-    taylor_t = screen_ray_taylor(px0 + j, py, screen_rows, screen_row0, screen_t, xi_scale, xi_offset, taylor);
-#endif
+    if (RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN)
+      taylor_t = screen_ray_taylor(px0 + j, py, screen_rows, screen_row0, screen_t, xi_scale, xi_offset, taylor);
     segment_coefficients(lane_origin(&unit, j), lane_direction(&unit, j), t_in[j], t_out[j], exps, coefs, mono_count,
                          binomials, even_axes, root[j], root_lo[j], &terms[j], taylor, taylor_t, probe_log);
   }

@@ -16,17 +16,12 @@ __kernel void univariate(__global const REAL* polys, uint count, __constant cons
   REAL root[NCOEF], root_lo[NCOEF], iso_c[NCOEF];
   for (int k = 0; k <= DEGREE; ++k) {
     root[k] = polys[(size_t)i * NCOEF + k];
-#if ALGRAY_COMPENSATED
-    root_lo[k] = polys[(size_t)count * NCOEF + (size_t)i * NCOEF + k]; /* the low parts follow all high parts */
-#else
-    root_lo[k] = 0;
-#endif
+    /* mixed precision's low parts follow all high parts */
+    root_lo[k] = ALGRAY_COMPENSATED ? polys[(size_t)count * NCOEF + (size_t)i * NCOEF + k] : (REAL)0;
   }
   RayTerms terms;
-#if ALGRAY_ESCALATE
   /* The coefficients are given, rounded once: their own size is their noise's. */
-  terms = known_terms(0);
-#endif
+  if (ALGRAY_ESCALATE) terms = known_terms(0);
   LaneIsolation iso;
   set_lane_isolation(&iso, 0, isolate_method(root, root_lo, (REAL)0, (REAL)1, iso_c, &terms, NO_PROBE));
   LaneRoots roots;

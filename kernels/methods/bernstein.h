@@ -30,17 +30,6 @@ ALGRAY_INLINE void ff_combine(LREAL a, LREAL a_lo, LREAL x1, LREAL x1_lo, LREAL 
   *lo = e - (*hi - s);
 }
 
-/* The restriction produced scaled coefficients c_k = C(n,k) b_k; Descartes' rule and de Casteljau want b_k. */
-void bernstein_from_scaled(REAL* c, REAL* c_lo, __constant const REAL* binomials) {
-  __constant const REAL* row = binomials + DEGREE * NCOEF;
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) {
-    const REAL q = c[k] / row[k];
-    if (ALGRAY_COMPENSATED) c_lo[k] = (fma(-q, row[k], c[k]) + c_lo[k]) / row[k]; /* the division's remainder is exact */
-    c[k] = q;
-  }
-}
-
 /* x1 a + x b: de Casteljau's recurrence in plain arithmetic. */
 #define CASTELJAU_COMBINE(x1, a, x, b) ((x1) * (a) + (x) * (b))
 
@@ -193,9 +182,7 @@ ALGRAY_INLINE LMASK refinable_in_float(const LREAL* c) {
  * sign seen by selections alone and sum the changes as a tree (added one after another, each waiting on the last,
  * they were the longest chain of the search's step). The same counts: a NaN counts as a zero. */
 ALGRAY_INLINE LREAL bernstein_sign_variations(const LREAL* c) {
-#if LANES == 1
-  return (REAL)sign_variations(c);
-#else
+  if (LANES == 1) return (REAL)sign_variations((const REAL*)c);
   LREAL change[NCOEF];
   LMASK seen = c[0] > 0 || c[0] < 0, prev_negative = c[0] < 0;
   ALGRAY_UNROLL
@@ -210,7 +197,6 @@ ALGRAY_INLINE LREAL bernstein_sign_variations(const LREAL* c) {
   for (int span = 1; span <= DEGREE; span *= 2) ALGRAY_UNROLL
   for (int k = 0; k + span <= DEGREE; k += 2 * span) change[k] += change[k + span];
   return change[0];
-#endif
 }
 
 /* The search's next interval after the one ending at next_at: next_interval (isolation.h) without its loop. It
@@ -252,6 +238,14 @@ ALGRAY_INLINE LREAL lanes_smaller_end(const LREAL* c, LREAL lo) {
  * every lane's terms summed. Other builds never read it. */
 #if LANES == 1
 typedef RayTerms LaneTerms;
+ALGRAY_INLINE LaneRays terms_rays(const LaneTerms* t) { return one_lane_rays(t->o, t->d); }
+ALGRAY_INLINE LMASK terms_have_rays(const LaneTerms* t) { return t->has_ray; }
+/* isolate_bernstein's ray as the search takes its terms: as they are */
+ALGRAY_INLINE LaneTerms* one_ray_terms(RayTerms* terms, LaneTerms* lanes, LaneRays* rays) {
+  (void)lanes;
+  (void)rays;
+  return terms;
+}
 #else
 typedef struct {
   LREAL value;
@@ -260,6 +254,23 @@ typedef struct {
   __global const REAL* coefs;
   uint count;
 } LaneTerms;
+ALGRAY_INLINE LaneRays terms_rays(const LaneTerms* t) { return *t->rays; }
+ALGRAY_INLINE LMASK terms_have_rays(const LaneTerms* t) {
+  (void)t;
+  return (LMASK)(-1); /* every lane */
+}
+/* Lanes builds search their rays together (surface.h); isolate_bernstein's one ray, in lane 0, measures its noise as
+ * lanes do. Only adaptive builds read the terms. */
+ALGRAY_INLINE LaneTerms* one_ray_terms(RayTerms* terms, LaneTerms* lanes, LaneRays* rays) {
+  if (!ALGRAY_ESCALATE) return (LaneTerms*)0;
+  *rays = one_lane_rays(terms->o, terms->d);
+  lanes->value = ray_terms_exact(terms);
+  lanes->rays = rays;
+  lanes->exps = terms->exps;
+  lanes->coefs = terms->coefs;
+  lanes->count = terms->count;
+  return lanes;
+}
 #endif
 
 /* The search's noise (isolation.h, DOUBT_NOISE), and P's signs proven in float-float at interval ends
@@ -289,8 +300,6 @@ ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREA
   return within;
 }
 ALGRAY_INLINE LREAL found_noise(LaneNoise* n, LMASK found) { return found ? exact_noise(&n->one) : (REAL)0; }
-ALGRAY_INLINE LaneRays terms_rays(const LaneTerms* t) { return one_lane_rays(t->o, t->d); }
-ALGRAY_INLINE LMASK terms_have_rays(const LaneTerms* t) { return t->has_ray; }
 #elif ALGRAY_ESCALATE
 /* Lanes: every lane's noise on its terms summed. */
 typedef struct {
@@ -314,14 +323,10 @@ ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREA
   return fabs(value) <= n->noise;
 }
 ALGRAY_INLINE LREAL found_noise(LaneNoise* n, LMASK found) { return LANE_SEL((LREAL)0, n->noise, found); }
-ALGRAY_INLINE LaneRays terms_rays(const LaneTerms* t) { return *t->rays; }
-ALGRAY_INLINE LMASK terms_have_rays(const LaneTerms* t) {
-  (void)t;
-  return (LMASK)(-1); /* every lane */
-}
 #else
 typedef struct {
   LREAL noise;
+  ProvenEnds proven; /* never filled: discards_settled, which reads it, returns first in these builds */
 } LaneNoise;
 ALGRAY_INLINE LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
   (void)root;
@@ -408,7 +413,6 @@ ALGRAY_INLINE void settle_isolated(BernsteinSearch* s, LREAL v, LaneNoise* noise
  * in float-float. */
 #define ALGRAY_SETTLES_DISCARDS (ALGRAY_ESCALATE && !ALGRAY_SHADOW_RAYS && ALGRAY_SETTLE_DOUBTS)
 
-#if ALGRAY_SETTLES_DISCARDS
 /* The end value of an interval at fraction `end` as the probe shows a settled discard doubt: P in float-float and
  * its rounding where that end was within the noise (in proven), else float's value c and the noise it stood clear
  * of. */
@@ -429,6 +433,7 @@ ALGRAY_INLINE void settled_end(const ProvenEnds* proven, LREAL end, LREAL c, LRE
  * The probe sees what settled it (ALGRAY_EVENT_CONFIRMED, decision 3). */
 ALGRAY_INLINE LMASK discards_settled(const BernsteinSearch* s, LMASK end_doubted, LaneNoise* noise, LaneTerms* terms, LREAL t_in,
                        LREAL t_out, ProbeLog* probe_log) {
+  if (!ALGRAY_SETTLES_DISCARDS) return (LMASK)0;
   const LREAL at = s->at, hi = s->at + s->width;
   const LMASK inner_clear = end_doubted && terms_have_rays(terms) &&
                             !within_lanes_noise(noise, lanes_smallest_magnitude(s->cur, at, 0), at, hi);
@@ -455,9 +460,6 @@ ALGRAY_INLINE LMASK discards_settled(const BernsteinSearch* s, LMASK end_doubted
   }
   return settled;
 }
-#else
-#define discards_settled(s, end_doubted, noise, terms, t_in, t_out, probe_log) ((end_doubted) && !(end_doubted))
-#endif
 
 /* Adaptive builds: no sign variation, but a coefficient within the noise of zero: the interval is not yet shown
  * root-free. Its end coefficients are P's values: near zero there, float cannot tell, and the search ends in doubt
@@ -543,7 +545,7 @@ ALGRAY_INLINE void move_on(BernsteinSearch* s, LMASK move, const LREAL* root, co
  * settled it (ALGRAY_EVENT_CONFIRMED, decision 2). */
 ALGRAY_INLINE void settle_brackets(BernsteinSearch* s, LaneTerms* terms, LREAL t_in, LREAL t_out,
                                    ProbeLog* probe_log) {
-#if ALGRAY_ESCALATE && !ALGRAY_SHADOW_RAYS
+  if (!ALGRAY_ESCALATE || ALGRAY_SHADOW_RAYS) return;
   const LMASK doubted = s->brackets_doubted && terms_have_rays(terms);
   if (!LANE_ANY(doubted)) return;
   const LaneRays rays = terms_rays(terms);
@@ -554,13 +556,6 @@ ALGRAY_INLINE void settle_brackets(BernsteinSearch* s, LaneTerms* terms, LREAL t
   if (LANE_ANY(settled)) PROBE(ALGRAY_EVENT_CONFIRMED, 0, 2u, 0u, v_lo, rounding_lo, v_hi, rounding_hi);
   s->status = LANE_SEL(s->status, (LREAL)ISOLATION_BRACKET, settled);
   s->doubt = LANE_SEL(s->doubt, (LREAL)0, settled);
-#else
-  (void)s;
-  (void)terms;
-  (void)t_in;
-  (void)t_out;
-  (void)probe_log;
-#endif
 }
 
 /* Finds the leftmost subinterval of [0,1] that isolates the smallest root of the polynomial with Bernstein
@@ -631,22 +626,9 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
     r_lo[k] = ALGRAY_COMPENSATED ? root_lo[k] : (REAL)0;
   }
   LaneIsolation iso;
-#if LANES == 1
-  LaneTerms* lane_terms = terms;
-#elif ALGRAY_ESCALATE
-  /* lanes builds search their rays together (surface.h); one ray in lane 0 measures its noise as lanes do */
-  const LaneRays rays = one_lane_rays(terms->o, terms->d);
+  LaneRays rays;
   LaneTerms ray_lanes;
-  ray_lanes.value = ray_terms_exact(terms);
-  ray_lanes.rays = &rays;
-  ray_lanes.exps = terms->exps;
-  ray_lanes.coefs = terms->coefs;
-  ray_lanes.count = terms->count;
-  LaneTerms* lane_terms = &ray_lanes;
-#else
-  (void)terms;
-  LaneTerms* lane_terms = (LaneTerms*)0; /* read by adaptive builds only */
-#endif
+  LaneTerms* lane_terms = one_ray_terms(terms, &ray_lanes, &rays);
   isolate_bernstein_search(lanes_of_bits(1u), r, r_lo, t_in, t_out, &iso, c, lane_terms, probe_log);
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) cur[k] = lane_get(c[k], 0);
