@@ -60,29 +60,7 @@ def _figures(root):
         for m in re.finditer(r"^[A-Za-z_][\w \*]*?\b(\w+_lanes)\s*\(", text, re.M):
             lanes_twins.append(f"{path.name}:{m.group(1)}")
 
-    long_functions = []
-    for path in kernel_files + source_files:
-        lines = path.read_text().split("\n")
-        start = None
-        for i, line in enumerate(lines):
-            if start is None:
-                if (re.match(r"[A-Za-z_]", line) and "(" in line and not re.match(
-                        r"(struct|typedef|namespace|class|enum|union|using|static_assert|#)\b", line)
-                        and not line.rstrip().endswith(";")):
-                    # the definition's opening brace ends this line or one of the next few (a wrapped signature)
-                    for j in range(i, min(i + 6, len(lines))):
-                        if lines[j].rstrip().endswith("{"):
-                            start = i
-                            break
-                        if lines[j].rstrip().endswith(";"):
-                            break
-            elif lines[i].startswith("}"):
-                length = i - start + 1
-                if length > 80:
-                    name = re.search(r"([\w:~]+)\s*\(", lines[start])
-                    long_functions.append((length, f"{path.relative_to(root)}:{start + 1} {name.group(1) if name else '?'}"))
-                start = None
-
+    long_functions = [f for path in kernel_files + source_files for f in _long_functions(path, root)]
     long_functions.sort(reverse=True)
     function_macros = sorted(set(function_macros))
     splicing_macros = sorted(set(splicing_macros))
@@ -95,6 +73,76 @@ def _figures(root):
         ("functions over 80 lines in kernels/ and src/", len(long_functions),
          ", ".join(f"{where} ({length})" for length, where in long_functions[:5]) + (", ..." if len(long_functions) > 5 else "")),
     ]
+
+
+# Functions over 80 lines, by brace matching on the text with comments, literals and preprocessor lines blanked:
+# a definition at any depth (members inside a class body too) runs from the line of its name to its closing brace,
+# and whatever is defined inside it (lambdas) is part of it. (Until 2026-12-06 the count took only definitions
+# that start a line at column 0 and end at a "}" there, which missed members written in class bodies.)
+_KEYWORDS = {"if", "for", "while", "switch", "catch", "return", "sizeof", "defined", "alignof", "decltype", "static_assert"}
+
+
+def _strip(text):
+    """Comments, string and character literals and preprocessor lines blanked, newlines kept."""
+    out = []
+    i, n = 0, len(text)
+    line_start = True
+    while i < n:
+        c = text[i]
+        if line_start and c == "#" :
+            j = i
+            while j < n and (text[j] != "\n" or text[j-1] == "\\"):
+                j += 1
+            out.append(re.sub(r"[^\n]", " ", text[i:j])); i = j; continue
+        if text.startswith("//", i):
+            j = text.find("\n", i); j = n if j < 0 else j
+            out.append(" " * (j - i)); i = j; continue
+        if text.startswith("/*", i):
+            j = text.find("*/", i + 2); j = n if j < 0 else j + 2
+            out.append(re.sub(r"[^\n]", " ", text[i:j])); i = j; continue
+        if text.startswith('R"', i) and (i == 0 or not (text[i-1].isalnum() or text[i-1] == "_")):
+            m = re.match(r'R"([^(]*)\(', text[i:])
+            if m:
+                end = text.find(")" + m.group(1) + '"', i)
+                j = n if end < 0 else end + len(m.group(1)) + 2
+                out.append(re.sub(r"[^\n]", " ", text[i:j])); i = j; continue
+        if c in "\"'":
+            if c == "'" and i > 0 and text[i-1].isalnum():  # digit separator 1'000
+                out.append(c); i += 1; continue
+            j = i + 1
+            while j < n and text[j] != c:
+                j += 2 if text[j] == "\\" else 1
+            out.append(c + " " * (min(j, n) - i - 1) + c); i = j + 1; continue
+        out.append(c)
+        line_start = c == "\n" or (line_start and c in " \t")
+        i += 1
+    return "".join(out)
+
+_HEAD = re.compile(r"([~\w:]+)\s*\(([^;{}()]|\([^;{}()]*\))*\)\s*(const\s*)?(noexcept\s*)?(override\s*)?(->\s*[\w:<>&*\s]+?)?\s*(:\s*[^;{}]*?)?\{")
+
+
+def _long_functions(path, root, limit=80):
+    text = _strip(path.read_text())
+    found = []
+    i = 0
+    while True:
+        m = _HEAD.search(text, i)
+        if not m:
+            return found
+        name = m.group(1)
+        if name.split("::")[-1] in _KEYWORDS:
+            i = m.start(1) + len(name)
+            continue
+        depth, j = 0, m.end() - 1
+        while j < len(text):
+            depth += {"{": 1, "}": -1}.get(text[j], 0)
+            if depth == 0:
+                break
+            j += 1
+        first, last = text.count("\n", 0, m.start(1)) + 1, text.count("\n", 0, j) + 1
+        if last - first + 1 > limit:
+            found.append((last - first + 1, f"{path.relative_to(root)}:{first} {name}"))
+        i = j + 1
 
 
 def main():

@@ -116,11 +116,7 @@ REAL chain_root(const REAL* c, int m, REAL lo, REAL hi, REAL f_lo, REAL f_hi, RE
 #define CHAIN_BOTTOM (DEGREE >= 3 ? 2 : 1)
 int chain_bottom_roots(const REAL* c, REAL* r) {
   const REAL c0 = c[0], c1 = c[1];
-#if CHAIN_BOTTOM == 2
-  const REAL c2 = c[2];
-#else
-  const REAL c2 = 0;
-#endif
+  const REAL c2 = CHAIN_BOTTOM == 2 ? c[2] : (REAL)0;
   REAL x0 = -1, x1 = -1;
   if (c2 == 0) {
     if (c1 != 0) x0 = -c0 / c1;
@@ -190,30 +186,10 @@ int chain_visit(ChainWalk* w, Isolation* iso, const REAL* a, REAL x, ProbeLog* p
   return 0;
 }
 
-/* p is P*(s) in the power basis, the extent interval being s in [s0, s0 + len_s], mapped once to A(y) on
- * [0, 1]. The roots in (0, 1) of each level of the chain are the piece boundaries of the level above, up to A,
- * whose first piece with a sign change is the bracket. A zero of A at y = 0 is a root whatever its
- * multiplicity, as in the other methods: the ray starts on the surface. iso.steps counts polynomial
- * evaluations: piece ends at every level, inner solver iterations, the closed-form bottom as one. On return
- * `a1` is A1 on [lo, hi] when the status is a bracket. */
-Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out,
-                                   REAL* a1, ProbeLog* probe_log) {
-  Isolation iso = isolation_none();
-  REAL a[NCOEF];
-  power_on_interval(p, s0, len_s, a);
-  ++iso.steps;
-  if (a[0] == 0) {
-    iso.status = ISOLATION_EXACT;
-    iso.lo = iso.hi = 0;
-    PROBE_STEP(iso, -1, ALGRAY_STEP_EXACT_ZERO, 0);
-    return iso;
-  }
-  ChainWalk walk;
-  walk.x = 0;
-  walk.f = a[0];
-  walk.sign = a[0] > 0 ? 1 : -1;
-  walk.zero = -1;
-
+/* Walks A's pieces from y = 0 until walk finds the first sign change (chain_visit) or reaches the end 1. The
+ * roots in (0, 1) of each level of the chain are the piece boundaries of the level above, up to A. */
+ALGRAY_INLINE void walk_chain_pieces(const REAL* a, REAL t_in, REAL t_out, ChainWalk* walk, Isolation* iso,
+                                     ProbeLog* probe_log) {
 #if DEGREE > 1
   /* The stopping width where it is smallest on [t_in, t_out], nearest t = 0, as a fraction of the interval. */
   const REAL len = t_out - t_in;
@@ -227,7 +203,7 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
   REAL bottom[2];
   const int bottom_count = chain_bottom_roots(chain + chain_offset(CHAIN_BOTTOM), bottom);
   int bottom_taken = 0;
-  ++iso.steps;
+  ++iso->steps;
 
   /* The levels as a pipeline, each a stream of its roots in increasing order: a level takes the next root of
    * the level below as its next piece boundary, and sends a root up when that piece changes sign. Pulled from
@@ -254,12 +230,12 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
       }
     } else {
       const REAL* c = chain + chain_offset(m);
-      ++iso.steps;
+      ++iso->steps;
       const REAL v = chain_value(c, m, y);
       const REAL u = last_f[m];
       REAL root = -1;
       if ((u < 0 && v > 0) || (u > 0 && v < 0))
-        root = chain_root(c, m, last_x[m], y, u, v, tol, &iso, probe_log);
+        root = chain_root(c, m, last_x[m], y, u, v, tol, iso, probe_log);
       else if (v == 0 && y < (REAL)1)
         root = y; /* a root on a boundary: one too many is harmless, a monotone piece split in two */
       last_x[m] = y;
@@ -274,7 +250,7 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
     }
     /* y is the next root of level m, or the end 1: the next piece boundary of the level above */
     if (m == DEGREE - 1) {
-      if (chain_visit(&walk, &iso, a, y, probe_log) || y == (REAL)1) break;
+      if (chain_visit(walk, iso, a, y, probe_log) || y == (REAL)1) break;
       have = 0;
     } else {
       ++m;
@@ -284,8 +260,34 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
 #else
   (void)t_in;
   (void)t_out;
-  chain_visit(&walk, &iso, a, (REAL)1, probe_log);
+  chain_visit(walk, iso, a, (REAL)1, probe_log);
 #endif
+}
+
+/* p is P*(s) in the power basis, the extent interval being s in [s0, s0 + len_s], mapped once to A(y) on
+ * [0, 1]. A's first piece with a sign change is the bracket (walk_chain_pieces). A zero of A at y = 0 is a root whatever its
+ * multiplicity, as in the other methods: the ray starts on the surface. iso.steps counts polynomial
+ * evaluations: piece ends at every level, inner solver iterations, the closed-form bottom as one. On return
+ * `a1` is A1 on [lo, hi] when the status is a bracket. */
+Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out,
+                                   REAL* a1, ProbeLog* probe_log) {
+  Isolation iso = isolation_none();
+  REAL a[NCOEF];
+  power_on_interval(p, s0, len_s, a);
+  ++iso.steps;
+  if (a[0] == 0) {
+    iso.status = ISOLATION_EXACT;
+    iso.lo = iso.hi = 0;
+    PROBE_STEP(iso, -1, ALGRAY_STEP_EXACT_ZERO, 0);
+    return iso;
+  }
+  ChainWalk walk;
+  walk.x = 0;
+  walk.f = a[0];
+  walk.sign = a[0] > 0 ? 1 : -1;
+  walk.zero = -1;
+
+  walk_chain_pieces(a, t_in, t_out, &walk, &iso, probe_log);
   /* The bracket's own polynomial, from A as its end values were, so that refinement sees the same signs. */
   if (iso.status == ISOLATION_BRACKET) power_on_interval(a, iso.lo, iso.hi - iso.lo, a1);
   return iso;

@@ -772,62 +772,64 @@ class PovReader {
     optional_comma();
     return static_cast<int>(o);
   }
+  // One object and its modifiers into out: a CSG group's members each, a shape as one.
   void object(const Token& kind, std::vector<Object>& out) {
     expect("{", "'{'");
-    if (kind.text == "union" || kind.text == "merge") {
-      const std::size_t first = out.size();
-      while (peek().kind == Token::Name && is_object(peek().text) && at_op("{", 1)) object(next(), out);
-      std::vector<Object*> members;
-      for (std::size_t i = first; i < out.size(); ++i) members.push_back(&out[i]);
-      if (members.empty()) fail(kind, "this " + kind.text + " holds no object algray reads");
-      modifiers(members, kind);
-      return;
-    }
-    if (kind.text == "intersection") {
-      // POV-Ray's samples cut a surface with a Clear sphere or box: read as the surface clipped to that region.
-      warn(kind, "intersection is read as its algebraic objects clipped by its spheres and boxes; the cut faces "
-                 "are not drawn (POV-Ray's samples make them Clear)");
-      const std::size_t first = out.size();
-      std::vector<std::pair<Clip, glm::dmat4>> clips;
-      while (peek().kind == Token::Name && at_op("{", 1)) {
-        const std::string w = peek().text;
-        if (w == "sphere" || w == "box" || (w == "object" && declared_clips_.count(peek(2).text))) {
-          glm::dmat4 own(1);
-          const Clip c = clip_shape(kind, own);
-          clips.push_back({c, own});
-        } else if (is_object(w)) {
-          object(next(), out);
-        } else {
-          break;
-        }
-      }
-      if (out.size() == first) fail(kind, "this intersection holds no algebraic object algray reads");
-      if (clips.empty()) fail(kind, "this intersection has no sphere or box to cut its objects with");
-      std::vector<Object*> members;
-      for (std::size_t i = first; i < out.size(); ++i) {
-        out[i].clips.insert(out[i].clips.end(), clips.begin(), clips.end());
-        members.push_back(&out[i]);
-      }
-      modifiers(members, kind);
-      return;
-    }
-    if (kind.text == "object") {  // object { NAME modifiers } or object { OBJECT modifiers }
-      const std::size_t first = out.size();
-      const Token name = next();
-      if (name.kind == Token::Name && is_object(name.text) && at_op("{")) {
-        object(name, out);
-      } else if (name.kind == Token::Name && declared_objects_.count(name.text)) {
-        for (const Object& o : declared_objects_.at(name.text)) out.push_back(o);
-      } else if (name.kind == Token::Name) {
-        unusable(name);
+    const std::size_t first = out.size();
+    if (kind.text == "union" || kind.text == "merge")
+      union_members(kind, out);
+    else if (kind.text == "intersection")
+      intersection_members(kind, out);
+    else if (kind.text == "object")
+      object_reference(out);
+    else
+      out.push_back(shape(kind));
+    std::vector<Object*> members;
+    for (std::size_t i = first; i < out.size(); ++i) members.push_back(&out[i]);
+    modifiers(members, kind);
+  }
+  void union_members(const Token& kind, std::vector<Object>& out) {
+    const std::size_t first = out.size();
+    while (peek().kind == Token::Name && is_object(peek().text) && at_op("{", 1)) object(next(), out);
+    if (out.size() == first) fail(kind, "this " + kind.text + " holds no object algray reads");
+  }
+  void intersection_members(const Token& kind, std::vector<Object>& out) {
+    // POV-Ray's samples cut a surface with a Clear sphere or box: read as the surface clipped to that region.
+    warn(kind, "intersection is read as its algebraic objects clipped by its spheres and boxes; the cut faces "
+               "are not drawn (POV-Ray's samples make them Clear)");
+    const std::size_t first = out.size();
+    std::vector<std::pair<Clip, glm::dmat4>> clips;
+    while (peek().kind == Token::Name && at_op("{", 1)) {
+      const std::string w = peek().text;
+      if (w == "sphere" || w == "box" || (w == "object" && declared_clips_.count(peek(2).text))) {
+        glm::dmat4 own(1);
+        const Clip c = clip_shape(kind, own);
+        clips.push_back({c, own});
+      } else if (is_object(w)) {
+        object(next(), out);
       } else {
-        fail(name, "expected a declared object's name, found " + describe(name));
+        break;
       }
-      std::vector<Object*> members;
-      for (std::size_t i = first; i < out.size(); ++i) members.push_back(&out[i]);
-      modifiers(members, kind);
-      return;
     }
+    if (out.size() == first) fail(kind, "this intersection holds no algebraic object algray reads");
+    if (clips.empty()) fail(kind, "this intersection has no sphere or box to cut its objects with");
+    for (std::size_t i = first; i < out.size(); ++i) out[i].clips.insert(out[i].clips.end(), clips.begin(), clips.end());
+  }
+  // object { NAME modifiers } or object { OBJECT modifiers }
+  void object_reference(std::vector<Object>& out) {
+    const Token name = next();
+    if (name.kind == Token::Name && is_object(name.text) && at_op("{")) {
+      object(name, out);
+    } else if (name.kind == Token::Name && declared_objects_.count(name.text)) {
+      for (const Object& o : declared_objects_.at(name.text)) out.push_back(o);
+    } else if (name.kind == Token::Name) {
+      unusable(name);
+    } else {
+      fail(name, "expected a declared object's name, found " + describe(name));
+    }
+  }
+  // A sphere, torus or polynomial shape, up to its modifiers.
+  Object shape(const Token& kind) {
     Object o;
     o.at = kind;
     o.kind = kind.text;
@@ -843,45 +845,52 @@ class PovReader {
       optional_comma();
       const double small = number();
       if (!(big > 0 && small > 0)) fail(kind, "a torus' radii must be positive");
-      // (x^2 + y^2 + z^2 + R^2 - r^2)^2 - 4 R^2 (x^2 + z^2), about the y axis.
-      SparsePoly q = SparsePoly::constant(big * big - small * small);
-      for (int a = 0; a < 3; ++a) {
-        SparsePoly::Exponents e{0, 0, 0};
-        e[static_cast<std::size_t>(a)] = 2;
-        q.add(e, 1);
-      }
-      PolyBudget budget;
-      o.poly = multiply(q, q, budget);
-      o.poly.add({2, 0, 0}, -4 * big * big);
-      o.poly.add({0, 0, 2}, -4 * big * big);
+      o.poly = torus_poly(big, small);
       o.natural = Clip{true, {0, 0, 0}, {}, {}, (big + small) * 1.001};
     } else if (kind.text == "poly" || kind.text == "quartic" || kind.text == "cubic") {
       const int order = kind.text == "poly" ? order_of(kind) : kind.text == "quartic" ? 4 : 3;
       const Token vat = peek();
       o.poly = listed_poly(order, expression(), vat);
     } else {  // polynomial
-      const int order = order_of(kind);
-      while (at_name("xyz")) {
-        const Token term = next();
-        expect("(", "'('");
-        int e[3];
-        for (int i = 0; i < 3; ++i) {
-          const double v = number();
-          if (v != std::floor(v) || v < 0 || v > order) fail(term, "exponents are whole numbers from 0 to the order");
-          e[i] = static_cast<int>(v);
-          if (i < 2) expect(",", "','");
-        }
-        expect(")", "')'");
-        expect(":", "':'");
-        if (e[0] + e[1] + e[2] > order) fail(term, "this term's degree is above the polynomial's order");
-        o.poly.add({e[0], e[1], e[2]}, number());
-        optional_comma();
-      }
+      o.poly = polynomial_terms(order_of(kind));
     }
     if (o.poly.degree() < 1) fail(kind, "this " + kind.text + " is constant: there is no surface");
-    out.push_back(o);
-    Object* self = &out.back();
-    modifiers({self}, kind);
+    return o;
+  }
+  // (x^2 + y^2 + z^2 + R^2 - r^2)^2 - 4 R^2 (x^2 + z^2), about the y axis.
+  static SparsePoly torus_poly(double big, double small) {
+    SparsePoly q = SparsePoly::constant(big * big - small * small);
+    for (int a = 0; a < 3; ++a) {
+      SparsePoly::Exponents e{0, 0, 0};
+      e[static_cast<std::size_t>(a)] = 2;
+      q.add(e, 1);
+    }
+    PolyBudget budget;
+    SparsePoly torus = multiply(q, q, budget);
+    torus.add({2, 0, 0}, -4 * big * big);
+    torus.add({0, 0, 2}, -4 * big * big);
+    return torus;
+  }
+  // polynomial's xyz(i, j, k): c terms.
+  SparsePoly polynomial_terms(int order) {
+    SparsePoly poly;
+    while (at_name("xyz")) {
+      const Token term = next();
+      expect("(", "'('");
+      int e[3];
+      for (int i = 0; i < 3; ++i) {
+        const double v = number();
+        if (v != std::floor(v) || v < 0 || v > order) fail(term, "exponents are whole numbers from 0 to the order");
+        e[i] = static_cast<int>(v);
+        if (i < 2) expect(",", "','");
+      }
+      expect(")", "')'");
+      expect(":", "':'");
+      if (e[0] + e[1] + e[2] > order) fail(term, "this term's degree is above the polynomial's order");
+      poly.add({e[0], e[1], e[2]}, number());
+      optional_comma();
+    }
+    return poly;
   }
   static bool is_object(const std::string& w) {
     return w == "sphere" || w == "torus" || w == "poly" || w == "polynomial" || w == "quartic" || w == "cubic" ||
