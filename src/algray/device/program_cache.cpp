@@ -97,14 +97,27 @@ std::filesystem::path ProgramCache::default_directory() {
   return std::filesystem::temp_directory_path() / "algray-cache";
 }
 
+const ProgramCache::AssembledSource& ProgramCache::assembled_source(const std::string& entry_file) {
+  const auto assemble = [&entry_file] {
+    AssembledSource a;
+    a.text = assemble_kernel_source(entry_file);
+    a.hash = fnv1a(a.text);
+    return a;
+  };
+  if (const char* dir = std::getenv("ALGRAY_KERNEL_DIR"); dir && *dir) return from_kernel_dir_ = assemble();
+  auto it = sources_.find(entry_file);
+  if (it == sources_.end()) it = sources_.emplace(entry_file, assemble()).first;
+  return it->second;
+}
+
 cl::Kernel ProgramCache::kernel(ClSession& session, const KernelConfig& config, ProgramRecord* record) {
   const auto start = std::chrono::steady_clock::now();
-  const std::string source = assemble_kernel_source(config.source_file());
+  const AssembledSource& source = assembled_source(config.source_file());
   const std::string options =
       config.build_options() + (session.copy ? " -DALGRAY_DEVICE_COPY=" + std::to_string(session.copy) : "");
   // Everything the binary depends on: a change to any of it must miss.
   const std::string identity =
-      "source-hash=" + hex64(fnv1a(source)) + "\noptions=" + options + "\n" + device_identity(session.info);
+      "source-hash=" + hex64(source.hash) + "\noptions=" + options + "\n" + device_identity(session.info);
   ProgramRecord rec{config.key(), options, "built", 0};
 
   cl::Program program;
@@ -117,7 +130,7 @@ cl::Kernel ProgramCache::kernel(ClSession& session, const KernelConfig& config, 
     if (enabled_ && load_from_disk(session, file, identity, options, program)) {
       rec.origin = "disk";
     } else {
-      program = build_from_source(session, source, options, rec.key);
+      program = build_from_source(session, source.text, options, rec.key);
       if (enabled_) store_on_disk(program, file, identity);
     }
     if (enabled_) memory_[memory_key] = program;

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <cstdint>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -64,8 +65,20 @@ class ProgramCache {
   // so that a user who wonders why every run compiles finds out.
   void warn_unusable(const std::error_code& why) const;
 
+  // An entry file's program text with its includes, and the text's hash (the identity's source-hash).
+  struct AssembledSource {
+    std::string text;
+    std::uint64_t hash = 0;
+  };
+  // Assembled once per entry file and kept: the embedded files do not change while the process runs, and
+  // assembling and hashing some 200 KB on every render was most of a render's host time under the sanitizers
+  // (and 1-3 ms of every frame of `algray view`). Files read from ALGRAY_KERNEL_DIR are read every time.
+  const AssembledSource& assembled_source(const std::string& entry_file);
+
   bool enabled_;
   std::filesystem::path dir_;
+  std::map<std::string, AssembledSource> sources_;  // by entry file, embedded sources only
+  AssembledSource from_kernel_dir_;                 // the last one read from ALGRAY_KERNEL_DIR
   std::map<std::string, cl::Program> memory_;  // keyed by device identity + options + source hash
   std::map<std::string, double> measured_;     // the cache off: remembered()'s numbers, by identity
 };
