@@ -165,6 +165,7 @@ bool read_png(const fs::path& p, PngData& out) {
 }
 
 using algray::testing::noisy_image;
+using algray::testing::unit_float;
 
 // Runs image_writer_tool with these arguments in a child process and returns its pid (-1 if fork failed).
 // The child execs at once instead of writing itself: this process may already run OpenEXR's global thread
@@ -469,10 +470,9 @@ FrameImage random_png_image(std::mt19937& rng, int width, int height, bool opaqu
   FrameImage im;
   im.width = width;
   im.height = height;
-  std::uniform_real_distribution<float> value(-0.2f, 1.3f);
-  std::uniform_int_distribution<int> special(0, 49);
+  const auto special = [&rng] { return rng() % 50; };
   auto draw = [&] {
-    switch (special(rng)) {
+    switch (special()) {
       case 0:
         return std::numeric_limits<float>::quiet_NaN();
       case 1:
@@ -480,14 +480,14 @@ FrameImage random_png_image(std::mt19937& rng, int width, int height, bool opaqu
       case 2:
         return 1.0f;
       default:
-        return value(rng);
+        return -0.2f + 1.5f * unit_float(rng);
     }
   };
   im.rgba.resize(4 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
   for (std::size_t i = 0; i < im.rgba.size(); ++i) im.rgba[i] = (opaque && i % 4 == 3) ? 1.0f : draw();
   // Runs of one colour, which deflate turns into back-references, across band boundaries too.
   for (std::size_t i = 4; i + 4 <= im.rgba.size() / 3; i += 4)
-    if (special(rng) < 25)
+    if (special() < 25)
       std::copy_n(im.rgba.begin() + static_cast<std::ptrdiff_t>(i) - 4, 4,
                   im.rgba.begin() + static_cast<std::ptrdiff_t>(i));
   // The writer drops the alpha channel when every alpha byte would be 255, which a small random image can
