@@ -78,6 +78,16 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
            : "cylinder centre " + vec_text(scene.extent.centre) + " radius " + std::to_string(scene.extent.radius) +
                  " axis " + "xyz"[scene.extent.axis] + " half_height " + std::to_string(scene.extent.half_height)},
   };
+  // The clipping planes, "a b c d" each (a*x + b*y + c*z + d <= 0 kept), separated by "; ".
+  if (!scene.extent.clips.empty()) {
+    std::string planes;
+    for (const glm::dvec4& p : scene.extent.clips) {
+      char w[40];
+      std::snprintf(w, sizeof w, " %.17g", p.w);
+      planes += (planes.empty() ? "" : "; ") + vec_text(glm::dvec3(p)) + w;
+    }
+    img.string_attributes.push_back({"algray/clip", planes});
+  }
   double kernel_ms = 0;
   for (const PassStats& p : r.passes) kernel_ms += p.kernel_ms;
   img.double_attributes = {
