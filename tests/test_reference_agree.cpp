@@ -269,12 +269,13 @@ TEST_CASE("clipping planes cut each surface as the certified reference does: 0 d
   ClSession& session = testing::device_session();
   ProgramCache cache(false);
   Renderer renderer(session, cache);
-  // Seeded planes: one to three per scene, their normals uniform on the sphere, each through a point within half
-  // the extent's radius of its centre, so that every plane cuts the surface open; one case in a box, one in a
-  // cylinder, the others in the scene's own sphere.
+  // Seeded planes: one to three per scene, their normals uniform on the sphere, each through a point 0.05 to 0.5
+  // of the extent's radius from its centre along the normal, keeping the centre's side: every plane cuts the
+  // surface open, and together they leave enough of it to see. One case in a box, one in a cylinder, the others
+  // in the scene's own sphere.
   std::mt19937 rng(46);
   std::normal_distribution<double> normal(0, 1);
-  std::uniform_real_distribution<double> offset(-0.5, 0.5);
+  std::uniform_real_distribution<double> offset(0.05, 0.5);
   struct Case {
     const char* scene;
     int planes;
