@@ -55,7 +55,8 @@ typedef cl_int algray_i32;
  * (render/kernel_binder.h), never by position, and test_kernel_args reads every kernel's names back from the driver
  * to hold each list to its kernel. REAL-typed arguments follow the build's precision; arguments a build does not
  * use (the screen form's rows elsewhere, `undecided` outside adaptive builds) are still passed, and never read. */
-#define ALGRAY_EXTENT_ARG_NAMES(X) X(extent_centre) X(extent_inv_scale) X(extent_box_half) X(extent_kind)
+#define ALGRAY_EXTENT_ARG_NAMES(X) \
+  X(extent_centre) X(extent_inv_scale) X(extent_box_half) X(extent_kind) X(clip_planes) X(clip_count)
 #define ALGRAY_SURFACE_ARG_NAMES(X) X(mono_exps) X(mono_coefs) X(mono_count) X(binomials) X(even_axes)
 #define ALGRAY_CAMERA_ARG_NAMES(X) X(ray_o00) X(ray_ou) X(ray_ov) X(ray_d00) X(ray_du) X(ray_dv)
 #define ALGRAY_SCREEN_ARG_NAMES(X) X(screen_rows) X(screen_row0) X(screen_t) X(xi_scale) X(xi_offset)

@@ -17,7 +17,7 @@
  * read. The arguments are ALGRAY_PRIMARY_ARG_NAMES (algray_shared.h), by which the host sets them. */
 __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, REAL4 ray_du, REAL4 ray_dv,
                       REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
-                      __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
+                      __global const REAL4* clip_planes, uint clip_count, __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
                       __constant const REAL* binomials, uint even_axes, __global const REAL* screen_rows,
                       uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset, uint tile_x0, uint tile_y0,
                       uint tile_w, uint tile_h, __global HitRecord* out) {
@@ -28,7 +28,7 @@ __kernel void primary(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, 
   const LaneRays rays = camera_rays(tile_x0 + x0, py, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
   HitRecord records[LANES];
   const int entered = trace_rays(count, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                 mono_exps, mono_coefs, mono_count, binomials, even_axes, records, tile_x0 + x0, py,
+                                 clip_planes, clip_count, mono_exps, mono_coefs, mono_count, binomials, even_axes, records, tile_x0 + x0, py,
                                  screen_rows, screen_row0, screen_t, xi_scale, xi_offset, NO_PROBE);
   for (uint j = 0; j < count; ++j) out[(size_t)gy * tile_w + x0 + j] = entered ? records[j] : missed_record();
 }

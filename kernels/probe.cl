@@ -17,7 +17,8 @@
  * ALGRAY_PROBE_ARG_NAMES (algray_shared.h), by which the host sets them. */
 __kernel void probe(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, REAL4 ray_du, REAL4 ray_dv, uint px,
                     uint py, int use_given_ray, REAL4 given_o, REAL4 given_d, REAL4 extent_centre,
-                    REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind, __global const uint* mono_exps,
+                    REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind, __global const REAL4* clip_planes,
+                    uint clip_count, __global const uint* mono_exps,
                     __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials, uint even_axes,
                     __global const REAL* screen_rows, uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset,
                     __global HitRecord* out, __global REAL4* ray_out, __global ProbeEvent* events,
@@ -33,7 +34,7 @@ __kernel void probe(REAL4 ray_o00, REAL4 ray_ou, REAL4 ray_ov, REAL4 ray_d00, RE
   /* Camera rays only: the host probes a given ray with the trace kernel's construction (RAY_ORIGIN=extent). */
   HitRecord record;
   const int entered = trace_rays(1, &ray, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                 mono_exps, mono_coefs, mono_count, binomials, even_axes, &record, px, py, screen_rows,
+                                 clip_planes, clip_count, mono_exps, mono_coefs, mono_count, binomials, even_axes, &record, px, py, screen_rows,
                                  screen_row0, screen_t, xi_scale, xi_offset, &log);
   out[0] = entered ? record : missed_record();
   ray_out[0] = (REAL4)(ray.ox, ray.oy, ray.oz, 0);

@@ -16,14 +16,42 @@
  * pixel's centre, (REAL)px + 0.5 and (REAL)py + 0.5. */
 #define CAMERA_AXIS(f_x, f_y, base, along_x, along_y) (((base) + (f_x) * (along_x)) + (f_y) * (along_y))
 
+/* [*lo, *hi] of rays o + t*d cut by the clip planes clip_planes[0 .. clip_count), each the half-space n.u + e <= 0
+ * kept, (n, e) in unit coordinates (the host's DeviceSurface::set_extent_args). Each plane is a convex cut, so the
+ * segment stays one interval: a ray crossing the plane loses the part beyond where it crosses, a ray along it all
+ * or nothing. Returns the lanes that are not along a plane outside it; of one ray or of lanes, each lane with one
+ * ray's operations. */
+ALGRAY_INLINE LMASK cut_by_clip_planes(LREAL ox, LREAL oy, LREAL oz, LREAL dx, LREAL dy, LREAL dz,
+                                       __global const REAL4* clip_planes, uint clip_count, LREAL* lo, LREAL* hi) {
+  LMASK kept = lanes_of_bits(~0u); /* every lane */
+  for (uint k = 0; k < clip_count; ++k) {
+    const REAL4 plane = clip_planes[k];
+    LREAL s, v;
+    {
+      /* as dot() sums them: three products, added left to right */
+#pragma OPENCL FP_CONTRACT OFF
+      s = ((plane.x * ox + plane.y * oy) + plane.z * oz) + plane.w;
+      v = (plane.x * dx + plane.y * dy) + plane.z * dz;
+    }
+    /* +-inf or NaN where v == 0, never selected */
+    const LREAL cross = -s / v;
+    *lo = LANE_SEL(*lo, fmax(*lo, cross), v < (REAL)0);
+    *hi = LANE_SEL(*hi, fmin(*hi, cross), v > (REAL)0);
+    kept = kept && (v != (REAL)0 || s <= (REAL)0);
+  }
+  return kept;
+}
+
 /* [t_in, t_out] of rays o + t*d inside the extent, given in unit coordinates u = (p - centre)/scale, where the
  * sphere is the unit sphere, the box is |u_i| <= half_i and the cylinder about axis a (kind
  * ALGRAY_EXTENT_CYLINDER + a) is the part of the infinite one of radius half_(across a) between its caps at
- * u_a = +-half_a; returns where they enter it. Of one ray or of
- * lanes (lanes.h), each lane with one ray's operations. A ray that misses leaves t_in, t_out undefined. Where no ray meets the sphere, its square root and divisions are skipped (more
- * than half of a typical view's lanes miss it, in whole groups). */
+ * u_a = +-half_a, then cut by the clip planes (cut_by_clip_planes); returns where they enter what is left. Of one
+ * ray or of lanes (lanes.h), each lane with one ray's operations. A ray that misses leaves t_in, t_out undefined.
+ * Where no ray meets the sphere, its square root and divisions are skipped (more than half of a typical view's
+ * lanes miss it, in whole groups). */
 ALGRAY_INLINE LMASK clip_lanes_to_extent(LREAL ox, LREAL oy, LREAL oz, LREAL dx, LREAL dy, LREAL dz, int kind,
-                                         REAL3 box_half, LREAL* t_in, LREAL* t_out) {
+                                         REAL3 box_half, __global const REAL4* clip_planes, uint clip_count,
+                                         LREAL* t_in, LREAL* t_out) {
   LREAL lo = 0, hi;
   LMASK hit;
   if (kind == ALGRAY_EXTENT_SPHERE) {
@@ -80,6 +108,8 @@ ALGRAY_INLINE LMASK clip_lanes_to_extent(LREAL ox, LREAL oy, LREAL oz, LREAL dx,
     hi = fmin(fmin(hi, fmax(ax, bx)), fmin(fmax(ay, by), fmax(az, bz)));
     hit = hi > lo;
   }
+  /* without planes, nothing of the cut runs: the extent's segment as it always was */
+  if (clip_count > 0) hit = hit && cut_by_clip_planes(ox, oy, oz, dx, dy, dz, clip_planes, clip_count, &lo, &hi);
   *t_in = lo;
   *t_out = hi;
   return hit && hi > lo;
@@ -103,10 +133,11 @@ ALGRAY_INLINE LaneRays one_lane_rays(REAL3 o, REAL3 d) {
 }
 
 /* One ray's clip_lanes_to_extent: the ray in every lane, lane 0 read (in one-ray builds, the only lane). */
-int clip_to_extent(REAL3 o, REAL3 d, int kind, REAL3 box_half, REAL* t_in, REAL* t_out) {
+int clip_to_extent(REAL3 o, REAL3 d, int kind, REAL3 box_half, __global const REAL4* clip_planes, uint clip_count,
+                   REAL* t_in, REAL* t_out) {
   LREAL lo, hi;
   const LMASK hit = clip_lanes_to_extent((LREAL)o.x, (LREAL)o.y, (LREAL)o.z, (LREAL)d.x, (LREAL)d.y, (LREAL)d.z, kind,
-                                         box_half, &lo, &hi);
+                                         box_half, clip_planes, clip_count, &lo, &hi);
   *t_in = lane_get(lo, 0);
   *t_out = lane_get(hi, 0);
   return lane_get_mask(hit, 0) != 0;

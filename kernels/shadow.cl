@@ -138,16 +138,16 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
  * (algray_shared.h), by which the host sets them. */
 __kernel void shadow(__global const REAL4* points, __global const float4* normals, uint point_count,
                      __global const REAL4* light_points, uint light_count, REAL offset, REAL4 extent_centre,
-                     REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind, __global const uint* mono_exps,
-                     __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
-                     uint even_axes, __global ulong* occluded, __global uint* rays_traced,
-                     __global ulong* undecided) {
+                     REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind, __global const REAL4* clip_planes,
+                     uint clip_count, __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
+                     __constant const REAL* binomials, uint even_axes, __global ulong* occluded,
+                     __global uint* rays_traced, __global ulong* undecided) {
 #if RAY_ORIGIN == ALGRAY_ORIGIN_POINT
   (void)even_axes;
   (void)undecided;
   shadow_point_form_item(points, normals, point_count, light_points, light_count, offset, extent_centre,
-                         extent_inv_scale, extent_box_half, extent_kind, mono_exps, mono_coefs, mono_count, binomials,
-                         occluded, rays_traced);
+                         extent_inv_scale, extent_box_half, extent_kind, clip_planes, clip_count, mono_exps, mono_coefs,
+                         mono_count, binomials, occluded, rays_traced);
 #else
   const uint i = get_global_id(0);
   if (i >= point_count) return;
@@ -175,7 +175,8 @@ __kernel void shadow(__global const REAL4* points, __global const float4* normal
       if (mask & bit) continue;
       REAL3 d_unit;
       const int kind = shadow_segment(p, n, o, o_unit, light_points[s].xyz, extent_inv_scale, extent_kind,
-                                      extent_box_half.xyz, &d_unit, &t_in[pending], &t_out[pending]);
+                                      extent_box_half.xyz, clip_planes, clip_count, &d_unit, &t_in[pending],
+                                      &t_out[pending]);
       if (kind == SHADOW_SELF) mask |= bit;
       if (kind != SHADOW_TRACE) continue;
       ++traced;

@@ -13,12 +13,14 @@
 /* p: the surface point (world), n its unit normal on the camera's side, o = p moved along n, o_unit the same in
  * unit coordinates; light: the sample point. The segment runs from o (t = 0) to the sample (t = 1). */
 int shadow_segment(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, REAL3 light, REAL extent_inv_scale, int extent_kind,
-                   REAL3 extent_box_half, REAL3* d_unit, REAL* t_in, REAL* t_out) {
+                   REAL3 extent_box_half, __global const REAL4* clip_planes, uint clip_count, REAL3* d_unit,
+                   REAL* t_in, REAL* t_out) {
   /* A light behind the tangent plane is hidden by the surface itself, whatever the roots say. The plane is the
    * surface point's, as in the shading, not the offset origin's. */
   if (dot(light - p, n) <= 0) return SHADOW_SELF;
   *d_unit = (light - o) * extent_inv_scale;
-  if (!clip_to_extent(o_unit, *d_unit, extent_kind, extent_box_half, t_in, t_out)) return SHADOW_CLEAR;
+  if (!clip_to_extent(o_unit, *d_unit, extent_kind, extent_box_half, clip_planes, clip_count, t_in, t_out))
+    return SHADOW_CLEAR;
   *t_in = fmax(*t_in, (REAL)0);
   *t_out = fmin(*t_out, (REAL)1);
   return *t_out > *t_in ? SHADOW_TRACE : SHADOW_CLEAR;
@@ -145,8 +147,8 @@ Isolation shadow_isolation(const REAL* b, const REAL* b_lo, REAL t_in, REAL t_ou
  * behind the tangent plane, and the lanes returned where the segment from o (t = 0) to the sample (t = 1) holds
  * [*t_in, *t_out] of the extent. */
 LMASK shadow_segments(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, LREAL lx, LREAL ly, LREAL lz, REAL extent_inv_scale,
-                      int extent_kind, REAL3 box_half, LMASK* self, LREAL* dx, LREAL* dy, LREAL* dz, LREAL* t_in,
-                      LREAL* t_out) {
+                      int extent_kind, REAL3 box_half, __global const REAL4* clip_planes, uint clip_count,
+                      LMASK* self, LREAL* dx, LREAL* dy, LREAL* dz, LREAL* t_in, LREAL* t_out) {
   {
     /* as dot() sums them: three products, added left to right */
 #pragma OPENCL FP_CONTRACT OFF
@@ -157,7 +159,7 @@ LMASK shadow_segments(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, LREAL lx, LREAL l
   *dz = (lz - o.z) * extent_inv_scale;
   LREAL lo, hi;
   const LMASK hit = clip_lanes_to_extent((LREAL)o_unit.x, (LREAL)o_unit.y, (LREAL)o_unit.z, *dx, *dy, *dz, extent_kind,
-                                         box_half, &lo, &hi);
+                                         box_half, clip_planes, clip_count, &lo, &hi);
   /* a lane that misses the extent gets [0, 1], not the clip's NaNs, for the lanes' arithmetic that follows */
   *t_in = LANE_SEL((LREAL)0, fmax(lo, (LREAL)0), hit);
   *t_out = LANE_SEL((LREAL)1, fmin(hi, (LREAL)1), hit);
@@ -267,8 +269,9 @@ ulong queue_for_search(SearchQueue* queue, const LREAL* c, LREAL t_in, LREAL t_o
 ulong shadow_mask_point_form(__global const REAL4* points, __global const float4* normals, uint i,
                              __global const REAL4* light_points, uint light_count, REAL offset, REAL4 extent_centre,
                              REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
-                             __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
-                             __constant const REAL* binomials, ulong mask, uint* traced) {
+                             __global const REAL4* clip_planes, uint clip_count, __global const uint* mono_exps,
+                             __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
+                             ulong mask, uint* traced) {
   REAL3 p, n, o, o_unit;
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
   PolyVec q[POINT_FORM_COLUMNS];
@@ -294,7 +297,7 @@ ulong shadow_mask_point_form(__global const REAL4* points, __global const float4
     LMASK self;
     LREAL dx, dy, dz, t_in, t_out;
     LMASK trace = shadow_segments(p, n, o, o_unit, Lx, Ly, Lz, extent_inv_scale, extent_kind, extent_box_half.xyz,
-                                  &self, &dx, &dy, &dz, &t_in, &t_out);
+                                  clip_planes, clip_count, &self, &dx, &dy, &dz, &t_in, &t_out);
     mask |= (ulong)lane_mask_bits(wanted && self) << s0;
     trace = trace && wanted;
     if (!LANE_ANY(trace)) continue;
@@ -320,14 +323,15 @@ ulong shadow_mask_point_form(__global const REAL4* points, __global const float4
 void shadow_point_form_item(__global const REAL4* points, __global const float4* normals, uint point_count,
                             __global const REAL4* light_points, uint light_count, REAL offset, REAL4 extent_centre,
                             REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
-                            __global const uint* mono_exps, __global const REAL* mono_coefs, uint mono_count,
-                            __constant const REAL* binomials, __global ulong* occluded, __global uint* rays_traced) {
+                            __global const REAL4* clip_planes, uint clip_count, __global const uint* mono_exps,
+                            __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
+                            __global ulong* occluded, __global uint* rays_traced) {
   const uint i = get_global_id(0);
   if (i >= point_count) return;
   uint traced = 0;
   occluded[i] = shadow_mask_point_form(points, normals, i, light_points, light_count, offset, extent_centre,
-                                       extent_inv_scale, extent_box_half, extent_kind, mono_exps, mono_coefs,
-                                       mono_count, binomials, occluded[i], &traced);
+                                       extent_inv_scale, extent_box_half, extent_kind, clip_planes, clip_count,
+                                       mono_exps, mono_coefs, mono_count, binomials, occluded[i], &traced);
   if (traced) atomic_add(rays_traced, traced);
 }
 #endif

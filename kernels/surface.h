@@ -223,12 +223,14 @@ Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, _
   return isolate_method(root, root_lo, t_in, t_out, iso_c, terms, probe_log);
 }
 
-/* The first `count` (<= LANES) of the rays, in unit coordinates (unit) and clipped to the extent: *lane_t_in,
+/* The first `count` (<= LANES) of the rays, in unit coordinates (unit) and clipped to the extent and its clip
+ * planes (clip_lanes_to_extent): *lane_t_in,
  * *lane_t_out get each lane's segment (0 and 1 where it misses). Returns the lanes that enter the extent (none from
  * `count` on). Unit coordinates keep every point of the extent within |u| <= 1: the conditioning step that makes
  * float usable. */
 LMASK enter_extent(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
-                   LaneRays* unit, LREAL* lane_t_in, LREAL* lane_t_out, ProbeLog* probe_log) {
+                   __global const REAL4* clip_planes, uint clip_count, LaneRays* unit, LREAL* lane_t_in,
+                   LREAL* lane_t_out, ProbeLog* probe_log) {
   unit->ox = (rays->ox - centre.x) * inv_scale;
   unit->oy = (rays->oy - centre.y) * inv_scale;
   unit->oz = (rays->oz - centre.z) * inv_scale;
@@ -238,7 +240,7 @@ LMASK enter_extent(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scal
   LREAL lo, hi;
   const LMASK inside = lanes_of_bits((1u << count) - 1u) &&
                        clip_lanes_to_extent(unit->ox, unit->oy, unit->oz, unit->dx, unit->dy, unit->dz, extent_kind,
-                                            box_half, &lo, &hi);
+                                            box_half, clip_planes, clip_count, &lo, &hi);
   *lane_t_in = LANE_SEL((LREAL)0, lo, inside);
   *lane_t_out = LANE_SEL((LREAL)1, hi, inside);
   if (LANE_ANY(inside)) PROBE(ALGRAY_EVENT_SEGMENT, 0, 0u, 0u, *lane_t_in, *lane_t_out, (REAL)0, (REAL)0);
@@ -494,15 +496,17 @@ ALGRAY_INLINE void screen_coefficients(__global const REAL* row, LREAL xi, LREAL
  * the probe, share it. px0, py: the first ray's pixel, and screen_rows .. xi_offset the image rows' polynomials, for
  * the screen form (other builds never read them). */
 int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
-               __global const uint* exps, __global const REAL* coefs, uint mono_count, __constant const REAL* binomials,
-               uint even_axes, HitRecord* records, uint px0, uint py, __global const REAL* screen_rows,
-               uint screen_row0, REAL screen_t, REAL xi_scale, REAL xi_offset, ProbeLog* probe_log) {
+               __global const REAL4* clip_planes, uint clip_count, __global const uint* exps,
+               __global const REAL* coefs, uint mono_count, __constant const REAL* binomials, uint even_axes,
+               HitRecord* records, uint px0, uint py, __global const REAL* screen_rows, uint screen_row0,
+               REAL screen_t, REAL xi_scale, REAL xi_offset, ProbeLog* probe_log) {
   LaneIsolation iso;
   LaneRoots roots;
   LREAL iso_c[NCOEF], lane_t_in, lane_t_out;
   LaneRays unit;
   const LMASK running =
-      enter_extent(count, rays, centre, inv_scale, box_half, extent_kind, &unit, &lane_t_in, &lane_t_out, probe_log);
+      enter_extent(count, rays, centre, inv_scale, box_half, extent_kind, clip_planes, clip_count, &unit, &lane_t_in,
+                   &lane_t_out, probe_log);
   /* no ray enters the extent (whole groups of most views): the caller writes missed_record() for each */
   if (!LANE_ANY(running)) return 0;
 #if SCREEN_LANES

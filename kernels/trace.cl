@@ -15,7 +15,8 @@
  * primary kernel writes it (t, depth, normal facing the ray, side, work). Global size ceil(count / LANES), LANES
  * consecutive rays per work-item (trace_rays). */
 __kernel void trace(__global const REAL4* origins, __global const REAL4* directions, uint count, REAL4 extent_centre,
-                    REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind, __global const uint* mono_exps,
+                    REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind, __global const REAL4* clip_planes,
+                    uint clip_count, __global const uint* mono_exps,
                     __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials, uint even_axes,
                     __global HitRecord* out) {
   const uint first = get_global_id(0) * LANES;
@@ -45,7 +46,7 @@ __kernel void trace(__global const REAL4* origins, __global const REAL4* directi
 #undef DIRECTION_Z
   HitRecord records[LANES];
   const int entered = trace_rays(group, &rays, extent_centre.xyz, extent_inv_scale, extent_box_half.xyz, extent_kind,
-                                 mono_exps, mono_coefs, mono_count, binomials, even_axes, records, 0, 0, 0, 0, 0, 0, 0,
+                                 clip_planes, clip_count, mono_exps, mono_coefs, mono_count, binomials, even_axes, records, 0, 0, 0, 0, 0, 0, 0,
                                  NO_PROBE);
   for (uint j = 0; j < group; ++j) out[first + j] = entered ? records[j] : missed_record();
 }

@@ -547,3 +547,44 @@ TEST_CASE("--section draws a plane's curve, --radius comes before --set, and bad
   CHECK_THAT(missing.err, Catch::Contains("no [[section]] tables"));
   CHECK_FALSE(fs::exists(box.work / "bad.png"));
 }
+
+TEST_CASE("--clip cuts the surface open, --stats lists its planes, and bad ones exit 2 writing nothing",
+          "[cli][clip]") {
+  require_device();
+  Sandbox box;
+  const std::string torus = (fs::path(ALGRAY_SOURCE_DIR) / "scenes" / "torus.toml").string();
+  REQUIRE(box.run("render " + torus + " --preview -o plain.exr -q " + kTiny).exit_code == 0);
+  const Result cut = box.run("render " + torus + " --preview --clip 'z<0.3' --clip 'x>=-1' --stats s.json -o cut.exr " +
+                             kTiny);
+  INFO(cut.err);
+  REQUIRE(cut.exit_code == 0);
+  const nlohmann::json s = box.stats("s.json");
+  CHECK(s["plan"]["clip_planes"] == nlohmann::json::parse("[[0, 0, 1, -0.3], [-1, 0, 0, -1]]"));
+  CHECK_THAT(read_text(box.work / "s.json"), Catch::Contains("[[clip]]"));
+  const algray::FrameImage plain = algray::read_exr(box.work / "plain.exr"), clipped = algray::read_exr(box.work / "cut.exr");
+  // The cut takes surface away and adds none: pixels that hit only where the uncut torus does, fewer of them.
+  long plain_hits = 0, cut_hits = 0, new_hits = 0;
+  for (std::size_t i = 0; i < plain.depth.size(); ++i) {
+    plain_hits += std::isfinite(plain.depth[i]);
+    cut_hits += std::isfinite(clipped.depth[i]);
+    new_hits += std::isfinite(clipped.depth[i]) && !std::isfinite(plain.depth[i]);
+  }
+  CHECK(cut_hits > 0);
+  CHECK(cut_hits < plain_hits);
+  CHECK(new_hits == 0);
+  // A plane beyond the extent cuts nothing: the same pixels, bit for bit; one before it, everything.
+  REQUIRE(box.run("render " + torus + " --preview --clip 'z<100' -o far.exr -q " + kTiny).exit_code == 0);
+  CHECK(algray::read_exr(box.work / "far.exr").rgba == plain.rgba);
+  REQUIRE(box.run("render " + torus + " --preview --clip 'z>100' -o none.exr -q " + kTiny).exit_code == 0);
+  const algray::FrameImage none = algray::read_exr(box.work / "none.exr");
+  CHECK(std::none_of(none.depth.begin(), none.depth.end(), [](float d) { return std::isfinite(d); }));
+  // Bad planes: located, exit 2, nothing written.
+  const Result equal = box.run("render " + torus + " --clip z=0.5 -o bad.png " + kTiny);
+  CHECK(equal.exit_code == 2);
+  CHECK_THAT(equal.err, Catch::StartsWith("--clip z=0.5: error: ") && Catch::Contains("not an '='") &&
+                            Catch::Contains("  z=0.5\n   ^"));
+  const Result missing = box.run("render " + torus + " --set clip.0.plane=[0,0,1,0] -o bad.png " + kTiny);
+  CHECK(missing.exit_code == 2);
+  CHECK_THAT(missing.err, Catch::Contains("no [[clip]] tables"));
+  CHECK_FALSE(fs::exists(box.work / "bad.png"));
+}

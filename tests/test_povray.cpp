@@ -158,10 +158,6 @@ TEST_CASE("clips: a sphere or box, moved by the transforms after them, one regio
   CHECK_THAT(
       error_of("camera { location <0, 0, -10> look_at 0 }\npoly { 2, <1,0,0,0,1,0,0,1,0,-4> translate -z*50 }").message,
       Catch::Contains("clipped_by"));
-  // Clipping planes (POV-Ray's grafbic sample) do not exist in algray: located at the plane.
-  const SceneError plane = error_of("poly { 2, <1,0,0,0,1,0,0,1,0,-4>\n  clipped_by { plane { x, 0.5 } } }");
-  CHECK(plane.where == "bad.pov:2:16");
-  CHECK_THAT(plane.message, Catch::Contains("no clipping planes"));
   // Two boxes turned differently (or one sheared) have no common frame.
   CHECK_THAT(error_of("sphere { 0, 1 clipped_by { box { -1, 1 rotate y*30 } } clipped_by { box { -2, 2 } } }").message,
              Catch::Contains("axis-aligned"));
@@ -298,6 +294,14 @@ TEST_CASE("#include reads a .inc file in place: its colours, floats and declared
   const SceneError texture = error_of_at("#include \"include/shapes47.inc\"\nobject { Skin47 }\n", scene_path);
   CHECK(texture.where == scene_path + ":2:10");
   CHECK_THAT(texture.message, Catch::Contains("'Skin47' is a texture"));
+  // A declared object algray cannot draw (grafbic's axes: infinite quadric cylinders) is skipped with a warning
+  // where the scene has something else to draw; alone, it is the error it was.
+  const Scene axes = scene("object { Ring47 }\nobject { Axes47 rotate 30*y }\n");
+  CHECK(axes.surfaces.size() == 1);
+  CHECK(any_contains(axes.warnings, scene_path + ":5:10: 'Axes47' is a union algray cannot draw"));
+  const SceneError alone = error_of_at("#include \"include/shapes47.inc\"\nobject { Axes47 }\n", scene_path);
+  CHECK(alone.where == scene_path + ":2:10");
+  CHECK_THAT(alone.message, Catch::Contains("'Axes47' is a union algray cannot draw"));
 }
 
 TEST_CASE("#include's errors are located in the include file, and it reads only .inc files, never forever",
@@ -425,4 +429,66 @@ TEST_CASE("no clipped_by or bounded_by: a closed surface the camera sees whole i
                          "clipped_by { sphere { x, 2.5 } } }\n"));
   CHECK(seen.count > 300);
   CHECK(seen.count == clipped.count);
+}
+
+TEST_CASE("clipped_by { plane { n, d } } keeps n.x <= d: algray's clipping planes, moved by the transforms after it",
+          "[povray][clip]") {
+  // The default camera is left-handed: algray reads z negated, so POV-Ray's z <= 1 is algray's -z - 1 <= 0.
+  const Scene cut = pov_scene("poly { 2, <1,0,0,0,1,0,0,1,0,-4>\n"
+                              "  clipped_by { plane { x, 0.5 } plane { z, 1 } } translate x*1 }\n");
+  REQUIRE(cut.extent.clips.size() == 2);
+  CHECK(cut.extent.clips[0] == glm::dvec4(1, 0, 0, -1.5));
+  CHECK(cut.extent.clips[1] == glm::dvec4(0, 0, -1, -1));
+  // inverse keeps the other side; a normal of any length is the same plane, n.x <= d.
+  const Scene other = pov_scene("sphere { 0, 2 clipped_by { plane { <0, 2, 0>, 1 inverse } } }\n");
+  REQUIRE(other.extent.clips.size() == 1);
+  CHECK(other.extent.clips[0] == glm::dvec4(0, -1, 0, 0.5));
+  // A bound is POV-Ray's hint: a plane there is ignored, with a located warning.
+  const Scene bound = pov_scene("sphere { 0, 2 bounded_by { plane { x, 0 } } }\n");
+  CHECK(bound.extent.clips.empty());
+  CHECK(any_contains(bound.warnings, "test.pov:3:28: bounded_by { plane } is ignored"));
+  // Too many different planes for algray's kMaxClipPlanes, located at the first object.
+  const SceneError many = error_of("sphere { 0, 2 clipped_by { plane { x, 1 } plane { -x, 1 } plane { y, 1 } "
+                                   "plane { -y, 1 } plane { z, 1 } } }");
+  CHECK(many.where == "bad.pov:1:1");
+  CHECK_THAT(many.message, Catch::Contains("at most 4"));
+}
+
+TEST_CASE("grafbic's union of two objects, each clipped by its own planes, then turned: every surface cut by all",
+          "[povray][clip]") {
+  // As POV-Ray's grafbic sample: two nested spheres (its bicorns) in a union, each between its own pair of planes,
+  // the union turned afterwards. algray cuts both by all four planes, and says so at each object.
+  const Scene s = pov_scene("union {\n"
+                            "  sphere { 0, 2 clipped_by { plane { x, 0.5 } plane { -x, 0.5 } } }\n"
+                            "  sphere { 0, 1.9 clipped_by { plane { x, 0.49 } plane { -x, 0.49 } } }\n"
+                            "  rotate <0, 90, 0>\n"
+                            "}\n");
+  REQUIRE(s.surfaces.size() == 2);
+  REQUIRE(s.extent.clips.size() == 4);
+  // rotate y*90 turns POV-Ray's x plane into a z plane, 0.5 from the origin.
+  CHECK(std::fabs(s.extent.clips[0].z) == Approx(1));
+  CHECK(s.extent.clips[0].w == Approx(-0.5));
+  CHECK(std::fabs(s.extent.clips[0].x) < 1e-12);
+  CHECK(s.extent.clips[0].z == Approx(-s.extent.clips[1].z));
+  CHECK(any_contains(s.warnings, "test.pov:4:3: algray cuts every surface of a scene by the same planes"));
+  CHECK(any_contains(s.warnings, "test.pov:5:3: algray cuts every surface of a scene by the same planes"));
+  // grafbic's objects are quartics bounded (not clipped) by spheres of radius 3 and 2.99: two bounds alone are
+  // hints, so the scene's region holds both, fitted to what the rays see, where two clips would be an error.
+  const Scene bounds = pov_scene(
+      "poly { 2, <1,0,0,0,1,0,0,1,0,-4> bounded_by { sphere { 0, 3 } } clipped_by { plane { x, 0.5 } } }\n"
+      "poly { 2, <1,0,0,0,1,0,0,1,0,-3.9> bounded_by { sphere { 0, 2.99 } } clipped_by { plane { x, 0.49 } } }\n");
+  CHECK(bounds.surfaces.size() == 2);
+  CHECK(bounds.extent.clips.size() == 2);
+  CHECK_THAT(error_of("poly { 2, <1,0,0,0,1,0,0,1,0,-4> clipped_by { sphere { 0, 3 } } }\n"
+                      "poly { 2, <1,0,0,0,1,0,0,1,0,-4> clipped_by { sphere { 0, 2.99 } } }\n")
+                 .message,
+             Catch::Contains("clipped differently"));
+  // Rendered: the camera on -z sees the ball of radius 2 as a disc, and the slab |y| <= 0.5 of it as a band
+  // across the disc's middle.
+  const Coverage whole = coverage(pov_scene("sphere { 0, 2 }\n"));
+  const Coverage slab = coverage(pov_scene("sphere { 0, 2 clipped_by { plane { y, 0.5 } plane { -y, 0.5 } } }\n"));
+  CHECK(whole.count > 300);
+  CHECK(slab.count > 0);
+  CHECK(slab.count < whole.count / 2);  // the band |y| <= 0.5 across a disc of radius 2 seen face on
+  CHECK(std::fabs(slab.y) < 0.1);
 }

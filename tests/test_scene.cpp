@@ -718,3 +718,83 @@ TEST_CASE("--section adds a plane section from a linear equation; --set changes 
                                               "t.toml", {{"section", "2"}});
   CHECK(param.parameters.at("section") == 2);
 }
+
+TEST_CASE("[[clip]] planes keep a*x + b*y + c*z + d <= 0; --clip adds one from an inequality", "[scene][clip]") {
+  // Read, in unit coordinates for the kernels, and written back.
+  const Scene read = algray::load_scene_text(
+      sphere_with({{5, "centre = [1, 0, 0]\nradius = 2"}}, {"[[clip]]", "plane = [0, 0, 2, -1]", "[[clip]]",
+                                                             "plane = [1, 0, 0, 0]"}),
+      "t.toml");
+  REQUIRE(read.extent.clips.size() == 2);
+  CHECK(read.extent.clips[0] == glm::dvec4(0, 0, 2, -1));
+  const std::vector<glm::dvec4> unit = read.extent.unit_clips();
+  REQUIRE(unit.size() == 2);
+  // z <= 0.5 about the centre (1, 0, 0) at scale 2: u_z <= 0.25; x <= 0: u_x <= -0.5.
+  CHECK(unit[0] == glm::dvec4(0, 0, 1, -0.25));
+  CHECK(unit[1] == glm::dvec4(1, 0, 0, 0.5));
+  const Scene again = algray::load_scene_text(algray::scene_to_toml(read), "again.toml");
+  CHECK(again.extent.clips == read.extent.clips);
+  // No [[clip]]: nothing is cut, and nothing is written.
+  const Scene plain = algray::load_scene_text(sphere_with({}), "t.toml");
+  CHECK(plain.extent.clips.empty());
+  CHECK(algray::scene_to_toml(plain).find("[[clip]]") == std::string::npos);
+
+  // --clip: the side kept, < and <= alike, > and >= the other side, with the scene's parameters.
+  const std::string s = "[parameters]\nh = 0.25\n" + sphere_with({});
+  const Scene cut = algray::load_scene_text(s, "t.toml",
+                                            {{algray::kClipOverrideKey, "z<0.5"},
+                                             {algray::kClipOverrideKey, "x + 2*y >= h"},
+                                             {algray::kClipOverrideKey, "'y <= -z'"}});
+  REQUIRE(cut.extent.clips.size() == 3);
+  CHECK(cut.extent.clips[0] == glm::dvec4(0, 0, 1, -0.5));
+  CHECK(cut.extent.clips[1] == glm::dvec4(-1, -2, 0, 0.25));
+  CHECK(cut.extent.clips[2] == glm::dvec4(0, 1, 1, 0));
+  // --set changes one, or drops them all; the count is limited.
+  CHECK(algray::load_scene_text(s, "t.toml", {{algray::kClipOverrideKey, "z<0.5"}, {"clip.0.plane", "[1, 0, 0, 0]"}})
+            .extent.clips[0] == glm::dvec4(1, 0, 0, 0));
+  CHECK(algray::load_scene_text(s, "t.toml", {{algray::kClipOverrideKey, "z<0.5"}, {"clip", "[]"}}).extent.clips.empty());
+  std::vector<Override> five;
+  for (int i = 0; i < 5; ++i) five.push_back({algray::kClipOverrideKey, "z<" + std::to_string(i)});
+  const SceneError fifth = error_of(s, five);
+  CHECK(fifth.where == "--clip z<4");
+  CHECK_THAT(fifth.message, Catch::Contains("at most 4 clipping planes"));
+  CHECK(algray::load_scene_text(s, "t.toml", {five.begin(), five.begin() + 4}).extent.clips.size() == 4);
+}
+
+TEST_CASE("clip errors name the file, line and column, or the --clip flag and its character", "[scene][clip][errors]") {
+  // Lines 11 on follow the unit sphere's ten.
+  check_error(sphere_with({}, {"[[clip]]", "plane = [0, 0, 0, 1]"}), "t.toml:12:9", "a, b and c are all 0");
+  check_error(sphere_with({}, {"[[clip]]", "plane = [0, 0, 1]"}), "t.toml:12:9", "array of 4 numbers");
+  check_error(sphere_with({}, {"[[clip]]", "plane = [0, 0, \"z\", 1]"}), "t.toml:12:16", "clip.plane[2]");
+  check_error(sphere_with({}, {"[[clip]]", "normal = [0, 0, 1, 0]"}), "t.toml:12:1", "normal");
+  check_error(sphere_with({}, {"[[clip]]"}), "t.toml:11:1", "a clip needs plane = [a, b, c, d]");
+  check_error(sphere_with({{1, "clip = 1"}}), "t.toml:1:8", "[[clip]] tables");
+  std::vector<std::string> five;
+  for (int i = 0; i < 5; ++i) five.insert(five.end(), {"[[clip]]", "plane = [0, 0, 1, " + std::to_string(i) + "]"});
+  check_error(sphere_with({}, five), "t.toml:19:1", "at most 4 clipping planes");
+
+  const std::string s = sphere_with({});
+  const auto clip_error = [&](const std::string& plane) {
+    try {
+      algray::load_scene_text(s, "t.toml", {{algray::kClipOverrideKey, plane}});
+    } catch (const SceneError& e) {
+      CHECK(e.where == "--clip " + plane);
+      return e;
+    }
+    FAIL("--clip " << plane << " was accepted");
+    throw std::logic_error("unreachable");
+  };
+  CHECK_THAT(clip_error("z=0.5").message, Catch::Contains("not an '='") && Catch::Contains("at character 2"));
+  CHECK_THAT(clip_error("z").message, Catch::Contains("--clip takes a half-space"));
+  CHECK_THAT(clip_error("x^2<1").message, Catch::Contains("degree 2"));
+  CHECK_THAT(clip_error("2<3").message, Catch::Contains("no x, y or z"));
+  CHECK_THAT(clip_error("z<1<2").message, Catch::Contains("one inequality") && Catch::Contains("at character 4"));
+  CHECK_THAT(clip_error("<1").message, Catch::Contains("left side of the plane is empty"));
+  CHECK_THAT(clip_error("z>=").message, Catch::Contains("right side of the plane is empty"));
+  const SceneError star = clip_error("x+*y<1");
+  CHECK_THAT(star.message, Catch::Contains("at character 3 of the plane"));
+  CHECK(star.excerpt == "  x+*y<1\n    ^");
+  // A clip that is not there is named, with what adds one.
+  CHECK_THAT(error_of(s, {{"clip.0.plane", "[1, 0, 0, 0]"}}).message,
+             Catch::Contains("no [[clip]] tables") && Catch::Contains("--clip"));
+}

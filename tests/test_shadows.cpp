@@ -124,9 +124,10 @@ struct Tally {
 };
 
 // Traces each (surface point, light point) pair with the shadow kernel and checks it against the reference.
-// `make_light` picks the light point of ray `index`.
+// `make_light` picks the light point of ray `index`; `extra` overrides every scene (clipping planes).
 template <typename MakeLight>
-Tally check_shadow_rays(Precision precision, RayOrigin origin, int rays_per_scene, MakeLight make_light) {
+Tally check_shadow_rays(Precision precision, RayOrigin origin, int rays_per_scene, MakeLight make_light,
+                        const std::vector<Override>& extra = {}) {
   ClSession& session = testing::device_session();
   ProgramCache cache(false);
   Renderer renderer(session, cache);
@@ -138,11 +139,13 @@ Tally check_shadow_rays(Precision precision, RayOrigin origin, int rays_per_scen
   for (const char* file : kScenes) {
     std::string path = ALGRAY_SOURCE_DIR "/scenes/";  // appended, not added: the same false warning otherwise
     path += file;
-    const Scene scene = load_scene_file(path, {{"image.width", "48"},
-                                               {"image.height", "36"},
-                                               {"antialias.samples", "1"},
-                                               {"render.preview", "true"},
-                                               {"render.precision", precision_value}});
+    std::vector<Override> overrides = {{"image.width", "48"},
+                                       {"image.height", "36"},
+                                       {"antialias.samples", "1"},
+                                       {"render.preview", "true"},
+                                       {"render.precision", precision_value}};
+    overrides.insert(overrides.end(), extra.begin(), extra.end());
+    const Scene scene = load_scene_file(path, overrides);
     const std::vector<SurfacePoint> points = surface_points(renderer, scene);
     REQUIRE(points.size() > 100);
     const RenderPlan plan = make_render_plan(scene, precision);
@@ -215,6 +218,34 @@ TEST_CASE("shadow answers agree with the reference towards the lights of a scene
             if (glm::dot(light - sp.point, glm::dvec3(sp.normal)) > 0) return light;
           }
         });
+    INFO(to_string(precision) << " " << to_string(origin) << ": " << t.certified << " certified, " << t.ambiguous
+                              << " ambiguous");
+    CHECK(t.failures == 0);
+    CHECK(t.certified >= 900);
+  }
+}
+
+TEST_CASE("shadow rays are cut by clipping planes as the reference cuts them: what is cut away casts no shadow",
+          "[shadows][clip]") {
+  // Two planes across every scene (each centred on the origin): x <= 0.5 and y >= -1. The surface points are the
+  // cut surface's, from a render at 96x72 (the cut leaves a half to a third of the points of 48x36), and the
+  // lights where a scene puts its lights, so that many shadow rays pass where the cut took surface away.
+  const std::vector<Override> planes = {{"clip", "[{plane = [1, 0, 0, -0.5]}, {plane = [0, -1, 0, -1]}]"},
+                                        {"image.width", "96"},
+                                        {"image.height", "72"}};
+  for (const auto& [precision, origin] : kConstructions) {
+    const Tally t = check_shadow_rays(
+        precision, origin, 200,
+        [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
+          REQUIRE(scene.extent.clips.size() == 2);
+          std::normal_distribution<double> g;
+          for (;;) {
+            const glm::dvec3 dir = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
+            const glm::dvec3 light = scene.extent.unit_centre() + 3 * scene.extent.unit_scale() * dir;
+            if (glm::dot(light - sp.point, glm::dvec3(sp.normal)) > 0) return light;
+          }
+        },
+        planes);
     INFO(to_string(precision) << " " << to_string(origin) << ": " << t.certified << " certified, " << t.ambiguous
                               << " ambiguous");
     CHECK(t.failures == 0);

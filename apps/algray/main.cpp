@@ -37,6 +37,7 @@ struct SceneOptions {
   double radius = 0;     // --radius: extent.radius
   std::vector<std::string> sets;
   std::vector<std::string> sections;  // --section: plane sections added, each a linear equation
+  std::vector<std::string> clips;     // --clip: clipping planes added, each a linear inequality (the side kept)
   int width = 0, height = 0;
   std::string precision, isolation, refinement, tolerance, max_iterations;
   std::string device_spec;
@@ -87,19 +88,25 @@ void add_scene_options(CLI::App* cmd, SceneOptions& o, bool scene_positional = t
                   "draw the curve where this plane meets the surface (surf's cut_with_plane), a linear equation in "
                   "x, y, z such as z=0.5 or x+y=1; repeatable, appended to the scene's [[section]] list before any "
                   "--set");
+  cmd->add_option("--clip", o.clips,
+                  "cut the surface open with a plane, keeping the side this linear inequality in x, y, z gives, such "
+                  "as 'z<0.5' or 'x+y>=1' (quote it for the shell); repeatable, up to " +
+                      std::to_string(kMaxClipPlanes) + " in a scene, appended to its [[clip]] list before any --set");
   cmd->add_flag("--preview", o.preview,
                 "the paper's preview mode: primary rays only (no shadows); sets render.preview");
   cmd->add_flag("--no-cache", o.no_cache, "compile kernels from source; neither read nor write the program cache");
   add_no_fp64_flag(cmd);
 }
 
-// --radius and --section, then --set, then the other flags, which are overrides like any --set applied last so
-// that they win. Returns false
+// --radius, --section and --clip, then --set, then the other flags, which are overrides like any --set applied
+// last so that they win. Returns false
 // (after saying why) on a malformed --set.
 bool collect_overrides(const CLI::App* cmd, const SceneOptions& o, std::vector<Override>& out) {
-  // --radius and --section first: they make the sphere and the sections that a --set may then change.
+  // --radius, --section and --clip first: they make the sphere, the sections and the planes that a --set may then
+  // change.
   if (cmd->count("--radius")) out.push_back({"extent.radius", cmd->get_option("--radius")->as<std::string>()});
   for (const std::string& s : o.sections) out.push_back({kSectionOverrideKey, s});
+  for (const std::string& s : o.clips) out.push_back({kClipOverrideKey, s});
   for (const std::string& s : o.sets) {
     const auto eq = s.find('=');
     if (eq == std::string::npos || eq == 0) {

@@ -152,7 +152,8 @@ json scene_summary(const api::Scene& scene, const std::string& device) {
   if (const toml::array* list = t["light"].as_array())
     for (const toml::node& l : *list) lights.push_back(l.as_table()->get("intensity")->value_or(1.0));
   const std::array<double, 3> angles = scene.camera_angles();
-  // The extent as its kind has it, and the plane sections, for the page's clip and section controls.
+  // The extent as its kind has it, the plane sections and the clipping planes, for the page's clip, section and
+  // cut controls.
   const toml::node_view<const toml::node> e = t["extent"];
   json extent{{"type", e["type"].value_or(std::string("sphere"))}};
   for (const char* key : {"centre", "min", "max"})
@@ -165,6 +166,9 @@ json scene_summary(const api::Scene& scene, const std::string& device) {
     for (const toml::node& section : *list)
       sections.push_back({{"plane", numbers(section.as_table()->get("plane"))},
                           {"colour", numbers(section.as_table()->get("colour"))}});
+  json clips = json::array();
+  if (const toml::array* list = t["clip"].as_array())
+    for (const toml::node& clip : *list) clips.push_back({{"plane", numbers(clip.as_table()->get("plane"))}});
   json parameters = json::object();
   for (const auto& [name, value] : scene.parameters()) parameters[name] = value;
   json precisions = choice_names(kPrecisions);
@@ -189,6 +193,7 @@ json scene_summary(const api::Scene& scene, const std::string& device) {
           {"extent_radius", t["extent"]["radius"].value_or(1.0)},
           {"extent", extent},
           {"sections", sections},
+          {"clips", clips},
           {"precision", t["render"]["precision"].value_or(std::string("auto"))},
           {"isolation", t["render"]["isolation"].value_or(std::string("bernstein"))},
           {"refinement", t["render"]["refinement"].value_or(std::string("brent"))},

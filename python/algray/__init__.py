@@ -25,7 +25,8 @@ __all__ = ["Scene", "Renderer", "Image", "Animation", "SceneError", "DeviceError
 def _scene_set(self, key, value):
     """Changes this scene in place, and returns it for chaining: sets a dotted scene key, or a parameter by its
     bare name, as `algray render --set key=value` does; a bare name that is no parameter but a table sets the table
-    or list whole ("section", []), and the key "--section" adds a plane section, as the flag. The value may be a
+    or list whole ("section", []), the key "--section" adds a plane section and "--clip" a clipping plane (the
+    side of it kept: "z<0.5"), as the flags. The value may be a
     Python number, bool, string or list (written as TOML). Use copy.copy(scene) first to keep the original.
 
     >>> scene = algray.Scene.from_equation("x^2+y^2+z^2-r^2", parameters={"r": 1})
@@ -42,6 +43,8 @@ def _scene_set(self, key, value):
     [0.0, 0.0, 1.0, -0.5]
     >>> scene.set("--section", "x=0").set("section.1.colour", [1, 0, 0]).to_dict()["section"][1]["plane"]
     [1.0, 0.0, 0.0, 0.0]
+    >>> scene.set("--clip", "z>0.25").to_dict()["clip"][0]["plane"]
+    [0.0, 0.0, -1.0, 0.25]
     """
     self._set(key, _toml.value(value))
     return self

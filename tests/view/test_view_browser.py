@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """`algray view` in a real browser: headless Chromium driven by Selenium loads the page and its first frame, a drag
 turns the camera, a slider moves a parameter, each control of the panel (colours, light, background,
-transparency, axis views, clip shape and radius, plane sections, reset, saved image) changes what the server
+transparency, axis views, clip shape and radius, plane sections, clipping planes, reset, saved image) changes what the server
 renders, a bad equation shows its error at the command line's column and keeps the image, and the saved scene
 renders to the view's last full-size frame.
 
@@ -213,12 +213,29 @@ try:
     planes = [x["plane"] for x in server_scene().get("section", [])]
     if len(planes) != 1 or not close(planes[0], [1, 0, 0, 0]) or picture == shown:
         fail(f"the first section removed: the server has {planes}")
+    shown = picture
+    # Clipping planes: keep z < 0.2, then x > 0; each cuts the surface open and is in the server's [[clip]] list.
+    for axis, side, offset in (("z", "<", "0.2"), ("x", ">", "0")):
+        picture = control("""document.getElementById('clip-axis').value = arguments[0];
+                             document.getElementById('clip-side').value = arguments[1];
+                             document.getElementById('clip-offset').value = arguments[2];
+                             document.getElementById('clip-add').click();""", axis, side, offset)
+        if picture == shown:
+            fail(f"the image did not change with the clip {axis} {side} {offset}")
+        shown = picture
+    planes = [x["plane"] for x in server_scene()["clip"]]
+    if len(planes) != 2 or not close(planes[0], [0, 0, 1, -0.2]) or not close(planes[1], [-1, 0, 0, 0]):
+        fail(f"two clips added, z < 0.2 and x > 0: the server has {planes}")
+    picture = control("document.querySelector('#clips .clip-remove').click()")
+    planes = [x["plane"] for x in server_scene().get("clip", [])]
+    if len(planes) != 1 or not close(planes[0], [-1, 0, 0, 0]) or picture == shown:
+        fail(f"the first clip removed: the server has {planes}")
     # Reset: the scene's own view, colours, clip and sections again, and its first frame's pixels.
     n = frames()
     driver.execute_script("document.getElementById('reset').click()")
     reset = settle(n)
-    if driver.execute_script("return [view.camera.azimuth, view.light, view.transparency, view.sections.length]") != \
-            [camera["azimuth"], 1, 0, 0] or idat(reset) != idat(first) or \
+    if driver.execute_script("return [view.camera.azimuth, view.light, view.transparency, view.sections.length, "
+                             "view.clips.length]") != [camera["azimuth"], 1, 0, 0, 0] or idat(reset) != idat(first) or \
             driver.execute_script("return document.getElementById('extent-type').value") != "sphere":
         fail("Reset does not bring back the scene's own view")
     # Save image: the server renders the size and quality asked for, not the frame on screen.
@@ -298,5 +315,5 @@ finally:
             process.terminate()
             process.wait(timeout=30)
 print("test_view_browser: first frame, hint, fps while moving, drag, slider, zoom, colours, lights, transparency, "
-      "axis views, clip shape and radius, sections, reset, saved image at both qualities, located error, saved scene "
+      "axis views, clip shape and radius, sections, clipping planes, reset, saved image at both qualities, located error, saved scene "
       "and an equation in a box all hold in Chromium")

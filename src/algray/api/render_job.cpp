@@ -43,6 +43,26 @@ std::string vec_text(const glm::dvec3& v) {
   return buf;
 }
 
+// The extent as the header's algray/extent gives it: its kind and its numbers.
+std::string extent_text(const Extent& e) {
+  if (e.kind == ExtentKind::Sphere) return "sphere centre " + vec_text(e.centre) + " radius " + std::to_string(e.radius);
+  if (e.kind == ExtentKind::Box) return "box min " + vec_text(e.min) + " max " + vec_text(e.max);
+  return "cylinder centre " + vec_text(e.centre) + " radius " + std::to_string(e.radius) + " axis " + "xyz"[e.axis] +
+         " half_height " + std::to_string(e.half_height);
+}
+
+// The clipping planes as the header's algray/clip gives them: "a b c d" each (a*x + b*y + c*z + d <= 0 kept),
+// separated by "; ".
+std::string clip_text(const Extent& e) {
+  std::string planes;
+  for (const glm::dvec4& p : e.clips) {
+    char w[40];
+    std::snprintf(w, sizeof w, " %.17g", p.w);
+    planes += (planes.empty() ? "" : "; ") + vec_text(glm::dvec3(p)) + w;
+  }
+  return planes;
+}
+
 // Metadata that lets anyone rebuild any pixel's ray from the file and docs/outputs.md's camera convention.
 void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, const DeviceInfo& device) {
   const RayBasis& b = r.basis;
@@ -70,14 +90,9 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
       {"algray/ray/d00", vec_text(b.d00)},
       {"algray/ray/du", vec_text(b.du)},
       {"algray/ray/dv", vec_text(b.dv)},
-      {"algray/extent",
-       scene.extent.kind == ExtentKind::Sphere
-           ? "sphere centre " + vec_text(scene.extent.centre) + " radius " + std::to_string(scene.extent.radius)
-       : scene.extent.kind == ExtentKind::Box
-           ? "box min " + vec_text(scene.extent.min) + " max " + vec_text(scene.extent.max)
-           : "cylinder centre " + vec_text(scene.extent.centre) + " radius " + std::to_string(scene.extent.radius) +
-                 " axis " + "xyz"[scene.extent.axis] + " half_height " + std::to_string(scene.extent.half_height)},
+      {"algray/extent", extent_text(scene.extent)},
   };
+  if (!scene.extent.clips.empty()) img.string_attributes.push_back({"algray/clip", clip_text(scene.extent)});
   double kernel_ms = 0;
   for (const PassStats& p : r.passes) kernel_ms += p.kernel_ms;
   img.double_attributes = {

@@ -128,6 +128,10 @@ DeviceSurface::DeviceSurface(const cl::Context& ctx, const Scene& scene, Precisi
   }
   coefs_ = real_buffer(ctx, coefficient_data, precision);
   binomials_ = real_buffer(ctx, binomial_table(data_.degree), precision);
+  // Each clipping plane (n, e), n.u + e <= 0 kept, as one REAL4.
+  std::vector<double> clips;
+  for (const glm::dvec4& p : extent_.unit_clips()) clips.insert(clips.end(), {p.x, p.y, p.z, p.w});
+  if (!clips.empty()) clips_ = real_buffer(ctx, clips, precision);
 }
 
 void DeviceSurface::set_extent_args(KernelBinder& args) const {
@@ -139,6 +143,12 @@ void DeviceSurface::set_extent_args(KernelBinder& args) const {
                       : extent_.kind == ExtentKind::Box  ? ALGRAY_EXTENT_BOX
                                                          : ALGRAY_EXTENT_CYLINDER + extent_.axis;
   args.plain("extent_kind", kind);
+  // Without planes the kernels never read clip_planes (kernels/ray.h).
+  if (extent_.clips.empty())
+    args.unused_buffer("clip_planes");
+  else
+    args.plain("clip_planes", clips_);
+  args.plain("clip_count", static_cast<cl_uint>(extent_.clips.size()));
 }
 
 void DeviceSurface::set_surface_args(KernelBinder& args) const {

@@ -85,7 +85,8 @@ class DeviceSurface {
   DeviceSurface(const cl::Context& ctx, const Scene& scene, Precision precision, std::size_t surface = 0);
   Precision precision() const { return precision_; }
   const SurfaceData& data() const { return data_; }
-  // The extent's and the surface's arguments of every kernel (ALGRAY_EXTENT_ARGS, ALGRAY_SURFACE_ARGS).
+  // The extent's and the surface's arguments of every kernel (ALGRAY_EXTENT_ARGS, ALGRAY_SURFACE_ARGS); the
+  // extent's include its clipping planes, a count of 0 where there are none.
   void set_extent_args(KernelBinder& args) const;
   void set_surface_args(KernelBinder& args) const;
   // The screen form's arguments of the primary and probe kernels (ALGRAY_SCREEN_ARGS): rows row0 .. row0 + rows - 1
@@ -99,6 +100,7 @@ class DeviceSurface {
   Extent extent_;
   SurfaceData data_;
   cl::Buffer exps_, coefs_, binomials_;
+  cl::Buffer clips_;  // the extent's clipping planes in unit coordinates (REAL4 each); none without planes
   // The screen form of the last camera set_screen_args saw: a render asks for it band by band, and expanding P
   // along the rays again for each band would repeat the costliest step.
   struct ScreenCache;

@@ -119,6 +119,18 @@ bool extent_interval(const Extent& e, const PixelRay& ray, long double& t_in, lo
       t_out = std::min(t_out, std::max(t0, t1));
     }
   }
+  // The clipping planes, in world coordinates: where the ray crosses a plane, the part beyond it is cut away; a
+  // ray along a plane keeps all or nothing.
+  for (const glm::dvec4& p : e.clips) {
+    const R s = R(p.x) * o[0] + R(p.y) * o[1] + R(p.z) * o[2] + R(p.w);
+    const R v = R(p.x) * d[0] + R(p.y) * d[1] + R(p.z) * d[2];
+    if (v > 0)
+      t_out = std::min(t_out, -s / v);
+    else if (v < 0)
+      t_in = std::max(t_in, -s / v);
+    else if (s > 0)
+      return false;
+  }
   return t_out > t_in;
 }
 

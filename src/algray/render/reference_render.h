@@ -43,8 +43,9 @@ inline constexpr double kReferenceEndMargin = 256;
 // roundoff. Otherwise (a near-touch of another sheet, two nearly equal roots) the pixel is RayRounding.
 inline constexpr double kReferenceRayRoundings = 8;
 
-// [t_in, t_out] of a ray in the extent, in long double: close to the kernels' clipping, which is what the
-// reference needs (roots near the ends are treated as ambiguous), not exact. False when the ray misses.
+// [t_in, t_out] of a ray in the extent and its clipping planes, in long double: close to the kernels' clipping,
+// which is what the reference needs (roots near the ends are treated as ambiguous), not exact. False when the ray
+// misses.
 bool extent_interval(const Extent& extent, const PixelRay& ray, long double& t_in, long double& t_out);
 
 // Whether moving each component of `ray` by kReferenceRayRoundings * eps of its size could change the number of

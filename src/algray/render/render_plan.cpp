@@ -251,6 +251,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
   RenderPlan plan;
   plan.width = scene.image.width;
   plan.height = scene.image.height;
+  plan.clip_planes = scene.extent.clips;
   plan.tile_size = tile_size > 0                  ? tile_size
                    : scene.render.tile_size > 0 ? scene.render.tile_size
                                                 : default_tile_size(DeviceInfo{});  // a device of no kind: a CPU's
@@ -338,6 +339,8 @@ nlohmann::json RenderPlan::json() const {
   }
   for (const PlannedBuffer& b : buffers) j["buffers"].push_back({{"name", b.name}, {"bytes", b.bytes}});
   j["shadow_lights"] = shadow_lights;
+  j["clip_planes"] = nlohmann::json::array();
+  for (const glm::dvec4& p : clip_planes) j["clip_planes"].push_back({p.x, p.y, p.z, p.w});
   j["skipped"] = skipped;
   j["estimated_memory_bytes"] = estimated_memory_bytes();
   return j;

@@ -67,6 +67,9 @@ struct RenderPlan {
   std::vector<PlannedPass> passes;
   std::vector<PlannedBuffer> buffers;
   std::vector<int> shadow_lights;  // indices into Scene::lights whose shadows the shadow pass traces
+  // The extent's clipping planes (a, b, c, d), a*x + b*y + c*z + d <= 0 kept, which every pass's rays are cut by
+  // (kernels/ray.h); --stats lists them.
+  std::vector<glm::dvec4> clip_planes;
   // Everything left out, and why ("shadow: no light casts shadows"), so --stats explains the plan.
   std::vector<std::string> skipped;
 

@@ -18,6 +18,9 @@
 //   surface along it, inside the bound or not (the hyptorus sample shows its arms beyond its bounding sphere, cut
 //   off only along the sphere's outline). No sphere or box does that for every ray, so run() picks the one that
 //   agrees best on rays traced here; an object with no region at all gets a sphere about what the camera sees.
+// - plane { n, d } is the half-space n.x <= d, the side away from n (POV-Ray's documentation: the normal points
+//   outside); clipped_by { plane { ... } } keeps the object's part in it. algray cuts every surface of a scene by
+//   the same clipping planes ([[clip]]), so an object's planes cut the others too, with a warning.
 // - #include "name.inc" reads the file in place; POV-Ray's own includes (colors.inc, shapesq.inc, ...) declare
 //   colours, objects and macros with #declare, #macro and #ifndef guards.
 //
@@ -78,6 +81,9 @@ struct Object {
   SparsePoly poly;          // in the object's own coordinates
   glm::dmat4 transform{1};  // object to world (POV-Ray's coordinates)
   std::vector<std::pair<Clip, glm::dmat4>> clips;  // each with its own object-to-world transform
+  // clipped_by { plane { n, d } }: (n, -d), whose n.x - d <= 0 is kept (POV-Ray's inside), in the plane's own
+  // coordinates, with its object-to-world transform.
+  std::vector<std::pair<glm::dvec4, glm::dmat4>> planes;
   std::optional<Clip> natural;                     // the bound of a sphere or torus, in object coordinates
   std::optional<glm::dvec3> front, back;
   bool inverse = false;
@@ -625,11 +631,36 @@ class PovReader {
   }
 
   // --- objects ---
+  // plane { <n>, d modifiers } in clipped_by, the keyword next: (n, -d), n.x - d <= 0 kept (POV-Ray's inside, the
+  // side away from n; inverse keeps the other), and its own transforms in `own`.
+  glm::dvec4 clip_plane(glm::dmat4& own) {
+    const Token shape = next();
+    expect("{", "'{'");
+    const Token at = peek();
+    const glm::dvec3 n = vector3();
+    optional_comma();
+    const double d = number();
+    if (glm::length(n) == 0) fail(at, "the plane's normal is zero");
+    glm::dvec4 plane(n, -d);
+    while (!at_op("}")) {
+      if (auto m = transform_step()) {
+        own = *m * own;
+        continue;
+      }
+      const Token t = next();
+      if (t.kind == Token::End) fail(shape, "this plane is never closed");
+      if (t.text == "inverse") {
+        plane = -plane;
+        continue;
+      }
+      warn(t, "'" + t.text + "' in a clipping plane is ignored");
+      skip_item();
+    }
+    next();
+    return plane;
+  }
   Clip clip_shape(const Token& at, glm::dmat4& own) {
     const Token shape = next();
-    if (shape.kind == Token::Name && shape.text == "plane")
-      fail(shape, std::string(at.text) + " { plane }: algray has no clipping planes yet; it clips to one sphere, box "
-                                         "or cylinder");
     if (shape.kind != Token::Name || (shape.text != "sphere" && shape.text != "box" && shape.text != "object"))
       fail(shape, std::string(at.text) + " takes a sphere or a box here; algray clips to one of those");
     expect("{", "'{'");
@@ -674,12 +705,23 @@ class PovReader {
     expect("{", "'{'");
     // bounded_by { clipped_by } and clipped_by { bounded_by }: the same region, already recorded.
     if ((at.text == "bounded_by" && at_name("clipped_by")) || (at.text == "clipped_by" && at_name("bounded_by"))) {
-      if (o.clips.empty()) fail(peek(), peek().text + " names no region yet: give the other one first");
+      if (o.clips.empty() && o.planes.empty())
+        fail(peek(), peek().text + " names no region yet: give the other one first");
       next();
       for (auto& [c, t] : o.clips) c.bound = false;  // clipped_by { bounded_by }: the bound clips too
     } else {
       while (!at_op("}")) {
         glm::dmat4 own(1);
+        if (at_name("plane") && at_op("{", 1)) {
+          // A plane clips (clipped_by); as a bound it is POV-Ray's hint, which algray has no use for.
+          const Token plane = peek();
+          const glm::dvec4 p = clip_plane(own);
+          if (at.text == "clipped_by")
+            o.planes.push_back({p, own});
+          else
+            warn(plane, "bounded_by { plane } is ignored: a bound is POV-Ray's hint, not a clip");
+          continue;
+        }
         Clip c = clip_shape(at, own);
         c.bound = at.text == "bounded_by";
         o.clips.push_back({c, own});
@@ -694,6 +736,7 @@ class PovReader {
         for (Object* o : objects) {
           o->transform = *m * o->transform;
           for (auto& [clip, t] : o->clips) t = *m * t;
+          for (auto& [plane, t] : o->planes) t = *m * t;
         }
         continue;
       }
@@ -1175,6 +1218,20 @@ class PovReader {
                   "#ifndef, #else, #end, #version (and skips #macro, #while, #for, #switch, #debug, #warning)");
     }
   }
+  // object { NAME ... } in the scene, the '{' next, of a declared object algray cannot draw (grafbic's axes, infinite
+  // quadric cylinders from axisbox.inc): skipped with a warning, as any other object algray does not draw; if the
+  // scene then has nothing to draw, run() gives the reason as the error.
+  bool undrawable_object(const Token& name) {
+    const auto u = unread_.find(name.text);
+    if (name.kind != Token::Name || u == unread_.end() || u->second.second.find(" algray cannot ") == std::string::npos)
+      return false;
+    const std::string why = "'" + name.text + "' is " + u->second.second + " (declared at " + where(u->second.first) +
+                            "), which this reader does not read";
+    if (!undrawn_) undrawn_ = {name, why};
+    warn(name, why + "; skipped");
+    skip_block();
+    return true;
+  }
   void item() {
     const Token t = next();
     if (t.kind == Token::Directive) return directive(t);
@@ -1198,6 +1255,7 @@ class PovReader {
       next();
       return;
     }
+    if (t.text == "object" && at_op("{") && undrawable_object(peek(1))) return;
     if (is_object(t.text)) return object(t, objects_);
     if (at_op("{")) {
       warn(t, "'" + t.text + "' is ignored: algray reads poly, polynomial, quartic, cubic, sphere and torus objects");
@@ -1278,9 +1336,11 @@ class PovReader {
     int width = 0, height = 0;
     std::optional<Clip> drawn;  // the extent in algray's coordinates
     std::string extent_note;    // why it differs from POV-Ray's region, if it does
+    std::vector<glm::dvec4> planes;  // the clipping planes in algray's coordinates, a.q + d <= 0 kept
   };
   void frame(Translated& scene);
   void common_region(Translated& scene);
+  void clip_planes(Translated& scene, const glm::dmat4& flip);
   std::vector<SparsePoly> algray_polys(const glm::dmat4& flip);
   void algray_view(Translated& scene);
   void fit_extent(Translated& scene);
@@ -1336,6 +1396,7 @@ class PovReader {
   bool quiet_ = false;  // warnings are dropped (reading an include file's declarations)
   std::vector<Token> open_ifs_;                                    // #if, #ifdef, #ifndef being read
   std::vector<Object> objects_;
+  std::optional<std::pair<Token, std::string>> undrawn_;  // the first object skipped by undrawable_object, and why
   Camera camera_;
   std::optional<Token> camera_at_;
   std::vector<PovLight> lights_;
@@ -1407,7 +1468,9 @@ struct Sight {
   std::vector<Ray> rays;
   static constexpr int kColumns = 64, kRows = 48;
 };
-Sight look(const CameraSpec& camera, int width, int height, const std::vector<SparsePoly>& polys, double scale) {
+// Roots beyond a clipping plane (planes: a.q + d <= 0 kept) are cut away, as algray draws them.
+Sight look(const CameraSpec& camera, int width, int height, const std::vector<SparsePoly>& polys, double scale,
+           const std::vector<glm::dvec4>& planes) {
   Sight sight;
   const RayBasis basis = make_ray_basis(camera, width, height);
   for (int j = 0; j < Sight::kRows; ++j)
@@ -1415,8 +1478,10 @@ Sight look(const CameraSpec& camera, int width, int height, const std::vector<Sp
       const PixelRay ray = pixel_ray(basis, false, i * width / Sight::kColumns, j * height / Sight::kRows);
       Sight::Ray r{ray.origin, glm::normalize(ray.direction), {}};
       for (const SparsePoly& p : polys) {
-        const std::vector<double> roots = ray_roots(p, r.o, r.d, 1e-5 * scale, 1e5 * scale);
-        r.roots.insert(r.roots.end(), roots.begin(), roots.end());
+        for (const double t : ray_roots(p, r.o, r.d, 1e-5 * scale, 1e5 * scale))
+          if (std::all_of(planes.begin(), planes.end(),
+                          [&](const glm::dvec4& k) { return glm::dot(glm::dvec3(k), r.o + t * r.d) + k.w <= 0; }))
+            r.roots.push_back(t);
       }
       std::sort(r.roots.begin(), r.roots.end());
       sight.rays.push_back(std::move(r));
@@ -1461,6 +1526,7 @@ std::optional<Clip> seen_sphere(const Sight& sight, const std::vector<bool>& sho
 // (algray_view), an extent fitted where POV-Ray's own region is not a clip (fit_extent), then written out.
 PovTranslation PovReader::run() {
   while (peek().kind != Token::End) item();
+  if (objects_.empty() && undrawn_) fail(undrawn_->first, undrawn_->second);
   if (objects_.empty())
     fail(peek(), "the scene holds no object algray reads (poly, polynomial, quartic, cubic, sphere, torus)");
   if (objects_.size() > kMaxSurfaces)
@@ -1481,6 +1547,7 @@ PovTranslation PovReader::run() {
   flip[2][2] = scene.mirror.z;
 
   scene.polys = algray_polys(flip);
+  clip_planes(scene, flip);
   algray_view(scene);
   fit_extent(scene);
   return write_toml(scene);
@@ -1497,6 +1564,7 @@ void PovReader::frame(Translated& scene) {
   for (Object& o : objects_) {
     o.transform = to_frame * o.transform;
     for (auto& [c, t] : o.clips) t = to_frame * t;
+    for (auto& [plane, t] : o.planes) t = to_frame * t;
   }
   scene.camera.location = point(scene.camera.location);
   if (scene.camera.look_at) scene.camera.look_at = point(*scene.camera.look_at);
@@ -1524,9 +1592,19 @@ void PovReader::common_region(Translated& scene) {
         open.push_back(&o);
         continue;
       }
-      if (extent && !same(*extent, *r))
+      if (extent && !same(*extent, *r) && extent->bound && r->bound) {
+        // Bounds alone (bounded_by, no clip) are POV-Ray's hints, not clips (grafbic's two bicorns have spheres of
+        // radius 3 and 2.99): the scene's is one that holds them all, which fit_extent fits to what rays see.
+        if (inside(*r, *extent)) {
+          r = extent;
+        } else if (!inside(*extent, *r)) {
+          r = enclosing(*extent, *r);
+          r->bound = true;
+        }
+      } else if (extent && !same(*extent, *r)) {
         fail(o.at, "this object is clipped differently from the " + clipped_by->kind + " at line " +
                        std::to_string(clipped_by->at.line) + "; algray clips every surface of a scene to one region");
+      }
       if (extent) r->bound = r->bound && extent->bound;
       extent = r;
       clipped_by = &o;
@@ -1576,6 +1654,42 @@ std::vector<SparsePoly> PovReader::algray_polys(const glm::dmat4& flip) {
   return polys;
 }
 
+void PovReader::clip_planes(Translated& scene, const glm::dmat4& flip) {
+  // Each object's planes in algray's coordinates: the plane P (P.(x, 1) <= 0 kept) under the map M from its own
+  // coordinates to POV-Ray's world is P M^-1 there, and P M^-1 flip in algray's (flip is its own inverse).
+  // algray cuts every surface of a scene by the same planes: all objects' planes together, each once.
+  const auto same_plane = [](const glm::dvec4& a, const glm::dvec4& b) { return glm::length(a - b) <= 1e-9; };
+  std::vector<std::vector<glm::dvec4>> own(objects_.size());
+  for (std::size_t n = 0; n < objects_.size(); ++n) {
+    const Object& o = objects_[n];
+    for (const auto& [p, t] : o.planes) {
+      glm::dvec4 q = flip * (glm::transpose(glm::inverse(t)) * p);
+      const double length = glm::length(glm::dvec3(q));
+      if (!(length > 0) || !std::isfinite(length))
+        fail(o.at, "a clipping plane of this " + o.kind + " degenerates under its transforms");
+      q /= length;
+      for (int i = 0; i < 4; ++i)
+        if (std::fabs(q[i]) < 1e-15) q[i] = 0;  // a rotation's rounding, not a tilt
+      own[n].push_back(q);
+      if (std::none_of(scene.planes.begin(), scene.planes.end(), [&](const glm::dvec4& k) { return same_plane(k, q); }))
+        scene.planes.push_back(q);
+    }
+  }
+  if (scene.planes.size() > kMaxClipPlanes)
+    fail(objects_.front().at, "the objects are clipped by " + std::to_string(scene.planes.size()) +
+                                  " different planes together; algray cuts a scene by at most " +
+                                  std::to_string(kMaxClipPlanes) + ", the same for every surface");
+  if (scene.planes.empty()) return;
+  for (std::size_t n = 0; n < objects_.size(); ++n) {
+    const bool all = std::all_of(scene.planes.begin(), scene.planes.end(), [&](const glm::dvec4& k) {
+      return std::any_of(own[n].begin(), own[n].end(), [&](const glm::dvec4& q) { return same_plane(k, q); });
+    });
+    if (!all)
+      warn(objects_[n].at, "algray cuts every surface of a scene by the same planes: this " + objects_[n].kind +
+                               " is also cut by the clipped_by planes of the scene's other objects");
+  }
+}
+
 void PovReader::algray_view(Translated& scene) {
   // The camera: angle sets direction's length from right's; the view is |up| tall at |direction|.
   double distance = glm::length(scene.camera.direction);
@@ -1623,7 +1737,7 @@ void PovReader::fit_extent(Translated& scene) {
   // best with that on a grid of rays traced here.
   if (!open.empty() || (drawn && drawn->bound)) {
     const double scale = std::max({1.0, glm::length(view.eye), drawn ? glm::length(drawn->centre - view.eye) : 0.0});
-    const Sight sight = look(view, scene.width, scene.height, scene.polys, scale);
+    const Sight sight = look(view, scene.width, scene.height, scene.polys, scale, scene.planes);
     std::vector<bool> shown;
     for (const Sight::Ray& r : sight.rays)
       shown.push_back(!r.roots.empty() && (!drawn || span(*drawn, r.o, r.d).has_value()));
@@ -1717,6 +1831,10 @@ PovTranslation PovReader::write_toml(const Translated& scene) const {
     toml << "type = \"sphere\"\ncentre = " << toml_vector(e.centre) << "\nradius = " << toml_number(e.radius) << "\n";
   else
     toml << "type = \"box\"\nmin = " << toml_vector(e.min) << "\nmax = " << toml_vector(e.max) << "\n";
+
+  for (const glm::dvec4& p : scene.planes)
+    toml << "\n[[clip]]  # clipped_by { plane }\nplane = [" << toml_number(p.x) << ", " << toml_number(p.y) << ", "
+         << toml_number(p.z) << ", " << toml_number(p.w) << "]\n";
 
   toml << "\n[camera]\neye = " << toml_vector(scene.view.eye) << "\nlook_at = " << toml_vector(scene.view.look_at)
        << "\nup = " << toml_vector(scene.view.up) << "\n";

@@ -32,9 +32,10 @@ std::string format_what(const std::string& where, const std::string& message, co
   return s;
 }
 
-const std::set<std::string> kTopKeys{"surface",  "parameters", "extent",    "camera", "image",
-                                     "material", "light",      "antialias", "render", "section"};
+const std::set<std::string> kTopKeys{"surface", "parameters", "extent",  "camera", "image", "material",
+                                     "light",   "antialias",  "render",  "section", "clip"};
 const std::set<std::string> kSectionKeys{"plane", "colour"};
+const std::set<std::string> kClipKeys{"plane"};
 const std::set<std::string> kSurfaceKeys{"name", "equation", "terms", "material"};
 const std::set<std::string> kExtentKeys = [] {
   std::set<std::string> keys{"type"};
@@ -192,62 +193,115 @@ void switch_extent_kind(toml::table& root, const std::string& label, std::vector
                   " extent and " + (dropped.size() == 1 ? "was" : "were") + " dropped" + made);
 }
 
-// The [[section]] list's table for a new section, appended (the list made where there is none).
-toml::array& section_list(toml::table& root) {
-  toml::node* at = root.get("section");
+// The list of [[name]] tables (section, clip), made where there is none, for a new table to be appended.
+toml::array& table_list(toml::table& root, const char* name) {
+  toml::node* at = root.get(name);
   if (!at || !at->is_array()) {
-    root.insert_or_assign("section", toml::array{});
-    at = root.get("section");
+    root.insert_or_assign(name, toml::array{});
+    at = root.get(name);
   }
   return *at->as_array();
+}
+
+// A plane given as text on the command line: --section's equation or --clip's inequality, its errors naming the
+// text's character under `label`.
+struct PlaneText {
+  const std::string& text;
+  const std::string& label;
+  const char* noun;      // "section", "clip"
+  const char* relation;  // "equation", "inequality"
+  const char* example;   // "z=0.5", "z<0.5"
+  [[noreturn]] void fail_at(std::size_t offset, const std::string& message) const {
+    throw SceneError(label, message + " (at character " + std::to_string(offset + 1) + " of the plane)",
+                     "  " + text + "\n  " + std::string(std::min(offset, text.size()), ' ') + "^");
+  }
+  // One side of the relation, text[from, from + length), as a polynomial in x, y, z with the scene's parameters;
+  // `related`: the text has a relation sign (an empty side is the left or the right one).
+  Polynomial side(const toml::table& root, std::size_t from, std::size_t length, bool related) const;
+  // (a, b, c, d) of `poly`, which must be of degree 1.
+  std::array<double, 4> coefficients(const Polynomial& poly) const;
+};
+
+Polynomial PlaneText::side(const toml::table& root, std::size_t from, std::size_t length, bool related) const {
+  std::map<std::string, double> parameters;
+  if (const toml::table* p = root["parameters"].as_table())
+    for (auto&& [name, node] : *p)
+      if (const auto v = node.value<double>()) parameters[std::string(name.str())] = *v;
+  const std::string part = text.substr(from, length);
+  if (part.find_first_not_of(" \t") == std::string::npos) {
+    if (!related) fail_at(from, std::string("--") + noun + " takes a plane, as " + example + " or x+y=1");
+    fail_at(from, std::string("the ") + (from == 0 ? "left" : "right") + " side of the plane is empty");
+  }
+  try {
+    return parse_equation(part, parameters);
+  } catch (const EquationError& e) {
+    fail_at(from + e.position, e.what());
+  }
+}
+
+std::array<double, 4> PlaneText::coefficients(const Polynomial& p) const {
+  if (p.degree() != 1)
+    fail_at(0, p.degree() < 1 ? std::string("the plane has no x, y or z: a ") + noun + " is a plane such as " + example
+                              : std::string("a ") + noun + " is a plane, of degree 1 in x, y and z; this " +
+                                    relation + " has degree " + std::to_string(p.degree()));
+  std::array<double, 4> plane = {0, 0, 0, 0};
+  for (const auto& [e, c] : p.terms()) plane[e[0] ? 0 : e[1] ? 1 : e[2] ? 2 : 3] = nearest_double(c);
+  for (const double c : plane)
+    if (!std::isfinite(c)) fail_at(0, "the plane's coefficients do not fit a double");
+  return plane;
 }
 
 // --section EQUATION: a plane as a linear equation in x, y and z ("z=0.5", "x+y=1", "x-2*z", the last = 0), with
 // the scene's parameters, appended as a [[section]] table. Errors name the character of the equation.
 void add_section(toml::table& root, const std::string& text, const std::string& label) {
-  const auto fail_at = [&](std::size_t offset, const std::string& message) {
-    throw SceneError(label, message + " (at character " + std::to_string(offset + 1) + " of the plane)",
-                     "  " + text + "\n  " + std::string(std::min(offset, text.size()), ' ') + "^");
-  };
-  std::map<std::string, double> parameters;
-  if (const toml::table* p = root["parameters"].as_table())
-    for (auto&& [name, node] : *p)
-      if (const auto v = node.value<double>()) parameters[std::string(name.str())] = *v;
+  const PlaneText plane{text, label, "section", "equation", "z=0.5"};
   const std::size_t eq = text.find('=');
   if (eq != std::string::npos && text.find('=', eq + 1) != std::string::npos)
-    fail_at(text.find('=', eq + 1), "a plane is one equation, as z=0.5 or x+y=1: it has one '='");
-  const auto side = [&](std::size_t from, std::size_t length) {
-    const std::string part = text.substr(from, length);
-    if (part.find_first_not_of(" \t") == std::string::npos) {
-      if (eq == std::string::npos) fail_at(from, "--section takes a plane, as z=0.5 or x+y=1");
-      fail_at(from, std::string("the ") + (from == 0 ? "left" : "right") + " side of the plane is empty");
-    }
-    try {
-      return parse_equation(part, parameters);
-    } catch (const EquationError& e) {
-      fail_at(from + e.position, e.what());
-    }
-    return Polynomial();
-  };
-  const Polynomial p = eq == std::string::npos ? side(0, std::string::npos)
-                                               : side(0, eq) - side(eq + 1, std::string::npos);
-  if (p.degree() != 1)
-    fail_at(0, p.degree() < 1 ? "the plane has no x, y or z: a section is a plane such as z=0.5"
-                              : "a section is a plane, of degree 1 in x, y and z; this equation has degree " +
-                                    std::to_string(p.degree()));
-  double plane[4] = {0, 0, 0, 0};
-  for (const auto& [e, c] : p.terms()) plane[e[0] ? 0 : e[1] ? 1 : e[2] ? 2 : 3] = nearest_double(c);
-  for (const double c : plane)
-    if (!std::isfinite(c)) fail_at(0, "the plane's coefficients do not fit a double");
+    plane.fail_at(text.find('=', eq + 1), "a plane is one equation, as z=0.5 or x+y=1: it has one '='");
+  const Polynomial p = eq == std::string::npos
+                           ? plane.side(root, 0, std::string::npos, false)
+                           : plane.side(root, 0, eq, true) - plane.side(root, eq + 1, std::string::npos, true);
+  const std::array<double, 4> c = plane.coefficients(p);
   toml::table section;
-  section.insert("plane", toml::array{plane[0], plane[1], plane[2], plane[3]});
-  section_list(root).push_back(std::move(section));
+  section.insert("plane", toml::array{c[0], c[1], c[2], c[3]});
+  table_list(root, "section").push_back(std::move(section));
+}
+
+// --clip INEQUALITY: the half-space kept, as a linear inequality in x, y and z with <, <=, > or >= ("z<0.5",
+// "x+y>=1"; < and <= alike, as the plane itself is drawn either way), with the scene's parameters, appended as a
+// [[clip]] table whose plane keeps a*x + b*y + c*z + d <= 0. Errors name the character of the inequality.
+void add_clip(toml::table& root, const std::string& text, const std::string& label) {
+  const PlaneText plane{text, label, "clip", "inequality", "z<0.5"};
+  toml::array& clips = table_list(root, "clip");
+  if (clips.size() >= kMaxClipPlanes)
+    plane.fail_at(0, "at most " + std::to_string(kMaxClipPlanes) + " clipping planes cut a scene, and it has " +
+                         std::to_string(clips.size()) + " already");
+  const std::size_t op = text.find_first_of("<>");
+  if (op == std::string::npos) {
+    const std::size_t eq = text.find('=');
+    if (eq != std::string::npos)
+      plane.fail_at(eq, "a clip keeps one side of a plane: write an inequality such as z<0.5 or z>0.5, not an '='");
+    plane.fail_at(0, "--clip takes a half-space, the side of a plane to keep, as z<0.5 or x+y>=1");
+  }
+  const std::size_t width = op + 1 < text.size() && text[op + 1] == '=' ? 2 : 1;
+  const std::size_t rest = op + width;
+  if (const std::size_t again = text.find_first_of("<>=", rest); again != std::string::npos)
+    plane.fail_at(again, "a half-space is one inequality, as z<0.5 or x+y>=1: it has one '<' or '>'");
+  const Polynomial lhs_minus_rhs = plane.side(root, 0, op, true) - plane.side(root, rest, std::string::npos, true);
+  // lhs < rhs keeps lhs - rhs <= 0; lhs > rhs keeps rhs - lhs <= 0.
+  std::array<double, 4> c = plane.coefficients(lhs_minus_rhs);
+  if (text[op] == '>')
+    for (double& v : c) v = v == 0 ? 0.0 : -v;
+  toml::table clip;
+  clip.insert("plane", toml::array{c[0], c[1], c[2], c[3]});
+  clips.push_back(std::move(clip));
 }
 
 // Why LIST.INDEX names nothing: the scene has no [[LIST]] tables, and what adds one.
 std::string no_list_message(const std::string& list, const std::string& index) {
   std::string m = "the scene has no [[" + list + "]] tables, so there is no " + list + "." + index;
   if (list == "section") m += "; --section adds one, as --section z=0.5";
+  if (list == "clip") m += "; --clip adds one, as --clip 'z<0.5'";
   if (list == "light")
     m += "; it is lit by a headlight at the eye (a scene that places camera.eye); [[light]] tables give it lights";
   return m;
@@ -258,16 +312,22 @@ std::string shown(const std::string& t) {
   return t.size() <= 120 ? t : t.substr(0, 100) + "...(" + std::to_string(t.size()) + " characters)";
 }
 
-// --section given as an override: the plane as written, or as a TOML string (Python's Scene.set and a job's set
-// table quote it).
-void apply_section_override(toml::table& root, const Override& o) {
+// --section or --clip given as an override: the plane as written, or as a TOML string (Python's Scene.set and a
+// job's set table quote it).
+void apply_plane_override(toml::table& root, const Override& o) {
   std::string plane = o.value;
   if (!plane.empty() && (plane.front() == '"' || plane.front() == '\'')) try {
       plane = toml::parse("v = " + plane)["v"].value_or(plane);
     } catch (const toml::parse_error&) {
       // not a TOML string after all: the plane's own reading says what is wrong
     }
-  add_section(root, plane, (o.origin.empty() ? "--section " : o.origin + ": section ") + shown(plane));
+  const bool clip = o.key == kClipOverrideKey;
+  const std::string noun = clip ? "clip " : "section ";
+  const std::string label = (o.origin.empty() ? "--" + noun : o.origin + ": " + noun) + shown(plane);
+  if (clip)
+    add_clip(root, plane, label);
+  else
+    add_section(root, plane, label);
 }
 
 // A bare name must be one of the scene's parameters, so that a typo is not a new parameter nothing uses.
@@ -381,7 +441,7 @@ void apply_override(toml::table& root, const Override& o, std::vector<std::strin
   // A scene without [extent] has algray's sphere of radius kDefaultExtentRadius: extent.KEY changes that one.
   if (o.key.rfind("extent.", 0) == 0 && !root.get("extent"))
     root.insert("extent", toml::table{{"radius", kDefaultExtentRadius}});
-  if (o.key == kSectionOverrideKey) return apply_section_override(root, o);
+  if (o.key == kSectionOverrideKey || o.key == kClipOverrideKey) return apply_plane_override(root, o);
   const std::string label = (o.origin.empty() ? "--set " : o.origin + ": set ") + shown(o.key) + "=" + shown(o.value);
   // A bare name is a parameter; any other key is a dotted path into the scene; parameters.NAME adds a parameter.
   // A bare name that is no parameter but a top-level table of the scene is that table: --set 'section=[]' drops
@@ -841,6 +901,34 @@ void read_sections(const TomlReader& r, const toml::table& root, std::vector<Sec
   }
 }
 
+// [[clip]] tables: plane = [a, b, c, d], the half-space a*x + b*y + c*z + d <= 0 kept ((a, b, c) not zero); at
+// most kMaxClipPlanes of them.
+void read_clips(const TomlReader& r, const toml::table& root, std::vector<glm::dvec4>& out) {
+  const toml::node* clips = root.get("clip");
+  if (!clips) return;
+  const toml::array* list = clips->as_array();
+  if (list && list->empty()) return;  // clip = []: none
+  if (!list || !list->is_array_of_tables())
+    r.fail(clips->source(), "clipping planes are written as [[clip]] tables, one per plane");
+  for (const toml::node& node : *list) {
+    const toml::table& t = *node.as_table();
+    if (out.size() == kMaxClipPlanes)
+      r.fail(t.source(), "at most " + std::to_string(kMaxClipPlanes) + " clipping planes ([[clip]] tables) cut a " +
+                             "scene; this is clip." + std::to_string(out.size()));
+    r.check_keys(t, "clip." + std::to_string(out.size()), kClipKeys);
+    const toml::node* plane = t.get("plane");
+    if (!plane)
+      r.fail(t.source(), "a clip needs plane = [a, b, c, d] (the half-space a*x + b*y + c*z + d <= 0 is kept)");
+    const toml::array* a = plane->as_array();
+    if (!a || a->size() != 4) r.fail(plane->source(), "clip.plane must be an array of 4 numbers [a, b, c, d]");
+    glm::dvec4 p;
+    for (int i = 0; i < 4; ++i)
+      p[i] = r.coordinate(*a->get(static_cast<std::size_t>(i)), "clip.plane[" + std::to_string(i) + "]");
+    if (p.x == 0 && p.y == 0 && p.z == 0) r.fail(plane->source(), "clip.plane is no plane: a, b and c are all 0");
+    out.push_back(p);
+  }
+}
+
 void read_antialias(const TomlReader& r, const toml::table& root, Antialias& out) {
   const toml::table* aa = r.subtable(root, "antialias");
   if (!aa) return;
@@ -922,6 +1010,7 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
   int degree = 0;
   for (const SceneSurface& s : scene.surfaces) degree = std::max(degree, s.polynomial.degree());
   read_extent(r, root, scene.extent);
+  read_clips(r, root, scene.extent.clips);
   read_camera(r, root, scene.extent, scene.camera);
   read_image(r, root, scene.image);
   read_surface_materials(r, root, surface_tables, scene.surfaces);
@@ -945,6 +1034,19 @@ SceneError::SceneError(std::string where_, std::string message_, std::string exc
       excerpt(std::move(excerpt_)) {}
 
 glm::dvec3 Extent::unit_centre() const { return kind == ExtentKind::Box ? (min + max) * 0.5 : centre; }
+
+// a.p + d <= 0 with p = centre + scale * u is a.u + (a.centre + d) / scale <= 0, divided by |a|.
+std::vector<glm::dvec4> Extent::unit_clips() const {
+  std::vector<glm::dvec4> out;
+  const glm::dvec3 c = unit_centre();
+  const double s = unit_scale();
+  for (const glm::dvec4& p : clips) {
+    const glm::dvec3 a(p);
+    const double length = glm::length(a);
+    out.emplace_back(a / length, (glm::dot(a, c) + p.w) / (s * length));
+  }
+  return out;
+}
 
 // A cylinder's scale is the distance from its centre to a cap's rim, so that it fits in |u| <= 1.
 double Extent::unit_scale() const {
@@ -1242,6 +1344,9 @@ std::string scene_to_toml(const Scene& scene) {
     out << "\n[[section]]\nplane = [" << toml_number(sec.plane.x) << ", " << toml_number(sec.plane.y) << ", "
         << toml_number(sec.plane.z) << ", " << toml_number(sec.plane.w) << "]\ncolour = " << toml_vector(sec.colour)
         << "\n";
+  for (const glm::dvec4& c : scene.extent.clips)
+    out << "\n[[clip]]\nplane = [" << toml_number(c.x) << ", " << toml_number(c.y) << ", " << toml_number(c.z) << ", "
+        << toml_number(c.w) << "]\n";
   const Antialias& aa = scene.antialias;
   out << "\n[antialias]\nsamples = " << aa.samples << "\nadaptive = " << (aa.adaptive ? "true" : "false")
       << "\nthreshold = " << toml_number(aa.threshold) << "\n";

@@ -57,7 +57,18 @@ struct Extent {
   // Box half-sizes in unit coordinates; for a cylinder, those of the box around it (radius across, half_height
   // along its axis), from which the kernels take the cylinder (kernels/ray.h).
   glm::dvec3 unit_box_half() const;
+
+  // Clipping planes ([[clip]] tables, --clip) that cut the surface open: each keeps the half-space
+  // a*x + b*y + c*z + d <= 0 of its (a, b, c, d), (a, b, c) not zero, and what is drawn is the part of the surface
+  // inside the extent and every one of them. At most kMaxClipPlanes; none cuts nothing.
+  std::vector<glm::dvec4> clips;
+  // The planes in unit coordinates, as the kernels take them: (n, e) with n unit and n.u + e <= 0 kept.
+  std::vector<glm::dvec4> unit_clips() const;
 };
+
+// How many clipping planes a scene may have: the kernels loop over as many as are given (kernels/ray.h), and a
+// few planes are what users cut a surface open with (a slab, a wedge, a corner).
+inline constexpr std::size_t kMaxClipPlanes = 4;
 
 // A plane section, surf's cut_with_plane: the curve where the plane a*x + b*y + c*z + d = 0 meets the surface,
 // drawn over the shading in `colour` as a line one pixel wide (shade.cpp).
@@ -173,6 +184,7 @@ struct Scene {
   ImageSpec image;
   std::vector<Light> lights;  // none: a headlight at the eye shades the surface, without shadows
   std::vector<Section> sections;  // plane sections drawn on the surface ([[section]])
+  // (the clipping planes, [[clip]], are the extent's: extent.clips)
   Antialias antialias;
   RenderSettings render;
   // What the scene's reader could not render as written (a .jsurf feature algray draws differently, an unknown
@@ -186,8 +198,10 @@ struct Scene {
 // "key=value" from --set (or a flag such as --width): key is a dotted scene key; a key without a dot names a
 // parameter, or else a top-level table (--set 'section=[]'). The value is read as TOML, or as a string when it is
 // not valid TOML. The key kSectionOverrideKey is --section: its value, a plane as a linear equation in x, y, z
-// ("z=0.5", "x+y=1"), is appended as a [[section]] table.
+// ("z=0.5", "x+y=1"), is appended as a [[section]] table. The key kClipOverrideKey is --clip: its value, a
+// half-space as a linear inequality in x, y, z ("z<0.5", "x+y>=1": the side kept), is appended as a [[clip]] table.
 inline constexpr const char* kSectionOverrideKey = "--section";
+inline constexpr const char* kClipOverrideKey = "--clip";
 struct Override {
   std::string key;
   std::string value;
