@@ -77,7 +77,8 @@ void Shader::shade_hits(const HitToShade* hits, std::size_t count, const ShadowL
 
 // A hit whose pixel the section's curve passes through takes the section's colour: |s(p)| within half the change
 // of s(p) = n.p + d from one pixel to the next along x or y (whichever is larger), which draws the curve as an
-// unbroken line one pixel wide, as a digital line is. Moving to the next pixel moves the ray by e = ou + t*du
+// unbroken line one pixel wide, as a digital line is; a section `width` pixels wide takes `width` times that band.
+// A section of one surface marks that surface's hits only. Moving to the next pixel moves the ray by e = ou + t*du
 // (or ov + t*dv) times the samples per pixel at parameter t (docs/outputs.md), and its hit along the tangent
 // plane by e - d (N.e)/(N.d).
 void Shader::draw_sections(const HitToShade* hits, std::size_t count, glm::dvec3* out) const {
@@ -94,8 +95,9 @@ void Shader::draw_sections(const HitToShade* hits, std::size_t count, glm::dvec3
       ey -= d * (glm::dot(normal, ey) / facing);
     }
     for (const Section& sec : scene_.sections) {
+      if (sec.surface >= 0 && sec.surface != hits[i].surface) continue;
       const glm::dvec3 n(sec.plane);
-      const double band = 0.5 * std::max(std::fabs(glm::dot(n, ex)), std::fabs(glm::dot(n, ey)));
+      const double band = 0.5 * sec.width * std::max(std::fabs(glm::dot(n, ex)), std::fabs(glm::dot(n, ey)));
       if (std::fabs(glm::dot(n, p) + sec.plane.w) <= band) {
         out[i] = sec.colour;
         break;
