@@ -44,7 +44,7 @@ const std::set<std::string> kExtentKeys = [] {
 // The eye, or the angles about look_at (camera.h's CameraAngles): one or the other.
 const std::set<std::string> kCameraAngleKeys{"azimuth", "elevation", "distance"};
 const std::set<std::string> kCameraKeys{"projection", "eye",     "look_at",   "up",      "fov_y",
-                                        "height",     "azimuth", "elevation", "distance"};
+                                        "height",     "azimuth", "elevation", "distance", "shift"};
 const std::set<std::string> kImageKeys{"width", "height", "background"};
 const std::set<std::string> kMaterialKeys{"front", "back"};
 const std::set<std::string> kMaterialSideKeys{"colour",   "ambient",      "diffuse",     "specular",
@@ -733,6 +733,15 @@ void read_camera(const TomlReader& r, const toml::table& root, const Extent& ext
     r.fail(camera->get("projection")->source(),
            "an orthographic camera needs camera.height (the view height in world units)");
   }
+  // An off-axis view: the image's centre moved across the image plane, in image widths and heights.
+  if (const toml::node* n = camera->get("shift")) {
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != 2)
+      r.fail(n->source(), "camera.shift must be an array of 2 numbers [x, y] (image widths right, heights up)");
+    for (int i = 0; i < 2; ++i)
+      cam.shift[i] = r.number_in(*a->get(static_cast<std::size_t>(i)), "camera.shift[" + std::to_string(i) + "]",
+                                 -kMaxCameraShift, kMaxCameraShift);
+  }
 }
 
 void read_image(const TomlReader& r, const toml::table& root, ImageSpec& out) {
@@ -1196,6 +1205,8 @@ void write_camera(std::ostringstream& out, const CameraSpec& c) {
       << "\"\neye = " << toml_vector(c.eye) << "\nlook_at = " << toml_vector(c.look_at)
       << "\nup = " << toml_vector(c.up) << "\n"
       << (perspective ? "fov_y = " + toml_number(c.fov_y_degrees) : "height = " + toml_number(c.ortho_height)) << "\n";
+  if (c.shift != glm::dvec2(0))
+    out << "shift = [" << toml_number(c.shift.x) << ", " << toml_number(c.shift.y) << "]\n";
 }
 
 void write_lights(std::ostringstream& out, const std::vector<Light>& lights) {
