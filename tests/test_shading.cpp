@@ -237,3 +237,29 @@ TEST_CASE("a section of one surface marks that surface only, and a section `widt
     }
   }
 }
+
+TEST_CASE("a section seen through a transparent surface is as wide as one seen directly", "[shading][section]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  // The ring where z = 0.5 cuts the unit ball, seen from +z, directly and through the clear plane z = 1.5: the
+  // transmitted ray starts at the plane, and its pixel's footprint still grows with the distance from the eye.
+  const std::string ball = "[[surface]]\nequation = \"x^2+y^2+z^2-1\"\n";
+  const std::string pane =
+      "[[surface]]\nequation = \"z-1.5\"\n[surface.material.front]\ntransparency = 1\nspecular = 0\n"
+      "[surface.material.back]\ntransparency = 1\nspecular = 0\n";
+  const std::string rest =
+      "[extent]\nradius = 2\n[camera]\neye = [0, 0, 8]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nfov_y = 30\n"
+      "[image]\nwidth = 96\nheight = 96\n[antialias]\nsamples = 1\n[render]\nprecision = \"double\"\n"
+      "[[section]]\nplane = [0, 0, 1, -0.5]\ncolour = [0, 1, 0]\nsurface = 0\n";
+  const auto marked = [&](const std::string& text) {
+    const RenderResult r = renderer.render_with_records(load_scene_text(text, "t.toml"));
+    long n = 0;
+    for (std::size_t k = 0; k < r.hits.records.size(); ++k)
+      n += r.image.rgba[4 * k] < 0.1f && r.image.rgba[4 * k + 1] > 0.9f && r.image.rgba[4 * k + 2] < 0.1f;
+    return n;
+  };
+  const long direct = marked(ball + rest), through = marked(ball + pane + rest);
+  CHECK(direct >= 80);
+  CHECK(static_cast<double>(through) == Approx(static_cast<double>(direct)).epsilon(0.1));
+}
