@@ -238,14 +238,16 @@ TEST_CASE("a camera whose direction is not normal to right and up is POV-Ray's o
     REQUIRE(n > 20);
     CAPTURE(u, v);
     // Read on its axis (the view along direction), the corner's ball showed at 80.6%, 22.9%.
-    CHECK(sx / n == Approx(u).margin(0.006));
-    CHECK(sy / n == Approx(v).margin(0.006));
+    CHECK(sx / static_cast<double>(n) == Approx(u).margin(0.006));
+    CHECK(sy / static_cast<double>(n) == Approx(v).margin(0.006));
   }
   // look_at makes direction, right and up normal: no shift. A direction in the plane of right and up is refused.
   CHECK(load_povray_text("camera { location <0, 0, -4> direction <0.3, 0.5, 1.5> look_at 0 }\nsphere { 0, 1 }\n",
                          "l.pov")
             .camera.shift == glm::dvec2(0));
   CHECK(error_of("camera { location <0, 0, -4> direction <1, 0, 0> }\nsphere { 0, 1 }\n").where == "bad.pov:1:8");
+  CHECK(error_of("camera { location <0, 0, -4> up 0.001*y direction <0, 1, 1> }\nsphere { 0, 1 }\n").where ==
+        "bad.pov:1:8");
 }
 
 TEST_CASE("bad POV-Ray scenes get located errors; what is skipped, located warnings", "[povray][errors]") {

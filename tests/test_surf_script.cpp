@@ -335,6 +335,12 @@ TEST_CASE("cut_with_plane is a section of surface surf_nr, its plane moved with 
   CHECK(error_of(ball + "plane=x;\ncurve_green=256;\ncut_with_plane;\n").where == "bad.pic:4:1");
   CHECK(error_of(ball + "plane=x;\ncurve_width=0;\ncut_with_plane;\n").where == "bad.pic:4:1");
   CHECK(error_of(ball + "plane=x;\nsurf_nr=10;\ncut_with_plane;\n").where == "bad.pic:4:1");
+  // A plane far beyond anything drawn: a warning, and its numbers stay ones the scene reader takes.
+  const Scene far = load_surf_script_text(ball + "plane=z-1e300;\ncut_with_plane;\n", "f.pic");
+  CHECK(far.sections.empty());
+  CHECK(any_contains(far.warnings, "f.pic:4:1: cut_with_plane: the plane lies too far away"));
+  CHECK(load_surf_script_text(ball + "plane=1e30*z-2e30;\ncut_with_plane;\n", "f.pic").sections.at(0).plane ==
+        glm::dvec4(0, 0, 1, -2));
 }
 
 TEST_CASE("a surf script renders from the command line; a bad one exits 2 and writes nothing", "[surf][cli]") {

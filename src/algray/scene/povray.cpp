@@ -1635,6 +1635,9 @@ void PovReader::off_axis(Translated& scene, double& distance, glm::dvec3& axis) 
     return;
   }
   scene.view.shift = glm::dvec2(glm::dot(off, r) / glm::length(cam.right), glm::dot(off, u) / glm::length(cam.up));
+  if (!(std::fabs(scene.view.shift.x) <= kMaxCameraShift && std::fabs(scene.view.shift.y) <= kMaxCameraShift))
+    fail(at, "the camera's direction points more than " + std::to_string(static_cast<int>(kMaxCameraShift)) +
+                 " image widths or heights off its image: algray's off-axis views go that far");
   distance = along;
   axis = normal;
 }

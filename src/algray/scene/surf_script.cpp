@@ -665,7 +665,7 @@ class Script {
       for (const auto& [key, v] : globals_) terms += 1 + static_cast<double>(v.poly.terms.size());
       budget_.work += terms;
       if (budget_.work > budget_.limit) fail(name, "the script's pictures and arithmetic are too large to follow here");
-      last_drawn_ = Snapshot{globals_, name};
+      last_drawn_ = Snapshot{globals_, name, {}};
       ++draws_;
     } else if (c == "save_color_image") {
       if (last_drawn_ && !first_saved_) first_saved_ = last_drawn_;
@@ -921,8 +921,15 @@ void Script::write_sections(std::ostringstream& toml, const Snapshot& s, const A
       for (int i = 0; i < 3; ++i)
         if (e[static_cast<std::size_t>(i)] == 1) abcd[i] += c;
     }
-    if (abcd[0] == 0 && abcd[1] == 0 && abcd[2] == 0)
+    // Scaled to a unit largest normal component, so that its numbers are coordinates the scene reader takes.
+    const double largest = std::max({std::fabs(abcd[0]), std::fabs(abcd[1]), std::fabs(abcd[2])});
+    if (!(largest > 0))
       fail(k.at, "the plane is no plane after the position settings are applied (a scale of 0?)");
+    for (double& c : abcd) c /= largest;
+    if (!(std::fabs(abcd[3]) <= 1e15)) {
+      warn(k.at, "cut_with_plane: the plane lies too far away to meet what is drawn; nothing is drawn");
+      continue;
+    }
     if (std::fabs(abcd[2]) <= 1e-12 * std::hypot(abcd[0], abcd[1])) {
       warn(k.at, "cut_with_plane: the plane is seen edge-on (it holds the viewing direction), where surf draws no "
                  "section; nor does algray (--section draws it)");
@@ -933,7 +940,7 @@ void Script::write_sections(std::ostringstream& toml, const Snapshot& s, const A
     toml << "\n[[section]]  # cut_with_plane at " << where(k.at) << "\nplane = [" << toml_number(abcd[0]) << ", "
          << toml_number(abcd[1]) << ", " << toml_number(abcd[2]) << ", " << toml_number(abcd[3])
          << "]\ncolour = " << toml_vector(colour) << "\nsurface = " << index
-         << "\nwidth = " << toml_number(std::min(k.width * pixels_per_width, kMaxSectionWidth)) << "\n";
+         << "\nwidth = " << toml_number(std::clamp(k.width * pixels_per_width, 1e-3, kMaxSectionWidth)) << "\n";
   }
 }
 
