@@ -143,8 +143,7 @@ def main():
         "size, antialiasing and depth cueing off (the script says how the copies differ), algray one ray per pixel. "
         f"{len(ok)} of {len(rows)} render ({len(skipped)} more draw plane curves only); silhouette IoU median "
         f"{statistics.median(ious):.4f}" +
-        (f"; under {SHOWN_BELOW}: " + ", ".join(f"{name} {iou:.4f}" for name, iou, _, _ in low) +
-         " (surf's plane-section curves count against them)" if low else "") +
+        (f"; under {SHOWN_BELOW}: " + ", ".join(f"{name} {iou:.4f}" for name, iou, _, _ in low) if low else "") +
         ("; refused: " + ", ".join(f"{name} ({note.split(' error: ', 1)[-1]})" for name, _, _, note in failed)
          if failed else "") + ".")
     replace_bullet(args.output, HEADING, "- surf:", bullet, under=AREA)

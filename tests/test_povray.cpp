@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
+#include <tuple>
 
 #include "cli_sandbox.h"
 #include "algray/render/render_plan.h"
@@ -203,6 +204,46 @@ TEST_CASE("camera, lights, colours and background map to algray's scene", "[povr
       "camera { orthographic location <0, 0, -10> look_at 0 right 8*x up 6*y }\nsphere { 0, 1 }\n", "o.pov");
   CHECK(ortho.camera.projection == Projection::Orthographic);
   CHECK(ortho.camera.ortho_height == 6);
+}
+
+TEST_CASE("a camera whose direction is not normal to right and up is POV-Ray's off-axis view", "[povray]") {
+  // POV-Ray's ray for the image point (u, v), each from -1/2 to 1/2, is direction + u right + v up. Balls where
+  // the rays of (0, 0) and (0.35, 0.35) meet z = 2 show at the image's centre and at 85% across, 15% down.
+  const std::string camera =
+      "camera { location <0, 0, -4> right x*4/3 up y direction <0.3, 0.5, 1.5> }\n"
+      "light_source { <0, 0, -100> color rgb 1 }\n";
+  const Scene centre = load_povray_text(camera + "sphere { <1.2, 2, 2>, 0.15 }\n", "c.pov",
+                                        {{"image.width", "200"}, {"image.height", "150"}, {"antialias.samples", "1"}});
+  CHECK(centre.camera.shift.x == Approx(0.3 / (4.0 / 3)));
+  CHECK(centre.camera.shift.y == Approx(0.5));
+  const Scene corner = load_povray_text(camera + "sphere { <3.0666667, 3.4, 2>, 0.15 }\n", "k.pov",
+                                        {{"image.width", "200"}, {"image.height", "150"}, {"antialias.samples", "1"}});
+  static ProgramCache cache(true, algray::testing::shared_cache_dir());
+  Renderer renderer(device_session(), cache);
+  for (const auto& [scene, u, v] : {std::tuple{&centre, 0.5, 0.5}, std::tuple{&corner, 0.85, 0.15}}) {
+    const HitBuffer hits = renderer.render_with_records(*scene).hits;
+    double sx = 0, sy = 0;
+    long n = 0;
+    for (int y = 0; y < hits.height; ++y)
+      for (int x = 0; x < hits.width; ++x)
+        if (hits.at(x, y).flags & ALGRAY_HIT_FOUND) {
+          ++n;
+          sx += (x + 0.5) / hits.width;
+          sy += (y + 0.5) / hits.height;
+        }
+    REQUIRE(n > 20);
+    CAPTURE(u, v);
+    // Read on its axis (the view along direction), the corner's ball showed at 80.6%, 22.9%.
+    CHECK(sx / static_cast<double>(n) == Approx(u).margin(0.006));
+    CHECK(sy / static_cast<double>(n) == Approx(v).margin(0.006));
+  }
+  // look_at makes direction, right and up normal: no shift. A direction in the plane of right and up is refused.
+  CHECK(load_povray_text("camera { location <0, 0, -4> direction <0.3, 0.5, 1.5> look_at 0 }\nsphere { 0, 1 }\n",
+                         "l.pov")
+            .camera.shift == glm::dvec2(0));
+  CHECK(error_of("camera { location <0, 0, -4> direction <1, 0, 0> }\nsphere { 0, 1 }\n").where == "bad.pov:1:8");
+  CHECK(error_of("camera { location <0, 0, -4> up 0.001*y direction <0, 1, 1> }\nsphere { 0, 1 }\n").where ==
+        "bad.pov:1:8");
 }
 
 TEST_CASE("bad POV-Ray scenes get located errors; what is skipped, located warnings", "[povray][errors]") {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "algray/scene/camera.h"
 #include "algray/scene/expression.h"
 #include "algray/scene/scene.h"
 #include "scene_fixtures.h"
@@ -117,6 +118,34 @@ TEST_CASE("dotted overrides reach image, render and camera keys", "[scene]") {
   const Scene twice =
       algray::load_scene_text(sphere_with({}), "t.toml", {{"image.width", "64"}, {"image.width", "48"}});
   CHECK(twice.image.width == 48);
+}
+
+TEST_CASE("camera.shift moves the image's centre across the image plane; none is the camera as before",
+          "[scene][camera]") {
+  const std::string text = "[surface]\nequation = \"x^2+y^2+z^2-1\"\n[camera]\neye = [0, 0, 5]\nlook_at = [0, 0, 0]\n"
+                           "fov_y = 40\n";
+  const Scene plain = algray::load_scene_text(text, "t.toml");
+  const Scene shifted = algray::load_scene_text(text + "shift = [0.25, -0.5]\n", "t.toml");
+  CHECK(plain.camera.shift == glm::dvec2(0));
+  CHECK(shifted.camera.shift == glm::dvec2(0.25, -0.5));
+  // The centre of a 200 x 100 image: on the axis without a shift; a quarter width right and half a height down
+  // with it, that is half the view's half-width and its whole half-height.
+  const double h = std::tan(20 * 3.14159265358979 / 180), aspect = 2;
+  const auto centre_ray = [](const Scene& s) {
+    const algray::RayBasis b = algray::make_ray_basis(s.camera, 200, 100);
+    return b.d00 + 100.0 * b.du + 50.0 * b.dv;
+  };
+  const glm::dvec3 c0 = centre_ray(plain), c1 = centre_ray(shifted);
+  CHECK(c0.x == Approx(0).margin(1e-12));
+  CHECK(c0.y == Approx(0).margin(1e-12));
+  CHECK(c1.x / -c1.z == Approx(0.5 * h * aspect));
+  CHECK(c1.y / -c1.z == Approx(-h));
+  // The rest of the ray basis is unchanged, and the shift reads back from the scene's TOML.
+  CHECK(algray::make_ray_basis(shifted.camera, 200, 100).du == algray::make_ray_basis(plain.camera, 200, 100).du);
+  CHECK(algray::load_scene_text(algray::scene_to_toml(shifted), "again.toml").camera.shift == shifted.camera.shift);
+  CHECK(algray::scene_to_toml(plain).find("shift") == std::string::npos);
+  check_error(text + "shift = [0.25]\n", "t.toml:7:9", "camera.shift must be an array of 2 numbers");
+  check_error(text + "shift = [0, 1000]\n", "t.toml:7:13", "camera.shift[1] must be between");
 }
 
 TEST_CASE("the paper's term list gives the same polynomial as the equation", "[scene]") {

@@ -182,3 +182,84 @@ TEST_CASE("a section plane through the unit sphere marks the ring where it cuts 
   CHECK(again.sections[0].plane == glm::dvec4(0, 0, 2, -1));
   CHECK(again.sections[0].colour == glm::dvec3(0, 1, 0));
 }
+
+TEST_CASE("a section of one surface marks that surface only, and a section `width` pixels wide that many times as "
+          "many pixels",
+          "[shading][section]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  // Two unit balls side by side, seen from +z; the plane z = 0.5 cuts both in a ring of radius sqrt(0.75).
+  const std::string base =
+      "[[surface]]\nequation = \"(x+1.2)^2+y^2+z^2-1\"\n[[surface]]\nequation = \"(x-1.2)^2+y^2+z^2-1\"\n"
+      "[extent]\nradius = 2.5\n"
+      "[camera]\neye = [0, 0, 8]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nfov_y = 40\n"
+      "[image]\nwidth = 128\nheight = 96\n[antialias]\nsamples = 1\n[render]\nprecision = \"double\"\npreview = true\n";
+  const auto marked_on = [&](const std::string& section, long& left, long& right) {
+    const RenderResult r = renderer.render_with_records(load_scene_text(base + section, "cut.toml"));
+    left = right = 0;
+    for (std::size_t k = 0; k < r.hits.records.size(); ++k) {
+      const bool marked =
+          r.image.rgba[4 * k] == 0.0f && r.image.rgba[4 * k + 1] == 1.0f && r.image.rgba[4 * k + 2] == 0.0f;
+      if (!marked) continue;
+      REQUIRE((r.hits.records[k].flags & ALGRAY_HIT_FOUND) != 0);
+      (r.hits.surface_of(k) == 0 ? left : right) += 1;
+    }
+  };
+  long every_left = 0, every_right = 0, one_left = 0, one_right = 0, wide_left = 0, wide_right = 0;
+  marked_on("[[section]]\nplane = [0, 0, 1, -0.5]\ncolour = [0, 1, 0]\n", every_left, every_right);
+  marked_on("[[section]]\nplane = [0, 0, 1, -0.5]\ncolour = [0, 1, 0]\nsurface = 1\n", one_left, one_right);
+  marked_on("[[section]]\nplane = [0, 0, 1, -0.5]\ncolour = [0, 1, 0]\nsurface = 1\nwidth = 3\n", wide_left,
+            wide_right);
+  // Both rings alike (the scene is symmetric), each a closed digital circle of radius about 12 pixels.
+  CHECK(every_left >= 50);
+  CHECK(std::labs(every_left - every_right) <= every_left / 10);
+  CHECK(one_left == 0);
+  CHECK(one_right == every_right);
+  CHECK(wide_left == 0);
+  CHECK(static_cast<double>(wide_right) == Approx(3.0 * static_cast<double>(one_right)).epsilon(0.25));
+  // Both keys read back from the scene's TOML; a surface index past the list is a located error.
+  const Scene again = load_scene_text(
+      scene_to_toml(load_scene_text(base + "[[section]]\nplane = [0, 0, 1, 0]\nsurface = 1\nwidth = 2.5\n", "a.toml")),
+      "again.toml");
+  REQUIRE(again.sections.size() == 1);
+  CHECK(again.sections[0].surface == 1);
+  CHECK(again.sections[0].width == 2.5);
+  CHECK(load_scene_text(base + "[[section]]\nplane = [0, 0, 1, 0]\n", "b.toml").sections[0].surface == -1);
+  for (const char* bad : {"surface = 2", "surface = -1", "width = 0", "width = 65", "surface = 0.5"}) {
+    CAPTURE(bad);
+    try {
+      load_scene_text(base + "[[section]]\nplane = [0, 0, 1, 0]\n" + bad + "\n", "bad.toml");
+      FAIL("accepted");
+    } catch (const SceneError& e) {
+      // The value's line (the base's 19 lines, the table's header and plane before it) and column.
+      CHECK(e.where == "bad.toml:22:" + std::to_string(std::strchr(bad, '=') - bad + 3));
+    }
+  }
+}
+
+TEST_CASE("a section seen through a transparent surface is as wide as one seen directly", "[shading][section]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  // The ring where z = 0.5 cuts the unit ball, seen from +z, directly and through the clear plane z = 1.5: the
+  // transmitted ray starts at the plane, and its pixel's footprint still grows with the distance from the eye.
+  const std::string ball = "[[surface]]\nequation = \"x^2+y^2+z^2-1\"\n";
+  const std::string pane =
+      "[[surface]]\nequation = \"z-1.5\"\n[surface.material.front]\ntransparency = 1\nspecular = 0\n"
+      "[surface.material.back]\ntransparency = 1\nspecular = 0\n";
+  const std::string rest =
+      "[extent]\nradius = 2\n[camera]\neye = [0, 0, 8]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\nfov_y = 30\n"
+      "[image]\nwidth = 96\nheight = 96\n[antialias]\nsamples = 1\n[render]\nprecision = \"double\"\n"
+      "[[section]]\nplane = [0, 0, 1, -0.5]\ncolour = [0, 1, 0]\nsurface = 0\n";
+  const auto marked = [&](const std::string& text) {
+    const RenderResult r = renderer.render_with_records(load_scene_text(text, "t.toml"));
+    long n = 0;
+    for (std::size_t k = 0; k < r.hits.records.size(); ++k)
+      n += r.image.rgba[4 * k] < 0.1f && r.image.rgba[4 * k + 1] > 0.9f && r.image.rgba[4 * k + 2] < 0.1f;
+    return n;
+  };
+  const long direct = marked(ball + rest), through = marked(ball + pane + rest);
+  CHECK(direct >= 80);
+  CHECK(static_cast<double>(through) == Approx(static_cast<double>(direct)).epsilon(0.1));
+}

@@ -163,9 +163,14 @@ json scene_summary(const api::Scene& scene, const std::string& device) {
   if (e["axis"]) extent["axis"] = e["axis"].value_or(std::string("z"));
   json sections = json::array();
   if (const toml::array* list = t["section"].as_array())
-    for (const toml::node& section : *list)
-      sections.push_back({{"plane", numbers(section.as_table()->get("plane"))},
-                          {"colour", numbers(section.as_table()->get("colour"))}});
+    for (const toml::node& section : *list) {
+      const toml::table& st = *section.as_table();
+      json one{{"plane", numbers(st.get("plane"))}, {"colour", numbers(st.get("colour"))}};
+      // The one surface it cuts and its width (surf's cut_with_plane) go back as they came.
+      if (const toml::node* n = st.get("surface")) one["surface"] = n->value_or(std::int64_t{0});
+      if (const toml::node* n = st.get("width")) one["width"] = n->value_or(1.0);
+      sections.push_back(one);
+    }
   json clips = json::array();
   if (const toml::array* list = t["clip"].as_array())
     for (const toml::node& clip : *list) clips.push_back({{"plane", numbers(clip.as_table()->get("plane"))}});

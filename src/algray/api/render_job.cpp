@@ -102,6 +102,8 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
       {"algray/kernelMs", kernel_ms},
       {"algray/camera/fovY", cam.fov_y_degrees},
       {"algray/camera/orthoHeight", cam.ortho_height},
+      {"algray/camera/shiftX", cam.shift.x},
+      {"algray/camera/shiftY", cam.shift.y},
       // The ray basis above is per antialiasing sample: pixel (px, py) averages samples x samples rays.
       {"algray/antialiasSamples", r.plan.samples},
   };

@@ -77,16 +77,22 @@ void Shader::shade_hits(const HitToShade* hits, std::size_t count, const ShadowL
 
 // A hit whose pixel the section's curve passes through takes the section's colour: |s(p)| within half the change
 // of s(p) = n.p + d from one pixel to the next along x or y (whichever is larger), which draws the curve as an
-// unbroken line one pixel wide, as a digital line is. Moving to the next pixel moves the ray by e = ou + t*du
+// unbroken line one pixel wide, as a digital line is; a section `width` pixels wide takes `width` times that band.
+// A section of one surface marks that surface's hits only. Moving to the next pixel moves the ray by e = ou + t*du
 // (or ov + t*dv) times the samples per pixel at parameter t (docs/outputs.md), and its hit along the tangent
-// plane by e - d (N.e)/(N.d).
+// plane by e - d (N.e)/(N.d). A reflected or transmitted ray starts where an earlier one hit: its t counts from
+// there, so the distance back to the eye is added (exactly so along a transmitted ray, which keeps the camera
+// ray's direction; the straight distance to a mirror's hit for a reflected one).
 void Shader::draw_sections(const HitToShade* hits, std::size_t count, glm::dvec3* out) const {
   for (std::size_t i = 0; i < count; ++i) {
     const HitRecord& h = *hits[i].hit;
     const double t = static_cast<double>(h.t_hi) + static_cast<double>(h.t_lo);
     const glm::dvec3 d = hits[i].ray.direction, p = hits[i].ray.origin + t * d;
     const glm::dvec3 normal(h.normal_x, h.normal_y, h.normal_z);
-    glm::dvec3 ex = double(samples_) * (basis_.ou + t * basis_.du), ey = double(samples_) * (basis_.ov + t * basis_.dv);
+    const double from_eye =
+        hits[i].secondary ? t + glm::length(hits[i].ray.origin - basis_.o00) / glm::length(d) : t;
+    glm::dvec3 ex = double(samples_) * (basis_.ou + from_eye * basis_.du),
+               ey = double(samples_) * (basis_.ov + from_eye * basis_.dv);
     const double facing = glm::dot(normal, d);
     // At the silhouette the hit runs off along the ray; the move across the image stands for it there.
     if (std::fabs(facing) > 1e-3 * glm::length(d)) {
@@ -94,8 +100,9 @@ void Shader::draw_sections(const HitToShade* hits, std::size_t count, glm::dvec3
       ey -= d * (glm::dot(normal, ey) / facing);
     }
     for (const Section& sec : scene_.sections) {
+      if (sec.surface >= 0 && sec.surface != hits[i].surface) continue;
       const glm::dvec3 n(sec.plane);
-      const double band = 0.5 * std::max(std::fabs(glm::dot(n, ex)), std::fabs(glm::dot(n, ey)));
+      const double band = 0.5 * sec.width * std::max(std::fabs(glm::dot(n, ex)), std::fabs(glm::dot(n, ey)));
       if (std::fabs(glm::dot(n, p) + sec.plane.w) <= band) {
         out[i] = sec.colour;
         break;
@@ -256,7 +263,8 @@ void Shader::add_batch(const SecondaryBatch& batch, std::vector<glm::dvec3>& col
     std::vector<glm::dvec3> shaded;
     for (std::size_t i = begin; i < end; ++i)
       if (batch.hits[i].flags & ALGRAY_HIT_FOUND)
-        found.push_back({&batch.hits[i], batch.hit_surface.empty() ? 0 : batch.hit_surface[i], batch.rays[i], i});
+        found.push_back({&batch.hits[i], batch.hit_surface.empty() ? 0 : batch.hit_surface[i], batch.rays[i], i,
+                         batch.pass != PassKind::Antialias});
     shaded.resize(found.size());
     shade_hits(found.data(), found.size(), shadows, shaded.data());
     for (std::size_t f = 0; f < found.size(); ++f) seen[found[f].hit_index] = shaded[f];

@@ -70,6 +70,7 @@ class Shader {
     int surface;
     PixelRay ray;
     std::size_t hit_index;
+    bool secondary = false;  // a reflected or transmitted ray, starting where an earlier one hit
   };
   // Colour of each of `count` hits: the side's own colour (times 1 - transparency, the rest coming from the
   // transmission pass), lit by every light's points that the shadow pass left visible.

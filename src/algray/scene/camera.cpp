@@ -16,12 +16,13 @@ RayBasis make_ray_basis(const CameraSpec& camera, int width, int height) {
     const double half_tan = std::tan(glm::radians(camera.fov_y_degrees) / 2);
     b.o00 = camera.eye;
     b.ou = b.ov = glm::dvec3(0);
-    b.d00 = b.forward - half_tan * aspect * b.right + half_tan * b.true_up;
+    b.d00 = b.forward + half_tan * aspect * (2 * camera.shift.x - 1) * b.right +
+            half_tan * (2 * camera.shift.y + 1) * b.true_up;
     b.du = (2 * half_tan * aspect / w) * b.right;
     b.dv = (-2 * half_tan / h) * b.true_up;
   } else {
     const double half_h = camera.ortho_height / 2, half_w = half_h * aspect;
-    b.o00 = camera.eye - half_w * b.right + half_h * b.true_up;
+    b.o00 = camera.eye + half_w * (2 * camera.shift.x - 1) * b.right + half_h * (2 * camera.shift.y + 1) * b.true_up;
     b.ou = (2 * half_w / w) * b.right;
     b.ov = (-2 * half_h / h) * b.true_up;
     b.d00 = b.forward;
@@ -134,12 +135,16 @@ std::array<float, 16> world_to_ndc_matrix(const CameraSpec& camera, const RayBas
     proj[5] = 1 / half_tan;
     proj[10] = 1;  // z passes through; w = -z
     proj[11] = -1;
+    proj[8] = 2 * camera.shift.x;  // the shifted centre is NDC (0, 0)
+    proj[9] = 2 * camera.shift.y;
   } else {
     const double half_h = camera.ortho_height / 2;
     proj[0] = 1 / (half_h * aspect);
     proj[5] = 1 / half_h;
     proj[10] = 1;
     proj[15] = 1;
+    proj[12] = -2 * camera.shift.x;
+    proj[13] = -2 * camera.shift.y;
   }
   std::array<float, 16> out{};
   for (int r = 0; r < 4; ++r)

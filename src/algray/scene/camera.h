@@ -22,6 +22,8 @@ struct CameraAngles {
 // A scene that gives no eye is seen from these angles, from kFramingDistance times its extent's radius R (a box's
 // half-diagonal) through the default 45 degrees: the shipped scenes' framing, which shows all of the extent.
 inline constexpr double kFramingDistance = 3;
+// camera.shift's bound, in image widths and heights.
+inline constexpr double kMaxCameraShift = 100;
 
 struct CameraSpec {
   Projection projection = Projection::Perspective;
@@ -30,6 +32,9 @@ struct CameraSpec {
   glm::dvec3 up{0, 1, 0};
   double fov_y_degrees = 45;  // perspective: full vertical field of view
   double ortho_height = 2;    // orthographic: height of the view in world units
+  // The image's centre moved across the image plane by shift.x image widths to the right and shift.y heights up:
+  // an off-axis view (a shifted lens, or POV-Ray's direction not normal to its right and up). Zero: on axis.
+  glm::dvec2 shift{0, 0};
   // Set when the scene placed the camera by angles: those angles, and the up vector as written. `eye` and `up`
   // above are then the placed eye and the image's up direction (camera_from_angles).
   std::optional<CameraAngles> angles;

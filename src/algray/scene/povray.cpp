@@ -13,7 +13,10 @@
 //   P < 0. torus { R, r } lies around the y axis.
 // - The camera: direction <0, 0, 1>, right <1.33, 0, 0>, up and sky <0, 1, 0> by default; angle is the horizontal
 //   field of view and sets direction's length to |right| / 2 / tan(angle / 2). The view spans |right| across and
-//   |up| down at distance |direction|, whatever the image's size.
+//   |up| down at distance |direction|, whatever the image's size. Without look_at the rays are direction + u right
+//   + v up (u, v from -1/2 to 1/2) as written: a direction not normal to right and up (the trough and witch
+//   samples' <0, 0.1, 1.5>) is an off-axis view, its image plane still spanned by right and up; look_at makes the
+//   three normal to each other.
 // - bounded_by alone is no clip: a ray that misses the bound skips the object, one that meets it sees all of the
 //   surface along it, inside the bound or not (the hyptorus sample shows its arms beyond its bounding sphere, cut
 //   off only along the sphere's outline). No sphere or box does that for every ray, so run() picks the one that
@@ -1343,6 +1346,7 @@ class PovReader {
   void clip_planes(Translated& scene, const glm::dmat4& flip);
   std::vector<SparsePoly> algray_polys(const glm::dmat4& flip);
   void algray_view(Translated& scene);
+  void off_axis(Translated& scene, double& distance, glm::dvec3& axis);
   void fit_extent(Translated& scene);
   PovTranslation write_toml(const Translated& scene) const;
   static bool same(const Clip& a, const Clip& b) {
@@ -1703,8 +1707,10 @@ void PovReader::algray_view(Translated& scene) {
   if (glm::length(glm::cross(glm::normalize(forward), glm::normalize(up))) < 1e-9)
     fail(camera_at_ ? *camera_at_ : objects_.front().at, "the camera looks along its sky (or up) vector");
   CameraSpec& view = scene.view;
+  glm::dvec3 axis = glm::normalize(forward);
+  if (!scene.camera.look_at) off_axis(scene, distance, axis);
   view.eye = scene.camera.location * scene.mirror;
-  view.look_at = (scene.camera.location + glm::normalize(forward)) * scene.mirror;
+  view.look_at = (scene.camera.location + axis) * scene.mirror;
   view.up = up * scene.mirror;
   view.projection = scene.camera.orthographic ? Projection::Orthographic : Projection::Perspective;
   view.ortho_height = glm::length(scene.camera.up);
@@ -1716,6 +1722,38 @@ void PovReader::algray_view(Translated& scene) {
                            : std::max(1, static_cast<int>(std::lround(scene.width * glm::length(scene.camera.up) /
                                                                       glm::length(scene.camera.right)))),
                32768);
+}
+
+// A perspective camera without look_at whose direction is not normal to right and up: the image plane is the one
+// right and up span, at the tip of direction, and the view is off its axis. algray's camera then looks along the
+// plane's normal, `distance` away, with the image's centre shifted (camera.shift) to where direction meets it.
+void PovReader::off_axis(Translated& scene, double& distance, glm::dvec3& axis) {
+  const Camera& cam = scene.camera;
+  const glm::dvec3 r = glm::normalize(cam.right), u = glm::normalize(cam.up);
+  const Token& at = camera_at_ ? *camera_at_ : objects_.front().at;
+  if (std::fabs(glm::dot(r, u)) > 1e-9) {
+    warn(at, "the camera's right and up are not at right angles: POV-Ray shows the image sheared, algray does not");
+    return;
+  }
+  glm::dvec3 normal = glm::cross(r, u);
+  const glm::dvec3 direction = distance * glm::normalize(cam.direction);
+  if (glm::dot(normal, direction) < 0) normal = -normal;
+  const double along = glm::dot(normal, direction);
+  if (along <= 1e-6 * distance)
+    fail(at, "the camera's direction lies in the plane of its right and up: POV-Ray shows no image of it");
+  const glm::dvec3 off = direction - along * normal;
+  if (glm::length(off) <= 1e-12 * distance) return;  // on axis: the camera as before, bit for bit
+  if (cam.orthographic) {
+    warn(at, "an orthographic camera whose direction is not normal to right and up projects obliquely in "
+             "POV-Ray; algray projects along direction");
+    return;
+  }
+  scene.view.shift = glm::dvec2(glm::dot(off, r) / glm::length(cam.right), glm::dot(off, u) / glm::length(cam.up));
+  if (!(std::fabs(scene.view.shift.x) <= kMaxCameraShift && std::fabs(scene.view.shift.y) <= kMaxCameraShift))
+    fail(at, "the camera's direction points more than " + std::to_string(static_cast<int>(kMaxCameraShift)) +
+                 " image widths or heights off its image: algray's off-axis views go that far");
+  distance = along;
+  axis = normal;
 }
 
 void PovReader::fit_extent(Translated& scene) {
@@ -1842,6 +1880,9 @@ PovTranslation PovReader::write_toml(const Translated& scene) const {
     toml << "projection = \"orthographic\"\nheight = " << toml_number(scene.view.ortho_height) << "\n";
   else
     toml << "projection = \"perspective\"\nfov_y = " << toml_number(scene.view.fov_y_degrees) << "\n";
+  if (scene.view.shift != glm::dvec2(0))
+    toml << "shift = [" << toml_number(scene.view.shift.x) << ", " << toml_number(scene.view.shift.y)
+         << "]  # POV-Ray's direction is not normal to its right and up: an off-axis view\n";
 
   toml << "\n[image]\nwidth = " << scene.width << "\nheight = " << scene.height
        << "\nbackground = " << toml_vector(glm::min(background_.value_or(glm::dvec3(0)), glm::dvec3(1))) << "\n";

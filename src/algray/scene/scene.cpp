@@ -34,7 +34,7 @@ std::string format_what(const std::string& where, const std::string& message, co
 
 const std::set<std::string> kTopKeys{"surface", "parameters", "extent",  "camera", "image", "material",
                                      "light",   "antialias",  "render",  "section", "clip"};
-const std::set<std::string> kSectionKeys{"plane", "colour"};
+const std::set<std::string> kSectionKeys{"plane", "colour", "surface", "width"};
 const std::set<std::string> kClipKeys{"plane"};
 const std::set<std::string> kSurfaceKeys{"name", "equation", "terms", "material"};
 const std::set<std::string> kExtentKeys = [] {
@@ -45,7 +45,7 @@ const std::set<std::string> kExtentKeys = [] {
 // The eye, or the angles about look_at (camera.h's CameraAngles): one or the other.
 const std::set<std::string> kCameraAngleKeys{"azimuth", "elevation", "distance"};
 const std::set<std::string> kCameraKeys{"projection", "eye",     "look_at",   "up",      "fov_y",
-                                        "height",     "azimuth", "elevation", "distance"};
+                                        "height",     "azimuth", "elevation", "distance", "shift"};
 const std::set<std::string> kImageKeys{"width", "height", "background"};
 const std::set<std::string> kMaterialKeys{"front", "back"};
 const std::set<std::string> kMaterialSideKeys{"colour",   "ambient",      "diffuse",     "specular",
@@ -793,6 +793,15 @@ void read_camera(const TomlReader& r, const toml::table& root, const Extent& ext
     r.fail(camera->get("projection")->source(),
            "an orthographic camera needs camera.height (the view height in world units)");
   }
+  // An off-axis view: the image's centre moved across the image plane, in image widths and heights.
+  if (const toml::node* n = camera->get("shift")) {
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != 2)
+      r.fail(n->source(), "camera.shift must be an array of 2 numbers [x, y] (image widths right, heights up)");
+    for (int i = 0; i < 2; ++i)
+      cam.shift[i] = r.number_in(*a->get(static_cast<std::size_t>(i)), "camera.shift[" + std::to_string(i) + "]",
+                                 -kMaxCameraShift, kMaxCameraShift);
+  }
 }
 
 void read_image(const TomlReader& r, const toml::table& root, ImageSpec& out) {
@@ -876,8 +885,9 @@ void read_lights(const TomlReader& r, const toml::table& root, const CameraSpec&
   for (const toml::node& node : *list) out.push_back(read_light(r, *node.as_table(), camera, out.size()));
 }
 
-// [[section]] tables: plane = [a, b, c, d] (a plane: (a, b, c) not zero) and an optional colour.
-void read_sections(const TomlReader& r, const toml::table& root, std::vector<Section>& out) {
+// [[section]] tables: plane = [a, b, c, d] (a plane: (a, b, c) not zero), an optional colour, width in pixels and
+// surface (the index of the one surface it cuts, from 0 as --set counts them; every surface without it).
+void read_sections(const TomlReader& r, const toml::table& root, std::size_t surfaces, std::vector<Section>& out) {
   const toml::node* sections = root.get("section");
   if (!sections) return;
   const toml::array* list = sections->as_array();
@@ -897,6 +907,13 @@ void read_sections(const TomlReader& r, const toml::table& root, std::vector<Sec
     if (s.plane.x == 0 && s.plane.y == 0 && s.plane.z == 0)
       r.fail(plane->source(), "section.plane is no plane: a, b and c are all 0");
     if (const toml::node* c = t.get("colour")) s.colour = glm::dvec3(r.colour(*c, "section.colour", false));
+    if (const toml::node* w = t.get("width")) {
+      s.width = r.number_in(*w, "section.width", 0, kMaxSectionWidth);
+      if (s.width == 0) r.fail(w->source(), "section.width must be above 0 (pixels)");
+    }
+    if (const toml::node* n = t.get("surface"))
+      s.surface = static_cast<int>(r.integer(*n, "section.surface (the surface's index, from 0)", 0,
+                                             static_cast<long long>(surfaces) - 1));
     out.push_back(s);
   }
 }
@@ -1015,7 +1032,7 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
   read_image(r, root, scene.image);
   read_surface_materials(r, root, surface_tables, scene.surfaces);
   read_lights(r, root, scene.camera, scene.lights);
-  read_sections(r, root, scene.sections);
+  read_sections(r, root, scene.surfaces.size(), scene.sections);
   if (framed && !root.get("light")) scene.lights = framing_lights(scene.extent.unit_scale(), scene.camera);
   // 2x2 unless the scene gives antialias.samples (a --set antialias.adaptive=true alone keeps the 2x2).
   const toml::table* aa = root["antialias"].as_table();
@@ -1290,6 +1307,8 @@ void write_camera(std::ostringstream& out, const CameraSpec& c) {
       << "\"\neye = " << toml_vector(c.eye) << "\nlook_at = " << toml_vector(c.look_at)
       << "\nup = " << toml_vector(c.up) << "\n"
       << (perspective ? "fov_y = " + toml_number(c.fov_y_degrees) : "height = " + toml_number(c.ortho_height)) << "\n";
+  if (c.shift != glm::dvec2(0))
+    out << "shift = [" << toml_number(c.shift.x) << ", " << toml_number(c.shift.y) << "]\n";
 }
 
 void write_lights(std::ostringstream& out, const std::vector<Light>& lights) {
@@ -1343,7 +1362,8 @@ std::string scene_to_toml(const Scene& scene) {
   for (const Section& sec : scene.sections)
     out << "\n[[section]]\nplane = [" << toml_number(sec.plane.x) << ", " << toml_number(sec.plane.y) << ", "
         << toml_number(sec.plane.z) << ", " << toml_number(sec.plane.w) << "]\ncolour = " << toml_vector(sec.colour)
-        << "\n";
+        << "\n" << (sec.surface >= 0 ? "surface = " + std::to_string(sec.surface) + "\n" : "")
+        << (sec.width != 1 ? "width = " + toml_number(sec.width) + "\n" : "");
   for (const glm::dvec4& c : scene.extent.clips)
     out << "\n[[clip]]\nplane = [" << toml_number(c.x) << ", " << toml_number(c.y) << ", " << toml_number(c.z) << ", "
         << toml_number(c.w) << "]\n";

@@ -71,11 +71,14 @@ struct Extent {
 inline constexpr std::size_t kMaxClipPlanes = 4;
 
 // A plane section, surf's cut_with_plane: the curve where the plane a*x + b*y + c*z + d = 0 meets the surface,
-// drawn over the shading in `colour` as a line one pixel wide (shade.cpp).
+// drawn over the shading in `colour` as a line `width` pixels wide (shade.cpp), on every surface or on one.
 struct Section {
   glm::dvec4 plane{0, 0, 1, 0};  // a, b, c, d
   glm::dvec3 colour{0.05, 0.05, 0.05};
+  int surface = -1;    // the index in Scene::surfaces of the one surface it cuts; -1: every surface
+  double width = 1;    // in pixels
 };
+inline constexpr double kMaxSectionWidth = 64;
 
 struct ImageSpec {
   int width = 800;

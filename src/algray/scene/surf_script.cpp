@@ -13,6 +13,12 @@
 //   the slab clip_back <= z <= clip_front.
 // - Unary minus binds tighter than ^ (-x^2 is x^2), ^ is left-associative, and / divides integers as reals.
 // - Lights are fixed in screen space; their default places are the 3 x 3 grid (-100..100, 100..-100, 100).
+// - cut_with_plane draws, on the picture drawn last, the curve where `plane` meets surface number surf_nr
+//   (surface_n is the same variable; 1 by default), hidden where another surface is in front. The plane is in the
+//   surfaces' own coordinates and moves with them (rot_x = 0.8 shows y = 0 as a tilted ellipse; scale_x = 2 shows
+//   x = 1 at 0.5). The curve is curve_width / 400 of the image's shorter side wide (3 by default), in
+//   curve_red/green/blue (white by default) shaded like the surface. A plane with no z once moved (seen edge-on)
+//   gets no curve at all.
 #include "algray/scene/surf_script.h"
 
 #include <algorithm>
@@ -37,6 +43,7 @@ namespace {
 constexpr long kMaxStatements = 200000;
 constexpr int kSurfaces = 9;
 constexpr int kLights = 9;
+constexpr std::size_t kMaxCuts = 64;  // cut_with_plane on one picture
 
 struct Token {
   enum Kind { Name, Int, Real, String, Op, End } kind = End;
@@ -82,9 +89,8 @@ const std::set<std::string>& no_effect_names() {
       "filename", "color_file_format", "color_file_colormap", "dither_file_format", "dither_colors", "dither_steps",
       "dithering_method", "serpentine_raster", "random_weights", "weight", "barons", "pattern_size", "enhance_edges",
       "alpha", "background", "tone_scale_adjustment", "gamma", "pixel_size", "print_resolution", "resolution",
-      "optimize_colors", "epsilon", "iterations", "root_finder", "curve", "curve_red", "curve_green", "curve_blue",
-      "curve_width", "curve_gamma", "plane", "surf_nr", "do_background", "cutsurface1", "cutsurface2", "jpeg_quality",
-      "color_slider"};
+      "optimize_colors", "epsilon", "iterations", "root_finder", "curve", "curve_gamma", "do_background",
+      "cutsurface1", "cutsurface2", "jpeg_quality", "color_slider"};
   return names;
 }
 
@@ -135,6 +141,11 @@ std::map<std::string, Value> reserved_defaults() {
   d("clip_front", 10);
   d("clip_back", -10);
   i("illumination", 7);
+  // cut_with_plane's plane and the curve it draws (see Script::cut).
+  v["plane"] = Value::of_poly({});
+  i("surf_nr", 1);
+  for (const char* c : {"red", "green", "blue"}) i(std::string("curve_") + c, 255);
+  d("curve_width", 3);
   for (const char* c : {"red", "green", "blue"}) i(std::string("background_") + c, 0);
   for (int n = 1; n <= kSurfaces; ++n) {
     const std::string s = surface_suffix(n);
@@ -167,6 +178,7 @@ std::map<std::string, Value> reserved_defaults() {
 // surf spells some names two ways.
 std::string canonical_name(const std::string& name) {
   static const std::string volume = "_volume", transparency = "transparency";
+  if (name == "surface_n") return "surf_nr";
   if (name.size() > volume.size() && name.compare(name.size() - volume.size(), volume.size(), volume) == 0)
     return name.substr(0, name.size() - volume.size()) + "_vol";
   if (name.compare(0, transparency.size(), transparency) == 0)
@@ -194,9 +206,18 @@ class Script {
   SurfTranslation run(int width, int height);
 
  private:
+  // A plane section drawn on a picture: the values cut_with_plane read, where it ran.
+  struct Cut {
+    Poly plane;  // in the script's own coordinates, as the surfaces are
+    int surface = 1;
+    glm::dvec3 colour;  // 0..255
+    double width = 1;
+    Token at;
+  };
   struct Snapshot {
     std::map<std::string, Value> globals;
     Token at;
+    std::vector<Cut> cuts;  // the cut_with_plane runs after this draw_surface, in order
   };
 
   // --- messages ---
@@ -644,14 +665,13 @@ class Script {
       for (const auto& [key, v] : globals_) terms += 1 + static_cast<double>(v.poly.terms.size());
       budget_.work += terms;
       if (budget_.work > budget_.limit) fail(name, "the script's pictures and arithmetic are too large to follow here");
-      last_drawn_ = Snapshot{globals_, name};
+      last_drawn_ = Snapshot{globals_, name, {}};
       ++draws_;
     } else if (c == "save_color_image") {
       if (last_drawn_ && !first_saved_) first_saved_ = last_drawn_;
       if (last_drawn_) ++saves_;
     } else if (c == "cut_with_plane") {
-      warn_once(name, c, "cut_with_plane: algray has no plane sections yet, so the curve where the plane meets the "
-                         "surface is not drawn");
+      cut(name);
     } else if (c == "draw_curve") {
       warn_once(name, c, "draw_curve: algray draws surfaces, not plane curves; ignored");
       curve_at_ = name;
@@ -660,6 +680,45 @@ class Script {
     } else if (!quiet_commands().count(c)) {
       warn_once(name, c, "'" + c + "' is no command algray follows in surf scripts; ignored");
     }
+  }
+  // cut_with_plane: the curve where `plane` meets surface number surf_nr, drawn on the picture draw_surface drew
+  // last in the curve's colour and width; written as a [[section]] of that surface (translate()).
+  void cut(const Token& at) {
+    if (!last_drawn_) {
+      warn_once(at, "cut_with_plane", "cut_with_plane before any draw_surface: surf draws the section on the picture "
+                                      "drawn last, and there is none yet; ignored");
+      return;
+    }
+    if (last_drawn_->cuts.size() >= kMaxCuts)
+      fail(at, "more than " + std::to_string(kMaxCuts) + " cut_with_plane on one picture; algray draws up to " +
+                   std::to_string(kMaxCuts));
+    Cut k;
+    k.at = at;
+    k.plane = globals_.at("plane").poly;
+    if (k.plane.degree() != 1)
+      fail(set_at_now("plane", at), "cut_with_plane needs plane to be linear in x, y and z (plane = z; or plane = "
+                                "x+y-1;); it is " + (k.plane.degree() < 1 ? std::string("a constant")
+                                                                          : "of degree " +
+                                                                                std::to_string(k.plane.degree())));
+    const double n = globals_.at("surf_nr").number;
+    if (n != std::trunc(n) || n < 1 || n > kSurfaces)
+      fail(set_at_now("surf_nr", at), "surf_nr must be a surface's number, 1 to " + std::to_string(kSurfaces));
+    k.surface = static_cast<int>(n);
+    for (int i = 0; i < 3; ++i) {
+      const std::string key = std::string("curve_") + (i == 0 ? "red" : i == 1 ? "green" : "blue");
+      k.colour[i] = globals_.at(key).number;
+      if (k.colour[i] < 0 || k.colour[i] > 255) fail(set_at_now(key, at), key + " must be between 0 and 255");
+    }
+    k.width = globals_.at("curve_width").number;
+    if (!(k.width > 0 && k.width <= kMaxSectionWidth))
+      fail(set_at_now("curve_width", at), "curve_width must be above 0 and at most " +
+                                          std::to_string(static_cast<int>(kMaxSectionWidth)) + " (pixels)");
+    last_drawn_->cuts.push_back(std::move(k));
+  }
+  // Where a reserved value was last set, or `otherwise` where it was never set.
+  const Token& set_at_now(const std::string& key, const Token& otherwise) const {
+    const auto it = assigned_at_.find(key);
+    return it != assigned_at_.end() ? it->second : otherwise;
   }
   void if_goto(const Token& at) {
     expect("(", "'(' after if");
@@ -722,6 +781,7 @@ class Script {
     glm::dvec3 centre;
     double radius, clip;
     double width, height;  // the script's image size
+    double rendered_width, rendered_height;  // the size it is rendered at
     double half_w, half_h;
     bool central;
     double spec_z;
@@ -729,7 +789,11 @@ class Script {
   std::string translate(const Snapshot& s);
   Affine screen_to_script(const Snapshot& s) const;
   Affine undone_position_step(const Snapshot& s, const char* order) const;
-  void write_surfaces(std::ostringstream& toml, const Snapshot& s, const Affine& inverse);
+  // Writes the surfaces; surface number n (1..9) becomes algray's surface index_of[n], -1 where it is empty.
+  void write_surfaces(std::ostringstream& toml, const Snapshot& s, const Affine& inverse,
+                      std::array<int, kSurfaces + 1>& index_of);
+  void write_sections(std::ostringstream& toml, const Snapshot& s, const Affine& inverse,
+                      const std::array<int, kSurfaces + 1>& index_of, const View& v);
   void write_material(std::ostringstream& toml, const Snapshot& s, const std::string& sfx, const char* side,
                       bool transmitted) const;
   View view(const Snapshot& s) const;
@@ -803,8 +867,10 @@ Script::Affine Script::undone_position_step(const Snapshot& s, const char* order
   return step;
 }
 
-void Script::write_surfaces(std::ostringstream& toml, const Snapshot& s, const Affine& inverse) {
+void Script::write_surfaces(std::ostringstream& toml, const Snapshot& s, const Affine& inverse,
+                            std::array<int, kSurfaces + 1>& index_of) {
   int surfaces = 0;
+  index_of.fill(-1);
   const bool transmitted = (static_cast<long>(number(s, "illumination")) & 8) != 0;
   const std::size_t slash = source_.find_last_of('/');
   for (int n = 1; n <= kSurfaces; ++n) {
@@ -814,6 +880,7 @@ void Script::write_surfaces(std::ostringstream& toml, const Snapshot& s, const A
     const Token& at = set_at(s, "surface" + sfx);
     const Poly p = substitute(own, inverse, at);
     if (p.degree() < 1) fail(at, "surface" + sfx + " is a constant after its position is applied; nothing to draw");
+    index_of[static_cast<std::size_t>(n)] = surfaces;
     ++surfaces;
     toml << "\n[[surface]]\nname = " << toml_quoted(source_.substr(slash == std::string::npos ? 0 : slash + 1) +
                                                    (n == 1 ? "" : " surface" + sfx))
@@ -831,6 +898,50 @@ void Script::write_surfaces(std::ostringstream& toml, const Snapshot& s, const A
   if (surfaces > static_cast<int>(kMaxSurfaces))
     fail(s.at, std::to_string(surfaces) + " surfaces: algray draws up to " + std::to_string(kMaxSurfaces) +
                    " in one scene");
+}
+
+// Each cut_with_plane as a [[section]] of its surface. The plane is in the script's own coordinates, as the
+// surfaces are, and moves with them: L(inverse x), still linear. surf draws the curve curve_width / 400 of the
+// image's shorter side wide, and draws nothing for a plane seen edge-on (no z in screen space): nor does algray.
+void Script::write_sections(std::ostringstream& toml, const Snapshot& s, const Affine& inverse,
+                            const std::array<int, kSurfaces + 1>& index_of, const View& v) {
+  const double pixels_per_width = std::min(v.rendered_width, v.rendered_height) / 400;
+  for (const Cut& k : s.cuts) {
+    const int index = index_of[static_cast<std::size_t>(k.surface)];
+    if (index < 0) {
+      warn(k.at, "cut_with_plane cuts surface" + surface_suffix(k.surface) + " (surf_nr = " +
+                     std::to_string(k.surface) + "), which is not set when draw_surface runs; nothing is drawn");
+      continue;
+    }
+    const Poly plane = substitute(k.plane, inverse, k.at);
+    double abcd[4] = {0, 0, 0, 0};
+    for (const auto& [e, c] : plane.terms) {
+      if (!std::isfinite(c)) fail(k.at, "the plane's coefficients overflow after the position settings are applied");
+      if (e[0] + e[1] + e[2] == 0) abcd[3] += c;
+      for (int i = 0; i < 3; ++i)
+        if (e[static_cast<std::size_t>(i)] == 1) abcd[i] += c;
+    }
+    // Scaled to a unit largest normal component, so that its numbers are coordinates the scene reader takes.
+    const double largest = std::max({std::fabs(abcd[0]), std::fabs(abcd[1]), std::fabs(abcd[2])});
+    if (!(largest > 0))
+      fail(k.at, "the plane is no plane after the position settings are applied (a scale of 0?)");
+    for (double& c : abcd) c /= largest;
+    if (!(std::fabs(abcd[3]) <= 1e15)) {
+      warn(k.at, "cut_with_plane: the plane lies too far away to meet what is drawn; nothing is drawn");
+      continue;
+    }
+    if (std::fabs(abcd[2]) <= 1e-12 * std::hypot(abcd[0], abcd[1])) {
+      warn(k.at, "cut_with_plane: the plane is seen edge-on (it holds the viewing direction), where surf draws no "
+                 "section; nor does algray (--section draws it)");
+      continue;
+    }
+    glm::dvec3 colour;
+    for (int i = 0; i < 3; ++i) colour[i] = srgb_to_linear(k.colour[i] / 255);  // display values, as surfaces' are
+    toml << "\n[[section]]  # cut_with_plane at " << where(k.at) << "\nplane = [" << toml_number(abcd[0]) << ", "
+         << toml_number(abcd[1]) << ", " << toml_number(abcd[2]) << ", " << toml_number(abcd[3])
+         << "]\ncolour = " << toml_vector(colour) << "\nsurface = " << index
+         << "\nwidth = " << toml_number(std::clamp(k.width * pixels_per_width, 1e-3, kMaxSectionWidth)) << "\n";
+  }
 }
 
 void Script::write_material(std::ostringstream& toml, const Snapshot& s, const std::string& sfx, const char* side,
@@ -861,6 +972,8 @@ Script::View Script::view(const Snapshot& s) const {
   // The framing follows the size the image is rendered at, which --set or --width may change.
   const double fw = rendered_width_ > 0 ? rendered_width_ : v.width;
   const double fh = rendered_height_ > 0 ? rendered_height_ : v.height;
+  v.rendered_width = fw;
+  v.rendered_height = fh;
   v.half_w = 10 * fw / std::min(fw, fh);
   v.half_h = 10 * fh / std::min(fw, fh);
   v.central = number(s, "perspective") != 0;
@@ -930,11 +1043,14 @@ void Script::write_lights(std::ostringstream& toml, const Snapshot& s) const {
 std::string Script::translate(const Snapshot& s) {
   std::ostringstream toml;
   toml << "# Translated from " << source_ << " (surf script)\n";
-  write_surfaces(toml, s, screen_to_script(s));
+  const Affine inverse = screen_to_script(s);
+  std::array<int, kSurfaces + 1> index_of{};
+  write_surfaces(toml, s, inverse, index_of);
   const View v = view(s);
   write_extent(toml, s, v);
   write_camera_and_image(toml, s, v);
   write_lights(toml, s);
+  write_sections(toml, s, inverse, index_of, v);
   return toml.str();
 }
 
