@@ -126,7 +126,7 @@ TEST_CASE("the screen form meets the double line on seeded random surfaces of ev
   Renderer renderer(session, cache);
   // Every degree under the `exhaustive` label; otherwise the ends and a seeded sample (the reference costs ~1 s a
   // degree).
-  for (int degree : testing::sampled_degrees("test_reference_agree random surface degrees", kMaxDegree, 5))
+  for (int degree : testing::sampled_degrees("test_reference_agree random surface degrees", kMaxDegree, 3))
     for (unsigned seed : {1000u + static_cast<unsigned>(degree)}) {
       const Scene scene = load_scene_text(random_scene(degree, seed, Precision::Double), "random");
       const RenderResult kernel = renderer.render_with_records(scene);

@@ -162,7 +162,7 @@ TEST_CASE("batched shadow rays answer as the serial ones, bit for bit, at every 
     for (std::size_t c = 0; c < std::size(cases); ++c)
       if (!compensated || cases[c].degree <= kMaxMixedDegree) indices.push_back(static_cast<int>(c));
     if (precision == Precision::Adaptive) always.insert(always.end(), {3, 5});
-    for (int index : testing::sampled("test_shadows_batched " + to_string(precision) + " cases", indices, always, 3)) {
+    for (int index : testing::sampled("test_shadows_batched " + to_string(precision) + " cases", indices, always, 2)) {
       const std::size_t c = static_cast<std::size_t>(index);
       const Case& k = cases[c];
       const unsigned seed = kSeed + 100 * static_cast<unsigned>(precision) + static_cast<unsigned>(c);
