@@ -118,6 +118,26 @@ void check_adaptive_without_fp64(const std::vector<std::filesystem::path>& files
   for (const auto& file : files) check_scene(renderer, file, "adaptive", "adapt-ff");
 }
 
+// A clipped scene against its reference: in double 0 disagreements, with one ray per work-item too (the scalar
+// instance of the clipping in kernels/ray.h, 16 lanes the vector one: the same hits); otherwise the float line.
+void check_clipped_agreement(Renderer& renderer, const Scene& scene, const ReferenceResult& ref,
+                             const ReferenceComparison& c, bool is_double) {
+  if (!is_double) {
+    CHECK(static_cast<double>(c.disagreements) <=
+          testing::kFloatImage.disagreement_share * static_cast<double>(c.certified));
+    CHECK(c.worst_depth <= testing::kFloatImage.depth_error);
+    return;
+  }
+  CHECK(c.disagreements == 0);
+  CHECK(c.worst_depth <= testing::kDoubleImage.depth_error);
+  Scene one_lane = scene;
+  one_lane.render.lanes = 1;
+  const ReferenceComparison c1 = compare_with_reference(renderer.render_with_records(one_lane).hits, ref);
+  INFO("one lane: " << c1.disagreements << " of " << c1.certified << " disagree");
+  CHECK(c1.disagreements == 0);
+  CHECK(c1.simple_hits == c.simple_hits);
+}
+
 }  // namespace
 
 TEST_CASE("the screen form meets the double line on seeded random surfaces of every degree", "[reference]") {
@@ -244,22 +264,7 @@ TEST_CASE("a cylinder extent about each axis clips as the certified reference do
       CHECK(c.simple_hits > 64 * 48 / 16);
       CHECK(outside > 0);         // rays that miss the cylinder
       CHECK(cut > 64 * 48 / 100);  // pixels of the surface that the cylinder cut away
-      if (is_double) {
-        CHECK(c.disagreements == 0);
-        CHECK(c.worst_depth <= testing::kDoubleImage.depth_error);
-        // One ray per work-item clips in the scalar instance of the clipping (kernels/ray.h), 16 in the vector
-        // one: the same hits.
-        Scene one_lane = scene;
-        one_lane.render.lanes = 1;
-        const ReferenceComparison c1 = compare_with_reference(renderer.render_with_records(one_lane).hits, ref);
-        INFO("one lane: " << c1.disagreements << " of " << c1.certified << " disagree");
-        CHECK(c1.disagreements == 0);
-        CHECK(c1.simple_hits == c.simple_hits);
-      } else {
-        CHECK(static_cast<double>(c.disagreements) <=
-              testing::kFloatImage.disagreement_share * static_cast<double>(c.certified));
-        CHECK(c.worst_depth <= testing::kFloatImage.depth_error);
-      }
+      check_clipped_agreement(renderer, scene, ref, c, is_double);
     }
   }
 }
@@ -335,23 +340,8 @@ TEST_CASE("clipping planes cut each surface as the certified reference does: 0 d
       CHECK(c.certified > 64 * 48 / 8);
       CHECK(c.simple_hits > 64 * 48 / 32);
       CHECK(cut > 64 * 48 / 100);  // pixels of the surface that the planes cut away
-      if (is_double) {
-        CHECK(added == 0);  // a cut takes surface away, never adds any
-        CHECK(c.disagreements == 0);
-        CHECK(c.worst_depth <= testing::kDoubleImage.depth_error);
-        // One ray per work-item clips in the scalar instance of the cut (kernels/ray.h): the same hits.
-        Scene one_lane = scene;
-        one_lane.render.lanes = 1;
-        const RenderResult single = renderer.render_with_records(one_lane);
-        const ReferenceComparison c1 = compare_with_reference(single.hits, ref);
-        INFO("one lane: " << c1.disagreements << " of " << c1.certified << " disagree");
-        CHECK(c1.disagreements == 0);
-        CHECK(c1.simple_hits == c.simple_hits);
-      } else {
-        CHECK(static_cast<double>(c.disagreements) <=
-              testing::kFloatImage.disagreement_share * static_cast<double>(c.certified));
-        CHECK(c.worst_depth <= testing::kFloatImage.depth_error);
-      }
+      if (is_double) CHECK(added == 0);  // a cut takes surface away, never adds any
+      check_clipped_agreement(renderer, scene, ref, c, is_double);
     }
   }
 }
