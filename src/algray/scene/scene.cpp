@@ -875,37 +875,47 @@ void write_framing_lights(const TomlReader& r, toml::table& root) {
   root.insert_or_assign("light", std::move(lights));
 }
 
+// The [[key]] tables of root; none where it is absent or `key = []`. Anything else is a located error, `written`.
+const toml::array* table_list(const TomlReader& r, const toml::table& root, const char* key, const char* written) {
+  const toml::node* node = root.get(key);
+  if (!node) return nullptr;
+  const toml::array* list = node->as_array();
+  if (list && list->empty()) return nullptr;
+  if (!list || !list->is_array_of_tables()) r.fail(node->source(), written);
+  return list;
+}
+
 void read_lights(const TomlReader& r, const toml::table& root, const CameraSpec& camera, std::vector<Light>& out) {
-  const toml::node* lights = root.get("light");
-  if (!lights) return;
-  const toml::array* list = lights->as_array();
-  if (list && list->empty()) return;  // light = []: the headlight
-  if (!list || !list->is_array_of_tables())
-    r.fail(lights->source(), "lights are written as [[light]] tables, one per light");
+  // light = []: the headlight
+  const toml::array* list = table_list(r, root, "light", "lights are written as [[light]] tables, one per light");
+  if (!list) return;
   for (const toml::node& node : *list) out.push_back(read_light(r, *node.as_table(), camera, out.size()));
+}
+
+// A [[section]] or [[clip]] table's plane = [a, b, c, d], (a, b, c) not zero; `meaning` says what the plane does.
+glm::dvec4 read_plane(const TomlReader& r, const toml::table& t, const std::string& name, const std::string& meaning) {
+  const toml::node* plane = t.get("plane");
+  if (!plane) r.fail(t.source(), "a " + name + " needs plane = [a, b, c, d] (" + meaning + ")");
+  const toml::array* a = plane->as_array();
+  if (!a || a->size() != 4) r.fail(plane->source(), name + ".plane must be an array of 4 numbers [a, b, c, d]");
+  glm::dvec4 p;
+  for (int i = 0; i < 4; ++i)
+    p[i] = r.coordinate(*a->get(static_cast<std::size_t>(i)), name + ".plane[" + std::to_string(i) + "]");
+  if (p.x == 0 && p.y == 0 && p.z == 0) r.fail(plane->source(), name + ".plane is no plane: a, b and c are all 0");
+  return p;
 }
 
 // [[section]] tables: plane = [a, b, c, d] (a plane: (a, b, c) not zero), an optional colour, width in pixels and
 // surface (the index of the one surface it cuts, from 0 as --set counts them; every surface without it).
 void read_sections(const TomlReader& r, const toml::table& root, std::size_t surfaces, std::vector<Section>& out) {
-  const toml::node* sections = root.get("section");
-  if (!sections) return;
-  const toml::array* list = sections->as_array();
-  if (list && list->empty()) return;  // section = []: none
-  if (!list || !list->is_array_of_tables())
-    r.fail(sections->source(), "plane sections are written as [[section]] tables, one per plane");
+  const toml::array* list =
+      table_list(r, root, "section", "plane sections are written as [[section]] tables, one per plane");
+  if (!list) return;
   for (const toml::node& node : *list) {
     const toml::table& t = *node.as_table();
     r.check_keys(t, "section." + std::to_string(out.size()), kSectionKeys);
     Section s;
-    const toml::node* plane = t.get("plane");
-    if (!plane) r.fail(t.source(), "a section needs plane = [a, b, c, d] (the plane a*x + b*y + c*z + d = 0)");
-    const toml::array* a = plane->as_array();
-    if (!a || a->size() != 4) r.fail(plane->source(), "section.plane must be an array of 4 numbers [a, b, c, d]");
-    for (int i = 0; i < 4; ++i)
-      s.plane[i] = r.coordinate(*a->get(static_cast<std::size_t>(i)), "section.plane[" + std::to_string(i) + "]");
-    if (s.plane.x == 0 && s.plane.y == 0 && s.plane.z == 0)
-      r.fail(plane->source(), "section.plane is no plane: a, b and c are all 0");
+    s.plane = read_plane(r, t, "section", "the plane a*x + b*y + c*z + d = 0");
     if (const toml::node* c = t.get("colour")) s.colour = glm::dvec3(r.colour(*c, "section.colour", false));
     if (const toml::node* w = t.get("width")) {
       s.width = r.number_in(*w, "section.width", 0, kMaxSectionWidth);
@@ -921,28 +931,15 @@ void read_sections(const TomlReader& r, const toml::table& root, std::size_t sur
 // [[clip]] tables: plane = [a, b, c, d], the half-space a*x + b*y + c*z + d <= 0 kept ((a, b, c) not zero); at
 // most kMaxClipPlanes of them.
 void read_clips(const TomlReader& r, const toml::table& root, std::vector<glm::dvec4>& out) {
-  const toml::node* clips = root.get("clip");
-  if (!clips) return;
-  const toml::array* list = clips->as_array();
-  if (list && list->empty()) return;  // clip = []: none
-  if (!list || !list->is_array_of_tables())
-    r.fail(clips->source(), "clipping planes are written as [[clip]] tables, one per plane");
+  const toml::array* list = table_list(r, root, "clip", "clipping planes are written as [[clip]] tables, one per plane");
+  if (!list) return;
   for (const toml::node& node : *list) {
     const toml::table& t = *node.as_table();
     if (out.size() == kMaxClipPlanes)
       r.fail(t.source(), "at most " + std::to_string(kMaxClipPlanes) + " clipping planes ([[clip]] tables) cut a " +
                              "scene; this is clip." + std::to_string(out.size()));
     r.check_keys(t, "clip." + std::to_string(out.size()), kClipKeys);
-    const toml::node* plane = t.get("plane");
-    if (!plane)
-      r.fail(t.source(), "a clip needs plane = [a, b, c, d] (the half-space a*x + b*y + c*z + d <= 0 is kept)");
-    const toml::array* a = plane->as_array();
-    if (!a || a->size() != 4) r.fail(plane->source(), "clip.plane must be an array of 4 numbers [a, b, c, d]");
-    glm::dvec4 p;
-    for (int i = 0; i < 4; ++i)
-      p[i] = r.coordinate(*a->get(static_cast<std::size_t>(i)), "clip.plane[" + std::to_string(i) + "]");
-    if (p.x == 0 && p.y == 0 && p.z == 0) r.fail(plane->source(), "clip.plane is no plane: a, b and c are all 0");
-    out.push_back(p);
+    out.push_back(read_plane(r, t, "clip", "the half-space a*x + b*y + c*z + d <= 0 is kept"));
   }
 }
 
