@@ -124,6 +124,12 @@
 #ifndef ALGRAY_TERMS_FACTOR
 #define ALGRAY_TERMS_FACTOR 0.25f
 #endif
+/* The screen form's terms (surface.h, screen_terms) count this many times the extent construction's in the noise:
+ * its coefficients come through two Horner chains, in the column and then along the ray, where the extent
+ * construction's come through one. */
+#ifndef ALGRAY_SCREEN_TERMS_WEIGHT
+#define ALGRAY_SCREEN_TERMS_WEIGHT 2
+#endif
 /* The noise local to an interval of a shadow ray, this many times (local_noise). */
 #ifndef ALGRAY_LOCAL_FACTOR
 #define ALGRAY_LOCAL_FACTOR 16

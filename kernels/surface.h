@@ -16,8 +16,11 @@
 #if ALGRAY_ESCALATE && !ISOLATION_ADAPTIVE
 #error "adaptive precision needs an isolation method that doubts (ISOLATION_ADAPTIVE)"
 #endif
-#if RAY_ORIGIN != ALGRAY_ORIGIN_EXTENT && ALGRAY_ESCALATE
-#error "adaptive precision builds P*(t) on the segment (RAY_ORIGIN=extent), whose terms it measures its noise by"
+#if RAY_ORIGIN != ALGRAY_ORIGIN_EXTENT && RAY_ORIGIN != ALGRAY_ORIGIN_SCREEN && ALGRAY_ESCALATE
+#error "adaptive precision measures its noise by the terms of the extent construction or of the screen form"
+#endif
+#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && ALGRAY_ESCALATE && LANES > 1 && DEGREE > 15
+#error "adaptive precision's screen form in lanes is screen_coefficients' (DEGREE <= 15, as adaptive itself)"
 #endif
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && ALGRAY_COMPENSATED
 #error "RAY_ORIGIN=screen is built in plain float or double"
@@ -39,6 +42,40 @@ ALGRAY_INLINE REAL screen_column(uint px, REAL xi_scale, REAL xi_offset) {
 /* Image row py's polynomials in xi (screen_taylor's row). */
 ALGRAY_INLINE __global const REAL* screen_row(__global const REAL* rows, uint py, uint row0) {
   return rows + (size_t)(py - row0) * (NCOEF * NCOEF);
+}
+
+/* Adaptive builds: the size of the terms the screen form sums a ray's coefficients from, of one ray or of lanes:
+ * sum over k of (sum over j of |row's xi^j coefficient of tau^k| |xi|^j) reach^k, reach the larger |tau| at the
+ * segment's ends. Each Bernstein coefficient on the segment is a sum of the Taylor coefficients times products of
+ * |tau| <= reach, and each Taylor coefficient a Horner sum of the row's, so this bounds what every coefficient was
+ * summed from, as RayTerms' sum does for the extent construction; the noise is measured alike (isolation.h,
+ * DOUBT_NOISE), with ALGRAY_SCREEN_TERMS_WEIGHT for the screen form's two Horner chains where the extent
+ * construction has one, and 2^-10 more for this sum's own rounding. */
+LREAL screen_terms(__global const REAL* row, LREAL xi, LREAL tau_in, LREAL tau_out) {
+  const LREAL ax = fabs(xi), reach = fmax(fabs(tau_in), fabs(tau_out));
+  LREAL total = 0;
+  for (int k = DEGREE; k >= 0; --k) {
+    LREAL coefficient = fabs((LREAL)row[DEGREE * NCOEF + k]);
+    for (int j = DEGREE - 1; j >= 0; --j) coefficient = coefficient * ax + fabs(row[j * NCOEF + k]);
+    total = total * reach + coefficient;
+  }
+  return total * (REAL)(ALGRAY_SCREEN_TERMS_WEIGHT * (1 + 1.0 / 1024));
+}
+
+/* Adaptive builds: a camera ray's terms in the screen form (screen_terms, exact from the start) with what the search
+ * evaluates P from in float-float: the ray in unit coordinates, its segment, and the monomials. */
+RayTerms screen_ray_terms(REAL value, REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
+                          __global const REAL* coefs, uint count) {
+  RayTerms t = known_terms(value);
+  t.exps = exps;
+  t.coefs = coefs;
+  t.count = count;
+  t.has_ray = 1;
+  t.o = o;
+  t.d = d;
+  t.t_in = t_in;
+  t.t_out = t_out;
+  return t;
 }
 
 /* Pixel (px, py)'s Taylor coefficients; returns the t they are expanded about. */
@@ -518,8 +555,19 @@ int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, R
   /* lanes outside the extent start from zeros, as isolate_rays gives them */
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) lane_root[k] = LANE_SEL((LREAL)0, lane_root[k], running);
-  isolate_bernstein_search(running, lane_root, lane_root, lane_t_in, lane_t_out, &iso, iso_c, (LaneTerms*)0,
-                           probe_log);
+  LaneTerms screen_lanes;
+  if (ALGRAY_ESCALATE) {
+    screen_lanes.value =
+        LANE_SEL((LREAL)0,
+                 screen_terms(screen_row(screen_rows, py, screen_row0), xi, lane_t_in - screen_t, lane_t_out - screen_t),
+                 running);
+    screen_lanes.rays = &unit;
+    screen_lanes.exps = exps;
+    screen_lanes.coefs = coefs;
+    screen_lanes.count = mono_count;
+  }
+  isolate_bernstein_search(running, lane_root, lane_root, lane_t_in, lane_t_out, &iso, iso_c,
+                           ALGRAY_ESCALATE ? &screen_lanes : (LaneTerms*)0, probe_log);
 #else
   /* one ray at a time: each lane's segment and whether it entered. The loops over lanes run to min(count, LANES),
    * never to count alone: a bound the compiler cannot see is at most 1 kept one-ray builds' arrays in memory (8%
@@ -539,6 +587,13 @@ int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, R
       taylor_t = screen_ray_taylor(px0 + j, py, screen_rows, screen_row0, screen_t, xi_scale, xi_offset, taylor);
     segment_coefficients(lane_origin(&unit, j), lane_direction(&unit, j), t_in[j], t_out[j], exps, coefs, mono_count,
                          binomials, even_axes, root[j], root_lo[j], &terms[j], taylor, taylor_t, probe_log);
+    if (RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && ALGRAY_ESCALATE)
+      terms[j] = screen_ray_terms(lane_get(screen_terms(screen_row(screen_rows, py, screen_row0),
+                                                        screen_column(px0 + j, xi_scale, xi_offset),
+                                                        t_in[j] - taylor_t, t_out[j] - taylor_t),
+                                           0),
+                                  lane_origin(&unit, j), lane_direction(&unit, j), t_in[j], t_out[j], exps, coefs,
+                                  mono_count);
   }
   isolate_rays(count, in_extent, &unit, root, root_lo, t_in, t_out, &iso, iso_c, terms, probe_log);
 #endif

@@ -54,6 +54,7 @@ TEST_CASE("every kernel declares the arguments the host sets by name, in every k
       config_of("primary", Precision::Float, RayOrigin::Extent, 1),
       config_of("primary", Precision::Double, RayOrigin::Screen, 8),
       config_of("primary", Precision::Adaptive, RayOrigin::Extent, 8),
+      config_of("primary", Precision::Adaptive, RayOrigin::Screen, 16),
       config_of("trace", Precision::Mixed, RayOrigin::Extent, 1),
       config_of("shadow", Precision::Adaptive, RayOrigin::Extent, 1),
       config_of("shadow", Precision::Double, RayOrigin::Point, 8),

@@ -162,11 +162,17 @@ TEST_CASE("the screen form meets the double line on seeded random surfaces of ev
     }
 }
 
-TEST_CASE("auto builds camera rays in the screen form and shadow rays in the point form, in double only",
+TEST_CASE("auto builds camera rays in the screen form in double and adaptive precision, and shadow rays in the point "
+          "form in double only",
           "[reference]") {
   const Scene base = load_scene_text(random_scene(6, 1006, Precision::Double), "random");
-  const RenderPlan plan = make_render_plan(base, Precision::Double);
-  CHECK(plan.find(PassKind::Primary)->kernels.at(0).ray_origin == RayOrigin::Screen);
+  for (Precision p : {Precision::Double, Precision::Adaptive}) {
+    const RenderPlan plan = make_render_plan(base, p);
+    CHECK(plan.find(PassKind::Primary)->kernels.at(0).ray_origin == RayOrigin::Screen);
+    // adaptive's doubted camera rays go again through the extent construction (the trace kernel)
+    for (const KernelConfig& again : plan.find(PassKind::Primary)->escalation)
+      CHECK(again.ray_origin == RayOrigin::Extent);
+  }
   for (Precision p : {Precision::Float, Precision::Mixed})
     CHECK(make_render_plan(base, p).find(PassKind::Primary)->kernels.at(0).ray_origin == RayOrigin::Extent);
   // The eye inside the extent: expansion points would lie on both sides of it, far from some rays' segments.

@@ -13,7 +13,7 @@
 namespace algray {
 
 bool screen_form_applies(const Scene& scene, Precision precision) {
-  if (precision != Precision::Double) return false;
+  if (precision != Precision::Double && precision != Precision::Adaptive) return false;
   const RayBasis basis = make_ray_basis(scene.camera, scene.image.width, scene.image.height);
   return screen_geometry(basis, scene.image.width, scene.image.height, scene.extent).well_placed;
 }

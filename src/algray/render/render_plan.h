@@ -100,10 +100,12 @@ void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device);
 // render.lanes, when set, comes first.
 RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size = 0, int lanes = 1);
 
-// Whether RayOrigin::Auto means the screen form for camera rays: in double, with the camera outside the extent,
-// facing its centre. Measured to keep the double line at every degree; in float it found the wrong sheet on the
-// Chebyshev nonic and the Roman surface (depth errors 0.15 and 0.08), so float keeps the extent construction
-// (bench/history/2026-12.md, "The screen form").
+// Whether RayOrigin::Auto means the screen form for camera rays: in double and adaptive precision, with the camera
+// outside the extent, facing its centre. Measured to keep the double line at every degree. Adaptive's float pass
+// measures the screen form's noise ray by ray (kernels/surface.h, screen_terms) and escalates the rays it doubts,
+// as it does the extent construction's. Plain float has no such check: there the screen form is more accurate
+// than the extent construction on the shipped scenes but far less on thin shells (bench/RESULTS.md), so plain
+// float keeps the extent construction.
 bool screen_form_applies(const Scene& scene, Precision precision);
 
 // Whether RayOrigin::Auto means the point form for a shadow kernel (kernels/point_form.h: P expanded once about
