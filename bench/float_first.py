@@ -1,0 +1,94 @@
+#!/usr/bin/env python3
+"""Issue 44's goal 1: float and adaptive precision against double, kernel time at 1024x768 on the paper's seven
+surfaces and the Endrass octic, the Kummer surface, Goursat's dodecic and the Chebyshev nonic, in preview (camera
+rays, one per pixel) and in full mode (the scene as it is: its lights, shadows and antialiasing).
+
+Modes: double, float, adaptive (its second pass in double: this CPU's fp64 is fast) and adaptive with
+ALGRAY_NO_FP64=1 (its second pass in float-float, as on a GPU without fast fp64). Each round runs every mode once,
+the order rotating from round to round; the table gives each mode's median kernel time (device time of every pass,
+the second pass included) and its ratio to double's median. Targets: float at most 0.6x double, adaptive (either)
+at most 0.7x.
+
+Writes its section of bench/RESULTS.md ("Float first: float and adaptive against double", under "Precision modes:
+time and accuracy"), with the date, machine, commit and command.
+"""
+import argparse
+import datetime
+import os
+import statistics
+import tempfile
+from pathlib import Path
+
+from bench_common import ROOT, command_line, commit, machine, replace_section, run_render
+
+AREA = "## Precision modes: time and accuracy"
+HEADING = "### Float first: float and adaptive against double"
+SCENES = ["barth_sextic", "cusp_catastrophe", "torus", "tooth", "lemniscate", "barth_decic", "tanglecube",
+          "endrass_octic", "kummer", "goursat12", "chebyshev_nonic"]
+# (column, --precision, extra environment)
+MODES = [("double", "double", {}), ("float", "float", {}), ("adaptive", "adaptive", {}),
+         ("adaptive, no fp64", "adaptive", {"ALGRAY_NO_FP64": "1"})]
+TARGETS = {"float": 0.6, "adaptive": 0.7, "adaptive, no fp64": 0.7}
+
+
+def kernel_ms(stats):
+    return sum(p["kernel_ms"] for p in stats["passes"])
+
+
+def measure(binary, scene, preview, runs, work):
+    args = ["--width", "1024", "--height", "768"] + (["--preview", "--set", "antialias.samples=1"] if preview else [])
+    times = {name: [] for name, _, _ in MODES}
+    for r in range(runs + 1):  # the first round warms the program caches and is not counted
+        order = MODES[r % len(MODES):] + MODES[:r % len(MODES)]
+        for name, precision, extra in order:
+            _, stats = run_render(binary, scene, args + ["--precision", precision], dict(os.environ, **extra), work)
+            if r > 0:
+                times[name].append(kernel_ms(stats))
+    return {name: statistics.median(t) for name, t in times.items()}
+
+
+def cell(ms, double_ms, target):
+    ratio = ms / double_ms
+    text = f"{ms:.1f} ({ratio:.2f})"
+    return f"**{text}**" if target is not None and ratio > target else text
+
+
+def section(rows, runs, binary, note):
+    lines = [HEADING, "", f"- Date: {datetime.date.today().isoformat()}", f"- Machine: {machine()}",
+             f"- Commit: {commit(binary)}", f"- Command: `{command_line()}` (after `cmake --build build`)"]
+    lines += [f"- Conditions: {note}", ""] if note else [""]
+    lines += [
+             "Kernel ms at 1024x768 (median of " + str(runs) + " interleaved rounds after a warm-up round; device "
+             "time of every pass, adaptive's second pass included) and the ratio to double's. **Bold**: over the "
+             "target (float 0.6x, adaptive 0.7x). Preview: camera rays, one per pixel; full: the scene's lights, "
+             "shadows and antialiasing.", "",
+             "| scene | mode | double ms | float | adaptive | adaptive, no fp64 |", "|---|---|---|---|---|---|"]
+    for r in rows:
+        t = r["ms"]
+        lines.append(f"| {r['scene']} | {r['mode']} | {t['double']:.1f} | "
+                     + " | ".join(cell(t[m], t["double"], TARGETS[m]) for m in ("float", "adaptive",
+                                                                              "adaptive, no fp64")) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--binary", default=ROOT / "build/apps/algray/algray")
+    ap.add_argument("--runs", type=int, default=5)
+    ap.add_argument("--scenes", nargs="*", default=SCENES)
+    ap.add_argument("--modes", nargs="*", default=["preview", "full"], choices=["preview", "full"])
+    ap.add_argument("--output", default=ROOT / "bench/RESULTS.md")
+    ap.add_argument("--note", default="", help="a line on the conditions of the run, for the page")
+    args = ap.parse_args()
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in args.scenes:
+            for mode in args.modes:
+                ms = measure(args.binary, ROOT / "scenes" / f"{name}.toml", mode == "preview", args.runs, Path(tmp))
+                rows.append({"scene": name, "mode": mode, "ms": ms})
+                print(name, mode, {m: round(v, 1) for m, v in ms.items()}, flush=True)
+    replace_section(args.output, HEADING, section(rows, args.runs, args.binary, args.note), under=AREA)
+
+
+if __name__ == "__main__":
+    main()
