@@ -32,6 +32,10 @@ typedef cl_int algray_i32;
 /* A cylinder about axis a (0 x, 1 y, 2 z) is kind ALGRAY_EXTENT_CYLINDER + a: the axis is chosen with the kind, not
  * an argument of its own, and extent_box_half is the box around it (its radius across, half-height along a). */
 #define ALGRAY_EXTENT_CYLINDER 2
+/* Added to a kind: the shape is a ray gate (the scene's extent.gate), not a cut. A ray that does not meet it misses;
+ * a ray that does is traced along the unit sphere (the gate's far sphere), the shape then being given by
+ * extent_box_half, a sphere's radius in its x (kernels/ray.h, clip_lanes_to_extent). */
+#define ALGRAY_EXTENT_GATE 8
 
 /* Compile-time solver choices, passed as -D ISOLATION=... -D REFINEMENT=... */
 #define ALGRAY_ISOLATION_BERNSTEIN 1   /* Descartes' rule on Bernstein coefficients over [t_in, t_out], de Casteljau halving */

@@ -42,40 +42,51 @@ ALGRAY_INLINE LMASK cut_by_clip_planes(LREAL ox, LREAL oy, LREAL oz, LREAL dx, L
   return kept;
 }
 
-/* [t_in, t_out] of rays o + t*d inside the extent, given in unit coordinates u = (p - centre)/scale, where the
- * sphere is the unit sphere, the box is |u_i| <= half_i and the cylinder about axis a (kind
- * ALGRAY_EXTENT_CYLINDER + a) is the part of the infinite one of radius half_(across a) between its caps at
- * u_a = +-half_a, then cut by the clip planes (cut_by_clip_planes); returns where they enter what is left. Of one
- * ray or of lanes (lanes.h), each lane with one ray's operations. A ray that misses leaves t_in, t_out undefined.
- * Where no ray meets the sphere, its square root and divisions are skipped (more than half of a typical view's
+/* [*lo, *hi] of rays o + t*d inside the sphere |u|^2 <= r2 about the origin, from t = 0 on; returns the lanes that
+ * meet it. Where no ray meets it, its square root and divisions are skipped (more than half of a typical view's
  * lanes miss it, in whole groups). */
+ALGRAY_INLINE LMASK sphere_lanes(LREAL ox, LREAL oy, LREAL oz, LREAL dx, LREAL dy, LREAL dz, REAL r2, LREAL* lo,
+                                 LREAL* hi) {
+  LREAL a, b, c;
+  {
+    /* as dot() sums them: three products, added left to right */
+#pragma OPENCL FP_CONTRACT OFF
+    a = (dx * dx + dy * dy) + dz * dz;
+    b = (ox * dx + oy * dy) + oz * dz;
+    c = ((ox * ox + oy * oy) + oz * oz) - r2;
+  }
+  const LREAL disc = b * b - a * c;
+  const LMASK hit = disc > 0 && a > 0;
+  *lo = 0;
+  *hi = 0;
+  if (LANE_ANY(hit)) {
+    /* The product form avoids cancellation when one intersection is near the origin. */
+    const LREAL q = -(b + copysign(sqrt(disc), b));
+    const LREAL t0 = q / a, t1 = c / q;
+    *lo = fmax(fmin(t0, t1), (LREAL)0);
+    *hi = fmax(t0, t1);
+  }
+  return hit;
+}
+
+/* [t_in, t_out] of rays o + t*d inside the extent, given in unit coordinates u = (p - centre)/scale, where the
+ * sphere is the one of radius box_half.x (the unit sphere, but for a gate), the box is |u_i| <= half_i and the
+ * cylinder about axis a (kind ALGRAY_EXTENT_CYLINDER + a) is the part of the infinite one of radius half_(across a)
+ * between its caps at u_a = +-half_a, then cut by the clip planes (cut_by_clip_planes); returns where they enter
+ * what is left. A gate (kind + ALGRAY_EXTENT_GATE) only chooses the rays: those that meet its shape from t = 0 on
+ * get the unit sphere's segment, the far sphere, before the planes cut it. Of one ray or of lanes (lanes.h), each
+ * lane with one ray's operations. A ray that misses leaves t_in, t_out undefined. */
 ALGRAY_INLINE LMASK clip_lanes_to_extent(LREAL ox, LREAL oy, LREAL oz, LREAL dx, LREAL dy, LREAL dz, int kind,
                                          REAL3 box_half, __global const REAL4* clip_planes, uint clip_count,
                                          LREAL* t_in, LREAL* t_out) {
+  const int shape = kind & ~ALGRAY_EXTENT_GATE;
   LREAL lo = 0, hi;
   LMASK hit;
-  if (kind == ALGRAY_EXTENT_SPHERE) {
-    LREAL a, b, c;
-    {
-      /* as dot() sums them: three products, added left to right */
+  if (shape == ALGRAY_EXTENT_SPHERE) {
+    hit = sphere_lanes(ox, oy, oz, dx, dy, dz, box_half.x * box_half.x, &lo, &hi);
+  } else if (shape >= ALGRAY_EXTENT_CYLINDER) {
 #pragma OPENCL FP_CONTRACT OFF
-      a = (dx * dx + dy * dy) + dz * dz;
-      b = (ox * dx + oy * dy) + oz * dz;
-      c = ((ox * ox + oy * oy) + oz * oz) - (REAL)1;
-    }
-    const LREAL disc = b * b - a * c;
-    hit = disc > 0 && a > 0;
-    hi = 0;
-    if (LANE_ANY(hit)) {
-      /* The product form avoids cancellation when one intersection is near the origin. */
-      const LREAL q = -(b + copysign(sqrt(disc), b));
-      const LREAL t0 = q / a, t1 = c / q;
-      lo = fmax(fmin(t0, t1), (LREAL)0);
-      hi = fmax(t0, t1);
-    }
-  } else if (kind >= ALGRAY_EXTENT_CYLINDER) {
-#pragma OPENCL FP_CONTRACT OFF
-    const int axis = kind - ALGRAY_EXTENT_CYLINDER;
+    const int axis = shape - ALGRAY_EXTENT_CYLINDER;
     /* (p1, p2) across the axis, pa along it */
     const LREAL p1 = axis == 0 ? oy : ox, p2 = axis == 2 ? oy : oz, pa = axis == 0 ? ox : axis == 1 ? oy : oz;
     const LREAL q1 = axis == 0 ? dy : dx, q2 = axis == 2 ? dy : dz, qa = axis == 0 ? dx : axis == 1 ? dy : dz;
@@ -107,6 +118,11 @@ ALGRAY_INLINE LMASK clip_lanes_to_extent(LREAL ox, LREAL oy, LREAL oz, LREAL dx,
     lo = fmax(fmax(lo, fmin(ax, bx)), fmax(fmin(ay, by), fmin(az, bz)));
     hi = fmin(fmin(hi, fmax(ax, bx)), fmin(fmax(ay, by), fmax(az, bz)));
     hit = hi > lo;
+  }
+  /* a gate's rays that meet it, along the far sphere (which holds the gate, so they all meet it) */
+  if (kind & ALGRAY_EXTENT_GATE) {
+    const LMASK passed = hit && hi > lo;
+    hit = passed && sphere_lanes(ox, oy, oz, dx, dy, dz, (REAL)1, &lo, &hi);
   }
   /* without planes, nothing of the cut runs: the extent's segment as it always was */
   if (clip_count > 0) hit = hit && cut_by_clip_planes(ox, oy, oz, dx, dy, dz, clip_planes, clip_count, &lo, &hi);

@@ -548,8 +548,8 @@ TEST_CASE("--section draws a plane's curve, --radius comes before --set, and bad
   CHECK_FALSE(fs::exists(box.work / "bad.png"));
 }
 
-TEST_CASE("--clip cuts the surface open, --stats lists its planes, and bad ones exit 2 writing nothing",
-          "[cli][clip]") {
+TEST_CASE("--clip cuts the surface open, --stats lists its planes and a gate, and bad ones exit 2 writing nothing",
+          "[cli][clip][gate]") {
   require_device();
   Sandbox box;
   const std::string torus = (fs::path(ALGRAY_SOURCE_DIR) / "scenes" / "torus.toml").string();
@@ -586,5 +586,22 @@ TEST_CASE("--clip cuts the surface open, --stats lists its planes, and bad ones 
   const Result missing = box.run("render " + torus + " --set clip.0.plane=[0,0,1,0] -o bad.png " + kTiny);
   CHECK(missing.exit_code == 2);
   CHECK_THAT(missing.err, Catch::Contains("no [[clip]] tables"));
+  CHECK_FALSE(fs::exists(box.work / "bad.png"));
+  // The extent as a gate: --stats shows its far sphere (none above), the header says so, and a reach without a
+  // gate is refused.
+  CHECK(s["plan"]["extent_gate"].is_null());
+  const Result gated = box.run("render " + torus + " --preview --set extent.gate=true --set extent.reach=2 "
+                               "--stats g.json -o gate.exr " + kTiny);
+  INFO(gated.err);
+  REQUIRE(gated.exit_code == 0);
+  const nlohmann::json g = box.stats("g.json");
+  CHECK(g["plan"]["extent_gate"]["reach"] == 2);
+  CHECK(g["plan"]["extent_gate"]["far_sphere"]["radius"] == 7);  // the torus' sphere of radius 3.5, twice
+  std::map<std::string, std::string> attrs;
+  for (const auto& [k, v] : algray::read_exr(box.work / "gate.exr").string_attributes) attrs[k] = v;
+  CHECK_THAT(attrs["algray/extent"], Catch::EndsWith("gate reach 2.000000"));
+  const Result reach = box.run("render " + torus + " --set extent.reach=2 -o bad.png " + kTiny);
+  CHECK(reach.exit_code == 2);
+  CHECK_THAT(reach.err, Catch::Contains("it needs extent.gate = true"));
   CHECK_FALSE(fs::exists(box.work / "bad.png"));
 }

@@ -1,6 +1,6 @@
 // Every scene at 160x120, in double and float, against the certified reference (issue 3's image thresholds),
-// adaptive's float line on every pixel of the cancelling octic and decic at 512x384, the cylinder extent and clipping
-// planes.
+// adaptive's float line on every pixel of the cancelling octic and decic at 512x384, the cylinder extent, clipping
+// planes and the extent as a ray gate.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -347,6 +347,75 @@ TEST_CASE("clipping planes cut each surface as the certified reference does: 0 d
       CHECK(c.simple_hits > 64 * 48 / 32);
       CHECK(cut > 64 * 48 / 100);  // pixels of the surface that the planes cut away
       if (is_double) CHECK(added == 0);  // a cut takes surface away, never adds any
+      check_clipped_agreement(renderer, scene, ref, c, is_double);
+    }
+  }
+}
+
+TEST_CASE("a gate passes the rays that meet it, which see the surface beyond it, as the certified reference does",
+          "[reference][extent][gate]") {
+  ClSession& session = testing::device_session();
+  ProgramCache cache(false);
+  Renderer renderer(session, cache);
+  // Two quartics (one degree: the same kernels) at 64x48, each gated by a shape smaller than the surface: the
+  // Kummer surface's arms, which run to infinity, through a sphere; the torus through a box, cut by a plane too.
+  // Rays that miss the gate must miss; those that pass it see the surface out to the far sphere.
+  struct Case {
+    const char* scene;
+    std::vector<Override> gate;
+    bool float_too;
+  };
+  const Case cases[] = {
+      {"kummer", {{"extent.radius", "1.2"}, {"extent.gate", "true"}}, true},
+      {"torus",
+       {{"extent.type", "box"},
+        {"extent.min", "[-2.8, -2.8, -0.3]"},
+        {"extent.max", "[2.8, 2.8, 0.3]"},
+        {"extent.gate", "true"},
+        {"extent.reach", "3"},
+        {"clip", "[{plane = [0.3, 1, 0, -1]}]"}},
+       false}};
+  print_header();
+  const auto hit = [](const HitRecord& r) { return (r.flags & ALGRAY_HIT_FOUND) != 0; };
+  for (const Case& k : cases) {
+    const std::filesystem::path file =
+        std::filesystem::path(ALGRAY_SOURCE_DIR "/scenes") / (std::string(k.scene) + ".toml");
+    std::vector<Override> base = {{"image.width", "64"},
+                                  {"image.height", "48"},
+                                  {"antialias.samples", "1"},
+                                  {"render.preview", "true"}};
+    base.insert(base.end(), k.gate.begin(), k.gate.end());
+    for (const char* precision : {"double", "float"}) {
+      const bool is_double = std::string(precision) == "double";
+      if (!is_double && !k.float_too) continue;
+      std::vector<Override> overrides = base;
+      overrides.push_back({"render.precision", precision});
+      const Scene scene = load_scene_file(file.string(), overrides);
+      REQUIRE(scene.extent.gate);
+      // The same shape as a cut: what the gate shows beyond it is what the cut takes away.
+      Scene cut_scene = scene;
+      cut_scene.extent.gate = false;
+      const RenderResult kernel = renderer.render_with_records(scene);
+      const RenderResult cut = renderer.render_with_records(cut_scene);
+      const ReferenceResult ref = render_reference(scene, is_double ? Precision::Double : Precision::Float);
+      const ReferenceComparison c = compare_with_reference(kernel.hits, ref);
+      long beyond = 0, lost = 0;
+      for (std::size_t i = 0; i < kernel.hits.records.size(); ++i) {
+        beyond += hit(kernel.hits.records[i]) && !hit(cut.hits.records[i]);
+        lost += !hit(kernel.hits.records[i]) && hit(cut.hits.records[i]);
+      }
+      const long outside =
+          std::count(ref.classes.begin(), ref.classes.end(), static_cast<std::uint32_t>(PixelClass::OutsideExtent));
+      std::printf("%-28s %-8s %9ld %9ld %9ld %12ld %9ld %12.3g at %d,%d  (gate; %ld outside it, %ld seen beyond it)\n",
+                  k.scene, precision, c.certified, c.ambiguous, c.ray_rounding, c.disagreements, c.simple_hits,
+                  c.worst_depth, c.worst_x, c.worst_y, outside, beyond);
+      INFO(k.scene << " gated, " << precision << ": " << c.disagreements << " of " << c.certified
+                   << " certified pixels disagree (first at " << c.disagree_x << "," << c.disagree_y
+                   << "); worst depth " << c.worst_depth);
+      CHECK(c.certified > 64 * 48 / 8);
+      CHECK(outside > 64 * 48 / 8);        // rays that miss the gate
+      CHECK(beyond > 64 * 48 / 50);        // surface seen through the gate beyond it, which a cut would not show
+      if (is_double) CHECK(lost == 0);     // a gate shows all that the same shape as a cut shows
       check_clipped_agreement(renderer, scene, ref, c, is_double);
     }
   }

@@ -644,6 +644,40 @@ TEST_CASE("a cylinder extent reads, round-trips, refuses other kinds' keys and i
   }
 }
 
+TEST_CASE("extent.gate makes the shape a ray gate with a far sphere reach times its size; errors are located",
+          "[scene][extent]") {
+  const Scene g = algray::load_scene_text(sphere_with({{5, "radius = 2\ngate = true\nreach = 3"}}), "t.toml");
+  CHECK(g.extent.gate);
+  CHECK(g.extent.reach == 3);
+  // The kernels' unit sphere is the far sphere; the gate is the sphere of radius 1/reach in it; the camera and
+  // the default lights are framed by the gate, not the far sphere.
+  CHECK(g.extent.shape_scale() == 2);
+  CHECK(g.extent.unit_scale() == 6);
+  CHECK(g.extent.unit_box_half().x == Approx(1.0 / 3).epsilon(1e-15));
+  const Scene framed = algray::load_scene_text("[surface]\nequation = \"x^2+y^2+z^2-1\"\n", "eq.toml",
+                                               {{"extent.gate", "true"}});
+  const Scene plain = algray::load_scene_text("[surface]\nequation = \"x^2+y^2+z^2-1\"\n", "eq.toml");
+  CHECK(framed.extent.reach == algray::kDefaultGateReach);
+  CHECK(framed.camera.eye == plain.camera.eye);
+  CHECK(framed.lights.at(0).position == plain.lights.at(0).position);
+  // A box or a cylinder gates too; the far sphere holds its half-diagonal (or its cap's rim) reach times.
+  const Scene box = algray::load_scene_text(
+      sphere_with({{5, "type = \"box\"\nmin = [-1, -2, -2]\nmax = [1, 2, 2]\ngate = true"}}), "t.toml");
+  CHECK(box.extent.unit_scale() == Approx(3 * algray::kDefaultGateReach).epsilon(1e-15));
+  CHECK(box.extent.unit_box_half().x == Approx(1 / (3 * algray::kDefaultGateReach)).epsilon(1e-15));
+  // Written back by scene_to_toml; without a gate, nothing is written and nothing changes.
+  const Scene again = algray::load_scene_text(algray::scene_to_toml(g), "again.toml");
+  CHECK(again.extent.gate);
+  CHECK(again.extent.reach == 3);
+  CHECK_FALSE(algray::load_scene_text(algray::scene_to_toml(plain), "again.toml").extent.gate);
+  CHECK(plain.extent.unit_box_half() == glm::dvec3(1));
+  check_error(sphere_with({{5, "radius = 2\ngate = 1"}}), "t.toml:6:8", "extent.gate must be true or false");
+  check_error(sphere_with({{5, "radius = 2\nreach = 3"}}), "t.toml:6:9", "it needs extent.gate = true");
+  check_error(sphere_with({{5, "radius = 2\ngate = true\nreach = 0.5"}}), "t.toml:7:9", "extent.reach must be");
+  check_error(sphere_with({{5, "radius = 2\ngate = true\nreach = 1e6"}}), "t.toml:7:9", "extent.reach must be");
+  CHECK(error_of(sphere_with({}), {{"extent.reach", "2"}}).message.find("needs extent.gate") != std::string::npos);
+}
+
 TEST_CASE("an error in -e's equation names its column in the equation", "[scene][errors]") {
   try {
     algray::load_equation("x^2+*y");

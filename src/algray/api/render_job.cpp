@@ -43,12 +43,14 @@ std::string vec_text(const glm::dvec3& v) {
   return buf;
 }
 
-// The extent as the header's algray/extent gives it: its kind and its numbers.
+// The extent as the header's algray/extent gives it: its kind and its numbers, then " gate reach R" for a gate.
 std::string extent_text(const Extent& e) {
-  if (e.kind == ExtentKind::Sphere) return "sphere centre " + vec_text(e.centre) + " radius " + std::to_string(e.radius);
-  if (e.kind == ExtentKind::Box) return "box min " + vec_text(e.min) + " max " + vec_text(e.max);
+  const std::string gate = e.gate ? " gate reach " + std::to_string(e.reach) : "";
+  if (e.kind == ExtentKind::Sphere)
+    return "sphere centre " + vec_text(e.centre) + " radius " + std::to_string(e.radius) + gate;
+  if (e.kind == ExtentKind::Box) return "box min " + vec_text(e.min) + " max " + vec_text(e.max) + gate;
   return "cylinder centre " + vec_text(e.centre) + " radius " + std::to_string(e.radius) + " axis " + "xyz"[e.axis] +
-         " half_height " + std::to_string(e.half_height);
+         " half_height " + std::to_string(e.half_height) + gate;
 }
 
 // The clipping planes as the header's algray/clip gives them: "a b c d" each (a*x + b*y + c*z + d <= 0 kept),

@@ -138,11 +138,11 @@ void DeviceSurface::set_extent_args(KernelBinder& args) const {
   args.real_vec("extent_centre", extent_.unit_centre());
   args.real("extent_inv_scale", 1 / extent_.unit_scale());
   args.real_vec("extent_box_half", extent_.unit_box_half());
-  // A cylinder's axis rides on its kind (kernels/algray_shared.h).
-  const cl_int kind = extent_.kind == ExtentKind::Sphere ? ALGRAY_EXTENT_SPHERE
-                      : extent_.kind == ExtentKind::Box  ? ALGRAY_EXTENT_BOX
-                                                         : ALGRAY_EXTENT_CYLINDER + extent_.axis;
-  args.plain("extent_kind", kind);
+  // A cylinder's axis and a gate ride on its kind (kernels/algray_shared.h).
+  const cl_int shape = extent_.kind == ExtentKind::Sphere ? ALGRAY_EXTENT_SPHERE
+                       : extent_.kind == ExtentKind::Box  ? ALGRAY_EXTENT_BOX
+                                                          : ALGRAY_EXTENT_CYLINDER + extent_.axis;
+  args.plain("extent_kind", static_cast<cl_int>(shape + (extent_.gate ? ALGRAY_EXTENT_GATE : 0)));
   // Without planes the kernels never read clip_planes (kernels/ray.h).
   if (extent_.clips.empty())
     args.unused_buffer("clip_planes");

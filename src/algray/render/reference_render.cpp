@@ -77,22 +77,34 @@ const char* pixel_class_name(PixelClass c) {
   return "?";
 }
 
-bool extent_interval(const Extent& e, const PixelRay& ray, long double& t_in, long double& t_out) {
+namespace {
+
+// [t_in, t_out] of the ray inside the sphere of `radius` about `centre`, from t = 0 on; false where it misses.
+bool sphere_interval(const glm::dvec3& centre, double radius, const PixelRay& ray, long double& t_in,
+                     long double& t_out) {
   using R = long double;
   const R o[3] = {ray.origin.x, ray.origin.y, ray.origin.z}, d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
-  if (e.kind == ExtentKind::Sphere) {
-    R a = 0, b = 0, c = -R(e.radius) * R(e.radius);
-    for (int i = 0; i < 3; ++i) {
-      const R oc = o[i] - R(e.centre[i]);
-      a += d[i] * d[i];
-      b += oc * d[i];
-      c += oc * oc;
-    }
-    const R disc = b * b - a * c;
-    if (!(disc > 0)) return false;
-    t_in = std::max<R>(0, (-b - std::sqrt(disc)) / a);
-    t_out = (-b + std::sqrt(disc)) / a;
-  } else if (e.kind == ExtentKind::Cylinder) {
+  R a = 0, b = 0, c = -R(radius) * R(radius);
+  for (int i = 0; i < 3; ++i) {
+    const R oc = o[i] - R(centre[i]);
+    a += d[i] * d[i];
+    b += oc * d[i];
+    c += oc * oc;
+  }
+  const R disc = b * b - a * c;
+  if (!(disc > 0)) return false;
+  t_in = std::max<R>(0, (-b - std::sqrt(disc)) / a);
+  t_out = (-b + std::sqrt(disc)) / a;
+  return true;
+}
+
+// [t_in, t_out] of the ray inside the extent's shape (sphere, box or cylinder), from t = 0 on, not yet cut by its
+// planes; false where it misses the sphere or the cylinder's side (a box's miss is t_out <= t_in).
+bool shape_interval(const Extent& e, const PixelRay& ray, long double& t_in, long double& t_out) {
+  using R = long double;
+  const R o[3] = {ray.origin.x, ray.origin.y, ray.origin.z}, d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+  if (e.kind == ExtentKind::Sphere) return sphere_interval(e.centre, e.radius, ray, t_in, t_out);
+  if (e.kind == ExtentKind::Cylinder) {
     // The slab between the caps, then the infinite cylinder's quadratic across the axis.
     const int a = e.axis, i = a == 0 ? 1 : 0, j = a == 2 ? 1 : 2;
     const R t0 = (R(e.centre[a]) - R(e.half_height) - o[a]) / d[a],
@@ -102,23 +114,31 @@ bool extent_interval(const Extent& e, const PixelRay& ray, long double& t_in, lo
     const R pi = o[i] - R(e.centre[i]), pj = o[j] - R(e.centre[j]);
     const R qa = d[i] * d[i] + d[j] * d[j], qb = pi * d[i] + pj * d[j];
     const R qc = pi * pi + pj * pj - R(e.radius) * R(e.radius);
-    if (qa == 0) {
-      if (qc > 0) return false;  // along the axis, outside it
-    } else {
-      const R disc = qb * qb - qa * qc;
-      if (!(disc > 0)) return false;
-      t_in = std::max(t_in, (-qb - std::sqrt(disc)) / qa);
-      t_out = std::min(t_out, (-qb + std::sqrt(disc)) / qa);
-    }
-  } else {
-    t_in = 0;
-    t_out = std::numeric_limits<R>::max();
-    for (int i = 0; i < 3; ++i) {
-      const R t0 = (R(e.min[i]) - o[i]) / d[i], t1 = (R(e.max[i]) - o[i]) / d[i];
-      t_in = std::max(t_in, std::min(t0, t1));
-      t_out = std::min(t_out, std::max(t0, t1));
-    }
+    if (qa == 0) return qc <= 0;  // along the axis: inside it or not
+    const R disc = qb * qb - qa * qc;
+    if (!(disc > 0)) return false;
+    t_in = std::max(t_in, (-qb - std::sqrt(disc)) / qa);
+    t_out = std::min(t_out, (-qb + std::sqrt(disc)) / qa);
+    return true;
   }
+  t_in = 0;
+  t_out = std::numeric_limits<R>::max();
+  for (int i = 0; i < 3; ++i) {
+    const R t0 = (R(e.min[i]) - o[i]) / d[i], t1 = (R(e.max[i]) - o[i]) / d[i];
+    t_in = std::max(t_in, std::min(t0, t1));
+    t_out = std::min(t_out, std::max(t0, t1));
+  }
+  return true;
+}
+
+}  // namespace
+
+bool extent_interval(const Extent& e, const PixelRay& ray, long double& t_in, long double& t_out) {
+  using R = long double;
+  const R o[3] = {ray.origin.x, ray.origin.y, ray.origin.z}, d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
+  if (!shape_interval(e, ray, t_in, t_out)) return false;
+  // A gate passes the rays that meet it, each along its far sphere (the unit sphere of the kernels' coordinates).
+  if (e.gate && !(t_out > t_in && sphere_interval(e.unit_centre(), e.unit_scale(), ray, t_in, t_out))) return false;
   // The clipping planes, in world coordinates: where the ray crosses a plane, the part beyond it is cut away; a
   // ray along a plane keeps all or nothing.
   for (const glm::dvec4& p : e.clips) {

@@ -252,6 +252,8 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
   plan.width = scene.image.width;
   plan.height = scene.image.height;
   plan.clip_planes = scene.extent.clips;
+  if (scene.extent.gate)
+    plan.gate = {true, scene.extent.unit_centre(), scene.extent.unit_scale(), scene.extent.reach};
   plan.tile_size = tile_size > 0                  ? tile_size
                    : scene.render.tile_size > 0 ? scene.render.tile_size
                                                 : default_tile_size(DeviceInfo{});  // a device of no kind: a CPU's
@@ -341,6 +343,12 @@ nlohmann::json RenderPlan::json() const {
   j["shadow_lights"] = shadow_lights;
   j["clip_planes"] = nlohmann::json::array();
   for (const glm::dvec4& p : clip_planes) j["clip_planes"].push_back({p.x, p.y, p.z, p.w});
+  j["extent_gate"] = nullptr;
+  if (gate.on)
+    j["extent_gate"] = {{"reach", gate.reach},
+                        {"far_sphere",
+                         {{"centre", {gate.far_centre.x, gate.far_centre.y, gate.far_centre.z}},
+                          {"radius", gate.far_radius}}}};
   j["skipped"] = skipped;
   j["estimated_memory_bytes"] = estimated_memory_bytes();
   return j;

@@ -70,6 +70,14 @@ struct RenderPlan {
   // The extent's clipping planes (a, b, c, d), a*x + b*y + c*z + d <= 0 kept, which every pass's rays are cut by
   // (kernels/ray.h); --stats lists them.
   std::vector<glm::dvec4> clip_planes;
+  // A gate (extent.gate): the far sphere that the rays passing it are traced within (kernels/ray.h), its centre and
+  // radius, and its reach (the radius over the gate's own); --stats shows them. Off: no gate.
+  struct Gate {
+    bool on = false;
+    glm::dvec3 far_centre{0};
+    double far_radius = 0;
+    double reach = 0;
+  } gate;
   // Everything left out, and why ("shadow: no light casts shadows"), so --stats explains the plan.
   std::vector<std::string> skipped;
 

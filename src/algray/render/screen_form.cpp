@@ -58,7 +58,7 @@ void multiply(Trivariate& p, const Coordinate& f, int times, Trivariate& scratch
 }
 
 bool inside_extent(const glm::dvec3& u, const Extent& extent) {
-  if (extent.kind == ExtentKind::Sphere) return glm::dot(u, u) <= 1;
+  if (extent.kind == ExtentKind::Sphere || extent.gate) return glm::dot(u, u) <= 1;  // a gate's rays: its far sphere
   const glm::dvec3 half = extent.unit_box_half();
   if (extent.kind == ExtentKind::Cylinder) {
     const int a = extent.axis, i = a == 0 ? 1 : 0, j = a == 2 ? 1 : 2;

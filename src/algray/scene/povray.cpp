@@ -19,8 +19,9 @@
 //   three normal to each other.
 // - bounded_by alone is no clip: a ray that misses the bound skips the object, one that meets it sees all of the
 //   surface along it, inside the bound or not (the hyptorus sample shows its arms beyond its bounding sphere, cut
-//   off only along the sphere's outline). No sphere or box does that for every ray, so run() picks the one that
-//   agrees best on rays traced here; an object with no region at all gets a sphere about what the camera sees.
+//   off only along the sphere's outline). That is algray's extent gate (extent.gate), whose far sphere (reach) is
+//   set to hold what rays traced here see through the bound (gate_reach). An object with no region at all gets a
+//   sphere about what the camera sees.
 // - plane { n, d } is the half-space n.x <= d, the side away from n (POV-Ray's documentation: the normal points
 //   outside); clipped_by { plane { ... } } keeps the object's part in it. algray cuts every surface of a scene by
 //   the same clipping planes ([[clip]]), so an object's planes cut the others too, with a warning.
@@ -1339,6 +1340,7 @@ class PovReader {
     int width = 0, height = 0;
     std::optional<Clip> drawn;  // the extent in algray's coordinates
     std::string extent_note;    // why it differs from POV-Ray's region, if it does
+    double gate_reach = 0;      // drawn is a gate (bounded_by alone) with this reach; 0: a cut
     std::vector<glm::dvec4> planes;  // the clipping planes in algray's coordinates, a.q + d <= 0 kept
   };
   void frame(Translated& scene);
@@ -1348,6 +1350,7 @@ class PovReader {
   void algray_view(Translated& scene);
   void off_axis(Translated& scene, double& distance, glm::dvec3& axis);
   void fit_extent(Translated& scene);
+  void gate_reach(Translated& scene);
   PovTranslation write_toml(const Translated& scene) const;
   static bool same(const Clip& a, const Clip& b) {
     if (a.sphere != b.sphere) return false;
@@ -1770,70 +1773,95 @@ void PovReader::fit_extent(Translated& scene) {
     drawn->min = glm::min(a, b);
     drawn->max = glm::max(a, b);
   }
-  // Objects without a region, or with bounded_by alone: POV-Ray draws all of the surface that the rays meet (that
-  // pass the bound), which no sphere or box holds in general. algray draws within the sphere or box that agrees
-  // best with that on a grid of rays traced here.
-  if (!open.empty() || (drawn && drawn->bound)) {
-    const double scale = std::max({1.0, glm::length(view.eye), drawn ? glm::length(drawn->centre - view.eye) : 0.0});
-    const Sight sight = look(view, scene.width, scene.height, scene.polys, scale, scene.planes);
-    std::vector<bool> shown;
-    for (const Sight::Ray& r : sight.rays)
-      shown.push_back(!r.roots.empty() && (!drawn || span(*drawn, r.o, r.d).has_value()));
-    std::vector<Clip> candidates;
-    if (drawn && !scene.camera.orthographic) {
-      // The bound moved k times as far from the eye: the same rays meet it, each over k times its stretch.
-      std::vector<double> ks = {1};
-      for (int i = 1; i <= 40; ++i) {
-        ks.push_back(std::pow(16.0, i / 40.0));
-        ks.push_back(std::pow(0.5, i / 40.0));
-      }
-      std::sort(ks.begin(), ks.end(),
-                [](double a, double b) { return std::fabs(std::log(a)) < std::fabs(std::log(b)); });
-      for (double k : ks) {
-        Clip c = *drawn;
-        c.centre = view.eye + k * (c.centre - view.eye);
-        c.radius *= k;
-        c.min = view.eye + k * (c.min - view.eye);
-        c.max = view.eye + k * (c.max - view.eye);
-        candidates.push_back(c);
-      }
-    } else if (drawn) {
-      candidates.push_back(*drawn);
+  // bounded_by alone (common_region leaves no object without a region beside it): POV-Ray's rule is the gate.
+  if (drawn && drawn->bound) {
+    gate_reach(scene);
+    return;
+  }
+  if (open.empty()) return;
+  // Objects without a region: POV-Ray draws all of the surface that the rays meet, which no sphere or box holds in
+  // general. algray draws within the sphere or box that agrees best with that on a grid of rays traced here.
+  const double scale = std::max({1.0, glm::length(view.eye), drawn ? glm::length(drawn->centre - view.eye) : 0.0});
+  const Sight sight = look(view, scene.width, scene.height, scene.polys, scale, scene.planes);
+  std::vector<bool> shown;
+  for (const Sight::Ray& r : sight.rays)
+    shown.push_back(!r.roots.empty() && (!drawn || span(*drawn, r.o, r.d).has_value()));
+  std::vector<Clip> candidates;
+  if (drawn && !scene.camera.orthographic) {
+    // The self-bounded objects' region moved k times as far from the eye: the same rays meet it, each over k
+    // times its stretch.
+    std::vector<double> ks = {1};
+    for (int i = 1; i <= 40; ++i) {
+      ks.push_back(std::pow(16.0, i / 40.0));
+      ks.push_back(std::pow(0.5, i / 40.0));
     }
-    for (double margin : {1.25, 1.1, 1.5, 2.0, 3.0})
-      if (const auto c = seen_sphere(sight, shown, margin)) candidates.push_back(*c);
-    if (candidates.empty()) {
-      const Object& o = *open.front();
-      fail(o.at, "this " + o.kind +
-                     " has no clipped_by or bounded_by, and no ray of the camera meets it; POV-Ray draws it without "
-                     "end, algray within a sphere or box: add clipped_by { sphere { ... } }");
+    std::sort(ks.begin(), ks.end(), [](double a, double b) { return std::fabs(std::log(a)) < std::fabs(std::log(b)); });
+    for (double k : ks) {
+      Clip c = *drawn;
+      c.centre = view.eye + k * (c.centre - view.eye);
+      c.radius *= k;
+      c.min = view.eye + k * (c.min - view.eye);
+      c.max = view.eye + k * (c.max - view.eye);
+      candidates.push_back(c);
     }
-    double best = -1;
-    bool first = true, kept = false;  // kept: the bound itself (the first candidate where there is a bound)
-    for (const Clip& c : candidates) {
-      const double iou = agreement(sight, shown, c);
-      if (iou > best + 1e-9) {
-        best = iou;
-        drawn = c;
-        kept = first && open.empty();
-      }
-      first = false;
-    }
-    drawn->bound = false;
-    if (!(kept && best == 1)) {  // a bound that holds all that the rays see is what POV-Ray shows: nothing to say
-      std::ostringstream note;
-      note.precision(4);
-      const Object& o = open.empty() ? *scene.clipped_by : *open.front();
-      note << (open.empty() ? "bounded_by alone does not clip in POV-Ray: the rays that pass the bound see all of "
-                              "the surface"
-                            : "no clipped_by or bounded_by: POV-Ray draws this " + o.kind + " without end")
-           << "; algray draws it within the " << (drawn->sphere ? "sphere" : "box")
-           << " that agrees best with that on a " << Sight::kColumns << " x " << Sight::kRows
-           << " grid of rays traced here (IoU " << best << ")";
-      scene.extent_note = note.str();
-      warn(o.at, scene.extent_note);
+  } else if (drawn) {
+    candidates.push_back(*drawn);
+  }
+  for (double margin : {1.25, 1.1, 1.5, 2.0, 3.0})
+    if (const auto c = seen_sphere(sight, shown, margin)) candidates.push_back(*c);
+  const Object& o = *open.front();
+  if (candidates.empty())
+    fail(o.at, "this " + o.kind +
+                   " has no clipped_by or bounded_by, and no ray of the camera meets it; POV-Ray draws it without "
+                   "end, algray within a sphere or box: add clipped_by { sphere { ... } }");
+  double best = -1;
+  for (const Clip& c : candidates) {
+    const double iou = agreement(sight, shown, c);
+    if (iou > best + 1e-9) {
+      best = iou;
+      drawn = c;
     }
   }
+  std::ostringstream note;
+  note.precision(4);
+  note << "no clipped_by or bounded_by: POV-Ray draws this " << o.kind << " without end; algray draws it within the "
+       << (drawn->sphere ? "sphere" : "box") << " that agrees best with that on a " << Sight::kColumns << " x "
+       << Sight::kRows << " grid of rays traced here (IoU " << best << ")";
+  scene.extent_note = note.str();
+  warn(o.at, scene.extent_note);
+}
+
+// The gate's reach: POV-Ray looks along a ray that meets the bound without end, algray within the far sphere, so
+// the far sphere is made to hold the first surface point of every ray of a grid that passes the bound, with room
+// to spare (kGateMargin), and never less than kDefaultGateReach. Where that needs more than kMaxGateReach, what
+// lies beyond is not drawn, with a note.
+void PovReader::gate_reach(Translated& scene) {
+  // Beyond the farthest point seen: the grid's rays are kColumns x kRows of the image's, and a surface seen
+  // through the bound can reach farther between them.
+  constexpr double kGateMargin = 1.5;
+  const Clip& gate = *scene.drawn;
+  const glm::dvec3 centre = gate.sphere ? gate.centre : 0.5 * (gate.min + gate.max);
+  const double radius = gate.sphere ? gate.radius : 0.5 * glm::length(gate.max - gate.min);
+  const CameraSpec& view = scene.view;
+  const double scale = std::max({1.0, glm::length(view.eye), glm::length(centre - view.eye)});
+  const Sight sight = look(view, scene.width, scene.height, scene.polys, scale, scene.planes);
+  double needed = 0;
+  for (const Sight::Ray& r : sight.rays)
+    if (!r.roots.empty() && span(gate, r.o, r.d))
+      needed = std::max(needed, glm::length(r.o + r.roots.front() * r.d - centre) / radius);
+  scene.gate_reach = std::clamp(needed * kGateMargin, kDefaultGateReach, kMaxGateReach);
+  std::ostringstream note;
+  note.precision(4);
+  note << "bounded_by alone: a ray gate, as POV-Ray's; the rays that pass it see the surface within " << scene.gate_reach
+       << " times its radius, which holds what a " << Sight::kColumns << " x " << Sight::kRows
+       << " grid of rays traced here sees through it (the farthest " << needed << " times its radius away)";
+  if (needed * kGateMargin > kMaxGateReach) {
+    note.str("");
+    note << "bounded_by alone: a ray gate, as POV-Ray's, whose rays see the surface within " << kMaxGateReach
+         << " times its radius; POV-Ray draws surface up to " << needed << " times its radius away";
+    warn(scene.clipped_by->at, note.str());
+  }
+  scene.extent_note = note.str();
 }
 
 PovTranslation PovReader::write_toml(const Translated& scene) const {
@@ -1869,6 +1897,7 @@ PovTranslation PovReader::write_toml(const Translated& scene) const {
     toml << "type = \"sphere\"\ncentre = " << toml_vector(e.centre) << "\nradius = " << toml_number(e.radius) << "\n";
   else
     toml << "type = \"box\"\nmin = " << toml_vector(e.min) << "\nmax = " << toml_vector(e.max) << "\n";
+  if (scene.gate_reach > 0) toml << "gate = true\nreach = " << toml_number(scene.gate_reach) << "\n";
 
   for (const glm::dvec4& p : scene.planes)
     toml << "\n[[clip]]  # clipped_by { plane }\nplane = [" << toml_number(p.x) << ", " << toml_number(p.y) << ", "

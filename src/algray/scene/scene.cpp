@@ -37,8 +37,9 @@ const std::set<std::string> kTopKeys{"surface", "parameters", "extent",  "camera
 const std::set<std::string> kSectionKeys{"plane", "colour", "surface", "width"};
 const std::set<std::string> kClipKeys{"plane"};
 const std::set<std::string> kSurfaceKeys{"name", "equation", "terms", "material"};
+// The keys of every kind: type, and the gate's two (Extent::gate, Extent::reach).
 const std::set<std::string> kExtentKeys = [] {
-  std::set<std::string> keys{"type"};
+  std::set<std::string> keys{"type", "gate", "reach"};
   for (const ExtentKindInfo& k : extent_kinds()) keys.insert(k.keys.begin(), k.keys.end());
   return keys;
 }();
@@ -700,8 +701,18 @@ void read_box_extent(const TomlReader& r, const toml::table& extent, Extent& out
   for (int i = 0; i < 3; ++i)
     if (!(out.min[i] < out.max[i]))
       r.fail(mx->source(), std::string("the extent is empty: max.") + "xyz"[i] + " must exceed min." + "xyz"[i]);
-  if (out.unit_scale() < 1 / kMaxCoordinate)
+  if (out.shape_scale() < 1 / kMaxCoordinate)
     r.fail(mx->source(), "the extent is too small to render: its half-diagonal must be at least 1e-18");
+}
+
+// gate = true makes the shape a ray gate; reach (only with a gate) sets its far sphere.
+void read_gate(const TomlReader& r, const toml::table& extent, Extent& out) {
+  if (const toml::node* n = extent.get("gate")) out.gate = r.boolean(*n, "extent.gate");
+  const toml::node* reach = extent.get("reach");
+  if (!reach) return;
+  if (!out.gate)
+    r.fail(reach->source(), "extent.reach is the far limit of a gate: it needs extent.gate = true");
+  out.reach = r.number_in(*reach, "extent.reach", 1, kMaxGateReach);
 }
 
 // "\"sphere\" or \"box\"", from extent_kinds().
@@ -730,6 +741,7 @@ void read_extent(const TomlReader& r, const toml::table& root, Extent& out) {
     read_cylinder_extent(r, *extent, out);
   else
     r.fail(extent->get("type")->source(), "extent.type must be " + extent_kind_choices());
+  read_gate(r, *extent, out);
 }
 
 // The camera: by its eye, or by angles about look_at (CameraAngles), which is algray's framing when the scene
@@ -767,7 +779,7 @@ void read_camera(const TomlReader& r, const toml::table& root, const Extent& ext
       r.fail((up ? up : eye)->source(), "degenerate camera: up is zero or parallel to the viewing direction");
   } else {
     CameraAngles a;
-    a.distance = kFramingDistance * extent.unit_scale();
+    a.distance = kFramingDistance * extent.shape_scale();
     if (const toml::node* n = camera->get("azimuth")) a.azimuth = r.number_in(*n, "camera.azimuth", -3600, 3600);
     if (const toml::node* n = camera->get("elevation")) a.elevation = r.number_in(*n, "camera.elevation", -90, 90);
     if (const toml::node* n = camera->get("distance")) {
@@ -859,7 +871,7 @@ std::vector<Light> framing_lights(double radius, const CameraSpec& camera) {
 void write_framing_lights(const TomlReader& r, toml::table& root) {
   Extent extent;
   read_extent(r, root, extent);
-  const double radius = extent.unit_scale();
+  const double radius = extent.shape_scale();
   toml::array lights;
   for (const FramingLight& f : kFramingLights) {
     toml::table t;
@@ -1030,7 +1042,7 @@ Scene interpret(const TomlReader& r, const toml::table& root, const std::string&
   read_surface_materials(r, root, surface_tables, scene.surfaces);
   read_lights(r, root, scene.camera, scene.lights);
   read_sections(r, root, scene.surfaces.size(), scene.sections);
-  if (framed && !root.get("light")) scene.lights = framing_lights(scene.extent.unit_scale(), scene.camera);
+  if (framed && !root.get("light")) scene.lights = framing_lights(scene.extent.shape_scale(), scene.camera);
   // 2x2 unless the scene gives antialias.samples (a --set antialias.adaptive=true alone keeps the 2x2).
   const toml::table* aa = root["antialias"].as_table();
   if (framed && (!aa || !aa->get("samples"))) scene.antialias.samples = 2;
@@ -1063,7 +1075,7 @@ std::vector<glm::dvec4> Extent::unit_clips() const {
 }
 
 // A cylinder's scale is the distance from its centre to a cap's rim, so that it fits in |u| <= 1.
-double Extent::unit_scale() const {
+double Extent::shape_scale() const {
   switch (kind) {
     case ExtentKind::Sphere:
       return radius;
@@ -1075,9 +1087,11 @@ double Extent::unit_scale() const {
   return std::hypot(radius, half_height);
 }
 
+double Extent::unit_scale() const { return gate ? shape_scale() * reach : shape_scale(); }
+
 glm::dvec3 Extent::unit_box_half() const {
   if (kind == ExtentKind::Box) return (max - min) * 0.5 / unit_scale();
-  if (kind == ExtentKind::Sphere) return glm::dvec3(1);
+  if (kind == ExtentKind::Sphere) return glm::dvec3(gate ? radius / unit_scale() : 1);
   glm::dvec3 half(radius / unit_scale());
   half[axis] = half_height / unit_scale();
   return half;
@@ -1290,6 +1304,7 @@ void write_extent(std::ostringstream& out, const Extent& e) {
     out << "\n[extent]\ntype = \"cylinder\"\ncentre = " << toml_vector(e.centre)
         << "\nradius = " << toml_number(e.radius) << "\naxis = \""
         << "xyz"[e.axis] << "\"\nhalf_height = " << toml_number(e.half_height) << "\n";
+  if (e.gate) out << "gate = true\nreach = " << toml_number(e.reach) << "\n";
 }
 
 void write_camera(std::ostringstream& out, const CameraSpec& c) {

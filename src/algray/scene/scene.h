@@ -23,8 +23,9 @@ struct SceneError : std::runtime_error {
 
 enum class ExtentKind { Sphere, Box, Cylinder };
 
-// The extent kinds: the name extent.type takes and the keys that belong to each, besides type. One row per kind,
-// read by the scene reader and by --set extent.type, which drops the keys of the other kinds (with a note).
+// The extent kinds: the name extent.type takes and the keys that belong to each, besides those every kind has
+// (type, gate, reach: scene.cpp's kExtentKeys). One row per kind, read by the scene reader and by --set
+// extent.type, which drops the keys of the other kinds (with a note).
 struct ExtentKindInfo {
   ExtentKind kind;
   const char* name;
@@ -41,6 +42,18 @@ inline const std::vector<ExtentKindInfo>& extent_kinds() {
 // A scene that gives no [extent] is a sphere of this radius about the origin (`algray render -e ... --radius R`).
 inline constexpr double kDefaultExtentRadius = 2;
 
+// A gate's far sphere is this many times the radius of the sphere around the gate, unless extent.reach says
+// otherwise (1 to kMaxGateReach). POV-Ray looks along a ray that passes its bound without end, but root isolation
+// needs a finite interval, and the farther it reaches, the more digits the surface near the gate loses in the
+// kernels' unit coordinates (the far sphere's). Measured: in POV-Ray's quartic samples that have bounded_by alone,
+// all that POV-Ray shows through the bound lies within 1.86 of its radii of its centre (quarcyl; hyptorus 1.60),
+// so 4 holds it with room to spare. The Kummer surface gated by a sphere of radius 1.2 (test_reference_agree,
+// 64x48) has in float a worst relative depth error of 4.4e-6 at reach 2, 9.7e-5 at 4, 4.1e-4 at 8, 6.3e-4 at 16
+// and 1.3e-3 at 64, past float's line of 1e-3 (in double about 1e-9 at every reach up to 1000). The POV-Ray reader
+// raises it where its own rays see farther (povray.cpp, gate_reach).
+inline constexpr double kDefaultGateReach = 4;
+inline constexpr double kMaxGateReach = 1000;
+
 struct Extent {
   ExtentKind kind = ExtentKind::Sphere;
   glm::dvec3 centre{0};  // sphere
@@ -50,12 +63,23 @@ struct Extent {
   // its caps half_height either side of the centre along that axis
   int axis = 2;
   double half_height = 1;
+  // gate = true: the shape above is a ray gate (POV-Ray's bounded_by), not a cut. A ray that does not meet it sees
+  // nothing of the surface; a ray that does sees the surface all along it, within the far sphere: about the
+  // shape's centre, `reach` times the radius of the sphere around the shape (shape_scale()). Root isolation needs
+  // a finite interval, and the far sphere is it; kDefaultGateReach says why its default is what it is.
+  bool gate = false;
+  double reach = kDefaultGateReach;
 
-  // The kernels work in u = (p - unit_centre()) / unit_scale(), where the extent fits in |u| <= 1.
+  // The radius of the sphere about unit_centre() that holds the shape (a box's half-diagonal, a cylinder's distance
+  // from its centre to a cap's rim): what the camera is framed by.
+  double shape_scale() const;
+  // The kernels work in u = (p - unit_centre()) / unit_scale(), where the extent fits in |u| <= 1: the shape, or
+  // with a gate, the far sphere (the unit sphere), which holds the gate.
   glm::dvec3 unit_centre() const;
   double unit_scale() const;
   // Box half-sizes in unit coordinates; for a cylinder, those of the box around it (radius across, half_height
-  // along its axis), from which the kernels take the cylinder (kernels/ray.h).
+  // along its axis), from which the kernels take the cylinder (kernels/ray.h); for a sphere, its radius in each
+  // (1 without a gate).
   glm::dvec3 unit_box_half() const;
 
   // Clipping planes ([[clip]] tables, --clip) that cut the surface open: each keeps the half-space
