@@ -4,12 +4,12 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
-#include <condition_variable>
+#include <memory>
 #include <cstdlib>
 #include <functional>
 #include <map>
-#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
@@ -24,6 +24,7 @@
 #include "exit_codes.h"
 #include "view_query.h"
 #include "view_server.h"
+#include "view_stream.h"
 
 namespace algray {
 // The page and its script (apps/algray/view/), embedded at build time.
@@ -112,6 +113,60 @@ FrameQuery parse_query(const api::Scene& base, const httplib::Request& req, cons
   if (full != "0" && full != "1") throw BadRequest("full must be 0 or 1, not '" + full + "'");
   q.full = full == "1";
   return q;
+}
+
+// A frame over --max-frame-samples is refused before it starts (413).
+void check_frame_cost(const FrameQuery& q, const ViewLimits& limits) {
+  const std::uint64_t samples = frame_samples(q.scene.to_toml(), q.width, q.height, q.full);
+  if (samples > limits.max_frame_samples)
+    throw BadRequest("the frame needs " + std::to_string(samples) +
+                         " samples (camera rays x (1 + shadow points) x (1 + bounces)); --max-frame-samples allows " +
+                         std::to_string(limits.max_frame_samples),
+                     {}, 0, 413, "--max-frame-samples");
+}
+
+// The page's name for its stream (`page`): 1 to 64 letters, digits, '-' or '_', as the page makes it.
+std::string page_name(const httplib::Request& req) {
+  const std::string page = req.get_param_value("page");
+  const bool ok = !page.empty() && page.size() <= 64 && std::all_of(page.begin(), page.end(), [](unsigned char c) {
+    return std::isalnum(c) || c == '-' || c == '_';
+  });
+  if (!ok) throw BadRequest("page must be 1 to 64 letters, digits, '-' or '_'", "page");
+  return page;
+}
+
+// A state's place in its page's order (`seq`): a whole number from 1 to 2^53 (a JavaScript number's exact range).
+std::uint64_t state_seq(const httplib::Request& req) {
+  const std::string text = req.get_param_value("seq");
+  std::uint64_t seq = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), seq);
+  if (ec != std::errc() || end != text.data() + text.size() || seq < 1 || seq > (std::uint64_t{1} << 53))
+    throw BadRequest("seq must be a whole number from 1 to 2^53, not '" + text + "'", "seq");
+  return seq;
+}
+
+// The state a page posts to /state: its settings as /frame.png takes them, its stage and how to encode the frame.
+std::shared_ptr<const StreamState> stream_state(const api::Scene& base, const httplib::Request& req,
+                                                const ViewLimits& limits) {
+  const std::uint64_t seq = state_seq(req);
+  const std::string stage = req.has_param("stage") ? req.get_param_value("stage") : "still";
+  if (stage != "moving" && stage != "still" && stage != "full")
+    throw BadRequest("stage must be moving, still or full, not '" + stage + "'", "stage");
+  const FrameEncoding encoding = parse_encoding(req.has_param("encoding") ? req.get_param_value("encoding") : "png");
+  const int quality = int_param(req, "quality", 80, 1, 100);
+  FrameQuery q = parse_query(base, req, limits);
+  check_frame_cost(q, limits);
+  auto state = std::make_shared<StreamState>(std::move(q.scene));
+  state->seq = seq;
+  state->stage = stage;
+  state->moving = stage == "moving";
+  state->encoding = encoding;
+  state->quality = quality;
+  state->width = q.width;
+  state->height = q.height;
+  state->full = q.full;
+  state->arrived = StreamClock::now();
+  return state;
 }
 
 std::vector<double> numbers(const toml::node* node) {
@@ -237,53 +292,6 @@ httplib::Server::Handler guarded(F handle) {
   };
 }
 
-// The one OpenCL queue, taken by one frame at a time. A frame waits for it only while it is still wanted: its
-// client there, its time left, and no newer frame of its page (the page's `page` parameter) come since.
-class FrameQueue {
- public:
-  // A frame's place: its page's generation when it came; superseded once a newer one of the page came.
-  struct Ticket {
-    std::string page;
-    std::uint64_t generation = 0;
-  };
-  Ticket arrive(const std::string& page) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    return {page, page.empty() ? 0 : ++latest_[page]};
-  }
-  bool superseded(const Ticket& t) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    return !t.page.empty() && latest_[t.page] != t.generation;
-  }
-  void leave(const Ticket& t) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (!t.page.empty() && latest_[t.page] == t.generation) latest_.erase(t.page);
-  }
-  // Waits for the queue, checking `going_on` (which throws to give up) every 50 ms.
-  void take(const std::function<void()>& going_on) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    while (busy_) {
-      lock.unlock();
-      going_on();
-      lock.lock();
-      free_.wait_for(lock, std::chrono::milliseconds(50), [&] { return !busy_; });
-    }
-    busy_ = true;
-  }
-  void give_back() {
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      busy_ = false;
-    }
-    free_.notify_one();
-  }
-
- private:
-  std::mutex mutex_;
-  std::condition_variable free_;
-  bool busy_ = false;
-  std::map<std::string, std::uint64_t> latest_;  // a page's newest frame; only pages with frames pending
-};
-
 // A token as Jupyter's: 24 random bytes in hex, from the system's entropy source.
 std::string random_token() {
   std::random_device entropy;
@@ -323,17 +331,22 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
   }
   const ViewLimits& limits = request.limits;
   FrameQueue frames;
+  // The pages' streams, and the thread that renders their frames on the same queue as /frame.png's.
+  StreamHub streams(*renderer, frames, limits);
   const bool loopback = is_loopback(request.host);
   // Off loopback anyone who can reach the port could use it: a token in the URL, as Jupyter's, keeps them out.
   const std::string token = !request.token.empty() ? request.token : loopback ? std::string() : random_token();
 
-  const std::string page = [] {
+  const std::string page_html = [] {
     for (const EmbeddedFile& f : embedded_view_files())
       if (std::string(f.name) == "index.html") return std::string(f.text);
     throw std::logic_error("the view page was not embedded");
   }();
 
   ViewServer server(limits);
+  // A page posts a small state for each input, on connections it keeps: cpp-httplib's default of 5 requests per
+  // connection would make it connect anew every fifth. Each request keeps its own limits.
+  server.set_keep_alive_max_count(1000);
   // Before any route: the token, the Host header (a page of another site that rebinds its name to 127.0.0.1
   // sends its own name, and must not read the scene, which names its file), and parameters that are text.
   server.set_pre_routing_handler([&](const httplib::Request& req, httplib::Response& res) {
@@ -353,7 +366,7 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
     }
     return httplib::Server::HandlerResponse::Unhandled;
   });
-  server.Get("/", [&](const httplib::Request&, httplib::Response& res) { res.set_content(page, "text/html"); });
+  server.Get("/", [&](const httplib::Request&, httplib::Response& res) { res.set_content(page_html, "text/html"); });
   server.Get("/scene.json", guarded([&](const httplib::Request&, httplib::Response& res) {
                res.set_content(algray::dump_json(scene_summary(base, device)), "application/json");
              }));
@@ -371,13 +384,7 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
                settings.height = q.height;
                settings.preview = !q.full;
                settings.depth_and_normal = false;
-               const std::uint64_t samples = frame_samples(q.scene.to_toml(), q.width, q.height, q.full);
-               if (samples > limits.max_frame_samples)
-                 throw BadRequest("the frame needs " + std::to_string(samples) +
-                                      " samples (camera rays x (1 + shadow points) x (1 + bounces)); "
-                                      "--max-frame-samples allows " +
-                                      std::to_string(limits.max_frame_samples),
-                                  {}, 0, 413, "--max-frame-samples");
+               check_frame_cost(q, limits);
                // Asked between tiles: the render stops, and gives the queue to the next frame, as soon as this
                // one is not wanted.
                std::optional<BadRequest> stopped;
@@ -404,19 +411,55 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
                  throw;
                }
                frames.give_back();
-               const json s = json::parse(stats);
-               double kernel_ms = 0;
-               for (const json& p : s["passes"]) kernel_ms += p.value("kernel_ms", 0.0);
-               int new_programs = 0;  // built or loaded from disk for this frame, rather than kept in memory
-               for (const json& p : s["programs"]) new_programs += p.value("origin", "") != "memory";
-               res.set_header("X-Algray-New-Programs", std::to_string(new_programs));
-               int degree = 0;
-               for (const json& surface : s["surfaces"]) degree = std::max(degree, surface.value("degree", 0));
-               res.set_header("X-Algray-Kernel-Ms", std::to_string(kernel_ms));
-               res.set_header("X-Algray-Degree", std::to_string(degree));
+               const FrameFacts facts = frame_facts(stats);
+               // Programs built or loaded from disk for this frame, rather than kept in memory.
+               res.set_header("X-Algray-New-Programs", std::to_string(facts.new_programs));
+               res.set_header("X-Algray-Kernel-Ms", std::to_string(facts.kernel_ms));
+               res.set_header("X-Algray-Degree", std::to_string(facts.degree));
                res.set_header("Cache-Control", "no-store");
                res.set_content(png, "image/png");
              }));
+  // The page's frames: one long-lived response per page, whose messages (StreamHub::next_message) this
+  // connection's thread encodes and sends while the stream thread renders the next frame.
+  server.Get("/stream", guarded([&](const httplib::Request& req, httplib::Response& res) {
+               const std::string page_id = page_name(req);
+               const std::shared_ptr<StreamSession> session = streams.open(page_id);
+               res.set_header("Cache-Control", "no-store");
+               res.set_header("X-Content-Type-Options", "nosniff");
+               auto hello = std::make_shared<bool>(true);
+               auto last_send_ms = std::make_shared<double>(0);
+               res.set_chunked_content_provider(
+                   "application/octet-stream",
+                   [&streams, &server, session, page_id, hello, last_send_ms](std::size_t, httplib::DataSink& sink) {
+                     std::optional<std::string> message;
+                     if (*hello) {
+                       *hello = false;
+                       message = StreamHub::hello_message(page_id);
+                     } else {
+                       message = streams.next_message(
+                           session, [&server] { return ViewServer::client_gone() || !server.is_running(); },
+                           *last_send_ms);
+                     }
+                     if (!message) return false;
+                     const auto started = ViewClock::now();
+                     // A client that stops reading fails this write after the server's write timeout, which
+                     // ends the stream: its page holds one frame, never more, until then.
+                     const bool sent = sink.write(message->data(), message->size());
+                     *last_send_ms = std::chrono::duration<double, std::milli>(ViewClock::now() - started).count();
+                     return sent;
+                   },
+                   [&streams, session](bool) { streams.close(session); });
+             }));
+  // A page's newest state, for its stream's next frame. Refused as /frame.png refuses a frame (a bad equation
+  // with its column, a limit); 404 when the page has no stream open.
+  server.Post("/state", guarded([&](const httplib::Request& req, httplib::Response& res) {
+                const std::string page_id = page_name(req);
+                const std::shared_ptr<const StreamState> state = stream_state(base, req, limits);
+                const bool accepted = streams.post(page_id, state);
+                res.set_header("Cache-Control", "no-store");
+                res.set_content(algray::dump_json(json{{"seq", state->seq}, {"accepted", accepted}}),
+                                "application/json");
+              }));
   server.Get("/scene.toml", guarded([&](const httplib::Request& req, httplib::Response& res) {
                FrameQuery q = parse_query(base, req, limits);
                q.scene.set("image.width", std::to_string(q.width));
@@ -463,6 +506,7 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
     if (std::system(command.c_str()) != 0) err << "algray view: could not open a browser; visit " << url << "\n";
   }
   server.listen_after_bind();
+  streams.stop();
   return kExitOk;
 }
 
