@@ -159,7 +159,6 @@ std::shared_ptr<const StreamState> stream_state(const api::Scene& base, const ht
   auto state = std::make_shared<StreamState>(std::move(q.scene));
   state->seq = seq;
   state->stage = stage;
-  state->moving = stage == "moving";
   state->encoding = encoding;
   state->quality = quality;
   state->width = q.width;

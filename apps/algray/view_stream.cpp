@@ -118,6 +118,7 @@ FrameFacts frame_facts(const std::string& stats_json) {
   for (const json& surface : s["surfaces"]) f.degree = std::max(f.degree, surface.value("degree", 0));
   f.passes_ms = s["render_ms"].value("passes_wall", 0.0);
   f.shade_ms = s["render_ms"].value("host_shading", 0.0);
+  f.phases_json = s.value("phases_ms", json::object()).dump();
   return f;
 }
 
@@ -230,11 +231,10 @@ void StreamHub::render(const std::shared_ptr<StreamSession>& session,
                        const std::shared_ptr<const StreamState>& state) {
   const auto deadline = StreamClock::now() + std::chrono::duration_cast<StreamClock::duration>(
                                                  std::chrono::duration<double>(limits_.request_timeout_s));
-  // Still wanted: its stream open, and (a still frame) no newer state come. A moving frame runs to its end, so
-  // that a page whose input never rests still sees frames.
+  // Still wanted: its stream open, and (a full-mode frame) no newer state come.
   const auto wanted = [&] {
     const std::lock_guard<std::mutex> lock(mutex_);
-    return !stopping_ && !session->closed && (state->moving || session->state->seq == state->seq);
+    return !stopping_ && !session->closed && (!state->full || session->state->seq == state->seq);
   };
   bool timed_out = false;
   api::RenderSettings settings;
@@ -350,6 +350,7 @@ std::optional<std::string> StreamHub::next_message(const std::shared_ptr<StreamS
                  {"shade_ms", f.shade_ms},
                  {"encode_ms", ms_since(started)},
                  {"previous_send_ms", last_send_ms},
+                 {"phases_ms", json::parse(f.phases_json)},
                  {"bytes", body.size()}});
   return message(header, body);
 }

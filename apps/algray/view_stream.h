@@ -50,15 +50,14 @@ class FrameQueue {
 enum class FrameEncoding { Png, Jpeg, Webp };
 
 // What the page wants on screen: the scene with its settings applied, the frame's size and mode, and how to send
-// it. `moving`: the page's input is moving, so a newer state does not stop this frame (else a drag would never
-// see one finish); a still frame is stopped by any newer state.
+// it. Only a frame in the scene's full mode (antialiasing, shadows: seconds) stops for a newer state; a preview
+// runs to its end, so that a page whose states come faster than frames (a drag) still sees every frame it can.
 struct StreamState {
   explicit StreamState(api::Scene scene_) : scene(std::move(scene_)) {}
   std::uint64_t seq = 0;  // the page's count, newer is larger
   api::Scene scene;
   int width = 0, height = 0;
   bool full = false;
-  bool moving = false;
   std::string stage;  // the page's name for it, sent back with the frame
   FrameEncoding encoding = FrameEncoding::Png;
   int quality = 80;
@@ -69,6 +68,7 @@ struct StreamState {
 struct FrameFacts {
   double kernel_ms = 0, passes_ms = 0, shade_ms = 0;
   int degree = 0, new_programs = 0;
+  std::string phases_json;  // the render's phases and their wall times (--stats' phases_ms)
 };
 FrameFacts frame_facts(const std::string& stats_json);
 

@@ -58,8 +58,6 @@ bool jpeg_rows(jpeg_compress_struct& info, JpegError& error, const std::uint8_t*
   info.in_color_space = channels == 4 ? JCS_EXT_RGBA : JCS_RGB;
   jpeg_set_defaults(&info);
   jpeg_set_quality(&info, quality, TRUE);
-  // The fast integer DCT: measured no larger and a third faster than the default at 512^2 on the view's frames.
-  info.dct_method = JDCT_IFAST;
   jpeg_start_compress(&info, TRUE);
   const std::size_t stride = static_cast<std::size_t>(width) * channels;
   while (info.next_scanline < info.image_height) {
