@@ -423,6 +423,8 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
   server.Get("/stream", guarded([&](const httplib::Request& req, httplib::Response& res) {
                const std::string page_id = page_name(req);
                const std::shared_ptr<StreamSession> session = streams.open(page_id);
+               // 256 KiB (the kernel doubles it): a 512^2 JPEG frame is some 30 KB, a 1024^2 PNG some 200 KB.
+               ViewServer::limit_send_buffer(256 << 10);
                res.set_header("Cache-Control", "no-store");
                res.set_header("X-Content-Type-Options", "nosniff");
                auto hello = std::make_shared<bool>(true);

@@ -228,6 +228,10 @@ bool ViewServer::client_gone() {
 
 ViewClock::time_point ViewServer::deadline() { return current_deadline; }
 
+void ViewServer::limit_send_buffer(int bytes) {
+  if (current_socket != INVALID_SOCKET) ::setsockopt(current_socket, SOL_SOCKET, SO_SNDBUF, &bytes, sizeof bytes);
+}
+
 bool ViewServer::process_and_close_socket(socket_t sock) {
   struct Count {
     std::atomic<int>& open;
