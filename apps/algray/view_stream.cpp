@@ -29,6 +29,7 @@ class StreamSession {
   const std::string page;
   std::condition_variable ready;               // `held` filled, or the stream ended
   std::shared_ptr<const StreamState> state;    // the page's newest
+  std::shared_ptr<const AppliedSettings> applied = std::make_shared<AppliedSettings>();  // its settings
   std::uint64_t done_seq = 0;                  // the newest state rendered or failed, not to be rendered again
   std::optional<Held> held;
   bool closed = false;
@@ -69,6 +70,10 @@ const char* mime_of(FrameEncoding e) {
       break;
   }
   return "image/png";
+}
+
+BadRequest no_stream(const std::string& page) {
+  return BadRequest("no stream is open for page '" + page + "': open /stream?page=" + page + " first", "page", 0, 404);
 }
 
 // Thrown by the queue's wait when the frame is no longer wanted.
@@ -171,9 +176,7 @@ bool StreamHub::post(const std::string& page, std::shared_ptr<const StreamState>
   {
     const std::lock_guard<std::mutex> lock(mutex_);
     const auto it = sessions_.find(page);
-    if (it == sessions_.end())
-      throw BadRequest("no stream is open for page '" + page + "': open /stream?page=" + page + " first", "page", 0,
-                       404);
+    if (it == sessions_.end()) throw no_stream(page);
     StreamSession& s = *it->second;
     // States come in order from one page; one that overtook a newer one on another connection is dropped.
     if (s.state && state->seq <= s.state->seq) return false;
@@ -181,6 +184,18 @@ bool StreamHub::post(const std::string& page, std::shared_ptr<const StreamState>
   }
   work_.notify_all();
   return true;
+}
+
+std::shared_ptr<const AppliedSettings> StreamHub::applied_settings(const std::string& page) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = sessions_.find(page);
+  if (it == sessions_.end()) throw no_stream(page);
+  return it->second->applied;
+}
+
+void StreamHub::remember_settings(const std::string& page, std::shared_ptr<const AppliedSettings> applied) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (const auto it = sessions_.find(page); it != sessions_.end()) it->second->applied = std::move(applied);
 }
 
 void StreamHub::close(const std::shared_ptr<StreamSession>& session) {
@@ -237,10 +252,8 @@ void StreamHub::render(const std::shared_ptr<StreamSession>& session,
     return !stopping_ && !session->closed && (!state->full || session->state->seq == state->seq);
   };
   bool timed_out = false;
+  // The size and preview mode are the scene's own (StreamState), so that the render does not read it again.
   api::RenderSettings settings;
-  settings.width = state->width;
-  settings.height = state->height;
-  settings.preview = !state->full;
   settings.depth_and_normal = false;
   // Asked between tiles: the device goes to the next frame as soon as this one is not wanted.
   settings.cancelled = [&] {

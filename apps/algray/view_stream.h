@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "view_limits.h"
 #include "view_query.h"
@@ -45,6 +46,13 @@ class FrameQueue {
   std::map<std::string, std::uint64_t> latest_;  // a page's newest frame; only pages with frames pending
 };
 
+// One setting of a page's state applied, and the scene after it (for the page's next state, which repeats most).
+struct AppliedSetting {
+  Setting setting;
+  api::Scene scene;
+};
+using AppliedSettings = std::vector<AppliedSetting>;
+
 // How a streamed frame is encoded, as the page asks: PNG (lossless, the scene embedded, as /frame.png and
 // `algray render` write it) or JPEG or WebP at a quality from 1 to 100.
 enum class FrameEncoding { Png, Jpeg, Webp };
@@ -55,7 +63,7 @@ enum class FrameEncoding { Png, Jpeg, Webp };
 struct StreamState {
   explicit StreamState(api::Scene scene_) : scene(std::move(scene_)) {}
   std::uint64_t seq = 0;  // the page's count, newer is larger
-  api::Scene scene;
+  api::Scene scene;       // with the frame's size and preview mode set (image.width, image.height, render.preview)
   int width = 0, height = 0;
   bool full = false;
   std::string stage;  // the page's name for it, sent back with the frame
@@ -90,6 +98,10 @@ class StreamHub {
   // The page's newest state: false when `state` is not newer than the last one it sent (dropped). BadRequest
   // 404 when the page has no stream open.
   bool post(const std::string& page, std::shared_ptr<const StreamState> state);
+  // The settings of the page's last state, with the scene after each (empty at first), and this state's for the
+  // next. BadRequest 404 when the page has no stream open.
+  std::shared_ptr<const AppliedSettings> applied_settings(const std::string& page);
+  void remember_settings(const std::string& page, std::shared_ptr<const AppliedSettings> applied);
   // Ends the session's stream: its frame stops between tiles, and its page may open another.
   void close(const std::shared_ptr<StreamSession>& session);
   void stop();  // closes every stream and ends the render thread

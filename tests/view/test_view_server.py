@@ -208,6 +208,13 @@ try:
     header, _ = again.message()
     if header["seq"] != 7:
         fail(f"the new stream's frame: {header}")
+    # A state that repeats the last one's first settings starts from the scene after them: the same frame as one
+    # whose settings are all applied afresh.
+    for seq, params in ((8, moved), (9, view + [("full", "0")])):
+        post_state(base, "page1", seq, params)
+        header, body = again.message()
+    if header["seq"] != 9 or idat(body) != idat(expected):
+        fail(f"a state after one differing only in phi: {header}, or not /frame.png's frame")
     again.close()
 finally:
     server.terminate()
