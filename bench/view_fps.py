@@ -53,7 +53,8 @@ const done = arguments[0];
 })();"""
 
 # The stream's per-frame timings, medians reported (ms, but bytes).
-TIMINGS = ("queue_ms", "render_ms", "kernel_ms", "passes_ms", "shade_ms", "encode_ms", "previous_send_ms", "bytes")
+TIMINGS = ("queue_ms", "render_ms", "kernel_ms", "passes_ms", "shade_ms", "rest_ms", "encode_ms", "previous_send_ms",
+           "bytes")
 
 
 def measure(binary, scene, seconds, mode):
@@ -77,6 +78,8 @@ def measure(binary, scene, seconds, mode):
         driver.quit()
         server.terminate()
         server.wait()
+    for t in result["times"]:
+        t["rest_ms"] = t["render_ms"] - t["passes_ms"] - t["shade_ms"]
     times = {k: statistics.median(t[k] for t in result["times"]) for k in TIMINGS} if result["times"] else None
     latency = statistics.median(result["latencies"]) if result["latencies"] else float("nan")
     return {"fps": result["frames"] / seconds, "latency": latency, "frames": len(result["latencies"]),
@@ -149,11 +152,12 @@ def main():
                          f"{fmt(median(name, mode, 'after', 'latency'), 0)} |")
     lines += ["", "Where a streamed frame's time goes (after; the server's own timings, median per frame): queue, from "
               "the state's arrival to its render's start; render, the library's whole render call, of which kernels "
-              "(device time), passes (the passes' wall time: launches, staging, read-back) and host shading; encode "
+              "(device time), passes (the passes' wall time: launches, staging, read-back), host shading and the "
+              "rest (the library's set-up around the passes each frame: plan, film, tile buffers, stats); encode "
               "(to JPEG or PNG, on the stream's thread while the next frame renders); send, the write of the frame "
               "before.", "",
-              "| scene | mode | queue | render | kernels | passes | host shading | encode | send | KB |",
-              "|---|---|---|---|---|---|---|---|---|---|"]
+              "| scene | mode | queue | render | kernels | passes | host shading | rest | encode | send | KB |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name in args.scenes:
         for mode in MODES:
             t = {k: median_time(name, mode, k) for k in TIMINGS}
