@@ -328,7 +328,7 @@ try:
     # on); its write times out and the stream ends, after which its page's states are answered 404.
     stuck = Stream(host, port, "stuck", timeout=5, receive_buffer=4096)
     stuck.message()
-    posted_until = time.monotonic() + 3.0
+    posted_until = time.monotonic() + 2.0
     seq = 0
     cpu_from = None
     while time.monotonic() < posted_until:
