@@ -13,6 +13,7 @@ render_packages=(
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgmp-dev
   libcpp-httplib-dev  # `algray view`'s local web server, in algray-full, which `algray` is built with
+  libjpeg62-turbo-dev libwebp-dev  # `algray view`'s frames while the input moves: JPEG or WebP, in algray-full
 )
 test_packages=(
   clinfo catch2

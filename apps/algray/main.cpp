@@ -407,6 +407,9 @@ struct ViewCommand {
     cmd->add_option("--max-connections", l.max_connections, "connections open at once; more are answered 429")
         ->capture_default_str()
         ->check(CLI::Range(1, 1024));
+    cmd->add_option("--max-streams", l.max_streams, "pages' frame streams open at once; more are answered 429")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1024));
     cmd->add_option("--max-header-bytes", l.max_header_bytes, "bytes of a request's line and headers; more: 431")
         ->capture_default_str()
         ->check(CLI::Range(1024, 1 << 24));

@@ -4,12 +4,12 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
-#include <condition_variable>
+#include <memory>
 #include <cstdlib>
 #include <functional>
 #include <map>
-#include <mutex>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <random>
@@ -24,6 +24,7 @@
 #include "exit_codes.h"
 #include "view_query.h"
 #include "view_server.h"
+#include "view_stream.h"
 
 namespace algray {
 // The page and its script (apps/algray/view/), embedded at build time.
@@ -74,17 +75,44 @@ void check_going_on(const ViewLimits& limits, const std::function<bool()>& super
   if (superseded && superseded()) throw BadRequest("a newer frame of this page replaced this one", {}, 0, 409);
 }
 
-FrameQuery parse_query(const api::Scene& base, const httplib::Request& req, const ViewLimits& limits) {
+// The request's settings applied to `base` in order. `before`: the settings of the page's last state, each with
+// the scene after it; a state whose first settings are those starts from the scene after them rather than
+// applying them again (each set() reads the scene again: the page's 21 settings took 4 ms for the Barth sextic and
+// 6-11 ms for the decic). `applied`, where given, gets this request's. `size_in_scene`: the frame's size and
+// preview mode are set on the scene too (image.width, image.height, render.preview), so that the render reads
+// the scene no more.
+FrameQuery parse_query(const api::Scene& base, const httplib::Request& req, const ViewLimits& limits,
+                       const AppliedSettings* before = nullptr, AppliedSettings* applied = nullptr,
+                       bool size_in_scene = false) {
   FrameQuery q{base};
+  q.width = int_param(req, "width", base.width(), 1, kMaxViewSide);
+  q.height = int_param(req, "height", base.height(), 1, kMaxViewSide);
+  const std::string full = req.has_param("full") ? req.get_param_value("full") : "0";
+  if (full != "0" && full != "1") throw BadRequest("full must be 0 or 1, not '" + full + "'");
+  q.full = full == "1";
   std::vector<std::string> items;
   for (std::size_t i = 0, n = req.get_param_value_count("set"); i < n; ++i)
     items.push_back(req.get_param_value("set", i));
-  const std::vector<Setting> settings = parse_settings(items, limits.max_settings);
+  std::vector<Setting> settings = parse_settings(items, limits.max_settings);
+  // First, so that they are among the settings a page's states share while only its camera moves.
+  if (size_in_scene) {
+    std::vector<Setting> size{{"image.width", std::to_string(q.width)}, {"image.height", std::to_string(q.height)}};
+    if (!q.full) size.push_back({"render.preview", "true"});
+    settings.insert(settings.begin(), size.begin(), size.end());
+  }
+  std::size_t kept = 0;
+  if (before)
+    while (kept < before->size() && kept < settings.size() && (*before)[kept].setting.key == settings[kept].key &&
+           (*before)[kept].setting.value == settings[kept].value)
+      ++kept;
+  if (kept > 0) q.scene = (*before)[kept - 1].scene;
+  if (applied) applied->assign(before ? before->begin() : applied->end(), before ? before->begin() + kept : applied->end());
   // One equation's expansion is bounded by the parser's own budget, and stops when its client leaves (below); what a
   // request may add up is bounded here.
   const auto parse_deadline = ViewClock::now() + std::chrono::duration_cast<ViewClock::duration>(
                                                      std::chrono::duration<double, std::milli>(limits.max_parse_ms));
-  for (const Setting& s : settings) {
+  for (std::size_t i = kept; i < settings.size(); ++i) {
+    const Setting& s = settings[i];
     check_going_on(limits);
     const auto too_long = [&] {
       return BadRequest("applying the request's set= items took longer than --max-parse-ms (" +
@@ -105,13 +133,67 @@ FrameQuery parse_query(const api::Scene& base, const httplib::Request& req, cons
       check_going_on(limits);  // the client left or the request's time ran out: that is the answer
       throw too_long();
     }
+    if (applied) applied->push_back({s, q.scene});
   }
-  q.width = int_param(req, "width", base.width(), 1, kMaxViewSide);
-  q.height = int_param(req, "height", base.height(), 1, kMaxViewSide);
-  const std::string full = req.has_param("full") ? req.get_param_value("full") : "0";
-  if (full != "0" && full != "1") throw BadRequest("full must be 0 or 1, not '" + full + "'");
-  q.full = full == "1";
   return q;
+}
+
+// A frame over --max-frame-samples is refused before it starts (413).
+void check_frame_cost(const FrameQuery& q, const ViewLimits& limits) {
+  const std::uint64_t samples = frame_samples(q.scene.to_toml(), q.width, q.height, q.full);
+  if (samples > limits.max_frame_samples)
+    throw BadRequest("the frame needs " + std::to_string(samples) +
+                         " samples (camera rays x (1 + shadow points) x (1 + bounces)); --max-frame-samples allows " +
+                         std::to_string(limits.max_frame_samples),
+                     {}, 0, 413, "--max-frame-samples");
+}
+
+// The page's name for its stream (`page`): 1 to 64 letters, digits, '-' or '_', as the page makes it.
+std::string page_name(const httplib::Request& req) {
+  const std::string page = req.get_param_value("page");
+  const bool ok = !page.empty() && page.size() <= 64 && std::all_of(page.begin(), page.end(), [](unsigned char c) {
+    return std::isalnum(c) || c == '-' || c == '_';
+  });
+  if (!ok) throw BadRequest("page must be 1 to 64 letters, digits, '-' or '_'", "page");
+  return page;
+}
+
+// A state's place in its page's order (`seq`): a whole number from 1 to 2^53 (a JavaScript number's exact range).
+std::uint64_t state_seq(const httplib::Request& req) {
+  const std::string text = req.get_param_value("seq");
+  std::uint64_t seq = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), seq);
+  if (ec != std::errc() || end != text.data() + text.size() || seq < 1 || seq > (std::uint64_t{1} << 53))
+    throw BadRequest("seq must be a whole number from 1 to 2^53, not '" + text + "'", "seq");
+  return seq;
+}
+
+// The state a page posts to /state: its settings as /frame.png takes them, its stage and how to encode the frame.
+std::shared_ptr<const StreamState> stream_state(const api::Scene& base, const httplib::Request& req,
+                                                const ViewLimits& limits, StreamHub& streams) {
+  const std::uint64_t seq = state_seq(req);
+  const std::string stage = req.has_param("stage") ? req.get_param_value("stage") : "still";
+  if (stage != "moving" && stage != "still" && stage != "full")
+    throw BadRequest("stage must be moving, still or full, not '" + stage + "'", "stage");
+  const FrameEncoding encoding = parse_encoding(req.has_param("encoding") ? req.get_param_value("encoding") : "png");
+  const int quality = int_param(req, "quality", 80, 1, 100);
+  const std::string page_id = page_name(req);
+  // Its page's last settings, for those this state repeats (404 when the page has no stream).
+  const std::shared_ptr<const AppliedSettings> before = streams.applied_settings(page_id);
+  auto applied = std::make_shared<AppliedSettings>();
+  FrameQuery q = parse_query(base, req, limits, before.get(), applied.get(), true);
+  check_frame_cost(q, limits);
+  streams.remember_settings(page_id, applied);
+  auto state = std::make_shared<StreamState>(std::move(q.scene));
+  state->seq = seq;
+  state->stage = stage;
+  state->encoding = encoding;
+  state->quality = quality;
+  state->width = q.width;
+  state->height = q.height;
+  state->full = q.full;
+  state->arrived = StreamClock::now();
+  return state;
 }
 
 std::vector<double> numbers(const toml::node* node) {
@@ -237,53 +319,6 @@ httplib::Server::Handler guarded(F handle) {
   };
 }
 
-// The one OpenCL queue, taken by one frame at a time. A frame waits for it only while it is still wanted: its
-// client there, its time left, and no newer frame of its page (the page's `page` parameter) come since.
-class FrameQueue {
- public:
-  // A frame's place: its page's generation when it came; superseded once a newer one of the page came.
-  struct Ticket {
-    std::string page;
-    std::uint64_t generation = 0;
-  };
-  Ticket arrive(const std::string& page) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    return {page, page.empty() ? 0 : ++latest_[page]};
-  }
-  bool superseded(const Ticket& t) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    return !t.page.empty() && latest_[t.page] != t.generation;
-  }
-  void leave(const Ticket& t) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (!t.page.empty() && latest_[t.page] == t.generation) latest_.erase(t.page);
-  }
-  // Waits for the queue, checking `going_on` (which throws to give up) every 50 ms.
-  void take(const std::function<void()>& going_on) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    while (busy_) {
-      lock.unlock();
-      going_on();
-      lock.lock();
-      free_.wait_for(lock, std::chrono::milliseconds(50), [&] { return !busy_; });
-    }
-    busy_ = true;
-  }
-  void give_back() {
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      busy_ = false;
-    }
-    free_.notify_one();
-  }
-
- private:
-  std::mutex mutex_;
-  std::condition_variable free_;
-  bool busy_ = false;
-  std::map<std::string, std::uint64_t> latest_;  // a page's newest frame; only pages with frames pending
-};
-
 // A token as Jupyter's: 24 random bytes in hex, from the system's entropy source.
 std::string random_token() {
   std::random_device entropy;
@@ -323,17 +358,22 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
   }
   const ViewLimits& limits = request.limits;
   FrameQueue frames;
+  // The pages' streams, and the thread that renders their frames on the same queue as /frame.png's.
+  StreamHub streams(*renderer, frames, limits);
   const bool loopback = is_loopback(request.host);
   // Off loopback anyone who can reach the port could use it: a token in the URL, as Jupyter's, keeps them out.
   const std::string token = !request.token.empty() ? request.token : loopback ? std::string() : random_token();
 
-  const std::string page = [] {
+  const std::string page_html = [] {
     for (const EmbeddedFile& f : embedded_view_files())
       if (std::string(f.name) == "index.html") return std::string(f.text);
     throw std::logic_error("the view page was not embedded");
   }();
 
   ViewServer server(limits);
+  // A page posts a small state for each input, on connections it keeps: cpp-httplib's default of 5 requests per
+  // connection would make it connect anew every fifth. Each request keeps its own limits.
+  server.set_keep_alive_max_count(1000);
   // Before any route: the token, the Host header (a page of another site that rebinds its name to 127.0.0.1
   // sends its own name, and must not read the scene, which names its file), and parameters that are text.
   server.set_pre_routing_handler([&](const httplib::Request& req, httplib::Response& res) {
@@ -353,7 +393,7 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
     }
     return httplib::Server::HandlerResponse::Unhandled;
   });
-  server.Get("/", [&](const httplib::Request&, httplib::Response& res) { res.set_content(page, "text/html"); });
+  server.Get("/", [&](const httplib::Request&, httplib::Response& res) { res.set_content(page_html, "text/html"); });
   server.Get("/scene.json", guarded([&](const httplib::Request&, httplib::Response& res) {
                res.set_content(algray::dump_json(scene_summary(base, device)), "application/json");
              }));
@@ -371,13 +411,7 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
                settings.height = q.height;
                settings.preview = !q.full;
                settings.depth_and_normal = false;
-               const std::uint64_t samples = frame_samples(q.scene.to_toml(), q.width, q.height, q.full);
-               if (samples > limits.max_frame_samples)
-                 throw BadRequest("the frame needs " + std::to_string(samples) +
-                                      " samples (camera rays x (1 + shadow points) x (1 + bounces)); "
-                                      "--max-frame-samples allows " +
-                                      std::to_string(limits.max_frame_samples),
-                                  {}, 0, 413, "--max-frame-samples");
+               check_frame_cost(q, limits);
                // Asked between tiles: the render stops, and gives the queue to the next frame, as soon as this
                // one is not wanted.
                std::optional<BadRequest> stopped;
@@ -404,19 +438,57 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
                  throw;
                }
                frames.give_back();
-               const json s = json::parse(stats);
-               double kernel_ms = 0;
-               for (const json& p : s["passes"]) kernel_ms += p.value("kernel_ms", 0.0);
-               int new_programs = 0;  // built or loaded from disk for this frame, rather than kept in memory
-               for (const json& p : s["programs"]) new_programs += p.value("origin", "") != "memory";
-               res.set_header("X-Algray-New-Programs", std::to_string(new_programs));
-               int degree = 0;
-               for (const json& surface : s["surfaces"]) degree = std::max(degree, surface.value("degree", 0));
-               res.set_header("X-Algray-Kernel-Ms", std::to_string(kernel_ms));
-               res.set_header("X-Algray-Degree", std::to_string(degree));
+               const FrameFacts facts = frame_facts(stats);
+               // Programs built or loaded from disk for this frame, rather than kept in memory.
+               res.set_header("X-Algray-New-Programs", std::to_string(facts.new_programs));
+               res.set_header("X-Algray-Kernel-Ms", std::to_string(facts.kernel_ms));
+               res.set_header("X-Algray-Degree", std::to_string(facts.degree));
                res.set_header("Cache-Control", "no-store");
                res.set_content(png, "image/png");
              }));
+  // The page's frames: one long-lived response per page, whose messages (StreamHub::next_message) this
+  // connection's thread encodes and sends while the stream thread renders the next frame.
+  server.Get("/stream", guarded([&](const httplib::Request& req, httplib::Response& res) {
+               const std::string page_id = page_name(req);
+               const std::shared_ptr<StreamSession> session = streams.open(page_id);
+               // 256 KiB (the kernel doubles it): a 512^2 JPEG frame is some 30 KB, a 1024^2 PNG some 200 KB.
+               ViewServer::limit_send_buffer(256 << 10);
+               res.set_header("Cache-Control", "no-store");
+               res.set_header("X-Content-Type-Options", "nosniff");
+               auto hello = std::make_shared<bool>(true);
+               auto last_send_ms = std::make_shared<double>(0);
+               res.set_chunked_content_provider(
+                   "application/octet-stream",
+                   [&streams, &server, session, page_id, hello, last_send_ms](std::size_t, httplib::DataSink& sink) {
+                     std::optional<std::string> message;
+                     if (*hello) {
+                       *hello = false;
+                       message = StreamHub::hello_message(page_id);
+                     } else {
+                       message = streams.next_message(
+                           session, [&server] { return ViewServer::client_gone() || !server.is_running(); },
+                           *last_send_ms);
+                     }
+                     if (!message) return false;
+                     const auto started = ViewClock::now();
+                     // A client that stops reading fails this write after the server's write timeout, which
+                     // ends the stream: its page holds one frame, never more, until then.
+                     const bool sent = sink.write(message->data(), message->size());
+                     *last_send_ms = std::chrono::duration<double, std::milli>(ViewClock::now() - started).count();
+                     return sent;
+                   },
+                   [&streams, session](bool) { streams.close(session); });
+             }));
+  // A page's newest state, for its stream's next frame. Refused as /frame.png refuses a frame (a bad equation
+  // with its column, a limit); 404 when the page has no stream open.
+  server.Post("/state", guarded([&](const httplib::Request& req, httplib::Response& res) {
+                const std::string page_id = page_name(req);
+                const std::shared_ptr<const StreamState> state = stream_state(base, req, limits, streams);
+                const bool accepted = streams.post(page_id, state);
+                res.set_header("Cache-Control", "no-store");
+                res.set_content(algray::dump_json(json{{"seq", state->seq}, {"accepted", accepted}}),
+                                "application/json");
+              }));
   server.Get("/scene.toml", guarded([&](const httplib::Request& req, httplib::Response& res) {
                FrameQuery q = parse_query(base, req, limits);
                q.scene.set("image.width", std::to_string(q.width));
@@ -463,6 +535,7 @@ int run_view(const ViewRequest& request, std::ostream& out, std::ostream& err) {
     if (std::system(command.c_str()) != 0) err << "algray view: could not open a browser; visit " << url << "\n";
   }
   server.listen_after_bind();
+  streams.stop();
   return kExitOk;
 }
 

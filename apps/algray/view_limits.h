@@ -11,6 +11,7 @@ namespace algray::cli {
 // the page show any scene at its own size in full mode, and let no single request hold the server for long.
 struct ViewLimits {
   int max_connections = 64;              // open at once; one more is answered 429 and closed
+  int max_streams = 8;                   // pages' frame streams open at once (each holds a connection)
   std::size_t max_header_bytes = 65536;  // request line and headers together (cpp-httplib caps only each line)
   double header_timeout_s = 5;           // to receive a request's line and headers, however slowly they trickle
   double request_timeout_s = 60;         // from the request's first byte to its answer: queueing, parsing, rendering

@@ -28,6 +28,9 @@ class ViewServer : public httplib::Server {
   // and when this request's time (--request-timeout, from its first byte) runs out.
   static bool client_gone();
   static ViewClock::time_point deadline();
+  // Caps the bytes the kernel queues for this request's client (SO_SNDBUF): a stream's writer then waits for a
+  // slow client after little more than one frame, rather than after megabytes of stale ones.
+  static void limit_send_buffer(int bytes);
 
  private:
   bool process_and_close_socket(socket_t sock) override;

@@ -2,7 +2,7 @@
 """`algray view` in a real browser: headless Chromium driven by Selenium loads the page and its first frame, a drag
 turns the camera, a slider moves a parameter, each control of the panel (colours, light, background,
 transparency, axis views, clip shape and radius, plane sections, clipping planes, reset, saved image) changes what the server
-renders, a bad equation shows its error at the command line's column and keeps the image, and the saved scene
+renders, frames come down the page's stream as JPEG or WebP while moving and PNG at rest, a bad equation shows its error at the command line's column and keeps the image, and the saved scene
 renders to the view's last full-size frame.
 
 Usage: test_view_browser.py ALGRAY_BINARY WORK_DIR. Needs chromium, chromium-driver and python3-selenium
@@ -139,6 +139,19 @@ try:
     zoomed = settle(n)
     if zoomed == slid:
         fail("the image did not change with the zoom")
+    # Frames while moving come down the stream as the Advanced fold says: JPEG by default, WebP when chosen; at
+    # rest, PNG (the frames compared above).
+    moving_as = "return frameTimes.some(t => t.stage === 'moving' && t.mime === arguments[0])"
+    if not driver.execute_script(moving_as, "image/jpeg"):
+        fail("no frame came as JPEG while the input moved")
+    driver.execute_script("""const e = document.getElementById('moving-encoding'); e.value = 'webp';
+                             e.dispatchEvent(new Event('change'));""")
+    n = frames()
+    driver.execute_script("document.getElementById('frame').dispatchEvent("
+                          "new WheelEvent('wheel', {deltaY: -100, cancelable: true}))")
+    zoomed = settle(n)
+    if not driver.execute_script(moving_as, "image/webp"):
+        fail("no frame came as WebP while the input moved, with WebP chosen")
 
     # Each control of the panel changes what the server renders, by the scene keys it names.
     def control(script, *args):
@@ -315,5 +328,5 @@ finally:
             process.terminate()
             process.wait(timeout=30)
 print("test_view_browser: first frame, hint, fps while moving, drag, slider, zoom, colours, lights, transparency, "
-      "axis views, clip shape and radius, sections, clipping planes, reset, saved image at both qualities, located error, saved scene "
+      "axis views, clip shape and radius, sections, clipping planes, reset, saved image at both qualities, JPEG and WebP frames while moving, located error, saved scene "
       "and an equation in a box all hold in Chromium")

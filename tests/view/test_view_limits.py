@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """`algray view` under hostile or careless clients (issue 48): slow and idle connections, endless headers, costly
 set= lists, abandoned and oversized frames, a second server on the port, bytes that are not text, foreign Host
-headers, tokens; then a seeded property test of the request parser. After each case other clients are served
+headers, tokens; frame streams past --max-streams, a stream whose client stops reading, and one closed in the
+middle of a frame (issue 45); then a seeded property test of the request parser. After each case other clients are served
 within 1 s, RSS stays bounded and CPU stops within 1 s of the clients leaving.
 
 Usage: test_view_limits.py ALGRAY_BINARY. Fails (exit 1) on the first broken expectation, naming the seed (set
@@ -16,6 +17,8 @@ import sys
 import threading
 import time
 import urllib.parse
+
+from stream_client import Stream, post_state
 
 BINARY = sys.argv[1]
 SEED = int(os.environ.get("ALGRAY_TEST_SEED", str(random.SystemRandom().randrange(1 << 30))))
@@ -134,7 +137,7 @@ def error_of(status, body, want_status, want_text, limit=None):
 
 
 server, host, port, url = start("--header-timeout", "2", "--request-timeout", "2", "--max-connections", "24",
-                                "--max-frame-samples", str(1 << 32))
+                                "--max-frame-samples", str(1 << 32), "--max-streams", "4")
 pid = server.pid
 try:
     served(host, port, "at start")
@@ -296,6 +299,85 @@ try:
         fail(f"RSS grew from {rss_frames:.0f} to {rss_mib(pid):.0f} MiB over 150 small requests")
     idle_after(server, "the parser cases")
 
+    # 7. Frame streams. Past --max-streams: 429 naming it; idle streams cost nothing; once one closes, another
+    # opens.
+    base = url.rstrip("/")
+    rss_streams = rss_mib(pid)
+    streams = [Stream(host, port, f"idle{k}", timeout=5) for k in range(4)]
+    for s in streams:
+        s.message()
+    extra = Stream(host, port, "one-more", timeout=5)
+    problem = error_of(extra.status, json.dumps(extra.error), 429, "--max-streams", "--max-streams")
+    extra.close()
+    if problem:
+        fail(f"a stream past --max-streams 4: {problem}")
+    idle_after(server, "4 idle streams")
+    served(host, port, "4 idle streams")
+    streams.pop().close()
+    time.sleep(0.2)
+    again = Stream(host, port, "after", timeout=5)
+    if again.status != 200:
+        fail(f"a stream after one of 4 closed: {again.status} {again.error}")
+    streams.append(again)
+    for s in streams:
+        s.close()
+    time.sleep(0.2)
+
+    # A client that stops reading its stream while its page keeps posting states: the server writes until the
+    # socket's buffers fill, holds one frame more, and renders nothing else for it (no CPU while the posts go
+    # on); its write times out and the stream ends, after which its page's states are answered 404.
+    stuck = Stream(host, port, "stuck", timeout=5, receive_buffer=4096)
+    stuck.message()
+    posted_until = time.monotonic() + 2.0
+    seq = 0
+    cpu_from = None
+    while time.monotonic() < posted_until:
+        seq += 1
+        status, answer = post_state(base, "stuck", seq, [("width", "512"), ("height", "512"), ("stage", "still"),
+                                                          ("set", f"phi=1.{seq:04}")], timeout=2)
+        if status != 200:
+            fail(f"state {seq} of a stream not read: {status} {answer}")
+        if cpu_from is None and time.monotonic() > posted_until - 1.0:
+            cpu_from = cpu_seconds(pid)
+        time.sleep(0.05)
+    used = cpu_seconds(pid) - cpu_from
+    if used > 0.25:
+        fail(f"a stream not read: the server used {used:.2f} s of CPU in the last second of its page's {seq} states")
+
+    # A stream closed in the middle of a costly frame (2048^2, full mode: seconds): the frame stops within a
+    # second, and the next client is served.
+    mid = Stream(host, port, "closed-mid-frame", timeout=5)
+    mid.message()
+    status, answer = post_state(base, "closed-mid-frame", 1, [("width", "2048"), ("height", "2048"), ("full", "1"),
+                                                              ("stage", "full")])
+    if status != 200:
+        fail(f"a 2048^2 full frame's state: {status} {answer}")
+    time.sleep(0.3)
+    mid.close()
+    time.sleep(0.5)
+    before = cpu_seconds(pid)
+    time.sleep(1.0)
+    used = cpu_seconds(pid) - before
+    if used > 0.25:
+        fail(f"a stream closed mid-frame: the server used {used:.2f} s of CPU in the second after")
+    status, _, body = request(host, port, "/frame.png?width=64&height=64", timeout=1.0)
+    if status != 200:
+        fail(f"a 64x64 frame after a stream closed mid-frame got {status} {body!r:.200}")
+
+    # The stream not read ends when its write times out (cpp-httplib's 5 s), and frees its page.
+    deadline = time.monotonic() + 10
+    while True:
+        status, answer = post_state(base, "stuck", seq + 1, [("width", "8"), ("height", "8")], timeout=2)
+        if status == 404:
+            break
+        if time.monotonic() > deadline:
+            fail(f"a stream not read was still open 10 s after its last read: {status} {answer}")
+        time.sleep(0.25)
+    stuck.close()
+    if rss_mib(pid) - rss_streams > 64:
+        fail(f"RSS grew from {rss_streams:.0f} to {rss_mib(pid):.0f} MiB over the streams")
+    idle_after(server, "the streams")
+
     # 5. A second server on the same port does not start: exit 2, naming the address.
     second = subprocess.run([BINARY, "view", "--port", str(port)], capture_output=True, text=True, timeout=30)
     if second.returncode != 2 or f"cannot listen on 127.0.0.1:{port}" not in second.stderr:
@@ -350,5 +432,5 @@ if socket.has_ipv6 and os.path.exists("/proc/net/if_inet6"):
         fail("--host ::1 was warned about as if it were not loopback")
 if failures:
     sys.exit(1)
-print(f"test_view_limits: slow, idle, endless, costly, abandoned and foreign requests bounded; "
+print(f"test_view_limits: slow, idle, endless, costly, abandoned and foreign requests and streams bounded; "
       f"150 parser cases (seed {SEED})")

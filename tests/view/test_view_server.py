@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """`algray view` without a browser: 200 concurrent valid and malformed requests to one server, the errors it
 answers, saved scenes that `algray render` turns into the view's own frames, an orbit job that `algray batch`
-renders, and programs kept in memory across frames of one degree.
+renders, programs kept in memory across frames of one degree, and the page's frame stream: each encoding as asked,
+its PNG the frame /frame.png gives, stale and refused states, and a second stream of one page replacing the first.
 
 Usage: test_view_server.py ALGRAY_BINARY WORK_DIR. Fails (exit 1) on the first broken expectation, naming the
 seed and the request; needs an OpenCL device, as every render does."""
@@ -16,6 +17,7 @@ import urllib.parse
 import urllib.request
 
 from png_data import idat
+from stream_client import Stream, post_state
 
 BINARY, WORK = sys.argv[1], sys.argv[2]
 SEED = int(os.environ.get("ALGRAY_TEST_SEED", "20261204"))
@@ -152,8 +154,70 @@ try:
     status, _, _ = get(base, "/orbit.toml", view + [("frames", "1")])
     if status != 400:
         fail(f"an orbit of 1 frame got {status}")
+
+    # The stream: a greeting, then a frame for each state posted, encoded as the state asks; the PNG is the frame
+    # /frame.png gives for the same settings.
+    parsed = urllib.parse.urlsplit(base)
+    stream = Stream(parsed.hostname, parsed.port, "page1")
+    hello, _ = stream.message()
+    if stream.status != 200 or hello != {"type": "hello", "page": "page1", "encodings": ["png", "jpeg", "webp"]}:
+        fail(f"the stream's greeting: {stream.status} {hello}")
+    _, _, expected = get(base, "/frame.png", view + [("full", "0")])
+    for seq, (encoding, mime, magic) in enumerate((("png", "image/png", b"\x89PNG"), ("jpeg", "image/jpeg", b"\xff\xd8"),
+                                                   ("webp", "image/webp", b"RIFF")), 1):
+        status, answer = post_state(base, "page1", seq, view + [("full", "0"), ("stage", "still"),
+                                                                ("encoding", encoding), ("quality", "70")])
+        if status != 200 or answer != {"seq": seq, "accepted": True}:
+            fail(f"state {seq} ({encoding}): {status} {answer}")
+        header, body = stream.message()
+        if header["type"] != "frame" or header["seq"] != seq or header["mime"] != mime or not body.startswith(magic) \
+                or (header["width"], header["height"]) != (64, 48) or header["stage"] != "still":
+            fail(f"the frame of state {seq} ({encoding}): {header} {body[:8]!r}")
+        if encoding == "png" and idat(body) != idat(expected):
+            fail("the stream's PNG frame is not /frame.png's for the same settings")
+    # A state not newer than the last is dropped; a bad equation is refused at its column, and no frame comes.
+    status, answer = post_state(base, "page1", 2, view)
+    if status != 200 or answer["accepted"]:
+        fail(f"an older state: {status} {answer}")
+    status, answer = post_state(base, "page1", 4, [("set", 'surface.equation="x^2+*y"')])
+    if status != 400 or answer["key"] != "surface.equation" or answer["column"] != 5:
+        fail(f"a bad equation on the stream: {status} {answer}")
+    for params, why in (([("encoding", "gif")], "encoding must be"), ([("quality", "0")], "quality must be"),
+                        ([("stage", "resting")], "stage must be")):
+        status, answer = post_state(base, "page1", 5, params)
+        if status != 400 or why not in answer["error"]:
+            fail(f"{params}: {status} {answer}")
+    status, answer = post_state(base, "nopage", 1, view)
+    if status != 404 or "no stream is open" not in answer["error"]:
+        fail(f"a state for a page without a stream: {status} {answer}")
+    # A parameter change builds no program; the frame says so, with its timings.
+    moved = [p for p in view if p != ("set", "phi=1.7")] + [("set", "phi=1.65"), ("encoding", "jpeg")]
+    status, answer = post_state(base, "page1", 6, moved)
+    if status != 200:
+        fail(f"a parameter change on the stream: {status} {answer}")
+    header, _ = stream.message()
+    if header["seq"] != 6 or header["new_programs"] != 0 or header["degree"] != 6 or \
+            not all(header[k] >= 0 for k in ("render_ms", "kernel_ms", "encode_ms", "queue_ms")):
+        fail(f"a parameter change on the stream: {header}")
+    # The page opens its stream again (after a network error, say): the new one replaces the old, which ends.
+    again = Stream(parsed.hostname, parsed.port, "page1")
+    again.message()
+    if not stream.ended():
+        fail("the first stream of page1 did not end when the page opened another")
+    post_state(base, "page1", 7, view)
+    header, _ = again.message()
+    if header["seq"] != 7:
+        fail(f"the new stream's frame: {header}")
+    # A state that repeats the last one's first settings starts from the scene after them: the same frame as one
+    # whose settings are all applied afresh.
+    for seq, params in ((8, moved), (9, view + [("full", "0")])):
+        post_state(base, "page1", seq, params)
+        header, body = again.message()
+    if header["seq"] != 9 or idat(body) != idat(expected):
+        fail(f"a state after one differing only in phi: {header}, or not /frame.png's frame")
+    again.close()
 finally:
     server.terminate()
     server.wait(timeout=30)
 print("test_view_server: 200 concurrent requests answered, errors located, saved scenes and orbit jobs render, "
-      "programs kept")
+      "programs kept, frames streamed in each encoding")
