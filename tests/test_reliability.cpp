@@ -93,7 +93,8 @@ TEST_CASE("a damaged program-cache entry is rebuilt, never handed to OpenCL", "[
   require_device();
   Sandbox box;
   box.cache = box.root / "cache";  // this test's own cache, so its entry is the only one
-  const std::string render = "render --preview -o out.png " + kTiny + " --stats s.json";  // one kernel
+  // One kernel: in double (a preview left open is adaptive, which builds its second pass's kernel too).
+  const std::string render = "render --preview --precision double -o out.png " + kTiny + " --stats s.json";
   REQUIRE(box.run(render).exit_code == 0);
   const std::vector<fs::path> entries = cache_entries(box.cache);
   REQUIRE(entries.size() == 1);
