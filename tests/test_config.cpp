@@ -119,28 +119,6 @@ TEST_CASE("precision follows the device: double refused without fp64, auto takes
   CHECK(resolve_precision(scene, with_fp64, 1.0) == Precision::Adaptive);
 }
 
-TEST_CASE("previews left open render in adaptive precision where its camera rays take the screen form", "[config]") {
-  DeviceInfo fast_fp64;
-  fast_fp64.name = "toy device";
-  fast_fp64.fp64 = true;
-  const Scene preview = load_scene_text(kSphereScene, "t.toml", {{"render.preview", "true"}});
-  CHECK(previews_in_adaptive(preview));
-  CHECK(resolve_precision(preview, fast_fp64, 1.02) == Precision::Adaptive);
-  // A final render keeps the device's choice.
-  const Scene final_render = load_scene_text(kSphereScene, "t.toml");
-  CHECK_FALSE(previews_in_adaptive(final_render));
-  CHECK(resolve_precision(final_render, fast_fp64, 1.02) == Precision::Double);
-  // Where the screen form does not apply (the eye inside the extent) or adaptive does not (Sturm), nor does this.
-  const Scene inside = load_scene_text(kSphereScene, "t.toml", {{"render.preview", "true"}, {"camera.eye", "[1, 0, 0.5]"}});
-  CHECK(resolve_precision(inside, fast_fp64, 1.02) == Precision::Double);
-  const Scene sturm =
-      load_scene_text(kSphereScene, "t.toml", {{"render.preview", "true"}, {"render.isolation", "\"sturm\""}});
-  CHECK(resolve_precision(sturm, fast_fp64, 1.02) == Precision::Double);
-  // Asked for, a precision is kept.
-  const Scene asked = load_scene_text(kSphereScene, "t.toml", {{"render.preview", "true"}, {"render.precision", "\"double\""}});
-  CHECK(resolve_precision(asked, fast_fp64, 1.02) == Precision::Double);
-}
-
 TEST_CASE("adaptive precision is refused, naming the line, where it cannot escalate", "[config]") {
   CHECK_THROWS_WITH(
       load_scene_text(kSphereScene, "t.toml", {{"render.precision", "adaptive"}, {"render.isolation", "sturm"}}),

@@ -56,8 +56,7 @@ TEST_CASE("only the passes a scene calls for are built, launched and counted", "
   const std::vector<PlanCase> cases = {
       {"no lights: a headlight, no shadows", {}, "", false},
       {"a light that casts no shadows", light_lines("shadows = false"), "", false},
-      // (in double: a preview left open renders in adaptive precision, whose second pass adds its own buffer)
-      {"a shadow-casting light in preview mode", light_lines(), "--preview --precision double", false},
+      {"a shadow-casting light in preview mode", light_lines(), "--preview", false},
       {"a shadow-casting light", light_lines(), "", true},
       {"two lights, one casting shadows", [] {
          std::vector<std::string> l = light_lines("shadows = false");
@@ -152,10 +151,7 @@ TEST_CASE("reflection and transmission passes run only for materials that ask, a
       {"a reflective side", {"[material.front]", "reflectivity = 0.4"}, "", {"reflection"}},
       {"a transparent side", {"[material.front]", "transparency = 0.5"}, "", {"transmission"}},
       {"both", {"[material.front]", "reflectivity = 0.3", "transparency = 0.5"}, "", {"reflection", "transmission"}},
-      {"both, in preview mode",  // in double, as above: adaptive's second pass builds a trace kernel of its own
-       {"[material.front]", "reflectivity = 0.3", "transparency = 0.5"},
-       "--preview --precision double",
-       {}},
+      {"both, in preview mode", {"[material.front]", "reflectivity = 0.3", "transparency = 0.5"}, "--preview", {}},
       {"both, with no bounces allowed",
        {"[material.front]", "reflectivity = 0.3", "transparency = 0.5", "[render]", "max_depth = 0"},
        "",

@@ -20,11 +20,6 @@ using namespace renderer_parts;
 
 std::size_t tile_memory_bytes(const RenderPlan& plan) { return plan.tile_rays() * sizeof(HitRecord); }
 
-bool previews_in_adaptive(const Scene& scene) {
-  return scene.render.preview && float_precision_for(scene) == Precision::Adaptive &&
-         screen_form_applies(scene, Precision::Adaptive);
-}
-
 Precision float_precision_for(const Scene& scene) {
   for (const SceneSurface& surface : scene.surfaces)
     if (!adaptive_unsupported(surface.polynomial.degree(), scene.render.isolation).empty()) return Precision::Float;
@@ -32,11 +27,9 @@ Precision float_precision_for(const Scene& scene) {
 }
 
 Precision resolve_precision(const Scene& scene, const DeviceInfo& device, std::optional<double> fp64_slowdown) {
-  if (!scene.render.precision) {
-    if (previews_in_adaptive(scene)) return Precision::Adaptive;
+  if (!scene.render.precision)
     return device.fp64 && fp64_slowdown && *fp64_slowdown <= kFastFp64Slowdown ? Precision::Double
                                                                                : float_precision_for(scene);
-  }
   if (*scene.render.precision == Precision::Double && !device.fp64)
     throw DeviceError("device '" + device.name + "' has no double precision (" +
                       (device.fp64_hidden ? "cl_khr_fp64 is hidden by --no-fp64 or ALGRAY_NO_FP64" : "cl_khr_fp64") +

@@ -135,10 +135,9 @@ struct RenderResult {
 // datacenter GPUs measure 1-2, most other GPUs 16-64, where adaptive float costs about 1.1-1.3x plain float.
 inline constexpr double kFastFp64Slowdown = 2.0;
 
-// Precision a scene renders in on a device: as asked; left open, adaptive for previews where previews_in_adaptive
-// says so, else double where the device's fp64 is fast (fp64_slowdown: fp64_slowdown()'s measure for it), else
-// adaptive where the scene's surfaces allow it (adaptive_unsupported), else float. Throws DeviceError when double
-// is asked of a device without fp64.
+// Precision a scene renders in on a device: as asked; left open, double where the device's fp64 is fast
+// (fp64_slowdown: fp64_slowdown()'s measure for it), else adaptive where the scene's surfaces allow it
+// (adaptive_unsupported), else float. Throws DeviceError when double is asked of a device without fp64.
 Precision resolve_precision(const Scene& scene, const DeviceInfo& device, std::optional<double> fp64_slowdown);
 // The same, with the device's fp64 measured (once, then kept by the cache) where the scene leaves precision open.
 Precision resolve_precision(const Scene& scene, const DeviceInfo& device, ProgramCache& cache);
@@ -148,14 +147,6 @@ Precision escalation_precision(const DeviceInfo& device, ProgramCache& cache);
 
 // The precision left open resolves to on a device without fast fp64.
 Precision float_precision_for(const Scene& scene);
-
-// Whether a preview (render.preview: `algray view` while the input moves, Python's preview=True, --preview) whose
-// precision is left open renders in adaptive precision on every device: where adaptive applies to every surface
-// and builds its camera rays in the screen form (screen_form_applies). There its time is at most double's on this
-// project's CPU and far below it on GPUs without fast fp64, with the same hits within its line (0 wrong pixels,
-// depth at most 1e-4 on every scene and hard surface: bench/RESULTS.md, "Float first"). Final renders keep the
-// device's choice.
-bool previews_in_adaptive(const Scene& scene);
 
 // The output image from a render's records (RenderOptions::keep_records, or the reference's hits), shaded as
 // the renderer shades its film.
