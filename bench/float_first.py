@@ -14,12 +14,11 @@ time and accuracy"), with the date, machine, commit and command.
 """
 import argparse
 import datetime
-import os
-import statistics
 import tempfile
 from pathlib import Path
 
-from bench_common import ROOT, command_line, commit, machine, replace_section, run_render
+from bench_common import ROOT, command_line, commit, machine, replace_section
+from precision_modes import speed
 
 AREA = "## Precision modes: time and accuracy"
 HEADING = "### Float first: float and adaptive against double"
@@ -31,20 +30,10 @@ MODES = [("double", "double", {}), ("float", "float", {}), ("adaptive", "adaptiv
 TARGETS = {"float": 0.6, "adaptive": 0.7, "adaptive, no fp64": 0.7}
 
 
-def kernel_ms(stats):
-    return sum(p["kernel_ms"] for p in stats["passes"])
-
-
 def measure(binary, scene, preview, runs, work):
     args = ["--width", "1024", "--height", "768"] + (["--preview", "--set", "antialias.samples=1"] if preview else [])
-    times = {name: [] for name, _, _ in MODES}
-    for r in range(runs + 1):  # the first round warms the program caches and is not counted
-        order = MODES[r % len(MODES):] + MODES[:r % len(MODES)]
-        for name, precision, extra in order:
-            _, stats = run_render(binary, scene, args + ["--precision", precision], dict(os.environ, **extra), work)
-            if r > 0:
-                times[name].append(kernel_ms(stats))
-    return {name: statistics.median(t) for name, t in times.items()}
+    medians, _ = speed(binary, scene, runs, work, modes=MODES, args=args, warm_up=True)
+    return medians
 
 
 def cell(ms, double_ms, target):

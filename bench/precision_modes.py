@@ -56,15 +56,22 @@ def pass_sum(stats, key, name=None):
     return sum(p[key] for p in stats["passes"] if name is None or p["name"] == name)
 
 
-def speed(binary, scene, runs, work):
-    size = ["--width", "1024", "--height", "768", "--set", "antialias.samples=1"]
-    times = {m[0]: [] for m in SPEED_MODES}
+def speed(binary, scene, runs, work, modes=SPEED_MODES, args=None, warm_up=False):
+    """Each mode's median kernel time over `runs` rounds, the modes' order rotating from round to round (a first
+    round not counted with warm_up), and each mode's escalated share per pass. modes: (name, --precision, extra
+    environment); args: the render's other arguments (default 1024x768, one ray per pixel)."""
+    if args is None:
+        args = ["--width", "1024", "--height", "768", "--set", "antialias.samples=1"]
+    times = {m[0]: [] for m in modes}
     shares = {}
-    for r in range(runs):
-        order = SPEED_MODES[r % len(SPEED_MODES):] + SPEED_MODES[:r % len(SPEED_MODES)]
+    first = -1 if warm_up else 0
+    for r in range(first, runs):
+        order = modes[r % len(modes):] + modes[:r % len(modes)]
         for name, precision, extra in order:
             env = dict(os.environ, **extra)
-            _, stats = run_render(binary, scene, size + ["--precision", precision], env, work)
+            _, stats = run_render(binary, scene, args + ["--precision", precision], env, work)
+            if r < 0:
+                continue
             times[name].append(pass_sum(stats, "kernel_ms"))
             shares[name] = {p["name"]: p["escalated"] / max(p["rays"], 1) for p in stats["passes"]}
     return {m: statistics.median(t) for m, t in times.items()}, shares
