@@ -1,4 +1,5 @@
-// Compares two algray EXR files pixel by pixel: hit/miss disagreements, relative depth differences, identical bits.
+// Compares two algray EXR files pixel by pixel: hit/miss disagreements, relative depth differences, colour
+// differences in 8-bit steps, identical bits.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -46,6 +47,19 @@ int main(int argc, char** argv) {
         ref.depth.size(), hit_miss, 100.0 * static_cast<double>(hit_miss) / static_cast<double>(ref.depth.size()), both,
         off_1e6, off_1e3, 100.0 * static_cast<double>(off_1e3) / static_cast<double>(std::max(both, 1L)), worst);
     if (!where.empty()) std::printf("hit/miss disagreements at%s%s\n", where.c_str(), hit_miss > 8 ? " ..." : "");
+    // Colour in 8-bit steps of the linear values (what a change to shading or shadows moves): pixels whose largest
+    // channel difference exceeds 1 and 16 steps, and the largest.
+    long colour_off_1 = 0, colour_off_16 = 0;
+    double colour_worst = 0;
+    for (std::size_t i = 0; i + 3 < ref.rgba.size() && i + 3 < test.rgba.size(); i += 4) {
+      double d = 0;
+      for (std::size_t c = 0; c < 4; ++c) d = std::max(d, std::fabs(double(test.rgba[i + c]) - ref.rgba[i + c]) * 255);
+      colour_off_1 += d > 1;
+      colour_off_16 += d > 16;
+      colour_worst = std::max(colour_worst, d);
+    }
+    std::printf("colour off by >1/255 %ld pixels, >16/255 %ld, largest %.1f/255\n", colour_off_1, colour_off_16,
+                colour_worst);
     // Whether a change kept every stored value (colour, depth, normal, solver channels) bit for bit: the check
     // for work that must not move an image. NaNs compare by their bits too.
     const auto same_bits = [](const auto& a, const auto& b) {

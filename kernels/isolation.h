@@ -147,25 +147,39 @@ REAL exact_noise(SearchNoise* n) {
 int within_noise(SearchNoise* n, REAL value) { return fabs(value) <= n->noise && fabs(value) <= exact_noise(n); }
 
 /* The largest Bernstein coefficient on [lo, hi] of sum_k |c_k| B_k, with room for its own rounding: the size
- * that de Casteljau's roundings on [lo, hi] are relative to. */
-REAL local_scale(const REAL* c, REAL lo, REAL hi) {
-  REAL t[NCOEF];
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]);
-  const REAL x1 = (REAL)1 - hi;
-  ALGRAY_UNROLL
-  for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-  for (int k = DEGREE; k >= 1; --k)
-    if (k >= r) t[k] = x1 * t[k - 1] + hi * t[k];
-  if (lo > 0) {
-    const REAL x = lo / hi, y1 = (REAL)1 - x;
-    ALGRAY_UNROLL
-    for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
-    for (int k = 0; k < DEGREE; ++k)
-      if (k <= DEGREE - r) t[k] = y1 * t[k] + x * t[k + 1];
+ * that de Casteljau's roundings on [lo, hi] are relative to. local_scale for one ray; lanes_local_scale
+ * (methods/bernstein.h) for lanes, each lane with one ray's operations: T the type, LARGER its larger of two, SEL
+ * and ANY its choice by a mask and whether any lane is set. */
+#define LOCAL_SCALE(T, name, LARGER, SEL, ANY)                         \
+  T name(const T* c, T lo, T hi) {                                     \
+    T t[NCOEF];                                                        \
+    ALGRAY_UNROLL                                                      \
+    for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]);               \
+    const T x1 = (REAL)1 - hi;                                         \
+    ALGRAY_UNROLL                                                      \
+    for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL                    \
+    for (int k = DEGREE; k >= 1; --k)                                  \
+      if (k >= r) t[k] = x1 * t[k - 1] + hi * t[k];                    \
+    if (ANY(lo > 0)) {                                                 \
+      const T x = lo / hi, y1 = (REAL)1 - x;                           \
+      T u[NCOEF];                                                      \
+      ALGRAY_UNROLL                                                    \
+      for (int k = 0; k <= DEGREE; ++k) u[k] = t[k];                   \
+      ALGRAY_UNROLL                                                    \
+      for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL                  \
+      for (int k = 0; k < DEGREE; ++k)                                 \
+        if (k <= DEGREE - r) u[k] = y1 * u[k] + x * u[k + 1];          \
+      ALGRAY_UNROLL                                                    \
+      for (int k = 0; k <= DEGREE; ++k) t[k] = SEL(t[k], u[k], lo > 0); \
+    }                                                                  \
+    MAGNITUDE_TREE(t, LARGER);                                         \
+    return t[0] * (REAL)(1 + 1.0 / 1024);                              \
   }
-  return largest_magnitude(t) * (REAL)(1 + 1.0 / 1024);
-}
+#define SCALAR_SEL(a, b, m) ((m) ? (b) : (a))
+#define SCALAR_ANY(m) (m)
+LOCAL_SCALE(REAL, local_scale, PICK_LARGER, SCALAR_SEL, SCALAR_ANY)
+#undef SCALAR_SEL
+#undef SCALAR_ANY
 
 /* The noise local to the part [lo, hi] of the segment: DOUBT_NOISE of local_scale and of the terms there
  * (ray_terms_local), ALGRAY_LOCAL_FACTOR times. c: the segment's coefficients, scale their largest magnitude.

@@ -14,7 +14,9 @@
  * from a shared expansion"). The origin lies on the surface, inside the extent, and the segment to the extent's edge is
  * at most its diameter long, so the power basis about o keeps the extent construction's digits: every term is
  * bounded by the same sums of |a_m| times powers of coordinates within the extent (up to the binomial weights
- * of the shift, at most 2^DEGREE in the worst case, which double precision absorbs; float is not offered). */
+ * of the shift, at most 2^DEGREE in the worst case, which double precision absorbs). Float loses those digits: plain
+ * float keeps the extent construction, and adaptive precision measures the point form's own noise (shadow.h,
+ * PointTerms) and sends what it doubts to its second pass. */
 #if DEGREE > 15
 #error "the point form keeps its expansion in vectors of up to 16 coefficients (degree 15)"
 #endif
@@ -124,15 +126,29 @@ void point_form_segment(const LREAL* c, LREAL t_in, LREAL t_out, __constant cons
 /* Whether P*(t), power basis c, changes sign within [t_in, t_out]: its value at seven evenly spaced points
  * against start, its value at t_in. A sign opposite to start's is a crossing, by the intermediate value theorem;
  * most shadow rays that meet the surface pass through it, so this settles them without the search (Barth
- * decic: the search took 55% of the shadow kernel, most of it on such rays). */
-LMASK sign_change_sampled(const LREAL* c, LREAL t_in, LREAL t_out, LREAL start, LMASK open) {
+ * decic: the search took 55% of the shadow kernel, most of it on such rays). Adaptive builds count a value only
+ * beyond Horner's rounding (2n + 1 roundings over the sum of |terms|, t >= 0, with room) plus `noise`, the
+ * coefficients' own; other builds never read `noise`. */
+LMASK sign_change_sampled(const LREAL* c, LREAL t_in, LREAL t_out, LREAL start, LMASK open, LREAL noise) {
+  (void)noise;
   LMASK crossed = open && !open; /* all lanes false, of the mask type */
   ALGRAY_UNROLL
   for (int j = 1; j < 8; ++j) {
     const LREAL t = t_in + (t_out - t_in) * ((REAL)j / 8);
     LREAL v = c[DEGREE];
+#if ALGRAY_ESCALATE
+    LREAL size = fabs(v);
+#endif
     ALGRAY_UNROLL
-    for (int k = DEGREE - 1; k >= 0; --k) v = v * t + c[k];
+    for (int k = DEGREE - 1; k >= 0; --k) {
+      v = v * t + c[k];
+#if ALGRAY_ESCALATE
+      size = size * t + fabs(c[k]);
+#endif
+    }
+#if ALGRAY_ESCALATE
+    v = LANE_SEL(v, (LREAL)0, fabs(v) <= size * (REAL)((2 * DEGREE + 2) * REAL_EPS) + noise);
+#endif
     crossed = crossed || (start > 0 && v < 0) || (start < 0 && v > 0);
   }
   return open && crossed;

@@ -96,23 +96,31 @@ RayTerms known_terms(REAL value) {
 
 /* An upper bound on the terms of any ray whose coordinates are all at most r: the per-degree sums at r. Its
  * rounding could put it a few ulps of count below the exact sum's (both are sums of positive products): 2^-10
- * more covers every degree up to 32. */
-REAL terms_within(__global const REAL* coefs, uint count, REAL r) {
-  /* Estrin's scheme: pairs of degrees joined by r, then pairs of those by r^2, and so on, log2(DEGREE) steps deep.
-   * Horner's rule was a chain of DEGREE dependent multiply-adds that every shadow ray reaching its terms waited
-   * on: 12% of the Endrass octic's adaptive shadow kernel body in perf. */
-  REAL part[NCOEF];
-  ALGRAY_UNROLL
-  for (int d = 0; d <= DEGREE; ++d) part[d] = coefs[count + (uint)d];
-  REAL power = r; /* r^step */
-  ALGRAY_UNROLL
-  for (int step = 1; step <= DEGREE; step *= 2) {
-    ALGRAY_UNROLL
-    for (int d = 0; d + step <= DEGREE; d += 2 * step) part[d] = fma(part[d + step], power, part[d]);
-    power *= power;
+ * more covers every degree up to 32. terms_within takes one r, lanes_terms_within one per lane.
+ * Estrin's scheme: pairs of degrees joined by r, then pairs of those by r^2, and so on, log2(DEGREE) steps deep.
+ * Horner's rule was a chain of DEGREE dependent multiply-adds that every shadow ray reaching its terms waited
+ * on: 12% of the Endrass octic's adaptive shadow kernel body in perf. */
+#define TERMS_WITHIN(T, name)                                                                          \
+  T name(__global const REAL* coefs, uint count, T r) {                                                \
+    T part[NCOEF];                                                                                     \
+    ALGRAY_UNROLL                                                                                      \
+    for (int d = 0; d <= DEGREE; ++d) part[d] = coefs[count + (uint)d];                                \
+    T power = r; /* r^step */                                                                          \
+    ALGRAY_UNROLL                                                                                      \
+    for (int step = 1; step <= DEGREE; step *= 2) {                                                    \
+      ALGRAY_UNROLL                                                                                    \
+      for (int d = 0; d + step <= DEGREE; d += 2 * step) part[d] = fma(part[d + step], power, part[d]); \
+      power *= power;                                                                                  \
+    }                                                                                                  \
+    return part[0] * (REAL)(1 + 1.0 / 1024);                                                           \
   }
-  return part[0] * (REAL)(1 + 1.0 / 1024);
-}
+TERMS_WITHIN(REAL, terms_within)
+#if LANES > 1
+TERMS_WITHIN(LREAL, lanes_terms_within)
+#else
+#define lanes_terms_within terms_within
+#endif
+#undef TERMS_WITHIN
 
 /* A ray's terms, with the upper bound of terms_within its largest coordinate. */
 RayTerms ray_terms(__global const uint* exps, __global const REAL* coefs, uint count, AxisFactor fx, AxisFactor fy,

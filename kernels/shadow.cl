@@ -26,27 +26,8 @@
 /* Adaptive builds' checks of the signs against the noise (the helpers below compile everywhere, adaptive builds
  * call them). */
 
-/* C(DEGREE, k): a constant wherever k is one (the loops below unroll), so no division is left at run time. */
-ALGRAY_INLINE REAL degree_binomial(int k) {
-  ulong c = 1;
-  ALGRAY_UNROLL
-  for (int j = 0; j < DEGREE; ++j)
-    if (j < k) c = c * (ulong)(DEGREE - j) / (ulong)(j + 1);
-  return (REAL)c;
-}
-
-/* An upper bound on the scale of the search's noise (isolation.h, search_noise): the largest |b_k|, b_k = c_k /
- * C(n,k) the Bernstein coefficients of the scaled coefficients c (bernstein_from_scaled). Multiplied by the
- * reciprocals instead of divided: the four divisions per ray were most of what the shortcut cost the Cayley
- * cubic's shadow pass, which it settles almost whole. The room of 8 REAL_EPS covers the product's roundings and
- * the search's own division, which OpenCL lets be 2.5 ulp off. */
-ALGRAY_INLINE REAL search_scale_bound(const REAL* c) {
-  REAL t[NCOEF];
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]) * ((REAL)1 / degree_binomial(k));
-  MAGNITUDE_TREE(t, PICK_LARGER);
-  return t[0] * (REAL)(1 + 8 * REAL_EPS);
-}
+/* The scale of the search's noise for one ray (shadow.h, SCALE_BOUND). */
+SCALE_BOUND(REAL, search_scale_bound, PICK_LARGER)
 
 /* Whether the scaled coefficients c have one strict sign throughout with each but c_0 beyond limit[k]: with the
  * limits of segment_has_root's caller, what bernstein_root_by_signs and signs_clear_of settle as no root, from the
@@ -144,10 +125,9 @@ __kernel void shadow(__global const REAL4* points, __global const float4* normal
                      __global uint* rays_traced, __global ulong* undecided) {
 #if RAY_ORIGIN == ALGRAY_ORIGIN_POINT
   (void)even_axes;
-  (void)undecided;
   shadow_point_form_item(points, normals, point_count, light_points, light_count, offset, extent_centre,
                          extent_inv_scale, extent_box_half, extent_kind, clip_planes, clip_count, mono_exps, mono_coefs,
-                         mono_count, binomials, occluded, rays_traced);
+                         mono_count, binomials, occluded, rays_traced, undecided);
 #else
   const uint i = get_global_id(0);
   if (i >= point_count) return;

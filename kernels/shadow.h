@@ -10,6 +10,30 @@
 #define SHADOW_CLEAR 1 /* the segment misses the extent: nothing hides the sample */
 #define SHADOW_TRACE 2 /* the roots of P* on [*t_in, *t_out] of o_unit + t * *d_unit decide */
 
+/* C(DEGREE, k): a constant wherever k is one (the loops that call it unroll), so no division is left at run time. */
+ALGRAY_INLINE REAL degree_binomial(int k) {
+  ulong c = 1;
+  ALGRAY_UNROLL
+  for (int j = 0; j < DEGREE; ++j)
+    if (j < k) c = c * (ulong)(DEGREE - j) / (ulong)(j + 1);
+  return (REAL)c;
+}
+
+/* An upper bound on the scale of the search's noise (isolation.h, search_noise): the largest |b_k|, b_k = c_k /
+ * C(n,k) the Bernstein coefficients of the scaled coefficients c (bernstein_from_scaled). Multiplied by the
+ * reciprocals instead of divided: the four divisions per ray were most of what the shortcut cost the Cayley
+ * cubic's shadow pass, which it settles almost whole. The room of 8 REAL_EPS covers the product's roundings and
+ * the search's own division, which OpenCL lets be 2.5 ulp off. For one ray (search_scale_bound) or for lanes
+ * (lanes_scale_bound): T the type, LARGER its larger of two. */
+#define SCALE_BOUND(T, name, LARGER)                                                                  \
+  ALGRAY_INLINE T name(const T* c) {                                                                  \
+    T t[NCOEF];                                                                                       \
+    ALGRAY_UNROLL                                                                                     \
+    for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]) * ((REAL)1 / degree_binomial(k));            \
+    MAGNITUDE_TREE(t, LARGER);                                                                        \
+    return t[0] * (REAL)(1 + 8 * REAL_EPS);                                                           \
+  }
+
 /* p: the surface point (world), n its unit normal on the camera's side, o = p moved along n, o_unit the same in
  * unit coordinates; light: the sample point. The segment runs from o (t = 0) to the sample (t = 1). */
 int shadow_segment(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, REAL3 light, REAL extent_inv_scale, int extent_kind,
@@ -139,8 +163,8 @@ Isolation shadow_isolation(const REAL* b, const REAL* b_lo, REAL t_in, REAL t_ou
 #include "methods/bernstein.h"
 #include "point_form.h"
 
-#if ALGRAY_ESCALATE || ALGRAY_COMPENSATED || !ISOLATION_POINT_FORM
-#error "the point form is built in plain float or double, for isolation methods with ISOLATION_POINT_FORM"
+#if ALGRAY_COMPENSATED || !ISOLATION_POINT_FORM
+#error "the point form is built in plain float, adaptive or double, for isolation methods with ISOLATION_POINT_FORM"
 #endif
 
 /* shadow_segment for LANES light samples (lx, ly, lz), each lane its result bit for bit: *self where the sample is
@@ -172,8 +196,11 @@ LMASK shadow_segments(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, LREAL lx, LREAL l
 /* Whether every one of the 2^SHADOW_PIECE_LEVELS equal pieces of the segment has Bernstein coefficients of one
  * strict sign (c: scaled coefficients on the whole segment): then no piece, and so no part of the segment, holds
  * a root. De Casteljau's halving keeps a piece of one sign so, so this is what the search concludes after as many
- * halvings, without its bookkeeping: most segments the search excludes are settled by one or two halvings. */
-LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials) {
+ * halvings, without its bookkeeping: most segments the search excludes are settled by one or two halvings.
+ * Adaptive builds also want every coefficient beyond `noise` but the first, P at the ray's start (first_counted);
+ * other builds never read it. */
+LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials, LREAL noise) {
+  (void)noise;
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   LREAL piece[1 << SHADOW_PIECE_LEVELS][NCOEF];
   ALGRAY_UNROLL
@@ -195,56 +222,185 @@ LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials) {
   }
   LMASK all_clear = c[0] == c[0]; /* every lane set (the coefficients are finite) */
   ALGRAY_UNROLL
-  for (int p = 0; p < (1 << SHADOW_PIECE_LEVELS); ++p) all_clear = all_clear && one_strict_sign(piece[p]);
+  for (int p = 0; p < (1 << SHADOW_PIECE_LEVELS); ++p) {
+    all_clear = all_clear && one_strict_sign(piece[p]);
+#if ALGRAY_ESCALATE
+    ALGRAY_UNROLL
+    for (int k = p == 0 ? 1 : 0; k <= DEGREE; ++k) all_clear = all_clear && fabs(piece[p][k]) > noise;
+#endif
+  }
   return all_clear;
 }
+
+/* Adaptive builds measure the point form's noise as the extent construction's (isolation.h, DOUBT_NOISE): by the
+ * size of the terms its coefficients were summed from. Expanding P about o (taylor_at_point), restricting it to d
+ * (point_form_restrict) and changing to the segment's Bernstein basis (point_form_segment, t_in >= 0) multiply and
+ * add |a_m|, binomials, powers of |o| and of t |d|, and all those products together come to
+ * Pabs(|o| + t_out |d|), Pabs = sum_m |a_m| x^i y^j z^k, axis by axis: the point form's terms. They exceed the extent
+ * construction's, Pabs at |o + t d|, as a segment from o reaches further than o + t d does from the centre. */
+typedef struct {
+  LREAL x, y, z;    /* |o| + t_out |d| per axis, where Pabs is summed */
+  LREAL x0, y0, z0; /* |o| + t_in |d|: with x, y, z the line |o| + t |d|, for the search's local noise */
+  LREAL value;      /* an upper bound (lanes_terms_within at each lane's largest coordinate) until `exact` */
+  int exact;
+} PointTerms;
+
+PointTerms point_terms(REAL3 o, LREAL dx, LREAL dy, LREAL dz, LREAL t_in, LREAL t_out, __global const REAL* coefs,
+                       uint count) {
+  PointTerms t;
+  t.x0 = fabs(o.x) + t_in * fabs(dx);
+  t.y0 = fabs(o.y) + t_in * fabs(dy);
+  t.z0 = fabs(o.z) + t_in * fabs(dz);
+  t.x = fabs(o.x) + t_out * fabs(dx);
+  t.y = fabs(o.y) + t_out * fabs(dy);
+  t.z = fabs(o.z) + t_out * fabs(dz);
+  t.value = lanes_terms_within(coefs, count, fmax(t.x, fmax(t.y, t.z)));
+  t.exact = 0;
+  return t;
+}
+
+/* The terms summed, every lane at once (terms_sum), with room for the sum's rounding as terms_within's. */
+void point_terms_exact(PointTerms* t, __global const uint* exps, __global const REAL* coefs, uint count) {
+  t->value = terms_sum(exps, coefs, count, t->x, t->y, t->z) * (REAL)(1 + 1.0 / 1024);
+  t->exact = 1;
+}
+
+/* segment_roots_settled for adaptive builds, with the noise of coefficients of largest Bernstein magnitude
+ * `scale` summed from terms of size `terms`: each shortcut answers a lane only where the values it reads stand
+ * beyond the noise, as the search would (its first interval's coefficients all clear of its noise and of one sign;
+ * P at the far end beyond the noise for any scale, noise_bound; P at the start counts with the sign it has).
+ * The others are left to the search (*open), which doubts what it cannot settle. */
+LMASK segment_roots_settled_clear(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced,
+                                  LMASK* open, __constant const REAL* binomials, LREAL scale, LREAL terms) {
+  const LREAL noise = DOUBT_NOISE(scale, terms) * (REAL)(1 + 8 * REAL_EPS);
+  const LREAL end_noise = DOUBT_NOISE(terms, terms);
+  LMASK none = one_strict_sign(c);
+  ALGRAY_UNROLL
+  for (int k = 1; k <= DEGREE; ++k) none = none && fabs(c[k]) > noise * degree_binomial(k);
+  const LREAL start = c[0], end = c[DEGREE];
+  const LMASK root =
+      traced && start != 0 && ((start < 0 && end > 0) || (start > 0 && end < 0)) && fabs(end) > end_noise;
+  *open = traced && !none && !root;
+  if (!LANE_ANY(*open)) return root;
+  const LMASK crossed = sign_change_sampled(power, t_in, t_out, start, *open, end_noise);
+  *open = *open && !crossed;
+  if (LANE_ANY(*open)) *open = *open && !no_root_in_pieces(c, binomials, noise);
+  return root || crossed;
+}
+
+/* search_scale_bound's (shadow.cl) for lanes: the scale of the search's noise. */
+SCALE_BOUND(LREAL, lanes_scale_bound, LANE_LARGER)
 
 /* Which of the traced lanes' segments a cheap test shows to hold a root, from the scaled Bernstein coefficients c
  * on [t_in, t_out] (power basis power, the same polynomial); *open gets the lanes only the search can settle. The
  * signs of c settle most (bernstein_root_by_signs' answers), and a sign change at seven points of the segment
- * most of the rest. */
+ * most of the rest. Adaptive builds ask the same of values beyond their noise (segment_roots_settled_clear), first
+ * on the terms' upper bound, then, where a lane is left open, on the terms summed (*terms made exact). */
 LMASK segment_roots_settled(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced, LMASK* open,
-                            __constant const REAL* binomials) {
+                            __constant const REAL* binomials, PointTerms* terms, __global const uint* exps,
+                            __global const REAL* coefs, uint count) {
+#if ALGRAY_ESCALATE
+  const LREAL scale = lanes_scale_bound(c);
+  LMASK root = segment_roots_settled_clear(c, power, t_in, t_out, traced, open, binomials, scale, terms->value);
+  if (!LANE_ANY(*open)) return root;
+  /* what the bound settled, the sum settles alike: each of its values is beyond a smaller noise */
+  point_terms_exact(terms, exps, coefs, count);
+  return segment_roots_settled_clear(c, power, t_in, t_out, traced, open, binomials, scale, terms->value);
+#else
+  (void)terms;
+  (void)exps;
+  (void)coefs;
+  (void)count;
   const LREAL start = c[0], end = c[DEGREE];
   const LMASK none = one_strict_sign(c);
   LMASK root = traced && !none && (start == 0 || end == 0 || (start < 0 && end > 0) || (start > 0 && end < 0));
   *open = traced && !none && !root;
   if (!LANE_ANY(*open)) return root;
-  const LMASK crossed = sign_change_sampled(power, t_in, t_out, start, *open);
+  const LMASK crossed = sign_change_sampled(power, t_in, t_out, start, *open, (LREAL)0);
   *open = *open && !crossed;
-  if (LANE_ANY(*open)) *open = *open && !no_root_in_pieces(c, binomials);
+  if (LANE_ANY(*open)) *open = *open && !no_root_in_pieces(c, binomials, (LREAL)0);
   return root || crossed;
+#endif
 }
 
 /* Segments waiting for the search, gathered from the blocks of lanes of one surface point until they fill a block:
- * the search in lanes costs every lane while any runs, and a block holds two open segments on average. */
+ * the search in lanes costs every lane while any runs, and a block holds two open segments on average. Adaptive
+ * builds keep each segment's terms (summed) and, for the search's noise local to a part of the segment
+ * (isolation.h, within_noise_at), |o| + t |d| per axis at its ends. */
 typedef struct {
   LREAL b[NCOEF]; /* Bernstein coefficients (bernstein_from_scaled's) */
   LREAL t_in, t_out;
   uint sample[LANES];
   uint count;
+#if ALGRAY_ESCALATE
+  LREAL terms;
+  LREAL x0, y0, z0, x1, y1, z1;
+#endif
 } SearchQueue;
 
-/* The samples whose queued segments hold a root, by the Bernstein search over the queue's lanes; the queue is
- * emptied. */
-ulong search_queued(SearchQueue* queue) {
+/* What the search of the queue's lanes measures its noise by (adaptive builds; methods/bernstein.h, LaneTerms):
+ * one ray's RayTerms, or the lanes' own. |o| + t |d| is linear in t: the ends' values interpolate it exactly, as
+ * the noise local to a part reads them (within_noise_at, within_lanes_noise). */
+#if ALGRAY_ESCALATE
+ALGRAY_INLINE LaneTerms queued_terms(const SearchQueue* queue, __global const uint* exps, __global const REAL* coefs,
+                                     uint count) {
+#if LANES == 1
+  LaneTerms t = known_terms(queue->terms);
+  t.x = queue->x1;
+  t.y = queue->y1;
+  t.z = queue->z1;
+#else
+  LaneTerms t;
+  t.value = queue->terms;
+  t.rays = (const LaneRays*)0; /* shadow rays' searches evaluate nothing in float-float */
+  t.by_part = ALGRAY_SETTLE_DOUBTS; /* as one ray's search (isolation.h, within_noise_at) */
+#endif
+  t.exps = exps;
+  t.coefs = coefs;
+  t.count = count;
+  t.x0 = queue->x0;
+  t.x1 = queue->x1;
+  t.y0 = queue->y0;
+  t.y1 = queue->y1;
+  t.z0 = queue->z0;
+  t.z1 = queue->z1;
+  return t;
+}
+#endif
+
+/* The samples whose queued segments hold a root, by the Bernstein search over the queue's lanes; in adaptive
+ * builds, *doubted gets those it doubted. The queue is emptied. */
+ulong search_queued(SearchQueue* queue, ulong* doubted, __global const uint* exps, __global const REAL* coefs,
+                    uint count) {
   ulong found = 0;
   LREAL cur[NCOEF];
   const LMASK running = lanes_of_bits((1u << queue->count) - 1);
   LaneIsolation iso;
-  isolate_bernstein_search(running, queue->b, queue->b, queue->t_in, queue->t_out, &iso, cur, (LaneTerms*)0,
-                           NO_PROBE);
+#if ALGRAY_ESCALATE
+  LaneTerms terms = queued_terms(queue, exps, coefs, count);
+  LaneTerms* search_terms = &terms;
+#else
+  (void)exps;
+  (void)coefs;
+  (void)count;
+  LaneTerms* search_terms = (LaneTerms*)0;
+#endif
+  isolate_bernstein_search(running, queue->b, queue->b, queue->t_in, queue->t_out, &iso, cur, search_terms, NO_PROBE);
   const uint found_bits = lane_mask_bits(running && iso.status != (REAL)ISOLATION_NONE);
-  for (uint j = 0; j < queue->count; ++j)
+  const uint doubt_bits = ALGRAY_ESCALATE ? lane_mask_bits(running && iso.doubt != (REAL)0) : 0u;
+  for (uint j = 0; j < queue->count; ++j) {
     if ((found_bits >> j) & 1u) found |= (ulong)1 << queue->sample[j];
+    if ((doubt_bits >> j) & 1u) *doubted |= (ulong)1 << queue->sample[j];
+  }
   queue->count = 0;
   return found;
 }
 
 /* Queues the open lanes of the block of samples s0 ..; searches whenever the queue fills. Returns the samples
- * found hidden. */
+ * found hidden; *doubted gets those the search doubted. */
 ulong queue_for_search(SearchQueue* queue, const LREAL* c, LREAL t_in, LREAL t_out, uint open_bits, uint s0,
-                       __constant const REAL* binomials) {
+                       __constant const REAL* binomials, ulong* doubted, const PointTerms* terms,
+                       __global const uint* exps, __global const REAL* coefs, uint count) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   LREAL b[NCOEF];
   ALGRAY_UNROLL
@@ -257,21 +413,31 @@ ulong queue_for_search(SearchQueue* queue, const LREAL* c, LREAL t_in, LREAL t_o
     for (int k = 0; k <= DEGREE; ++k) lane_set(&queue->b[k], at, lane_get(b[k], j));
     lane_set(&queue->t_in, at, lane_get(t_in, j));
     lane_set(&queue->t_out, at, lane_get(t_out, j));
+#if ALGRAY_ESCALATE
+    lane_set(&queue->terms, at, lane_get(terms->value, j));
+    lane_set(&queue->x0, at, lane_get(terms->x0, j));
+    lane_set(&queue->y0, at, lane_get(terms->y0, j));
+    lane_set(&queue->z0, at, lane_get(terms->z0, j));
+    lane_set(&queue->x1, at, lane_get(terms->x, j));
+    lane_set(&queue->y1, at, lane_get(terms->y, j));
+    lane_set(&queue->z1, at, lane_get(terms->z, j));
+#endif
     queue->sample[at] = s0 + j;
-    if (++queue->count == LANES) found |= search_queued(queue);
+    if (++queue->count == LANES) found |= search_queued(queue, doubted, exps, coefs, count);
   }
   return found;
 }
 
 /* The shadow kernels' answer for surface point i in the point form: its occlusion mask, with the number of rays
- * traced added to *traced. LANES light samples at a time, so the one-lane build (shadow_serial, GPUs) takes the
- * same decisions ray by ray. P is expanded about the origin once, when the first ray is traced. */
+ * traced added to *traced, and in adaptive builds the samples whose answers the float search doubted in
+ * *undecided. LANES light samples at a time, so the one-lane build (shadow_serial, GPUs) takes the same decisions
+ * ray by ray. P is expanded about the origin once, when the first ray is traced. */
 ulong shadow_mask_point_form(__global const REAL4* points, __global const float4* normals, uint i,
                              __global const REAL4* light_points, uint light_count, REAL offset, REAL4 extent_centre,
                              REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
                              __global const REAL4* clip_planes, uint clip_count, __global const uint* mono_exps,
                              __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
-                             ulong mask, uint* traced) {
+                             ulong mask, uint* traced, ulong* undecided) {
   REAL3 p, n, o, o_unit;
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
   PolyVec q[POINT_FORM_COLUMNS];
@@ -283,6 +449,10 @@ ulong shadow_mask_point_form(__global const REAL4* points, __global const float4
   for (int k = 0; k <= DEGREE; ++k) queue.b[k] = 1;
   queue.t_in = 0;
   queue.t_out = 1;
+#if ALGRAY_ESCALATE
+  queue.terms = 1;
+  queue.x0 = queue.y0 = queue.z0 = queue.x1 = queue.y1 = queue.z1 = 1;
+#endif
   for (uint s0 = 0; s0 < light_count; s0 += LANES) {
     /* The host pads the light points to a multiple of 16, so a block may read past light_count. */
 #define LIGHT_X(j) light_points[s0 + (j)].x
@@ -309,29 +479,38 @@ ulong shadow_mask_point_form(__global const REAL4* points, __global const float4
     LREAL power[NCOEF], c[NCOEF];
     point_form_restrict(q, dx, dy, dz, power);
     point_form_segment(power, t_in, t_out, binomials, c);
+    PointTerms terms;
+#if ALGRAY_ESCALATE
+    terms = point_terms(o_unit, dx, dy, dz, t_in, t_out, mono_coefs, mono_count);
+#endif
     LMASK open;
-    mask |= (ulong)lane_mask_bits(segment_roots_settled(c, power, t_in, t_out, trace, &open, binomials)) << s0;
-    if (LANE_ANY(open)) mask |= queue_for_search(&queue, c, t_in, t_out, lane_mask_bits(open), s0, binomials);
+    mask |= (ulong)lane_mask_bits(segment_roots_settled(c, power, t_in, t_out, trace, &open, binomials, &terms,
+                                                        mono_exps, mono_coefs, mono_count))
+            << s0;
+    if (LANE_ANY(open))
+      mask |= queue_for_search(&queue, c, t_in, t_out, lane_mask_bits(open), s0, binomials, undecided, &terms,
+                               mono_exps, mono_coefs, mono_count);
   }
-  if (queue.count) mask |= search_queued(&queue);
+  if (queue.count) mask |= search_queued(&queue, undecided, mono_exps, mono_coefs, mono_count);
   return mask;
 }
 
-/* One work-item of the point form's kernels (shadow.cl, and shadow_serial.cl with one lane): surface point i's
- * mask, and its traced rays counted. */
-/* The point form's work-item of the shadow kernels, whose arguments these are (shadow.cl). */
+/* The point form's work-item of the shadow kernels, whose arguments these are (shadow.cl): surface point i's mask,
+ * its traced rays counted, and in adaptive builds its doubted samples. */
 void shadow_point_form_item(__global const REAL4* points, __global const float4* normals, uint point_count,
                             __global const REAL4* light_points, uint light_count, REAL offset, REAL4 extent_centre,
                             REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
                             __global const REAL4* clip_planes, uint clip_count, __global const uint* mono_exps,
                             __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
-                            __global ulong* occluded, __global uint* rays_traced) {
+                            __global ulong* occluded, __global uint* rays_traced, __global ulong* undecided) {
   const uint i = get_global_id(0);
   if (i >= point_count) return;
   uint traced = 0;
+  ulong unsure = 0;
   occluded[i] = shadow_mask_point_form(points, normals, i, light_points, light_count, offset, extent_centre,
                                        extent_inv_scale, extent_box_half, extent_kind, clip_planes, clip_count,
-                                       mono_exps, mono_coefs, mono_count, binomials, occluded[i], &traced);
+                                       mono_exps, mono_coefs, mono_count, binomials, occluded[i], &traced, &unsure);
+  if (ALGRAY_ESCALATE) undecided[i] = unsure;
   if (traced) atomic_add(rays_traced, traced);
 }
 #endif

@@ -28,10 +28,9 @@ __kernel void shadow_serial(__global const REAL4* points, __global const float4*
 #if RAY_ORIGIN == ALGRAY_ORIGIN_POINT
   /* The point form one ray at a time: shadow.cl's code built with one lane. */
   (void)even_axes;
-  (void)undecided;
   shadow_point_form_item(points, normals, point_count, light_points, light_count, offset, extent_centre,
                          extent_inv_scale, extent_box_half, extent_kind, clip_planes, clip_count, mono_exps, mono_coefs,
-                         mono_count, binomials, occluded, rays_traced);
+                         mono_count, binomials, occluded, rays_traced, undecided);
 #else
   const uint i = get_global_id(0);
   if (i >= point_count) return;

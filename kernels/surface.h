@@ -16,8 +16,9 @@
 #if ALGRAY_ESCALATE && !ISOLATION_ADAPTIVE
 #error "adaptive precision needs an isolation method that doubts (ISOLATION_ADAPTIVE)"
 #endif
-#if RAY_ORIGIN != ALGRAY_ORIGIN_EXTENT && RAY_ORIGIN != ALGRAY_ORIGIN_SCREEN && ALGRAY_ESCALATE
-#error "adaptive precision measures its noise by the terms of the extent construction or of the screen form"
+#if RAY_ORIGIN != ALGRAY_ORIGIN_EXTENT && RAY_ORIGIN != ALGRAY_ORIGIN_SCREEN && RAY_ORIGIN != ALGRAY_ORIGIN_POINT && \
+    ALGRAY_ESCALATE
+#error "adaptive precision measures its noise by the terms of the extent construction, the screen form or the point form"
 #endif
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && ALGRAY_ESCALATE && LANES > 1 && DEGREE > 15
 #error "adaptive precision's screen form in lanes is screen_coefficients' (DEGREE <= 15, as adaptive itself)"
@@ -561,6 +562,7 @@ int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, R
         LANE_SEL((LREAL)0,
                  screen_terms(screen_row(screen_rows, py, screen_row0), xi, lane_t_in - screen_t, lane_t_out - screen_t),
                  running);
+    screen_lanes.by_part = 0;
     screen_lanes.rays = &unit;
     screen_lanes.exps = exps;
     screen_lanes.coefs = coefs;

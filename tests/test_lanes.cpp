@@ -241,6 +241,10 @@ TEST_CASE("the plan gives lanes to the camera and secondary rays' kernels, where
   const RenderPlan adaptive = make_render_plan(full, Precision::Adaptive, 0, 8);
   CHECK(adaptive.find(PassKind::Primary)->escalation.at(0).entry == "trace");
   CHECK(adaptive.find(PassKind::Primary)->escalation.at(0).lanes == 8);
+  // Adaptive's float shadow pass is the point form in lanes; mixed precision's second pass the extent form.
+  CHECK(adaptive.find(PassKind::Shadow)->kernels.at(0).ray_origin == RayOrigin::Point);
+  CHECK(adaptive.find(PassKind::Shadow)->kernels.at(0).lanes == 8);
+  CHECK(adaptive.find(PassKind::Shadow)->escalation.at(0).ray_origin == RayOrigin::Extent);
   CHECK(adaptive.find(PassKind::Shadow)->escalation.at(0).lanes == 1);
   // Where double's fp64 is fast the doubted shadow rays go again in double, in the point form and its lanes; in
   // mixed precision through the extent form.
@@ -249,7 +253,8 @@ TEST_CASE("the plan gives lanes to the camera and secondary rays' kernels, where
   CHECK(in_double.find(PassKind::Shadow)->escalation.at(0).ray_origin == RayOrigin::Point);
   CHECK(in_double.find(PassKind::Shadow)->escalation.at(0).lanes == 8);
   CHECK(in_double.find(PassKind::Primary)->escalation.at(0).ray_origin == RayOrigin::Extent);
-  // Camera and secondary rays take 16 lanes where asked; the shadow kernel's point form at most kMaxShadowLanes.
+  // Camera and secondary rays take 16 lanes where asked; the shadow kernel's point form in double at most
+  // kMaxShadowLanes.
   const RenderPlan wide = make_render_plan(full, Precision::Double, 0, 16);
   CHECK(wide.find(PassKind::Primary)->kernels.at(0).lanes == 16);
   CHECK(wide.find(PassKind::Reflection)->kernels.at(0).lanes == 16);
@@ -258,6 +263,8 @@ TEST_CASE("the plan gives lanes to the camera and secondary rays' kernels, where
   escalate_in(wide_adaptive, Precision::Double);
   CHECK(wide_adaptive.find(PassKind::Primary)->escalation.at(0).lanes == 16);
   CHECK(wide_adaptive.find(PassKind::Shadow)->escalation.at(0).lanes == kMaxShadowLanes);
+  // Float vectors hold twice the lanes: adaptive's float point form takes 16.
+  CHECK(wide_adaptive.find(PassKind::Shadow)->kernels.at(0).lanes == kMaxFloatShadowLanes);
   RenderPlan in_mixed = adaptive;
   escalate_in(in_mixed, Precision::Mixed);
   CHECK(in_mixed.find(PassKind::Shadow)->escalation.at(0).ray_origin == RayOrigin::Extent);

@@ -1,5 +1,6 @@
 // The shadow kernel against shadow_serial, the plain one-segment-at-a-time construction: whatever shortcuts
 // shadow.cl takes, the occlusion masks must be identical on seeded random surfaces, points and lights.
+#include <bit>
 #include <catch2/catch.hpp>
 #include <random>
 #include <sstream>
@@ -45,15 +46,16 @@ Scene random_scene(std::mt19937& rng, int degree, bool even, Precision precision
 
 struct Counts {
   long hidden = 0, visible = 0, traced = 0;
+  long doubted = 0;  // adaptive builds' undecided samples
 };
 
-// The config both kernels are built with; entry names the kernel. The point form's shadow kernel runs 8 lanes,
-// and shadow_serial the same code in one.
+// The config both kernels are built with; entry names the kernel. The point form's shadow kernel runs the lanes
+// the plan gives it on a CPU (8 in double, 16 in float), and shadow_serial the same code in one.
 KernelConfig shadow_config(const Scene& scene, Precision precision, Isolation isolation, const std::string& entry,
                            RayOrigin origin, bool settle_doubts) {
   KernelConfig config = primary_config(scene, precision);
   config.ray_origin = origin;
-  config.lanes = origin == RayOrigin::Point && entry == "shadow" ? 8 : 1;
+  config.lanes = origin == RayOrigin::Point && entry == "shadow" ? shadow_lanes(16, precision) : 1;
   config.isolation = isolation;
   config.refinement = Refinement::Brent;
   config.max_iterations = default_max_iterations(Refinement::Brent);
@@ -133,6 +135,7 @@ Counts check_same_masks(const Scene& scene, Precision precision, Isolation isola
     CHECK(a.undecided.size() == (precision == Precision::Adaptive ? a.masks.size() : 0u));
     CHECK(a.undecided == b.undecided);
     counts.traced += a.rays_traced;
+    for (std::uint64_t bits : a.undecided) counts.doubted += std::popcount(bits);
     const std::uint64_t all = light_count == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << light_count) - 1;
     for (std::size_t i = 0; i < a.masks.size(); ++i)
       for (int s = 0; s < light_count; ++s) {
@@ -215,6 +218,25 @@ TEST_CASE("the point form's shadow rays in lanes answer as one at a time, bit fo
   std::mt19937 rng(kSeed + 3);
   check_same_masks(barth, Precision::Double, Isolation::Bernstein, rng,
                    "point form (seed " + std::to_string(kSeed + 3) + "), Barth sextic", RayOrigin::Point);
+  // Adaptive's point form: its noise checks, doubts and (where it settles doubts) the noise local to each part
+  // decide alike in 16 lanes and in one, undecided samples included (check_same_masks compares them), on two
+  // surfaces whose shadow rays it doubts often.
+  for (const auto& [file, settle_doubts] : {std::pair{"barth_decic.toml", false}, std::pair{"endrass_octic.toml", true}}) {
+    const unsigned seed = kSeed + 5;
+    std::mt19937 own(seed);
+    const Scene scene = load_scene_file(std::string(ALGRAY_SOURCE_DIR "/scenes/") + file,
+                                        {{"render.precision", "\"adaptive\""}});
+    std::ostringstream what;
+    what << "adaptive point form (seed " << seed << "), " << file << (settle_doubts ? ", settling doubts" : "");
+    const Counts n = check_same_masks(scene, Precision::Adaptive, Isolation::Bernstein, own, what.str(),
+                                      RayOrigin::Point, settle_doubts);
+    INFO(what.str() << ": " << n.traced << " rays traced, " << n.hidden << " samples hidden, " << n.visible
+                    << " visible, " << n.doubted << " doubted");
+    CHECK(n.traced >= 1000);
+    CHECK(n.hidden >= 100);
+    CHECK(n.visible >= 100);
+    CHECK(n.doubted >= 10);  // doubts too, so that their answers are compared
+  }
 }
 
 TEST_CASE("batched shadow rays answer as the serial ones with a power-basis isolation and on the Barth sextic",

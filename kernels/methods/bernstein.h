@@ -253,6 +253,11 @@ typedef struct {
   __global const uint* exps;
   __global const REAL* coefs;
   uint count;
+  /* The point form's shadow rays in builds that settle doubts (shadow.h, PointTerms): each lane's noise local to a
+   * part of its segment, as one ray's (isolation.h, within_noise_at), from its terms' coordinates at the segment's
+   * ends; 0 elsewhere. */
+  int by_part;
+  LREAL x0, y0, z0, x1, y1, z1;
 } LaneTerms;
 ALGRAY_INLINE LaneRays terms_rays(const LaneTerms* t) { return *t->rays; }
 ALGRAY_INLINE LMASK terms_have_rays(const LaneTerms* t) {
@@ -265,6 +270,7 @@ ALGRAY_INLINE LaneTerms* one_ray_terms(RayTerms* terms, LaneTerms* lanes, LaneRa
   if (!ALGRAY_ESCALATE) return (LaneTerms*)0;
   *rays = one_lane_rays(terms->o, terms->d);
   lanes->value = ray_terms_exact(terms);
+  lanes->by_part = 0;
   lanes->rays = rays;
   lanes->exps = terms->exps;
   lanes->coefs = terms->coefs;
@@ -301,9 +307,15 @@ ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREA
 }
 ALGRAY_INLINE LREAL found_noise(LaneNoise* n, LMASK found) { return found ? exact_noise(&n->one) : (REAL)0; }
 #elif ALGRAY_ESCALATE
-/* Lanes: every lane's noise on its terms summed. */
+/* Lanes: every lane's noise on its terms summed; for the point form's shadow rays also local to each part of the
+ * segment (LaneTerms' by_part), with the operations of one ray's within_noise_at, so that a lane decides as the
+ * one-ray build does. */
 typedef struct {
   LREAL noise;
+  LREAL scale; /* max |b_k| of the coefficients the search starts from */
+  const LREAL* root;
+  const LaneTerms* terms;
+  LREAL part_lo, part_hi, part_noise; /* the last local noise computed, and its part */
   ProvenEnds proven;
 } LaneNoise;
 
@@ -314,13 +326,39 @@ LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(root[k]);
   MAGNITUDE_TREE(magnitude, LANE_LARGER);
+  n.scale = magnitude[0];
+  n.root = root;
+  n.terms = terms;
+  n.part_lo = n.part_hi = -1;
+  n.part_noise = 0;
   n.noise = DOUBT_NOISE(magnitude[0], terms->value);
   return n;
 }
+#define LANE_SELECT(a, b, m) LANE_SEL(a, b, m)
+#define LANE_ANY_OF(m) LANE_ANY(m)
+LOCAL_SCALE(LREAL, lanes_local_scale, LANE_LARGER, LANE_SELECT, LANE_ANY_OF)
+#undef LANE_SELECT
+#undef LANE_ANY_OF
 ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREAL hi) {
-  (void)lo;
-  (void)hi;
-  return fabs(value) <= n->noise;
+  LMASK within = fabs(value) <= n->noise;
+  const LaneTerms* t = n->terms;
+  if (!t->by_part || !LANE_ANY(within)) return within;
+  /* within_noise_at's local checks: the per-degree sums at the part's largest coordinate, then the terms summed */
+  const LREAL x = fmax(mix(t->x0, t->x1, lo), mix(t->x0, t->x1, hi));
+  const LREAL y = fmax(mix(t->y0, t->y1, lo), mix(t->y0, t->y1, hi));
+  const LREAL z = fmax(mix(t->z0, t->z1, lo), mix(t->z0, t->z1, hi));
+  const LREAL above = lanes_terms_within(t->coefs, t->count, fmax(x, fmax(y, z)));
+  within = within && !(fabs(value) > (REAL)ALGRAY_LOCAL_FACTOR * DOUBT_NOISE(fmin(n->scale, above), above));
+  if (!LANE_ANY(within)) return within;
+  /* the part's own noise, computed once per part as one ray's (a search step asks about one part several times) */
+  if (LANE_ANY(lo != n->part_lo || hi != n->part_hi)) {
+    n->part_lo = lo;
+    n->part_hi = hi;
+    const LREAL part_terms = terms_sum(t->exps, t->coefs, t->count, x, y, z) * (REAL)(1 + 1.0 / 1024);
+    n->part_noise =
+        (REAL)ALGRAY_LOCAL_FACTOR * DOUBT_NOISE(fmin(n->scale, lanes_local_scale(n->root, lo, hi)), part_terms);
+  }
+  return within && fabs(value) <= n->part_noise;
 }
 ALGRAY_INLINE LREAL found_noise(LaneNoise* n, LMASK found) { return LANE_SEL((LREAL)0, n->noise, found); }
 #else
@@ -684,6 +722,7 @@ void isolate_rays_together(uint count, const int* in_extent, const LaneRays* ray
     LaneTerms search_terms; /* read by adaptive builds only */
     if (ALGRAY_ESCALATE) {
       search_terms.value = lane_terms;
+      search_terms.by_part = 0;
       search_terms.rays = rays;
       search_terms.exps = terms[first].exps;
       search_terms.coefs = terms[first].coefs;

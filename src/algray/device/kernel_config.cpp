@@ -79,7 +79,9 @@ const BuildSwitch kBuildSwitches[] = {
 }  // namespace
 
 int default_lanes(const std::string& device_type) { return device_type == "CPU" ? 16 : 1; }
-int shadow_lanes(int lanes) { return lanes < kMaxShadowLanes ? lanes : kMaxShadowLanes; }
+int shadow_lanes(int lanes, Precision precision) {
+  return std::min(lanes, precision == Precision::Double ? kMaxShadowLanes : kMaxFloatShadowLanes);
+}
 bool lanes_apply(const KernelConfig& c) {
   if (c.entry == "shadow") return c.ray_origin == RayOrigin::Point;  // the extent form batches its own way
   return (c.entry == "primary" || c.entry == "trace") && lanes_supported(c.isolation, c.refinement);

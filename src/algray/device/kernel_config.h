@@ -15,10 +15,12 @@ struct KernelConfig;
 // SIMD; and whether a kernel can be built with more than one lane at all.
 int default_lanes(const std::string& device_type);
 bool lanes_apply(const KernelConfig& config);
-// The shadow kernel's point form takes at most 8 light samples of a point side by side, whatever the camera rays
-// take: at 16 its pass took 1.5 times as long on the Barth sextic and decic (bench/RESULTS.md).
+// The shadow kernel's point form takes at most 8 light samples of a point side by side in double, whatever the
+// camera rays take: at 16 its pass took 1.5 times as long on the Barth sextic and decic (bench/RESULTS.md). Float
+// vectors hold twice the lanes: at 16 the float pass took 0.93x (sextic) and 0.82x (decic) its time at 8.
 constexpr int kMaxShadowLanes = 8;
-int shadow_lanes(int lanes);
+constexpr int kMaxFloatShadowLanes = 16;
+int shadow_lanes(int lanes, Precision precision);
 
 // The -D switches build_options() writes, in its order; kernels/build_switches.h declares each one.
 std::vector<std::string> build_switch_names();

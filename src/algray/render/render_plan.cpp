@@ -19,7 +19,8 @@ bool screen_form_applies(const Scene& scene, Precision precision) {
 }
 
 bool point_form_applies(const KernelConfig& shadow) {
-  return shadow.precision == Precision::Double && abilities(shadow.isolation).point_form &&
+  return (shadow.precision == Precision::Double || shadow.precision == Precision::Adaptive) &&
+         abilities(shadow.isolation).point_form &&
          shadow.degree <= kMaxPointFormDegree;
 }
 
@@ -53,7 +54,7 @@ void escalate_in(RenderPlan& plan, Precision precision) {
       // rays, their pass 132 -> 66 ms).
       if (pass.kind == PassKind::Shadow && c.ray_origin == RayOrigin::Extent && point_form_applies(c)) {
         c.ray_origin = RayOrigin::Point;
-        c.lanes = shadow_lanes(primary->kernels.at(i).lanes);
+        c.lanes = shadow_lanes(primary->kernels.at(i).lanes, c.precision);
       }
       // The first pass's settling costs about what double's second pass saves, or more (Barth decic: sign
       // sampling 1.28x -> 1.30x float's time, 1.69x -> 1.55x where the second pass is float-float; each interval's
@@ -126,7 +127,7 @@ void plan_shadows(RenderPlan& plan, const Scene& scene, const std::vector<Kernel
     if (c.ray_origin == RayOrigin::Eye) c.ray_origin = RayOrigin::Extent;
     if (scene.render.ray_origin == RayOrigin::Auto && point_form_applies(c)) {
       c.ray_origin = RayOrigin::Point;
-      c.lanes = shadow_lanes(primary[i].lanes);
+      c.lanes = shadow_lanes(primary[i].lanes, c.precision);
     }
   }
   std::size_t points = 0;
@@ -214,7 +215,15 @@ void plan_escalation(RenderPlan& plan, Precision precision, const std::vector<Ke
   }
   for (PlannedPass& pass : plan.passes) {
     pass.escalation = pass.kind == PassKind::Primary ? kernels_for(primary, "trace") : pass.kernels;
-    for (KernelConfig& c : pass.escalation) c.precision = Precision::Mixed;
+    for (KernelConfig& c : pass.escalation) {
+      c.precision = Precision::Mixed;
+      // The point form has no float-float build: mixed precision takes doubted shadow rays in the extent
+      // construction (escalate_in turns them back to the point form where the second pass is double).
+      if (c.ray_origin == RayOrigin::Point) {
+        c.ray_origin = RayOrigin::Extent;
+        if (!lanes_apply(c)) c.lanes = 1;
+      }
+    }
     // Rays the float pass can settle after all need no float-float pass (escalate_in undoes it for double).
     for (KernelConfig& c : pass.kernels) c.settle_doubts = true;
   }

@@ -117,12 +117,13 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
 bool screen_form_applies(const Scene& scene, Precision precision);
 
 // Whether RayOrigin::Auto means the point form for a shadow kernel (kernels/point_form.h: P expanded once about
-// each surface point, restricted to its shadow rays in lanes): in double with Bernstein isolation, up to the degree
-// its vectors hold. Measured bit for bit against the extent construction's images on the shipped scenes, and
-// against the certified reference in test_shadows. Float keeps the extent construction: in float the point form
-// passes test_shadows too, but shadows nine scenes' pixels differently at 400x300 (the Barth decic 518), and the
-// extent form's are nearer double's in two thirds of them (bench/RESULTS.md); adaptive precision's noise is
-// measured on the extent form's digits.
+// each surface point, restricted to its shadow rays in lanes): in double and adaptive precision with Bernstein
+// isolation, up to the degree its vectors hold. Double's images are the extent construction's bit for bit on the
+// shipped scenes; adaptive's float pass measures the point form's own noise (kernels/shadow.h, PointTerms) and its
+// images are the extent form's on every shipped scene and hard surface but two, which differ by less than 1/255
+// (test_shadows holds both to the certified reference). Plain float keeps the extent construction: there the point
+// form passes test_shadows too, but shadows nine scenes' pixels differently at 400x300 (the Barth decic 518), and
+// the extent form's are nearer double's in two thirds of them (bench/RESULTS.md).
 inline constexpr int kMaxPointFormDegree = 15;
 bool point_form_applies(const KernelConfig& shadow);
 
