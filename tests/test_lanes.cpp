@@ -234,9 +234,16 @@ TEST_CASE("the plan gives lanes to the camera and secondary rays' kernels, where
   // The shadow kernel's point form (double) runs lanes too; the extent form batches rays its own way.
   CHECK(plan.find(PassKind::Shadow)->kernels.at(0).ray_origin == RayOrigin::Point);
   CHECK(plan.find(PassKind::Shadow)->kernels.at(0).lanes == 8);
+  // Plain float's shadow pass is adaptive's float point form, its doubted rays float's extent form (one ray per
+  // work-item: the extent form batches its own way).
   const RenderPlan float_plan = make_render_plan(full, Precision::Float, 0, 8);
-  CHECK(float_plan.find(PassKind::Shadow)->kernels.at(0).ray_origin == RayOrigin::Extent);
-  CHECK(float_plan.find(PassKind::Shadow)->kernels.at(0).lanes == 1);
+  CHECK(float_plan.find(PassKind::Shadow)->kernels.at(0).ray_origin == RayOrigin::Point);
+  CHECK(float_plan.find(PassKind::Shadow)->kernels.at(0).precision == Precision::Adaptive);
+  CHECK(float_plan.find(PassKind::Shadow)->kernels.at(0).lanes == 8);
+  CHECK(float_plan.find(PassKind::Shadow)->escalation.at(0).ray_origin == RayOrigin::Extent);
+  CHECK(float_plan.find(PassKind::Shadow)->escalation.at(0).precision == Precision::Float);
+  CHECK(float_plan.find(PassKind::Shadow)->escalation.at(0).lanes == 1);
+  CHECK(float_plan.find(PassKind::Primary)->escalation.empty());
   // Adaptive precision's second pass for camera rays is the trace kernel: in lanes too.
   const RenderPlan adaptive = make_render_plan(full, Precision::Adaptive, 0, 8);
   CHECK(adaptive.find(PassKind::Primary)->escalation.at(0).entry == "trace");

@@ -189,11 +189,16 @@ TEST_CASE("auto builds camera rays in the screen form in double and adaptive pre
     CHECK(pass.kernels.at(0).ray_origin == (pass.kind == PassKind::Primary  ? RayOrigin::Screen
                                             : pass.kind == PassKind::Shadow ? RayOrigin::Point
                                                                             : RayOrigin::Extent));
-  for (Precision p : {Precision::Float, Precision::Mixed})
-    CHECK(make_render_plan(full, p).find(PassKind::Shadow)->kernels.at(0).ray_origin == RayOrigin::Extent);
-  // Adaptive's float shadow pass measures the point form's noise (kernels/shadow.h, PointTerms).
-  CHECK(make_render_plan(full, Precision::Adaptive).find(PassKind::Shadow)->kernels.at(0).ray_origin ==
-        RayOrigin::Point);
+  CHECK(make_render_plan(full, Precision::Mixed).find(PassKind::Shadow)->kernels.at(0).ray_origin ==
+        RayOrigin::Extent);
+  // Adaptive's float shadow pass measures the point form's noise (kernels/shadow.h, PointTerms); plain float runs
+  // the same kernel, its doubted rays through its own extent form.
+  for (Precision p : {Precision::Float, Precision::Adaptive}) {
+    const PlannedPass& shadow = *make_render_plan(full, p).find(PassKind::Shadow);
+    CHECK(shadow.kernels.at(0).ray_origin == RayOrigin::Point);
+    CHECK(shadow.kernels.at(0).precision == Precision::Adaptive);
+    CHECK(shadow.escalation.at(0).ray_origin == RayOrigin::Extent);
+  }
   // A scene that asks for the extent construction gets it for every kernel.
   const Scene extent = load_scene_text(random_scene(6, 1006, Precision::Double) + "[[light]]\nposition = [3, 3, 3]\n",
                                        "random", {{"render.preview", "false"}, {"render.ray_origin", "\"extent\""}});

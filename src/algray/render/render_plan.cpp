@@ -125,18 +125,33 @@ void plan_shadows(RenderPlan& plan, const Scene& scene, const std::vector<Kernel
     // Its batched search restricts P on segments (kernels/shadow.cl): the paper's construction about the ray's
     // origin is camera and secondary rays' alone, and a shadow ray's origin is the surface point anyway.
     if (c.ray_origin == RayOrigin::Eye) c.ray_origin = RayOrigin::Extent;
-    if (scene.render.ray_origin == RayOrigin::Auto && point_form_applies(c)) {
-      c.ray_origin = RayOrigin::Point;
-      c.lanes = shadow_lanes(primary[i].lanes, c.precision);
-    }
   }
+  // Plain float: where the point form applies, its float kernel as adaptive precision builds it, which measures
+  // its noise and doubts what it cannot settle; the doubted rays go again through float's own extent construction
+  // (the escalation, in float). Settled beyond the noise, a ray's answer is the extent form's but where that one
+  // errs, and the rest are the extent form's: the image is today's or nearer double's, at the point form's speed.
+  const std::vector<KernelConfig> extent_form = shadow;
+  bool doubts_in_float = false;
+  for (std::size_t i = 0; i < shadow.size(); ++i) {
+    KernelConfig& c = shadow[i];
+    if (scene.render.ray_origin != RayOrigin::Auto) continue;
+    KernelConfig point = c;
+    if (c.precision == Precision::Float) point.precision = Precision::Adaptive;
+    if (!point_form_applies(point)) continue;
+    doubts_in_float |= c.precision == Precision::Float;
+    c = point;
+    c.ray_origin = RayOrigin::Point;
+    c.lanes = shadow_lanes(primary[i].lanes, c.precision);
+  }
+  // Every surface gets its fallback, unused where its kernel doubts nothing (the extent form itself).
+  const std::vector<KernelConfig> fallback = doubts_in_float ? extent_form : std::vector<KernelConfig>{};
   std::size_t points = 0;
   for (int i : plan.shadow_lights) points += scene.lights[static_cast<std::size_t>(i)].sample_points().size();
   plan.passes.push_back({PassKind::Shadow,
                          std::to_string(plan.shadow_lights.size()) + " shadow-casting light(s), " +
                              std::to_string(points) + " sample point(s) per lit surface point",
                          shadow,
-                         {}});
+                         fallback});
   // A batch of surface points at a time, asked about each light in turn.
   const std::size_t batch = std::min(rays, kBatchRays);
   plan.buffers.push_back({"shading points (per batch)", batch * 4 * real_size});

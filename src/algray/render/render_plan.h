@@ -28,8 +28,9 @@ struct PlannedPass {
   std::string purpose;                // why the scene needs it, for --stats
   std::vector<KernelConfig> kernels;  // one per surface of the scene, in scene order
   // Adaptive precision: per surface, the kernel, in mixed precision or double (escalate_in), that traces again
-  // the rays `kernels` doubted (the trace kernel for ray passes, the shadow kernel for the shadow pass); empty in
-  // other precisions.
+  // the rays `kernels` doubted (the trace kernel for ray passes, the shadow kernel for the shadow pass). Plain
+  // float's shadow pass: float's extent form, for the rays its point form doubted (plan_shadows). Empty
+  // elsewhere.
   std::vector<KernelConfig> escalation;
 };
 
@@ -121,9 +122,10 @@ bool screen_form_applies(const Scene& scene, Precision precision);
 // isolation, up to the degree its vectors hold. Double's images are the extent construction's bit for bit on the
 // shipped scenes; adaptive's float pass measures the point form's own noise (kernels/shadow.h, PointTerms) and its
 // images are the extent form's on every shipped scene and hard surface but two, which differ by less than 1/255
-// (test_shadows holds both to the certified reference). Plain float keeps the extent construction: there the point
-// form passes test_shadows too, but shadows nine scenes' pixels differently at 400x300 (the Barth decic 518), and
-// the extent form's are nearer double's in two thirds of them (bench/RESULTS.md).
+// (test_shadows holds both to the certified reference). Plain float alone would not: its point form passes
+// test_shadows, but shadows nine scenes' pixels differently at 400x300 (the Barth decic 518), and the extent
+// form's are nearer double's in two thirds of them. So plain float's shadow pass runs adaptive's float kernel and
+// sends what it doubts to float's extent form (plan_shadows): its images are the extent form's.
 inline constexpr int kMaxPointFormDegree = 15;
 bool point_form_applies(const KernelConfig& shadow);
 
