@@ -59,7 +59,7 @@ TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") 
   cases.push_back({6, Precision::Double, "extent", {2, 4, 8, 16}});
   cases.push_back({10, Precision::Float, "auto", {2, 4, 16}});
   cases.push_back({9, Precision::Double, "auto", {2, 4, 16}});  // the screen form's lanes (screen_coefficients)
-  cases.push_back({9, Precision::Adaptive, "auto", {16}});        // with adaptive's noise (screen_terms)
+  cases.push_back({9, Precision::Adaptive, "auto", {16}});      // with adaptive's noise (screen_terms)
   std::size_t hits = 0;
   for (std::size_t index = 0; index < cases.size(); ++index) {
     const Case& c = cases[index];
@@ -196,14 +196,13 @@ TEST_CASE("secondary rays in lanes give the one-ray kernel's hit records bit for
     for (const NamedChoice<Precision>& choice : kPrecisions) {
       if (choice.value == Precision::Mixed && degree > kMaxMixedDegree) continue;
       const auto render = [&](int lanes) {
-        return renderer.render_with_records(load_scene_text(
-            testing::random_scene(degree, seed, choice.value), "random",
-            {{"render.preview", "false"},
-             {"image.width", "96"},
-             {"image.height", "72"},
-             {"render.lanes", std::to_string(lanes)},
-             {"material.front.reflectivity", "0.5"},
-             {"material.back.transparency", "0.5"}}));
+        return renderer.render_with_records(load_scene_text(testing::random_scene(degree, seed, choice.value), "random",
+                                                            {{"render.preview", "false"},
+                                                             {"image.width", "96"},
+                                                             {"image.height", "72"},
+                                                             {"render.lanes", std::to_string(lanes)},
+                                                             {"material.front.reflectivity", "0.5"},
+                                                             {"material.back.transparency", "0.5"}}));
       };
       const RenderResult one = render(1), many = render(8);
       REQUIRE(many.plan.find(PassKind::Reflection)->kernels.at(0).lanes == 8);
@@ -234,8 +233,9 @@ TEST_CASE("the plan gives lanes to the camera and secondary rays' kernels, where
   // The shadow kernel's point form (double) runs lanes too; the extent form batches rays its own way.
   CHECK(plan.find(PassKind::Shadow)->kernels.at(0).ray_origin == RayOrigin::Point);
   CHECK(plan.find(PassKind::Shadow)->kernels.at(0).lanes == 8);
-  // Plain float's shadow pass is adaptive's float point form, its doubted rays float's extent form (one ray per
-  // work-item: the extent form batches its own way).
+  // Plain float runs adaptive's float kernels (float_measures_noise): its shadow pass is the float point form,
+  // its doubted rays float's extent form (one ray per work-item: the extent form batches its own way), and its
+  // doubted camera rays float's trace kernel, in lanes.
   const RenderPlan float_plan = make_render_plan(full, Precision::Float, 0, 8);
   CHECK(float_plan.find(PassKind::Shadow)->kernels.at(0).ray_origin == RayOrigin::Point);
   CHECK(float_plan.find(PassKind::Shadow)->kernels.at(0).precision == Precision::Adaptive);
@@ -243,7 +243,9 @@ TEST_CASE("the plan gives lanes to the camera and secondary rays' kernels, where
   CHECK(float_plan.find(PassKind::Shadow)->escalation.at(0).ray_origin == RayOrigin::Extent);
   CHECK(float_plan.find(PassKind::Shadow)->escalation.at(0).precision == Precision::Float);
   CHECK(float_plan.find(PassKind::Shadow)->escalation.at(0).lanes == 1);
-  CHECK(float_plan.find(PassKind::Primary)->escalation.empty());
+  CHECK(float_plan.find(PassKind::Primary)->escalation.at(0).entry == "trace");
+  CHECK(float_plan.find(PassKind::Primary)->escalation.at(0).precision == Precision::Float);
+  CHECK(float_plan.find(PassKind::Primary)->escalation.at(0).lanes == 8);
   // Adaptive precision's second pass for camera rays is the trace kernel: in lanes too.
   const RenderPlan adaptive = make_render_plan(full, Precision::Adaptive, 0, 8);
   CHECK(adaptive.find(PassKind::Primary)->escalation.at(0).entry == "trace");

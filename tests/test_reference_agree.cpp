@@ -69,9 +69,8 @@ SceneAgreement agreement(Renderer& renderer, const std::filesystem::path& file, 
   const ReferenceResult& ref = scene_reference(file, scene, is_float ? Precision::Float : Precision::Double);
   const ReferenceComparison c = compare_with_reference(kernel.hits, ref);
   std::printf("%-28s %-8s %9ld %9ld %9ld %12ld %9ld %12.3g at %d,%d\n", file.stem().string().c_str(),
-              label ? label : precision,
-              c.certified, c.ambiguous, c.ray_rounding, c.disagreements, c.simple_hits, c.worst_depth, c.worst_x,
-              c.worst_y);
+              label ? label : precision, c.certified, c.ambiguous, c.ray_rounding, c.disagreements, c.simple_hits,
+              c.worst_depth, c.worst_x, c.worst_y);
   return {c, is_double ? testing::kDoubleImage : testing::kFloatImage};
 }
 
@@ -79,9 +78,9 @@ void check_scene(Renderer& renderer, const std::filesystem::path& file, const ch
                  const char* label = nullptr) {
   const SceneAgreement a = agreement(renderer, file, precision, label);
   const ReferenceComparison& c = a.c;
-  INFO(file.filename().string() << " " << (label ? label : precision) << ": " << c.disagreements << " of " << c.certified
-                                << " certified pixels disagree on hit/miss (first at " << c.disagree_x << ","
-                                << c.disagree_y << "); worst relative depth error " << c.worst_depth << " at "
+  INFO(file.filename().string() << " " << (label ? label : precision) << ": " << c.disagreements << " of "
+                                << c.certified << " certified pixels disagree on hit/miss (first at " << c.disagree_x
+                                << "," << c.disagree_y << "); worst relative depth error " << c.worst_depth << " at "
                                 << c.worst_x << "," << c.worst_y << "; " << c.ambiguous << " ambiguous ("
                                 << c.ray_rounding << " of them within ray rounding)");
   CHECK(c.certified > kWidth * kHeight / 10);
@@ -162,19 +161,28 @@ TEST_CASE("the screen form meets the double line on seeded random surfaces of ev
     }
 }
 
-TEST_CASE("auto builds camera rays in the screen form in double and adaptive precision, and shadow rays in the point "
-          "form in double only",
-          "[reference]") {
+TEST_CASE(
+    "auto builds camera rays in the screen form in double, adaptive and float precision, and shadow rays in the "
+    "point form",
+    "[reference]") {
   const Scene base = load_scene_text(random_scene(6, 1006, Precision::Double), "random");
-  for (Precision p : {Precision::Double, Precision::Adaptive}) {
+  // Plain float takes adaptive's float kernels first, its own (the extent form) for the rays they doubt.
+  for (Precision p : {Precision::Double, Precision::Adaptive, Precision::Float}) {
     const RenderPlan plan = make_render_plan(base, p);
     CHECK(plan.find(PassKind::Primary)->kernels.at(0).ray_origin == RayOrigin::Screen);
     // adaptive's doubted camera rays go again through the extent construction (the trace kernel)
     for (const KernelConfig& again : plan.find(PassKind::Primary)->escalation)
       CHECK(again.ray_origin == RayOrigin::Extent);
   }
-  for (Precision p : {Precision::Float, Precision::Mixed})
-    CHECK(make_render_plan(base, p).find(PassKind::Primary)->kernels.at(0).ray_origin == RayOrigin::Extent);
+  CHECK(make_render_plan(base, Precision::Mixed).find(PassKind::Primary)->kernels.at(0).ray_origin ==
+        RayOrigin::Extent);
+  CHECK(make_render_plan(base, Precision::Float).find(PassKind::Primary)->escalation.at(0).precision ==
+        Precision::Float);
+  // Where adaptive does not apply (above degree 15), plain float keeps its own kernels throughout.
+  const Scene high = load_scene_text(random_scene(16, 1016, Precision::Float), "random");
+  CHECK(make_render_plan(high, Precision::Float).find(PassKind::Primary)->kernels.at(0).ray_origin ==
+        RayOrigin::Extent);
+  CHECK(make_render_plan(high, Precision::Float).find(PassKind::Primary)->escalation.empty());
   // The eye inside the extent: expansion points would lie on both sides of it, far from some rays' segments.
   const Scene inside =
       load_scene_text(random_scene(6, 1006, Precision::Double), "random", {{"camera.eye", "[0.2, 0.1, 0.5]"}});
@@ -189,8 +197,7 @@ TEST_CASE("auto builds camera rays in the screen form in double and adaptive pre
     CHECK(pass.kernels.at(0).ray_origin == (pass.kind == PassKind::Primary  ? RayOrigin::Screen
                                             : pass.kind == PassKind::Shadow ? RayOrigin::Point
                                                                             : RayOrigin::Extent));
-  CHECK(make_render_plan(full, Precision::Mixed).find(PassKind::Shadow)->kernels.at(0).ray_origin ==
-        RayOrigin::Extent);
+  CHECK(make_render_plan(full, Precision::Mixed).find(PassKind::Shadow)->kernels.at(0).ray_origin == RayOrigin::Extent);
   // Adaptive's float shadow pass measures the point form's noise (kernels/shadow.h, PointTerms); plain float runs
   // the same kernel, its doubted rays through its own extent form.
   for (Precision p : {Precision::Float, Precision::Adaptive}) {
@@ -276,7 +283,7 @@ TEST_CASE("a cylinder extent about each axis clips as the certified reference do
                    << "); worst depth " << c.worst_depth);
       CHECK(c.certified > 64 * 48 / 8);
       CHECK(c.simple_hits > 64 * 48 / 16);
-      CHECK(outside > 0);         // rays that miss the cylinder
+      CHECK(outside > 0);          // rays that miss the cylinder
       CHECK(cut > 64 * 48 / 100);  // pixels of the surface that the cylinder cut away
       check_clipped_agreement(renderer, scene, ref, c, is_double);
     }
@@ -309,10 +316,8 @@ TEST_CASE("clipping planes cut each surface as the certified reference does: 0 d
   for (const Case& k : cases) {
     const std::filesystem::path file =
         std::filesystem::path(ALGRAY_SOURCE_DIR "/scenes") / (std::string(k.scene) + ".toml");
-    std::vector<Override> base = {{"image.width", "64"},
-                                  {"image.height", "48"},
-                                  {"antialias.samples", "1"},
-                                  {"render.preview", "true"}};
+    std::vector<Override> base = {
+        {"image.width", "64"}, {"image.height", "48"}, {"antialias.samples", "1"}, {"render.preview", "true"}};
     base.insert(base.end(), k.extent.begin(), k.extent.end());
     std::vector<Override> uncut_overrides = base;
     uncut_overrides.push_back({"render.precision", "double"});
@@ -353,7 +358,7 @@ TEST_CASE("clipping planes cut each surface as the certified reference does: 0 d
                    << "); worst depth " << c.worst_depth);
       CHECK(c.certified > 64 * 48 / 8);
       CHECK(c.simple_hits > 64 * 48 / 32);
-      CHECK(cut > 64 * 48 / 100);  // pixels of the surface that the planes cut away
+      CHECK(cut > 64 * 48 / 100);        // pixels of the surface that the planes cut away
       if (is_double) CHECK(added == 0);  // a cut takes surface away, never adds any
       check_clipped_agreement(renderer, scene, ref, c, is_double);
     }
@@ -373,25 +378,22 @@ TEST_CASE("a gate passes the rays that meet it, which see the surface beyond it,
     std::vector<Override> gate;
     bool float_too;
   };
-  const Case cases[] = {
-      {"kummer", {{"extent.radius", "1.2"}, {"extent.gate", "true"}}, true},
-      {"torus",
-       {{"extent.type", "box"},
-        {"extent.min", "[-2.8, -2.8, -0.3]"},
-        {"extent.max", "[2.8, 2.8, 0.3]"},
-        {"extent.gate", "true"},
-        {"extent.reach", "3"},
-        {"clip", "[{plane = [0.3, 1, 0, -1]}]"}},
-       false}};
+  const Case cases[] = {{"kummer", {{"extent.radius", "1.2"}, {"extent.gate", "true"}}, true},
+                        {"torus",
+                         {{"extent.type", "box"},
+                          {"extent.min", "[-2.8, -2.8, -0.3]"},
+                          {"extent.max", "[2.8, 2.8, 0.3]"},
+                          {"extent.gate", "true"},
+                          {"extent.reach", "3"},
+                          {"clip", "[{plane = [0.3, 1, 0, -1]}]"}},
+                         false}};
   print_header();
   const auto hit = [](const HitRecord& r) { return (r.flags & ALGRAY_HIT_FOUND) != 0; };
   for (const Case& k : cases) {
     const std::filesystem::path file =
         std::filesystem::path(ALGRAY_SOURCE_DIR "/scenes") / (std::string(k.scene) + ".toml");
-    std::vector<Override> base = {{"image.width", "64"},
-                                  {"image.height", "48"},
-                                  {"antialias.samples", "1"},
-                                  {"render.preview", "true"}};
+    std::vector<Override> base = {
+        {"image.width", "64"}, {"image.height", "48"}, {"antialias.samples", "1"}, {"render.preview", "true"}};
     base.insert(base.end(), k.gate.begin(), k.gate.end());
     for (const char* precision : {"double", "float"}) {
       const bool is_double = std::string(precision) == "double";
@@ -421,9 +423,9 @@ TEST_CASE("a gate passes the rays that meet it, which see the surface beyond it,
                    << " certified pixels disagree (first at " << c.disagree_x << "," << c.disagree_y
                    << "); worst depth " << c.worst_depth);
       CHECK(c.certified > 64 * 48 / 8);
-      CHECK(outside > 64 * 48 / 8);        // rays that miss the gate
-      CHECK(beyond > 64 * 48 / 50);        // surface seen through the gate beyond it, which a cut would not show
-      if (is_double) CHECK(lost == 0);     // a gate shows all that the same shape as a cut shows
+      CHECK(outside > 64 * 48 / 8);     // rays that miss the gate
+      CHECK(beyond > 64 * 48 / 50);     // surface seen through the gate beyond it, which a cut would not show
+      if (is_double) CHECK(lost == 0);  // a gate shows all that the same shape as a cut shows
       check_clipped_agreement(renderer, scene, ref, c, is_double);
     }
   }
@@ -507,9 +509,10 @@ TEST_CASE("adaptive float agrees with the certified reference wherever it differ
           CHECK(std::fabs(t_a - static_cast<double>(c.answer.t_nearest)) <=
                 testing::kFloatImage.depth_error * static_cast<double>(c.answer.t_nearest));
       }
-    std::printf("%s at 512x384: adaptive escalated %d rays; it differs from double at %d pixels, %d of them "
-                "certified\n",
-                name, escalated, differing, certified);
+    std::printf(
+        "%s at 512x384: adaptive escalated %d rays; it differs from double at %d pixels, %d of them "
+        "certified\n",
+        name, escalated, differing, certified);
     CHECK(escalated > 0);  // these surfaces do exercise the escalation
   }
 }

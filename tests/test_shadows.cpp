@@ -241,9 +241,8 @@ TEST_CASE("shadow rays are cut by clipping planes as the reference cuts them: wh
   // Two planes across every scene (each centred on the origin): x <= 0.5 and y >= -1. The surface points are the
   // cut surface's, from a render at 96x72 (the cut leaves a half to a third of the points of 48x36), and the
   // lights where a scene puts its lights, so that many shadow rays pass where the cut took surface away.
-  const std::vector<Override> planes = {{"clip", "[{plane = [1, 0, 0, -0.5]}, {plane = [0, -1, 0, -1]}]"},
-                                        {"image.width", "96"},
-                                        {"image.height", "72"}};
+  const std::vector<Override> planes = {
+      {"clip", "[{plane = [1, 0, 0, -0.5]}, {plane = [0, -1, 0, -1]}]"}, {"image.width", "96"}, {"image.height", "72"}};
   for (const auto& [precision, origin] : kConstructions) {
     const Tally t = check_shadow_rays(
         precision, origin, 200,
@@ -271,18 +270,18 @@ TEST_CASE("a gate's shadow rays see the surface beyond it, and those that miss i
   // puts its lights, 3 of the gate's radii from its centre.
   const std::vector<Override> gate = {{"extent.radius", "2.2"}, {"extent.gate", "true"}};
   for (const auto& [precision, origin] : kConstructions) {
-    const Tally t = check_shadow_rays(
-        precision, origin, 150,
-        [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
-          REQUIRE(scene.extent.gate);
-          std::normal_distribution<double> g;
-          for (;;) {
-            const glm::dvec3 dir = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
-            const glm::dvec3 light = scene.extent.unit_centre() + 3 * scene.extent.shape_scale() * dir;
-            if (glm::dot(light - sp.point, glm::dvec3(sp.normal)) > 0) return light;
-          }
-        },
-        gate, {"torus.toml", "kummer.toml"});
+    const Tally t = check_shadow_rays(precision, origin, 150,
+                                      [](std::mt19937& rng, const Scene& scene, const SurfacePoint& sp) {
+                                        REQUIRE(scene.extent.gate);
+                                        std::normal_distribution<double> g;
+                                        for (;;) {
+                                          const glm::dvec3 dir = glm::normalize(glm::dvec3(g(rng), g(rng), g(rng)));
+                                          const glm::dvec3 light =
+                                              scene.extent.unit_centre() + 3 * scene.extent.shape_scale() * dir;
+                                          if (glm::dot(light - sp.point, glm::dvec3(sp.normal)) > 0) return light;
+                                        }
+                                      },
+                                      gate, {"torus.toml", "kummer.toml"});
     INFO(to_string(precision) << " " << to_string(origin) << ": " << t.certified << " certified, " << t.ambiguous
                               << " ambiguous, " << t.doubted << " doubted");
     CHECK(t.failures == 0);
@@ -309,7 +308,10 @@ PairedRays paired_rays(Renderer& renderer, const char* file, unsigned seed) {
                                       {"antialias.samples", "1"},
                                       {"render.preview", "true"},
                                       {"render.precision", "\"adaptive\""}}),
-               {}, {}, {}, {}};
+               {},
+               {},
+               {},
+               {}};
   r.sps = surface_points(renderer, r.scene);
   for (const SurfacePoint& sp : r.sps) {
     r.points.push_back(sp.point);
@@ -374,13 +376,12 @@ TEST_CASE("adaptive shadow rays that settle_doubts settles are only doubted ones
         const Verdict v = reference_verdict(r.scene, Precision::Adaptive, r.sps[i], r.lights[s], ray);
         if (v != Verdict::Visible && v != Verdict::Hidden) continue;
         ++certified;
-        INFO("light " << s << ": settled " << (is_hidden ? "hidden" : "visible") << ", the reference says "
-                      << name(v));
+        INFO("light " << s << ": settled " << (is_hidden ? "hidden" : "visible") << ", the reference says " << name(v));
         CHECK(is_hidden == (v == Verdict::Hidden));
       }
     }
-    std::printf("%s: %d doubted shadow rays, %d of them settled (%d hidden), %d of those certified\n", file,
-                doubted, settled, hidden, certified);
+    std::printf("%s: %d doubted shadow rays, %d of them settled (%d hidden), %d of those certified\n", file, doubted,
+                settled, hidden, certified);
     CHECK(settled * 2 > doubted);  // the noise of each interval settles most of them
     CHECK(hidden > 0);
     CHECK(hidden < settled);
@@ -389,9 +390,10 @@ TEST_CASE("adaptive shadow rays that settle_doubts settles are only doubted ones
   CHECK(certified_total >= 100);  // enough certified rays for the reference's answers to mean something
 }
 
-TEST_CASE("adaptive shadow rays the float kernel decides agree with the reference wherever the second pass answers "
-          "otherwise",
-          "[shadows]") {
+TEST_CASE(
+    "adaptive shadow rays the float kernel decides agree with the reference wherever the second pass answers "
+    "otherwise",
+    "[shadows]") {
   // The decided rays are adaptive's answers as they stand; a doubt withdrawn by the noise local to an interval
   // (kernels/isolation.h, within_noise_at) must not turn one the wrong way. The second pass traces the same float
   // rays (double's start closer to the surface); where it answers otherwise, the reference decides. Three of the
@@ -450,10 +452,11 @@ TEST_CASE("adaptive shadow rays the float kernel decides agree with the referenc
         CHECK(hidden == (v == Verdict::Hidden));
       }
     }
-    std::printf("%s, %s form%s: %ld shadow rays decided in float, %ld of them answered otherwise in %s, %ld of those "
-                "certified\n",
-                p.file, to_string(p.origin).c_str(), p.settle_doubts ? " settling doubts" : "", decided, differing,
-                to_string(p.second).c_str(), certified);
+    std::printf(
+        "%s, %s form%s: %ld shadow rays decided in float, %ld of them answered otherwise in %s, %ld of those "
+        "certified\n",
+        p.file, to_string(p.origin).c_str(), p.settle_doubts ? " settling doubts" : "", decided, differing,
+        to_string(p.second).c_str(), certified);
     CHECK(decided > 20000);
   }
 }

@@ -123,8 +123,8 @@ Counts check_same_masks(const Scene& scene, Precision precision, Isolation isola
     for (std::size_t i = 0; i < a.masks.size(); ++i) {
       if (a.masks[i] == b.masks[i]) continue;
       if (mismatches++ == 0)
-        UNSCOPED_INFO(what << ", round " << round << ", point " << i << " of " << point_count
-                           << " (" << points[i].x << ", " << points[i].y << ", " << points[i].z << "), " << light_count
+        UNSCOPED_INFO(what << ", round " << round << ", point " << i << " of " << point_count << " (" << points[i].x
+                           << ", " << points[i].y << ", " << points[i].z << "), " << light_count
                            << " lights: batched mask " << std::hex << a.masks[i] << ", serial " << b.masks[i]
                            << std::dec);
     }
@@ -172,8 +172,8 @@ TEST_CASE("batched shadow rays answer as the serial ones, bit for bit, at every 
       std::mt19937 rng(seed);
       const Scene scene = random_scene(rng, k.degree, k.even, precision, Isolation::Bernstein);
       std::ostringstream what;
-      what << to_string(precision) << " case " << c << " (degree " << k.degree << (k.even ? ", even" : "")
-           << ", seed " << seed << ")";
+      what << to_string(precision) << " case " << c << " (degree " << k.degree << (k.even ? ", even" : "") << ", seed "
+           << seed << ")";
       const Counts n = check_same_masks(scene, precision, Isolation::Bernstein, rng, what.str());
       INFO(what.str() << ": " << n.traced << " rays traced, " << n.hidden << " samples hidden, " << n.visible
                       << " visible");
@@ -221,11 +221,12 @@ TEST_CASE("the point form's shadow rays in lanes answer as one at a time, bit fo
   // Adaptive's point form: its noise checks, doubts and (where it settles doubts) the noise local to each part
   // decide alike in 16 lanes and in one, undecided samples included (check_same_masks compares them), on two
   // surfaces whose shadow rays it doubts often.
-  for (const auto& [file, settle_doubts] : {std::pair{"barth_decic.toml", false}, std::pair{"endrass_octic.toml", true}}) {
+  for (const auto& [file, settle_doubts] :
+       {std::pair{"barth_decic.toml", false}, std::pair{"endrass_octic.toml", true}}) {
     const unsigned seed = kSeed + 5;
     std::mt19937 own(seed);
-    const Scene scene = load_scene_file(std::string(ALGRAY_SOURCE_DIR "/scenes/") + file,
-                                        {{"render.precision", "\"adaptive\""}});
+    const Scene scene =
+        load_scene_file(std::string(ALGRAY_SOURCE_DIR "/scenes/") + file, {{"render.precision", "\"adaptive\""}});
     std::ostringstream what;
     what << "adaptive point form (seed " << seed << "), " << file << (settle_doubts ? ", settling doubts" : "");
     const Counts n = check_same_masks(scene, Precision::Adaptive, Isolation::Bernstein, own, what.str(),

@@ -20,8 +20,7 @@ bool screen_form_applies(const Scene& scene, Precision precision) {
 
 bool point_form_applies(const KernelConfig& shadow) {
   return (shadow.precision == Precision::Double || shadow.precision == Precision::Adaptive) &&
-         abilities(shadow.isolation).point_form &&
-         shadow.degree <= kMaxPointFormDegree;
+         abilities(shadow.isolation).point_form && shadow.degree <= kMaxPointFormDegree;
 }
 
 KernelConfig primary_config(const Scene& scene, Precision precision, std::size_t surface) {
@@ -60,7 +59,8 @@ void escalate_in(RenderPlan& plan, Precision precision) {
       // sampling 1.28x -> 1.30x float's time, 1.69x -> 1.55x where the second pass is float-float; each interval's
       // own noise 1.24x either way, 1.45x -> 1.32x where it is float-float; Kummer shell, discard doubts settled
       // in float-float: 2.2x -> 2.7x, 4.1x -> 3.9x).
-      if (precision == Precision::Double) pass.kernels.at(i).settle_doubts = false;
+      // A float second pass (plain float's, make_render_plan) costs less still.
+      if (precision != Precision::Mixed) pass.kernels.at(i).settle_doubts = false;
     }
 }
 
@@ -125,33 +125,18 @@ void plan_shadows(RenderPlan& plan, const Scene& scene, const std::vector<Kernel
     // Its batched search restricts P on segments (kernels/shadow.cl): the paper's construction about the ray's
     // origin is camera and secondary rays' alone, and a shadow ray's origin is the surface point anyway.
     if (c.ray_origin == RayOrigin::Eye) c.ray_origin = RayOrigin::Extent;
+    if (scene.render.ray_origin == RayOrigin::Auto && point_form_applies(c)) {
+      c.ray_origin = RayOrigin::Point;
+      c.lanes = shadow_lanes(primary[i].lanes, c.precision);
+    }
   }
-  // Plain float: where the point form applies, its float kernel as adaptive precision builds it, which measures
-  // its noise and doubts what it cannot settle; the doubted rays go again through float's own extent construction
-  // (the escalation, in float). Settled beyond the noise, a ray's answer is the extent form's but where that one
-  // errs, and the rest are the extent form's: the image is today's or nearer double's, at the point form's speed.
-  const std::vector<KernelConfig> extent_form = shadow;
-  bool doubts_in_float = false;
-  for (std::size_t i = 0; i < shadow.size(); ++i) {
-    KernelConfig& c = shadow[i];
-    if (scene.render.ray_origin != RayOrigin::Auto) continue;
-    KernelConfig point = c;
-    if (c.precision == Precision::Float) point.precision = Precision::Adaptive;
-    if (!point_form_applies(point)) continue;
-    doubts_in_float |= c.precision == Precision::Float;
-    c = point;
-    c.ray_origin = RayOrigin::Point;
-    c.lanes = shadow_lanes(primary[i].lanes, c.precision);
-  }
-  // Every surface gets its fallback, unused where its kernel doubts nothing (the extent form itself).
-  const std::vector<KernelConfig> fallback = doubts_in_float ? extent_form : std::vector<KernelConfig>{};
   std::size_t points = 0;
   for (int i : plan.shadow_lights) points += scene.lights[static_cast<std::size_t>(i)].sample_points().size();
   plan.passes.push_back({PassKind::Shadow,
                          std::to_string(plan.shadow_lights.size()) + " shadow-casting light(s), " +
                              std::to_string(points) + " sample point(s) per lit surface point",
                          shadow,
-                         fallback});
+                         {}});
   // A batch of surface points at a time, asked about each light in turn.
   const std::size_t batch = std::min(rays, kBatchRays);
   plan.buffers.push_back({"shading points (per batch)", batch * 4 * real_size});
@@ -271,14 +256,25 @@ std::uint64_t host_bytes_per_tile(const RenderPlan& plan, const Scene& scene, st
 
 int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 256 : 1024; }
 
+bool float_measures_noise(const Scene& scene) {
+  if (scene.render.ray_origin != RayOrigin::Auto) return false;
+  for (const SceneSurface& surface : scene.surfaces)
+    if (!adaptive_unsupported(surface.polynomial.degree(), scene.render.isolation).empty()) return false;
+  return true;
+}
+
 RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size, int lanes) {
+  if (precision == Precision::Float && float_measures_noise(scene)) {
+    RenderPlan plan = make_render_plan(scene, Precision::Adaptive, tile_size, lanes);
+    escalate_in(plan, Precision::Float);
+    return plan;
+  }
   RenderPlan plan;
   plan.width = scene.image.width;
   plan.height = scene.image.height;
   plan.clip_planes = scene.extent.clips;
-  if (scene.extent.gate)
-    plan.gate = {true, scene.extent.unit_centre(), scene.extent.unit_scale(), scene.extent.reach};
-  plan.tile_size = tile_size > 0                  ? tile_size
+  if (scene.extent.gate) plan.gate = {true, scene.extent.unit_centre(), scene.extent.unit_scale(), scene.extent.reach};
+  plan.tile_size = tile_size > 0                ? tile_size
                    : scene.render.tile_size > 0 ? scene.render.tile_size
                                                 : default_tile_size(DeviceInfo{});  // a device of no kind: a CPU's
   // Preview mode is the paper's quick look: one camera ray per pixel, whatever the scene's antialiasing.
@@ -369,10 +365,10 @@ nlohmann::json RenderPlan::json() const {
   for (const glm::dvec4& p : clip_planes) j["clip_planes"].push_back({p.x, p.y, p.z, p.w});
   j["extent_gate"] = nullptr;
   if (gate.on)
-    j["extent_gate"] = {{"reach", gate.reach},
-                        {"far_sphere",
-                         {{"centre", {gate.far_centre.x, gate.far_centre.y, gate.far_centre.z}},
-                          {"radius", gate.far_radius}}}};
+    j["extent_gate"] = {
+        {"reach", gate.reach},
+        {"far_sphere",
+         {{"centre", {gate.far_centre.x, gate.far_centre.y, gate.far_centre.z}}, {"radius", gate.far_radius}}}};
   j["skipped"] = skipped;
   j["estimated_memory_bytes"] = estimated_memory_bytes();
   return j;

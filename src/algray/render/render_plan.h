@@ -28,9 +28,8 @@ struct PlannedPass {
   std::string purpose;                // why the scene needs it, for --stats
   std::vector<KernelConfig> kernels;  // one per surface of the scene, in scene order
   // Adaptive precision: per surface, the kernel, in mixed precision or double (escalate_in), that traces again
-  // the rays `kernels` doubted (the trace kernel for ray passes, the shadow kernel for the shadow pass). Plain
-  // float's shadow pass: float's extent form, for the rays its point form doubted (plan_shadows). Empty
-  // elsewhere.
+  // the rays `kernels` doubted (the trace kernel for ray passes, the shadow kernel for the shadow pass); in plain
+  // float, float's own (float_measures_noise). Empty elsewhere.
   std::vector<KernelConfig> escalation;
 };
 
@@ -109,6 +108,14 @@ void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device);
 // render.lanes, when set, comes first.
 RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size = 0, int lanes = 1);
 
+// Whether plain float renders `scene` with adaptive precision's float kernels, which measure their noise and doubt
+// what it could decide, and traces the doubted rays again in float's own kernels (make_render_plan plans it so,
+// escalate_in(Float)): where adaptive applies (degree at most 15, Bernstein isolation) and the scene leaves the
+// ray origin open. Each ray's answer is then adaptive's where it is sure and plain float's elsewhere, so the image
+// is float's or nearer the truth, and float gets adaptive's fast forms: the screen form for camera rays, the
+// point form for shadow rays (measured: bench/RESULTS.md, "Float first").
+bool float_measures_noise(const Scene& scene);
+
 // Whether RayOrigin::Auto means the screen form for camera rays: in double and adaptive precision, with the camera
 // outside the extent, facing its centre. Measured to keep the double line at every degree. Adaptive's float pass
 // measures the screen form's noise ray by ray (kernels/surface.h, screen_terms) and escalates the rays it doubts,
@@ -148,7 +155,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::
 
 // Adaptive precision's escalation kernels in `precision` instead: double where every device's fp64 is fast (the
 // doubted rays then cost about what float does; shadow rays in the point form where it applies), mixed otherwise
-// (what make_render_plan plans).
+// (what make_render_plan plans); float for plain float (float_measures_noise).
 void escalate_in(RenderPlan& plan, Precision precision);
 
 // The kernel of the primary pass for one surface of `scene`.

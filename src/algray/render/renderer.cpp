@@ -17,7 +17,6 @@
 namespace algray {
 using namespace renderer_parts;
 
-
 std::size_t tile_memory_bytes(const RenderPlan& plan) { return plan.tile_rays() * sizeof(HitRecord); }
 
 Precision float_precision_for(const Scene& scene) {
@@ -112,6 +111,8 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   result.plan = make_render_plan(scene, precision, plan_devices(precision));
   for (const ClSession* session : sessions_) check_plan_fits(result.plan, session->info);
   result.config = result.plan.passes.front().kernels.front();
+  // Plain float runs adaptive's float kernels first (float_measures_noise): the render's precision is still float.
+  result.config.precision = precision;
   const RenderPlan& plan = result.plan;
   const int trace_width = plan.trace_width(), trace_height = plan.trace_height();
   result.basis = make_ray_basis(scene.camera, trace_width, trace_height);
@@ -126,7 +127,8 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
     devices.push_back(std::make_unique<Passes>(*session, shared, scene, options, precision, result));
     Passes& passes = *devices.back();
     for (std::size_t i = 0; i < scene.surfaces.size(); ++i)
-      passes.kernels.surfaces.push_back(std::make_unique<DeviceSurface>(session->context, scene, precision, i));
+      passes.kernels.surfaces.push_back(
+          std::make_unique<DeviceSurface>(session->context, scene, plan.passes.front().kernels.at(i).precision, i));
     prepare_passes(passes, devices.size() == 1);
     passes.shader = &shader;
   }

@@ -24,12 +24,11 @@ inline double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-
 // Keeps, per ray, the nearer of the hits found so far (surface `best`) and `other`'s hits (surface `index`).
 // The solver work of both is added up, and a depth-limited isolation on either is kept, so the statistics
 // and the solver channels count every surface's kernel.
-inline void keep_nearest(HitRecord* best, std::size_t count, std::vector<std::uint8_t>& best_surface, const HitRecord* other,
-                  std::uint8_t index) {
+inline void keep_nearest(HitRecord* best, std::size_t count, std::vector<std::uint8_t>& best_surface,
+                         const HitRecord* other, std::uint8_t index) {
   if (best_surface.size() != count) best_surface.assign(count, 0);
   for (std::size_t i = 0; i < count; ++i) {
     const HitRecord& o = other[i];
@@ -176,9 +175,9 @@ struct Renderer::DeviceKernels {
   std::vector<std::unique_ptr<ShadowTracer>> shadows;    // one per surface, when the plan has a shadow pass
   // Plain float's point form: adaptive's surface data, which its shadow kernels read (plan_shadows).
   std::vector<std::unique_ptr<DeviceSurface>> shadow_surfaces;
-  std::unique_ptr<ShadowPoints> shadow_points;           // a batch's surface points on the device
-  std::vector<LightGroup> light_groups;                  // the plan's shadow-casting lights, a launch per group
-  std::vector<std::unique_ptr<RayTracer>> rays;          // one per surface, when it has a secondary pass
+  std::unique_ptr<ShadowPoints> shadow_points;   // a batch's surface points on the device
+  std::vector<LightGroup> light_groups;          // the plan's shadow-casting lights, a launch per group
+  std::vector<std::unique_ptr<RayTracer>> rays;  // one per surface, when it has a secondary pass
   // Adaptive precision: per surface, mixed precision's trace kernel for doubted camera and secondary rays, and
   // its shadow kernel for doubted shadow rays (when the plan has a shadow pass); plain float: its extent form's
   // shadow kernel for the rays its point form doubted.
@@ -271,7 +270,7 @@ inline void count_escalation(PassStats& stats, std::size_t program, const Escala
 // float kernel doubted, ray_of(i) being record i's ray, and counts them in the pass's stats.
 template <typename Passes, typename RayOf>
 inline void escalate_doubted(Passes& p, PassStats& stats, std::size_t surface, HitRecord* records, std::size_t count,
-                      RayOf ray_of) {
+                             RayOf ray_of) {
   if (p.kernels.escalate_rays.empty()) return;
   const EscalationCount done = p.kernels.escalate_rays[surface]->redo(records, count, ray_of, p.options.batch_rays);
   count_escalation(stats, p.kernels.surfaces.size() + surface, done);
@@ -313,8 +312,9 @@ inline ShadowData trace_shadows(Passes& p, const HitRecord* hits, std::size_t co
         ++stats.launches;
         if (s == 0) stats.rays += answer.rays_traced;
         if (!p.kernels.escalate_shadows.empty()) {
-          count_escalation(stats, p.kernels.shadows.size() + s,
-                           p.kernels.escalate_shadows[s]->redo(points, normals, group.points, answer.undecided, answer.masks));
+          count_escalation(
+              stats, p.kernels.shadows.size() + s,
+              p.kernels.escalate_shadows[s]->redo(points, normals, group.points, answer.undecided, answer.masks));
         }
         hidden = std::move(answer.masks);
       }
