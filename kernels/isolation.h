@@ -92,6 +92,8 @@ ALGRAY_INLINE int first_counted(REAL lo) { return ALGRAY_SHADOW_RAYS && lo == 0;
   } while (0)
 #define PICK_LARGER(a, b) ((b) > (a) ? (b) : (a))
 #define PICK_SMALLER(a, b) ((b) < (a) ? (b) : (a))
+#define LANE_LARGER(a, b) LANE_SEL((a), (b), (b) > (a))
+#define LANE_SMALLER(a, b) LANE_SEL((a), (b), (b) < (a))
 ALGRAY_INLINE REAL largest_magnitude(const REAL* c) {
   REAL t[NCOEF];
   ALGRAY_UNROLL
@@ -147,39 +149,32 @@ REAL exact_noise(SearchNoise* n) {
 int within_noise(SearchNoise* n, REAL value) { return fabs(value) <= n->noise && fabs(value) <= exact_noise(n); }
 
 /* The largest Bernstein coefficient on [lo, hi] of sum_k |c_k| B_k, with room for its own rounding: the size
- * that de Casteljau's roundings on [lo, hi] are relative to. local_scale for one ray; lanes_local_scale
- * (methods/bernstein.h) for lanes, each lane with one ray's operations: T the type, LARGER its larger of two, SEL
- * and ANY its choice by a mask and whether any lane is set. */
-#define LOCAL_SCALE(T, name, LARGER, SEL, ANY)                         \
-  T name(const T* c, T lo, T hi) {                                     \
-    T t[NCOEF];                                                        \
-    ALGRAY_UNROLL                                                      \
-    for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]);               \
-    const T x1 = (REAL)1 - hi;                                         \
-    ALGRAY_UNROLL                                                      \
-    for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL                    \
-    for (int k = DEGREE; k >= 1; --k)                                  \
-      if (k >= r) t[k] = x1 * t[k - 1] + hi * t[k];                    \
-    if (ANY(lo > 0)) {                                                 \
-      const T x = lo / hi, y1 = (REAL)1 - x;                           \
-      T u[NCOEF];                                                      \
-      ALGRAY_UNROLL                                                    \
-      for (int k = 0; k <= DEGREE; ++k) u[k] = t[k];                   \
-      ALGRAY_UNROLL                                                    \
-      for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL                  \
-      for (int k = 0; k < DEGREE; ++k)                                 \
-        if (k <= DEGREE - r) u[k] = y1 * u[k] + x * u[k + 1];          \
-      ALGRAY_UNROLL                                                    \
-      for (int k = 0; k <= DEGREE; ++k) t[k] = SEL(t[k], u[k], lo > 0); \
-    }                                                                  \
-    MAGNITUDE_TREE(t, LARGER);                                         \
-    return t[0] * (REAL)(1 + 1.0 / 1024);                              \
+ * that de Casteljau's roundings on [lo, hi] are relative to; lane by lane (one ray: local_noise below). */
+LREAL local_scale(const LREAL* c, LREAL lo, LREAL hi) {
+  LREAL t[NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]);
+  const LREAL x1 = (REAL)1 - hi;
+  ALGRAY_UNROLL
+  for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
+  for (int k = DEGREE; k >= 1; --k)
+    if (k >= r) t[k] = x1 * t[k - 1] + hi * t[k];
+  const LMASK inner = lo > 0;
+  if (LANE_ANY(inner)) {
+    const LREAL x = lo / hi, y1 = (REAL)1 - x;
+    LREAL u[NCOEF];
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) u[k] = t[k];
+    ALGRAY_UNROLL
+    for (int r = 1; r <= DEGREE; ++r) ALGRAY_UNROLL
+    for (int k = 0; k < DEGREE; ++k)
+      if (k <= DEGREE - r) u[k] = y1 * u[k] + x * u[k + 1];
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) t[k] = LANE_SEL(t[k], u[k], inner);
   }
-#define SCALAR_SEL(a, b, m) ((m) ? (b) : (a))
-#define SCALAR_ANY(m) (m)
-LOCAL_SCALE(REAL, local_scale, PICK_LARGER, SCALAR_SEL, SCALAR_ANY)
-#undef SCALAR_SEL
-#undef SCALAR_ANY
+  MAGNITUDE_TREE(t, LANE_LARGER);
+  return t[0] * (REAL)(1 + 1.0 / 1024);
+}
 
 /* The noise local to the part [lo, hi] of the segment: DOUBT_NOISE of local_scale and of the terms there
  * (ray_terms_local), ALGRAY_LOCAL_FACTOR times. c: the segment's coefficients, scale their largest magnitude.
@@ -188,7 +183,11 @@ LOCAL_SCALE(REAL, local_scale, PICK_LARGER, SCALAR_SEL, SCALAR_ANY)
  * anywhere (tests/test_reference_agree); 16 keeps 4 times that margin. On shadow rays, factor 0 (no doubt near
  * the start) answers certified rays wrongly and 1 does not (tests/test_shadows). */
 REAL local_noise(const REAL* c, REAL scale, RayTerms* terms, REAL lo, REAL hi) {
-  return (REAL)ALGRAY_LOCAL_FACTOR * DOUBT_NOISE(fmin(scale, local_scale(c, lo, hi)), ray_terms_local(terms, lo, hi));
+  LREAL lanes[NCOEF]; /* the ray in every lane, lane 0 read (in one-ray builds, the only lane) */
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) lanes[k] = c[k];
+  const REAL size = lane_get(local_scale(lanes, (LREAL)lo, (LREAL)hi), 0);
+  return (REAL)ALGRAY_LOCAL_FACTOR * DOUBT_NOISE(fmin(scale, size), ray_terms_local(terms, lo, hi));
 }
 
 /* Whether |value|, on the part [lo, hi] of the segment, is within the noise: the segment's, and in shadow kernels

@@ -130,25 +130,17 @@ void point_form_segment(const LREAL* c, LREAL t_in, LREAL t_out, __constant cons
  * beyond Horner's rounding (2n + 1 roundings over the sum of |terms|, t >= 0, with room) plus `noise`, the
  * coefficients' own; other builds never read `noise`. */
 LMASK sign_change_sampled(const LREAL* c, LREAL t_in, LREAL t_out, LREAL start, LMASK open, LREAL noise) {
-  (void)noise;
   LMASK crossed = open && !open; /* all lanes false, of the mask type */
   ALGRAY_UNROLL
   for (int j = 1; j < 8; ++j) {
     const LREAL t = t_in + (t_out - t_in) * ((REAL)j / 8);
-    LREAL v = c[DEGREE];
-#if ALGRAY_ESCALATE
-    LREAL size = fabs(v);
-#endif
+    LREAL v = c[DEGREE], size = fabs(v); /* size: adaptive builds' only (others drop it) */
     ALGRAY_UNROLL
     for (int k = DEGREE - 1; k >= 0; --k) {
       v = v * t + c[k];
-#if ALGRAY_ESCALATE
       size = size * t + fabs(c[k]);
-#endif
     }
-#if ALGRAY_ESCALATE
-    v = LANE_SEL(v, (LREAL)0, fabs(v) <= size * (REAL)((2 * DEGREE + 2) * REAL_EPS) + noise);
-#endif
+    if (ALGRAY_ESCALATE) v = LANE_SEL(v, (LREAL)0, fabs(v) <= size * (REAL)((2 * DEGREE + 2) * REAL_EPS) + noise);
     crossed = crossed || (start > 0 && v < 0) || (start < 0 && v > 0);
   }
   return open && crossed;

@@ -96,31 +96,26 @@ RayTerms known_terms(REAL value) {
 
 /* An upper bound on the terms of any ray whose coordinates are all at most r: the per-degree sums at r. Its
  * rounding could put it a few ulps of count below the exact sum's (both are sums of positive products): 2^-10
- * more covers every degree up to 32. terms_within takes one r, lanes_terms_within one per lane.
+ * more covers every degree up to 32. Over lanes, each lane's r; one ray's is lane 0 of its r in every lane.
  * Estrin's scheme: pairs of degrees joined by r, then pairs of those by r^2, and so on, log2(DEGREE) steps deep.
  * Horner's rule was a chain of DEGREE dependent multiply-adds that every shadow ray reaching its terms waited
  * on: 12% of the Endrass octic's adaptive shadow kernel body in perf. */
-#define TERMS_WITHIN(T, name)                                                                          \
-  T name(__global const REAL* coefs, uint count, T r) {                                                \
-    T part[NCOEF];                                                                                     \
-    ALGRAY_UNROLL                                                                                      \
-    for (int d = 0; d <= DEGREE; ++d) part[d] = coefs[count + (uint)d];                                \
-    T power = r; /* r^step */                                                                          \
-    ALGRAY_UNROLL                                                                                      \
-    for (int step = 1; step <= DEGREE; step *= 2) {                                                    \
-      ALGRAY_UNROLL                                                                                    \
-      for (int d = 0; d + step <= DEGREE; d += 2 * step) part[d] = fma(part[d + step], power, part[d]); \
-      power *= power;                                                                                  \
-    }                                                                                                  \
-    return part[0] * (REAL)(1 + 1.0 / 1024);                                                           \
+LREAL terms_within(__global const REAL* coefs, uint count, LREAL r) {
+  LREAL part[NCOEF];
+  ALGRAY_UNROLL
+  for (int d = 0; d <= DEGREE; ++d) part[d] = coefs[count + (uint)d];
+  LREAL power = r; /* r^step */
+  ALGRAY_UNROLL
+  for (int step = 1; step <= DEGREE; step *= 2) {
+    ALGRAY_UNROLL
+    for (int d = 0; d + step <= DEGREE; d += 2 * step) part[d] = fma(part[d + step], power, part[d]);
+    power *= power;
   }
-TERMS_WITHIN(REAL, terms_within)
-#if LANES > 1
-TERMS_WITHIN(LREAL, lanes_terms_within)
-#else
-#define lanes_terms_within terms_within
-#endif
-#undef TERMS_WITHIN
+  return part[0] * (REAL)(1 + 1.0 / 1024);
+}
+ALGRAY_INLINE REAL one_ray_terms_within(__global const REAL* coefs, uint count, REAL r) {
+  return lane_get(terms_within(coefs, count, (LREAL)r), 0);
+}
 
 /* A ray's terms, with the upper bound of terms_within its largest coordinate. */
 RayTerms ray_terms(__global const uint* exps, __global const REAL* coefs, uint count, AxisFactor fx, AxisFactor fy,
@@ -139,7 +134,7 @@ RayTerms ray_terms(__global const uint* exps, __global const REAL* coefs, uint c
   t.y1 = fabs(fy.l1);
   t.z0 = fabs(fz.l0);
   t.z1 = fabs(fz.l1);
-  t.value = terms_within(coefs, count, fmax(t.x, fmax(t.y, t.z)));
+  t.value = one_ray_terms_within(coefs, count, fmax(t.x, fmax(t.y, t.z)));
   t.has_ray = 0;
   return t;
 }
@@ -227,7 +222,7 @@ void bernstein_from_scaled(REAL* c, REAL* c_lo, __constant const REAL* binomials
 REAL ray_terms_within_part(const RayTerms* t, REAL lo, REAL hi) {
   if (t->coefs == 0) return t->value;
   const REAL3 q = part_coordinates(t, lo, hi);
-  return terms_within(t->coefs, t->count, fmax(q.x, fmax(q.y, q.z)));
+  return one_ray_terms_within(t->coefs, t->count, fmax(q.x, fmax(q.y, q.z)));
 }
 
 /* c (degree n) plus a * one^n. binomials[n * NCOEF + k] = C(n, k), zero for k > n. */

@@ -26,9 +26,6 @@
 /* Adaptive builds' checks of the signs against the noise (the helpers below compile everywhere, adaptive builds
  * call them). */
 
-/* The scale of the search's noise for one ray (shadow.h, SCALE_BOUND). */
-SCALE_BOUND(REAL, search_scale_bound, PICK_LARGER)
-
 /* Whether the scaled coefficients c have one strict sign throughout with each but c_0 beyond limit[k]: with the
  * limits of segment_has_root's caller, what bernstein_root_by_signs and signs_clear_of settle as no root, from the
  * compares by_signs makes alone. */
@@ -81,7 +78,7 @@ ALGRAY_INLINE int segment_has_root(REAL* root, REAL* root_lo, REAL t_in, REAL t_
   REAL scale = 0;
 #if !ISOLATION_POWER_BASIS
   by_signs = bernstein_root_by_signs(root);
-  if (ALGRAY_ESCALATE && by_signs == ISOLATION_NONE) scale = search_scale_bound(root);
+  if (ALGRAY_ESCALATE && by_signs == ISOLATION_NONE) scale = search_scale_bound(root); /* one lane: LANES = 1 here */
   if (by_signs >= 0 && (!ALGRAY_ESCALATE || signs_clear_of(root, by_signs, scale, extent_terms)))
     return by_signs != ISOLATION_NONE;
 #endif
@@ -138,7 +135,7 @@ __kernel void shadow(__global const REAL4* points, __global const float4* normal
   /* Adaptive builds: every Bernstein coefficient of a segment in the extent is at most its terms, which
    * extent_terms bounds with room to spare, so no coefficients' scale makes the search's noise larger than
    * noise_bound's. */
-  const REAL extent_terms = ALGRAY_ESCALATE ? terms_within(mono_coefs, mono_count, 1) : 0; /* |u| <= 1 */
+  const REAL extent_terms = ALGRAY_ESCALATE ? one_ray_terms_within(mono_coefs, mono_count, 1) : 0; /* |u| <= 1 */
   REAL clear_limit[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k)

@@ -20,19 +20,17 @@ ALGRAY_INLINE REAL degree_binomial(int k) {
 }
 
 /* An upper bound on the scale of the search's noise (isolation.h, search_noise): the largest |b_k|, b_k = c_k /
- * C(n,k) the Bernstein coefficients of the scaled coefficients c (bernstein_from_scaled). Multiplied by the
- * reciprocals instead of divided: the four divisions per ray were most of what the shortcut cost the Cayley
- * cubic's shadow pass, which it settles almost whole. The room of 8 REAL_EPS covers the product's roundings and
- * the search's own division, which OpenCL lets be 2.5 ulp off. For one ray (search_scale_bound) or for lanes
- * (lanes_scale_bound): T the type, LARGER its larger of two. */
-#define SCALE_BOUND(T, name, LARGER)                                                                  \
-  ALGRAY_INLINE T name(const T* c) {                                                                  \
-    T t[NCOEF];                                                                                       \
-    ALGRAY_UNROLL                                                                                     \
-    for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]) * ((REAL)1 / degree_binomial(k));            \
-    MAGNITUDE_TREE(t, LARGER);                                                                        \
-    return t[0] * (REAL)(1 + 8 * REAL_EPS);                                                           \
-  }
+ * C(n,k) the Bernstein coefficients of the scaled coefficients c (bernstein_from_scaled), lane by lane.
+ * Multiplied by the reciprocals instead of divided: the four divisions per ray were most of what the shortcut cost
+ * the Cayley cubic's shadow pass, which it settles almost whole. The room of 8 REAL_EPS covers the product's
+ * roundings and the search's own division, which OpenCL lets be 2.5 ulp off. */
+ALGRAY_INLINE LREAL search_scale_bound(const LREAL* c) {
+  LREAL t[NCOEF];
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]) * ((REAL)1 / degree_binomial(k));
+  MAGNITUDE_TREE(t, LANE_LARGER);
+  return t[0] * (REAL)(1 + 8 * REAL_EPS);
+}
 
 /* p: the surface point (world), n its unit normal on the camera's side, o = p moved along n, o_unit the same in
  * unit coordinates; light: the sample point. The segment runs from o (t = 0) to the sample (t = 1). */
@@ -200,7 +198,6 @@ LMASK shadow_segments(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, LREAL lx, LREAL l
  * Adaptive builds also want every coefficient beyond `noise` but the first, P at the ray's start (first_counted);
  * other builds never read it. */
 LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials, LREAL noise) {
-  (void)noise;
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   LREAL piece[1 << SHADOW_PIECE_LEVELS][NCOEF];
   ALGRAY_UNROLL
@@ -224,10 +221,10 @@ LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials, LREAL 
   ALGRAY_UNROLL
   for (int p = 0; p < (1 << SHADOW_PIECE_LEVELS); ++p) {
     all_clear = all_clear && one_strict_sign(piece[p]);
-#if ALGRAY_ESCALATE
-    ALGRAY_UNROLL
-    for (int k = p == 0 ? 1 : 0; k <= DEGREE; ++k) all_clear = all_clear && fabs(piece[p][k]) > noise;
-#endif
+    if (ALGRAY_ESCALATE) {
+      ALGRAY_UNROLL
+      for (int k = p == 0 ? 1 : 0; k <= DEGREE; ++k) all_clear = all_clear && fabs(piece[p][k]) > noise;
+    }
   }
   return all_clear;
 }
@@ -241,7 +238,7 @@ LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials, LREAL 
 typedef struct {
   LREAL x, y, z;    /* |o| + t_out |d| per axis, where Pabs is summed */
   LREAL x0, y0, z0; /* |o| + t_in |d|: with x, y, z the line |o| + t |d|, for the search's local noise */
-  LREAL value;      /* an upper bound (lanes_terms_within at each lane's largest coordinate) until `exact` */
+  LREAL value;      /* an upper bound (terms_within at each lane's largest coordinate) until `exact` */
   int exact;
 } PointTerms;
 
@@ -254,7 +251,7 @@ PointTerms point_terms(REAL3 o, LREAL dx, LREAL dy, LREAL dz, LREAL t_in, LREAL 
   t.x = fabs(o.x) + t_out * fabs(dx);
   t.y = fabs(o.y) + t_out * fabs(dy);
   t.z = fabs(o.z) + t_out * fabs(dz);
-  t.value = lanes_terms_within(coefs, count, fmax(t.x, fmax(t.y, t.z)));
+  t.value = terms_within(coefs, count, fmax(t.x, fmax(t.y, t.z)));
   t.exact = 0;
   return t;
 }
@@ -288,8 +285,6 @@ LMASK segment_roots_settled_clear(const LREAL* c, const LREAL* power, LREAL t_in
   return root || crossed;
 }
 
-/* search_scale_bound's (shadow.cl) for lanes: the scale of the search's noise. */
-SCALE_BOUND(LREAL, lanes_scale_bound, LANE_LARGER)
 
 /* Which of the traced lanes' segments a cheap test shows to hold a root, from the scaled Bernstein coefficients c
  * on [t_in, t_out] (power basis power, the same polynomial); *open gets the lanes only the search can settle. The
@@ -299,18 +294,15 @@ SCALE_BOUND(LREAL, lanes_scale_bound, LANE_LARGER)
 LMASK segment_roots_settled(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced, LMASK* open,
                             __constant const REAL* binomials, PointTerms* terms, __global const uint* exps,
                             __global const REAL* coefs, uint count) {
-#if ALGRAY_ESCALATE
-  const LREAL scale = lanes_scale_bound(c);
-  LMASK root = segment_roots_settled_clear(c, power, t_in, t_out, traced, open, binomials, scale, terms->value);
-  if (!LANE_ANY(*open)) return root;
-  /* what the bound settled, the sum settles alike: each of its values is beyond a smaller noise */
-  point_terms_exact(terms, exps, coefs, count);
-  return segment_roots_settled_clear(c, power, t_in, t_out, traced, open, binomials, scale, terms->value);
-#else
-  (void)terms;
-  (void)exps;
-  (void)coefs;
-  (void)count;
+  if (ALGRAY_ESCALATE) {
+    const LREAL scale = search_scale_bound(c);
+    const LMASK root =
+        segment_roots_settled_clear(c, power, t_in, t_out, traced, open, binomials, scale, terms->value);
+    if (!LANE_ANY(*open)) return root;
+    /* what the bound settled, the sum settles alike: each of its values is beyond a smaller noise */
+    point_terms_exact(terms, exps, coefs, count);
+    return segment_roots_settled_clear(c, power, t_in, t_out, traced, open, binomials, scale, terms->value);
+  }
   const LREAL start = c[0], end = c[DEGREE];
   const LMASK none = one_strict_sign(c);
   LMASK root = traced && !none && (start == 0 || end == 0 || (start < 0 && end > 0) || (start > 0 && end < 0));
@@ -320,7 +312,6 @@ LMASK segment_roots_settled(const LREAL* c, const LREAL* power, LREAL t_in, LREA
   *open = *open && !crossed;
   if (LANE_ANY(*open)) *open = *open && !no_root_in_pieces(c, binomials, (LREAL)0);
   return root || crossed;
-#endif
 }
 
 /* Segments waiting for the search, gathered from the blocks of lanes of one surface point until they fill a block:
@@ -332,16 +323,13 @@ typedef struct {
   LREAL t_in, t_out;
   uint sample[LANES];
   uint count;
-#if ALGRAY_ESCALATE
-  LREAL terms;
+  LREAL terms; /* adaptive builds' */
   LREAL x0, y0, z0, x1, y1, z1;
-#endif
 } SearchQueue;
 
 /* What the search of the queue's lanes measures its noise by (adaptive builds; methods/bernstein.h, LaneTerms):
  * one ray's RayTerms, or the lanes' own. |o| + t |d| is linear in t: the ends' values interpolate it exactly, as
  * the noise local to a part reads them (within_noise_at, within_lanes_noise). */
-#if ALGRAY_ESCALATE
 ALGRAY_INLINE LaneTerms queued_terms(const SearchQueue* queue, __global const uint* exps, __global const REAL* coefs,
                                      uint count) {
 #if LANES == 1
@@ -366,7 +354,6 @@ ALGRAY_INLINE LaneTerms queued_terms(const SearchQueue* queue, __global const ui
   t.z1 = queue->z1;
   return t;
 }
-#endif
 
 /* The samples whose queued segments hold a root, by the Bernstein search over the queue's lanes; in adaptive
  * builds, *doubted gets those it doubted. The queue is emptied. */
@@ -376,16 +363,9 @@ ulong search_queued(SearchQueue* queue, ulong* doubted, __global const uint* exp
   LREAL cur[NCOEF];
   const LMASK running = lanes_of_bits((1u << queue->count) - 1);
   LaneIsolation iso;
-#if ALGRAY_ESCALATE
   LaneTerms terms = queued_terms(queue, exps, coefs, count);
-  LaneTerms* search_terms = &terms;
-#else
-  (void)exps;
-  (void)coefs;
-  (void)count;
-  LaneTerms* search_terms = (LaneTerms*)0;
-#endif
-  isolate_bernstein_search(running, queue->b, queue->b, queue->t_in, queue->t_out, &iso, cur, search_terms, NO_PROBE);
+  isolate_bernstein_search(running, queue->b, queue->b, queue->t_in, queue->t_out, &iso, cur,
+                           ALGRAY_ESCALATE ? &terms : (LaneTerms*)0, NO_PROBE);
   const uint found_bits = lane_mask_bits(running && iso.status != (REAL)ISOLATION_NONE);
   const uint doubt_bits = ALGRAY_ESCALATE ? lane_mask_bits(running && iso.doubt != (REAL)0) : 0u;
   for (uint j = 0; j < queue->count; ++j) {
@@ -413,15 +393,15 @@ ulong queue_for_search(SearchQueue* queue, const LREAL* c, LREAL t_in, LREAL t_o
     for (int k = 0; k <= DEGREE; ++k) lane_set(&queue->b[k], at, lane_get(b[k], j));
     lane_set(&queue->t_in, at, lane_get(t_in, j));
     lane_set(&queue->t_out, at, lane_get(t_out, j));
-#if ALGRAY_ESCALATE
-    lane_set(&queue->terms, at, lane_get(terms->value, j));
-    lane_set(&queue->x0, at, lane_get(terms->x0, j));
-    lane_set(&queue->y0, at, lane_get(terms->y0, j));
-    lane_set(&queue->z0, at, lane_get(terms->z0, j));
-    lane_set(&queue->x1, at, lane_get(terms->x, j));
-    lane_set(&queue->y1, at, lane_get(terms->y, j));
-    lane_set(&queue->z1, at, lane_get(terms->z, j));
-#endif
+    if (ALGRAY_ESCALATE) {
+      lane_set(&queue->terms, at, lane_get(terms->value, j));
+      lane_set(&queue->x0, at, lane_get(terms->x0, j));
+      lane_set(&queue->y0, at, lane_get(terms->y0, j));
+      lane_set(&queue->z0, at, lane_get(terms->z0, j));
+      lane_set(&queue->x1, at, lane_get(terms->x, j));
+      lane_set(&queue->y1, at, lane_get(terms->y, j));
+      lane_set(&queue->z1, at, lane_get(terms->z, j));
+    }
     queue->sample[at] = s0 + j;
     if (++queue->count == LANES) found |= search_queued(queue, doubted, exps, coefs, count);
   }
@@ -449,10 +429,8 @@ ulong shadow_mask_point_form(__global const REAL4* points, __global const float4
   for (int k = 0; k <= DEGREE; ++k) queue.b[k] = 1;
   queue.t_in = 0;
   queue.t_out = 1;
-#if ALGRAY_ESCALATE
   queue.terms = 1;
   queue.x0 = queue.y0 = queue.z0 = queue.x1 = queue.y1 = queue.z1 = 1;
-#endif
   for (uint s0 = 0; s0 < light_count; s0 += LANES) {
     /* The host pads the light points to a multiple of 16, so a block may read past light_count. */
 #define LIGHT_X(j) light_points[s0 + (j)].x
@@ -480,9 +458,7 @@ ulong shadow_mask_point_form(__global const REAL4* points, __global const float4
     point_form_restrict(q, dx, dy, dz, power);
     point_form_segment(power, t_in, t_out, binomials, c);
     PointTerms terms;
-#if ALGRAY_ESCALATE
-    terms = point_terms(o_unit, dx, dy, dz, t_in, t_out, mono_coefs, mono_count);
-#endif
+    if (ALGRAY_ESCALATE) terms = point_terms(o_unit, dx, dy, dz, t_in, t_out, mono_coefs, mono_count);
     LMASK open;
     mask |= (ulong)lane_mask_bits(segment_roots_settled(c, power, t_in, t_out, trace, &open, binomials, &terms,
                                                         mono_exps, mono_coefs, mono_count))

@@ -213,8 +213,6 @@ ALGRAY_INLINE LREAL next_interval_width(LREAL next_at) {
 }
 
 /* isolation.h's PICK_LARGER and PICK_SMALLER, lane by lane */
-#define LANE_LARGER(a, b) LANE_SEL((a), (b), (b) > (a))
-#define LANE_SMALLER(a, b) LANE_SEL((a), (b), (b) < (a))
 
 /* The smallest |c_k| that counts (first_counted, isolation.h: an interval whose coefficients all stand clear of the
  * noise keeps its sign variations), or the smallest inner one (ends = 0); and the smaller |P| at the interval's
@@ -334,11 +332,6 @@ LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
   n.noise = DOUBT_NOISE(magnitude[0], terms->value);
   return n;
 }
-#define LANE_SELECT(a, b, m) LANE_SEL(a, b, m)
-#define LANE_ANY_OF(m) LANE_ANY(m)
-LOCAL_SCALE(LREAL, lanes_local_scale, LANE_LARGER, LANE_SELECT, LANE_ANY_OF)
-#undef LANE_SELECT
-#undef LANE_ANY_OF
 ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREAL hi) {
   LMASK within = fabs(value) <= n->noise;
   const LaneTerms* t = n->terms;
@@ -347,7 +340,7 @@ ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREA
   const LREAL x = fmax(mix(t->x0, t->x1, lo), mix(t->x0, t->x1, hi));
   const LREAL y = fmax(mix(t->y0, t->y1, lo), mix(t->y0, t->y1, hi));
   const LREAL z = fmax(mix(t->z0, t->z1, lo), mix(t->z0, t->z1, hi));
-  const LREAL above = lanes_terms_within(t->coefs, t->count, fmax(x, fmax(y, z)));
+  const LREAL above = terms_within(t->coefs, t->count, fmax(x, fmax(y, z)));
   within = within && !(fabs(value) > (REAL)ALGRAY_LOCAL_FACTOR * DOUBT_NOISE(fmin(n->scale, above), above));
   if (!LANE_ANY(within)) return within;
   /* the part's own noise, computed once per part as one ray's (a search step asks about one part several times) */
@@ -356,7 +349,7 @@ ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREA
     n->part_hi = hi;
     const LREAL part_terms = terms_sum(t->exps, t->coefs, t->count, x, y, z) * (REAL)(1 + 1.0 / 1024);
     n->part_noise =
-        (REAL)ALGRAY_LOCAL_FACTOR * DOUBT_NOISE(fmin(n->scale, lanes_local_scale(n->root, lo, hi)), part_terms);
+        (REAL)ALGRAY_LOCAL_FACTOR * DOUBT_NOISE(fmin(n->scale, local_scale(n->root, lo, hi)), part_terms);
   }
   return within && fabs(value) <= n->part_noise;
 }
