@@ -27,6 +27,14 @@ def run_render(binary, scene, args, env, workdir):
     return wall, json.loads(stats.read_text())
 
 
+def parse_degrees(text):
+    """Degrees given as a range ("1-32") or a list ("2,6,10")."""
+    if "-" in text:
+        lo, hi = (int(x) for x in text.split("-"))
+        return list(range(lo, hi + 1))
+    return [int(x) for x in text.split(",")]
+
+
 def fresh_caches(parent):
     """An environment whose algray and PoCL program caches start empty (a cold run)."""
     caches = Path(parent)

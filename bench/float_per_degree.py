@@ -15,7 +15,7 @@ import statistics
 import tempfile
 from pathlib import Path
 
-from bench_common import ROOT, command_line, commit, machine, replace_section, run_render
+from bench_common import ROOT, command_line, commit, machine, parse_degrees, replace_section, run_render
 from kernel_speed import random_surface
 
 AREA = "## Rays per second per degree"
@@ -50,11 +50,7 @@ def main():
     ap.add_argument("--degrees", default="1,2,3,4,5,6,8,12,15,16,24,32", help="e.g. 1-32 or 2,6,10")
     ap.add_argument("--results", action="store_true", help="write the section of bench/RESULTS.md")
     a = ap.parse_args()
-    if "-" in a.degrees:
-        lo, hi = (int(x) for x in a.degrees.split("-"))
-        degrees = list(range(lo, hi + 1))
-    else:
-        degrees = [int(x) for x in a.degrees.split(",")]
+    degrees = parse_degrees(a.degrees)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)

@@ -13,7 +13,8 @@ import statistics
 import tempfile
 from pathlib import Path
 
-from bench_common import RESULTS_MD, ROOT, command_line, commit, machine, replace_section, run_render
+from bench_common import (RESULTS_MD, ROOT, command_line, commit, machine, parse_degrees, replace_section,
+                          run_render)
 
 PAPER_SURFACES = ["barth_sextic", "cusp_catastrophe", "torus", "tooth", "lemniscate", "tanglecube", "barth_decic"]
 AREA = "## Rays per second per degree"
@@ -95,11 +96,7 @@ def main():
     ap.add_argument("--results", action="store_true", help="write the tables into their sections of "
                     "bench/RESULTS.md and the whole output to bench/results/")
     a = ap.parse_args()
-    if "-" in a.degrees:
-        lo, hi = (int(x) for x in a.degrees.split("-"))
-        degrees = list(range(lo, hi + 1))
-    else:
-        degrees = [int(x) for x in a.degrees.split(",")]
+    degrees = parse_degrees(a.degrees)
     if a.baseline is None:  # a device where no earlier build is at hand (a lent GPU)
         binaries = [a.algray]
         about = (f"`{a.algray}`; kernel ms of the primary pass, median of {a.repeat} runs after one warm-up. "
