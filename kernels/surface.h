@@ -20,9 +20,6 @@
     ALGRAY_ESCALATE
 #error "adaptive precision measures its noise by the terms of the extent construction, the screen form or the point form"
 #endif
-#if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && ALGRAY_ESCALATE && LANES > 1 && DEGREE > 15
-#error "adaptive precision's screen form in lanes is screen_coefficients' (DEGREE <= 15, as adaptive itself)"
-#endif
 #if RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && ALGRAY_COMPENSATED
 #error "RAY_ORIGIN=screen is built in plain float or double"
 #endif

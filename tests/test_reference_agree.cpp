@@ -178,11 +178,18 @@ TEST_CASE(
         RayOrigin::Extent);
   CHECK(make_render_plan(base, Precision::Float).find(PassKind::Primary)->escalation.at(0).precision ==
         Precision::Float);
-  // Where adaptive does not apply (above degree 15), plain float keeps its own kernels throughout.
-  const Scene high = load_scene_text(random_scene(16, 1016, Precision::Float), "random");
+  // Above adaptive's own limit of 15 too (its second pass is float's); with an isolation adaptive does not take,
+  // plain float keeps its own kernels throughout.
+  const Scene high = load_scene_text(random_scene(24, 1024, Precision::Float), "random");
   CHECK(make_render_plan(high, Precision::Float).find(PassKind::Primary)->kernels.at(0).ray_origin ==
+        RayOrigin::Screen);
+  CHECK(make_render_plan(high, Precision::Float).find(PassKind::Primary)->escalation.at(0).precision ==
+        Precision::Float);
+  const Scene sturm = load_scene_text(random_scene(6, 1006, Precision::Float), "random",
+                                      {{"render.isolation", "\"sturm\""}});
+  CHECK(make_render_plan(sturm, Precision::Float).find(PassKind::Primary)->kernels.at(0).ray_origin ==
         RayOrigin::Extent);
-  CHECK(make_render_plan(high, Precision::Float).find(PassKind::Primary)->escalation.empty());
+  CHECK(make_render_plan(sturm, Precision::Float).find(PassKind::Primary)->escalation.empty());
   // The eye inside the extent: expansion points would lie on both sides of it, far from some rays' segments.
   const Scene inside =
       load_scene_text(random_scene(6, 1006, Precision::Double), "random", {{"camera.eye", "[0.2, 0.1, 0.5]"}});

@@ -257,10 +257,8 @@ std::uint64_t host_bytes_per_tile(const RenderPlan& plan, const Scene& scene, st
 int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 256 : 1024; }
 
 bool float_measures_noise(const Scene& scene) {
-  if (scene.render.ray_origin != RayOrigin::Auto) return false;
-  for (const SceneSurface& surface : scene.surfaces)
-    if (!adaptive_unsupported(surface.polynomial.degree(), scene.render.isolation).empty()) return false;
-  return true;
+  // Any degree: adaptive's limit of 15 is its mixed-precision second pass's, and float's second pass is float.
+  return scene.render.ray_origin == RayOrigin::Auto && abilities(scene.render.isolation).adaptive;
 }
 
 RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size, int lanes) {

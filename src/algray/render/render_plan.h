@@ -110,8 +110,9 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
 
 // Whether plain float renders `scene` with adaptive precision's float kernels, which measure their noise and doubt
 // what it could decide, and traces the doubted rays again in float's own kernels (make_render_plan plans it so,
-// escalate_in(Float)): where adaptive applies (degree at most 15, Bernstein isolation) and the scene leaves the
-// ray origin open. Each ray's answer is then adaptive's where it is sure and plain float's elsewhere, so the image
+// escalate_in(Float)): with an isolation method adaptive precision takes (Bernstein), at any degree (adaptive's
+// own limit of 15 is its mixed second pass's; above 15 camera rays take the screen form one ray at a time, with
+// its terms, kernels/surface.h), where the scene leaves the ray origin open. Each ray's answer is then adaptive's where it is sure and plain float's elsewhere, so the image
 // is float's or nearer the truth, and float gets adaptive's fast forms: the screen form for camera rays, the
 // point form for shadow rays (measured: bench/RESULTS.md, "Float first").
 bool float_measures_noise(const Scene& scene);
