@@ -112,9 +112,10 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
 // what it could decide, and traces the doubted rays again in float's own kernels (make_render_plan plans it so,
 // escalate_in(Float)): with an isolation method adaptive precision takes (Bernstein), at any degree (adaptive's
 // own limit of 15 is its mixed second pass's; above 15 camera rays take the screen form one ray at a time, with
-// its terms, kernels/surface.h), where the scene leaves the ray origin open. Each ray's answer is then adaptive's where it is sure and plain float's elsewhere, so the image
-// is float's or nearer the truth, and float gets adaptive's fast forms: the screen form for camera rays, the
-// point form for shadow rays (measured: bench/RESULTS.md, "Float first").
+// its terms, kernels/surface.h), where the scene leaves the ray origin open. Each ray's answer is then adaptive's
+// where it is sure and plain float's elsewhere, so the image is float's or nearer the truth, and float gets
+// adaptive's fast forms: the screen form for camera rays, the point form for shadow rays (measured:
+// bench/RESULTS.md, "Float first").
 bool float_measures_noise(const Scene& scene);
 
 // Whether RayOrigin::Auto means the screen form for camera rays: in double and adaptive precision, with the camera
@@ -133,7 +134,7 @@ bool screen_form_applies(const Scene& scene, Precision precision);
 // (test_shadows holds both to the certified reference). Plain float alone would not: its point form passes
 // test_shadows, but shadows nine scenes' pixels differently at 400x300 (the Barth decic 518), and the extent
 // form's are nearer double's in two thirds of them. So plain float's shadow pass runs adaptive's float kernel and
-// sends what it doubts to float's extent form (plan_shadows): its images are the extent form's.
+// sends what it doubts to float's extent form (float_measures_noise): its images are the extent form's.
 inline constexpr int kMaxPointFormDegree = 15;
 bool point_form_applies(const KernelConfig& shadow);
 

@@ -53,31 +53,23 @@ void Renderer::prepare_shadows(Passes& passes, PassStats& stats) {
   const RenderPlan& plan = passes.result.plan;
   DeviceKernels& kernels = passes.kernels;
   const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
-  // Plain float's point form is adaptive's float kernel (plan_shadows), which reads adaptive's surface data.
-  Precision points_precision = passes.precision;
   for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-    const KernelConfig& config = plan.find(PassKind::Shadow)->kernels[i];
-    const DeviceSurface* surface = kernels.surfaces[i].get();
-    if (config.precision != passes.precision) {
-      kernels.shadow_surfaces.push_back(
-          std::make_unique<DeviceSurface>(passes.session.context, scene, config.precision, i));
-      surface = kernels.shadow_surfaces.back().get();
-      points_precision = config.precision;
-    }
-    kernels.shadows.push_back(std::make_unique<ShadowTracer>(passes.session, cache_, config, *surface, offset));
+    kernels.shadows.push_back(std::make_unique<ShadowTracer>(
+        passes.session, cache_, plan.find(PassKind::Shadow)->kernels[i], *kernels.surfaces[i], offset));
     passes.tally.programs.push_back(kernels.shadows.back()->program());
     stats.program_keys.push_back(kernels.shadows.back()->program().key);
     stats.program_ms.push_back(0);
   }
-  kernels.shadow_points = std::make_unique<ShadowPoints>(passes.session, points_precision);
+  // In the surfaces' precision: plain float's kernels are adaptive's (float_measures_noise), and so are its points.
+  kernels.shadow_points = std::make_unique<ShadowPoints>(passes.session, kernels.surfaces.front()->precision());
   std::vector<std::vector<glm::dvec3>> light_points;  // per shadow-casting light of the plan
   for (int light : plan.shadow_lights)
     light_points.push_back(scene.lights[static_cast<std::size_t>(light)].sample_points());
   kernels.light_groups = group_lights(light_points);
 }
 
-// Adaptive precision: every ray pass escalates to the same mixed trace kernels, and shadow rays to the second
-// pass's shadow kernels; plain float's point form sends its doubted shadow rays to float's extent form.
+// Adaptive precision (and plain float, which runs adaptive's kernels): every ray pass escalates to the same trace
+// kernels of the second pass's precision, and shadow rays to its shadow kernels.
 void Renderer::prepare_escalation(Passes& passes) {
   const Scene& scene = passes.scene;
   const RenderPlan& plan = passes.result.plan;
@@ -88,14 +80,13 @@ void Renderer::prepare_escalation(Passes& passes) {
           std::make_unique<RayEscalation>(passes.session, cache_, primary_pass->escalation[i], scene, i));
       passes.tally.programs.push_back(kernels.escalate_rays.back()->program());
     }
-  }
-  // Adaptive's second pass, or plain float's extent form behind its point form (plan_shadows).
-  if (const PlannedPass* shadow_pass = plan.find(PassKind::Shadow); shadow_pass && !shadow_pass->escalation.empty()) {
-    const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
-    for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
-      kernels.escalate_shadows.push_back(
-          std::make_unique<ShadowEscalation>(passes.session, cache_, shadow_pass->escalation[i], scene, i, offset));
-      passes.tally.programs.push_back(kernels.escalate_shadows.back()->program());
+    if (const PlannedPass* shadow_pass = plan.find(PassKind::Shadow)) {
+      const double offset = shadow_offset_unit(passes.precision) * scene.extent.unit_scale();
+      for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
+        kernels.escalate_shadows.push_back(
+            std::make_unique<ShadowEscalation>(passes.session, cache_, shadow_pass->escalation[i], scene, i, offset));
+        passes.tally.programs.push_back(kernels.escalate_shadows.back()->program());
+      }
     }
   }
 }

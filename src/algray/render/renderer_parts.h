@@ -173,14 +173,11 @@ struct Renderer::DeviceKernels {
   std::vector<cl::Buffer> screen_rows;                   // per surface: a band's rows for screen-form builds
   int band_y0 = -1;                                      // the band (row of tiles) whose arguments they hold
   std::vector<std::unique_ptr<ShadowTracer>> shadows;    // one per surface, when the plan has a shadow pass
-  // Plain float's point form: adaptive's surface data, which its shadow kernels read (plan_shadows).
-  std::vector<std::unique_ptr<DeviceSurface>> shadow_surfaces;
   std::unique_ptr<ShadowPoints> shadow_points;   // a batch's surface points on the device
   std::vector<LightGroup> light_groups;          // the plan's shadow-casting lights, a launch per group
   std::vector<std::unique_ptr<RayTracer>> rays;  // one per surface, when it has a secondary pass
   // Adaptive precision: per surface, mixed precision's trace kernel for doubted camera and secondary rays, and
-  // its shadow kernel for doubted shadow rays (when the plan has a shadow pass); plain float: its extent form's
-  // shadow kernel for the rays its point form doubted.
+  // its shadow kernel for doubted shadow rays (when the plan has a shadow pass); plain float: float's own.
   std::vector<std::unique_ptr<RayEscalation>> escalate_rays;
   std::vector<std::unique_ptr<ShadowEscalation>> escalate_shadows;
 };

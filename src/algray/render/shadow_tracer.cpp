@@ -65,9 +65,7 @@ ShadowAnswer ShadowTracer::trace(ShadowPoints& points, const std::vector<glm::dv
                                  const std::vector<std::uint64_t>& already_hidden) {
   if (light_points.empty() || light_points.size() > 64)
     throw std::invalid_argument("a shadow query takes 1 to 64 light points");
-  // Float, mixed and adaptive points are the same floats; adaptive kernels also need the doubts' buffer.
-  if ((points.precision_ == Precision::Double) != (surface_.precision() == Precision::Double) ||
-      (surface_.precision() == Precision::Adaptive && points.precision_ != Precision::Adaptive))
+  if (points.precision_ != surface_.precision())
     throw std::invalid_argument("shadow points uploaded in another precision than the surface's");
   ShadowAnswer answer;
   const std::size_t count = points.size();
