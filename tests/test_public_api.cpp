@@ -123,6 +123,37 @@ TEST_CASE("a render through the API is the renderer's own film, bit for bit, wit
   CHECK_FALSE(fs::exists(dir / "t.bmp"));
 }
 
+// A renderer keeps each device's tile buffers from one render to the next (Renderer::kept_work_): frames of other
+// sizes, a larger tile (the buffers are made again), two surfaces (a second buffer) and a full-mode frame with
+// shadows between them must each come out as a fresh renderer's, bit for bit.
+TEST_CASE("one renderer's frames of other sizes and scenes are fresh renderers' bit for bit", "[api]") {
+  algray::testing::device_session();
+  const std::string ball_and_ring = std::string(ALGRAY_SOURCE_DIR) + "/scenes/examples/ball_and_ring.toml";
+  struct Frame {
+    std::string scene;
+    int width, height;
+    bool preview;
+  };
+  const std::vector<Frame> frames = {{kTorus, 48, 40, true},       {kTorus, 300, 280, true},
+                                     {ball_and_ring, 64, 48, true}, {kTorus, 48, 40, true},
+                                     {kTorus, 40, 30, false},      {ball_and_ring, 320, 260, false}};
+  api::Renderer kept;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const Frame& f = frames[i];
+    api::RenderSettings settings;
+    settings.width = f.width;
+    settings.height = f.height;
+    settings.preview = f.preview;
+    const api::Image again = kept.render(api::Scene::load(f.scene), settings);
+    const api::Image fresh = api::Renderer().render(api::Scene::load(f.scene), settings);
+    INFO("frame " << i << ": " << f.scene << " at " << f.width << "x" << f.height << (f.preview ? " preview" : ""));
+    REQUIRE(again.width() == f.width);
+    CHECK(again.rgba() == fresh.rgba());
+    CHECK(again.depth() == fresh.depth());
+    CHECK(again.normal() == fresh.normal());
+  }
+}
+
 TEST_CASE("a cancelled render raises Cancelled and the renderer goes on", "[api]") {
   algray::testing::device_session();
   api::Renderer renderer;

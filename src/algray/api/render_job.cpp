@@ -324,6 +324,11 @@ ProgramCache& RenderContext::cache() {
   return *cache_;
 }
 
+Renderer& RenderContext::renderer() {
+  if (!renderer_) renderer_ = std::make_unique<Renderer>(sessions(), cache());
+  return *renderer_;
+}
+
 Scene SceneLoader::load(const std::optional<std::string>& path, const std::vector<Override>& overrides) {
   if (!path) return default_scene(overrides);
   if (*path != "-" && is_png_file(*path)) {
@@ -422,22 +427,25 @@ struct FilmAhead {
   std::future<PopulatedPages> tile_memory;
 };
 
-FilmAhead start_film(const Scene& scene, bool png, bool depth_and_normal) {
+// The renderer's tile memory is made ahead only where it holds none large enough (its first render, or a larger
+// tile than before).
+FilmAhead start_film(const Scene& scene, bool png, bool depth_and_normal, const Renderer* renderer) {
   const int film_width = scene.image.width, film_height = scene.image.height;
   DeviceInfo cpu;
   cpu.type = "CPU";
   const std::size_t tile_bytes =
       tile_memory_bytes(make_render_plan(scene, Precision::Double, std::vector<PlanDevice>{{cpu}}));
+  const bool make_tile = !renderer || !renderer->holds_tile_memory(tile_bytes);
   auto pages = std::make_shared<std::promise<PopulatedPages>>();
   FilmAhead ahead;
-  ahead.tile_memory = pages->get_future();
+  if (make_tile) ahead.tile_memory = pages->get_future();
   ahead.film = std::async(std::launch::async, [=] {
     // The tile first: the render needs it when its programs are loaded, the film only after the first tile.
-    try {
-      pages->set_value(PopulatedPages(tile_bytes));
-    } catch (...) {
-      pages->set_exception(std::current_exception());
-    }
+    if (make_tile) try {
+        pages->set_value(PopulatedPages(tile_bytes));
+      } catch (...) {
+        pages->set_exception(std::current_exception());
+      }
     if (png) srgb_byte(0.5f);
     return make_film(film_width, film_height, depth_and_normal);
   });
@@ -450,16 +458,15 @@ void render_on_device(const Scene& scene, const FrameRequest& request, RenderCon
   const int film_width = scene.image.width, film_height = scene.image.height;
   const bool ahead = film_made_ahead(film_width, film_height, depth_and_normal);
   FilmAhead made;
-  if (ahead) made = start_film(scene, request.png, depth_and_normal);
-  const std::vector<ClSession*> sessions = context.sessions();
-  frame.device = sessions.front()->info;
+  if (ahead) made = start_film(scene, request.png, depth_and_normal, context.renderer_if_made());
+  Renderer& renderer = context.renderer();  // the first call opens the devices while the film is made
+  frame.device = context.session().info;
   frame.timer.mark("device");
-  Renderer renderer(sessions, context.cache());
   RenderOptions options;
   // A larger film is made when the render has checked that it fits, with only the channels the outputs hold.
   if (ahead) {
     options.film = [&made] { return made.film.get(); };
-    options.tile_memory = [&made] { return made.tile_memory.get(); };
+    if (made.tile_memory.valid()) options.tile_memory = [&made] { return made.tile_memory.get(); };
   } else
     options.film = [=] { return make_film(film_width, film_height, depth_and_normal); };
   options.on_progress = callbacks.on_progress;

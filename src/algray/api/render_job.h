@@ -89,12 +89,17 @@ class RenderContext {
   std::vector<ClSession*> sessions();
   ProgramCache& cache();
   bool uses_cache() const { return use_cache_; }
+  // The devices' renderer, made on first use and kept: it keeps each device's tile buffers between renders, so
+  // the frames of a long-lived context (Python, the view, a batch) reuse them.
+  Renderer& renderer();
+  const Renderer* renderer_if_made() const { return renderer_.get(); }
 
  private:
   std::string device_spec_;
   bool use_cache_;
   std::vector<std::unique_ptr<ClSession>> sessions_;
   std::unique_ptr<ProgramCache> cache_;
+  std::unique_ptr<Renderer> renderer_;  // after the sessions and the cache it uses: destroyed before them
 };
 
 // The scene a command names: a scene file, a PNG that algray rendered (its embedded scene), "-" for standard

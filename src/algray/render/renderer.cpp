@@ -46,9 +46,19 @@ RenderResult Renderer::render_with_records(const Scene& scene) {
   return render(scene, options);
 }
 
+Renderer::Renderer(ClSession& session, ProgramCache& cache) : Renderer(std::vector<ClSession*>{&session}, cache) {}
+
 Renderer::Renderer(std::vector<ClSession*> sessions, ProgramCache& cache)
     : sessions_(std::move(sessions)), cache_(cache) {
   if (sessions_.empty()) throw DeviceError("a render needs at least one device");
+  for (std::size_t d = 0; d < sessions_.size(); ++d) kept_work_.push_back(std::make_unique<TileWork>());
+}
+
+Renderer::~Renderer() = default;
+
+bool Renderer::holds_tile_memory(std::size_t bytes) const {
+  const TileWork& work = *kept_work_.front();
+  return work.primary_out && work.primary_out->capacity() * sizeof(HitRecord) >= bytes;
 }
 
 Precision Renderer::precision_of(const Scene& scene) const {
@@ -123,8 +133,9 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   const Shader shader(scene, plan, result.basis, precision);
   // The devices' kernels are loaded one device after another: the program cache serves one caller at a time.
   std::vector<std::unique_ptr<Passes>> devices;
-  for (ClSession* session : sessions_) {
-    devices.push_back(std::make_unique<Passes>(*session, shared, scene, options, precision, result));
+  for (std::size_t d = 0; d < sessions_.size(); ++d) {
+    ClSession* session = sessions_[d];
+    devices.push_back(std::make_unique<Passes>(*session, shared, scene, options, precision, result, *kept_work_[d]));
     Passes& passes = *devices.back();
     for (std::size_t i = 0; i < scene.surfaces.size(); ++i)
       passes.kernels.surfaces.push_back(

@@ -154,17 +154,24 @@ FrameImage shade_frame(const Scene& scene, const RenderResult& result);
 
 class Renderer {
  public:
-  Renderer(ClSession& session, ProgramCache& cache) : sessions_{&session}, cache_(cache) {}
+  Renderer(ClSession& session, ProgramCache& cache);
   // Several devices render each image together. They take tiles from one queue, so a faster device takes more,
   // and the image is the one a single device of their kind renders, bit for bit. Precision left to the devices
   // is double only where every device has fast fp64; the tile size left to them gives each device about 8 tiles.
   Renderer(std::vector<ClSession*> sessions, ProgramCache& cache);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
   // Runs every pass of the scene's plan, tile by tile, into the film. Each tile's camera rays, shadow rays and
   // bounces are traced and shaded before the device's next tile starts, so memory holds the film and one tile's
   // work per device.
   RenderResult render(const Scene& scene, const RenderOptions& options);
   // The same render keeping every ray's record (tests and tools).
   RenderResult render_with_records(const Scene& scene);
+  // Whether the first device already holds host memory for a tile of `bytes` of camera-ray records: a renderer
+  // keeps each device's tile buffers from one render to the next (a long-lived one renders frame after frame),
+  // so a caller need not make that memory ahead (RenderOptions::tile_memory).
+  bool holds_tile_memory(std::size_t bytes) const;
 
  private:
   struct Shared;
@@ -209,6 +216,9 @@ class Renderer {
 
   std::vector<ClSession*> sessions_;
   ProgramCache& cache_;
+  // Per device, its tile buffers, kept from one render to the next: at 1024x768 the camera rays' records are
+  // 25 MB, whose page faults cost a fifth of a preview frame's host time when made anew each frame.
+  std::vector<std::unique_ptr<TileWork>> kept_work_;
 };
 
 }  // namespace algray

@@ -16,9 +16,16 @@ void Renderer::prepare_primary(Passes& passes, bool first_device) {
   // The largest tile: a tile's hit records are all the device holds for the camera rays. Their memory (32 MB
   // at 1024^2) is populated on another thread while this one loads the programs, a core's work either way.
   const std::size_t tile_rays = plan.tile_rays(), bytes = tile_memory_bytes(plan);
+  // The last render's buffers where they hold this one's tile (a long-lived renderer's frames).
+  TileWork& work = passes.work;
+  const bool keep_primary = work.primary_out && work.primary_out->capacity() >= tile_rays;
+  const bool several = passes.scene.surfaces.size() > 1;
+  if (!keep_primary) work.primary_out.reset();  // its memory goes before the new one is made
+  if (!several || (work.other_out && work.other_out->capacity() < tile_rays)) work.other_out.reset();
   // The caller's memory, made while the device started, when it fits the tile (the first device only).
-  std::future<PopulatedPages> hit_memory =
-      std::async(std::launch::async, [bytes, made = first_device ? passes.options.tile_memory : nullptr] {
+  std::future<PopulatedPages> hit_memory;
+  if (!keep_primary)
+    hit_memory = std::async(std::launch::async, [bytes, made = first_device ? passes.options.tile_memory : nullptr] {
         if (made) {
           try {
             PopulatedPages pages = made();
@@ -40,10 +47,11 @@ void Renderer::prepare_primary(Passes& passes, bool first_device) {
     primary.program_keys.push_back(record.key);
     primary.program_ms.push_back(0);
   }
-  passes.work.primary_out =
-      std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays, hit_memory.get());
-  if (passes.scene.surfaces.size() > 1)
-    passes.work.other_out =
+  if (!keep_primary)
+    work.primary_out =
+        std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays, hit_memory.get());
+  if (several && !work.other_out)
+    work.other_out =
         std::make_unique<TileHits>(passes.session.context, passes.session.queue, tile_rays, PopulatedPages(bytes));
 }
 

@@ -94,7 +94,8 @@ class Renderer::TileHits {
  public:
   // `memory` holds at least `capacity` records.
   TileHits(const cl::Context& context, cl::CommandQueue& queue, std::size_t capacity, PopulatedPages memory)
-      : memory_(std::move(memory)),
+      : capacity_(capacity),
+        memory_(std::move(memory)),
         buffer_(context, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, capacity * sizeof(HitRecord), memory_.data()),
         queue_(queue) {}
   TileHits(const TileHits&) = delete;
@@ -105,6 +106,7 @@ class Renderer::TileHits {
     clFinish(queue_());
   }
   const cl::Buffer& buffer() const { return buffer_; }
+  std::size_t capacity() const { return capacity_; }  // in records
   // The first `count` records as the queue's finished work left them, readable and writable on the host until
   // release(), which must come before the buffer is written again.
   HitRecord* map(std::size_t count) {
@@ -120,6 +122,7 @@ class Renderer::TileHits {
   }
 
  private:
+  std::size_t capacity_;
   PopulatedPages memory_;  // page-aligned, as zero-copy host pointers want
   cl::Buffer buffer_;
   cl::CommandQueue& queue_;
@@ -182,7 +185,8 @@ struct Renderer::DeviceKernels {
   std::vector<std::unique_ptr<ShadowEscalation>> escalate_shadows;
 };
 
-// One tile's buffers and intermediate results, which the device's next tile reuses.
+// One tile's buffers and intermediate results, which the device's next tile reuses, and the renderer's next
+// render too (Renderer::kept_work_).
 struct Renderer::TileWork {
   std::unique_ptr<TileHits> primary_out;  // a tile's hit records, of the first surface
   std::unique_ptr<TileHits> other_out;    // several surfaces: those of the next ones
@@ -206,8 +210,9 @@ struct Renderer::DeviceTally {
 // What every tile's passes on one device share while a render runs: the render's context, the device's kernels,
 // one tile's work, and the device's tallies.
 struct Renderer::Passes {
-  Passes(ClSession& se, Shared& sh, const Scene& s, const RenderOptions& o, Precision p, RenderResult& r)
-      : session(se), shared(sh), scene(s), options(o), precision(p), result(r) {
+  Passes(ClSession& se, Shared& sh, const Scene& s, const RenderOptions& o, Precision p, RenderResult& r,
+         TileWork& w)
+      : session(se), shared(sh), scene(s), options(o), precision(p), result(r), work(w) {
     tally.stats.resize(r.plan.passes.size());
   }
   ClSession& session;
@@ -219,7 +224,7 @@ struct Renderer::Passes {
   const Shader* shader = nullptr;  // the render's: shading is const, so the devices share one
   RayBasis fine;                   // adaptive antialiasing: the rays of the n-times finer grid
   DeviceKernels kernels;
-  TileWork work;
+  TileWork& work;  // the renderer's, kept for its next render
   DeviceTally tally;
   int film_y0 = 0;  // the image row of the film's row 0, and the output rows [first_row, end_row) kept
   int first_row = 0, end_row = 0;
