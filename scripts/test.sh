@@ -31,13 +31,6 @@ cmake --build build -j"$(nproc)"
 # The Python package into the system Python, where `import algray` finds it; the tests use the build tree's copy.
 scripts/install-python.sh
 phase "release build done"
-# In parallel: tests that assert their own wall time are RUN_SERIAL (TIMED in tests/CMakeLists.txt), and the
-# longest start first (COST), so the single-threaded kernel builds of one test overlap another's. Every test
-# shares one kernel cache, build/kernel-cache (algray's and PoCL's). The sweeps run a seeded sample with their
-# ends; their every case is the `exhaustive` label's (`ctest --test-dir build -L exhaustive`).
-ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)" -LE exhaustive
-phase "full test suite passed"
-
 # The same code once more under AddressSanitizer and UndefinedBehaviorSanitizer, in a clang tree of its own that
 # builds only what `ctest -L fast` and the fuzzers need (docs/fuzzing.md). Debug: -O0 compiles twice as fast.
 # clang++-15 is the clang PoCL itself depends on in Debian 12, and its compiler-rt (ASan, UBSan, libFuzzer) comes
@@ -55,10 +48,32 @@ gen=$(generator build-sanitize)
 # Its tests use the Release tree's kernel cache: the kernels are the same, so none is compiled twice.
 cmake -S . -B build-sanitize ${gen:+-G "$gen"} -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER="$cxx" \
       -DALGRAY_SANITIZE=ON -DALGRAY_FUZZ=ON -DALGRAY_TEST_KERNEL_CACHE="$PWD/build/kernel-cache"
-cmake --build build-sanitize -j"$(nproc)" --target algray_fast_tests algray_fuzzers
+# Built at the lowest priority while the Release tests run: those leave about a sixth of the two cores idle (tests
+# waiting on processes, sockets and single-threaded kernel builds), which this build takes; it yields to them
+# otherwise. Its log is printed if it fails.
+sanitize_log=build-sanitize/build.log
+# Job control gives it a process group of its own, which a failing test's exit takes down with its compilers; not
+# setsid, whose new session would be a scheduling group of its own (autogroup), where nice counts for nothing.
+set -m
+nice -n 19 cmake --build build-sanitize -j"$(nproc)" --target algray_fast_tests algray_fuzzers > "$sanitize_log" 2>&1 &
+sanitize_build=$!
+set +m
+trap 'kill -- -"$sanitize_build" 2>/dev/null; rm -f "$times_file"' EXIT
+# In parallel: tests that assert their own wall time are RUN_SERIAL (TIMED in tests/CMakeLists.txt), and the
+# longest start first (COST), so the single-threaded kernel builds of one test overlap another's. Every test
+# shares one kernel cache, build/kernel-cache (algray's and PoCL's). The sweeps run a seeded sample with their
+# ends; their every case is the `exhaustive` label's (`ctest --test-dir build -L exhaustive`).
+ctest --test-dir build --output-on-failure --timeout 900 -j"$(nproc)" -LE exhaustive
+phase "full test suite passed"
+if ! wait "$sanitize_build"; then
+  tail -n 100 "$sanitize_log" >&2
+  echo "test.sh: the sanitizer build failed (whole log: $sanitize_log)" >&2
+  exit 1
+fi
 phase "sanitizer build done"
 ctest --test-dir build-sanitize -L fast --output-on-failure --timeout 900 -j"$(nproc)"
 phase "fast tests passed under the sanitizers"
-# Each fuzzer runs 30 s from its seeds on one core; the tests print their runs and coverage.
+# Each fuzzer runs 20 s from its seeds on one core (a smoke test of the readers; docs/fuzzing.md has the hour-long
+# runs); the tests print their runs and coverage.
 ctest --test-dir build-sanitize -L fuzz -j"$(nproc)" --output-on-failure --verbose
 phase "fuzzers found nothing"
