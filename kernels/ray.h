@@ -45,7 +45,7 @@ ALGRAY_INLINE LMASK cut_by_clip_planes(LREAL ox, LREAL oy, LREAL oz, LREAL dx, L
 /* [*lo, *hi] of rays o + t*d inside the sphere |u|^2 <= r2 about the origin, from t = 0 on; returns the lanes that
  * meet it. Where no ray meets it, its square root and divisions are skipped (more than half of a typical view's
  * lanes miss it, in whole groups). */
-ALGRAY_INLINE LMASK sphere_lanes(LREAL ox, LREAL oy, LREAL oz, LREAL dx, LREAL dy, LREAL dz, REAL r2, LREAL* lo,
+ALGRAY_INLINE LMASK sphere_span(LREAL ox, LREAL oy, LREAL oz, LREAL dx, LREAL dy, LREAL dz, REAL r2, LREAL* lo,
                                  LREAL* hi) {
   LREAL a, b, c;
   {
@@ -83,7 +83,7 @@ ALGRAY_INLINE LMASK clip_lanes_to_extent(LREAL ox, LREAL oy, LREAL oz, LREAL dx,
   LREAL lo = 0, hi;
   LMASK hit;
   if (shape == ALGRAY_EXTENT_SPHERE) {
-    hit = sphere_lanes(ox, oy, oz, dx, dy, dz, box_half.x * box_half.x, &lo, &hi);
+    hit = sphere_span(ox, oy, oz, dx, dy, dz, box_half.x * box_half.x, &lo, &hi);
   } else if (shape >= ALGRAY_EXTENT_CYLINDER) {
 #pragma OPENCL FP_CONTRACT OFF
     const int axis = shape - ALGRAY_EXTENT_CYLINDER;
@@ -122,7 +122,7 @@ ALGRAY_INLINE LMASK clip_lanes_to_extent(LREAL ox, LREAL oy, LREAL oz, LREAL dx,
   /* a gate's rays that meet it, along the far sphere (which holds the gate, so they all meet it) */
   if (kind & ALGRAY_EXTENT_GATE) {
     const LMASK passed = hit && hi > lo;
-    hit = passed && sphere_lanes(ox, oy, oz, dx, dy, dz, (REAL)1, &lo, &hi);
+    hit = passed && sphere_span(ox, oy, oz, dx, dy, dz, (REAL)1, &lo, &hi);
   }
   /* without planes, nothing of the cut runs: the extent's segment as it always was */
   if (clip_count > 0) hit = hit && cut_by_clip_planes(ox, oy, oz, dx, dy, dz, clip_planes, clip_count, &lo, &hi);
