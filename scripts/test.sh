@@ -58,7 +58,8 @@ set -m
 nice -n 19 cmake --build build-sanitize -j"$(nproc)" --target algray_fast_tests algray_fuzzers > "$sanitize_log" 2>&1 &
 sanitize_build=$!
 set +m
-trap 'kill -- -"$sanitize_build" 2>/dev/null; rm -f "$times_file"' EXIT
+# '|| true': set -e holds in the trap too, and the build has usually ended by then (kill then fails).
+trap 'kill -- -"$sanitize_build" 2>/dev/null || true; rm -f "$times_file"' EXIT
 # In parallel: tests that assert their own wall time are RUN_SERIAL (TIMED in tests/CMakeLists.txt), and the
 # longest start first (COST), so the single-threaded kernel builds of one test overlap another's. Every test
 # shares one kernel cache, build/kernel-cache (algray's and PoCL's). The sweeps run a seeded sample with their
