@@ -57,8 +57,7 @@ Renderer::Renderer(std::vector<ClSession*> sessions, ProgramCache& cache)
 Renderer::~Renderer() = default;
 
 bool Renderer::holds_tile_memory(std::size_t bytes) const {
-  const TileWork& work = *kept_work_.front();
-  return work.primary_out && work.primary_out->capacity() * sizeof(HitRecord) >= bytes;
+  return kept_work_.front()->holds((bytes + sizeof(HitRecord) - 1) / sizeof(HitRecord));
 }
 
 Precision Renderer::precision_of(const Scene& scene) const {

@@ -18,7 +18,7 @@ void Renderer::prepare_primary(Passes& passes, bool first_device) {
   const std::size_t tile_rays = plan.tile_rays(), bytes = tile_memory_bytes(plan);
   // The last render's buffers where they hold this one's tile (a long-lived renderer's frames).
   TileWork& work = passes.work;
-  const bool keep_primary = work.primary_out && work.primary_out->capacity() >= tile_rays;
+  const bool keep_primary = work.holds(tile_rays);
   const bool several = passes.scene.surfaces.size() > 1;
   if (!keep_primary) work.primary_out.reset();  // its memory goes before the new one is made
   if (!several || (work.other_out && work.other_out->capacity() < tile_rays)) work.other_out.reset();

@@ -196,6 +196,8 @@ struct Renderer::TileWork {
   bool any_secondary = false;
   std::vector<glm::dvec3> refined_colour;  // adaptive antialiasing: per pixel of the tile
   std::vector<double> refined_alpha;
+  // Whether the last render's buffers hold a tile of `rays` camera rays (a long-lived renderer's next frame).
+  bool holds(std::size_t rays) const { return primary_out && primary_out->capacity() >= rays; }
 };
 
 // One device's share of the render's tallies, added into the result when every device is done.
