@@ -75,6 +75,12 @@ typedef cl_int algray_i32;
   ALGRAY_CAMERA_ARG_NAMES(X) X(px) X(py) X(use_given_ray) X(given_o) X(given_d) ALGRAY_EXTENT_ARG_NAMES(X)            \
   ALGRAY_SURFACE_ARG_NAMES(X) ALGRAY_SCREEN_ARG_NAMES(X) X(out) X(ray_out) X(events) X(values) X(capacity) X(event_count)
 #define ALGRAY_UNIVARIATE_ARG_NAMES(X) X(polys) X(count) X(binomials) X(out)
+#define ALGRAY_SHADE_ARG_NAMES(X)                                                                                  \
+  ALGRAY_CAMERA_ARG_NAMES(X) X(rays_in_float) X(samples) X(tile_x0) X(tile_y0) X(tile_w) X(tile_h) X(hits)         \
+  X(hit_surface) X(several_surfaces) X(materials) X(light_colours) X(light_first) X(light_occlusion) X(light_count)  \
+  X(headlight_ambient) X(light_points) X(point_of_hit) X(occlusion_masks) X(occlusion_stride) X(section_planes) X(section_looks)        \
+  X(section_surfaces) X(section_count) X(secondary) X(has_secondary) X(background) X(film_rgba) X(film_depth)       \
+  X(film_normal) X(film_depth_and_normal) X(film_width) X(film_y0) X(kept_first) X(kept_end) X(summary)
 
 /* Per-pixel result of the primary kernel; 32 bytes. */
 typedef struct {
@@ -95,6 +101,31 @@ typedef struct {
 #define ALGRAY_WORK_PACK(steps, iterations) ((steps) | ((iterations) << 16)) /* each at most ALGRAY_WORK_MAX */
 #define ALGRAY_WORK_ISOLATION_STEPS(work) ((work) & ALGRAY_WORK_MAX)
 #define ALGRAY_WORK_REFINE_ITERATIONS(work) ((work) >> 16)
+
+/* Shading (kernels/shade.cl). A material is ALGRAY_MATERIAL_VALUES numbers of the kernel's REAL, in this order: its
+ * colour, the Phong weights and exponent, the share of its own colour (1 - transparency where light passes through)
+ * and the highlight cutoff (r.v below it adds under 1/4096 of full strength). */
+#define ALGRAY_MATERIAL_RED 0
+#define ALGRAY_MATERIAL_GREEN 1
+#define ALGRAY_MATERIAL_BLUE 2
+#define ALGRAY_MATERIAL_AMBIENT 3
+#define ALGRAY_MATERIAL_DIFFUSE 4
+#define ALGRAY_MATERIAL_SPECULAR 5
+#define ALGRAY_MATERIAL_EXPONENT 6
+#define ALGRAY_MATERIAL_OWN 7
+#define ALGRAY_MATERIAL_CUTOFF 8
+#define ALGRAY_MATERIAL_VALUES 9
+/* The shading kernel's work-groups are this many pixels on a side; each writes its camera rays' totals, in this
+ * order, to its ALGRAY_SUMMARY_VALUES numbers of `summary` (the host's PrimarySummary). */
+#define ALGRAY_SHADE_GROUP_SIDE 8
+#define ALGRAY_SUMMARY_RAYS 0
+#define ALGRAY_SUMMARY_HITS 1
+#define ALGRAY_SUMMARY_DEPTH_LIMITED 2
+#define ALGRAY_SUMMARY_ISOLATION_STEPS 3
+#define ALGRAY_SUMMARY_REFINE_ITERATIONS 4
+#define ALGRAY_SUMMARY_PIXELS 5
+#define ALGRAY_SUMMARY_PIXELS_HIT 6
+#define ALGRAY_SUMMARY_VALUES 7
 
 /* The probe: kernels/probe.cl records what the solver did on one ray as a list of events, each with four REAL
  * values in a separate buffer (values[4 i .. 4 i + 3] belong to event i). */

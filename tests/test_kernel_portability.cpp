@@ -123,6 +123,15 @@ std::vector<Compile> every_configuration() {
           if (c.isolation != Isolation::Bernstein || c.refinement != Refinement::Brent) add(jobs, c);
         }
     }
+  // The shading kernel, which the solver's choices do not touch: in float and double, one pixel and lanes of them.
+  for (Precision precision : {Precision::Float, Precision::Double})
+    for (int lanes : {1, 8, 16}) {
+      KernelConfig c;
+      c.entry = "shade";
+      c.precision = precision;
+      c.lanes = lanes;
+      jobs.push_back({"shade " + to_string(precision), c.key(), c.source_file(), device_options(c)});
+    }
   for (bool in_double : {false, true})
     jobs.push_back(
         {std::string("fp_speed ") + (in_double ? "double" : "float"), "fp_speed", "fp_speed.cl",

@@ -1,5 +1,5 @@
-// The film's colours against Phong written out one ray and one light point at a time, bit for bit, and the
-// plane sections drawn over them.
+// The film's colours against Phong written out one ray and one light point at a time, bit for bit, the plane
+// sections drawn over them, and the device's shading kernel against the host's shading of the same records.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
@@ -10,6 +10,9 @@
 #include "algray/render/renderer.h"
 #include "algray/scene/scene.h"
 #include "algray/render/shade.h"
+#include "algray/render/trace_records.h"
+#include "film_compare.h"
+#include "scene_fixtures.h"
 #include "test_support.h"
 
 using namespace algray;
@@ -262,4 +265,61 @@ TEST_CASE("a section seen through a transparent surface is as wide as one seen d
   const long direct = marked(ball + rest), through = marked(ball + pane + rest);
   CHECK(direct >= 80);
   CHECK(static_cast<double>(through) == Approx(static_cast<double>(direct)).epsilon(0.1));
+}
+
+TEST_CASE("the shading kernel's film and totals are the host's shading of the same records: bit for bit in double, "
+          "within 1/255 in float", "[shading][device]") {
+  ClSession& session = testing::device_session();
+  REQUIRE(session.info.fp64);  // the double half of the check needs it; the float half hides it below
+  DeviceInfo without_fp64 = session.info;
+  without_fp64.fp64 = false;
+  without_fp64.fp64_hidden = true;
+  ClSession float_session(without_fp64);
+  ProgramCache cache(false);
+  // Full mode and preview (lights, shadows, both sides), the headlight, a section of two surfaces with bounces
+  // and adaptive antialiasing, and uniform 3x3 supersampling, each in an image whose width is no multiple of the
+  // kernel's lanes and work-groups.
+  std::vector<std::pair<std::string, Scene>> scenes = {{"two-sided, full", two_sided_scene(false)},
+                                                       {"two-sided, preview", two_sided_scene(true)}};
+  Scene headlight = two_sided_scene(true);
+  headlight.lights.clear();
+  scenes.emplace_back("headlight", headlight);
+  Scene sections = testing::ball_and_ring({{"antialias.adaptive", "true"}, {"antialias.samples", "2"}});
+  sections.sections.push_back({{0, 0, 1, -0.1}, {0.9, 0.1, 0.1}, -1, 2});
+  sections.sections.push_back({{1, 0, 0, 0}, {0.1, 0.9, 0.1}, 1, 1});
+  scenes.emplace_back("ball and ring, sections, adaptive antialiasing", sections);
+  scenes.emplace_back("ball and ring, 3x3", testing::ball_and_ring({{"antialias.samples", "3"}}));
+  for (auto& [what, scene] : scenes) {
+    for (ClSession* on : {&session, &float_session}) {
+      const bool in_double = on->info.fp64;
+      scene.render.precision = in_double ? Precision::Double : Precision::Adaptive;
+      Renderer renderer(*on, cache);
+      const RenderResult r = renderer.render_with_records(scene);
+      const FrameImage host = shade_frame(scene, r);
+      INFO(what << (in_double ? ", double" : ", without fp64") << ": first difference "
+                << testing::first_difference(r.image, host));
+      CHECK(testing::same_bits(r.image.depth, host.depth));
+      CHECK(testing::same_bits(r.image.normal, host.normal));
+      if (in_double) {
+        CHECK(testing::same_bits(r.image.rgba, host.rgba));
+      } else {
+        REQUIRE(r.image.rgba.size() == host.rgba.size());
+        float largest = 0;
+        for (std::size_t i = 0; i < host.rgba.size(); ++i)
+          largest = std::max(largest, std::fabs(r.image.rgba[i] - host.rgba[i]));
+        INFO("largest colour difference " << largest * 255 << "/255");
+        CHECK(largest <= 1.0f / 255);
+      }
+      // The kernel's totals of the camera rays are the records' own.
+      const PrimarySummary want = summarise_hits(r.hits, r.plan.samples), got = r.primary;
+      CHECK(got.rays == want.rays);
+      CHECK(got.hits == want.hits);
+      CHECK(got.depth_limited == want.depth_limited);
+      CHECK(got.isolation_steps == want.isolation_steps);
+      CHECK(got.refine_iterations == want.refine_iterations);
+      CHECK(got.pixels == want.pixels);
+      CHECK(got.pixels_hit == want.pixels_hit);
+      CHECK(want.hits > 100);
+    }
+  }
 }

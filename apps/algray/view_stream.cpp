@@ -118,11 +118,11 @@ void FrameQueue::give_back() {
 FrameFacts frame_facts(const std::string& stats_json) {
   const json s = json::parse(stats_json);
   FrameFacts f;
-  for (const json& p : s["passes"]) f.kernel_ms += p.value("kernel_ms", 0.0);
+  f.kernel_ms = s["render_ms"].value("kernel", 0.0);
   for (const json& p : s["programs"]) f.new_programs += p.value("origin", "") != "memory";
   for (const json& surface : s["surfaces"]) f.degree = std::max(f.degree, surface.value("degree", 0));
   f.passes_ms = s["render_ms"].value("passes_wall", 0.0);
-  f.shade_ms = s["render_ms"].value("host_shading", 0.0);
+  f.shade_ms = s["render_ms"].value("shading", 0.0);
   f.phases_json = s.value("phases_ms", json::object()).dump();
   return f;
 }

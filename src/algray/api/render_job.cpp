@@ -188,15 +188,19 @@ nlohmann::json pass_json(const PassStats& p, const std::vector<ProgramRecord>& p
           {"escalation_ms", p.escalation_ms}};
 }
 
-// Where the render's time went: device time of the launches, the passes' wall time (launches, staging and
-// readback), and the host's shading, which runs tile by tile inside the render.
+// Where the render's time went: device time of every launch (the shading kernel's too), the passes' wall time
+// (launches, staging and readback), and shading's wall time (the shading kernel's launches, and the host's
+// shading of bounces and refined pixels), which runs tile by tile inside the render, with its kernel's share.
 nlohmann::json render_ms_json(const RenderResult& r) {
-  double kernel_ms = 0, passes_ms = 0;
+  double kernel_ms = r.shade_kernel_ms, passes_ms = 0;
   for (const PassStats& pass : r.passes) {
     kernel_ms += pass.kernel_ms;
     passes_ms += pass.wall_ms;
   }
-  return {{"kernel", kernel_ms}, {"passes_wall", passes_ms}, {"host_shading", r.shade_ms}};
+  return {{"kernel", kernel_ms},
+          {"passes_wall", passes_ms},
+          {"shading", r.shade_ms},
+          {"shading_kernel", r.shade_kernel_ms}};
 }
 
 // A device's share of the tiles, of the rays of every pass, and of the device time.

@@ -111,6 +111,7 @@ nlohmann::json band_tally(const RenderResult& r) {
       {"passes", passes},
       {"devices", devices},
       {"shade_ms", r.shade_ms},
+      {"shade_kernel_ms", r.shade_kernel_ms},
       {"primary", {s.rays, s.hits, s.depth_limited, s.isolation_steps, s.refine_iterations, s.pixels, s.pixels_hit}}};
 }
 
@@ -144,6 +145,7 @@ class ImageTally {
         add_counts(*it, more);
     }
     shade_ms_ += band.at("shade_ms").get<double>();
+    shade_kernel_ms_ += band.at("shade_kernel_ms").get<double>();
     const std::vector<std::uint64_t> p = band.at("primary").get<std::vector<std::uint64_t>>();
     PrimarySummary s;
     s.rays = p.at(0), s.hits = p.at(1), s.depth_limited = p.at(2), s.isolation_steps = p.at(3);
@@ -163,6 +165,7 @@ class ImageTally {
       return a.rank != b.rank ? a.rank < b.rank : a.index < b.index;
     });
     result.shade_ms = shade_ms_;
+    result.shade_kernel_ms = shade_kernel_ms_;
     result.primary = primary_;
   }
 
@@ -170,7 +173,7 @@ class ImageTally {
   std::mutex lock_;
   std::vector<PassStats> passes_;
   std::vector<DeviceShare> devices_;
-  double shade_ms_ = 0;
+  double shade_ms_ = 0, shade_kernel_ms_ = 0;
   PrimarySummary primary_;
 };
 

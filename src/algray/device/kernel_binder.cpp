@@ -17,6 +17,7 @@ const std::vector<std::string>& kernel_arg_names(const std::string& entry) {
       {"shadow_serial", {ALGRAY_SHADOW_ARG_NAMES(ALGRAY_ARG_NAME)}},
       {"probe", {ALGRAY_PROBE_ARG_NAMES(ALGRAY_ARG_NAME)}},
       {"univariate", {ALGRAY_UNIVARIATE_ARG_NAMES(ALGRAY_ARG_NAME)}},
+      {"shade", {ALGRAY_SHADE_ARG_NAMES(ALGRAY_ARG_NAME)}},
   };
 #undef ALGRAY_ARG_NAME
   const auto it = lists.find(entry);
@@ -40,11 +41,14 @@ void KernelBinder::real(const std::string& name, double value) {
     plain(name, static_cast<float>(value));
 }
 
-void KernelBinder::real_vec(const std::string& name, const glm::dvec3& v) {
+void KernelBinder::real_vec(const std::string& name, const glm::dvec3& v) { real_vec4(name, glm::dvec4(v, 0)); }
+
+void KernelBinder::real_vec4(const std::string& name, const glm::dvec4& v) {
   if (double_)
-    plain(name, cl_double4{{v.x, v.y, v.z, 0}});
+    plain(name, cl_double4{{v.x, v.y, v.z, v.w}});
   else
-    plain(name, cl_float4{{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0}});
+    plain(name, cl_float4{{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z),
+                           static_cast<float>(v.w)}});
 }
 
 void KernelBinder::ray_basis(const RayBasis& b) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,7 @@ class KernelBinder {
   }
   void real(const std::string& name, double value);
   void real_vec(const std::string& name, const glm::dvec3& value);
+  void real_vec4(const std::string& name, const glm::dvec4& value);
   // ray_o00 .. ray_dv, as camera_rays() takes them (kernels/ray.h).
   void ray_basis(const RayBasis& basis);
   // A __global or __constant pointer the build never reads (the screen form's rows elsewhere, `undecided` outside

@@ -309,6 +309,42 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
   return plan;
 }
 
+KernelConfig shading_config(const DeviceInfo& device) {
+  KernelConfig config;
+  config.entry = "shade";
+  config.precision = device.fp64 ? Precision::Double : Precision::Float;
+  // As many pixels as the host's shading takes side by side in double (8), twice that in float.
+  config.lanes = std::min(default_lanes(device.type), device.fp64 ? 8 : 16);
+  return config;
+}
+
+namespace {
+
+// The shading kernel of the first device (each device builds its own, alike but for precision and lanes), what it
+// draws, and its buffers: a tile's shadow answers and bounces' colours, and with several devices a film of each
+// device's own, whose tiles are read back as they are shaded.
+void plan_shading(RenderPlan& plan, const Scene& scene, const std::vector<PlanDevice>& devices) {
+  plan.shading = shading_config(devices.front().info);
+  std::string what = scene.lights.empty() ? "the headlight" : std::to_string(scene.lights.size()) + " light(s)";
+  if (plan.find(PassKind::Shadow)) what += " with their shadows";
+  if (!scene.sections.empty()) what += ", " + std::to_string(scene.sections.size()) + " section(s)";
+  const bool bounces = plan.find(PassKind::Reflection) || plan.find(PassKind::Transmission);
+  if (bounces) what += ", the bounces' colour";
+  what += ", the background, " + std::to_string(plan.samples) + "x" + std::to_string(plan.samples) +
+          " samples per pixel averaged";
+  if (plan.refine_samples > 1) what += " (refined pixels on the host)";
+  plan.shading_purpose = what;
+  const std::size_t real = plan.shading.precision == Precision::Double ? sizeof(double) : sizeof(float);
+  const std::size_t per_ray =
+      (plan.find(PassKind::Shadow) ? sizeof(std::uint32_t) + sizeof(std::uint64_t) * plan.shadow_lights.size() : 0) +
+      (bounces ? 4 * real : 0);
+  if (per_ray > 0) plan.buffers.push_back({"shading: a tile's shadow answers and bounces' colours", per_ray * plan.tile_rays()});
+  if (devices.size() > 1)
+    plan.buffers.push_back({"shading: the film of each device", devices.size() * plan.film_bytes()});
+}
+
+}  // namespace
+
 RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::vector<PlanDevice>& devices) {
   if (devices.empty()) throw std::invalid_argument("a render plan needs at least one device");
   const int lanes = default_lanes(devices.front().info.type);
@@ -335,6 +371,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::
                                       [](const PlanDevice& d) { return d.escalation == Precision::Double; });
     escalate_in(plan, all_fast ? Precision::Double : Precision::Mixed);
   }
+  plan_shading(plan, scene, devices);
   return plan;
 }
 
@@ -358,6 +395,7 @@ nlohmann::json RenderPlan::json() const {
     j["passes"].push_back(pass);
   }
   for (const PlannedBuffer& b : buffers) j["buffers"].push_back({{"name", b.name}, {"bytes", b.bytes}});
+  j["shading"] = {{"kernel", shading.key()}, {"purpose", shading_purpose}};
   j["shadow_lights"] = shadow_lights;
   j["clip_planes"] = nlohmann::json::array();
   for (const glm::dvec4& p : clip_planes) j["clip_planes"].push_back({p.x, p.y, p.z, p.w});

@@ -78,6 +78,10 @@ struct RenderPlan {
     double far_radius = 0;
     double reach = 0;
   } gate;
+  // The shading kernel (kernels/shade.cl) that turns each tile's camera rays into the film's pixels on the device,
+  // and what it draws, for --stats.
+  KernelConfig shading;
+  std::string shading_purpose;
   // Everything left out, and why ("shadow: no light casts shadows"), so --stats explains the plan.
   std::vector<std::string> skipped;
 
@@ -137,6 +141,10 @@ bool screen_form_applies(const Scene& scene, Precision precision);
 // sends what it doubts to float's extent form (float_measures_noise): its images are the extent form's.
 inline constexpr int kMaxPointFormDegree = 15;
 bool point_form_applies(const KernelConfig& shadow);
+
+// The shading kernel for a device: in double where it has fp64 (the host's shading bit for bit), else in float;
+// pixels side by side in vector lanes on CPUs, whose work-items run one after another.
+KernelConfig shading_config(const DeviceInfo& device);
 
 // What the plan needs to know of a device that will carry it out.
 struct PlanDevice {

@@ -136,11 +136,11 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
     ClSession* session = sessions_[d];
     devices.push_back(std::make_unique<Passes>(*session, shared, scene, options, precision, result, *kept_work_[d]));
     Passes& passes = *devices.back();
+    passes.shader = &shader;
     for (std::size_t i = 0; i < scene.surfaces.size(); ++i)
       passes.kernels.surfaces.push_back(
           std::make_unique<DeviceSurface>(session->context, scene, plan.passes.front().kernels.at(i).precision, i));
     prepare_passes(passes, devices.size() == 1);
-    passes.shader = &shader;
   }
   if (options.keep_records) {
     result.hits.width = trace_width;
@@ -189,6 +189,7 @@ FrameImage Renderer::render_rows(std::vector<std::unique_ptr<Passes>>& devices, 
       film.rgba.size() != 4 * static_cast<std::size_t>(plan.width) * film_height)
     film = make_film(plan.width, film_height, true);
   std::swap(result.image, film);  // the devices' tiles go into result.image
+  for (auto& passes : devices) passes->kernels.shading->bind_film(result.image, traced_first, devices.size() == 1);
 
   // Row by row of tiles, as the film's lines are laid out.
   std::vector<Tile> tiles;
@@ -210,6 +211,7 @@ FrameImage Renderer::render_rows(std::vector<std::unique_ptr<Passes>>& devices, 
     finish_tile(passes, tile);
     ++passes.tally.tiles;
   });
+  for (auto& passes : devices) passes->kernels.shading->finish_film();
   if (adaptive) {
     // Every device's first colours are in the film before any pixel is chosen: a tile's choice at its border
     // sees its neighbours', whichever device traced them.

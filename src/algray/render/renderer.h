@@ -121,7 +121,11 @@ struct RenderResult {
   // The film: RGBA, depth and normal per output pixel, as shade_frame would make them from the records.
   FrameImage image;
   PrimarySummary primary;
-  double shade_ms = 0;  // host shading within the render; gathering a pass's rays is in the pass's wall_ms
+  // Shading's wall time within the render (the shading kernel's launches and read-backs, the host's shading of
+  // bounces and refined pixels), and the shading kernel's device time within it; gathering a pass's rays is in
+  // the pass's wall_ms.
+  double shade_ms = 0;
+  double shade_kernel_ms = 0;
 
   // Kept only with RenderOptions::keep_records:
   HitBuffer hits;                         // one record per traced ray: plan.trace_width() x plan.trace_height()

@@ -121,6 +121,8 @@ void Renderer::prepare_secondary(Passes& passes) {
 // The device's kernels, tracers and tile buffers for the plan's passes, with their programs in the tallies.
 void Renderer::prepare_passes(Passes& passes, bool first_device) {
   prepare_primary(passes, first_device);
+  passes.kernels.shading = std::make_unique<DeviceShader>(passes.session, cache_, passes.scene, *passes.shader);
+  passes.tally.programs.push_back(passes.kernels.shading->program());
   if (PassStats* stats = passes.stats_of(PassKind::Shadow)) prepare_shadows(passes, *stats);
   prepare_escalation(passes);
   prepare_secondary(passes);
@@ -263,35 +265,22 @@ void Renderer::finish_tile(Passes& passes, const Tile& tile) {
     if (!first.empty()) run_bounces(passes, tile, std::move(first), 1, false);
   }
 
+  // The tile's pixels, shaded on the device from the records where the primary kernel left them.
   const auto start = std::chrono::steady_clock::now();
-  const ShadowLookup lookup(shadows, rays, passes.scene.lights.size());
-  TracedBlock block;
-  block.x0 = tile.trace_x0;
-  block.y0 = tile.trace_y0;
-  block.width = tile.trace_w;
-  block.height = tile.trace_h;
-  block.hits = passes.work.hits;
-  block.surface = passes.work.hit_surface.empty() ? nullptr : passes.work.hit_surface.data();
-  block.shadows = &lookup;
-  block.secondary = passes.work.any_secondary ? passes.work.secondary.data() : nullptr;
-  block.film_y0 = passes.film_y0;
-  // The camera rays' totals, counted as the shading threads finish their rows, while the records are in cache
-  // (a pass of its own over a 1024^2 preview's 32 MB of records took 4 ms). Only the rows the film keeps: a
-  // band's extra rows are counted by the band they belong to.
-  PrimarySummary tile_summary;
-  std::mutex summary_lock;
-  block.after_rows = [&](int row_begin, int row_end) {
-    const int first = std::max(tile.y0 + row_begin, passes.first_row);
-    const int end = std::min(tile.y0 + row_end, passes.end_row);
-    if (end <= first) return;
-    PrimarySummary rows;
-    rows.add(passes.work.hits + static_cast<std::size_t>(first - tile.y0) * plan.samples * tile.trace_w, tile.trace_w,
-             (end - first) * plan.samples, plan.samples);
-    const std::lock_guard<std::mutex> hold(summary_lock);
-    tile_summary += rows;
-  };
-  passes.shader->resolve(block, result.image);
-  passes.tally.primary_summary += tile_summary;
+  passes.work.primary_out->release();
+  ShadeTile shade;
+  shade.trace_x0 = tile.trace_x0;
+  shade.trace_y0 = tile.trace_y0;
+  shade.trace_w = tile.trace_w;
+  shade.trace_h = tile.trace_h;
+  shade.hits = &passes.work.primary_out->buffer();
+  shade.surface = passes.work.hit_surface.empty() ? nullptr : passes.work.hit_surface.data();
+  shade.shadows = passes.kernels.shadows.empty() ? nullptr : &shadows;
+  shade.secondary = passes.work.any_secondary ? passes.work.secondary.data() : nullptr;
+  // Only the rows the film keeps: a band's extra rows are counted by the band they belong to.
+  shade.kept_first = passes.first_row;
+  shade.kept_end = passes.end_row;
+  passes.tally.primary_summary += passes.kernels.shading->shade(shade, passes.tally.shade_kernel_ms);
   passes.tally.shade_ms += ms_since(start);
 }
 

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <vector>
 
+#include "algray/render/device_shader.h"
 #include "algray/render/escalation.h"
 #include "algray/render/populated_pages.h"
 #include "algray/render/ray_tracer.h"
@@ -96,7 +97,7 @@ class Renderer::TileHits {
   TileHits(const cl::Context& context, cl::CommandQueue& queue, std::size_t capacity, PopulatedPages memory)
       : capacity_(capacity),
         memory_(std::move(memory)),
-        buffer_(context, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, capacity * sizeof(HitRecord), memory_.data()),
+        buffer_(context, CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, capacity * sizeof(HitRecord), memory_.data()),
         queue_(queue) {}
   TileHits(const TileHits&) = delete;
   TileHits& operator=(const TileHits&) = delete;
@@ -183,6 +184,7 @@ struct Renderer::DeviceKernels {
   // its shadow kernel for doubted shadow rays (when the plan has a shadow pass); plain float: float's own.
   std::vector<std::unique_ptr<RayEscalation>> escalate_rays;
   std::vector<std::unique_ptr<ShadowEscalation>> escalate_shadows;
+  std::unique_ptr<DeviceShader> shading;  // the camera rays' pixels into the film
 };
 
 // One tile's buffers and intermediate results, which the device's next tile reuses, and the renderer's next
@@ -205,6 +207,7 @@ struct Renderer::DeviceTally {
   std::vector<PassStats> stats;  // one per planned pass, in plan order
   PrimarySummary primary_summary;
   double shade_ms = 0;
+  double shade_kernel_ms = 0;
   std::vector<ProgramRecord> programs;
   int tiles = 0;
 };

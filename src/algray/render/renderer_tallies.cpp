@@ -36,10 +36,12 @@ void Renderer::add_device_tallies(const std::vector<std::unique_ptr<Passes>>& de
   for (const auto& passes : devices) {
     result.primary += passes->tally.primary_summary;
     result.shade_ms += passes->tally.shade_ms;
+    result.shade_kernel_ms += passes->tally.shade_kernel_ms;
     DeviceShare share;
     share.index = passes->session.info.index;
     share.name = passes->session.info.name;
     share.tiles = passes->tally.tiles;
+    share.kernel_ms = passes->tally.shade_kernel_ms;
     for (const PassStats& pass : passes->tally.stats) {
       share.rays += pass.rays;
       share.kernel_ms += pass.kernel_ms;

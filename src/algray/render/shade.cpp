@@ -333,7 +333,6 @@ void Shader::resolve(const TracedBlock& block, FrameImage& film) const {
         for (int c = 0; c < 3; ++c) film.normal[3 * i + c] = normal[c];
       }
     }
-    if (block.after_rows) block.after_rows(static_cast<int>(row_begin), static_cast<int>(row_end));
   });
 }
 

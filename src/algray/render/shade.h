@@ -3,7 +3,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <vector>
 
 #include "algray/io/image_io.h"
@@ -45,12 +44,10 @@ struct TracedBlock {
   const ShadowLookup* shadows = nullptr;      // of these hits
   const glm::dvec3* secondary = nullptr;      // per ray, what its bounces brought back; null without bounces
   int film_y0 = 0;                            // the image row of the film's first row (a band's film)
-  // Called on the shading thread with each range [first, end) of the block's pixel rows once they are shaded,
-  // while their records are still in that core's cache (the renderer's statistics); may be empty.
-  std::function<void(int first, int end)> after_rows;
 };
 
-// The lights and materials of one render, shared by the film and by shade_frame, so both shade alike.
+// The lights and materials of one render, shared by shade_frame, the bounces and the device's shading kernel
+// (render/device_shader.h), so all shade alike.
 class Shader {
  public:
   Shader(const Scene& scene, const RenderPlan& plan, const RayBasis& basis, Precision precision);
@@ -76,14 +73,24 @@ class Shader {
   // transmission pass), lit by every light's points that the shadow pass left visible.
   void shade_hits(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const;
 
- private:
-  // shade_hits' two steps: the lit colour, then the plane sections drawn over it.
-  void shade_lit(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const;
-  void draw_sections(const HitToShade* hits, std::size_t count, glm::dvec3* out) const;
+  // What the device's shading kernel takes of it (render/device_shader.h): each light with the points it is shaded
+  // from (its centre alone in a preview), whether the colour seen through a surface is added (a transmission pass),
+  // the highlight cutoff of each surface's side, the rays' precision and the samples per pixel side.
   struct LightSamples {
     const Light* light;
     std::vector<glm::dvec3> points;
   };
+  const std::vector<LightSamples>& lights() const { return lights_; }
+  bool transmits() const { return transmits_; }
+  double highlight_cutoff(std::size_t surface, bool back) const { return highlight_cutoff_[2 * surface + back]; }
+  bool single_precision_rays() const { return single_; }
+  int samples() const { return samples_; }
+  const RayBasis& basis() const { return basis_; }
+
+ private:
+  // shade_hits' two steps: the lit colour, then the plane sections drawn over it.
+  void shade_lit(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const;
+  void draw_sections(const HitToShade* hits, std::size_t count, glm::dvec3* out) const;
   // At most kShadeLanes of them, side by side (count >= 1).
   void shade_lanes(const HitToShade* hits, std::size_t count, const ShadowLookup& shadows, glm::dvec3* out) const;
   struct HitLanes;  // shade_lanes' hits as arrays, one element a lane (shade.cpp)
