@@ -174,6 +174,110 @@ ALGRAY_INLINE void draw_sections(const LaneHits* h, const LaneRays* ray, LMASK f
   }
 }
 
+/* The lanes' hits of one sample as the shading needs them: t, normal, surface, point on the ray, material. */
+ALGRAY_INLINE LaneHits lane_hits(const HitRecord rec[LANES], const size_t at[LANES], const LaneRays* ray,
+                                 __global const uchar* hit_surface, uint several_surfaces,
+                                 __global const REAL* materials) {
+#pragma OPENCL FP_CONTRACT OFF
+  LaneHits h;
+#define REC_T(j) ((REAL)rec[j].t_hi + (REAL)rec[j].t_lo)
+#define REC_NX(j) ((REAL)rec[j].normal_x)
+#define REC_NY(j) ((REAL)rec[j].normal_y)
+#define REC_NZ(j) ((REAL)rec[j].normal_z)
+#define REC_SURFACE(j) ((LANE_INT)(several_surfaces ? hit_surface[at[j]] : 0))
+  h.t = LANES_OF(LREAL, REC_T);
+  h.nx = LANES_OF(LREAL, REC_NX);
+  h.ny = LANES_OF(LREAL, REC_NY);
+  h.nz = LANES_OF(LREAL, REC_NZ);
+  h.surface = LANES_OF(LANE_INT_VEC, REC_SURFACE);
+#undef REC_T
+#undef REC_NX
+#undef REC_NY
+#undef REC_NZ
+#undef REC_SURFACE
+  h.px = ray->ox + h.t * ray->dx;
+  h.py = ray->oy + h.t * ray->dy;
+  h.pz = ray->oz + h.t * ray->dz;
+  /* each lane's material: its surface's front or back */
+  uint material[LANES];
+  for (uint j = 0; j < LANES; ++j)
+    material[j] = (2 * (several_surfaces ? (uint)hit_surface[at[j]] : 0u) + ((rec[j].flags & ALGRAY_HIT_BACK) ? 1u : 0u)) *
+                  ALGRAY_MATERIAL_VALUES;
+  for (uint v = 0; v < ALGRAY_MATERIAL_VALUES; ++v) {
+#define MATERIAL_VALUE(j) (materials[material[j] + v])
+    h.m[v] = LANES_OF(LREAL, MATERIAL_VALUE);
+#undef MATERIAL_VALUE
+  }
+  return h;
+}
+
+/* What each lane's bounces brought back, added to its colour. */
+ALGRAY_INLINE void add_secondary(__global const REAL4* secondary, const size_t at[LANES], LREAL* cr, LREAL* cg,
+                                 LREAL* cb) {
+#pragma OPENCL FP_CONTRACT OFF
+#define MORE_R(j) (secondary[at[j]].x)
+#define MORE_G(j) (secondary[at[j]].y)
+#define MORE_B(j) (secondary[at[j]].z)
+  *cr += LANES_OF(LREAL, MORE_R);
+  *cg += LANES_OF(LREAL, MORE_G);
+  *cb += LANES_OF(LREAL, MORE_B);
+#undef MORE_R
+#undef MORE_G
+#undef MORE_B
+}
+
+/* The records of sample (sx, sy) of the lanes' `count` pixels from x0 in tile row y, at[j] where lane j's lies
+ * (lanes past the tile's edge repeat the first lane's, and are never written), counted into the totals. */
+ALGRAY_INLINE void load_records(__global const HitRecord* hits, uint tile_w, uint samples, uint x0, uint y, uint sx,
+                                uint sy, uint count, HitRecord rec[LANES], size_t at[LANES],
+                                uint counts[ALGRAY_SUMMARY_VALUES], uint* any_found) {
+  for (uint j = 0; j < LANES; ++j) {
+    at[j] = (size_t)(y * samples + sy) * tile_w + (x0 + (j < count ? j : 0)) * samples + sx;
+    rec[j] = hits[at[j]];
+    const uint flags = rec[j].flags;
+    if (j < count) {
+      counts[ALGRAY_SUMMARY_HITS] += (flags & ALGRAY_HIT_FOUND) != 0;
+      counts[ALGRAY_SUMMARY_DEPTH_LIMITED] += (flags & ALGRAY_HIT_BUDGET) != 0;
+      counts[ALGRAY_SUMMARY_ISOLATION_STEPS] += ALGRAY_WORK_ISOLATION_STEPS(rec[j].work);
+      counts[ALGRAY_SUMMARY_REFINE_ITERATIONS] += ALGRAY_WORK_REFINE_ITERATIONS(rec[j].work);
+      *any_found |= (flags & ALGRAY_HIT_FOUND) ? 1u << j : 0u;
+    }
+  }
+}
+
+/* The lanes' first `count` pixels into the film from index `at`: the samples' sums times `weight`, and where the
+ * film has them the nearest sample's depth and normal. */
+ALGRAY_INLINE void store_pixels(size_t at, uint count, REAL weight, LREAL r, LREAL g, LREAL b, LREAL a, LREAL depth,
+                                LREAL nx, LREAL ny, LREAL nz, __global float4* film_rgba, __global float* film_depth,
+                                __global float* film_normal, uint film_depth_and_normal) {
+  for (uint j = 0; j < count; ++j) {
+    film_rgba[at + j] = (float4)((float)(lane_get(r, j) * weight), (float)(lane_get(g, j) * weight),
+                                 (float)(lane_get(b, j) * weight), (float)(lane_get(a, j) * weight));
+    if (film_depth_and_normal) {
+      film_depth[at + j] = (float)lane_get(depth, j);
+      film_normal[3 * (at + j)] = (float)lane_get(nx, j);
+      film_normal[3 * (at + j) + 1] = (float)lane_get(ny, j);
+      film_normal[3 * (at + j) + 2] = (float)lane_get(nz, j);
+    }
+  }
+}
+
+/* The work-group's totals of every work-item's counts into its ALGRAY_SUMMARY_VALUES numbers of summary: integer
+ * sums, the same in any order. Every work-item of the group calls it (a barrier). */
+ALGRAY_INLINE void store_group_totals(const uint counts[ALGRAY_SUMMARY_VALUES], __local uint* group_counts,
+                                      __global uint* summary) {
+  const uint items = ALGRAY_SHADE_GROUP_SIDE * ALGRAY_SHADE_GROUP_SIDE;
+  const uint me = get_local_id(1) * ALGRAY_SHADE_GROUP_SIDE + get_local_id(0);
+  for (int i = 0; i < ALGRAY_SUMMARY_VALUES; ++i) group_counts[i * items + me] = counts[i];
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (me < ALGRAY_SUMMARY_VALUES) {
+    uint total = 0;
+    for (uint j = 0; j < items; ++j) total += group_counts[me * items + j];
+    const size_t group = (size_t)get_group_id(1) * get_num_groups(0) + get_group_id(0);
+    summary[group * ALGRAY_SUMMARY_VALUES + me] = total;
+  }
+}
+
 /* Pixels x0 .. x0 + LANES - 1 (x0 = LANES * global id 0) of tile row y (global id 1), each from its samples x samples
  * camera rays at hits[(y * samples + sy) * tile_w + x * samples + sx] (the primary kernel's records, tile_w x tile_h
  * of them; tile_x0, tile_y0, tile_w and tile_h count traced rays). A pixel's RGBA (and, where film_depth_and_normal,
@@ -207,21 +311,9 @@ __kernel __attribute__((reqd_work_group_size(ALGRAY_SHADE_GROUP_SIDE, ALGRAY_SHA
     uint any_found = 0; /* bit j: some sample of lane j's pixel hit */
     for (uint sy = 0; sy < samples; ++sy)
       for (uint sx = 0; sx < samples; ++sx) {
-        /* the lanes' records (lanes past the tile's edge repeat the first lane's, and are never written) */
         HitRecord rec[LANES];
         size_t at[LANES];
-        for (uint j = 0; j < LANES; ++j) {
-          at[j] = (size_t)(y * samples + sy) * tile_w + (x0 + (j < count ? j : 0)) * samples + sx;
-          rec[j] = hits[at[j]];
-          const uint flags = rec[j].flags;
-          if (j < count) {
-            counts[ALGRAY_SUMMARY_HITS] += (flags & ALGRAY_HIT_FOUND) != 0;
-            counts[ALGRAY_SUMMARY_DEPTH_LIMITED] += (flags & ALGRAY_HIT_BUDGET) != 0;
-            counts[ALGRAY_SUMMARY_ISOLATION_STEPS] += ALGRAY_WORK_ISOLATION_STEPS(rec[j].work);
-            counts[ALGRAY_SUMMARY_REFINE_ITERATIONS] += ALGRAY_WORK_REFINE_ITERATIONS(rec[j].work);
-            any_found |= (flags & ALGRAY_HIT_FOUND) ? 1u << j : 0u;
-          }
-        }
+        load_records(hits, tile_w, samples, x0, y, sx, sy, count, rec, at, counts, &any_found);
 #define REC_FLAG(j) ((LANE_INT)((rec[j].flags & ALGRAY_HIT_FOUND) != 0))
         const LMASK found = LANES_OF(LANE_INT_VEC, REC_FLAG) != 0;
 #undef REC_FLAG
@@ -229,36 +321,7 @@ __kernel __attribute__((reqd_work_group_size(ALGRAY_SHADE_GROUP_SIDE, ALGRAY_SHA
         if (LANE_ANY(found)) {
           const LaneRays ray = shade_camera_rays(tile_x0 + x0 * samples + sx, samples, tile_y0 + y * samples + sy,
                                                  rays_in_float, ray_o00, ray_ou, ray_ov, ray_d00, ray_du, ray_dv);
-          LaneHits h;
-#define REC_T(j) ((REAL)rec[j].t_hi + (REAL)rec[j].t_lo)
-#define REC_NX(j) ((REAL)rec[j].normal_x)
-#define REC_NY(j) ((REAL)rec[j].normal_y)
-#define REC_NZ(j) ((REAL)rec[j].normal_z)
-#define REC_SURFACE(j) ((LANE_INT)(several_surfaces ? hit_surface[at[j]] : 0))
-          h.t = LANES_OF(LREAL, REC_T);
-          h.nx = LANES_OF(LREAL, REC_NX);
-          h.ny = LANES_OF(LREAL, REC_NY);
-          h.nz = LANES_OF(LREAL, REC_NZ);
-          h.surface = LANES_OF(LANE_INT_VEC, REC_SURFACE);
-#undef REC_T
-#undef REC_NX
-#undef REC_NY
-#undef REC_NZ
-#undef REC_SURFACE
-          h.px = ray.ox + h.t * ray.dx;
-          h.py = ray.oy + h.t * ray.dy;
-          h.pz = ray.oz + h.t * ray.dz;
-          /* each lane's material: its surface's front or back */
-          uint material[LANES];
-          for (uint j = 0; j < LANES; ++j)
-            material[j] = (2 * (several_surfaces ? (uint)hit_surface[at[j]] : 0u) +
-                           ((rec[j].flags & ALGRAY_HIT_BACK) ? 1u : 0u)) *
-                          ALGRAY_MATERIAL_VALUES;
-          for (uint v = 0; v < ALGRAY_MATERIAL_VALUES; ++v) {
-#define MATERIAL_VALUE(j) (materials[material[j] + v])
-            h.m[v] = LANES_OF(LREAL, MATERIAL_VALUE);
-#undef MATERIAL_VALUE
-          }
+          const LaneHits h = lane_hits(rec, at, &ray, hit_surface, several_surfaces, materials);
           /* where each lane's hit is among the points the shadow pass traced from */
           uint point[LANES];
           for (uint j = 0; j < LANES; ++j) point[j] = occlusion_stride > 0 ? point_of_hit[at[j]] : UINT_MAX;
@@ -267,17 +330,7 @@ __kernel __attribute__((reqd_work_group_size(ALGRAY_SHADE_GROUP_SIDE, ALGRAY_SHA
           if (section_count > 0)
             draw_sections(&h, &ray, found, (REAL)samples, ray_ou, ray_ov, ray_du, ray_dv, section_planes,
                           section_looks, section_surfaces, section_count, &cr, &cg, &cb);
-          if (has_secondary) {
-#define MORE_R(j) (secondary[at[j]].x)
-#define MORE_G(j) (secondary[at[j]].y)
-#define MORE_B(j) (secondary[at[j]].z)
-            cr += LANES_OF(LREAL, MORE_R);
-            cg += LANES_OF(LREAL, MORE_G);
-            cb += LANES_OF(LREAL, MORE_B);
-#undef MORE_R
-#undef MORE_G
-#undef MORE_B
-          }
+          if (has_secondary) add_secondary(secondary, at, &cr, &cg, &cb);
 #define REC_DEPTH(j) ((REAL)rec[j].depth)
           const LREAL d = LANES_OF(LREAL, REC_DEPTH);
 #undef REC_DEPTH
@@ -292,18 +345,9 @@ __kernel __attribute__((reqd_work_group_size(ALGRAY_SHADE_GROUP_SIDE, ALGRAY_SHA
         sum_b += LANE_SEL((LREAL)background.z, cb, found);
         sum_a += LANE_SEL((LREAL)background.w, (LREAL)1, found);
       }
-    const REAL weight = (REAL)1 / (REAL)(samples * samples);
-    const size_t row = (size_t)(image_y - film_y0) * film_width + tile_x0 / samples + x0;
-    for (uint j = 0; j < count; ++j) {
-      film_rgba[row + j] = (float4)((float)(lane_get(sum_r, j) * weight), (float)(lane_get(sum_g, j) * weight),
-                                    (float)(lane_get(sum_b, j) * weight), (float)(lane_get(sum_a, j) * weight));
-      if (film_depth_and_normal) {
-        film_depth[row + j] = (float)lane_get(depth, j);
-        film_normal[3 * (row + j)] = (float)lane_get(normal_x, j);
-        film_normal[3 * (row + j) + 1] = (float)lane_get(normal_y, j);
-        film_normal[3 * (row + j) + 2] = (float)lane_get(normal_z, j);
-      }
-    }
+    store_pixels((size_t)(image_y - film_y0) * film_width + tile_x0 / samples + x0, count,
+                 (REAL)1 / (REAL)(samples * samples), sum_r, sum_g, sum_b, sum_a, depth, normal_x, normal_y, normal_z,
+                 film_rgba, film_depth, film_normal, film_depth_and_normal);
     counts[ALGRAY_SUMMARY_RAYS] = count * samples * samples;
     counts[ALGRAY_SUMMARY_PIXELS] = count;
     counts[ALGRAY_SUMMARY_PIXELS_HIT] = popcount(any_found);
@@ -311,15 +355,6 @@ __kernel __attribute__((reqd_work_group_size(ALGRAY_SHADE_GROUP_SIDE, ALGRAY_SHA
     if (!kept)
       for (int i = 0; i < ALGRAY_SUMMARY_VALUES; ++i) counts[i] = 0;
   }
-  /* The group's totals: integer sums, the same in any order. */
-  __local uint group_counts[ALGRAY_SUMMARY_VALUES][ALGRAY_SHADE_GROUP_SIDE * ALGRAY_SHADE_GROUP_SIDE];
-  const uint me = get_local_id(1) * ALGRAY_SHADE_GROUP_SIDE + get_local_id(0);
-  for (int i = 0; i < ALGRAY_SUMMARY_VALUES; ++i) group_counts[i][me] = counts[i];
-  barrier(CLK_LOCAL_MEM_FENCE);
-  if (me < ALGRAY_SUMMARY_VALUES) {
-    uint total = 0;
-    for (uint j = 0; j < ALGRAY_SHADE_GROUP_SIDE * ALGRAY_SHADE_GROUP_SIDE; ++j) total += group_counts[me][j];
-    const size_t group = (size_t)get_group_id(1) * get_num_groups(0) + get_group_id(0);
-    summary[group * ALGRAY_SUMMARY_VALUES + me] = total;
-  }
+  __local uint group_counts[ALGRAY_SUMMARY_VALUES * ALGRAY_SHADE_GROUP_SIDE * ALGRAY_SHADE_GROUP_SIDE];
+  store_group_totals(counts, group_counts, summary);
 }
