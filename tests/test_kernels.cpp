@@ -91,7 +91,9 @@ TEST_CASE("every DEGREE from 1 to 32 builds and finds the smallest root, in floa
       // Adaptive, and float where it takes adaptive's kernels (float_measures_noise), with their second pass.
       const bool escalates =
           choice.value == Precision::Adaptive || (choice.value == Precision::Float && float_measures_noise(scene));
-      REQUIRE(result.programs.size() == (escalates ? 2u : 1u));
+      // The camera rays' kernel (and the second pass's), then the shading kernel.
+      REQUIRE(result.programs.size() == (escalates ? 3u : 2u));
+      CHECK(result.programs.back().key.rfind("shade ", 0) == 0);
       CHECK(result.programs[0].origin == "built");
       check_known_root(result, degree, precision);
     }

@@ -93,44 +93,50 @@ TEST_CASE("a damaged program-cache entry is rebuilt, never handed to OpenCL", "[
   require_device();
   Sandbox box;
   box.cache = box.root / "cache";  // this test's own cache, so its entry is the only one
-  // One kernel: in double (a preview left open is adaptive, which builds its second pass's kernel too).
+  // In double, so that the render builds one camera-ray kernel (a preview left open is adaptive, which builds its
+  // second pass's kernel too), and the shading kernel.
   const std::string render = "render --preview --precision double -o out.png " + kTiny + " --stats s.json";
   REQUIRE(box.run(render).exit_code == 0);
   const std::vector<fs::path> entries = cache_entries(box.cache);
-  REQUIRE(entries.size() == 1);
-  const fs::path entry = entries[0];
-  const std::string good = read_text(entry);
-  REQUIRE(good.size() > 100);
+  // Two entries, the camera rays' kernel and the shading kernel: each is damaged alike.
+  REQUIRE(entries.size() == 2);
+  std::vector<std::string> good;
+  for (const fs::path& entry : entries) {
+    good.push_back(read_text(entry));
+    REQUIRE(good.back().size() > 100);
+  }
   const std::string reference = read_text(box.work / "out.png");
 
   struct Damage {
     const char* what;
-    std::function<void()> apply;
+    std::function<void(const fs::path& entry, const std::string& good)> apply;
   };
-  const std::vector<Damage> damages = {{"cut to half its size", [&] { fs::resize_file(entry, good.size() / 2); }},
-                                       {"cut to its header", [&] { fs::resize_file(entry, good.find("\n--\n") + 4); }},
-                                       {"one payload byte flipped",
-                                        [&] {
-                                          std::string bad = good;
-                                          bad[bad.size() - bad.size() / 3] ^= 0x5a;
-                                          write_text(entry, bad);
-                                        }},
-                                       {"empty", [&] { write_text(entry, ""); }},
-                                       {"a directory", [&] {
-                                          fs::remove(entry);
-                                          fs::create_directory(entry);
-                                        }}};
+  const std::vector<Damage> damages = {
+      {"cut to half its size", [](const fs::path& entry, const std::string& g) { fs::resize_file(entry, g.size() / 2); }},
+      {"cut to its header",
+       [](const fs::path& entry, const std::string& g) { fs::resize_file(entry, g.find("\n--\n") + 4); }},
+      {"one payload byte flipped",
+       [](const fs::path& entry, const std::string& g) {
+         std::string bad = g;
+         bad[bad.size() - bad.size() / 3] ^= 0x5a;
+         write_text(entry, bad);
+       }},
+      {"empty", [](const fs::path& entry, const std::string&) { write_text(entry, ""); }},
+      {"a directory", [](const fs::path& entry, const std::string&) {
+         fs::remove(entry);
+         fs::create_directory(entry);
+       }}};
   // A temporary entry that a writer killed by SIGKILL left (a reaped child's pid is dead), old enough to be stale.
   const pid_t dead = fork();
   if (dead == 0) _exit(0);
   REQUIRE(dead > 0);
   REQUIRE(waitpid(dead, nullptr, 0) == dead);
-  const fs::path leftover = entry.string() + ".tmp-" + std::to_string(dead) + "-1";
+  const fs::path leftover = entries[0].string() + ".tmp-" + std::to_string(dead) + "-1";
   for (const Damage& d : damages) {
     SECTION(d.what) {
       write_text(leftover, "half an entry");
       fs::last_write_time(leftover, fs::file_time_type::clock::now() - std::chrono::minutes(5));
-      d.apply();
+      for (std::size_t e = 0; e < entries.size(); ++e) d.apply(entries[e], good[e]);
       const Result r = box.run(render);
       INFO(r.err);
       REQUIRE(r.exit_code == 0);
@@ -145,7 +151,7 @@ TEST_CASE("a damaged program-cache entry is rebuilt, never handed to OpenCL", "[
       // program as before; its payload need not be the same bytes, since PoCL's binary of a fresh compile differs
       // from one its own kernel cache serves (with an empty POCL_CACHE_DIR the first build here is the former).
       const auto identity = [](const std::string& e) { return e.substr(0, e.find("payload-bytes=")); };
-      CHECK(identity(read_text(entry)) == identity(good));
+      for (std::size_t e = 0; e < entries.size(); ++e) CHECK(identity(read_text(entries[e])) == identity(good[e]));
       CHECK_FALSE(fs::exists(leftover));  // the rebuild's write removed it
     }
   }

@@ -121,11 +121,12 @@ void Renderer::prepare_secondary(Passes& passes) {
 // The device's kernels, tracers and tile buffers for the plan's passes, with their programs in the tallies.
 void Renderer::prepare_passes(Passes& passes, bool first_device) {
   prepare_primary(passes, first_device);
-  passes.kernels.shading = std::make_unique<DeviceShader>(passes.session, cache_, passes.scene, *passes.shader);
-  passes.tally.programs.push_back(passes.kernels.shading->program());
   if (PassStats* stats = passes.stats_of(PassKind::Shadow)) prepare_shadows(passes, *stats);
   prepare_escalation(passes);
   prepare_secondary(passes);
+  // The last step of every tile, and the last program in the tallies.
+  passes.kernels.shading = std::make_unique<DeviceShader>(passes.session, cache_, passes.scene, *passes.shader);
+  passes.tally.programs.push_back(passes.kernels.shading->program());
   // The pass's stats list its escalation kernels after its own.
   const RenderPlan& plan = passes.result.plan;
   for (std::size_t i = 0; i < plan.passes.size(); ++i)
