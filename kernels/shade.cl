@@ -198,14 +198,17 @@ ALGRAY_INLINE LaneHits lane_hits(const HitRecord rec[LANES], const size_t at[LAN
   h.px = ray->ox + h.t * ray->dx;
   h.py = ray->oy + h.t * ray->dy;
   h.pz = ray->oz + h.t * ray->dz;
-  /* each lane's material: its surface's front or back */
+  /* each lane's material: its surface's front or back; read once where every lane has the same (most groups) */
   uint material[LANES];
-  for (uint j = 0; j < LANES; ++j)
+  uint mixed = 0;
+  for (uint j = 0; j < LANES; ++j) {
     material[j] = (2 * (several_surfaces ? (uint)hit_surface[at[j]] : 0u) + ((rec[j].flags & ALGRAY_HIT_BACK) ? 1u : 0u)) *
                   ALGRAY_MATERIAL_VALUES;
+    mixed |= material[j] ^ material[0];
+  }
   for (uint v = 0; v < ALGRAY_MATERIAL_VALUES; ++v) {
 #define MATERIAL_VALUE(j) (materials[material[j] + v])
-    h.m[v] = LANES_OF(LREAL, MATERIAL_VALUE);
+    h.m[v] = mixed ? LANES_OF(LREAL, MATERIAL_VALUE) : (LREAL)materials[material[0] + v];
 #undef MATERIAL_VALUE
   }
   return h;
