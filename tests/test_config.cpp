@@ -139,12 +139,24 @@ TEST_CASE("tolerances below the working precision are raised to it", "[config]")
   CHECK(primary_config(scene, Precision::Float).tolerance >= 1e-7);
 }
 
-TEST_CASE("GPUs get watchdog-sized tiles, CPUs few large ones", "[config]") {
+TEST_CASE("GPUs get launches that fill them, CPUs few large ones, and the plan says which", "[config]") {
   DeviceInfo gpu, cpu;
   gpu.type = "GPU";
   cpu.type = "CPU";
-  CHECK(default_tile_size(gpu) <= 256);
+  // A 1920x1080 preview is one launch per pass on a GPU.
+  CHECK(default_tile_size(gpu) >= 1920);
   CHECK(default_tile_size(cpu) >= 1024);
+  Scene scene = load_scene_text(kSphereScene, "t.toml", {{"image.width", "1920"}, {"image.height", "1080"}});
+  scene.render.preview = true;
+  const RenderPlan on_gpu = make_render_plan(scene, Precision::Float, std::vector<PlanDevice>{{gpu}});
+  CHECK(on_gpu.tile_rays() == 1920u * 1080u);
+  CHECK(on_gpu.tile_choice.find("GPU") != std::string::npos);
+  CHECK(on_gpu.json()["tile"]["choice"] == on_gpu.tile_choice);
+  const RenderPlan on_cpus = make_render_plan(scene, Precision::Float, std::vector<PlanDevice>{{cpu}, {cpu}});
+  CHECK(on_cpus.tile_choice.find("halved") != std::string::npos);
+  scene.render.tile_size = 64;
+  CHECK(make_render_plan(scene, Precision::Float, std::vector<PlanDevice>{{gpu}}).tile_choice ==
+        "the scene's render.tile_size");
 }
 
 TEST_CASE("the surface in unit coordinates vanishes where the world surface does", "[config]") {

@@ -254,7 +254,7 @@ std::uint64_t host_bytes_per_tile(const RenderPlan& plan, const Scene& scene, st
 
 }  // namespace
 
-int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? 256 : 1024; }
+int default_tile_size(const DeviceInfo& device) { return device.type == "GPU" ? kGpuTileSize : kCpuTileSize; }
 
 bool float_measures_noise(const Scene& scene) {
   // Any degree: adaptive's limit of 15 is its mixed-precision second pass's, and float's second pass is float.
@@ -351,10 +351,13 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::
   RenderPlan plan;
   if (scene.render.tile_size > 0) {
     plan = make_render_plan(scene, precision, scene.render.tile_size, lanes);
+    plan.tile_choice = "the scene's render.tile_size";
   } else {
     int side = default_tile_size(devices.front().info);
     for (const PlanDevice& device : devices) side = std::min(side, default_tile_size(device.info));
     plan = make_render_plan(scene, precision, side, lanes);
+    plan.tile_choice = side == kGpuTileSize ? "a GPU's: as many camera rays as fill it in one launch per pass"
+                                            : "a CPU's: few large launches";
     // Several devices take tiles from one queue: with about 8 tiles each, a device that finds its tiles cheaper
     // takes more of them, and none idles long at the end. The tile size changes no pixel (test_multi_device).
     const std::size_t wanted = devices.size() > 1 ? 8 * devices.size() : 1;
@@ -363,8 +366,12 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::
       return ((static_cast<std::size_t>(p.width) + side_pixels - 1) / side_pixels) *
              ((static_cast<std::size_t>(p.height) + side_pixels - 1) / side_pixels);
     };
+    const std::string choice = plan.tile_choice;
     while (tiles(plan) < wanted && plan.tile_size / 2 >= 16 * plan.samples)
       plan = make_render_plan(scene, precision, plan.tile_size / 2, lanes);
+    plan.tile_choice = choice;
+    if (plan.tile_size != side)
+      plan.tile_choice += ", halved to " + std::to_string(plan.tile_size) + " for about 8 tiles per device";
   }
   if (precision == Precision::Adaptive) {
     const bool all_fast = std::all_of(devices.begin(), devices.end(),
@@ -381,7 +388,7 @@ nlohmann::json RenderPlan::json() const {
   j["antialias_samples"] = samples;
   j["adaptive_antialias_samples"] = refine_samples;
   j["traced"] = {{"width", trace_width()}, {"height", trace_height()}};
-  j["tile"] = {{"size", tile_size}, {"pixels", tile_pixels()}, {"rays", tile_rays()}};
+  j["tile"] = {{"size", tile_size}, {"pixels", tile_pixels()}, {"rays", tile_rays()}, {"choice", tile_choice}};
   j["film_bytes"] = film_bytes();
   j["tile_host_bytes"] = tile_host_bytes;
   for (const PlannedPass& p : passes) {

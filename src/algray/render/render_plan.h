@@ -53,6 +53,7 @@ struct RenderPlan {
   // Side of a tile in traced rays; a tile holds whole pixels, tile_pixels() per side. The render works through
   // every pass one tile at a time, so its memory is the film plus one tile's work.
   int tile_size = 1024;
+  std::string tile_choice;  // why this size, for --stats: the scene's, or the devices' default and for which
   int tile_pixels() const { return std::max(1, tile_size / samples); }
   // Camera rays of the largest tile.
   std::size_t tile_rays() const {
@@ -152,9 +153,15 @@ struct PlanDevice {
   Precision escalation = Precision::Mixed;  // adaptive precision's second pass there (escalation_precision)
 };
 
-// Tile side, in traced rays, for a device when the scene leaves it open. GPUs get launches short enough for
-// display watchdogs; CPUs (PoCL) lose ~2 ms per launch and idle cores at each launch's tail, so they get few,
-// large launches: measured on the Barth sextic at 1024x768, 256-ray tiles 137 ms, one 1024-ray tile 109 ms.
+// Tile side, in traced rays, for a device when the scene leaves it open. GPUs get as many camera rays per launch
+// as fill any of them many times over (2048^2 = 4M rays, 128 MB of records; a 1920x1080 preview is one launch per
+// pass): the 256^2 tiles of before left an H200 idle between 35 launches, each pass's wall time 5-12 times its
+// kernel time (bench/RESULTS.md, "A lent GPU"). A display whose watchdog stops long launches (double at high
+// degree on a consumer GPU) takes a smaller render.tile_size. CPUs (PoCL) lose ~2 ms per launch and idle cores at
+// each launch's tail, so they get few, large launches too: measured on the Barth sextic at 1024x768, 256-ray
+// tiles 137 ms, one 1024-ray tile 109 ms.
+inline constexpr int kGpuTileSize = 2048;
+inline constexpr int kCpuTileSize = 1024;
 int default_tile_size(const DeviceInfo& device);
 
 // The render's plan, settled once for the devices that carry it out (at least one): its passes and their kernels,

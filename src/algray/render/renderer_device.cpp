@@ -124,6 +124,13 @@ void Renderer::prepare_passes(Passes& passes, bool first_device) {
   if (PassStats* stats = passes.stats_of(PassKind::Shadow)) prepare_shadows(passes, *stats);
   prepare_escalation(passes);
   prepare_secondary(passes);
+  // What the host does with a tile's camera-ray records besides shading them: escalate the doubted, keep the
+  // nearest of several surfaces, trace shadow rays and bounces from them, keep them or hand them to the caller.
+  const RenderOptions& options = passes.options;
+  DeviceKernels& kernels = passes.kernels;
+  kernels.host_reads_records = !kernels.escalate_rays.empty() || kernels.surfaces.size() > 1 ||
+                               !kernels.shadows.empty() || !kernels.rays.empty() || options.keep_records ||
+                               static_cast<bool>(options.on_primary_tile);
   // The last step of every tile, and the last program in the tallies.
   passes.kernels.shading = std::make_unique<DeviceShader>(passes.session, cache_, passes.scene, *passes.shader);
   passes.tally.programs.push_back(passes.kernels.shading->program());
@@ -181,8 +188,10 @@ void Renderer::trace_primary(Passes& passes, const Tile& tile) {
     if (s == 0) pass.rays += rays;  // each camera ray once, however many surfaces it is tested against
     auto camera_ray = [&](std::size_t k) { return passes.camera_ray(tile, k); };
     if (s == 0) {
-      passes.work.hits = passes.work.primary_out->map(rays);
-      escalate_doubted(passes, pass, s, passes.work.hits, rays, camera_ray);
+      // The records stay on the device for the shading kernel unless the host reads them: a GPU copies them
+      // back when mapped (32 bytes a ray), a CPU does not.
+      passes.work.hits = passes.kernels.host_reads_records ? passes.work.primary_out->map(rays) : nullptr;
+      if (passes.work.hits) escalate_doubted(passes, pass, s, passes.work.hits, rays, camera_ray);
     } else {
       HitRecord* other = passes.work.other_out->map(rays);
       escalate_doubted(passes, pass, s, other, rays, camera_ray);

@@ -185,6 +185,7 @@ struct Renderer::DeviceKernels {
   std::vector<std::unique_ptr<RayEscalation>> escalate_rays;
   std::vector<std::unique_ptr<ShadowEscalation>> escalate_shadows;
   std::unique_ptr<DeviceShader> shading;  // the camera rays' pixels into the film
+  bool host_reads_records = true;         // the host reads a tile's camera-ray records (prepare_passes)
 };
 
 // One tile's buffers and intermediate results, which the device's next tile reuses, and the renderer's next
@@ -192,7 +193,7 @@ struct Renderer::DeviceKernels {
 struct Renderer::TileWork {
   std::unique_ptr<TileHits> primary_out;  // a tile's hit records, of the first surface
   std::unique_ptr<TileHits> other_out;    // several surfaces: those of the next ones
-  HitRecord* hits = nullptr;              // camera rays, row-major in the tile: primary_out mapped
+  HitRecord* hits = nullptr;  // camera rays, row-major in the tile: primary_out mapped, where the host reads them
   std::vector<std::uint8_t> hit_surface;  // several surfaces: which one each hit
   std::vector<glm::dvec3> secondary;      // per camera ray: what its bounces bring back
   bool any_secondary = false;
