@@ -4,7 +4,7 @@ Chromium, during a scripted orbit (the azimuth turned 0.02 rad every 16 ms) of a
 modes: moving (the page asks for 512x512 previews while the input moves) and still (each input asks for the
 page's full-size 1024x1024 frame at rest, as after a click). The page reports both: its frame counter and its
 per-frame latencies; the streaming page also reports each frame's server timings (queue, render with its kernels,
-passes and host shading, encoding, sending), whose medians say where a frame's time goes.
+passes and shading, encoding, sending), whose medians say where a frame's time goes.
 
 With --baseline, an older binary runs interleaved with this one (rounds of: each scene and mode, old then new),
 each figure the median over the rounds. Writes its section of bench/RESULTS.md ("algray view: frames per second")
@@ -152,11 +152,11 @@ def main():
                          f"{fmt(median(name, mode, 'after', 'latency'), 0)} |")
     lines += ["", "Where a streamed frame's time goes (after; the server's own timings, median per frame): queue, from "
               "the state's arrival to its render's start; render, the library's whole render call, of which kernels "
-              "(device time), passes (the passes' wall time: launches, staging, read-back), host shading and the "
+              "(device time, the shading kernel's included), passes (the passes' wall time: launches, staging, read-back), shading (the shading kernel's launch and the host's part: host shading before the shading kernel) and the "
               "rest (the library's set-up around the passes each frame: plan, film, tile buffers, stats); encode "
               "(to JPEG or PNG, on the stream's thread while the next frame renders); send, the write of the frame "
               "before.", "",
-              "| scene | mode | queue | render | kernels | passes | host shading | rest | encode | send | KB |",
+              "| scene | mode | queue | render | kernels | passes | shading | rest | encode | send | KB |",
               "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name in args.scenes:
         for mode in MODES:
