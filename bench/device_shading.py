@@ -65,11 +65,16 @@ def main():
                 r = compare(a.exr_compare, new, old)
                 rows.append((scene.stem, mode, r))
                 print(scene.stem, mode, r, flush=True)
-    lines = ["| scene | mode | largest colour difference | pixels > 1/255 | hit/miss | depth | channels bit for bit |",
-             "|---|---|---|---|---|---|---|"]
-    for name, mode, r in rows:
-        lines.append(f"| {name} | {mode} | {r['largest']:.1f}/255 | {r['off']} | {r['disagree']} | {r['depth']:.1g} | "
-                     f"{r['channels']} |")
+    # One row per scene, a cell per mode: the largest colour difference, and which channels differ at all.
+    lines = ["| scene | " + " | ".join(MODES) + " |", "|---|" + "---|" * len(MODES)]
+    for name in dict.fromkeys(n for n, _, _ in rows):
+        cells = []
+        for mode in MODES:
+            r = next(r for n, m, r in rows if n == name and m == mode)
+            differs = "" if r["channels"] == "all" else f", {r['channels']} differ"
+            wrong = f", {r['off']} px > 1/255, {r['disagree']} hit/miss" if r["off"] or r["disagree"] else ""
+            cells.append(f"{r['largest']:.1f}/255{differs}{wrong}")
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
     worst = max(r["largest"] for _, _, r in rows)
     identical = sum(r["channels"] == "all" for _, _, r in rows)
     summary = (f"{len(rows)} renders: largest colour difference {worst:.1f}/255; every channel bit for bit in "
