@@ -482,14 +482,15 @@ void hit_records(uint count, const LaneRays* rays, const LaneRays* at, const Lan
   }
 }
 
-#if LANES > 1 && RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN && DEGREE <= 15
+#if LANES > 1 && RAY_ORIGIN == ALGRAY_ORIGIN_SCREEN
 #define SCREEN_LANES 1
 /* The screen form's coefficients for a group of lanes at once: screen_ray_taylor, restrict_from_taylor and
- * bernstein_from_scaled over lanes, each lane with the operations of the vector Horner steps that those run one
- * ray at a time (restrict.h), so every lane's coefficients are the one-ray build's bit for bit (tests/test_lanes).
- * One ray's steps are chains of dependent vector operations; over lanes the D + 1 coefficients' chains run side
- * by side. row: the image row's polynomials (screen_rows); xi: each lane's column; tau_in, tau_out: each lane's
- * segment about the row's t0. */
+ * bernstein_from_scaled over lanes, each lane with the operations that those run one ray at a time (restrict.h:
+ * vector Horner steps up to degree 15, the unrolled arrays above), so every lane's coefficients are the one-ray
+ * build's bit for bit (tests/test_lanes). One ray's steps are chains of dependent operations; over lanes the D + 1
+ * coefficients' chains run side by side (above degree 15 too, where a camera ray restricted one at a time made
+ * float 0.63-0.70x double's rate; bench/RESULTS.md, "Float against double, per degree"). row: the image row's
+ * polynomials (screen_rows); xi: each lane's column; tau_in, tau_out: each lane's segment about the row's t0. */
 ALGRAY_INLINE void screen_coefficients(__global const REAL* row, LREAL xi, LREAL tau_in, LREAL tau_out,
                                        __constant const REAL* binomials, LREAL* out) {
   LREAL taylor[NCOEF];
@@ -508,7 +509,8 @@ ALGRAY_INLINE void screen_coefficients(__global const REAL* row, LREAL xi, LREAL
     /* acc_mul_linear: l0 c + l1 (c shifted up one, a zero below) */
     ALGRAY_UNROLL
     for (int k = DEGREE; k > 0; --k) c[k] = l0 * c[k] + l1 * c[k - 1];
-    c[0] = l0 * c[0] + l1 * (LREAL)0;
+    /* the vector step adds the shifted-in zero (a -0 becomes +0); poly_mul_linear, above degree 15, does not */
+    c[0] = DEGREE <= 15 ? l0 * c[0] + l1 * (LREAL)0 : l0 * c[0];
     /* acc_add_constant */
     if (RESTRICT_BERNSTEIN) {
       ALGRAY_UNROLL
