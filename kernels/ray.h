@@ -167,11 +167,10 @@ LREAL lane_pixel_centres(uint px0) {
 #undef LANE_INDEX
 }
 
-/* The camera rays of pixels px0 .. px0 + LANES - 1 of row py, one per lane (the formula above). */
-LaneRays camera_rays(uint px0, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4 du, REAL4 dv) {
+/* The camera rays through the pixel centres (fx, fy), one per lane (the formula above). */
+ALGRAY_INLINE LaneRays camera_rays_through(LREAL fx, REAL fy, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4 du,
+                                           REAL4 dv) {
 #pragma OPENCL FP_CONTRACT OFF
-  const LREAL fx = lane_pixel_centres(px0);
-  const REAL fy = (REAL)py + (REAL)0.5;
   LaneRays r;
   r.ox = CAMERA_AXIS(fx, fy, o00.x, ou.x, ov.x);
   r.oy = CAMERA_AXIS(fx, fy, o00.y, ou.y, ov.y);
@@ -180,6 +179,11 @@ LaneRays camera_rays(uint px0, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00
   r.dy = CAMERA_AXIS(fx, fy, d00.y, du.y, dv.y);
   r.dz = CAMERA_AXIS(fx, fy, d00.z, du.z, dv.z);
   return r;
+}
+
+/* The camera rays of pixels px0 .. px0 + LANES - 1 of row py, one per lane. */
+LaneRays camera_rays(uint px0, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4 du, REAL4 dv) {
+  return camera_rays_through(lane_pixel_centres(px0), (REAL)py + (REAL)0.5, o00, ou, ov, d00, du, dv);
 }
 
 #endif /* ALGRAY_RAY_H */

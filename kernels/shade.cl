@@ -46,14 +46,7 @@ ALGRAY_INLINE LaneRays shade_camera_rays(uint px0, uint step, uint py, uint in_f
 #define PIXEL_CENTRE(j) ((REAL)(px0 + (j)*step) + (REAL)0.5)
   const LREAL fx = LANES_OF(LREAL, PIXEL_CENTRE);
 #undef PIXEL_CENTRE
-  const REAL fy = (REAL)py + (REAL)0.5;
-  r.ox = CAMERA_AXIS(fx, fy, o00.x, ou.x, ov.x);
-  r.oy = CAMERA_AXIS(fx, fy, o00.y, ou.y, ov.y);
-  r.oz = CAMERA_AXIS(fx, fy, o00.z, ou.z, ov.z);
-  r.dx = CAMERA_AXIS(fx, fy, d00.x, du.x, dv.x);
-  r.dy = CAMERA_AXIS(fx, fy, d00.y, du.y, dv.y);
-  r.dz = CAMERA_AXIS(fx, fy, d00.z, du.z, dv.z);
-  return r;
+  return camera_rays_through(fx, (REAL)py + (REAL)0.5, o00, ou, ov, d00, du, dv);
 }
 
 /* The lanes' hits as the shading needs them: point, normal, material values, and which surface and side. */
