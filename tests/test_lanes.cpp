@@ -60,7 +60,6 @@ TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") 
   cases.push_back({10, Precision::Float, "auto", {2, 4, 16}});
   cases.push_back({9, Precision::Double, "auto", {2, 4, 16}});  // the screen form's lanes (screen_coefficients)
   cases.push_back({9, Precision::Adaptive, "auto", {16}});      // with adaptive's noise (screen_terms)
-  cases.push_back({24, Precision::Float, "auto", {16}});  // adaptive's kernels above the vector widths (arrays)
   std::size_t hits = 0;
   for (std::size_t index = 0; index < cases.size(); ++index) {
     const Case& c = cases[index];

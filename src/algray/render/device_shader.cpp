@@ -24,8 +24,9 @@ std::size_t round_up(std::size_t n, std::size_t to) { return (n + to - 1) / to *
 }  // namespace
 
 DeviceShader::DeviceShader(ClSession& session, ProgramCache& cache, const Scene& scene, const Shader& shader)
-    : session_(session), shader_(shader), in_double_(session.info.fp64), samples_(shader.samples()) {
+    : session_(session), shader_(shader), samples_(shader.samples()) {
   const KernelConfig config = shading_config(session.info);
+  in_double_ = config.precision == Precision::Double;
   lanes_ = config.lanes;
   kernel_ = cache.kernel(session, config, &program_);
   const Precision precision = config.precision;
