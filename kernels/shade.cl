@@ -173,11 +173,13 @@ ALGRAY_INLINE LaneHits lane_hits(const HitRecord rec[LANES], const size_t at[LAN
                                  __global const REAL* materials) {
 #pragma OPENCL FP_CONTRACT OFF
   LaneHits h;
+  uint surface[LANES]; /* which surface each lane's hit is on */
+  for (uint j = 0; j < LANES; ++j) surface[j] = several_surfaces ? (uint)hit_surface[at[j]] : 0u;
 #define REC_T(j) ((REAL)rec[j].t_hi + (REAL)rec[j].t_lo)
 #define REC_NX(j) ((REAL)rec[j].normal_x)
 #define REC_NY(j) ((REAL)rec[j].normal_y)
 #define REC_NZ(j) ((REAL)rec[j].normal_z)
-#define REC_SURFACE(j) ((LANE_INT)(several_surfaces ? hit_surface[at[j]] : 0))
+#define REC_SURFACE(j) ((LANE_INT)surface[j])
   h.t = LANES_OF(LREAL, REC_T);
   h.nx = LANES_OF(LREAL, REC_NX);
   h.ny = LANES_OF(LREAL, REC_NY);
@@ -195,8 +197,7 @@ ALGRAY_INLINE LaneHits lane_hits(const HitRecord rec[LANES], const size_t at[LAN
   uint material[LANES];
   uint mixed = 0;
   for (uint j = 0; j < LANES; ++j) {
-    material[j] = (2 * (several_surfaces ? (uint)hit_surface[at[j]] : 0u) + ((rec[j].flags & ALGRAY_HIT_BACK) ? 1u : 0u)) *
-                  ALGRAY_MATERIAL_VALUES;
+    material[j] = (2 * surface[j] + ((rec[j].flags & ALGRAY_HIT_BACK) ? 1u : 0u)) * ALGRAY_MATERIAL_VALUES;
     mixed |= material[j] ^ material[0];
   }
   for (uint v = 0; v < ALGRAY_MATERIAL_VALUES; ++v) {

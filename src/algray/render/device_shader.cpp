@@ -26,7 +26,7 @@ std::size_t round_up(std::size_t n, std::size_t to) { return (n + to - 1) / to *
 DeviceShader::DeviceShader(ClSession& session, ProgramCache& cache, const Scene& scene, const Shader& shader)
     : session_(session), shader_(shader), samples_(shader.samples()) {
   const KernelConfig config = shading_config(session.info);
-  in_double_ = config.precision == Precision::Double;
+  precision_ = config.precision;
   lanes_ = config.lanes;
   kernel_ = cache.kernel(session, config, &program_);
   const Precision precision = config.precision;
@@ -128,7 +128,7 @@ void DeviceShader::bind_film(FrameImage& film, int film_y0, bool alone) {
     ensure(film_depth_, film_depth_bytes_, 0, CL_MEM_WRITE_ONLY);
     ensure(film_normal_, film_normal_bytes_, 0, CL_MEM_WRITE_ONLY);
   }
-  KernelBinder args(kernel_, "shade", in_double_ ? Precision::Double : Precision::Float);
+  KernelBinder args(kernel_, "shade", precision_);
   args.plain("film_rgba", film_rgba_);
   args.plain("film_depth", film_depth_);
   args.plain("film_normal", film_normal_);
@@ -164,7 +164,7 @@ void DeviceShader::upload_shadows(const ShadeTile& tile) {
   if (!occlusion_row_.empty())
     session_.queue.enqueueWriteBuffer(light_occlusion_, CL_FALSE, 0, occlusion_row_.size() * sizeof(cl_int),
                                       occlusion_row_.data());
-  KernelBinder args(kernel_, "shade", in_double_ ? Precision::Double : Precision::Float);
+  KernelBinder args(kernel_, "shade", precision_);
   args.plain("point_of_hit", point_of_hit_);
   args.plain("occlusion_masks", masks_);
   args.plain("occlusion_stride", static_cast<cl_uint>(points));
@@ -194,9 +194,10 @@ PrimarySummary DeviceShader::shade(const ShadeTile& tile, double& kernel_ms) {
   const std::size_t pixels_x = static_cast<std::size_t>(tile.trace_w / samples_),
                     pixels_y = static_cast<std::size_t>(tile.trace_h / samples_);
   const std::size_t side = ALGRAY_SHADE_GROUP_SIDE;
-  const std::size_t groups = round_up((pixels_x + static_cast<std::size_t>(lanes_) - 1) / static_cast<std::size_t>(lanes_), side) / side *
-                             (round_up(pixels_y, side) / side);
-  KernelBinder args(kernel_, "shade", in_double_ ? Precision::Double : Precision::Float);
+  // LANES pixels of a row per work-item, in square groups.
+  const std::size_t items_x = (pixels_x + static_cast<std::size_t>(lanes_) - 1) / static_cast<std::size_t>(lanes_);
+  const std::size_t groups = round_up(items_x, side) / side * (round_up(pixels_y, side) / side);
+  KernelBinder args(kernel_, "shade", precision_);
   args.plain("tile_x0", static_cast<cl_uint>(tile.trace_x0));
   args.plain("tile_y0", static_cast<cl_uint>(tile.trace_y0));
   args.plain("tile_w", static_cast<cl_uint>(tile.trace_w));
@@ -207,7 +208,7 @@ PrimarySummary DeviceShader::shade(const ShadeTile& tile, double& kernel_ms) {
   args.plain("hit_surface", surface_);
   upload_shadows(tile);
   if (tile.secondary) {
-    secondary_staging_.pack(rays, in_double_, [&](std::size_t k) { return tile.secondary[k]; });
+    secondary_staging_.pack(rays, precision_ == Precision::Double, [&](std::size_t k) { return tile.secondary[k]; });
     ensure(secondary_, secondary_bytes_, secondary_staging_.bytes(), CL_MEM_READ_ONLY);
     secondary_staging_.write(session_.queue, secondary_);
   } else {
@@ -221,7 +222,6 @@ PrimarySummary DeviceShader::shade(const ShadeTile& tile, double& kernel_ms) {
   args.plain("summary", summary_);
 
   cl::Event done;
-  const std::size_t items_x = (pixels_x + static_cast<std::size_t>(lanes_) - 1) / static_cast<std::size_t>(lanes_);
   session_.queue.enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(round_up(items_x, side), round_up(pixels_y, side)),
                                       cl::NDRange(side, side), nullptr, &done);
   summary_staging_.resize(groups * ALGRAY_SUMMARY_VALUES);

@@ -54,7 +54,7 @@ class DeviceShader {
   const Shader& shader_;
   ProgramRecord program_;
   cl::Kernel kernel_;
-  bool in_double_ = false;
+  Precision precision_ = Precision::Double;  // the kernel's REAL: double where the device has fp64
   int samples_ = 1;
   int lanes_ = 1;  // pixels of a row per work-item
   std::vector<int> occlusion_row_;  // per scene light: its row in a tile's ShadowData::occlusion, or -1
