@@ -74,7 +74,7 @@ fi
 phase "sanitizer build done"
 ctest --test-dir build-sanitize -L fast --output-on-failure --timeout 900 -j"$(nproc)"
 phase "fast tests passed under the sanitizers"
-# Each fuzzer runs 20 s from its seeds on one core (a smoke test of the readers; docs/fuzzing.md has the hour-long
+# Each fuzzer runs 10 s from its seeds on one core (a smoke test of the readers; docs/fuzzing.md has the hour-long
 # runs); the tests print their runs and coverage.
 ctest --test-dir build-sanitize -L fuzz -j"$(nproc)" --output-on-failure --verbose
 phase "fuzzers found nothing"

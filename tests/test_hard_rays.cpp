@@ -45,7 +45,7 @@ std::string scene_without_fov(const std::string& file) {
 
 // One renderer for the whole file, with an in-memory program cache: the rays below share a few programs.
 Renderer& renderer() {
-  static ProgramCache cache(true, std::filesystem::temp_directory_path() / "algray-test-hard-rays-cache");
+  static ProgramCache cache(true, {});
   static Renderer r(testing::device_session(), cache);
   return r;
 }

@@ -10,6 +10,7 @@
 #include "algray/render/renderer.h"
 #include "algray/scene/scene.h"
 #include "sweep.h"
+#include "temp_dir.h"
 #include "test_support.h"
 
 using namespace algray;
@@ -98,6 +99,29 @@ TEST_CASE("every DEGREE from 1 to 32 builds and finds the smallest root, in floa
       check_known_root(result, degree, precision);
     }
   }
+}
+
+TEST_CASE("a program cache without a directory keeps programs in memory and writes no file", "[kernels][cache]") {
+  ClSession& session = testing::device_session();
+  // Entries would land in the working directory (an empty directory joined to a name), so work in an empty one.
+  const testing::TempDir work("memory-cache");
+  const std::filesystem::path was = std::filesystem::current_path();
+  std::filesystem::current_path(work.path());
+  ProgramCache memory_only(true, {});
+  Renderer renderer(session, memory_only);
+  const Scene scene = degree_scene(2, "double");
+  const RenderResult first = renderer.render_with_records(scene);
+  const RenderResult again = renderer.render_with_records(scene);
+  int measured = 0;
+  memory_only.remembered(session.info, "test-measurement", [&] { return ++measured, 1.0; });
+  memory_only.remembered(session.info, "test-measurement", [&] { return ++measured, 2.0; });
+  std::filesystem::current_path(was);
+  REQUIRE(!first.programs.empty());
+  CHECK(first.programs[0].origin == "built");
+  REQUIRE(again.programs.size() == first.programs.size());
+  for (const ProgramRecord& p : again.programs) CHECK(p.origin == "memory");
+  CHECK(measured == 1);
+  CHECK(work.entries().empty());
 }
 
 TEST_CASE("the paper's power-basis method and plain bisection build and find the same root", "[kernels]") {

@@ -51,7 +51,7 @@ const std::filesystem::path& cache_dir() {
 }
 
 ProgramCache& test_cache() {
-  static ProgramCache cache(true, cache_dir());
+  static ProgramCache cache(true, {});  // memory only: a disk entry costs PoCL a compile (program_cache.h)
   return cache;
 }
 

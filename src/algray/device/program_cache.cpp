@@ -127,11 +127,11 @@ cl::Kernel ProgramCache::kernel(ClSession& session, const KernelConfig& config, 
     rec.origin = "memory";
   } else {
     const std::filesystem::path file = dir_ / (hex64(fnv1a(identity)) + ".bin");
-    if (enabled_ && load_from_disk(session, file, identity, options, program)) {
+    if (on_disk() && load_from_disk(session, file, identity, options, program)) {
       rec.origin = "disk";
     } else {
       program = build_from_source(session, source.text, options, rec.key);
-      if (enabled_) store_on_disk(program, file, identity);
+      if (on_disk()) store_on_disk(program, file, identity);
     }
     if (enabled_) memory_[memory_key] = program;
   }
@@ -146,16 +146,16 @@ double ProgramCache::remembered(const DeviceInfo& device, const std::string& nam
   const std::string identity = "measurement=" + name + "\n" + device_identity(device);
   const std::filesystem::path file = dir_ / (hex64(fnv1a(identity)) + ".measured");
   std::string payload;
-  if (enabled_ && read_entry(file, identity, payload)) {
+  if (on_disk() && read_entry(file, identity, payload)) {
     char* end = nullptr;
     const double value = std::strtod(payload.c_str(), &end);
     if (end != payload.c_str() && std::isfinite(value) && value > 0) return value;
   }
-  if (!enabled_)
+  if (!on_disk())
     if (const auto kept = measured_.find(identity); kept != measured_.end()) return kept->second;
   const double value = measure();
-  if (!enabled_) measured_[identity] = value;
-  if (enabled_) {
+  if (!on_disk()) measured_[identity] = value;
+  if (on_disk()) {
     char text[64];
     std::snprintf(text, sizeof text, "%.17g", value);
     // A cache that cannot be written just measures again, with a word why.

@@ -34,6 +34,10 @@ void set_cache_warning_handler(std::function<void(const std::string&)> handler);
 class ProgramCache {
  public:
   // enabled = false is `--no-cache`: every program is compiled from source and nothing is kept or stored.
+  // An empty `dir` keeps programs in this object's memory only. On PoCL that saves a compile per program:
+  // asking a built program for its binary, as the disk store must, makes PoCL compile every kernel in it once
+  // more for a work-group size fixed only at launch (about 1 s at degree 10), a cost worth paying only where a
+  // later process reads the entry.
   explicit ProgramCache(bool enabled, std::filesystem::path dir = default_directory());
 
   // The kernel named config.entry, from the cheapest place that has a valid program.
@@ -41,8 +45,8 @@ class ProgramCache {
 
   // A number measured on a device, such as its double arithmetic's speed: read from the cache directory when it
   // was measured before on this device and driver, otherwise measured now (`measure` opens the device only
-  // then) and kept there. With the cache off it is measured once for this object's life (a render asks on
-  // every frame), and never stored.
+  // then) and kept there. Without a directory, or with the cache off, it is measured once for this object's life
+  // (a render asks on every frame), and never stored.
   double remembered(const DeviceInfo& device, const std::string& name, const std::function<double()>& measure);
 
   // $ALGRAY_CACHE_DIR, else $XDG_CACHE_HOME/algray, else ~/.cache/algray.
@@ -75,8 +79,10 @@ class ProgramCache {
   // (and 1-3 ms of every frame of `algray view`). Files read from ALGRAY_KERNEL_DIR are read every time.
   const AssembledSource& assembled_source(const std::string& entry_file);
 
+  bool on_disk() const { return enabled_ && !dir_.empty(); }
+
   bool enabled_;
-  std::filesystem::path dir_;
+  std::filesystem::path dir_;  // empty: memory only
   std::map<std::string, AssembledSource> sources_;  // by entry file, embedded sources only
   AssembledSource from_kernel_dir_;                 // the last one read from ALGRAY_KERNEL_DIR
   std::map<std::string, cl::Program> memory_;  // keyed by device identity + options + source hash
