@@ -144,26 +144,25 @@ cl::Kernel ProgramCache::kernel(ClSession& session, const KernelConfig& config, 
 double ProgramCache::remembered(const DeviceInfo& device, const std::string& name,
                                 const std::function<double()>& measure) {
   const std::string identity = "measurement=" + name + "\n" + device_identity(device);
+  if (!on_disk()) {
+    const auto [kept, fresh] = measured_.try_emplace(identity, 0.0);
+    if (fresh) kept->second = measure();
+    return kept->second;
+  }
   const std::filesystem::path file = dir_ / (hex64(fnv1a(identity)) + ".measured");
-  std::string payload;
-  if (on_disk() && read_entry(file, identity, payload)) {
+  if (std::string payload; read_entry(file, identity, payload)) {
     char* end = nullptr;
     const double value = std::strtod(payload.c_str(), &end);
     if (end != payload.c_str() && std::isfinite(value) && value > 0) return value;
   }
-  if (!on_disk())
-    if (const auto kept = measured_.find(identity); kept != measured_.end()) return kept->second;
   const double value = measure();
-  if (!on_disk()) measured_[identity] = value;
-  if (on_disk()) {
-    char text[64];
-    std::snprintf(text, sizeof text, "%.17g", value);
-    // A cache that cannot be written just measures again, with a word why.
-    std::error_code ec;
-    std::filesystem::create_directories(dir_, ec);
-    if (!ec) ec = write_entry(file, entry_header(identity, text) + text);
-    if (ec) warn_unusable(ec);
-  }
+  char text[64];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  // A cache that cannot be written just measures again, with a word why.
+  std::error_code ec;
+  std::filesystem::create_directories(dir_, ec);
+  if (!ec) ec = write_entry(file, entry_header(identity, text) + text);
+  if (ec) warn_unusable(ec);
   return value;
 }
 

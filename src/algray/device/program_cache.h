@@ -86,7 +86,7 @@ class ProgramCache {
   std::map<std::string, AssembledSource> sources_;  // by entry file, embedded sources only
   AssembledSource from_kernel_dir_;                 // the last one read from ALGRAY_KERNEL_DIR
   std::map<std::string, cl::Program> memory_;  // keyed by device identity + options + source hash
-  std::map<std::string, double> measured_;     // the cache off: remembered()'s numbers, by identity
+  std::map<std::string, double> measured_;     // no disk: remembered()'s numbers, by identity
 };
 
 }  // namespace algray
