@@ -43,10 +43,9 @@ std::string scene_without_fov(const std::string& file) {
   return text;
 }
 
-// One renderer for the whole file, with an in-memory program cache: the rays below share a few programs.
+// One renderer for the whole file: the rays below share a few programs.
 Renderer& renderer() {
-  static ProgramCache cache(true, {});
-  static Renderer r(testing::device_session(), cache);
+  static Renderer r(testing::device_session(), testing::program_cache());
   return r;
 }
 

@@ -39,8 +39,7 @@ Scene jsurf_scene(const std::string& body, int size = 101) {
 }
 
 HitBuffer render_hits(const Scene& scene) {
-  static ProgramCache cache(true, {});  // memory only: a disk entry costs PoCL a compile (program_cache.h)
-  Renderer renderer(device_session(), cache);
+  Renderer renderer(device_session(), testing::program_cache());
   return renderer.render_with_records(scene).hits;
 }
 

@@ -41,7 +41,7 @@ long first_difference(const std::vector<HitRecord>& a, const std::vector<HitReco
 
 TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   struct Case {
     int degree;
@@ -96,7 +96,7 @@ TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") 
 // doubts are mostly brackets.
 TEST_CASE("lanes settle doubts in float-float as the one-ray kernel does, bit for bit", "[lanes]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   for (const char* name : {"tooth_cubed", "chebyshev_decic", "torus_shell"}) {
     const std::string file = std::string(ALGRAY_SOURCE_DIR) + "/tests/data/hard_surfaces/" + name + ".toml";
@@ -128,7 +128,7 @@ TEST_CASE("lanes settle discard doubts in float-float as the one-ray kernel does
     for (const HitRecord& h : r.hits.records) n += (h.flags & ALGRAY_HIT_ESCALATED) != 0;
     return n;
   };
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer with_fp64(testing::device_session(), cache);
   const testing::HiddenFp64 hidden;
   ClSession session(select_device(""));
@@ -159,7 +159,7 @@ TEST_CASE("lanes settle discard doubts in float-float as the one-ray kernel does
 // with and without a sign change; x y z has singular lines; the sphere's rim has tangent rays.
 TEST_CASE("lanes give the one-ray kernel's hit records where groups settle without refining", "[lanes]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   const char* const equations[] = {"z^3", "(z-0.1)^2", "x*y*z", "x^2+y^2+z^2-0.5"};
   for (const std::string equation : equations) {
@@ -197,7 +197,7 @@ TEST_CASE("lanes give the one-ray kernel's hit records where groups settle witho
 // No light casts shadows (the headlight shades): the shadow kernel's lanes are test_shadows_batched's.
 TEST_CASE("secondary rays in lanes give the one-ray kernel's hit records bit for bit", "[lanes]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   std::size_t rays = 0, partial_groups = 0;
   for (int degree : {3, 10}) {  // coefficients filling a float4, and 11 of a float16

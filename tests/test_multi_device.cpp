@@ -50,11 +50,6 @@ const std::filesystem::path& cache_dir() {
   return dir.path();
 }
 
-ProgramCache& test_cache() {
-  static ProgramCache cache(true, {});  // memory only: a disk entry costs PoCL a compile (program_cache.h)
-  return cache;
-}
-
 // A scene the renders are compared on, and what it is for the failure message.
 struct Case {
   std::string what;
@@ -92,8 +87,8 @@ TEST_CASE("device lists: all, indices, repeated name substrings, and the errors"
 
 TEST_CASE("two devices render the one-device image bit for bit, sharing the tiles", "[devices][tiles]") {
   const std::vector<ClSession*> both = two_devices();
-  Renderer one(*both[0], test_cache());
-  Renderer two(both, test_cache());
+  Renderer one(*both[0], testing::program_cache());
+  Renderer two(both, testing::program_cache());
   std::vector<Case> cases;
   // Everything that crosses a tile's border: two surfaces, bounces, an area light's shadows, and adaptive
   // antialiasing, whose choice at a tile's edge needs the neighbouring tiles' first colours from either device.
@@ -154,7 +149,7 @@ TEST_CASE("two devices render the one-device image bit for bit, sharing the tile
 
 TEST_CASE("with two devices the callbacks come one at a time, and cancelling stops both", "[devices][callbacks]") {
   const std::vector<ClSession*> both = two_devices();
-  Renderer two(both, test_cache());
+  Renderer two(both, testing::program_cache());
   Scene scene = testing::ball_and_ring({{"antialias.samples", "2"}});
 
   // The solver channels gathered from both devices' tiles are one device's, and every callback was alone.
@@ -184,7 +179,7 @@ TEST_CASE("with two devices the callbacks come one at a time, and cancelling sto
   CHECK(static_cast<int>(done.size()) == total);
   for (std::size_t i = 0; i < done.size(); ++i) CHECK(done[i] == static_cast<int>(i + 1));
   CHECK(threads.size() >= 2);  // each device's own thread reported its tiles (one pair of threads per sweep)
-  Renderer one(*both[0], test_cache());
+  Renderer one(*both[0], testing::program_cache());
   const SolverWork whole = solver_work(one.render_with_records(scene));
   CHECK(work.isolation_steps == whole.isolation_steps);
   CHECK(work.refine_iterations == whole.refine_iterations);
@@ -229,8 +224,8 @@ TEST_CASE("a render context of several devices renders with all of them and repo
 
 TEST_CASE("bands of rows, on one device or two, put together are the whole image bit for bit", "[devices][bands]") {
   const std::vector<ClSession*> both = two_devices();
-  Renderer one(*both[0], test_cache());
-  Renderer two(both, test_cache());
+  Renderer one(*both[0], testing::program_cache());
+  Renderer two(both, testing::program_cache());
   // Adaptive antialiasing chooses at a band's edge from the rows beyond it; bounces, shadows and two surfaces
   // cross every edge too.
   const std::vector<Case> cases = {

@@ -34,8 +34,7 @@ struct Coverage {
   double x = 0, y = 0;  // the centroid in POV-Ray's units on the plane z = 0, x right and y up
 };
 Coverage coverage(const Scene& scene) {
-  static ProgramCache cache(true, {});  // memory only: a disk entry costs PoCL a compile (program_cache.h)
-  Renderer renderer(device_session(), cache);
+  Renderer renderer(device_session(), testing::program_cache());
   const HitBuffer hits = renderer.render_with_records(scene).hits;
   const double unit = (hits.width / 2.0) / (10 * std::tan(30 * 3.14159265358979 / 180));  // pixels per unit
   Coverage c;
@@ -218,8 +217,7 @@ TEST_CASE("a camera whose direction is not normal to right and up is POV-Ray's o
   CHECK(centre.camera.shift.y == Approx(0.5));
   const Scene corner = load_povray_text(camera + "sphere { <3.0666667, 3.4, 2>, 0.15 }\n", "k.pov",
                                         {{"image.width", "200"}, {"image.height", "150"}, {"antialias.samples", "1"}});
-  static ProgramCache cache(true, {});  // memory only: a disk entry costs PoCL a compile (program_cache.h)
-  Renderer renderer(device_session(), cache);
+  Renderer renderer(device_session(), testing::program_cache());
   for (const auto& [scene, u, v] : {std::tuple{&centre, 0.5, 0.5}, std::tuple{&corner, 0.85, 0.15}}) {
     const HitBuffer hits = renderer.render_with_records(*scene).hits;
     double sx = 0, sy = 0;
@@ -433,8 +431,7 @@ TEST_CASE("bounded_by alone is a gate: the rays that pass the bound see the whol
   CHECK(bounded.extent.reach >= kDefaultGateReach);
   CHECK(bounded.warnings.empty());  // the gate is POV-Ray's rule: nothing to say
   CHECK_THAT(scene_to_toml(bounded), Catch::Contains("gate = true"));
-  static ProgramCache cache(true, {});  // memory only: a disk entry costs PoCL a compile (program_cache.h)
-  Renderer renderer(device_session(), cache);
+  Renderer renderer(device_session(), testing::program_cache());
   const HitBuffer hits = renderer.render_with_records(bounded).hits;
   const RayBasis basis = make_ray_basis(bounded.camera, hits.width, hits.height);
   long both = 0, either = 0, clipped = 0;

@@ -20,11 +20,6 @@ using algray::testing::device_session;
 
 namespace {
 
-ProgramCache& probe_cache() {
-  static ProgramCache cache(true, {});  // memory only: a disk entry costs PoCL a compile (program_cache.h)
-  return cache;
-}
-
 Scene torus_scene(std::vector<Override> extra = {}) {
   std::vector<Override> overrides = {{"antialias.samples", "1"}, {"render.preview", "true"}};
   overrides.insert(overrides.end(), extra.begin(), extra.end());
@@ -94,7 +89,7 @@ TEST_CASE("the probe names the smallest root of the Fig. 8 torus ray and the iso
   for (const Case& c : cases) {
     const KernelConfig config = solver(scene, Precision::Double, c.isolation, c.refinement);
     INFO(to_string(c.isolation) << " + " << to_string(c.refinement));
-    const SolverTrace tr = trace_probe(session, probe_cache(), scene, 0, config, target);
+    const SolverTrace tr = trace_probe(session, testing::program_cache(), scene, 0, config, target);
     REQUIRE(tr.in_extent);
     const double t_in = 5 - std::sqrt(3.5 * 3.5 - kHeight * kHeight);
     CHECK(tr.t_in == Approx(t_in).epsilon(1e-12));
@@ -153,8 +148,8 @@ TEST_CASE("a log too short for the ray keeps its first events and says how many 
   const Scene scene = torus_scene();
   const ProbeTarget target = fig8_ray();
   const KernelConfig config = primary_config(scene, Precision::Double);
-  const SolverTrace full = trace_probe(session, probe_cache(), scene, 0, config, target);
-  const SolverTrace cut = trace_probe(session, probe_cache(), scene, 0, config, target, 8);
+  const SolverTrace full = trace_probe(session, testing::program_cache(), scene, 0, config, target);
+  const SolverTrace cut = trace_probe(session, testing::program_cache(), scene, 0, config, target, 8);
   REQUIRE(full.events_offered == full.events_recorded);
   CHECK(cut.events_offered == full.events_offered);
   CHECK(cut.events_recorded == 8);
@@ -190,7 +185,7 @@ TEST_CASE("a probed pixel gets the render's hit record bit for bit", "[probe]") 
                                      {"render.isolation", toml_string(to_string(c.isolation))},
                                      {"render.refinement", toml_string(to_string(c.refinement))}});
     INFO(to_string(c.precision) << " " << to_string(c.isolation) << " + " << to_string(c.refinement));
-    Renderer renderer(session, probe_cache());
+    Renderer renderer(session, testing::program_cache());
     const RenderResult render = renderer.render_with_records(scene);
     REQUIRE(render.hits.width == 48);
     // The render's first kernel (plain float's is adaptive's float kernel: float_measures_noise); a pixel it
@@ -203,7 +198,7 @@ TEST_CASE("a probed pixel gets the render's hit record bit for bit", "[probe]") 
         ProbeTarget target;
         target.px = px;
         target.py = py;
-        const SolverTrace tr = trace_probe(session, probe_cache(), scene, 0, config, target);
+        const SolverTrace tr = trace_probe(session, testing::program_cache(), scene, 0, config, target);
         const HitRecord& rendered = render.hits.at(px, py);
         INFO("pixel (" << px << ", " << py << ")");
         if (rendered.flags & ALGRAY_HIT_ESCALATED) {

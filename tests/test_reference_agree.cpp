@@ -112,7 +112,7 @@ void check_adaptive_without_fp64(const std::vector<std::filesystem::path>& files
   const testing::HiddenFp64 hidden;
   ClSession session(select_device(""));
   REQUIRE_FALSE(session.info.fp64);
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   for (const auto& file : files) check_scene(renderer, file, "adaptive", "adapt-ff");
 }
@@ -141,7 +141,7 @@ void check_clipped_agreement(Renderer& renderer, const Scene& scene, const Refer
 
 TEST_CASE("the screen form meets the double line on seeded random surfaces of every degree", "[reference]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   // Every degree under the `exhaustive` label; otherwise the ends and a seeded sample (the reference costs ~1 s a
   // degree).
@@ -222,7 +222,7 @@ TEST_CASE(
 
 TEST_CASE("every scene agrees with the certified reference within issue 3's thresholds", "[reference]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   const auto files = scene_files();
   REQUIRE(files.size() >= 12);
@@ -239,7 +239,7 @@ TEST_CASE("every scene agrees with the certified reference within issue 3's thre
 TEST_CASE("a cylinder extent about each axis clips as the certified reference does: 0 disagreements in double",
           "[reference][extent]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   // Small images (64x48): each cylinder cuts its surface open, so many rays end on the cylinder's side or caps.
   struct Case {
@@ -300,7 +300,7 @@ TEST_CASE("a cylinder extent about each axis clips as the certified reference do
 TEST_CASE("clipping planes cut each surface as the certified reference does: 0 disagreements in double",
           "[reference][extent][clip]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   // Seeded planes: one to three per scene, their normals uniform on the sphere, each through a point 0.05 to 0.5
   // of the extent's radius from its centre along the normal, keeping the centre's side: every plane cuts the
@@ -375,7 +375,7 @@ TEST_CASE("clipping planes cut each surface as the certified reference does: 0 d
 TEST_CASE("a gate passes the rays that meet it, which see the surface beyond it, as the certified reference does",
           "[reference][extent][gate]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   // Two quartics (one degree: the same kernels) at 64x48, each gated by a shape smaller than the surface: the
   // Kummer surface's arms, which run to infinity, through a sphere; the torus through a box, cut by a plane too.
@@ -441,7 +441,7 @@ TEST_CASE("a gate passes the rays that meet it, which see the surface beyond it,
 TEST_CASE("plain float on the cancelling degree-8 and degree-10 surfaces (known to miss the line)",
           "[reference][!shouldfail]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   for (const auto& file : scene_files())
     if (kFloatNotYet.count(file.stem().string())) check_scene(renderer, file, "float");
@@ -450,7 +450,7 @@ TEST_CASE("plain float on the cancelling degree-8 and degree-10 surfaces (known 
 TEST_CASE("adaptive float holds the float line on harder surfaces of degree 7 to 12, where plain float fails",
           "[reference]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   const auto files = hard_surfaces();
   REQUIRE(files.size() >= 5);
@@ -478,7 +478,7 @@ TEST_CASE("adaptive float agrees with the certified reference wherever it differ
   // (A trial that held camera rays to the noise local to an interval, as shadow rays are, at ALGRAY_LOCAL_FACTOR
   // 1, left two certified Endrass octic pixels without their close pair of roots here.)
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   for (const char* name : {"endrass_octic", "barth_decic"}) {
     auto scene_in = [&](const char* precision) {

@@ -160,7 +160,7 @@ int significant_sign_changes(const Scan& s, Real t_limit, Real noise) {
 
 TEST_CASE("each scene agrees with an independent CPU check on a seeded sample of pixels", "[scenes]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   const std::vector<std::filesystem::path> files = testing::scene_files();
   REQUIRE(files.size() >= 12);

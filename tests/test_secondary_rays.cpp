@@ -87,7 +87,7 @@ void check_batches(const RenderResult& r, const std::vector<Sphere>& spheres, Pa
 
 TEST_CASE("transmission rays continue to the next root: nested spheres", "[secondary]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   // Radii 1 and 2 around the origin; both sides of both transparent, so rays pass through up to four sheets.
   const Scene scene =
@@ -104,7 +104,7 @@ TEST_CASE("transmission rays continue to the next root: nested spheres", "[secon
 
 TEST_CASE("reflection rays leave by the mirror direction and find the other sphere", "[secondary]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   const Scene scene = sphere_scene("((x-1.3)^2+y^2+z^2-1)*((x+1.3)^2+y^2+z^2-1)",
                                    {"[material.front]", "reflectivity = 0.5", "[render]", "precision = \"double\""});
@@ -119,7 +119,7 @@ TEST_CASE("reflection rays leave by the mirror direction and find the other sphe
 
 TEST_CASE("a transparent side without a transmission pass shows opaque, not darkened", "[secondary]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   for (const char* how : {"preview = true", "max_depth = 0"}) {
     INFO(how);
@@ -137,7 +137,7 @@ TEST_CASE("a transparent side without a transmission pass shows opaque, not dark
 
 TEST_CASE("tiles and batches change no pixel: small ones render the one-tile image bit for bit", "[secondary][tiles]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   // Full mode with everything that crosses a tile's border or fills a batch: two surfaces, a reflective ball
   // and a transparent ring (bounces), an area light's shadows, and adaptive antialiasing, whose choice at a
@@ -201,7 +201,7 @@ TEST_CASE("tiles and batches change no pixel: small ones render the one-tile ima
 
 TEST_CASE("without records a render keeps the film and the totals, not every ray", "[secondary][tiles]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   Scene scene = ball_and_ring({});
   scene.render.tile_size = 16;
@@ -241,7 +241,7 @@ TEST_CASE("without records a render keeps the film and the totals, not every ray
 TEST_CASE("adaptive precision escalates camera, shadow, reflected and transmitted rays alike, counted per pass",
           "[secondary][adaptive]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   std::ifstream in(std::string(ALGRAY_SOURCE_DIR) + "/tests/data/hard_surfaces/kummer_shell.toml");
   std::stringstream text;

@@ -74,7 +74,7 @@ glm::dvec3 phong(const Scene& scene, const HitRecord& h, const PixelRay& ray, co
 
 TEST_CASE("every hit's colour is Phong over the light points the shadow pass left, bit for bit", "[shading]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   for (bool preview : {false, true}) {
     for (const char* precision : {"double", "float"}) {
@@ -131,7 +131,7 @@ TEST_CASE("every hit's colour is Phong over the light points the shadow pass lef
 TEST_CASE("a section plane through the unit sphere marks the ring where it cuts the sphere, closed and one pixel wide",
           "[shading][section]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   // The plane z = 0.5, seen from +z: a circle of radius sqrt(0.75) on the near half of the sphere.
   const std::string base =
@@ -190,7 +190,7 @@ TEST_CASE("a section of one surface marks that surface only, and a section `widt
           "many pixels",
           "[shading][section]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   // Two unit balls side by side, seen from +z; the plane z = 0.5 cuts both in a ring of radius sqrt(0.75).
   const std::string base =
@@ -243,7 +243,7 @@ TEST_CASE("a section of one surface marks that surface only, and a section `widt
 
 TEST_CASE("a section seen through a transparent surface is as wide as one seen directly", "[shading][section]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   // The ring where z = 0.5 cuts the unit ball, seen from +z, directly and through the clear plane z = 1.5: the
   // transmitted ray starts at the plane, and its pixel's footprint still grows with the distance from the eye.
@@ -275,7 +275,7 @@ TEST_CASE("the shading kernel's film and totals are the host's shading of the sa
   without_fp64.fp64 = false;
   without_fp64.fp64_hidden = true;
   ClSession float_session(without_fp64);
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   // Full mode and preview (lights, shadows, both sides; 2x2 samples per pixel), the headlight, and sections of two
   // surfaces with bounces and adaptive antialiasing, each in an image whose width is no multiple of the kernel's
   // lanes and work-groups.

@@ -135,7 +135,7 @@ Tally check_shadow_rays(Precision precision, RayOrigin origin, int rays_per_scen
                         const std::vector<Override>& extra = {},
                         const std::vector<const char*>& scenes = {std::begin(kScenes), std::end(kScenes)}) {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   Tally tally;
   // Built piecewise: GCC 12 warns falsely (-Wrestrict) about "\"" + std::string + "\"".
@@ -344,7 +344,7 @@ TEST_CASE("adaptive shadow rays that settle_doubts settles are only doubted ones
   // noise of each interval, and a certain sign change at 16 points) against the same kernel without it, on the
   // scenes whose shadow rays it doubts most.
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   int certified_total = 0;
   for (const char* file : {"barth_decic.toml", "endrass_octic.toml"}) {
@@ -411,7 +411,7 @@ TEST_CASE(
                               {"barth_decic.toml", RayOrigin::Point, false, Precision::Double},
                               {"endrass_octic.toml", RayOrigin::Point, true, Precision::Mixed}};
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   for (const Pairing& p : pairings) {
     const PairedRays r = paired_rays(renderer, p.file, kSeed + 11);

@@ -74,10 +74,7 @@ struct TracerPair {
                 shadow_config(scene, precision, isolation, "shadow", origin, settle_doubts), surface, offset),
         serial(testing::device_session(), cache(),
                shadow_config(scene, precision, isolation, "shadow_serial", origin, settle_doubts), surface, offset) {}
-  static ProgramCache& cache() {
-    static ProgramCache c(false);
-    return c;
-  }
+  static ProgramCache& cache() { return testing::program_cache(); }
   DeviceSurface surface;
   double offset;
   ShadowTracer batched, serial;

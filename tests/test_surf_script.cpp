@@ -26,8 +26,7 @@ Scene surf_scene(const std::string& body, int width = kSize, int height = kSize)
 }
 
 HitBuffer render_hits(const Scene& scene) {
-  static ProgramCache cache(true, {});  // memory only: a disk entry costs PoCL a compile (program_cache.h)
-  Renderer renderer(device_session(), cache);
+  Renderer renderer(device_session(), testing::program_cache());
   return renderer.render_with_records(scene).hits;
 }
 

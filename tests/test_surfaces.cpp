@@ -37,7 +37,7 @@ double t_of(const HitRecord& h) { return static_cast<double>(h.t_hi) + static_ca
 
 TEST_CASE("a scene's surfaces each get their own kernel, and the nearest hit wins", "[surfaces]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   const Scene scene = two_surfaces();
   REQUIRE(scene.surfaces.size() == 2);
@@ -81,7 +81,7 @@ TEST_CASE("a scene's surfaces each get their own kernel, and the nearest hit win
 
 TEST_CASE("shadows and bounces see every surface", "[surfaces]") {
   ClSession& session = testing::device_session();
-  ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
   // A low light on +x: the ball shades the far (-x) side of the ring, which alone would be lit there.
   const std::string light = "[[light]]\nposition = [4, 3, 0]\n";

@@ -159,7 +159,7 @@ const std::vector<CaseReference>& case_references(const std::vector<Poly>& exact
 // checks each against the reference. The polynomials go to the kernel in the basis its isolation works in.
 void check_solver(const KernelConfig& solver, int max_degree) {
   ClSession& session = testing::device_session();
-  static ProgramCache cache(false);
+  ProgramCache& cache = testing::program_cache();
   {
     const Precision precision = solver.precision;
     const bool is_double = precision == Precision::Double, is_mixed = precision == Precision::Mixed;

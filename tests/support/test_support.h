@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "algray/device/cl_runtime.h"
+#include "algray/device/program_cache.h"
 
 namespace algray::testing {
 
@@ -26,6 +27,16 @@ inline ClSession& device_session() {
     session = std::make_unique<ClSession>(select_device(""));
   }
   return *session;
+}
+
+// One program cache for the whole test executable, in memory only. Every test that builds kernels through it
+// compiles each configuration once per process: a cache per test case, or `--no-cache`'s ProgramCache(false),
+// built every program again on every render through PoCL's own cache (60-130 ms each, some 1,300 times in a
+// cold suite). Memory only, because a disk entry costs PoCL a compile (program_cache.h). The tests of the
+// cache itself make their own.
+inline ProgramCache& program_cache() {
+  static ProgramCache cache(true, {});
+  return cache;
 }
 
 // Sets ALGRAY_NO_FP64 for one scope, and puts back what was there: devices enumerated (and sessions opened) in it
