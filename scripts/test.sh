@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds algray and runs the whole test suite, then the fast tests and fuzzers under ASan+UBSan.
+# Installs what is missing, builds algray and runs the whole test suite, then the host-side tests and fuzzers under ASan+UBSan.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -32,7 +32,7 @@ cmake --build build -j"$(nproc)"
 scripts/install-python.sh
 phase "release build done"
 # The same code once more under AddressSanitizer and UndefinedBehaviorSanitizer, in a clang tree of its own that
-# builds only what `ctest -L fast` and the fuzzers need (docs/fuzzing.md). Debug: -O0 compiles twice as fast.
+# builds only what `ctest -L sanitize` (tests/CMakeLists.txt says which) and the fuzzers need (docs/fuzzing.md). Debug: -O0 compiles twice as fast.
 # clang++-15 is the clang PoCL itself depends on in Debian 12, and its compiler-rt (ASan, UBSan, libFuzzer) comes
 # with it; any other clang++ with those runtimes will do.
 cxx=
@@ -55,7 +55,7 @@ sanitize_log=build-sanitize/build.log
 # Job control gives it a process group of its own, which a failing test's exit takes down with its compilers; not
 # setsid, whose new session would be a scheduling group of its own (autogroup), where nice counts for nothing.
 set -m
-nice -n 19 cmake --build build-sanitize -j"$(nproc)" --target algray_fast_tests algray_fuzzers > "$sanitize_log" 2>&1 &
+nice -n 19 cmake --build build-sanitize -j"$(nproc)" --target algray_sanitize_tests algray_fuzzers > "$sanitize_log" 2>&1 &
 sanitize_build=$!
 set +m
 # '|| true': set -e holds in the trap too, and the build has usually ended by then (kill then fails).
@@ -72,8 +72,8 @@ if ! wait "$sanitize_build"; then
   exit 1
 fi
 phase "sanitizer build done"
-ctest --test-dir build-sanitize -L fast --output-on-failure --timeout 900 -j"$(nproc)"
-phase "fast tests passed under the sanitizers"
+ctest --test-dir build-sanitize -L sanitize --output-on-failure --timeout 900 -j"$(nproc)"
+phase "sanitize-labelled tests passed under the sanitizers"
 # Each fuzzer runs 10 s from its seeds on one core (a smoke test of the readers; docs/fuzzing.md has the hour-long
 # runs); the tests print their runs and coverage.
 ctest --test-dir build-sanitize -L fuzz -j"$(nproc)" --output-on-failure --verbose
