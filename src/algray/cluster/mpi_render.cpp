@@ -31,7 +31,7 @@ namespace {
 // them), which asks for the next; its failure (the reason follows on kTextTag); or, when rank 0 had no more
 // bands, its tally of everything it rendered (on kTextTag). Rank 0 answers the first two with {next band or
 // kNoBand, its first row, its end row, whether to send depth and normal}.
-constexpr int kRequestTag = 11;
+constexpr int kBandRequestTag = 11;
 constexpr int kPixelsTag = 12;
 constexpr int kTextTag = 13;
 constexpr int kReplyTag = 14;
@@ -224,7 +224,7 @@ class Gatherer {
     for (int active = workers; active > 0;) {
       int arrived = 0;
       MPI_Status status;
-      MPI_Iprobe(MPI_ANY_SOURCE, kRequestTag, MPI_COMM_WORLD, &arrived, &status);
+      MPI_Iprobe(MPI_ANY_SOURCE, kBandRequestTag, MPI_COMM_WORLD, &arrived, &status);
       idle();
       if (!arrived) {
         std::this_thread::sleep_for(kMpiPollInterval);
@@ -232,7 +232,7 @@ class Gatherer {
       }
       const int source = status.MPI_SOURCE;
       int header[3];
-      MPI_Recv(header, 3, MPI_INT, source, kRequestTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      MPI_Recv(header, 3, MPI_INT, source, kBandRequestTag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
       if (header[1] == kFinished || header[1] == kFailed) {
         const std::string text = receive_text(source, header[2]);
         if (header[1] == kFinished)
@@ -365,7 +365,7 @@ RenderResult render_bands_as_rank0(Renderer& renderer, const Scene& scene, const
 void render_bands_as_worker(Renderer* renderer, const Scene& scene, const std::string& cannot_render) {
   auto send_text = [](WorkerStatus status, const std::string& text) {
     const int header[3] = {kNoBand, status, static_cast<int>(text.size())};
-    send_sleeping(header, 3, MPI_INT, kRequestTag);
+    send_sleeping(header, 3, MPI_INT, kBandRequestTag);
     send_sleeping(text.data(), static_cast<int>(text.size()), MPI_CHAR, kTextTag);
   };
   // Told to rank 0 as a failure, so that the render fails on every rank rather than waits for this one.
@@ -377,7 +377,7 @@ void render_bands_as_worker(Renderer* renderer, const Scene& scene, const std::s
   bands.next_band = [&]() -> std::optional<RenderOptions::RowBand> {
     if (!asked) {
       const int header[3] = {kNoBand, kFirstRequest, 0};
-      send_sleeping(header, 3, MPI_INT, kRequestTag);
+      send_sleeping(header, 3, MPI_INT, kBandRequestTag);
     }
     asked = false;
     int reply[4];
@@ -391,7 +391,7 @@ void render_bands_as_worker(Renderer* renderer, const Scene& scene, const std::s
   };
   bands.on_band = [&](const RenderOptions::RowBand&, FrameImage& pixels) {
     const int header[3] = {band_index, kBandDone, 0};
-    send_sleeping(header, 3, MPI_INT, kRequestTag);
+    send_sleeping(header, 3, MPI_INT, kBandRequestTag);
     send_sleeping(pixels.rgba.data(), message_count(pixels.rgba.size()), MPI_FLOAT, kPixelsTag);
     if (with_depth) {
       send_sleeping(pixels.depth.data(), message_count(pixels.depth.size()), MPI_FLOAT, kPixelsTag);

@@ -24,7 +24,7 @@ std::size_t round_up(std::size_t n, std::size_t to) { return (n + to - 1) / to *
 }  // namespace
 
 DeviceShader::DeviceShader(ClSession& session, ProgramCache& cache, const Scene& scene, const Shader& shader)
-    : session_(session), shader_(shader), samples_(shader.samples()) {
+    : session_(session), samples_(shader.samples()) {
   const KernelConfig config = shading_config(session.info);
   precision_ = config.precision;
   lanes_ = config.lanes;

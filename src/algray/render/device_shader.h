@@ -51,7 +51,6 @@ class DeviceShader {
   void read_back_tile(const ShadeTile& tile);
 
   ClSession& session_;
-  const Shader& shader_;
   ProgramRecord program_;
   cl::Kernel kernel_;
   Precision precision_ = Precision::Double;  // the kernel's REAL: double where the device has fp64

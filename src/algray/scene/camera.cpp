@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace algray {
 
@@ -33,10 +34,8 @@ RayBasis make_ray_basis(const CameraSpec& camera, int width, int height) {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-double radians(double degrees) { return degrees * kPi / 180; }
-double degrees(double radians) { return radians * 180 / kPi; }
+double radians(double degrees) { return degrees * std::numbers::pi / 180; }
+double degrees(double radians) { return radians * 180 / std::numbers::pi; }
 
 // The horizontal frame azimuths are measured in: the reference direction (azimuth 0) and the one at +90 degrees.
 void azimuth_frame(const glm::dvec3& unit_up, glm::dvec3& reference, glm::dvec3& side) {

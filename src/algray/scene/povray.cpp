@@ -45,6 +45,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -59,12 +60,11 @@
 namespace algray {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxIncludeDepth = 16;         // POV-Ray's own includes nest 3 deep
 constexpr int kMaxIncludes = 256;            // files read in all, repeats counted
 constexpr std::size_t kMaxTokens = 1 << 22;  // tokens of all files together
 
-struct Token {
+struct PovToken {
   enum Kind { Name, Number, String, Directive, Op, End } kind = End;
   std::string text;
   double number = 0;
@@ -93,7 +93,7 @@ struct Object {
   bool inverse = false;
   double ambient = 0.1, diffuse = 0.6, specular = 0, exponent = 40;  // POV-Ray's default finish
   bool finished = false;  // a finish was given
-  Token at;
+  PovToken at;
   std::string kind;
 };
 
@@ -133,19 +133,19 @@ class PovReader {
 
  private:
   // --- messages ---
-  const LocatedText& text_of(const Token& t) const { return *files_[static_cast<std::size_t>(t.file)].text; }
-  std::string where(const Token& t) const { return text_of(t).where(t.line, t.column); }
-  std::string excerpt(const Token& t) const { return text_of(t).excerpt(t.line, t.column); }
-  [[noreturn]] void fail(const Token& t, const std::string& message) const {
+  const LocatedText& text_of(const PovToken& t) const { return *files_[static_cast<std::size_t>(t.file)].text; }
+  std::string where(const PovToken& t) const { return text_of(t).where(t.line, t.column); }
+  std::string excerpt(const PovToken& t) const { return text_of(t).excerpt(t.line, t.column); }
+  [[noreturn]] void fail(const PovToken& t, const std::string& message) const {
     text_of(t).fail(t.line, t.column, message);
   }
-  void warn(const Token& t, const std::string& message) {
+  void warn(const PovToken& t, const std::string& message) {
     if (!quiet_) warnings_.push_back(where(t) + ": " + message);
   }
 
   // --- tokens ---
-  std::vector<Token> tokenize(const std::string& text, int file) {
-    std::vector<Token> tokens;
+  std::vector<PovToken> tokenize(const std::string& text, int file) {
+    std::vector<PovToken> tokens;
     TextCursor cursor(text);
     std::size_t& i = cursor.i;
     const int &line = cursor.line, &column = cursor.column;
@@ -156,7 +156,7 @@ class PovReader {
         advance(1);
         continue;
       }
-      Token t{Token::Op, "", 0, line, column, file};
+      PovToken t{PovToken::Op, "", 0, line, column, file};
       if (const int comment = cursor.skip_comment()) {
         if (comment < 0) fail(t, "this comment never ends (no */)");
         continue;
@@ -166,7 +166,7 @@ class PovReader {
         while (c == '#' && start < text.size() && (text[start] == ' ' || text[start] == '\t')) ++start;  // "#  debug"
         std::size_t j = start;
         while (j < text.size() && (std::isalnum(static_cast<unsigned char>(text[j])) || text[j] == '_')) ++j;
-        t.kind = c == '#' ? Token::Directive : Token::Name;
+        t.kind = c == '#' ? PovToken::Directive : PovToken::Name;
         t.text = text.substr(start, j - start);
         if (c == '#' && t.text.empty()) fail(t, "expected a directive after '#'");
         advance(j - i);
@@ -174,7 +174,7 @@ class PovReader {
                  (c == '.' && i + 1 < text.size() && std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
         bool real = false;
         const std::size_t j = cursor.number_end(&real);
-        t.kind = Token::Number;
+        t.kind = PovToken::Number;
         t.text = text.substr(i, j - i);
         std::istringstream in(t.text);
         in.imbue(std::locale::classic());
@@ -185,7 +185,7 @@ class PovReader {
         std::size_t j = i + 1;
         while (j < text.size() && text[j] != '"' && text[j] != '\n') j += text[j] == '\\' && j + 1 < text.size() ? 2 : 1;
         if (j >= text.size() || text[j] != '"') fail(t, "this string never ends (no closing \")");
-        t.kind = Token::String;
+        t.kind = PovToken::String;
         t.text = text.substr(i + 1, j - i - 1);
         advance(j + 1 - i);
       } else {
@@ -202,27 +202,27 @@ class PovReader {
       tokens.push_back(t);
       if (tokens.size() > kMaxTokens) fail(t, "more than " + std::to_string(kMaxTokens) + " tokens");
     }
-    tokens.push_back({Token::End, "", 0, line, column, file});
+    tokens.push_back({PovToken::End, "", 0, line, column, file});
     return tokens;
   }
 
-  const Token& peek(std::size_t ahead = 0) const { return tokens_[std::min(pos_ + ahead, tokens_.size() - 1)]; }
+  const PovToken& peek(std::size_t ahead = 0) const { return tokens_[std::min(pos_ + ahead, tokens_.size() - 1)]; }
   bool at_op(const char* op, std::size_t ahead = 0) const {
-    return peek(ahead).kind == Token::Op && peek(ahead).text == op;
+    return peek(ahead).kind == PovToken::Op && peek(ahead).text == op;
   }
-  bool at_name(const char* name) const { return peek().kind == Token::Name && peek().text == name; }
-  const Token& next() {
-    const Token& t = tokens_[pos_];
+  bool at_name(const char* name) const { return peek().kind == PovToken::Name && peek().text == name; }
+  const PovToken& next() {
+    const PovToken& t = tokens_[pos_];
     if (pos_ + 1 < tokens_.size()) ++pos_;
     return t;
   }
-  static std::string describe(const Token& t) {
+  static std::string describe(const PovToken& t) {
     switch (t.kind) {
-      case Token::End:
+      case PovToken::End:
         return "the end of the file";
-      case Token::String:
+      case PovToken::String:
         return "a string";
-      case Token::Directive:
+      case PovToken::Directive:
         return "'#" + t.text + "'";
       default:
         return "'" + t.text + "'";
@@ -237,20 +237,20 @@ class PovReader {
   }
   // Skips a { ... } block, the opening brace next.
   void skip_block() {
-    const Token open = peek();
+    const PovToken open = peek();
     expect("{", "'{'");
     int depth = 1;
     while (depth > 0) {
-      const Token& t = next();
-      if (t.kind == Token::End) fail(open, "this '{' is never closed");
-      if (t.kind == Token::Op && t.text == "{") ++depth;
-      if (t.kind == Token::Op && t.text == "}") --depth;
+      const PovToken& t = next();
+      if (t.kind == PovToken::End) fail(open, "this '{' is never closed");
+      if (t.kind == PovToken::Op && t.text == "{") ++depth;
+      if (t.kind == PovToken::Op && t.text == "}") --depth;
     }
   }
   // Skips what follows an item this reader does not read: its block, or its values up to the next word or '}'.
   void skip_item() {
     if (at_op("{")) return skip_block();
-    while (peek().kind != Token::End && !at_op("}") && peek().kind != Token::Name && peek().kind != Token::Directive) {
+    while (peek().kind != PovToken::End && !at_op("}") && peek().kind != PovToken::Name && peek().kind != PovToken::Directive) {
       if (at_op("{")) {
         skip_block();
         continue;
@@ -264,7 +264,7 @@ class PovReader {
     if (depth > 200) fail(peek(), "the expression is nested too deeply");
     Vec left = term(depth);
     while (at_op("+") || at_op("-")) {
-      const Token op = next();
+      const PovToken op = next();
       left = combine(left, term(depth), op);
     }
     return left;
@@ -272,7 +272,7 @@ class PovReader {
   Vec term(int depth) {
     Vec left = unary(depth);
     while (at_op("*") || at_op("/")) {
-      const Token op = next();
+      const PovToken op = next();
       left = combine(left, unary(depth), op);
     }
     return left;
@@ -294,8 +294,8 @@ class PovReader {
   Vec postfix(Vec v, int depth) {
     (void)depth;
     while (at_op(".")) {
-      const Token dot = next();
-      const Token member = next();
+      const PovToken dot = next();
+      const PovToken member = next();
       static const std::map<std::string, std::size_t> members = {{"x", 0},     {"u", 0},     {"red", 0},
                                                                  {"y", 1},     {"v", 1},     {"green", 1},
                                                                  {"z", 2},     {"blue", 2},  {"filter", 3},
@@ -307,7 +307,7 @@ class PovReader {
     }
     return v;
   }
-  Vec combine(const Vec& a, const Vec& b, const Token& op) {
+  Vec combine(const Vec& a, const Vec& b, const PovToken& op) {
     const std::size_t n = std::max(a.size(), b.size());
     const Vec x = widen(a, n, op), y = widen(b, n, op);
     Vec out(n);
@@ -324,7 +324,7 @@ class PovReader {
     return out;
   }
   // A float stands for the vector of that float in every component, as in POV-Ray.
-  Vec widen(const Vec& v, std::size_t n, const Token& at) const {
+  Vec widen(const Vec& v, std::size_t n, const PovToken& at) const {
     if (v.size() == n) return v;
     if (v.size() == 1) return Vec(n, v[0]);
     if (v.size() < n) {
@@ -335,14 +335,14 @@ class PovReader {
     fail(at, "expected " + std::to_string(n) + " components, found a vector of " + std::to_string(v.size()));
   }
   Vec primary(int depth) {
-    const Token t = next();
-    if (t.kind == Token::Number) return {t.number};
-    if (t.kind == Token::Op && t.text == "(") {
+    const PovToken t = next();
+    if (t.kind == PovToken::Number) return {t.number};
+    if (t.kind == PovToken::Op && t.text == "(") {
       Vec v = expression(depth + 1);
       expect(")", "')'");
       return v;
     }
-    if (t.kind == Token::Op && t.text == "<") {
+    if (t.kind == PovToken::Op && t.text == "<") {
       Vec v;
       for (;;) {
         const Vec c = expression(depth + 1);
@@ -353,17 +353,17 @@ class PovReader {
           next();
           continue;
         }
-        if (peek().kind == Token::Number) continue;  // POV-Ray reads <1 2> as <1, 2>; its samples rely on it
+        if (peek().kind == PovToken::Number) continue;  // POV-Ray reads <1 2> as <1, 2>; its samples rely on it
         break;
       }
       expect(">", "'>' or ','");
       return v;
     }
-    if (t.kind != Token::Name) fail(t, "expected a number or vector, found " + describe(t));
+    if (t.kind != PovToken::Name) fail(t, "expected a number or vector, found " + describe(t));
     if (at_op("(")) return call(t, depth);
     static const std::map<std::string, Vec> constants = {
         {"x", {1, 0, 0}}, {"y", {0, 1, 0}}, {"z", {0, 0, 1}}, {"u", {1, 0}},   {"v", {0, 1}},  {"t", {0, 0, 0, 1}},
-        {"pi", {kPi}},    {"clock", {0}},   {"true", {1}},    {"yes", {1}},    {"on", {1}},    {"false", {0}},
+        {"pi", {std::numbers::pi}},    {"clock", {0}},   {"true", {1}},    {"yes", {1}},    {"on", {1}},    {"false", {0}},
         {"no", {0}},      {"off", {0}},     {"clock_delta", {1}}, {"frame_number", {0}}, {"version", {3.7}}};
     if (const auto c = constants.find(t.text); c != constants.end()) return c->second;
     if (t.text == "image_width") return {static_cast<double>(image_width())};
@@ -372,7 +372,7 @@ class PovReader {
     unusable(t);
   }
   // A name that is no float or vector here: declared as something else, or not at all.
-  [[noreturn]] void unusable(const Token& t) const {
+  [[noreturn]] void unusable(const PovToken& t) const {
     if (const auto u = unread_.find(t.text); u != unread_.end())
       fail(t, "'" + t.text + "' is " + u->second.second + " (declared at " + where(u->second.first) +
                   "), which this reader does not read");
@@ -380,7 +380,7 @@ class PovReader {
     fail(t, "'" + t.text + "' is not declared" +
                 (missing_include_ ? " (an #include file was not found, so its names are unknown here)" : ""));
   }
-  Vec call(const Token& name, int depth) {
+  Vec call(const PovToken& name, int depth) {
     if (unread_.count(name.text)) unusable(name);  // a macro from an include, say
     expect("(", "'('");
     std::vector<Vec> args;
@@ -411,7 +411,7 @@ class PovReader {
         {"exp", [](double v) { return std::exp(v); }},       {"log", [](double v) { return std::log10(v); }},
         {"ln", [](double v) { return std::log(v); }},        {"floor", [](double v) { return std::floor(v); }},
         {"ceil", [](double v) { return std::ceil(v); }},     {"int", [](double v) { return std::trunc(v); }},
-        {"radians", [](double v) { return v * kPi / 180; }}, {"degrees", [](double v) { return v * 180 / kPi; }}};
+        {"radians", [](double v) { return v * std::numbers::pi / 180; }}, {"degrees", [](double v) { return v * 180 / std::numbers::pi; }}};
     if (const auto g = one.find(f); g != one.end()) {
       want(1);
       return result(g->second(scalar(0)));
@@ -445,13 +445,13 @@ class PovReader {
     fail(name, "'" + f + "' is not a function this reader knows");
   }
   double number() {
-    const Token at = peek();
+    const PovToken at = peek();
     const Vec v = expression();
     if (v.size() != 1) fail(at, "expected a float, found a vector");
     return v[0];
   }
   glm::dvec3 vector3() {
-    const Token at = peek();
+    const PovToken at = peek();
     const Vec v = widen(expression(), 3, at);
     if (v.size() != 3) fail(at, "expected a vector of 3 components");
     return {v[0], v[1], v[2]};
@@ -465,17 +465,17 @@ class PovReader {
   }
 
   // --- colours ---
-  glm::dvec3 colour(const Token& at) {
+  glm::dvec3 colour(const PovToken& at) {
     if (at_name("color") || at_name("colour")) next();
     static const std::map<std::string, std::size_t> forms = {{"rgb", 3}, {"rgbf", 4}, {"rgbt", 4}, {"rgbft", 5},
                                                               {"srgb", 3}, {"srgbf", 4}, {"srgbt", 4}, {"srgbft", 5}};
     glm::dvec3 c(0);
     bool any = false;
     for (;;) {
-      const Token& t = peek();
-      if (t.kind == Token::Name && forms.count(t.text)) {
-        const Token form = next();
-        const Token vat = peek();
+      const PovToken& t = peek();
+      if (t.kind == PovToken::Name && forms.count(t.text)) {
+        const PovToken form = next();
+        const PovToken vat = peek();
         const Vec v = widen(expression(), forms.at(form.text), vat);
         if (v.size() > 3 && (v[3] != 0 || (v.size() > 4 && v[4] != 0)))
           warn(form, "the colour's filter and transmit are ignored: algray's surfaces are opaque here");
@@ -485,13 +485,13 @@ class PovReader {
         any = true;
         continue;
       }
-      if (t.kind == Token::Name && (t.text == "red" || t.text == "green" || t.text == "blue")) {
+      if (t.kind == PovToken::Name && (t.text == "red" || t.text == "green" || t.text == "blue")) {
         const std::string channel = next().text;
         c[channel == "red" ? 0 : channel == "green" ? 1 : 2] = number();
         any = true;
         continue;
       }
-      if (t.kind == Token::Name && (t.text == "filter" || t.text == "transmit")) {
+      if (t.kind == PovToken::Name && (t.text == "filter" || t.text == "transmit")) {
         next();
         if (number() != 0) warn(t, "the colour's " + t.text + " is ignored: algray's surfaces are opaque here");
         continue;
@@ -499,7 +499,7 @@ class PovReader {
       break;
     }
     if (!any) {
-      const Token vat = peek();
+      const PovToken vat = peek();
       const Vec v = widen(expression(), 3, vat);
       c = {v[0], v[1], v[2]};
     }
@@ -508,23 +508,23 @@ class PovReader {
     return c;
   }
   // pigment { colour }: a pattern or map is skipped with a warning.
-  glm::dvec3 pigment(const Token& at) {
+  glm::dvec3 pigment(const PovToken& at) {
     expect("{", "'{' after pigment");
     glm::dvec3 c(0);
     bool coloured = false;
     while (!at_op("}")) {
-      if (peek().kind == Token::End) fail(at, "this pigment is never closed");
-      const Token& t = peek();
-      if (t.kind == Token::Name && (t.text == "color" || t.text == "colour" || t.text == "rgb" || t.text == "rgbf" ||
+      if (peek().kind == PovToken::End) fail(at, "this pigment is never closed");
+      const PovToken& t = peek();
+      if (t.kind == PovToken::Name && (t.text == "color" || t.text == "colour" || t.text == "rgb" || t.text == "rgbf" ||
                                     t.text == "rgbt" || t.text == "rgbft" || t.text == "srgb" || t.text == "red" ||
                                     t.text == "green" || t.text == "blue")) {
         c = colour(t);
         coloured = true;
-      } else if (!coloured && (t.kind == Token::Op || declared_.count(t.text))) {
+      } else if (!coloured && (t.kind == PovToken::Op || declared_.count(t.text))) {
         c = colour(t);
         coloured = true;
       } else {
-        const Token skipped = next();
+        const PovToken skipped = next();
         warn(skipped, "pigment '" + skipped.text + "' is ignored: algray reads plain colours");
         skip_item();
       }
@@ -534,19 +534,19 @@ class PovReader {
   }
   void finish(Object& o) {
     o.finished = true;
-    const Token open = peek();
+    const PovToken open = peek();
     expect("{", "'{' after finish");
     while (!at_op("}")) {
-      if (peek().kind == Token::End) fail(open, "this finish is never closed");
-      const Token t = next();
-      if (t.kind == Token::Name && t.text == "ambient") {
+      if (peek().kind == PovToken::End) fail(open, "this finish is never closed");
+      const PovToken t = next();
+      if (t.kind == PovToken::Name && t.text == "ambient") {
         const Vec v = expression();
         o.ambient = std::clamp(v.size() == 1 ? v[0] : (v[0] + v[1] + v[2]) / 3, 0.0, 1.0);
-      } else if (t.kind == Token::Name && t.text == "diffuse") {
+      } else if (t.kind == PovToken::Name && t.text == "diffuse") {
         o.diffuse = std::clamp(number(), 0.0, 1.0);
-      } else if (t.kind == Token::Name && t.text == "phong") {
+      } else if (t.kind == PovToken::Name && t.text == "phong") {
         o.specular = std::clamp(number(), 0.0, 1.0);
-      } else if (t.kind == Token::Name && t.text == "phong_size") {
+      } else if (t.kind == PovToken::Name && t.text == "phong_size") {
         o.exponent = std::clamp(number(), 1.0, 10000.0);
       } else {
         warn(t, "finish '" + t.text + "' is ignored (algray reads ambient, diffuse, phong and phong_size)");
@@ -564,14 +564,14 @@ class PovReader {
   }
   // texture { pigment {...} finish {...} ... }; interior_texture likewise for the inside (its finish is skipped).
   void texture(Object& o, bool inside) {
-    const Token open = peek();
+    const PovToken open = peek();
     expect("{", "'{' after texture");
     while (!at_op("}")) {
-      if (peek().kind == Token::End) fail(open, "this texture is never closed");
-      const Token t = next();
-      if (t.kind == Token::Name && t.text == "pigment") {
+      if (peek().kind == PovToken::End) fail(open, "this texture is never closed");
+      const PovToken t = next();
+      if (t.kind == PovToken::Name && t.text == "pigment") {
         (inside ? o.back : o.front) = pigment(t);
-      } else if (t.kind == Token::Name && t.text == "finish" && !inside) {
+      } else if (t.kind == PovToken::Name && t.text == "finish" && !inside) {
         finish(o);
       } else {
         warn(t, "texture '" + t.text + "' is ignored (algray reads a texture's pigment colour and finish)");
@@ -585,7 +585,7 @@ class PovReader {
   static glm::dmat4 rotation(const glm::dvec3& degrees) {
     glm::dmat4 m(1);
     for (int axis = 0; axis < 3; ++axis) {
-      const double a = degrees[axis] * kPi / 180, c = std::cos(a), s = std::sin(a);
+      const double a = degrees[axis] * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
       const int i = (axis + 1) % 3, j = (axis + 2) % 3;
       glm::dmat4 r(1);
       r[i][i] = c;  // glm: [column][row]; the usual matrix's (i, j) entry -s is column j, row i
@@ -598,10 +598,10 @@ class PovReader {
   }
   // A transform statement at the cursor, or nullopt when the next word is none.
   std::optional<glm::dmat4> transform_step() {
-    if (peek().kind != Token::Name) return std::nullopt;
+    if (peek().kind != PovToken::Name) return std::nullopt;
     const std::string w = peek().text;
     if (w == "scale") {
-      const Token at = next();
+      const PovToken at = next();
       const glm::dvec3 s = vector3();
       if (s.x == 0 || s.y == 0 || s.z == 0) fail(at, "scale by zero");
       glm::dmat4 m(1);
@@ -621,8 +621,8 @@ class PovReader {
       return m;
     }
     if (w == "matrix") {
-      const Token at = next();
-      const Token vat = peek();
+      const PovToken at = next();
+      const PovToken vat = peek();
       const Vec v = expression();
       if (v.size() != 12) fail(vat, "matrix takes 12 numbers, found " + std::to_string(v.size()));
       glm::dmat4 m(1);
@@ -638,9 +638,9 @@ class PovReader {
   // plane { <n>, d modifiers } in clipped_by, the keyword next: (n, -d), n.x - d <= 0 kept (POV-Ray's inside, the
   // side away from n; inverse keeps the other), and its own transforms in `own`.
   glm::dvec4 clip_plane(glm::dmat4& own) {
-    const Token shape = next();
+    const PovToken shape = next();
     expect("{", "'{'");
-    const Token at = peek();
+    const PovToken at = peek();
     const glm::dvec3 n = vector3();
     optional_comma();
     const double d = number();
@@ -651,8 +651,8 @@ class PovReader {
         own = *m * own;
         continue;
       }
-      const Token t = next();
-      if (t.kind == Token::End) fail(shape, "this plane is never closed");
+      const PovToken t = next();
+      if (t.kind == PovToken::End) fail(shape, "this plane is never closed");
       if (t.text == "inverse") {
         plane = -plane;
         continue;
@@ -663,17 +663,17 @@ class PovReader {
     next();
     return plane;
   }
-  Clip clip_shape(const Token& at, glm::dmat4& own) {
-    const Token shape = next();
-    if (shape.kind != Token::Name || (shape.text != "sphere" && shape.text != "box" && shape.text != "object"))
+  Clip clip_shape(const PovToken& at, glm::dmat4& own) {
+    const PovToken shape = next();
+    if (shape.kind != PovToken::Name || (shape.text != "sphere" && shape.text != "box" && shape.text != "object"))
       fail(shape, std::string(at.text) + " takes a sphere or a box here; algray clips to one of those");
     expect("{", "'{'");
     Clip c;
     if (shape.text == "object") {  // object { NAME ... } of a declared box or sphere
-      const Token name = next();
+      const PovToken name = next();
       const auto d = declared_clips_.find(name.text);
       if (d == declared_clips_.end()) {
-        if (name.kind == Token::Name && !declared_objects_.count(name.text)) unusable(name);
+        if (name.kind == PovToken::Name && !declared_objects_.count(name.text)) unusable(name);
         fail(name, std::string(at.text) + " takes a sphere or a box here; algray clips to one of those");
       }
       c = d->second.first;
@@ -697,15 +697,15 @@ class PovReader {
         own = *m * own;
         continue;
       }
-      const Token t = next();
-      if (t.kind == Token::End) fail(shape, "this " + shape.text + " is never closed");
+      const PovToken t = next();
+      if (t.kind == PovToken::End) fail(shape, "this " + shape.text + " is never closed");
       warn(t, "'" + t.text + "' in a clipping shape is ignored");
       skip_item();
     }
     next();
     return c;
   }
-  void clip_block(Object& o, const Token& at) {
+  void clip_block(Object& o, const PovToken& at) {
     expect("{", "'{'");
     // bounded_by { clipped_by } and clipped_by { bounded_by }: the same region, already recorded.
     if ((at.text == "bounded_by" && at_name("clipped_by")) || (at.text == "clipped_by" && at_name("bounded_by"))) {
@@ -718,7 +718,7 @@ class PovReader {
         glm::dmat4 own(1);
         if (at_name("plane") && at_op("{", 1)) {
           // A plane clips (clipped_by); as a bound it is POV-Ray's hint, which algray has no use for.
-          const Token plane = peek();
+          const PovToken plane = peek();
           const glm::dvec4 p = clip_plane(own);
           if (at.text == "clipped_by")
             o.planes.push_back({p, own});
@@ -733,9 +733,9 @@ class PovReader {
     }
     expect("}", "'}'");
   }
-  void modifiers(std::vector<Object*> objects, const Token& open) {
+  void modifiers(std::vector<Object*> objects, const PovToken& open) {
     while (!at_op("}")) {
-      if (peek().kind == Token::End) fail(open, "this '{' is never closed");
+      if (peek().kind == PovToken::End) fail(open, "this '{' is never closed");
       if (auto m = transform_step()) {
         for (Object* o : objects) {
           o->transform = *m * o->transform;
@@ -744,8 +744,8 @@ class PovReader {
         }
         continue;
       }
-      const Token t = next();
-      if (t.kind != Token::Name) fail(t, "expected an object modifier, found " + describe(t));
+      const PovToken t = next();
+      if (t.kind != PovToken::Name) fail(t, "expected an object modifier, found " + describe(t));
       if (t.text == "pigment") {
         const glm::dvec3 c = pigment(t);
         for (Object* o : objects)
@@ -786,7 +786,7 @@ class PovReader {
   // The optional on/off after a flag such as hollow.
   void switch_value() {
     static const std::set<std::string> words = {"on", "off", "true", "false", "yes", "no"};
-    if (peek().kind == Token::Number || (peek().kind == Token::Name && words.count(peek().text))) next();
+    if (peek().kind == PovToken::Number || (peek().kind == PovToken::Name && words.count(peek().text))) next();
   }
   static SparsePoly sphere_poly(const glm::dvec3& c, double r) {
     SparsePoly p = SparsePoly::constant(c.x * c.x + c.y * c.y + c.z * c.z - r * r);
@@ -800,7 +800,7 @@ class PovReader {
     return p;
   }
   // poly's coefficient order (see the top of the file).
-  SparsePoly listed_poly(int order, const Vec& coefficients, const Token& at) const {
+  SparsePoly listed_poly(int order, const Vec& coefficients, const PovToken& at) const {
     const std::size_t count = static_cast<std::size_t>((order + 1) * (order + 2) * (order + 3) / 6);
     if (coefficients.size() != count)
       fail(at, "a poly of order " + std::to_string(order) + " has " + std::to_string(count) + " coefficients, found " +
@@ -812,7 +812,7 @@ class PovReader {
         for (int k = order - i - j; k >= 0; --k) p.add({i, j, k}, coefficients[n++]);
     return p;
   }
-  int order_of(const Token& at) {
+  int order_of(const PovToken& at) {
     const double o = number();
     if (o != std::floor(o) || o < 1 || o > kMaxDegree)
       fail(at, "the order must be a whole number from 1 to " + std::to_string(kMaxDegree) + " (algray's degrees)");
@@ -820,7 +820,7 @@ class PovReader {
     return static_cast<int>(o);
   }
   // One object and its modifiers into out: a CSG group's members each, a shape as one.
-  void object(const Token& kind, std::vector<Object>& out) {
+  void object(const PovToken& kind, std::vector<Object>& out) {
     expect("{", "'{'");
     const std::size_t first = out.size();
     if (kind.text == "union" || kind.text == "merge")
@@ -835,18 +835,18 @@ class PovReader {
     for (std::size_t i = first; i < out.size(); ++i) members.push_back(&out[i]);
     modifiers(members, kind);
   }
-  void union_members(const Token& kind, std::vector<Object>& out) {
+  void union_members(const PovToken& kind, std::vector<Object>& out) {
     const std::size_t first = out.size();
-    while (peek().kind == Token::Name && is_object(peek().text) && at_op("{", 1)) object(next(), out);
+    while (peek().kind == PovToken::Name && is_object(peek().text) && at_op("{", 1)) object(next(), out);
     if (out.size() == first) fail(kind, "this " + kind.text + " holds no object algray reads");
   }
-  void intersection_members(const Token& kind, std::vector<Object>& out) {
+  void intersection_members(const PovToken& kind, std::vector<Object>& out) {
     // POV-Ray's samples cut a surface with a Clear sphere or box: read as the surface clipped to that region.
     warn(kind, "intersection is read as its algebraic objects clipped by its spheres and boxes; the cut faces "
                "are not drawn (POV-Ray's samples make them Clear)");
     const std::size_t first = out.size();
     std::vector<std::pair<Clip, glm::dmat4>> clips;
-    while (peek().kind == Token::Name && at_op("{", 1)) {
+    while (peek().kind == PovToken::Name && at_op("{", 1)) {
       const std::string w = peek().text;
       if (w == "sphere" || w == "box" || (w == "object" && declared_clips_.count(peek(2).text))) {
         glm::dmat4 own(1);
@@ -864,19 +864,19 @@ class PovReader {
   }
   // object { NAME modifiers } or object { OBJECT modifiers }
   void object_reference(std::vector<Object>& out) {
-    const Token name = next();
-    if (name.kind == Token::Name && is_object(name.text) && at_op("{")) {
+    const PovToken name = next();
+    if (name.kind == PovToken::Name && is_object(name.text) && at_op("{")) {
       object(name, out);
-    } else if (name.kind == Token::Name && declared_objects_.count(name.text)) {
+    } else if (name.kind == PovToken::Name && declared_objects_.count(name.text)) {
       for (const Object& o : declared_objects_.at(name.text)) out.push_back(o);
-    } else if (name.kind == Token::Name) {
+    } else if (name.kind == PovToken::Name) {
       unusable(name);
     } else {
       fail(name, "expected a declared object's name, found " + describe(name));
     }
   }
   // A sphere, torus or polynomial shape, up to its modifiers.
-  Object shape(const Token& kind) {
+  Object shape(const PovToken& kind) {
     Object o;
     o.at = kind;
     o.kind = kind.text;
@@ -896,7 +896,7 @@ class PovReader {
       o.natural = Clip{true, {0, 0, 0}, {}, {}, (big + small) * 1.001};
     } else if (kind.text == "poly" || kind.text == "quartic" || kind.text == "cubic") {
       const int order = kind.text == "poly" ? order_of(kind) : kind.text == "quartic" ? 4 : 3;
-      const Token vat = peek();
+      const PovToken vat = peek();
       o.poly = listed_poly(order, expression(), vat);
     } else {  // polynomial
       o.poly = polynomial_terms(order_of(kind));
@@ -922,7 +922,7 @@ class PovReader {
   SparsePoly polynomial_terms(int order) {
     SparsePoly poly;
     while (at_name("xyz")) {
-      const Token term = next();
+      const PovToken term = next();
       expect("(", "'('");
       int e[3];
       for (int i = 0; i < 3; ++i) {
@@ -946,12 +946,12 @@ class PovReader {
 
   // --- scene items ---
   void camera() {
-    const Token open = peek();
+    const PovToken open = peek();
     expect("{", "'{' after camera");
     while (!at_op("}")) {
-      const Token t = next();
-      if (t.kind == Token::End) fail(open, "this camera is never closed");
-      if (t.kind != Token::Name) fail(t, "expected a camera item, found " + describe(t));
+      const PovToken t = next();
+      if (t.kind == PovToken::End) fail(open, "this camera is never closed");
+      if (t.kind != PovToken::Name) fail(t, "expected a camera item, found " + describe(t));
       if (t.text == "perspective") camera_.orthographic = false;
       else if (t.text == "orthographic") camera_.orthographic = true;
       else if (t.text == "location") camera_.location = vector3();
@@ -977,7 +977,7 @@ class PovReader {
     next();
   }
   void light() {
-    const Token open = peek();
+    const PovToken open = peek();
     expect("{", "'{' after light_source");
     PovLight l;
     l.position = vector3();
@@ -990,8 +990,8 @@ class PovReader {
         l.edge_v = glm::dvec3(*m * glm::dvec4(l.edge_v, 0));
         continue;
       }
-      const Token t = next();
-      if (t.kind == Token::End) fail(open, "this light_source is never closed");
+      const PovToken t = next();
+      if (t.kind == PovToken::End) fail(open, "this light_source is never closed");
       if (t.text == "area_light") {
         l.area = true;
         l.edge_u = vector3();
@@ -1015,16 +1015,16 @@ class PovReader {
     lights_.push_back(l);
   }
   void background() {
-    const Token open = peek();
+    const PovToken open = peek();
     expect("{", "'{' after background");
     background_ = colour(open);
     expect("}", "'}'");
   }
   // --- directives ---
   // The file #include names, read and its tokens put in place of the directive.
-  void include(const Token& d) {
-    const Token file = next();
-    if (file.kind != Token::String) fail(file, "expected a file name after #include");
+  void include(const PovToken& d) {
+    const PovToken file = next();
+    if (file.kind != PovToken::String) fail(file, "expected a file name after #include");
     const std::filesystem::path name(file.text);
     bool plain = name.extension() == ".inc" && name.is_relative();
     for (const auto& part : name) plain = plain && part != "..";
@@ -1046,7 +1046,7 @@ class PovReader {
       if (!in && !in.eof()) fail(file, "cannot read " + path.string());
       const int index = static_cast<int>(files_.size());
       files_.push_back({std::make_unique<LocatedText>(text, path.string()), depth});
-      std::vector<Token> tokens = tokenize(text, index);
+      std::vector<PovToken> tokens = tokenize(text, index);
       tokens.pop_back();  // its End
       if (tokens_.size() + tokens.size() > kMaxTokens) fail(d, "the #include files hold too many tokens");
       tokens_.insert(tokens_.begin() + static_cast<std::ptrdiff_t>(pos_), tokens.begin(), tokens.end());
@@ -1058,13 +1058,13 @@ class PovReader {
   }
   // Skips to the #end that closes the block opened before the cursor; with stop_at_else, to its #else instead
   // when there is one. Returns whether it stopped at an #else.
-  bool skip_to_end(const Token& open, bool stop_at_else) {
+  bool skip_to_end(const PovToken& open, bool stop_at_else) {
     static const std::set<std::string> openers = {"if", "ifdef", "ifndef", "while", "for", "switch", "macro"};
     int depth = 0;
     for (;;) {
-      const Token t = next();
-      if (t.kind == Token::End) fail(open, "this #" + open.text + " has no #end");
-      if (t.kind != Token::Directive) continue;
+      const PovToken t = next();
+      if (t.kind == PovToken::End) fail(open, "this #" + open.text + " has no #end");
+      if (t.kind != PovToken::Directive) continue;
       if (openers.count(t.text)) ++depth;
       else if (t.text == "end" && depth-- == 0) return false;
       else if (t.text == "else" && depth == 0 && stop_at_else) return true;
@@ -1072,15 +1072,15 @@ class PovReader {
   }
   // Skips a value this reader does not read: NAME { ... }, or tokens up to ';' or the next directive.
   void skip_value() {
-    if (peek().kind == Token::Name && at_op("{", 1)) {
+    if (peek().kind == PovToken::Name && at_op("{", 1)) {
       next();
       skip_block();
     } else {
       int depth = 0;
-      while (peek().kind != Token::End && !(depth == 0 && (at_op(";") || peek().kind == Token::Directive))) {
-        const Token t = next();
-        if (t.kind == Token::Op && (t.text == "(" || t.text == "{" || t.text == "[")) ++depth;
-        if (t.kind == Token::Op && (t.text == ")" || t.text == "}" || t.text == "]")) --depth;
+      while (peek().kind != PovToken::End && !(depth == 0 && (at_op(";") || peek().kind == PovToken::Directive))) {
+        const PovToken t = next();
+        if (t.kind == PovToken::Op && (t.text == "(" || t.text == "{" || t.text == "[")) ++depth;
+        if (t.kind == PovToken::Op && (t.text == ")" || t.text == "}" || t.text == "]")) --depth;
       }
     }
     if (at_op(";")) next();
@@ -1094,18 +1094,18 @@ class PovReader {
     declared_objects_.erase(name);
     unread_.erase(name);
   }
-  void declaration(const Token& d) {
-    const Token name = next();
-    if (name.kind != Token::Name) fail(name, "expected a name after #" + d.text);
+  void declaration(const PovToken& d) {
+    const PovToken name = next();
+    if (name.kind != PovToken::Name) fail(name, "expected a name after #" + d.text);
     expect("=", "'='");
     forget(name.text);
     static const std::set<std::string> colour_words = {"color", "colour", "rgb", "rgbf", "rgbt", "rgbft", "srgb",
                                                         "srgbf", "srgbt", "srgbft", "red", "green", "blue"};
-    const Token value = peek();
-    if (value.kind == Token::Name && colour_words.count(value.text)) {
+    const PovToken value = peek();
+    if (value.kind == PovToken::Name && colour_words.count(value.text)) {
       const glm::dvec3 c = colour(name);
       declared_[name.text] = {c.x, c.y, c.z};
-    } else if (value.kind == Token::Name && value.text == "box" && at_op("{", 1)) {
+    } else if (value.kind == PovToken::Name && value.text == "box" && at_op("{", 1)) {
       // A box is no surface here, but clips one: intersection { OBJECT object { NAME } } and bounded_by use it.
       const std::size_t start = pos_;
       try {
@@ -1119,7 +1119,7 @@ class PovReader {
         skip_value();
         return;
       }
-    } else if (value.kind == Token::Name && is_object(value.text) && at_op("{", 1) && d.file != 0) {
+    } else if (value.kind == PovToken::Name && is_object(value.text) && at_op("{", 1) && d.file != 0) {
       // An include file's object this reader cannot read is an error only where the scene uses it.
       const std::size_t start = pos_;
       std::vector<Object> objects;
@@ -1132,14 +1132,14 @@ class PovReader {
         skip_value();
         return;
       }
-    } else if (value.kind == Token::Name && is_object(value.text) && at_op("{", 1)) {
+    } else if (value.kind == PovToken::Name && is_object(value.text) && at_op("{", 1)) {
       std::vector<Object> objects;
       object(next(), objects);
       declared_objects_[name.text] = std::move(objects);
-    } else if (value.kind == Token::Name && declared_objects_.count(value.text)) {
+    } else if (value.kind == PovToken::Name && declared_objects_.count(value.text)) {
       next();
       declared_objects_[name.text] = declared_objects_.at(value.text);
-    } else if (value.kind == Token::Name && at_op("{", 1)) {
+    } else if (value.kind == PovToken::Name && at_op("{", 1)) {
       // A texture, pigment, finish or another object: its name is remembered so that a use can say what it is.
       if (d.file == 0)
         warn(name, "#" + d.text + " " + name.text + " = " + value.text + " { ... } is ignored: algray declares " +
@@ -1163,7 +1163,7 @@ class PovReader {
     }
     if (at_op(";")) next();
   }
-  void directive(const Token& d) {
+  void directive(const PovToken& d) {
     if (d.text == "version") {
       number();
       if (at_op(";")) next();
@@ -1181,12 +1181,12 @@ class PovReader {
       }
       quiet_ = was;
     } else if (d.text == "undef") {
-      const Token name = next();
-      if (name.kind != Token::Name) fail(name, "expected a name after #undef");
+      const PovToken name = next();
+      if (name.kind != PovToken::Name) fail(name, "expected a name after #undef");
       forget(name.text);
     } else if (d.text == "macro") {
-      const Token name = next();
-      if (name.kind != Token::Name) fail(name, "expected a name after #macro");
+      const PovToken name = next();
+      if (name.kind != PovToken::Name) fail(name, "expected a name after #macro");
       if (d.file == 0) warn(d, "#macro " + name.text + " is skipped: this reader does not expand macros");
       unread_[name.text] = {name, "a macro"};
       skip_to_end(d, false);
@@ -1196,8 +1196,8 @@ class PovReader {
         holds = number() != 0;
       } else {
         expect("(", "'('");
-        const Token name = next();
-        if (name.kind != Token::Name) fail(name, "expected a name");
+        const PovToken name = next();
+        if (name.kind != PovToken::Name) fail(name, "expected a name");
         expect(")", "')'");
         holds = is_declared(name.text) == (d.text == "ifdef");
       }
@@ -1225,9 +1225,9 @@ class PovReader {
   // object { NAME ... } in the scene, the '{' next, of a declared object algray cannot draw (grafbic's axes, infinite
   // quadric cylinders from axisbox.inc): skipped with a warning, as any other object algray does not draw; if the
   // scene then has nothing to draw, run() gives the reason as the error.
-  bool undrawable_object(const Token& name) {
+  bool undrawable_object(const PovToken& name) {
     const auto u = unread_.find(name.text);
-    if (name.kind != Token::Name || u == unread_.end() || u->second.second.find(" algray cannot ") == std::string::npos)
+    if (name.kind != PovToken::Name || u == unread_.end() || u->second.second.find(" algray cannot ") == std::string::npos)
       return false;
     const std::string why = "'" + name.text + "' is " + u->second.second + " (declared at " + where(u->second.first) +
                             "), which this reader does not read";
@@ -1237,18 +1237,18 @@ class PovReader {
     return true;
   }
   void item() {
-    const Token t = next();
-    if (t.kind == Token::Directive) return directive(t);
-    if (t.kind != Token::Name) fail(t, "expected a scene item, found " + describe(t));
+    const PovToken t = next();
+    if (t.kind == PovToken::Directive) return directive(t);
+    if (t.kind != PovToken::Name) fail(t, "expected a scene item, found " + describe(t));
     if (t.text == "camera") return camera();
     if (t.text == "light_source") return light();
     if (t.text == "background") return background();
     if (t.text == "global_settings") {
-      const Token open = peek();
+      const PovToken open = peek();
       expect("{", "'{'");
       while (!at_op("}")) {
-        const Token s = next();
-        if (s.kind == Token::End) fail(open, "global_settings is never closed");
+        const PovToken s = next();
+        if (s.kind == PovToken::End) fail(open, "global_settings is never closed");
         if (s.text == "assumed_gamma") {
           if (number() != 1) warn(s, "assumed_gamma other than 1 is ignored: algray's colours are linear");
         } else {
@@ -1325,12 +1325,12 @@ class PovReader {
     if (!best && o.natural) best = place(*o.natural, o.transform, true);
     return best;
   }
-  glm::dmat4 box_frame(const Token*& at) const;
+  glm::dmat4 box_frame(const PovToken*& at) const;
   // --- the stages of run(): what they settle, in order ---
   struct Translated {
     Camera camera;
     std::vector<PovLight> lights;
-    const Token* framed_by = nullptr;  // the turned clipping box whose frame the scene is written in
+    const PovToken* framed_by = nullptr;  // the turned clipping box whose frame the scene is written in
     std::optional<Clip> extent;        // the objects' common region, in POV-Ray's coordinates
     const Object* clipped_by = nullptr;
     std::vector<const Object*> open;  // objects with no region at all
@@ -1393,19 +1393,19 @@ class PovReader {
   std::vector<std::filesystem::path> include_dirs_;
   std::vector<std::string>& warnings_;
   int width_, height_;
-  std::vector<Token> tokens_;
+  std::vector<PovToken> tokens_;
   std::size_t pos_ = 0;
   std::map<std::string, Vec> declared_;
   std::map<std::string, std::vector<Object>> declared_objects_;
   std::map<std::string, std::pair<Clip, glm::dmat4>> declared_clips_;  // declared boxes, with their transforms
-  std::map<std::string, std::pair<Token, std::string>> unread_;  // name: where declared, and what it is
+  std::map<std::string, std::pair<PovToken, std::string>> unread_;  // name: where declared, and what it is
   bool missing_include_ = false;
   bool quiet_ = false;  // warnings are dropped (reading an include file's declarations)
-  std::vector<Token> open_ifs_;                                    // #if, #ifdef, #ifndef being read
+  std::vector<PovToken> open_ifs_;                                    // #if, #ifdef, #ifndef being read
   std::vector<Object> objects_;
-  std::optional<std::pair<Token, std::string>> undrawn_;  // the first object skipped by undrawable_object, and why
+  std::optional<std::pair<PovToken, std::string>> undrawn_;  // the first object skipped by undrawable_object, and why
   Camera camera_;
-  std::optional<Token> camera_at_;
+  std::optional<PovToken> camera_at_;
   std::vector<PovLight> lights_;
   std::optional<glm::dvec3> background_;
 };
@@ -1414,7 +1414,7 @@ class PovReader {
 // which the box is axis-aligned; the identity where every box is axis-aligned already. A box stays a box under a
 // transform whose columns are orthogonal (rotations, translations, scales in any order); a sheared one is left
 // to region()'s message.
-glm::dmat4 PovReader::box_frame(const Token*& at) const {
+glm::dmat4 PovReader::box_frame(const PovToken*& at) const {
   for (const Object& o : objects_)
     for (const auto& [c, t] : o.clips) {
       if (c.sphere) continue;
@@ -1532,7 +1532,7 @@ std::optional<Clip> seen_sphere(const Sight& sight, const std::vector<bool>& sho
 // clipped to one region (common_region), mirrored where POV-Ray's camera is left-handed, the camera and image
 // (algray_view), an extent fitted where POV-Ray's own region is not a clip (fit_extent), then written out.
 PovTranslation PovReader::run() {
-  while (peek().kind != Token::End) item();
+  while (peek().kind != PovToken::End) item();
   if (objects_.empty() && undrawn_) fail(undrawn_->first, undrawn_->second);
   if (objects_.empty())
     fail(peek(), "the scene holds no object algray reads (poly, polynomial, quartic, cubic, sphere, torus)");
@@ -1701,7 +1701,7 @@ void PovReader::algray_view(Translated& scene) {
   // The camera: angle sets direction's length from right's; the view is |up| tall at |direction|.
   double distance = glm::length(scene.camera.direction);
   if (scene.camera.angle && !scene.camera.orthographic)
-    distance = 0.5 * glm::length(scene.camera.right) / std::tan(*scene.camera.angle * kPi / 360);
+    distance = 0.5 * glm::length(scene.camera.right) / std::tan(*scene.camera.angle * std::numbers::pi / 360);
   const glm::dvec3 forward =
       scene.camera.look_at ? *scene.camera.look_at - scene.camera.location : glm::normalize(scene.camera.direction);
   if (glm::length(forward) == 0)
@@ -1717,7 +1717,7 @@ void PovReader::algray_view(Translated& scene) {
   view.up = up * scene.mirror;
   view.projection = scene.camera.orthographic ? Projection::Orthographic : Projection::Perspective;
   view.ortho_height = glm::length(scene.camera.up);
-  view.fov_y_degrees = 2 * std::atan(0.5 * glm::length(scene.camera.up) / distance) * 180 / kPi;
+  view.fov_y_degrees = 2 * std::atan(0.5 * glm::length(scene.camera.up) / distance) * 180 / std::numbers::pi;
   // POV-Ray stretches right x up over whatever image it renders; algray's images keep that shape by default.
   scene.width = image_width();
   scene.height =
@@ -1733,7 +1733,7 @@ void PovReader::algray_view(Translated& scene) {
 void PovReader::off_axis(Translated& scene, double& distance, glm::dvec3& axis) {
   const Camera& cam = scene.camera;
   const glm::dvec3 r = glm::normalize(cam.right), u = glm::normalize(cam.up);
-  const Token& at = camera_at_ ? *camera_at_ : objects_.front().at;
+  const PovToken& at = camera_at_ ? *camera_at_ : objects_.front().at;
   if (std::fabs(glm::dot(r, u)) > 1e-9) {
     warn(at, "the camera's right and up are not at right angles: POV-Ray shows the image sheared, algray does not");
     return;

@@ -153,7 +153,7 @@ void switch_extent_kind(toml::table& root, const std::string& label, std::vector
     const int axis = axis_name && axis_name->size() == 1 && (*axis_name)[0] >= 'x' && (*axis_name)[0] <= 'z'
                          ? (*axis_name)[0] - 'x'
                          : 2;
-    if (half_height) half[axis] = *half_height;
+    if (const toml::node* h = extent->get("half_height")) half[axis] = h->value_or(half[axis]);
     extent->insert("min", toml_array(centre - half));
     extent->insert("max", toml_array(centre + half));
     made = std::string("; the box is the ") + (half_height ? "box around the cylinder" : "cube about the sphere") +

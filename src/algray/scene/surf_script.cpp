@@ -45,7 +45,7 @@ constexpr int kSurfaces = 9;
 constexpr int kLights = 9;
 constexpr std::size_t kMaxCuts = 64;  // cut_with_plane on one picture
 
-struct Token {
+struct SurfToken {
   enum Kind { Name, Int, Real, String, Op, End } kind = End;
   std::string text;
   double number = 0;
@@ -212,20 +212,20 @@ class Script {
     int surface = 1;
     glm::dvec3 colour;  // 0..255
     double width = 1;
-    Token at;
+    SurfToken at;
   };
   struct Snapshot {
     std::map<std::string, Value> globals;
-    Token at;
+    SurfToken at;
     std::vector<Cut> cuts;  // the cut_with_plane runs after this draw_surface, in order
   };
 
   // --- messages ---
-  std::string where(const Token& t) const { return text_.where(t.line, t.column); }
-  std::string excerpt(const Token& t) const { return text_.excerpt(t.line, t.column); }
-  [[noreturn]] void fail(const Token& t, const std::string& message) const { text_.fail(t.line, t.column, message); }
-  void warn(const Token& t, const std::string& message) { warnings_.push_back(where(t) + ": " + message); }
-  void warn_once(const Token& t, const std::string& key, const std::string& message) {
+  std::string where(const SurfToken& t) const { return text_.where(t.line, t.column); }
+  std::string excerpt(const SurfToken& t) const { return text_.excerpt(t.line, t.column); }
+  [[noreturn]] void fail(const SurfToken& t, const std::string& message) const { text_.fail(t.line, t.column, message); }
+  void warn(const SurfToken& t, const std::string& message) { warnings_.push_back(where(t) + ": " + message); }
+  void warn_once(const SurfToken& t, const std::string& key, const std::string& message) {
     if (warned_.insert(key).second) warn(t, message);
   }
 
@@ -242,21 +242,21 @@ class Script {
         continue;
       }
       if (const int comment = cursor.skip_comment()) {
-        if (comment < 0) fail(Token{Token::Op, "/*", 0, line, column}, "this comment never ends (no */)");
+        if (comment < 0) fail(SurfToken{SurfToken::Op, "/*", 0, line, column}, "this comment never ends (no */)");
         continue;
       }
-      Token t{Token::Op, "", 0, line, column};
+      SurfToken t{SurfToken::Op, "", 0, line, column};
       if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
         std::size_t j = i;
         while (j < text.size() && (std::isalnum(static_cast<unsigned char>(text[j])) || text[j] == '_')) ++j;
-        t.kind = Token::Name;
+        t.kind = SurfToken::Name;
         t.text = text.substr(i, j - i);
         advance(j - i);
       } else if (std::isdigit(static_cast<unsigned char>(c)) ||
                  (c == '.' && i + 1 < text.size() && std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
         bool real = false;
         const std::size_t j = cursor.number_end(&real);
-        t.kind = real ? Token::Real : Token::Int;
+        t.kind = real ? SurfToken::Real : SurfToken::Int;
         t.text = text.substr(i, j - i);
         std::istringstream in(t.text);
         in.imbue(std::locale::classic());
@@ -267,7 +267,7 @@ class Script {
         std::size_t j = i + 1;
         while (j < text.size() && text[j] != '"' && text[j] != '\n') ++j;
         if (j >= text.size() || text[j] != '"') fail(t, "this string never ends (no closing \")");
-        t.kind = Token::String;
+        t.kind = SurfToken::String;
         t.text = text.substr(i + 1, j - i - 1);
         advance(j + 1 - i);
       } else {
@@ -286,15 +286,15 @@ class Script {
       }
       tokens_.push_back(t);
     }
-    tokens_.push_back({Token::End, "", 0, line, column});
+    tokens_.push_back({SurfToken::End, "", 0, line, column});
   }
 
-  const Token& peek(std::size_t ahead = 0) const { return tokens_[std::min(pos_ + ahead, tokens_.size() - 1)]; }
+  const SurfToken& peek(std::size_t ahead = 0) const { return tokens_[std::min(pos_ + ahead, tokens_.size() - 1)]; }
   bool at_op(const char* op, std::size_t ahead = 0) const {
-    return peek(ahead).kind == Token::Op && peek(ahead).text == op;
+    return peek(ahead).kind == SurfToken::Op && peek(ahead).text == op;
   }
-  const Token& next() {
-    const Token& t = tokens_[pos_];
+  const SurfToken& next() {
+    const SurfToken& t = tokens_[pos_];
     if (pos_ + 1 < tokens_.size()) ++pos_;
     return t;
   }
@@ -302,37 +302,37 @@ class Script {
     if (!at_op(op)) fail(peek(), std::string("expected ") + what + ", found " + describe(peek()));
     next();
   }
-  static std::string describe(const Token& t) {
+  static std::string describe(const SurfToken& t) {
     switch (t.kind) {
-      case Token::End:
+      case SurfToken::End:
         return "the end of the file";
-      case Token::String:
+      case SurfToken::String:
         return "a string";
       default:
         return "'" + t.text + "'";
     }
   }
   void skip_statement() {
-    while (peek().kind != Token::End && !at_op(";")) next();
+    while (peek().kind != SurfToken::End && !at_op(";")) next();
     if (at_op(";")) next();
   }
 
   // --- expressions ---
-  Poly multiply(const Poly& a, const Poly& b, const Token& at) {
+  Poly multiply(const Poly& a, const Poly& b, const SurfToken& at) {
     try {
       return algray::multiply(a, b, budget_);
     } catch (const PolyTooLarge& e) {
       fail(at, e.what());
     }
   }
-  Poly power(const Poly& p, long e, const Token& at) {
+  Poly power(const Poly& p, long e, const SurfToken& at) {
     try {
       return algray::power(p, e, budget_);
     } catch (const PolyTooLarge& error) {
       fail(at, error.what());
     }
   }
-  Poly substitute(const Poly& p, const std::array<std::array<double, 4>, 3>& m, const Token& at) {
+  Poly substitute(const Poly& p, const std::array<std::array<double, 4>, 3>& m, const SurfToken& at) {
     try {
       return algray::substitute(p, m, budget_);
     } catch (const PolyTooLarge& e) {
@@ -353,7 +353,7 @@ class Script {
     return r;
   }
   // The surface P turned by `angle`: P(R^-1 x), R^-1 being R's transpose.
-  Poly rotated(const Poly& p, int axis, double angle, const Token& at) {
+  Poly rotated(const Poly& p, int axis, double angle, const SurfToken& at) {
     const auto r = rotation(static_cast<std::size_t>(axis), angle);
     std::array<std::array<double, 4>, 3> m{};
     for (int i = 0; i < 3; ++i)
@@ -361,16 +361,16 @@ class Script {
     return substitute(p, m, at);
   }
 
-  double real_result(double v, const Token& at) {
+  double real_result(double v, const SurfToken& at) {
     if (!std::isfinite(v)) fail(at, "this gives " + std::string(std::isnan(v) ? "no real number" : "an infinity"));
     return v;
   }
-  Value number_result(double v, bool both_int, const Token& at) {
+  Value number_result(double v, bool both_int, const SurfToken& at) {
     real_result(v, at);
     return both_int && std::fabs(v) < 9.007e15 ? Value::of_int(v) : Value::of_real(v);
   }
 
-  Value binary(const std::string& op, const Value& a, const Value& b, const Token& at) {
+  Value binary(const std::string& op, const Value& a, const Value& b, const SurfToken& at) {
     if (a.kind == Value::String || b.kind == Value::String) {
       if (op == "+" && a.kind == Value::String && b.kind == Value::String) return Value::of_string(a.text + b.text);
       if ((op == "==" || op == "!=") && a.kind == Value::String && b.kind == Value::String)
@@ -435,11 +435,11 @@ class Script {
     if (level == static_cast<int>(levels.size())) return unary(depth);
     Value left = binary_level(level + 1, depth);
     for (;;) {
-      const Token& t = peek();
-      if (t.kind != Token::Op ||
+      const SurfToken& t = peek();
+      if (t.kind != SurfToken::Op ||
           std::find(levels[level].begin(), levels[level].end(), t.text) == levels[level].end())
         return left;
-      const Token op = next();
+      const SurfToken op = next();
       const Value right = binary_level(level + 1, depth);
       left = binary(op.text, left, right, op);
     }
@@ -447,7 +447,7 @@ class Script {
   Value unary(int depth) {
     if (depth > 200) fail(peek(), "the expression is nested too deeply");
     if (at_op("-") || at_op("+") || at_op("!")) {
-      const Token op = next();
+      const SurfToken op = next();
       Value v = unary(depth + 1);
       if (op.text == "+") {
         if (v.kind == Value::String) fail(op, "unary '+' does not apply to a string");
@@ -478,11 +478,11 @@ class Script {
     expect(")", "')' or ','");
     return args;
   }
-  double number_arg(const Value& v, const Token& at, const std::string& function) {
+  double number_arg(const Value& v, const SurfToken& at, const std::string& function) {
     if (!v.is_number()) fail(at, function + " takes numbers, not a " + kind_name(v.kind));
     return v.number;
   }
-  Value call(const Token& name, int depth) {
+  Value call(const SurfToken& name, int depth) {
     const std::vector<Value> args = arguments(depth);
     const std::string& f = name.text;
     auto want = [&](std::size_t n) {
@@ -548,24 +548,24 @@ class Script {
                          "arcsin, arccos, arctan, rotate, deg, len, diff, itostr, itostrn)");
   }
   Value primary(int depth) {
-    const Token t = next();
+    const SurfToken t = next();
     switch (t.kind) {
-      case Token::Int:
+      case SurfToken::Int:
         return Value::of_int(t.number);
-      case Token::Real:
+      case SurfToken::Real:
         return Value::of_real(t.number);
-      case Token::String:
+      case SurfToken::String:
         return Value::of_string(t.text);
-      case Token::Op:
+      case SurfToken::Op:
         if (t.text == "(") {
           Value v = expression(depth + 1);
           expect(")", "')'");
           return v;
         }
         fail(t, "expected a value, found " + describe(t));
-      case Token::End:
+      case SurfToken::End:
         fail(t, "expected a value, found the end of the file");
-      case Token::Name:
+      case SurfToken::Name:
         break;
     }
     if (at_op("(")) return call(t, depth);
@@ -578,7 +578,7 @@ class Script {
   }
 
   // --- statements ---
-  Value converted(const Value& v, Value::Kind kind, const Token& at) {
+  Value converted(const Value& v, Value::Kind kind, const SurfToken& at) {
     if (v.kind == kind) return v;
     if (kind == Value::Polynomial && v.is_number()) return Value::of_poly(Poly::constant(v.number));
     if (kind == Value::Real && v.kind == Value::Int) return Value::of_real(v.number);
@@ -590,14 +590,14 @@ class Script {
       return Value::of_int(v.number);
     fail(at, std::string("a ") + kind_name(kind) + " cannot hold this " + kind_name(v.kind) + " value");
   }
-  void declaration(const Token& type) {
+  void declaration(const SurfToken& type) {
     static const std::map<std::string, Value::Kind> types = {{"int", Value::Int},
                                                              {"double", Value::Real},
                                                              {"poly", Value::Polynomial},
                                                              {"polyxyz", Value::Polynomial},
                                                              {"string", Value::String}};
-    const Token name = next();
-    if (name.kind != Token::Name) fail(name, "expected a name after " + type.text + ", found " + describe(name));
+    const SurfToken name = next();
+    if (name.kind != SurfToken::Name) fail(name, "expected a name after " + type.text + ", found " + describe(name));
     if (locals_.count(name.text)) fail(name, "'" + name.text + "' is already declared");
     if (globals_.count(canonical_name(name.text)) || constants().count(name.text) || name.text == "x" ||
         name.text == "y" || name.text == "z" || types.count(name.text))
@@ -608,14 +608,14 @@ class Script {
                   : kind == Value::String    ? Value::of_string("")
                                              : Value::of_poly({});
     if (at_op("=")) {
-      const Token eq = next();
+      const SurfToken eq = next();
       value = converted(expression(), kind, eq);
     }
     locals_[name.text] = value;
     expect(";", "';'");
   }
-  void assignment(const Token& name) {
-    const Token eq = next();  // '='
+  void assignment(const SurfToken& name) {
+    const SurfToken eq = next();  // '='
     const std::string key = canonical_name(name.text);
     if (const auto it = locals_.find(name.text); it != locals_.end()) {
       it->second = converted(expression(), it->second.kind, eq);
@@ -644,7 +644,7 @@ class Script {
     expect(";", "';'");
   }
   // Values algray draws differently: said once, where they are set.
-  void note_assignment(const Token& at, const std::string& key, const Value& v) {
+  void note_assignment(const SurfToken& at, const std::string& key, const Value& v) {
     if (key == "clip" && (v.number == 1 || v.number == 2 || v.number == 3))
       fail(at, "clip to a cylinder: algray clips to a ball, a cube or none (the slab between clip_back and "
                "clip_front)");
@@ -655,7 +655,7 @@ class Script {
     if (key.compare(0, 9, "thickness") == 0 && v.number != 0)
       warn_once(at, key, key + ": algray's transparent surfaces have no thickness; ignored");
   }
-  void command(const Token& name) {
+  void command(const SurfToken& name) {
     expect(";", "';' after the command");
     const std::string& c = name.text;
     if (c == "draw_surface") {
@@ -683,7 +683,7 @@ class Script {
   }
   // cut_with_plane: the curve where `plane` meets surface number surf_nr, drawn on the picture draw_surface drew
   // last in the curve's colour and width; written as a [[section]] of that surface (translate()).
-  void cut(const Token& at) {
+  void cut(const SurfToken& at) {
     if (!last_drawn_) {
       warn_once(at, "cut_with_plane", "cut_with_plane before any draw_surface: surf draws the section on the picture "
                                       "drawn last, and there is none yet; ignored");
@@ -716,19 +716,19 @@ class Script {
     last_drawn_->cuts.push_back(std::move(k));
   }
   // Where a reserved value was last set, or `otherwise` where it was never set.
-  const Token& set_at_now(const std::string& key, const Token& otherwise) const {
+  const SurfToken& set_at_now(const std::string& key, const SurfToken& otherwise) const {
     const auto it = assigned_at_.find(key);
     return it != assigned_at_.end() ? it->second : otherwise;
   }
-  void if_goto(const Token& at) {
+  void if_goto(const SurfToken& at) {
     expect("(", "'(' after if");
     const Value condition = expression();
     expect(")", "')'");
     if (!condition.is_number()) fail(at, "if needs a number (a comparison)");
-    const Token go = next();
-    if (go.kind != Token::Name || go.text != "goto") fail(go, "surf's if is `if (condition) goto LABEL;`");
-    const Token label = next();
-    if (label.kind != Token::Name) fail(label, "expected a label after goto");
+    const SurfToken go = next();
+    if (go.kind != SurfToken::Name || go.text != "goto") fail(go, "surf's if is `if (condition) goto LABEL;`");
+    const SurfToken label = next();
+    if (label.kind != SurfToken::Name) fail(label, "expected a label after goto");
     const auto target = labels_.find(label.text);
     if (target == labels_.end()) fail(label, "no label '" + label.text + ":' before this goto");
     expect(";", "';'");
@@ -738,9 +738,9 @@ class Script {
     if (++statements_ > kMaxStatements)
       fail(peek(), "the script runs more than " + std::to_string(kMaxStatements) +
                        " statements (a goto loop that does not end?)");
-    const Token t = next();
-    if (t.kind == Token::Op && t.text == ";") return;
-    if (t.kind != Token::Name) fail(t, "expected a statement, found " + describe(t));
+    const SurfToken t = next();
+    if (t.kind == SurfToken::Op && t.text == ";") return;
+    if (t.kind != SurfToken::Name) fail(t, "expected a statement, found " + describe(t));
     if (t.text == "int" || t.text == "double" || t.text == "poly" || t.text == "polyxyz" || t.text == "string")
       return declaration(t);
     if (t.text == "if" && at_op("(")) return if_goto(t);
@@ -756,7 +756,7 @@ class Script {
 
   // --- the scene ---
   double number(const Snapshot& s, const std::string& key) const { return s.globals.at(key).number; }
-  const Token& set_at(const Snapshot& s, const std::string& key) const {
+  const SurfToken& set_at(const Snapshot& s, const std::string& key) const {
     const auto it = assigned_at_.find(key);
     return it != assigned_at_.end() ? it->second : s.at;
   }
@@ -804,18 +804,18 @@ class Script {
   LocatedText text_;
   const std::string& source_;
   std::vector<std::string>& warnings_;
-  std::vector<Token> tokens_;
+  std::vector<SurfToken> tokens_;
   std::size_t pos_ = 0;
   long statements_ = 0;
   PolyBudget budget_;  // the script's polynomial arithmetic, all of it
   std::map<std::string, Value> locals_, globals_;
-  std::map<std::string, Token> assigned_at_;
+  std::map<std::string, SurfToken> assigned_at_;
   std::map<std::string, std::size_t> labels_;
   std::set<std::string> warned_;
   // Only the pictures algray may render are kept: a loop may draw thousands.
   std::optional<Snapshot> last_drawn_, first_saved_;
   long draws_ = 0, saves_ = 0;
-  std::optional<Token> curve_at_;
+  std::optional<SurfToken> curve_at_;
   int rendered_width_ = 0, rendered_height_ = 0;  // overrides of width and height, 0 where none
 };
 
@@ -877,7 +877,7 @@ void Script::write_surfaces(std::ostringstream& toml, const Snapshot& s, const A
     const std::string sfx = surface_suffix(n);
     const Poly& own = s.globals.at("surface" + sfx).poly;
     if (own.terms.empty()) continue;
-    const Token& at = set_at(s, "surface" + sfx);
+    const SurfToken& at = set_at(s, "surface" + sfx);
     const Poly p = substitute(own, inverse, at);
     if (p.degree() < 1) fail(at, "surface" + sfx + " is a constant after its position is applied; nothing to draw");
     index_of[static_cast<std::size_t>(n)] = surfaces;
@@ -1058,7 +1058,7 @@ SurfTranslation Script::run(int width, int height) {
   rendered_width_ = width;
   rendered_height_ = height;
   // A label is known once its statement has run: surf's goto jumps back only.
-  while (peek().kind != Token::End) statement();
+  while (peek().kind != SurfToken::End) statement();
   if (!last_drawn_) {
     if (curve_at_) fail(*curve_at_, "this script draws plane curves only; algray draws surfaces (draw_surface)");
     fail(peek(), "the script never draws a surface (no draw_surface)");
