@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds algray and runs the whole test suite, then the host-side tests and fuzzers under ASan+UBSan.
+# Installs what is missing, builds algray and runs the whole test suite, then the sanitize-labelled tests and the
+# fuzzers under ASan+UBSan.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -32,7 +33,8 @@ cmake --build build -j"$(nproc)"
 scripts/install-python.sh
 phase "release build done"
 # The same code once more under AddressSanitizer and UndefinedBehaviorSanitizer, in a clang tree of its own that
-# builds only what `ctest -L sanitize` (tests/CMakeLists.txt says which) and the fuzzers need (docs/fuzzing.md). Debug: -O0 compiles twice as fast.
+# builds only what `ctest -L sanitize` (tests/CMakeLists.txt says which) and the fuzzers need (docs/fuzzing.md).
+# Debug: -O0 compiles twice as fast.
 # clang++-15 is the clang PoCL itself depends on in Debian 12, and its compiler-rt (ASan, UBSan, libFuzzer) comes
 # with it; any other clang++ with those runtimes will do.
 cxx=

@@ -70,11 +70,10 @@ struct TracerPair {
              bool settle_doubts = false)
       : surface(testing::device_session().context, scene, precision),
         offset(shadow_offset_unit(precision) * scene.extent.unit_scale()),
-        batched(testing::device_session(), cache(),
+        batched(testing::device_session(), testing::program_cache(),
                 shadow_config(scene, precision, isolation, "shadow", origin, settle_doubts), surface, offset),
-        serial(testing::device_session(), cache(),
+        serial(testing::device_session(), testing::program_cache(),
                shadow_config(scene, precision, isolation, "shadow_serial", origin, settle_doubts), surface, offset) {}
-  static ProgramCache& cache() { return testing::program_cache(); }
   DeviceSurface surface;
   double offset;
   ShadowTracer batched, serial;

@@ -153,6 +153,8 @@ void switch_extent_kind(toml::table& root, const std::string& label, std::vector
     const int axis = axis_name && axis_name->size() == 1 && (*axis_name)[0] >= 'x' && (*axis_name)[0] <= 'z'
                          ? (*axis_name)[0] - 'x'
                          : 2;
+    // read from the node: through the optional above, GCC 12 warns falsely (-Wmaybe-uninitialized) once this file
+    // is compiled in a unity batch
     if (const toml::node* h = extent->get("half_height")) half[axis] = h->value_or(half[axis]);
     extent->insert("min", toml_array(centre - half));
     extent->insert("max", toml_array(centre + half));
