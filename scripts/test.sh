@@ -49,7 +49,8 @@ fi
 gen=$(generator build-sanitize)
 # Its tests use the Release tree's kernel cache: the kernels are the same, so none is compiled twice.
 cmake -S . -B build-sanitize ${gen:+-G "$gen"} -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER="$cxx" \
-      -DALGRAY_SANITIZE=ON -DALGRAY_FUZZ=ON -DALGRAY_TEST_KERNEL_CACHE="$PWD/build/kernel-cache"
+      -DALGRAY_SANITIZE=ON -DALGRAY_FUZZ=ON -DALGRAY_TEST_KERNEL_CACHE="$PWD/build/kernel-cache" \
+      -DALGRAY_BUILD_FULL_WITH_CLI=OFF
 # Built at the lowest priority while the Release tests run: those leave about a sixth of the two cores idle (tests
 # waiting on processes, sockets and single-threaded kernel builds), which this build takes; it yields to them
 # otherwise. Its log is printed if it fails.
@@ -76,7 +77,7 @@ fi
 phase "sanitizer build done"
 ctest --test-dir build-sanitize -L sanitize --output-on-failure --timeout 900 -j"$(nproc)"
 phase "sanitize-labelled tests passed under the sanitizers"
-# Each fuzzer runs 10 s from its seeds on one core (a smoke test of the readers; docs/fuzzing.md has the hour-long
+# Each fuzzer runs 5 s from its seeds on one core (a smoke test of the readers; docs/fuzzing.md has the hour-long
 # runs); the tests print their runs and coverage.
 ctest --test-dir build-sanitize -L fuzz -j"$(nproc)" --output-on-failure --verbose
 phase "fuzzers found nothing"
