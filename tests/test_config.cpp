@@ -12,6 +12,7 @@
 
 #include "algray/device/kernel_config.h"
 #include "algray/device/kernel_sources.h"
+#include "algray/render/precision_race.h"
 #include "algray/render/renderer.h"
 #include "algray/scene/camera.h"
 #include "algray/scene/expression.h"
@@ -119,6 +120,62 @@ TEST_CASE("precision follows the device: double refused without fp64, auto takes
   CHECK(resolve_precision(scene, with_fp64, 32.0) == Precision::Double);  // asked for: slow or not
   scene.render.precision = Precision::Adaptive;
   CHECK(resolve_precision(scene, with_fp64, 1.0) == Precision::Adaptive);
+}
+
+// PrecisionRace's schedule and decision (the frames themselves: test_public_api).
+TEST_CASE("a precision race alternates double and adaptive, then keeps the faster, adaptive on a tie", "[config]") {
+  PrecisionRace race;
+  const std::string slow_double = "a", tie = "b";
+  std::vector<Precision> order;
+  const double double_ms[] = {9.0, 8.0}, adaptive_ms[] = {7.5, 8.5};
+  for (int frame = 0; frame < 2 * PrecisionRace::kRounds; ++frame) {
+    const Precision p = race.next(slow_double);
+    order.push_back(p);
+    race.record(slow_double, p, p == Precision::Double ? double_ms[frame / 2] : adaptive_ms[frame / 2]);
+  }
+  CHECK(order ==
+        std::vector<Precision>{Precision::Double, Precision::Adaptive, Precision::Double, Precision::Adaptive});
+  CHECK(race.next(slow_double) == Precision::Adaptive);  // fastest frames: adaptive 7.5 against double 8.0
+  CHECK_THAT(race.reason(slow_double),
+             Catch::Contains("adaptive: its fastest of 2 frames took 7.5 ms") && Catch::Contains("double's 8 ms"));
+  race.record(slow_double, Precision::Adaptive, 100.0);  // decided: later frames do not reopen it
+  CHECK(race.next(slow_double) == Precision::Adaptive);
+  CHECK(race.next(tie) == Precision::Double);  // a key of its own, racing from its first frame
+  CHECK_THAT(race.reason(tie), Catch::Contains("first frame"));
+  for (int frame = 0; frame < 2 * PrecisionRace::kRounds; ++frame) race.record(tie, race.next(tie), 5.0);
+  CHECK(race.next(tie) == Precision::Adaptive);
+  PrecisionRace faster_double;
+  for (int frame = 0; frame < 2 * PrecisionRace::kRounds; ++frame) {
+    const Precision p = faster_double.next("c");
+    faster_double.record("c", p, p == Precision::Double ? 4.0 : 6.0);
+  }
+  CHECK(faster_double.next("c") == Precision::Double);
+  CHECK_THAT(faster_double.reason("c"), Catch::StartsWith("double: ") && Catch::Contains("adaptive's 6 ms"));
+  // Float and mixed frames are not the race's.
+  PrecisionRace other;
+  other.record("d", Precision::Float, 1.0);
+  CHECK(other.next("d") == Precision::Double);
+  CHECK_THAT(other.reason("d"), Catch::Contains("first frame"));
+  // The oldest key is forgotten past kKeys and races again.
+  PrecisionRace many;
+  for (int frame = 0; frame < 2 * PrecisionRace::kRounds; ++frame) many.record("first", many.next("first"), 1.0);
+  REQUIRE(many.next("first") == Precision::Adaptive);
+  for (std::size_t k = 0; k < PrecisionRace::kKeys; ++k) many.record("key " + std::to_string(k), Precision::Double, 1);
+  CHECK(many.next("first") == Precision::Double);
+}
+
+TEST_CASE("a precision race's key keeps a surface's race while its coefficients move, not its size or shape",
+          "[config]") {
+  const Scene base = load_scene_text(kSphereScene, "t.toml");
+  const auto key = [](const std::string& text, const std::vector<Override>& overrides) {
+    return PrecisionRace::key_of(load_scene_text(text, "t.toml", overrides));
+  };
+  const std::string k = PrecisionRace::key_of(base);
+  CHECK(key(kSphereScene, {{"camera.eye", "[0, 1, 7]"}}) == k);
+  CHECK(key(kSphereScene, {{"image.width", "333"}}) != k);
+  CHECK(key(kSphereScene, {{"surface.equation", "\"(x-1)^2 + y^2 + z^2 - 0.3\""}}) == k);  // a parameter moved
+  CHECK(key(kSphereScene, {{"surface.equation", "\"x^4 + y^2 + z^2 - 1\""}}) != k);        // another surface
+  CHECK(key(kSphereScene, {{"render.isolation", "\"sturm\""}}) != k);
 }
 
 TEST_CASE("adaptive precision is refused, naming the line, where it cannot escalate", "[config]") {

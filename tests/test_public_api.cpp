@@ -11,6 +11,7 @@
 
 #include "algray/api/render_job.h"
 #include "algray/io/image_io.h"
+#include "algray/render/precision_race.h"
 #include "algray/render/renderer.h"
 #include "temp_dir.h"
 #include "test_support.h"
@@ -141,6 +142,7 @@ TEST_CASE("one renderer's frames of other sizes and scenes are fresh renderers' 
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const Frame& f = frames[i];
     api::RenderSettings settings;
+    settings.precision = "double";  // the kept renderer's previews would race precisions (the next test case)
     settings.width = f.width;
     settings.height = f.height;
     settings.preview = f.preview;
@@ -152,6 +154,53 @@ TEST_CASE("one renderer's frames of other sizes and scenes are fresh renderers' 
     CHECK(again.depth() == fresh.depth());
     CHECK(again.normal() == fresh.normal());
   }
+}
+
+// Issue 44, goal 3: an API renderer draws frame after frame, so its previews with the precision left open race
+// double against adaptive (render/precision_race.h) and keep the faster; each frame is a fresh render's in its
+// precision, bit for bit. Final renders and a precision the scene sets do not race.
+TEST_CASE("an API renderer's previews race double against adaptive and keep the faster, and nothing else races",
+          "[api]") {
+  algray::testing::device_session();
+  api::Renderer renderer;
+  const api::Scene scene = api::Scene::load(kTorus);
+  api::RenderSettings preview;
+  preview.width = 64;
+  preview.height = 48;
+  preview.preview = true;
+  const auto solver = [](const api::Image& image) { return nlohmann::json::parse(image.stats_json())["solver"]; };
+  std::vector<std::string> precisions;
+  const int frames = 2 * algray::PrecisionRace::kRounds + 2;
+  for (int i = 0; i < frames; ++i) {
+    const api::Image image = renderer.render(scene, preview);
+    const nlohmann::json s = solver(image);
+    precisions.push_back(s["precision"]);
+    INFO("frame " << i << ": " << s.dump());
+    if (i == 0) REQUIRE(precisions[0] == "double");  // this device's auto: fast fp64 (test_config's CPUs)
+    REQUIRE(s.contains("precision_reason"));
+    const std::string reason = s["precision_reason"];
+    CHECK_THAT(reason, i < 2 * algray::PrecisionRace::kRounds ? Catch::StartsWith("racing double against adaptive")
+                                                              : Catch::StartsWith(precisions.back() + ": "));
+    api::RenderSettings same = preview;
+    same.precision = precisions.back();
+    const api::Image fresh = api::Renderer().render(scene, same);
+    CHECK(image.rgba() == fresh.rgba());
+    CHECK(image.depth() == fresh.depth());
+    CHECK_FALSE(solver(fresh).contains("precision_reason"));  // asked for: no race
+  }
+  for (int i = 0; i < 2 * algray::PrecisionRace::kRounds; ++i)
+    CHECK(precisions[static_cast<std::size_t>(i)] == (i % 2 == 0 ? "double" : "adaptive"));
+  for (std::size_t i = 2 * algray::PrecisionRace::kRounds; i < precisions.size(); ++i)
+    CHECK(precisions[i] == precisions.back());
+  // Another size is another race; a final render keeps auto's double.
+  api::RenderSettings bigger = preview;
+  bigger.width = 80;
+  CHECK(solver(renderer.render(scene, bigger))["precision"] == "double");
+  api::RenderSettings final_render = preview;
+  final_render.preview = false;
+  const nlohmann::json final_solver = solver(renderer.render(scene, final_render));
+  CHECK(final_solver["precision"] == "double");
+  CHECK_FALSE(final_solver.contains("precision_reason"));
 }
 
 TEST_CASE("a cancelled render raises Cancelled and the renderer goes on", "[api]") {

@@ -214,6 +214,9 @@ Image Renderer::render(const Scene& scene, const RenderSettings& settings) {
     FrameRequest request;
     request.reference = settings.reference;
     request.depth_and_normal = settings.depth_and_normal;
+    // A renderer of the API draws frame after frame (the view, Python, notebooks): its previews with the
+    // precision left open race double against adaptive and keep the faster.
+    request.race_precision = true;
     if (!settings.aovs.empty()) {
       std::string list, error;
       for (const std::string& a : settings.aovs) list += (list.empty() ? "" : ",") + a;

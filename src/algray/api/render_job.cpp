@@ -235,6 +235,7 @@ nlohmann::json frame_stats(const Scene& scene, const RenderedFrame& frame, const
                              {"equation", utf8_for_json(s.equation)},
                              {"degree", s.polynomial.degree()}});
   j["solver"] = solver_json(r.config);
+  if (!r.precision_reason.empty()) j["solver"]["precision_reason"] = r.precision_reason;
   if (cache_used)
     put_path(j, "cache", ProgramCache::default_directory());
   else
@@ -475,6 +476,7 @@ void render_on_device(const Scene& scene, const FrameRequest& request, RenderCon
     options.film = [=] { return make_film(film_width, film_height, depth_and_normal); };
   options.on_progress = callbacks.on_progress;
   options.cancelled = callbacks.cancelled;
+  options.race_precision = request.race_precision;
   if (diagnostics) {
     options.on_primary_tile = [&](const PrimaryTile& tile) {
       if (work.isolation_steps.empty()) work = empty_solver_work(scene.image.width, scene.image.height, tile.samples);

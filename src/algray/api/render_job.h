@@ -171,6 +171,8 @@ struct FrameRequest {
   bool reference = false;
   std::vector<SolverAov> aovs;
   bool heatmap = false;
+  // One frame of a stream (the public API's renders): RenderOptions::race_precision.
+  bool race_precision = false;
 };
 
 // Renders `scene` on the context's device (or with solver_ref) into memory. Throws on failure.

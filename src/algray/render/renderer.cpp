@@ -116,7 +116,15 @@ void Renderer::sweep(std::vector<std::unique_ptr<Passes>>& devices, const std::v
 
 RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) {
   RenderResult result;
-  const Precision precision = precision_of(scene);
+  Precision precision = precision_of(scene);
+  std::string race_key;
+  if (options.race_precision && scene.render.preview && !scene.render.precision && precision == Precision::Double &&
+      float_precision_for(scene) == Precision::Adaptive) {
+    race_key = PrecisionRace::key_of(scene);
+    const std::lock_guard<std::mutex> lock(race_mutex_);
+    precision = race_.next(race_key);
+    result.precision_reason = race_.reason(race_key);
+  }
   result.plan = make_render_plan(scene, precision, plan_devices(precision));
   for (const ClSession* session : sessions_) check_plan_fits(result.plan, session->info);
   result.config = result.plan.passes.front().kernels.front();
@@ -159,6 +167,13 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
     result.image = render_rows(devices, options.rows.value_or(RenderOptions::RowBand{0, plan.height}), options.film);
   }
   add_device_tallies(devices, result);
+  if (!race_key.empty()) {
+    // The passes' device time: the shading kernel's is the same in both precisions.
+    double kernel_ms = 0;
+    for (const PassStats& pass : result.passes) kernel_ms += pass.kernel_ms;
+    const std::lock_guard<std::mutex> lock(race_mutex_);
+    race_.record(race_key, precision, kernel_ms);
+  }
   return result;
 }
 

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -14,6 +15,7 @@
 #include "algray/io/image_io.h"
 #include "algray/render/device_surface.h"
 #include "algray/render/populated_pages.h"
+#include "algray/render/precision_race.h"
 #include "algray/render/render_plan.h"
 #include "algray/render/trace_records.h"
 #include "algray/scene/camera.h"
@@ -92,6 +94,11 @@ struct RenderOptions {
   // (MPI ranks take bands so). The result then holds no film, and its counts are the bands' together.
   std::function<std::optional<RowBand>()> next_band;
   std::function<void(const RowBand&, FrameImage&)> on_band;
+  // A frame of a stream (the API's renders: `algray view`, Python): a preview whose scene leaves the precision
+  // open, on devices where that means double, renders in double or adaptive, whichever this renderer measured
+  // faster for frames like it (PrecisionRace); RenderResult::precision_reason says which and why. Final renders
+  // and the command line keep `auto` as it is.
+  bool race_precision = false;
 };
 
 // One device's share of a render of several: the tiles it took from the queue (the first sweep's, when
@@ -126,6 +133,8 @@ struct RenderResult {
   // the pass's wall_ms.
   double shade_ms = 0;
   double shade_kernel_ms = 0;
+  // Why the render is in its precision, where RenderOptions::race_precision chose it; empty elsewhere.
+  std::string precision_reason;
 
   // Kept only with RenderOptions::keep_records:
   HitBuffer hits;                         // one record per traced ray: plan.trace_width() x plan.trace_height()
@@ -226,6 +235,9 @@ class Renderer {
   // Per device, its tile buffers, kept from one render to the next: at 1024x768 the camera rays' records are
   // 25 MB, whose page faults cost a fifth of a preview frame's host time when made anew each frame.
   std::vector<std::unique_ptr<TileWork>> kept_work_;
+  // Streams' frames, double against adaptive (RenderOptions::race_precision); one render at a time uses it.
+  std::mutex race_mutex_;
+  PrecisionRace race_;
 };
 
 }  // namespace algray
