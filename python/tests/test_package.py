@@ -21,7 +21,21 @@ TORUS = os.path.join(ROOT, "scenes", "torus.toml")
 def renderer():
     if not algray.devices():
         pytest.fail("no OpenCL device: these tests need one (on Debian: apt-get install pocl-opencl-icd)")
-    return algray.Renderer()
+    # Double, as `auto` is on the CPUs the suite runs on: these tests compare renders bit for bit, and a renderer
+    # left to `auto` races double against adaptive over its first previews of each surface (the test below).
+    return algray.Renderer(precision="double")
+
+
+def test_previews_left_to_auto_race_double_against_adaptive_and_keep_the_faster():
+    racing = algray.Renderer()
+    scene = algray.Scene.load(TORUS)
+    solvers = [racing.render(scene, width=40, height=30, preview=True).stats["solver"] for _ in range(6)]
+    assert [s["precision"] for s in solvers[:4]] == ["double", "adaptive", "double", "adaptive"], solvers
+    assert solvers[4]["precision"] == solvers[5]["precision"] in ("double", "adaptive"), solvers
+    assert all(s["precision_reason"].startswith("racing") for s in solvers[:4]), solvers
+    assert solvers[5]["precision_reason"].startswith(solvers[5]["precision"] + ": "), solvers
+    final = racing.render(scene, width=40, height=30).stats["solver"]
+    assert final["precision"] == "double" and "precision_reason" not in final
 
 
 def test_a_render_from_python_is_the_command_lines_render_bit_for_bit(renderer, tmp_path):

@@ -46,7 +46,10 @@ fetch(document.getElementById("frame").src).then(r => r.arrayBuffer()).then(b =>
   let s = ""; for (const x of new Uint8Array(b)) s += String.fromCharCode(x); done(btoa(s));
 });"""
 
-server = subprocess.Popen([BINARY, "view", "--port", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+# Frames are compared bit for bit across requests and with `algray render`: double, as `auto` is here, since a
+# stream's previews left to `auto` race double against adaptive (docs/solvers.md, "Previews in a stream").
+server = subprocess.Popen([BINARY, "view", "--port", "0", "--precision", "double"], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True)
 driver = None
 other = None  # a second server, for an equation alone with a box extent
 try:

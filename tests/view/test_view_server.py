@@ -38,7 +38,10 @@ def get(base, path, params=()):
         return e.code, e.headers, e.read()
 
 
-server = subprocess.Popen([BINARY, "view", "--port", "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+# Frames are compared bit for bit across requests and with `algray render`: double, as `auto` is here, since a
+# stream's previews left to `auto` race double against adaptive (docs/solvers.md, "Previews in a stream").
+server = subprocess.Popen([BINARY, "view", "--port", "0", "--precision", "double"], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True)
 try:
     url = server.stdout.readline().strip()
     if not url.startswith("http://127.0.0.1:"):
