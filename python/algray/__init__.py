@@ -121,7 +121,9 @@ class Renderer:
     """One OpenCL device, its context and its program cache, kept for every render, probe and batch.
 
     device: None for the first GPU, else the first device; an index of devices(); or a substring of the device
-    or platform name. precision: "auto" (double where the device has fp64), "double", "float" or "mixed".
+    or platform name. precision: "auto" (double where the device's fp64 is fast, else adaptive; previews, where
+    that is double, race double against adaptive over their first frames of a surface and keep the faster:
+    image.stats["solver"]["precision_reason"] says which), "double", "float", "mixed" or "adaptive".
     cache: keep built kernels on disk between processes."""
 
     def __init__(self, device=None, precision="auto", cache=True):
