@@ -124,6 +124,9 @@ FrameFacts frame_facts(const std::string& stats_json) {
   f.passes_ms = s["render_ms"].value("passes_wall", 0.0);
   f.shade_ms = s["render_ms"].value("shading", 0.0);
   f.phases_json = s.value("phases_ms", json::object()).dump();
+  const json& solver = s["solver"];
+  f.precision = solver.value("precision", "");
+  f.precision_reason = solver.value("precision_reason", "");
   return f;
 }
 
@@ -355,6 +358,8 @@ std::optional<std::string> StreamHub::next_message(const std::shared_ptr<StreamS
                  {"width", held.image->width()},
                  {"height", held.image->height()},
                  {"degree", f.degree},
+                 {"precision", f.precision},
+                 {"precision_reason", f.precision_reason},
                  {"new_programs", f.new_programs},
                  {"queue_ms", held.queue_ms},
                  {"render_ms", held.render_ms},

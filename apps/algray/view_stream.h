@@ -77,6 +77,7 @@ struct FrameFacts {
   double kernel_ms = 0, passes_ms = 0, shade_ms = 0;
   int degree = 0, new_programs = 0;
   std::string phases_json;  // the render's phases and their wall times (--stats' phases_ms)
+  std::string precision, precision_reason;  // the reason where a stream's previews race (PrecisionRace)
 };
 FrameFacts frame_facts(const std::string& stats_json);
 
