@@ -1,6 +1,7 @@
 """What the render benchmarks share: running `algray render` with --stats, naming the machine and the commit, the
 command line as run, and replacing one section of bench/RESULTS.md (a page of current figures, a table per area
 with its date, machine, commit and command; the history is in bench/history/)."""
+import datetime
 import json
 import os
 import platform
@@ -113,17 +114,32 @@ def _join(before, section, after):
     return before + section + after
 
 
+def _to_history(old, heading):
+    """A section of bench/RESULTS.md about to be replaced, verbatim, at the end of this month's history file, its
+    heading saying when and by which script."""
+    old = old.rstrip("\n")
+    path = ROOT / "bench" / "history" / f"{datetime.date.today():%Y-%m}.md"
+    history = path.read_text() if path.exists() else "Superseded sections of bench/RESULTS.md, verbatim.\n"
+    script = Path(sys.argv[0]).name if sys.argv and sys.argv[0] else "a script"
+    replaced = f"(replaced on {datetime.date.today().isoformat()} by bench/{script}'s next run)"
+    # One level down from `##` at most, so that the history file's own `##` sections stay its top level.
+    title = "## " + heading.lstrip("#").strip()
+    path.write_text(history.rstrip("\n") + "\n\n" + old.replace(heading, title + " " + replaced, 1) + "\n")
+
+
 def replace_section(path, heading, section, under=None):
     """Puts `section` (starting with the Markdown heading line `heading`) in place of the old one in the file: from
     that heading's line to the next heading of the same or a higher level, so that a `##` section keeps going past
     its `###` ones and a `###` one stops at the next `###` or `##`. Where the file has no such heading, the section
     is appended: at the end of the section `under` names (its area's `##` heading, added too when missing), or
-    at the end of the file."""
+    at the end of the file. A section of bench/RESULTS.md that is replaced goes to bench/history/YYYY-MM.md."""
     out = Path(path)
     text = out.read_text() if out.exists() else "# Benchmark results\n\n"
     start = _find_heading(text, heading)
     if start is not None:
         end = _section_end(text, start, heading_level(heading))
+        if out.resolve() == RESULTS_MD.resolve():
+            _to_history(text[start:end], heading)
         text = _join(text[:start], section, text[end:])
     elif under and _find_heading(text, under) is not None:
         parent = _find_heading(text, under)

@@ -20,8 +20,7 @@ import sys
 from selenium import webdriver
 from selenium.webdriver.chrome.service import Service
 
-from bench_common import ROOT, _find_heading, _section_end, command_line, commit, heading_level, machine, \
-    replace_section
+from bench_common import ROOT, command_line, commit, machine, replace_section
 
 HEADING = "## algray view: frames per second"
 MODES = ("moving", "still")
@@ -84,18 +83,6 @@ def measure(binary, scene, seconds, mode):
     latency = statistics.median(result["latencies"]) if result["latencies"] else float("nan")
     return {"fps": result["frames"] / seconds, "latency": latency, "frames": len(result["latencies"]),
             "times": times}
-
-
-def to_history(text):
-    """The section about to be replaced, verbatim, at the end of this month's history file."""
-    start = _find_heading(text, HEADING)
-    if start is None:
-        return
-    old = text[start:_section_end(text, start, heading_level(HEADING))].rstrip("\n")
-    path = ROOT / "bench" / "history" / f"{datetime.date.today():%Y-%m}.md"
-    history = path.read_text() if path.exists() else "Superseded sections of bench/RESULTS.md, verbatim.\n"
-    replaced = f"(replaced on {datetime.date.today().isoformat()} by bench/view_fps.py's next run)"
-    path.write_text(history.rstrip("\n") + "\n\n" + old.replace(HEADING, HEADING + " " + replaced, 1) + "\n")
 
 
 def fmt(x, digits=1):
@@ -166,9 +153,7 @@ def main():
     text = "\n".join(lines) + "\n"
     print(text)
     if not args.no_results:
-        results = ROOT / "bench" / "RESULTS.md"
-        to_history(results.read_text())
-        replace_section(results, HEADING, text)
+        replace_section(ROOT / "bench" / "RESULTS.md", HEADING, text)  # the old section goes to bench/history/
 
 
 if __name__ == "__main__":
