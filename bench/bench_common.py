@@ -138,7 +138,7 @@ def replace_section(path, heading, section, under=None):
     start = _find_heading(text, heading)
     if start is not None:
         end = _section_end(text, start, heading_level(heading))
-        if out.resolve() == RESULTS_MD.resolve():
+        if out.resolve() == RESULTS_MD.resolve() and text[start:end].strip() != section.strip():
             _to_history(text[start:end], heading)
         text = _join(text[:start], section, text[end:])
     elif under and _find_heading(text, under) is not None:
