@@ -79,12 +79,8 @@ TEST_CASE("every DEGREE from 1 to 32 builds and finds the smallest root, in floa
   ClSession& session = testing::device_session();
   ProgramCache& cache = testing::program_cache();
   Renderer renderer(session, cache);
-  const std::vector<int> top =
-      testing::sampled("test_kernels precision at degree 32 (0 double, 1 float)", {0, 1}, {}, 1);
-  const auto top_tested = [&](Precision precision) {
-    const int index = precision == Precision::Double ? 0 : precision == Precision::Float ? 1 : -1;
-    return std::find(top.begin(), top.end(), index) != top.end();
-  };
+  const std::vector<Precision> top = testing::sampled_choices<Precision>(
+      "test_kernels precision at degree 32 (0 double, 1 float)", {Precision::Double, Precision::Float}, 1);
   for (const NamedChoice<Precision>& choice : kPrecisions) {
     const char* const precision = choice.name;
     if (std::string(precision) == "double" && !session.info.fp64) FAIL("the test device lacks fp64");
@@ -93,7 +89,7 @@ TEST_CASE("every DEGREE from 1 to 32 builds and finds the smallest root, in floa
     const bool compensated = choice.value == Precision::Mixed || choice.value == Precision::Adaptive;
     const int max_degree = compensated ? kMaxMixedDegree : 32;
     for (int degree : testing::sampled_degrees(std::string("test_kernels ") + precision + " degrees", max_degree, 2)) {
-      if (degree == 32 && !top_tested(choice.value)) continue;
+      if (degree == 32 && std::find(top.begin(), top.end(), choice.value) == top.end()) continue;
       INFO("DEGREE=" << degree << " precision=" << precision);
       const Scene scene = degree_scene(degree, precision);
       REQUIRE(scene.surface().polynomial.degree() == degree);

@@ -55,10 +55,10 @@ TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") 
   // precision a run, drawn (both when exhaustive): the lanes above degree 15 are the same code over LREAL in both,
   // and each degree-32 pair of programs takes PoCL some 20 s of a cold suite to compile (float's 40, with its
   // second pass).
-  const Precision top_choices[] = {Precision::Double, Precision::Float};
-  const std::vector<int> top = testing::sampled("test_lanes precisions at degree 32 (0 double, 1 float)", {0, 1}, {}, 1);
+  const std::vector<Precision> top = testing::sampled_choices<Precision>(
+      "test_lanes precisions at degree 32 (0 double, 1 float)", {Precision::Double, Precision::Float}, 1);
   const auto tested = [&](int degree, Precision precision) {
-    return degree < 32 || std::any_of(top.begin(), top.end(), [&](int i) { return top_choices[i] == precision; });
+    return degree < 32 || std::find(top.begin(), top.end(), precision) != top.end();
   };
   for (int degree : testing::sampled("test_lanes degrees", {1, 2, 3, 5, 6, 9, 12, 15, 20, 32}, {1, 2, 15, 32}, 1)) {
     if (tested(degree, Precision::Double)) cases.push_back({degree, Precision::Double, "auto", {8}});  // screen form

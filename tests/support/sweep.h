@@ -62,6 +62,17 @@ inline std::vector<int> sampled(const std::string& what, const std::vector<int>&
   return chosen;
 }
 
+// Of costly alternatives (`names` of `values`, such as the precisions of a degree-32 case), the ones this run
+// covers: all in an exhaustive run, else `extra` drawn, as sampled() draws them (and prints the draw by index).
+template <typename T>
+std::vector<T> sampled_choices(const std::string& what, const std::vector<T>& values, int extra) {
+  std::vector<int> indices;
+  for (std::size_t i = 0; i < values.size(); ++i) indices.push_back(static_cast<int>(i));
+  std::vector<T> chosen;
+  for (int i : sampled(what, indices, {}, extra)) chosen.push_back(values[static_cast<std::size_t>(i)]);
+  return chosen;
+}
+
 // Degrees 1 to `max_degree`: 1, 2 and `max_degree` on every run, and `extra` others.
 inline std::vector<int> sampled_degrees(const std::string& what, int max_degree, int extra = 3) {
   std::vector<int> all;

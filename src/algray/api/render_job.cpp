@@ -95,13 +95,11 @@ void add_metadata(FrameImage& img, const Scene& scene, const RenderResult& r, co
       {"algray/extent", extent_text(scene.extent)},
   };
   if (!scene.extent.clips.empty()) img.string_attributes.push_back({"algray/clip", clip_text(scene.extent)});
-  double kernel_ms = 0;
-  for (const PassStats& p : r.passes) kernel_ms += p.kernel_ms;
   img.double_attributes = {
       {"algray/degree", r.config.degree},
       {"algray/tolerance", r.config.tolerance},
       {"algray/maxIterations", r.config.max_iterations},
-      {"algray/kernelMs", kernel_ms},
+      {"algray/kernelMs", r.passes_kernel_ms()},
       {"algray/camera/fovY", cam.fov_y_degrees},
       {"algray/camera/orthoHeight", cam.ortho_height},
       {"algray/camera/shiftX", cam.shift.x},

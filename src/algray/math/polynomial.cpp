@@ -278,17 +278,22 @@ std::vector<Monomial> Polynomial::monomials() const {
 double Polynomial::evaluate(double x, double y, double z) const {
   const int d = degree();
   if (d < 0) return 0.0;
-  const std::size_t n = static_cast<std::size_t>(d) + 1;
-  std::vector<long double> px(n), py(n), pz(n);
-  px[0] = py[0] = pz[0] = 1.0L;
-  for (std::size_t t = 1; t < n; ++t) {
-    px[t] = px[t - 1] * x;
-    py[t] = py[t - 1] * y;
-    pz[t] = pz[t - 1] * z;
-  }
+  const auto [px, py, pz] = axis_powers(x, y, z, d);
   long double sum = 0.0L;
   for (const auto& [e, c] : terms_) sum += nearest_long_double(c) * px[e[0]] * py[e[1]] * pz[e[2]];
   return static_cast<double>(sum);
+}
+
+std::array<std::vector<long double>, 3> axis_powers(long double x, long double y, long double z, int degree) {
+  const std::size_t n = static_cast<std::size_t>(std::max(degree, 0)) + 1;
+  std::array<std::vector<long double>, 3> powers;
+  const long double at[3] = {x, y, z};
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<long double>& p = powers[axis];
+    p.assign(n, 1.0L);
+    for (std::size_t t = 1; t < n; ++t) p[t] = p[t - 1] * at[axis];
+  }
+  return powers;
 }
 
 std::string Polynomial::to_string() const {

@@ -80,6 +80,10 @@ class Polynomial {
   std::map<Exponents, mpq_class> terms_;
 };
 
+// The powers 0 .. degree of each coordinate of a point, in long double: the tables the host's sums over monomials
+// read (powers[axis][n] = coordinate^n, by repeated multiplication).
+std::array<std::vector<long double>, 3> axis_powers(long double x, long double y, long double z, int degree);
+
 // The exact value of a finite double; throws std::domain_error on nan/inf.
 mpq_class exact_rational(double v);
 

@@ -41,15 +41,11 @@ PixelClass classify(ref::Classification kind) {
 std::array<long double, 3> gradient_at(const std::vector<Monomial>& monomials, const PixelRay& ray, long double t) {
   const long double p[3] = {ray.origin.x + t * ray.direction.x, ray.origin.y + t * ray.direction.y,
                             ray.origin.z + t * ray.direction.z};
-  // Powers by repeated multiplication, once per call: std::pow on long double (powl) was a tenth of a certified
-  // render's time. The gradient only shades and sizes a loose enclosure, so an ulp's difference is of no account.
+  // Power tables, not std::pow on long double (powl), which was a tenth of a certified render's time. The
+  // gradient only shades and sizes a loose enclosure, so an ulp's difference is of no account.
   int top = 0;
   for (const Monomial& m : monomials) top = std::max({top, m.i, m.j, m.k});
-  std::vector<long double> powers[3];
-  for (int axis = 0; axis < 3; ++axis) {
-    powers[axis].assign(static_cast<std::size_t>(top) + 1, 1.0L);
-    for (int k = 1; k <= top; ++k) powers[axis][k] = powers[axis][k - 1] * p[axis];
-  }
+  const std::array<std::vector<long double>, 3> powers = axis_powers(p[0], p[1], p[2], top);
   std::array<long double, 3> g = {0, 0, 0};
   for (const Monomial& m : monomials) {
     const int e[3] = {m.i, m.j, m.k};

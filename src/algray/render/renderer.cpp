@@ -169,10 +169,8 @@ RenderResult Renderer::render(const Scene& scene, const RenderOptions& options) 
   add_device_tallies(devices, result);
   if (!race_key.empty()) {
     // The passes' device time: the shading kernel's is the same in both precisions.
-    double kernel_ms = 0;
-    for (const PassStats& pass : result.passes) kernel_ms += pass.kernel_ms;
     const std::lock_guard<std::mutex> lock(race_mutex_);
-    race_.record(race_key, precision, kernel_ms);
+    race_.record(race_key, precision, result.passes_kernel_ms());
   }
   return result;
 }

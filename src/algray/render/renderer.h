@@ -135,6 +135,12 @@ struct RenderResult {
   double shade_kernel_ms = 0;
   // Why the render is in its precision, where RenderOptions::race_precision chose it; empty elsewhere.
   std::string precision_reason;
+  // The passes' device time summed (second passes included; the shading kernel's is shade_kernel_ms).
+  double passes_kernel_ms() const {
+    double ms = 0;
+    for (const PassStats& pass : passes) ms += pass.kernel_ms;
+    return ms;
+  }
 
   // Kept only with RenderOptions::keep_records:
   HitBuffer hits;                         // one record per traced ray: plan.trace_width() x plan.trace_height()
