@@ -5,6 +5,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -192,34 +193,28 @@ int multiplicity_in(const std::vector<ZPoly>& factors, const mpq_class& lo, cons
   throw std::logic_error("solver_ref: isolated root belongs to no square-free factor");
 }
 
-Answer solve(const ZPoly& p, const mpq_class& t_in, const mpq_class& t_out, const mpq_class& width) {
+Answer identically_zero(const mpq_class& t_in, const mpq_class& t_out) {
+  Answer a;
+  a.kind = Classification::IdenticallyZero;
+  a.lo = a.hi = t_in;
+  a.t_nearest = nearest_double(t_in);
+  a.root_at_t_in = true;
+  a.root_at_t_out = t_in == t_out;
+  return a;
+}
+
+void check_arguments(const mpq_class& t_in, const mpq_class& t_out, const mpq_class& width) {
   if (t_out < t_in) throw std::invalid_argument("smallest_root: t_in > t_out");
   if (sgn(width) <= 0) throw std::invalid_argument("smallest_root: width must be positive");
-  if (p.empty()) {
-    Answer a;
-    a.kind = Classification::IdenticallyZero;
-    a.lo = a.hi = t_in;
-    a.t_nearest = nearest_double(t_in);
-    a.root_at_t_in = true;
-    a.root_at_t_out = t_in == t_out;
-    return a;
-  }
-  if (detail::degree(p) == 0) return miss();
-  if (detail::sign_at(p, t_in) == 0) return exact_root(p, t_in, t_in, t_out);
-  if (t_in == t_out) return miss();
+}
 
-  const SquareFree sf = square_free(p);
-  const Segment seg(t_in, t_out);
-  ZPoly r = detail::to_unit_interval(sf.part, seg.A, seg.H, seg.M);
-  detail::make_primitive(r);
-  const std::optional<Isolated> found = leftmost(r, 0, 0);
-  if (!found) return detail::sign_at(sf.part, t_out) == 0 ? exact_root(p, t_out, t_in, t_out) : miss();
-  if (found->exact) return exact_root(p, seg.t_of(found->num, found->depth), t_in, t_out);
-
-  // Bisect at dyadic points of the isolating interval, in its local coordinate: [L, L + 1] / 2^j. The left
-  // end never vanishes (it is t_in or a midpoint already tested); the right end may be a root further on, and
-  // the multiplicity test needs both ends nonzero, so a zero there forces one more halving.
-  const ZPoly& local = found->local;
+// The root of p that `found` isolates, enclosed to `width`: bisection at dyadic points of the isolating interval,
+// in its local coordinate, [L, L + 1] / 2^j. The left end never vanishes (it is t_in or a midpoint already
+// tested); the right end may be a root further on, and the multiplicity test needs both ends nonzero, so a zero
+// there forces one more halving.
+Answer refine(const ZPoly& p, const SquareFree& sf, const Segment& seg, const Isolated& found, const mpq_class& t_in,
+              const mpq_class& t_out, const mpq_class& width) {
+  const ZPoly& local = found.local;
   const int sign_lo = sgn(local.front());
   mpz_class at_one = 0;  // the value at the right end is the sum of the coefficients
   for (const mpz_class& c : local) at_one += c;
@@ -229,10 +224,10 @@ Answer solve(const ZPoly& p, const mpq_class& t_in, const mpq_class& t_out, cons
   unsigned long j = 0;
   const auto global = [&](const mpz_class& k, unsigned long jj) {  // local k / 2^jj as s = num' / 2^depth'
     mpz_class g;
-    mpz_mul_2exp(g.get_mpz_t(), found->num.get_mpz_t(), jj);
-    return std::pair<mpz_class, unsigned long>(g + k, found->depth + jj);
+    mpz_mul_2exp(g.get_mpz_t(), found.num.get_mpz_t(), jj);
+    return std::pair<mpz_class, unsigned long>(g + k, found.depth + jj);
   };
-  while (found->depth + j < needed || hi_is_root) {
+  while (found.depth + j < needed || hi_is_root) {
     const mpz_class mid = 2 * L + 1;
     ++j;
     const int s = detail::sign_at_dyadic(local, mid, j);
@@ -257,7 +252,70 @@ Answer solve(const ZPoly& p, const mpq_class& t_in, const mpq_class& t_out, cons
   return a;
 }
 
+Answer solve(const ZPoly& p, const mpq_class& t_in, const mpq_class& t_out, const mpq_class& width) {
+  check_arguments(t_in, t_out, width);
+  if (p.empty()) return identically_zero(t_in, t_out);
+  if (detail::degree(p) == 0) return miss();
+  if (detail::sign_at(p, t_in) == 0) return exact_root(p, t_in, t_in, t_out);
+  if (t_in == t_out) return miss();
+
+  const SquareFree sf = square_free(p);
+  const Segment seg(t_in, t_out);
+  ZPoly r = detail::to_unit_interval(sf.part, seg.A, seg.H, seg.M);
+  detail::make_primitive(r);
+  const std::optional<Isolated> found = leftmost(r, 0, 0);
+  if (!found) return detail::sign_at(sf.part, t_out) == 0 ? exact_root(p, t_out, t_in, t_out) : miss();
+  if (found->exact) return exact_root(p, seg.t_of(found->num, found->depth), t_in, t_out);
+  return refine(p, sf, seg, *found, t_in, t_out, width);
+}
+
+// Every root of p in the open unit interval of `seg`, in increasing order, to `visit`: leftmost's descent, left
+// half first, carried on past each root instead of stopping at the first, so that the polynomial is made square-free
+// and moved to the unit interval once for all its roots.
+struct RootWalk {
+  const ZPoly& p;
+  const SquareFree& sf;
+  const Segment& seg;
+  const mpq_class &t_in, &t_out, &width;
+  const std::function<bool(const Answer&)>& visit;
+
+  // r square-free, r(0) != 0: its roots in (0, 1), the interval (num, num + 1) / 2^depth of the segment's. False
+  // once visit has asked to stop.
+  bool descend(const ZPoly& r, const mpz_class& num, unsigned long depth) const {
+    const int v = detail::descartes_bound_unit(r, 2);
+    if (v == 0) return true;
+    if (v == 1) return visit(refine(p, sf, seg, Isolated{false, num, depth, r}, t_in, t_out, width));
+    ZPoly left = detail::left_half(r);
+    detail::remove_power_of_two(left);
+    if (!descend(left, 2 * num, depth + 1)) return false;
+    ZPoly right = detail::taylor_shift_one(left);
+    if (sgn(right[0]) == 0) {  // a root at the midpoint: visited, then divided out (s > 0 keeps the signs)
+      if (!visit(exact_root(p, seg.t_of(2 * num + 1, depth + 1), t_in, t_out))) return false;
+      right.erase(right.begin());
+    }
+    detail::remove_power_of_two(right);
+    return descend(right, 2 * num + 1, depth + 1);
+  }
+};
+
 }  // namespace
+
+bool for_each_root(const std::vector<mpq_class>& poly, const mpq_class& t_in, const mpq_class& t_out,
+                   const mpq_class& width, const std::function<bool(const Answer&)>& visit) {
+  check_arguments(t_in, t_out, width);
+  const ZPoly p = detail::primitive_from_rational(poly);
+  if (p.empty()) return visit(identically_zero(t_in, t_out));
+  if (detail::degree(p) == 0) return true;
+  if (detail::sign_at(p, t_in) == 0 && !visit(exact_root(p, t_in, t_in, t_out))) return false;
+  if (t_in == t_out) return true;
+  const SquareFree sf = square_free(p);
+  const Segment seg(t_in, t_out);
+  ZPoly r = detail::to_unit_interval(sf.part, seg.A, seg.H, seg.M);
+  detail::make_primitive(r);
+  if (sgn(r[0]) == 0) r.erase(r.begin());  // the root at t_in, visited above
+  if (!RootWalk{p, sf, seg, t_in, t_out, width, visit}.descend(r, 0, 0)) return false;
+  return detail::sign_at(sf.part, t_out) != 0 || visit(exact_root(p, t_out, t_in, t_out));
+}
 
 Answer smallest_root(const std::vector<mpq_class>& poly, const mpq_class& t_in, const mpq_class& t_out,
                      const mpq_class& width) {

@@ -4,6 +4,7 @@
 #include <gmpxx.h>
 
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "algray/math/polynomial.h"
@@ -52,6 +53,12 @@ Answer smallest_root(const Polynomial& p, const ExactRay& ray, const mpq_class& 
 // The same for a univariate polynomial given by exact power-basis coefficients (poly[i] multiplies t^i).
 Answer smallest_root(const std::vector<mpq_class>& poly, const mpq_class& t_in, const mpq_class& t_out,
                      const mpq_class& width);
+
+// Every distinct root of poly in [t_in, t_out], in increasing order, each enclosed to width as smallest_root
+// encloses its root, to visit, until visit returns false; false when it did. The first is smallest_root's answer
+// on the same interval; the polynomial is prepared once for all (the reference's search for critical points).
+bool for_each_root(const std::vector<mpq_class>& poly, const mpq_class& t_in, const mpq_class& t_out,
+                   const mpq_class& width, const std::function<bool(const Answer&)>& visit);
 
 // Whether poly has a root in the open interval (a, b), exactly; roots at a or b do not count. The zero
 // polynomial has roots everywhere, so it answers a < b.

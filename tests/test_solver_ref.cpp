@@ -58,6 +58,67 @@ Polynomial xyz_poly(const std::vector<std::tuple<int, int, int, mpq_class>>& ter
   return p;
 }
 
+// A random polynomial of degree 1 to 16 with its real roots known (the rest in complex pairs, some barely off the
+// axis): simple and multiple, inside [t_in, t_out], at its ends and just outside them.
+struct KnownRoots {
+  mpq_class t_in, t_out;
+  Poly p;
+  std::map<mpq_class, int> roots;  // root -> multiplicity
+};
+
+KnownRoots random_known_roots(std::mt19937& rng) {
+  auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  KnownRoots c;
+  c.t_in = q(uniform(-50, 40), uniform(1, 9));
+  c.t_out = c.t_in + q(uniform(1, 60), uniform(1, 9));
+  const int degree = uniform(1, 16);
+  int used = 0;
+  c.p = Poly{uniform(1, 5) * (uniform(0, 1) ? 1 : -1)};
+  while (used < degree) {
+    const int kind = uniform(0, 9);
+    if (kind == 0 && used + 2 <= degree) {
+      // A complex pair (t - m)^2 + e, e > 0, sometimes barely off the axis.
+      const mpq_class m = q(uniform(-400, 400), uniform(1, 40));
+      const mpq_class e = uniform(0, 1) ? q(1, uniform(1, 9)) : q(1, 1000000000) * q(1, 1000000000);
+      c.p = times(c.p, Poly{m * m + e, -2 * m, 1});
+      used += 2;
+      continue;
+    }
+    mpq_class root;
+    if (kind <= 2) {
+      // Just outside, or exactly at, an end point.
+      const mpq_class eps = q(1, uniform(1, 1000000));
+      switch (uniform(0, 3)) {
+        case 0:
+          root = c.t_in - eps;
+          break;
+        case 1:
+          root = c.t_out + eps;
+          break;
+        case 2:
+          root = c.t_in;
+          break;
+        default:
+          root = c.t_out;
+          break;
+      }
+    } else {
+      root = c.t_in + (c.t_out - c.t_in) * q(uniform(-200, 1200), 1000);
+    }
+    const int m = std::min(degree - used, uniform(0, 3) == 0 ? uniform(2, 4) : 1);
+    c.roots[root] += m;
+    used += m;
+    for (int k = 0; k < m; ++k) c.p = times(c.p, Poly{-root, 1});
+  }
+  return c;
+}
+
+Classification classification_of(int multiplicity) {
+  return multiplicity == 1       ? Classification::SimpleRoot
+         : multiplicity % 2 == 0 ? Classification::EvenRootNoSignChange
+                                 : Classification::MultipleRootOddSignChange;
+}
+
 }  // namespace
 
 TEST_CASE("simple rational roots, the interval deciding which is smallest", "[solver_ref]") {
@@ -189,49 +250,7 @@ TEST_CASE("seeded random polynomials with known roots", "[solver_ref]") {
 
   for (int index = 0; index < 300; ++index) {
     INFO("case " << index);
-    const mpq_class t_in = q(uniform(-50, 40), uniform(1, 9));
-    const mpq_class t_out = t_in + q(uniform(1, 60), uniform(1, 9));
-    const int degree = uniform(1, 16);
-    std::map<mpq_class, int> roots;
-    int used = 0;
-    Poly p{uniform(1, 5) * (uniform(0, 1) ? 1 : -1)};
-    while (used < degree) {
-      const int kind = uniform(0, 9);
-      if (kind == 0 && used + 2 <= degree) {
-        // A complex pair (t - c)^2 + e, e > 0, sometimes barely off the axis.
-        const mpq_class c = q(uniform(-400, 400), uniform(1, 40));
-        const mpq_class e = uniform(0, 1) ? q(1, uniform(1, 9)) : q(1, 1000000000) * q(1, 1000000000);
-        p = times(p, Poly{c * c + e, -2 * c, 1});
-        used += 2;
-        continue;
-      }
-      mpq_class root;
-      if (kind <= 2) {
-        // Just outside, or exactly at, an end point.
-        const mpq_class eps = q(1, uniform(1, 1000000));
-        switch (uniform(0, 3)) {
-          case 0:
-            root = t_in - eps;
-            break;
-          case 1:
-            root = t_out + eps;
-            break;
-          case 2:
-            root = t_in;
-            break;
-          default:
-            root = t_out;
-            break;
-        }
-      } else {
-        root = t_in + (t_out - t_in) * q(uniform(-200, 1200), 1000);
-      }
-      const int m = std::min(degree - used, uniform(0, 3) == 0 ? uniform(2, 4) : 1);
-      roots[root] += m;
-      used += m;
-      for (int k = 0; k < m; ++k) p = times(p, Poly{-root, 1});
-    }
-
+    const auto [t_in, t_out, p, roots] = random_known_roots(rng);
     const mpq_class width = q(1, uniform(1, 1000000));
     const Answer a = smallest_root(p, t_in, t_out, width);
     const auto first = roots.lower_bound(t_in);
@@ -246,13 +265,75 @@ TEST_CASE("seeded random polynomials with known roots", "[solver_ref]") {
     CHECK(a.multiplicity == multiplicity);
     CHECK(a.root_at_t_in == (root == t_in));
     CHECK(a.root_at_t_out == (root == t_out));
-    const Classification expected = multiplicity == 1       ? Classification::SimpleRoot
-                                    : multiplicity % 2 == 0 ? Classification::EvenRootNoSignChange
-                                                            : Classification::MultipleRootOddSignChange;
-    CHECK(a.kind == expected);
+    CHECK(a.kind == classification_of(multiplicity));
     // A root strictly inside the interval, seen from the open interval.
     if (root > t_in) CHECK(has_root_in_open(p, t_in, t_out + 1));
   }
+}
+
+// The roots a walk should visit: those in [t_in, t_out], in order.
+std::vector<std::pair<mpq_class, int>> roots_within(const std::map<mpq_class, int>& roots, const mpq_class& t_in,
+                                                    const mpq_class& t_out) {
+  std::vector<std::pair<mpq_class, int>> within;
+  for (const auto& [root, multiplicity] : roots)
+    if (t_in <= root && root <= t_out) within.emplace_back(root, multiplicity);
+  return within;
+}
+
+TEST_CASE("for_each_root visits every root in the interval in order, the first as smallest_root gives it",
+          "[solver_ref]") {
+  const std::uint32_t seed = 20261207;
+  std::mt19937 rng(seed);
+  INFO("seed " << seed);
+  for (int index = 0; index < 300; ++index) {
+    INFO("case " << index);
+    const auto [t_in, t_out, p, roots] = random_known_roots(rng);
+    const mpq_class width = q(1, std::uniform_int_distribution<int>(1, 1000000)(rng));
+    std::vector<Answer> visited;
+    CHECK(algray::ref::for_each_root(p, t_in, t_out, width, [&](const Answer& a) {
+      visited.push_back(a);
+      return true;
+    }));
+    const std::vector<std::pair<mpq_class, int>> expected = roots_within(roots, t_in, t_out);
+    REQUIRE(visited.size() == expected.size());
+    for (std::size_t i = 0; i < visited.size(); ++i) {
+      INFO("root " << i << ": " << expected[i].first << ", multiplicity " << expected[i].second);
+      CHECK(encloses(visited[i], expected[i].first));
+      CHECK(visited[i].hi - visited[i].lo <= width);
+      CHECK(visited[i].multiplicity == expected[i].second);
+      CHECK(visited[i].kind == classification_of(expected[i].second));
+    }
+    if (!visited.empty()) {
+      const Answer first = smallest_root(p, t_in, t_out, width);
+      CHECK((first.lo == visited[0].lo && first.hi == visited[0].hi && first.t_nearest == visited[0].t_nearest));
+      // Asked to stop at the second, it does, and says so.
+      std::size_t calls = 0;
+      const bool completed =
+          algray::ref::for_each_root(p, t_in, t_out, width, [&](const Answer&) { return ++calls < 2; });
+      CHECK(completed == (visited.size() < 2));
+      CHECK(calls == std::min<std::size_t>(visited.size(), 2));
+    }
+  }
+}
+
+TEST_CASE("for_each_root at the ends and at the dyadic midpoints of its interval", "[solver_ref]") {
+  // Roots exactly where the descent splits (1/2, 1/4, 3/4 of [0, 1]) and at both ends; a double one at 1/4.
+  const Poly p = from_roots({{q(0), 1}, {q(1, 4), 2}, {q(1, 2), 1}, {q(3, 4), 1}, {q(1), 1}, {q(2), 1}});
+  std::vector<Answer> visited;
+  algray::ref::for_each_root(p, q(0), q(1), fine, [&](const Answer& a) {
+    visited.push_back(a);
+    return true;
+  });
+  REQUIRE(visited.size() == 5);
+  const mpq_class at[] = {q(0), q(1, 4), q(1, 2), q(3, 4), q(1)};
+  for (std::size_t i = 0; i < 5; ++i) {
+    INFO("root " << at[i]);
+    CHECK(visited[i].lo == at[i]);
+    CHECK(visited[i].hi == at[i]);
+    CHECK(visited[i].multiplicity == (i == 1 ? 2 : 1));
+  }
+  CHECK(visited.front().root_at_t_in);
+  CHECK(visited.back().root_at_t_out);
 }
 
 TEST_CASE("restriction to a floating-point ray is exact", "[solver_ref]") {

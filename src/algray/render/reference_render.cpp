@@ -166,23 +166,22 @@ bool flips_under_ray_rounding(const std::vector<mpq_class>& restricted, const st
   std::vector<mpq_class> derivative;
   for (std::size_t k = 1; k < restricted.size(); ++k) derivative.push_back(restricted[k] * static_cast<long>(k));
   while (!derivative.empty() && derivative.back() == 0) derivative.pop_back();
-  if (derivative.size() < 2) return false;  // P* linear or constant: no critical point
+  if (derivative.size() < 2 || limit < lo) return false;  // P* linear or constant: no critical point
   const mpq_class width = abs(limit) / 1000000000 + mpq_class(1, 1000000000);
   const double o[3] = {ray.origin.x, ray.origin.y, ray.origin.z},
                d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
-  mpq_class from = lo;
-  while (from <= limit) {
-    const ref::Answer c = ref::smallest_root(derivative, from, limit, width);
-    if (c.kind == ref::Classification::Miss || c.kind == ref::Classification::IdenticallyZero) return false;
+  // Each critical point's value against what rounding the ray's components could move it by.
+  bool flips = false;
+  ref::for_each_root(derivative, lo, limit, width, [&](const ref::Answer& c) {
     const long double t = c.t_nearest;
     const long double value = std::fabs(evaluate(restricted, exact_rational(c.t_nearest)).get_d());
     const std::array<long double, 3> g = gradient_at(monomials, ray, t);
     long double change = 0;
     for (int axis = 0; axis < 3; ++axis) change += std::fabs(g[axis]) * (std::fabs(o[axis]) + std::fabs(t * d[axis]));
-    if (value <= kReferenceRayRoundings * eps * change) return true;
-    from = c.hi + width;
-  }
-  return false;
+    flips = value <= kReferenceRayRoundings * eps * change;
+    return !flips;
+  });
+  return flips;
 }
 
 RayCertificate certify_ray(const Polynomial& polynomial, const std::vector<Monomial>& monomials, const Extent& extent,
