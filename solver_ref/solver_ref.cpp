@@ -208,10 +208,38 @@ void check_arguments(const mpq_class& t_in, const mpq_class& t_out, const mpq_cl
   if (sgn(width) <= 0) throw std::invalid_argument("smallest_root: width must be positive");
 }
 
+// Where in (0, 1) the one root of `local` lies, to about long double's precision where it is well conditioned: a
+// bisection of local's values in long double (coefficients scaled by a common power of two). Only a guess: refine
+// checks it exactly.
+long double approximate_root(const ZPoly& local, int sign_lo) {
+  std::vector<long> exponents(local.size());
+  std::vector<double> mantissas(local.size());
+  long top = LONG_MIN;
+  for (std::size_t i = 0; i < local.size(); ++i) {
+    mantissas[i] = mpz_get_d_2exp(&exponents[i], local[i].get_mpz_t());
+    if (mantissas[i] != 0) top = std::max(top, exponents[i]);
+  }
+  std::vector<long double> c(local.size());
+  for (std::size_t i = 0; i < local.size(); ++i)
+    c[i] = std::ldexp(static_cast<long double>(mantissas[i]), static_cast<int>(std::max(exponents[i] - top, -20000L)));
+  long double lo = 0, hi = 1;
+  for (int step = 0; step < 70; ++step) {
+    const long double mid = (lo + hi) / 2;
+    long double v = c.back();
+    for (std::size_t i = c.size() - 1; i-- > 0;) v = v * mid + c[i];
+    if (v == 0) return mid;
+    ((v > 0) == (sign_lo > 0) ? lo : hi) = mid;
+  }
+  return (lo + hi) / 2;
+}
+
 // The root of p that `found` isolates, enclosed to `width`: bisection at dyadic points of the isolating interval,
 // in its local coordinate, [L, L + 1] / 2^j. The left end never vanishes (it is t_in or a midpoint already
 // tested); the right end may be a root further on, and the multiplicity test needs both ends nonzero, so a zero
-// there forces one more halving.
+// there forces one more halving. The first steps are skipped where a guess of the root checks out: the cell of
+// depth j at the guess holds the root when local's signs at its ends are sign_lo's and the other one, both nonzero;
+// then no dyadic point of depth j or less is the root, and bisection would have come to that cell with the same
+// signs, so the answer is bisection's bit for bit (two exact evaluations at depth j in place of j growing ones).
 Answer refine(const ZPoly& p, const SquareFree& sf, const Segment& seg, const Isolated& found, const mpq_class& t_in,
               const mpq_class& t_out, const mpq_class& width) {
   const ZPoly& local = found.local;
@@ -222,6 +250,19 @@ Answer refine(const ZPoly& p, const SquareFree& sf, const Segment& seg, const Is
   const unsigned long needed = seg.depth_for(width);
   mpz_class L = 0;
   unsigned long j = 0;
+  const unsigned long remaining = needed > found.depth ? needed - found.depth : 0;
+  if (!hi_is_root && remaining >= 8) {
+    const unsigned long guess_depth = std::min<unsigned long>(remaining, 48);
+    const long double at = std::ldexp(approximate_root(local, sign_lo), static_cast<int>(guess_depth));
+    const unsigned long cells = 1UL << guess_depth;
+    const unsigned long cell = std::min(cells - 1, static_cast<unsigned long>(std::max<long double>(at, 0)));
+    const mpz_class left(cell), right(cell + 1);
+    if ((cell == 0 || detail::sign_at_dyadic(local, left, guess_depth) == sign_lo) &&
+        (cell + 1 == cells ? sgn(at_one) : detail::sign_at_dyadic(local, right, guess_depth)) == -sign_lo) {
+      L = left;
+      j = guess_depth;
+    }
+  }
   const auto global = [&](const mpz_class& k, unsigned long jj) {  // local k / 2^jj as s = num' / 2^depth'
     mpz_class g;
     mpz_mul_2exp(g.get_mpz_t(), found.num.get_mpz_t(), jj);

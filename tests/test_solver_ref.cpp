@@ -280,6 +280,26 @@ std::vector<std::pair<mpq_class, int>> roots_within(const std::map<mpq_class, in
   return within;
 }
 
+// Bisection's enclosure of a root on [t_in, t_out]: the cell of the grid of 2^D equal cells that holds it, D the
+// depth whose cells first fit within width (deeper where a root at a cell's right end forced more halvings: `depth`
+// at least D), or the root itself where it is a cell's end.
+bool is_bisection_cell(const Answer& a, const mpq_class& root, const mpq_class& t_in, const mpq_class& t_out,
+                       const mpq_class& width) {
+  if (a.lo == a.hi) return a.lo == root;
+  const mpq_class length = t_out - t_in;
+  mpz_class cells = 1;
+  while (length / cells > width) cells *= 2;
+  mpz_class deeper = cells;
+  while (length / deeper > a.hi - a.lo) deeper *= 2;
+  if (length / deeper != a.hi - a.lo) return false;  // not a cell of any depth
+  const mpq_class position = (root - t_in) / length * deeper;
+  mpz_class k;
+  mpz_fdiv_q(k.get_mpz_t(), position.get_num_mpz_t(), position.get_den_mpz_t());
+  mpq_class cell_start(k, deeper);
+  cell_start.canonicalize();
+  return a.lo == t_in + length * cell_start && (deeper == cells || a.hi != t_out);
+}
+
 TEST_CASE("for_each_root visits every root in the interval in order, the first as smallest_root gives it",
           "[solver_ref]") {
   const std::uint32_t seed = 20261207;
@@ -300,6 +320,10 @@ TEST_CASE("for_each_root visits every root in the interval in order, the first a
       INFO("root " << i << ": " << expected[i].first << ", multiplicity " << expected[i].second);
       CHECK(encloses(visited[i], expected[i].first));
       CHECK(visited[i].hi - visited[i].lo <= width);
+      // refine's guessed start gives bisection's cell
+      INFO("enclosure [" << visited[i].lo << ", " << visited[i].hi << "] on [" << t_in << ", " << t_out << "], width "
+                         << width);
+      CHECK(is_bisection_cell(visited[i], expected[i].first, t_in, t_out, width));
       CHECK(visited[i].multiplicity == expected[i].second);
       CHECK(visited[i].kind == classification_of(expected[i].second));
     }

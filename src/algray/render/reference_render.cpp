@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -199,7 +200,20 @@ RayCertificate certify_ray(const Polynomial& polynomial, const std::vector<Monom
   c.hi = exact_rational(static_cast<double>(c.t_out + margin));
   c.width = exact_rational(kReferenceWidth * static_cast<double>(std::max<long double>(c.t_out, 1)));
   c.restricted = ref::restrict_exact(polynomial, exact);
-  c.answer = ref::smallest_root(c.restricted, c.lo, c.hi, c.width);
+  // The smallest root, and past a simple one the second: P* keeps its shape up to it, so beyond it nothing a small
+  // move does changes the answer. One walk finds both.
+  bool found = false;
+  std::optional<ref::Answer> second;
+  ref::for_each_root(c.restricted, c.lo, c.hi, c.width, [&](const ref::Answer& root) {
+    if (found) {
+      second = root;
+      return false;
+    }
+    c.answer = root;
+    found = true;
+    return root.kind == ref::Classification::SimpleRoot;
+  });
+  if (!found) c.answer.t_nearest = std::numeric_limits<double>::infinity();  // a Miss, as smallest_root answers it
   c.cls = classify(c.answer.kind);
   if (c.answer.kind == ref::Classification::Miss) {
     if (flips_under_ray_rounding(c.restricted, monomials, ray, c.lo, c.hi, eps)) c.cls = PixelClass::RayRounding;
@@ -208,9 +222,7 @@ RayCertificate certify_ray(const Polynomial& polynomial, const std::vector<Monom
   const long double t = c.answer.t_nearest;
   if (t < c.t_in + margin || t > c.t_out - margin) c.cls = PixelClass::NearEnd;
   if (c.cls == PixelClass::SimpleRoot) {
-    // P* keeps its shape up to the second root: beyond it, nothing a small move does changes the answer.
-    const ref::Answer second = ref::smallest_root(c.restricted, c.answer.hi + c.width, c.hi, c.width);
-    const mpq_class limit = second.kind == ref::Classification::Miss ? c.hi : second.hi;
+    const mpq_class limit = second ? second->hi : c.hi;
     if (flips_under_ray_rounding(c.restricted, monomials, ray, c.lo, limit, eps)) c.cls = PixelClass::RayRounding;
   }
   return c;
