@@ -218,6 +218,41 @@ TEST_CASE("GPUs get launches that fill them, CPUs few large ones, and the plan s
         "the scene's render.tile_size");
 }
 
+TEST_CASE("the float shadow kernel takes as many lanes as a vector register holds floats", "[config]") {
+  // A light that casts shadows and full mode: the shadow pass, in the point form (degree 2).
+  Scene scene = load_scene_text(std::string(kSphereScene) + "[[light]]\nposition = [3, 3, 3]\n", "t.toml",
+                                {{"render.preview", "false"}});
+  const auto shadow_lanes_on = [&](Precision precision, std::vector<unsigned> widths) {
+    std::vector<PlanDevice> devices;
+    for (unsigned width : widths) {
+      DeviceInfo cpu;
+      cpu.type = "CPU";
+      cpu.native_float_width = width;
+      devices.push_back({cpu});
+    }
+    const RenderPlan plan = make_render_plan(scene, precision, devices);
+    const KernelConfig& shadow = plan.find(PassKind::Shadow)->kernels.at(0);
+    REQUIRE(shadow.ray_origin == RayOrigin::Point);
+    return shadow.lanes;
+  };
+  for (Precision precision : {Precision::Float, Precision::Adaptive}) {
+    INFO(to_string(precision));
+    CHECK(shadow_lanes_on(precision, {8}) == 8);    // AVX2
+    CHECK(shadow_lanes_on(precision, {16}) == 16);  // AVX-512
+    CHECK(shadow_lanes_on(precision, {4}) == 8);    // SSE: no fewer than 8
+    CHECK(shadow_lanes_on(precision, {0}) == kMaxFloatShadowLanes);
+    CHECK(shadow_lanes_on(precision, {16, 8}) == 8);  // what every device holds
+  }
+  CHECK(shadow_lanes_on(Precision::Double, {16}) == kMaxShadowLanes);
+  CHECK(shadow_lanes_on(Precision::Double, {8}) == kMaxShadowLanes);
+  // The camera rays keep theirs.
+  DeviceInfo cpu;
+  cpu.type = "CPU";
+  cpu.native_float_width = 8;
+  CHECK(make_render_plan(scene, Precision::Float, std::vector<PlanDevice>{{cpu}}).find(PassKind::Primary)->kernels.at(0).lanes ==
+        default_lanes("CPU"));
+}
+
 TEST_CASE("the surface in unit coordinates vanishes where the world surface does", "[config]") {
   const Scene scene = load_scene_text(kSphereScene, "t.toml");
   const SurfaceData data = prepare_surface(scene);

@@ -79,8 +79,12 @@ const BuildSwitch kBuildSwitches[] = {
 }  // namespace
 
 int default_lanes(const std::string& device_type) { return device_type == "CPU" ? 16 : 1; }
-int shadow_lanes(int lanes, Precision precision) {
-  return std::min(lanes, precision == Precision::Double ? kMaxShadowLanes : kMaxFloatShadowLanes);
+int float_shadow_lanes(unsigned native_float_width) {
+  if (native_float_width == 0) return kMaxFloatShadowLanes;
+  return native_float_width <= 8 ? 8 : kMaxFloatShadowLanes;
+}
+int shadow_lanes(int lanes, Precision precision, int float_lanes) {
+  return std::min(lanes, precision == Precision::Double ? kMaxShadowLanes : float_lanes);
 }
 bool lanes_apply(const KernelConfig& c) {
   if (c.entry == "shadow") return c.ray_origin == RayOrigin::Point;  // the extent form batches its own way

@@ -16,11 +16,17 @@ struct KernelConfig;
 int default_lanes(const std::string& device_type);
 bool lanes_apply(const KernelConfig& config);
 // The shadow kernel's point form takes at most 8 light samples of a point side by side in double, whatever the
-// camera rays take: at 16 its pass took 1.5 times as long on the Barth sextic and decic (bench/RESULTS.md). Float
-// vectors hold twice the lanes: at 16 the float pass took 0.93x (sextic) and 0.82x (decic) its time at 8.
+// camera rays take: at 16 its pass took 1.5 times as long on the Barth sextic and decic (bench/RESULTS.md). In
+// float, as many as one vector register holds: with AVX-512 (16 floats) 16 took 0.93x (sextic) and 0.82x (decic)
+// the time of 8; with AVX2 (8 floats) 16 took 1.16x to 1.34x the time of 8 on every scene measured
+// (bench/history/2026-12.md, "Float shadow lanes").
 constexpr int kMaxShadowLanes = 8;
 constexpr int kMaxFloatShadowLanes = 16;
-int shadow_lanes(int lanes, Precision precision);
+// The float shadow kernel's most lanes on a device whose vector registers hold native_float_width floats
+// (DeviceInfo::native_float_width): that many, within 8 and kMaxFloatShadowLanes; 0 (not known) gives the most.
+int float_shadow_lanes(unsigned native_float_width);
+// The point form's lanes: `lanes` (the camera rays'), at most kMaxShadowLanes in double and float_lanes otherwise.
+int shadow_lanes(int lanes, Precision precision, int float_lanes = kMaxFloatShadowLanes);
 
 // The -D switches build_options() writes, in its order; kernels/build_switches.h declares each one.
 std::vector<std::string> build_switch_names();

@@ -104,7 +104,7 @@ std::vector<KernelConfig> kernels_for(const std::vector<KernelConfig>& primary, 
 
 // The shadow pass, when a light casts shadows and the scene is not a preview; else why not, in plan.skipped.
 void plan_shadows(RenderPlan& plan, const Scene& scene, const std::vector<KernelConfig>& primary, std::size_t rays,
-                  std::size_t real_size) {
+                  std::size_t real_size, int float_shadow_lanes) {
   for (std::size_t i = 0; i < scene.lights.size(); ++i)
     if (scene.lights[i].shadows) plan.shadow_lights.push_back(static_cast<int>(i));
   if (scene.render.preview) {
@@ -127,7 +127,7 @@ void plan_shadows(RenderPlan& plan, const Scene& scene, const std::vector<Kernel
     if (c.ray_origin == RayOrigin::Eye) c.ray_origin = RayOrigin::Extent;
     if (scene.render.ray_origin == RayOrigin::Auto && point_form_applies(c)) {
       c.ray_origin = RayOrigin::Point;
-      c.lanes = shadow_lanes(primary[i].lanes, c.precision);
+      c.lanes = shadow_lanes(primary[i].lanes, c.precision, float_shadow_lanes);
     }
   }
   std::size_t points = 0;
@@ -261,9 +261,10 @@ bool float_measures_noise(const Scene& scene) {
   return scene.render.ray_origin == RayOrigin::Auto && abilities(scene.render.isolation).adaptive;
 }
 
-RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size, int lanes) {
+RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size, int lanes,
+                            int float_shadow_lanes) {
   if (precision == Precision::Float && float_measures_noise(scene)) {
-    RenderPlan plan = make_render_plan(scene, Precision::Adaptive, tile_size, lanes);
+    RenderPlan plan = make_render_plan(scene, Precision::Adaptive, tile_size, lanes, float_shadow_lanes);
     escalate_in(plan, Precision::Float);
     return plan;
   }
@@ -300,7 +301,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
                          primary,
                          {}});
   plan.buffers.push_back({"primary hits", rays * sizeof(HitRecord)});
-  plan_shadows(plan, scene, primary, rays, real_size);
+  plan_shadows(plan, scene, primary, rays, real_size, float_shadow_lanes);
   const std::vector<KernelConfig> trace = kernels_for(primary, "trace");
   plan_bounces(plan, scene, trace, rays, real_size);
   plan_antialias(plan, scene, trace, rays, real_size);
@@ -348,14 +349,16 @@ void plan_shading(RenderPlan& plan, const Scene& scene, const std::vector<PlanDe
 RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::vector<PlanDevice>& devices) {
   if (devices.empty()) throw std::invalid_argument("a render plan needs at least one device");
   const int lanes = default_lanes(devices.front().info.type);
+  int float_lanes = kMaxFloatShadowLanes;  // what every device's registers hold
+  for (const PlanDevice& device : devices) float_lanes = std::min(float_lanes, float_shadow_lanes(device.info.native_float_width));
   RenderPlan plan;
   if (scene.render.tile_size > 0) {
-    plan = make_render_plan(scene, precision, scene.render.tile_size, lanes);
+    plan = make_render_plan(scene, precision, scene.render.tile_size, lanes, float_lanes);
     plan.tile_choice = "the scene's render.tile_size";
   } else {
     int side = default_tile_size(devices.front().info);
     for (const PlanDevice& device : devices) side = std::min(side, default_tile_size(device.info));
-    plan = make_render_plan(scene, precision, side, lanes);
+    plan = make_render_plan(scene, precision, side, lanes, float_lanes);
     plan.tile_choice = side == kGpuTileSize ? "a GPU's: as many camera rays as fill it in one launch per pass"
                                             : "a CPU's: few large launches";
     // Several devices take tiles from one queue: with about 8 tiles each, a device that finds its tiles cheaper
@@ -368,7 +371,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::
     };
     const std::string choice = plan.tile_choice;
     while (tiles(plan) < wanted && plan.tile_size / 2 >= 16 * plan.samples)
-      plan = make_render_plan(scene, precision, plan.tile_size / 2, lanes);
+      plan = make_render_plan(scene, precision, plan.tile_size / 2, lanes, float_lanes);
     plan.tile_choice = choice;
     if (plan.tile_size != side)
       plan.tile_choice += ", halved to " + std::to_string(plan.tile_size) + " for about 8 tiles per device";

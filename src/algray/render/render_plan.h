@@ -110,8 +110,9 @@ void check_plan_fits(const RenderPlan& plan, const DeviceInfo& device);
 // light casts shadows and the scene is not a preview.
 // tile_size: the tile side in traced rays; 0 takes the scene's render.tile_size, or a CPU's default_tile_size.
 // lanes: rays per work-item of the primary and trace kernels where lanes_apply (kernel_config.h); the scene's
-// render.lanes, when set, comes first.
-RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size = 0, int lanes = 1);
+// render.lanes, when set, comes first. float_shadow_lanes: the most the float shadow kernel takes (shadow_lanes).
+RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_size = 0, int lanes = 1,
+                            int float_shadow_lanes = kMaxFloatShadowLanes);
 
 // Whether plain float renders `scene` with adaptive precision's float kernels, which measure their noise and doubt
 // what it could decide, and traces the doubted rays again in float's own kernels (make_render_plan plans it so,
