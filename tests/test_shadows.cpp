@@ -160,7 +160,7 @@ Tally check_shadow_rays(Precision precision, RayOrigin origin, int rays_per_scen
     // The render plan's two constructions of shadow rays: around each segment, or from P expanded about their
     // origin (in lanes, as on a CPU).
     config.ray_origin = origin;
-    if (origin == RayOrigin::Point) config.lanes = shadow_lanes(16, precision);
+    if (origin == RayOrigin::Point) config.lanes = testing::plan_shadow_lanes(precision);
     config.refinement = Refinement::Brent;
     config.max_iterations = default_max_iterations(Refinement::Brent);
     const DeviceSurface surface(session.context, scene, precision);
@@ -424,10 +424,10 @@ TEST_CASE(
     KernelConfig second_config = extent_shadow_config(r.scene, p.second);
     if (p.origin == RayOrigin::Point) {
       first_config.ray_origin = RayOrigin::Point;
-      first_config.lanes = shadow_lanes(16, Precision::Adaptive);
+      first_config.lanes = testing::plan_shadow_lanes(Precision::Adaptive);
       if (p.second == Precision::Double) {
         second_config.ray_origin = RayOrigin::Point;
-        second_config.lanes = shadow_lanes(16, Precision::Double);
+        second_config.lanes = testing::plan_shadow_lanes(Precision::Double);
       }
     }
     ShadowTracer adaptive(session, cache, first_config, float_surface, offset);

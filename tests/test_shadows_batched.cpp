@@ -50,12 +50,12 @@ struct Counts {
 };
 
 // The config both kernels are built with; entry names the kernel. The point form's shadow kernel runs the lanes
-// the plan gives it on a CPU (8 in double, 16 in float), and shadow_serial the same code in one.
+// the plan gives it on this device (testing::plan_shadow_lanes), and shadow_serial the same code in one.
 KernelConfig shadow_config(const Scene& scene, Precision precision, Isolation isolation, const std::string& entry,
                            RayOrigin origin, bool settle_doubts) {
   KernelConfig config = primary_config(scene, precision);
   config.ray_origin = origin;
-  config.lanes = origin == RayOrigin::Point && entry == "shadow" ? shadow_lanes(16, precision) : 1;
+  config.lanes = origin == RayOrigin::Point && entry == "shadow" ? testing::plan_shadow_lanes(precision) : 1;
   config.isolation = isolation;
   config.refinement = Refinement::Brent;
   config.max_iterations = default_max_iterations(Refinement::Brent);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "algray/device/cl_runtime.h"
+#include "algray/device/kernel_config.h"
 #include "algray/device/program_cache.h"
 
 namespace algray::testing {
@@ -27,6 +28,13 @@ inline ClSession& device_session() {
     session = std::make_unique<ClSession>(select_device(""));
   }
   return *session;
+}
+
+// The lanes a render's plan gives the point form's shadow kernel on the test device (render_plan.cpp), so that the
+// shadow tests run the programs renders run, and share them with the other tests' renders in a cold suite.
+inline int plan_shadow_lanes(Precision precision) {
+  const DeviceInfo& device = device_session().info;
+  return shadow_lanes(default_lanes(device.type), precision, float_shadow_lanes(device.native_float_width));
 }
 
 // One program cache for the whole test executable, in memory only. Every test that builds kernels through it
