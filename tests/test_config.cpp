@@ -138,8 +138,16 @@ TEST_CASE("a precision race alternates double and adaptive, then keeps the faste
   CHECK(race.next(slow_double) == Precision::Adaptive);  // fastest frames: adaptive 7.5 against double 8.0
   CHECK_THAT(race.reason(slow_double),
              Catch::Contains("adaptive: its fastest of 2 frames took 7.5 ms") && Catch::Contains("double's 8 ms"));
-  race.record(slow_double, Precision::Adaptive, 100.0);  // decided: later frames do not reopen it
+  // Decided: a frame slower than kReopen times double's fastest (8 ms), or several not in a row, keep it; kRounds
+  // in a row race the key again, from double.
+  race.record(slow_double, Precision::Adaptive, 100.0);
+  race.record(slow_double, Precision::Double, 100.0);  // not the chosen precision's: ignored
+  race.record(slow_double, Precision::Adaptive, 9.0);   // within 1.25 x 8 ms: the count starts over
+  for (int frame = 0; frame + 1 < PrecisionRace::kRounds; ++frame) race.record(slow_double, Precision::Adaptive, 10.5);
   CHECK(race.next(slow_double) == Precision::Adaptive);
+  race.record(slow_double, Precision::Adaptive, 10.5);
+  CHECK(race.next(slow_double) == Precision::Double);
+  CHECK_THAT(race.reason(slow_double), Catch::Contains("racing double against adaptive"));
   CHECK(race.next(tie) == Precision::Double);  // a key of its own, racing from its first frame
   CHECK_THAT(race.reason(tie), Catch::Contains("first frame"));
   for (int frame = 0; frame < 2 * PrecisionRace::kRounds; ++frame) race.record(tie, race.next(tie), 5.0);

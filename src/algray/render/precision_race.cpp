@@ -40,7 +40,13 @@ void PrecisionRace::record(const std::string& key, Precision precision, double k
   }
   Entry& e = it->second;
   e.last_used = ++clock_;
-  if (e.chosen) return;
+  if (e.chosen) {
+    if (precision != *e.chosen) return;
+    const double other = fastest(*e.chosen == Precision::Double ? e.adaptive_ms : e.double_ms);
+    e.slow_in_a_row = kernel_ms > kReopen * other ? e.slow_in_a_row + 1 : 0;
+    if (e.slow_in_a_row >= kRounds) e = Entry{{}, {}, std::nullopt, 0, e.last_used};  // race again
+    return;
+  }
   (precision == Precision::Double ? e.double_ms : e.adaptive_ms).push_back(kernel_ms);
   const std::size_t rounds = static_cast<std::size_t>(kRounds);
   if (e.double_ms.size() >= rounds && e.adaptive_ms.size() >= rounds)

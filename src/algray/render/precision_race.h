@@ -18,11 +18,16 @@ namespace algray {
 // kernel time in preview on one CPU). A preview frame has no use for double's last digits, so a renderer that
 // draws frame after frame (the view, Python) races the two: the frames of one race key alternate double,
 // adaptive, double, ... until each has run kRounds times, and from then on the key renders in the one whose
-// fastest frame took less device time, adaptive on a tie. Every frame of the race is a correct render in its
-// precision; a single render (the command line) only ever runs the first, double: today's `auto`.
+// fastest frame took less device time, adaptive on a tie. A decision is not for ever: the camera or the size of
+// the surface on screen can move the balance, so when kRounds frames in a row in the chosen precision each take
+// more than kReopen times the other's fastest, the key races again. Every frame of the race is a correct render
+// in its precision; a single render (the command line) only ever runs the first, double: today's `auto`.
 class PrecisionRace {
  public:
   static constexpr int kRounds = 2;
+  // How much slower than the other precision's fastest frame a frame in the chosen one may be before it counts
+  // against the decision: frames of one view vary by some 10% from one to the next.
+  static constexpr double kReopen = 1.25;
   // Keys kept at most: a long session over many surfaces forgets the oldest decisions and races them again.
   static constexpr std::size_t kKeys = 64;
 
@@ -43,6 +48,7 @@ class PrecisionRace {
   struct Entry {
     std::vector<double> double_ms, adaptive_ms;
     std::optional<Precision> chosen;
+    int slow_in_a_row = 0;  // frames in the chosen precision past kReopen times the other's fastest
     std::size_t last_used = 0;
   };
   std::map<std::string, Entry> entries_;
