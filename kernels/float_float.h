@@ -57,8 +57,8 @@ ALGRAY_INLINE FloatFloat ff_segment_point(LREAL t_in, LREAL t_out, LREAL s) {
  *    roundings): sum over the axes of dq times the terms' derivative along it, taken at |q| + dq, which bounds
  *    P's change.
  * Underflowing low parts can only make the bound too small by FLT_MIN-sized amounts: the absolute term. */
-LREAL direct_value_ff(const LaneRays* r, FloatFloat t, __global const uint* exps, __global const REAL* coefs,
-                      uint count, LREAL* rounding) {
+static LREAL direct_value_ff(const LaneRays* r, FloatFloat t, __global const uint* exps, __global const REAL* coefs,
+                             uint count, LREAL* rounding) {
   FloatFloat px[NCOEF], py[NCOEF], pz[NCOEF];
   const FloatFloat x = ff_point_axis(r->ox, t, r->dx), y = ff_point_axis(r->oy, t, r->dy),
                    z = ff_point_axis(r->oz, t, r->dz);
@@ -107,9 +107,9 @@ LREAL direct_value_ff(const LaneRays* r, FloatFloat t, __global const uint* exps
  * ends, of the signs float gave there (f_lo, f_hi, which differ), each value beyond its rounding: then P changes
  * sign inside, as surely as where float's own end values stand clear of its noise. *v_lo ... *rounding_hi: the
  * values and their bounds. */
-LMASK bracket_ends_in_float_float(LMASK doubted, const LaneRays* r, LREAL t_in, LREAL t_out, LREAL lo, LREAL hi,
-                                  LREAL f_lo, LREAL f_hi, __global const uint* exps, __global const REAL* coefs,
-                                  uint count, LREAL* v_lo, LREAL* rounding_lo, LREAL* v_hi, LREAL* rounding_hi) {
+static LMASK bracket_ends_in_float_float(LMASK doubted, const LaneRays* r, LREAL t_in, LREAL t_out, LREAL lo, LREAL hi,
+                                         LREAL f_lo, LREAL f_hi, __global const uint* exps, __global const REAL* coefs,
+                                         uint count, LREAL* v_lo, LREAL* rounding_lo, LREAL* v_hi, LREAL* rounding_hi) {
   *v_lo = direct_value_ff(r, ff_segment_point(t_in, t_out, lo), exps, coefs, count, rounding_lo);
   *v_hi = direct_value_ff(r, ff_segment_point(t_in, t_out, hi), exps, coefs, count, rounding_hi);
   return doubted && SIGN_PROVEN(*v_lo, *rounding_lo, f_lo) && SIGN_PROVEN(*v_hi, *rounding_hi, f_hi);
@@ -140,8 +140,8 @@ ALGRAY_INLINE LMASK proven_sign_of(const ProvenEnds* p, LREAL s, LREAL c) {
 
 /* P in float-float at the fraction s of [t_in, t_out], into p for the lanes in `take`: in the place of the one
  * that is not at `keep` (the interval's other end). */
-void prove_end(LMASK take, const LaneRays* r, LREAL t_in, LREAL t_out, LREAL s, LREAL keep,
-               __global const uint* exps, __global const REAL* coefs, uint count, ProvenEnds* p) {
+static void prove_end(LMASK take, const LaneRays* r, LREAL t_in, LREAL t_out, LREAL s, LREAL keep,
+                      __global const uint* exps, __global const REAL* coefs, uint count, ProvenEnds* p) {
   LREAL rounding;
   const LREAL v = direct_value_ff(r, ff_segment_point(t_in, t_out, s), exps, coefs, count, &rounding);
   const LMASK second = take && p->at[0] == keep, first = take && !second;

@@ -17,16 +17,16 @@
  * (root, with root_lo the low parts in mixed precision; both may be consumed). iso_c gets the polynomial on the
  * isolating interval, in the form the functions below take after prepare_isolated. terms: the ray's terms, which
  * adaptive builds measure their noise by (restrict.h); unread elsewhere. */
-Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
-                         ProbeLog* probe_log);
+static Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
+                                ProbeLog* probe_log);
 /* For the refinement (refine.h), of one ray or of lanes, on the isolating interval y in [0, 1]: a first estimate of
  * the root, or -1 for none; the coefficients made ready for the others; P's value, its value and slope, and the
  * size of the terms its value sums (whose rounding the value carries). */
-LREAL isolated_start(const LREAL* c);
-void prepare_isolated(LREAL* c, __constant const REAL* binomials);
-LREAL isolated_value(const LREAL* c, LREAL y);
-LREAL isolated_value_slope(const LREAL* c, LREAL y, LREAL* slope);
-LREAL isolated_magnitude(const LREAL* c, LREAL y);
+static LREAL isolated_start(const LREAL* c);
+static void prepare_isolated(LREAL* c, __constant const REAL* binomials);
+static LREAL isolated_value(const LREAL* c, LREAL y);
+static LREAL isolated_value_slope(const LREAL* c, LREAL y, LREAL* slope);
+static LREAL isolated_magnitude(const LREAL* c, LREAL y);
 
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
 #include "methods/bernstein.h"

@@ -33,7 +33,7 @@ typedef struct {
 } LaneIsolation;
 
 /* Lane j of lanes as one Isolation, and back. */
-Isolation lane_isolation(const LaneIsolation* lanes, uint j) {
+static Isolation lane_isolation(const LaneIsolation* lanes, uint j) {
   Isolation iso;
   iso.status = (int)lane_get(lanes->status, j);
   iso.budget = lane_get_mask(lanes->budget, j) != 0;
@@ -47,7 +47,7 @@ Isolation lane_isolation(const LaneIsolation* lanes, uint j) {
   iso.f_hi = lane_get(lanes->f_hi, j);
   return iso;
 }
-void set_lane_isolation(LaneIsolation* lanes, uint j, Isolation iso) {
+static void set_lane_isolation(LaneIsolation* lanes, uint j, Isolation iso) {
   lane_set(&lanes->status, j, (REAL)iso.status);
   lane_set_mask(&lanes->budget, j, iso.budget);
   lane_set_mask(&lanes->cluster, j, iso.cluster);
@@ -60,7 +60,7 @@ void set_lane_isolation(LaneIsolation* lanes, uint j, Isolation iso) {
   lane_set(&lanes->f_hi, j, iso.f_hi);
 }
 
-Isolation isolation_none(void) {
+static Isolation isolation_none(void) {
   Isolation iso;
   iso.status = ISOLATION_NONE;
   iso.budget = 0;
@@ -136,21 +136,21 @@ ALGRAY_INLINE SearchNoise search_noise(const REAL* c, RayTerms* terms) {
 }
 
 /* An upper bound on the noise of any coefficients summed from terms of size at most `terms`. */
-REAL noise_bound(REAL terms) { return DOUBT_NOISE(terms, terms); }
+static REAL noise_bound(REAL terms) { return DOUBT_NOISE(terms, terms); }
 
 /* The noise with the ray's terms summed: what a value within the upper bound's noise, and the refined root's
  * check (refine_rays), compare against. */
-REAL exact_noise(SearchNoise* n) {
+static REAL exact_noise(SearchNoise* n) {
   if (!n->terms->exact) n->noise = DOUBT_NOISE(n->scale, ray_terms_exact(n->terms));
   return n->noise;
 }
 
 /* Whether |value| is within the noise (a NaN is not). */
-int within_noise(SearchNoise* n, REAL value) { return fabs(value) <= n->noise && fabs(value) <= exact_noise(n); }
+static int within_noise(SearchNoise* n, REAL value) { return fabs(value) <= n->noise && fabs(value) <= exact_noise(n); }
 
 /* The largest Bernstein coefficient on [lo, hi] of sum_k |c_k| B_k, with room for its own rounding: the size
  * that de Casteljau's roundings on [lo, hi] are relative to; lane by lane (one ray: local_noise below). */
-LREAL local_scale(const LREAL* c, LREAL lo, LREAL hi) {
+static LREAL local_scale(const LREAL* c, LREAL lo, LREAL hi) {
   LREAL t[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) t[k] = fabs(c[k]);
@@ -182,7 +182,7 @@ LREAL local_scale(const LREAL* c, LREAL lo, LREAL hi) {
  * of roots at 512x384 (which needed 1.25), and from 4 on neither it nor the Barth decic differed from double
  * anywhere (tests/test_reference_agree); 16 keeps 4 times that margin. On shadow rays, factor 0 (no doubt near
  * the start) answers certified rays wrongly and 1 does not (tests/test_shadows). */
-REAL local_noise(const REAL* c, REAL scale, RayTerms* terms, REAL lo, REAL hi) {
+static REAL local_noise(const REAL* c, REAL scale, RayTerms* terms, REAL lo, REAL hi) {
   LREAL lanes[NCOEF]; /* the ray in every lane, lane 0 read (in one-ray builds, the only lane) */
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) lanes[k] = c[k];
@@ -197,7 +197,7 @@ REAL local_noise(const REAL* c, REAL scale, RayTerms* terms, REAL lo, REAL hi) {
  * doubted 177 862 -> 23 609, with the same image, and adaptive over float 1.45x -> 1.32x where the second pass is
  * float-float; where it is double, 1.24x either way. Camera rays run from sphere to sphere: with the local noise
  * their doubts fell by 8% only (30 452 -> 28 131), which the checks cost back. */
-int within_noise_at(SearchNoise* n, REAL value, REAL lo, REAL hi) {
+static int within_noise_at(SearchNoise* n, REAL value, REAL lo, REAL hi) {
   const int local_too = ALGRAY_SHADOW_RAYS && ALGRAY_SETTLE_DOUBTS;
   /* The cheap tests first, each of them enough to clear the value: the segment's noise on the terms' upper
    * bound, then an upper bound on the local noise that costs a few operations (terms_within at the part's
@@ -222,13 +222,15 @@ int within_noise_at(SearchNoise* n, REAL value, REAL lo, REAL hi) {
 
 /* Whether an interval `width` (a fraction of [t_in, t_out], starting at fraction lo) is down to the stopping
  * width: then it is located, however many roots Descartes' rule still allows in it. */
-int interval_located(REAL width, REAL lo, REAL t_in, REAL len) { return width * len <= stop_width(t_in + lo * len); }
+static int interval_located(REAL width, REAL lo, REAL t_in, REAL len) {
+  return width * len <= stop_width(t_in + lo * len);
+}
 
 /* An interval still holding several roots, or a complex pair, once it is located or at the halving limit: a
  * sign change between its ends is a root; without one it counts as no root. So a root of even multiplicity is
  * invisible, as on the true surface (an isolated point, a tangent ray), and a rounded double root that became
  * a complex pair is never reported. Returns 1 when it settled iso->status. */
-int settle_cluster(Isolation* iso, int located) {
+static int settle_cluster(Isolation* iso, int located) {
   if (!located) iso->budget = 1;
   if ((iso->f_lo < 0) != (iso->f_hi < 0)) {
     iso->status = ISOLATION_BRACKET;
@@ -241,7 +243,7 @@ int settle_cluster(Isolation* iso, int located) {
 /* Every interval before this one was root-free or without a sign change, so P should still have the sign it had
  * at t_in. If this interval starts with the other sign, P changed sign where two subdivisions meet, within
  * their rounding noise: that point is the root. Returns 1 when it settled iso->status. */
-int crossed_at_left_end(Isolation* iso, int start_sign) {
+static int crossed_at_left_end(Isolation* iso, int start_sign) {
   const int s = (iso->f_lo > 0) - (iso->f_lo < 0);
   if (s == 0 || s == start_sign) return 0;
   iso->status = ISOLATION_EXACT;
@@ -250,7 +252,7 @@ int crossed_at_left_end(Isolation* iso, int start_sign) {
 
 /* The checks every subdividing method makes first on an interval (iso.lo, iso.f_lo set): P exactly zero at its
  * left end, or of the other sign there than at t_in. Returns 1 when it settled iso->status. */
-int settled_at_left_end(Isolation* iso, int start_sign, int level, ProbeLog* probe_log) {
+static int settled_at_left_end(Isolation* iso, int start_sign, int level, ProbeLog* probe_log) {
   if (iso->f_lo == 0) {
     PROBE_STEP(*iso, -1, ALGRAY_STEP_EXACT_ZERO, level);
     iso->status = ISOLATION_EXACT;
@@ -267,7 +269,7 @@ int settled_at_left_end(Isolation* iso, int start_sign, int level, ProbeLog* pro
 #define INTERVAL_HALVE 0   /* halve it: go one level down, left half first */
 #define INTERVAL_SETTLED 1 /* a cluster with a sign change: iso->status is set */
 #define INTERVAL_NEXT 2    /* a cluster without one: go on to the next interval */
-int halve_or_settle(Isolation* iso, int count, int level, REAL width, REAL t_in, REAL len, ProbeLog* probe_log) {
+static int halve_or_settle(Isolation* iso, int count, int level, REAL width, REAL t_in, REAL len, ProbeLog* probe_log) {
   const int located = interval_located(width, iso->lo, t_in, len);
   if (!located && level < REAL_MAX_HALVINGS) {
     PROBE_STEP(*iso, count, ALGRAY_STEP_SPLIT, level);
@@ -283,7 +285,7 @@ int halve_or_settle(Isolation* iso, int count, int level, REAL width, REAL t_in,
 
 /* Every interval has been searched. They are half open, so the far end is the one point left: a root when
  * `zero` (P there is f_end). */
-Isolation isolation_at_far_end(Isolation iso, int zero, REAL f_end, ProbeLog* probe_log) {
+static Isolation isolation_at_far_end(Isolation iso, int zero, REAL f_end, ProbeLog* probe_log) {
   iso.status = zero ? ISOLATION_EXACT : ISOLATION_NONE;
   PROBE(ALGRAY_EVENT_STEP, -1, zero ? ALGRAY_STEP_END_ZERO : ALGRAY_STEP_END_NONE, 0u, (REAL)1, (REAL)1, f_end, f_end);
   iso.lo = iso.hi = 1;
@@ -293,7 +295,7 @@ Isolation isolation_at_far_end(Isolation iso, int zero, REAL f_end, ProbeLog* pr
 
 /* The next dyadic interval (level, idx) in depth-first, left-first order: climb while a right child, then
  * step right. Returns 0 when the whole interval has been searched. */
-int next_interval(int* level, ulong* idx) {
+static int next_interval(int* level, ulong* idx) {
   while (*idx & 1) {
     *idx >>= 1;
     --*level;

@@ -62,7 +62,7 @@ ALGRAY_INLINE void shift_columns(PolyVec* q, REAL s, int along_x) {
  * of one coefficient at a time was a chain of dependent operations, 3x slower). Every loop runs to DEGREE and
  * tests its bound inside: with bounds that depend on the outer indices LLVM unrolled the inner loops only partly
  * and kept the sums in memory (measured in PoCL's compiled kernel). */
-void taylor_at_point(__global const uint* exps, __global const REAL* coefs, uint count, REAL3 o, PolyVec* q) {
+static void taylor_at_point(__global const uint* exps, __global const REAL* coefs, uint count, REAL3 o, PolyVec* q) {
   PolyVec rows[NCOEF];
   shift_rows(o.z, rows);
   ALGRAY_UNROLL
@@ -78,7 +78,7 @@ void taylor_at_point(__global const uint* exps, __global const REAL* coefs, uint
 
 /* P(o + t d) = sum_k c[k] t^k for LANES directions d (unit coordinates), from taylor_at_point's q; its loops are
  * bounded as taylor_at_point's (left partly unrolled, the sums went through memory: four loads and stores a term). */
-void point_form_restrict(const PolyVec* columns, LREAL dx, LREAL dy, LREAL dz, LREAL* c) {
+static void point_form_restrict(const PolyVec* columns, LREAL dx, LREAL dy, LREAL dz, LREAL* c) {
   const REAL* q = (const REAL*)columns;
   LREAL pz[NCOEF], sum[NCOEF];
   pz[0] = 1;
@@ -106,7 +106,7 @@ void point_form_restrict(const PolyVec* columns, LREAL dx, LREAL dy, LREAL dz, L
 
 /* The power basis c of P*(t) turned into scaled Bernstein coefficients on [t_in, t_out] (C(n,k) b_k, as
  * restrict_to_rays leaves them): the homogeneous Horner scheme of restrict_from_taylor, lane by lane. */
-void point_form_segment(const LREAL* c, LREAL t_in, LREAL t_out, __constant const REAL* binomials, LREAL* out) {
+static void point_form_segment(const LREAL* c, LREAL t_in, LREAL t_out, __constant const REAL* binomials, LREAL* out) {
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) out[k] = 0;
   out[0] = c[DEGREE];
@@ -129,7 +129,7 @@ void point_form_segment(const LREAL* c, LREAL t_in, LREAL t_out, __constant cons
  * decic: the search took 55% of the shadow kernel, most of it on such rays). Adaptive builds count a value only
  * beyond Horner's rounding (2n + 1 roundings over the sum of |terms|, t >= 0, with room) plus `noise`, the
  * coefficients' own; other builds never read `noise`. */
-LMASK sign_change_sampled(const LREAL* c, LREAL t_in, LREAL t_out, LREAL start, LMASK open, LREAL noise) {
+static LMASK sign_change_sampled(const LREAL* c, LREAL t_in, LREAL t_out, LREAL start, LMASK open, LREAL noise) {
   LMASK crossed = open && !open; /* all lanes false, of the mask type */
   ALGRAY_UNROLL
   for (int j = 1; j < 8; ++j) {

@@ -17,7 +17,8 @@ typedef struct {
 #define NO_PROBE ((ProbeLog*)0)
 
 #if ALGRAY_PROBE
-void probe_record(ProbeLog* log, uint kind, int count, uint decision, uint level, REAL a, REAL b, REAL c, REAL d) {
+static void probe_record(ProbeLog* log, uint kind, int count, uint decision, uint level, REAL a, REAL b, REAL c,
+                         REAL d) {
   const uint i = log->count++;
   if (i >= log->capacity) return;
   ProbeEvent e;

@@ -149,8 +149,8 @@ ALGRAY_INLINE LaneRays one_lane_rays(REAL3 o, REAL3 d) {
 }
 
 /* One ray's clip_lanes_to_extent: the ray in every lane, lane 0 read (in one-ray builds, the only lane). */
-int clip_to_extent(REAL3 o, REAL3 d, int kind, REAL3 box_half, __global const REAL4* clip_planes, uint clip_count,
-                   REAL* t_in, REAL* t_out) {
+static int clip_to_extent(REAL3 o, REAL3 d, int kind, REAL3 box_half, __global const REAL4* clip_planes,
+                          uint clip_count, REAL* t_in, REAL* t_out) {
   LREAL lo, hi;
   const LMASK hit = clip_lanes_to_extent((LREAL)o.x, (LREAL)o.y, (LREAL)o.z, (LREAL)d.x, (LREAL)d.y, (LREAL)d.z, kind,
                                          box_half, clip_planes, clip_count, &lo, &hi);
@@ -161,7 +161,7 @@ int clip_to_extent(REAL3 o, REAL3 d, int kind, REAL3 box_half, __global const RE
 
 /* The pixel centres (REAL)px + 0.5 of columns px0 .. px0 + LANES - 1: px0 + j is exact in REAL for any image width a
  * float can index. */
-LREAL lane_pixel_centres(uint px0) {
+static LREAL lane_pixel_centres(uint px0) {
 #define LANE_INDEX(j) ((REAL)(j))
   return ((LREAL)((REAL)px0) + LANES_OF(LREAL, LANE_INDEX)) + (REAL)0.5;
 #undef LANE_INDEX
@@ -182,7 +182,7 @@ ALGRAY_INLINE LaneRays camera_rays_through(LREAL fx, REAL fy, REAL4 o00, REAL4 o
 }
 
 /* The camera rays of pixels px0 .. px0 + LANES - 1 of row py, one per lane. */
-LaneRays camera_rays(uint px0, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4 du, REAL4 dv) {
+static LaneRays camera_rays(uint px0, uint py, REAL4 o00, REAL4 ou, REAL4 ov, REAL4 d00, REAL4 du, REAL4 dv) {
   return camera_rays_through(lane_pixel_centres(px0), (REAL)py + (REAL)0.5, o00, ou, ov, d00, du, dv);
 }
 

@@ -35,11 +35,17 @@ typedef float16 REAL16;
 /* The polynomial loops run over DEGREE + 1 coefficients, a compile-time constant: fully unrolled and inlined
  * they keep the coefficients in registers (measured: 30% fewer instructions in the restriction). */
 #define ALGRAY_UNROLL _Pragma("unroll")
-#define ALGRAY_INLINE inline __attribute__((always_inline))
+/* Every helper is static: a program's module then holds only what its kernels call, and PoCL, which reads the whole
+ * module back on every load of a cached binary, loads a render's programs about 35% faster (bench/history/2026-12.md,
+ * "Static kernel helpers"). */
+#define ALGRAY_INLINE static inline __attribute__((always_inline))
+/* Kept out of line: large bodies whose every call inlined made the degree-16 shadow kernel 18% slower (static
+ * functions with one caller are inlined by default; bench/history/2026-12.md, "Static kernel helpers"). */
+#define ALGRAY_NOINLINE __attribute__((noinline))
 
 /* The paper's stopping width: a root is located once its bracket is at most 4*eps*max(|t|, 1) wide in t; of one t
  * or of lanes (lanes.h). */
 #define STOP_WIDTH(t) ((REAL)4 * (REAL)TOLERANCE * fmax(fabs(t), (REAL)1))
-REAL stop_width(REAL t) { return STOP_WIDTH(t); }
+static REAL stop_width(REAL t) { return STOP_WIDTH(t); }
 
 #endif /* ALGRAY_REAL_H */

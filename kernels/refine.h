@@ -26,7 +26,7 @@ ALGRAY_INLINE LREAL line_root(LREAL f0, LREAL f1) { return f0 / (f0 - f1); }
  * orders of magnitude larger than the terms near the root, and a coefficient-sized threshold stopped early
  * there: 726 of 4096 pixels more than 1e-6 deep on (z + x/10)^21 = a (derivative chain, double). It is at most
  * (DEGREE + 1) * scale, which skips computing it far from the root. */
-LMASK value_within_rounding(const LREAL* c, LREAL y, LREAL fy, LREAL scale) {
+static LMASK value_within_rounding(const LREAL* c, LREAL y, LREAL fy, LREAL scale) {
   return !(fabs(fy) > REAL_EPS * (REAL)(DEGREE + 1) * scale) && fabs(fy) <= REAL_EPS * isolated_magnitude(c, y);
 }
 
@@ -41,8 +41,8 @@ LMASK value_within_rounding(const LREAL* c, LREAL y, LREAL fy, LREAL scale) {
  * A lane with a start in (0, 1) (isolated_start: degree 2's formula) evaluates it first: it becomes b, the
  * bracket's end of the other sign c, and the other end a; the stopping rule then decides as always. Without a
  * start, the secant of the ends is the first step, as the paper has it. */
-LREAL refine_root(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL scale, LREAL start, LMASK running,
-                  LMASK* iterations, ProbeLog* probe_log) {
+static LREAL refine_root(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL scale, LREAL start, LMASK running,
+                         LMASK* iterations, ProbeLog* probe_log) {
   /* b: best estimate; c_: contrapoint, f(c_) of the other sign; a: the previous b. */
   LREAL a = 0, fa = f0, b = 1, fb = f1, cp = 0, fc = f0;
   LMASK done = !running;
@@ -111,8 +111,8 @@ LREAL refine_root(const LREAL* c, LREAL f0, LREAL f1, LREAL tol_y, LREAL scale, 
 }
 
 #elif REFINEMENT == ALGRAY_REFINEMENT_BISECTION
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, int running, int* iterations,
-                 ProbeLog* probe_log) {
+static REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, int running,
+                        int* iterations, ProbeLog* probe_log) {
   (void)start; /* the paper's start */
   (void)running; /* one ray */
   REAL lo = 0, hi = 1, flo = f0;
@@ -144,8 +144,8 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL s
  * good, so the bracket never shrinks below the stopping width and only |P*| <= eps_m or the iteration cap
  * stops it (the paper's Barth decic defects). The Illinois variant halves the value kept at an end that has
  * survived twice in a row, which breaks that one-sidedness. */
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, int running, int* iterations,
-                 ProbeLog* probe_log) {
+static REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, int running,
+                        int* iterations, ProbeLog* probe_log) {
   (void)start; /* the paper's start */
   (void)running; /* one ray */
   REAL a = 0, fa = f0, b = 1, fb = f1, x = fabs(f0) < fabs(f1) ? (REAL)0 : (REAL)1;
@@ -181,8 +181,8 @@ REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL s
 /* Newton's method inside the bracket: a step that would leave it, or that fails to halve |P*|, is replaced by
  * bisection, so it converges like bisection at worst and quadratically near a simple root. Needs
  * isolated_value_slope(c, y, &slope) from the isolation method. */
-REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, int running, int* iterations,
-                 ProbeLog* probe_log) {
+static REAL refine_root(const REAL* c, REAL f0, REAL f1, REAL tol_y, REAL scale, REAL start, int running,
+                        int* iterations, ProbeLog* probe_log) {
   (void)start; /* the paper's start */
   (void)running; /* one ray */
   REAL a = 0, b = 1, fa = f0;

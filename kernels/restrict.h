@@ -43,7 +43,7 @@ typedef struct {
   int even; /* every exponent of this coordinate in P is even: Horner steps by the square */
 } AxisFactor;
 
-AxisFactor axis_factor(REAL l0, REAL l1, int even) {
+static AxisFactor axis_factor(REAL l0, REAL l1, int even) {
   AxisFactor f;
   f.l0 = l0;
   f.l1 = l1;
@@ -81,7 +81,7 @@ typedef struct {
 } RayTerms;
 
 /* Terms of a known size (exact from the start): coefficients given as they are. */
-RayTerms known_terms(REAL value) {
+static RayTerms known_terms(REAL value) {
   RayTerms t;
   t.value = value;
   t.exact = 1;
@@ -100,7 +100,7 @@ RayTerms known_terms(REAL value) {
  * Estrin's scheme: pairs of degrees joined by r, then pairs of those by r^2, and so on, log2(DEGREE) steps deep.
  * Horner's rule was a chain of DEGREE dependent multiply-adds that every shadow ray reaching its terms waited
  * on: 12% of the Endrass octic's adaptive shadow kernel body in perf. */
-LREAL terms_within(__global const REAL* coefs, uint count, LREAL r) {
+static LREAL terms_within(__global const REAL* coefs, uint count, LREAL r) {
   LREAL part[NCOEF];
   ALGRAY_UNROLL
   for (int d = 0; d <= DEGREE; ++d) part[d] = coefs[count + (uint)d];
@@ -118,8 +118,8 @@ ALGRAY_INLINE REAL one_ray_terms_within(__global const REAL* coefs, uint count, 
 }
 
 /* A ray's terms, with the upper bound of terms_within its largest coordinate. */
-RayTerms ray_terms(__global const uint* exps, __global const REAL* coefs, uint count, AxisFactor fx, AxisFactor fy,
-                   AxisFactor fz) {
+static RayTerms ray_terms(__global const uint* exps, __global const REAL* coefs, uint count, AxisFactor fx,
+                          AxisFactor fy, AxisFactor fz) {
   RayTerms t;
   t.exact = 0;
   t.exps = exps;
@@ -155,7 +155,7 @@ ALGRAY_INLINE void axis_powers(REAL3 q, REAL* px, REAL* py, REAL* pz) {
  * decic's adaptive render: 1.5% of its kernel time less). Power tables measured faster than a nested Horner scheme
  * in scalars (like restrict_to_rays'). Over lanes, every lane's ray terms are summed at once: summed one lane at a
  * time, they were a tenth of the Endrass octic's adaptive camera pass. */
-LREAL terms_sum(__global const uint* exps, __global const REAL* coefs, uint count, LREAL x, LREAL y, LREAL z) {
+static LREAL terms_sum(__global const uint* exps, __global const REAL* coefs, uint count, LREAL x, LREAL y, LREAL z) {
   LREAL px[NCOEF], py[NCOEF], pz[NCOEF];
   px[0] = py[0] = pz[0] = 1;
   ALGRAY_UNROLL
@@ -180,12 +180,12 @@ LREAL terms_sum(__global const uint* exps, __global const REAL* coefs, uint coun
 }
 
 /* One ray's terms at q: terms_sum with the ray in every lane, lane 0 read (in one-ray builds, the only lane). */
-REAL terms_at(const RayTerms* t, REAL3 q) {
+static REAL terms_at(const RayTerms* t, REAL3 q) {
   return lane_get(terms_sum(t->exps, t->coefs, t->count, (LREAL)q.x, (LREAL)q.y, (LREAL)q.z), 0);
 }
 
 /* The ray's terms summed (terms_at its largest coordinates), computed once. */
-REAL ray_terms_exact(RayTerms* t) {
+static REAL ray_terms_exact(RayTerms* t) {
   if (t->exact) return t->value;
   t->value = terms_at(t, (REAL3)(t->x, t->y, t->z));
   t->exact = 1;
@@ -200,7 +200,7 @@ ALGRAY_INLINE REAL3 part_coordinates(const RayTerms* t, REAL lo, REAL hi) {
   return (REAL3)(fmax(mix(t->x0, t->x1, lo), mix(t->x0, t->x1, hi)), fmax(mix(t->y0, t->y1, lo), mix(t->y0, t->y1, hi)),
                  fmax(mix(t->z0, t->z1, lo), mix(t->z0, t->z1, hi)));
 }
-REAL ray_terms_local(const RayTerms* t, REAL lo, REAL hi) {
+static REAL ray_terms_local(const RayTerms* t, REAL lo, REAL hi) {
   if (t->coefs == 0) return t->value;
   /* room for the sum's own rounding, as in terms_within */
   return terms_at(t, part_coordinates(t, lo, hi)) * (REAL)(1 + 1.0 / 1024);
@@ -208,7 +208,7 @@ REAL ray_terms_local(const RayTerms* t, REAL lo, REAL hi) {
 
 /* The restriction produced scaled coefficients c_k = C(n,k) b_k; the Bernstein
  * methods' Descartes' rule and de Casteljau want b_k. */
-void bernstein_from_scaled(REAL* c, REAL* c_lo, __constant const REAL* binomials) {
+static void bernstein_from_scaled(REAL* c, REAL* c_lo, __constant const REAL* binomials) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) {
@@ -219,7 +219,7 @@ void bernstein_from_scaled(REAL* c, REAL* c_lo, __constant const REAL* binomials
 }
 
 /* An upper bound on ray_terms_local from the per-degree sums (terms_within) at the part's largest coordinate. */
-REAL ray_terms_within_part(const RayTerms* t, REAL lo, REAL hi) {
+static REAL ray_terms_within_part(const RayTerms* t, REAL lo, REAL hi) {
   if (t->coefs == 0) return t->value;
   const REAL3 q = part_coordinates(t, lo, hi);
   return one_ray_terms_within(t->coefs, t->count, fmax(q.x, fmax(q.y, q.z)));
@@ -442,9 +442,10 @@ ALGRAY_INLINE void acc_mul_one(RayAccs c, int times) {
  * accumulator homogeneous of one degree so that sums need no elevation.
  * fx[r], fy[r], fz[r]: ray r's coordinates' factors along its segment, r < RESTRICT_RAYS. Result: out[r][0..DEGREE];
  * mixed precision also writes out_lo[r], the low parts of the compensated result (other builds leave it alone). */
-void restrict_to_rays(__global const uint* exps, __global const REAL* coefs, uint count,
-                      __constant const REAL* binomials, const AxisFactor* fx, const AxisFactor* fy,
-                      const AxisFactor* fz, REAL (*out)[NCOEF], REAL (*out_lo)[NCOEF]) {
+static ALGRAY_NOINLINE void restrict_to_rays(__global const uint* exps, __global const REAL* coefs, uint count,
+                                             __constant const REAL* binomials, const AxisFactor* fx,
+                                             const AxisFactor* fy, const AxisFactor* fz, REAL (*out)[NCOEF],
+                                             REAL (*out_lo)[NCOEF]) {
   RayAccs acc_z, acc_y, acc_x;
   int deg_z = -1;             /* degree of acc_z; -1 while the (i, j) group is empty */
   int have_y = 0, have_x = 0; /* acc_y, out hold a partial sum */
@@ -511,9 +512,9 @@ void restrict_to_rays(__global const uint* exps, __global const REAL* coefs, uin
 
 /* One ray: restrict_to_rays with every ray of the batch the same (a build with RESTRICT_RAYS = 1, as every
  * kernel but the shadow rays', pays nothing for the batch). */
-void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint count,
-                     __constant const REAL* binomials, AxisFactor fx, AxisFactor fy, AxisFactor fz, REAL* out,
-                     REAL* out_lo) {
+static void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint count,
+                            __constant const REAL* binomials, AxisFactor fx, AxisFactor fy, AxisFactor fz, REAL* out,
+                            REAL* out_lo) {
   AxisFactor bx[RESTRICT_RAYS], by[RESTRICT_RAYS], bz[RESTRICT_RAYS];
   REAL c[RESTRICT_RAYS][NCOEF], c_lo[RESTRICT_RAYS][NCOEF];
   FOR_EACH_RAY({
@@ -530,7 +531,8 @@ void restrict_to_ray(__global const uint* exps, __global const REAL* coefs, uint
  * extent's middle. Over the segment t - t0 runs linearly from tau_in to tau_out, so Horner's scheme in t - t0 on
  * the homogeneous accumulators gives the coefficients in the isolation's basis directly: D linear steps instead
  * of one per monomial. */
-void restrict_from_taylor(const REAL* taylor, REAL tau_in, REAL tau_out, __constant const REAL* binomials, REAL* out) {
+static void restrict_from_taylor(const REAL* taylor, REAL tau_in, REAL tau_out, __constant const REAL* binomials,
+                                 REAL* out) {
   Acc acc[ACC_SLOTS];
   const REAL l0 = tau_in, l1 = RESTRICT_BERNSTEIN ? tau_out : tau_out - tau_in;
   acc_set_constant(acc, taylor[DEGREE], 0);
@@ -544,7 +546,7 @@ void restrict_from_taylor(const REAL* taylor, REAL tau_in, REAL tau_out, __const
 
 /* The Taylor coefficients of one camera ray from its image row's polynomials in the column xi (in [-1, 1]):
  * row[j * NCOEF + k] is the xi^j coefficient of taylor[k]. One vector Horner step per power of xi. */
-void screen_taylor(__global const REAL* row, REAL xi, REAL* taylor) {
+static void screen_taylor(__global const REAL* row, REAL xi, REAL* taylor) {
 #if DEGREE <= 15
   /* Lanes above the degree read the next power's coefficients; they never reach taylor[0..DEGREE]. The host
    * pads the rows' buffer so that the last power loads as one vector. */

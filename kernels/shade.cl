@@ -16,14 +16,14 @@
 
 /* One lane's camera ray component rounded in float (a single-precision render's rays), as the host's pixel_ray
  * rebuilds it, whatever REAL is. */
-REAL float_camera_axis(uint px, uint py, REAL base, REAL along_x, REAL along_y) {
+static REAL float_camera_axis(uint px, uint py, REAL base, REAL along_x, REAL along_y) {
 #pragma OPENCL FP_CONTRACT OFF
   const float fx = (float)px + 0.5f, fy = (float)py + 0.5f;
   return (REAL)CAMERA_AXIS(fx, fy, (float)base, (float)along_x, (float)along_y);
 }
 
 /* Those components of the lanes' rays, pixel columns px0, px0 + step, ... */
-LREAL float_camera_axes(uint px0, uint step, uint py, REAL base, REAL along_x, REAL along_y) {
+static LREAL float_camera_axes(uint px0, uint step, uint py, REAL base, REAL along_x, REAL along_y) {
 #define FLOAT_AXIS(j) float_camera_axis(px0 + (j)*step, py, base, along_x, along_y)
   return LANES_OF(LREAL, FLOAT_AXIS);
 #undef FLOAT_AXIS

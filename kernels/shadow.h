@@ -34,9 +34,9 @@ ALGRAY_INLINE LREAL search_scale_bound(const LREAL* c) {
 
 /* p: the surface point (world), n its unit normal on the camera's side, o = p moved along n, o_unit the same in
  * unit coordinates; light: the sample point. The segment runs from o (t = 0) to the sample (t = 1). */
-int shadow_segment(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, REAL3 light, REAL extent_inv_scale, int extent_kind,
-                   REAL3 extent_box_half, __global const REAL4* clip_planes, uint clip_count, REAL3* d_unit,
-                   REAL* t_in, REAL* t_out) {
+static int shadow_segment(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, REAL3 light, REAL extent_inv_scale, int extent_kind,
+                          REAL3 extent_box_half, __global const REAL4* clip_planes, uint clip_count, REAL3* d_unit,
+                          REAL* t_in, REAL* t_out) {
   /* A light behind the tangent plane is hidden by the surface itself, whatever the roots say. The plane is the
    * surface point's, as in the shading, not the offset origin's. */
   if (dot(light - p, n) <= 0) return SHADOW_SELF;
@@ -50,8 +50,8 @@ int shadow_segment(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, REAL3 light, REAL ex
 
 /* Work-item i's surface point p and normal n, and the shadow rays' origin o off the surface to the camera's side
  * (the point's own root moves behind the ray's start), in world and unit coordinates. */
-void shadow_origin(__global const REAL4* points, __global const float4* normals, uint i, REAL offset,
-                   REAL4 extent_centre, REAL extent_inv_scale, REAL3* p, REAL3* n, REAL3* o, REAL3* o_unit) {
+static void shadow_origin(__global const REAL4* points, __global const float4* normals, uint i, REAL offset,
+                          REAL4 extent_centre, REAL extent_inv_scale, REAL3* p, REAL3* n, REAL3* o, REAL3* o_unit) {
   *p = points[i].xyz;
   const float4 nf = normals[i];
   *n = (REAL3)((REAL)nf.x, (REAL)nf.y, (REAL)nf.z);
@@ -139,8 +139,8 @@ ALGRAY_INLINE int sampled_sign_change(const REAL* b, int pieces, __constant cons
 /* A shadow ray's answer from its segment's Bernstein coefficients b (and b_lo): a root where
  * sampled_sign_change finds one, else the search's; in builds that settle doubts by signs, a doubt settled as a
  * root where a finer sampling finds one. What shadow and shadow_serial both answer. */
-Isolation shadow_isolation(const REAL* b, const REAL* b_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
-                           REAL* iso_c, RayTerms* terms) {
+static ALGRAY_NOINLINE Isolation shadow_isolation(const REAL* b, const REAL* b_lo, REAL t_in, REAL t_out,
+                                                  __constant const REAL* binomials, REAL* iso_c, RayTerms* terms) {
   Isolation iso = isolation_none();
   if (sampled_sign_change(b, SHADOW_SAMPLE_PIECES, binomials, terms)) {
     iso.status = ISOLATION_BRACKET;
@@ -168,9 +168,9 @@ Isolation shadow_isolation(const REAL* b, const REAL* b_lo, REAL t_in, REAL t_ou
 /* shadow_segment for LANES light samples (lx, ly, lz), each lane its result bit for bit: *self where the sample is
  * behind the tangent plane, and the lanes returned where the segment from o (t = 0) to the sample (t = 1) holds
  * [*t_in, *t_out] of the extent. */
-LMASK shadow_segments(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, LREAL lx, LREAL ly, LREAL lz, REAL extent_inv_scale,
-                      int extent_kind, REAL3 box_half, __global const REAL4* clip_planes, uint clip_count,
-                      LMASK* self, LREAL* dx, LREAL* dy, LREAL* dz, LREAL* t_in, LREAL* t_out) {
+static LMASK shadow_segments(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, LREAL lx, LREAL ly, LREAL lz,
+                             REAL extent_inv_scale, int extent_kind, REAL3 box_half, __global const REAL4* clip_planes,
+                             uint clip_count, LMASK* self, LREAL* dx, LREAL* dy, LREAL* dz, LREAL* t_in, LREAL* t_out) {
   {
     /* as dot() sums them: three products, added left to right */
 #pragma OPENCL FP_CONTRACT OFF
@@ -197,7 +197,7 @@ LMASK shadow_segments(REAL3 p, REAL3 n, REAL3 o, REAL3 o_unit, LREAL lx, LREAL l
  * halvings, without its bookkeeping: most segments the search excludes are settled by one or two halvings.
  * Adaptive builds also want every coefficient beyond `noise` but the first, P at the ray's start (first_counted);
  * other builds never read it. */
-LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials, LREAL noise) {
+static LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials, LREAL noise) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   LREAL piece[1 << SHADOW_PIECE_LEVELS][NCOEF];
   ALGRAY_UNROLL
@@ -242,8 +242,8 @@ typedef struct {
   int exact;
 } PointTerms;
 
-PointTerms point_terms(REAL3 o, LREAL dx, LREAL dy, LREAL dz, LREAL t_in, LREAL t_out, __global const REAL* coefs,
-                       uint count) {
+static PointTerms point_terms(REAL3 o, LREAL dx, LREAL dy, LREAL dz, LREAL t_in, LREAL t_out,
+                              __global const REAL* coefs, uint count) {
   PointTerms t;
   t.x0 = fabs(o.x) + t_in * fabs(dx);
   t.y0 = fabs(o.y) + t_in * fabs(dy);
@@ -257,7 +257,7 @@ PointTerms point_terms(REAL3 o, LREAL dx, LREAL dy, LREAL dz, LREAL t_in, LREAL 
 }
 
 /* The terms summed, every lane at once (terms_sum), with room for the sum's rounding as terms_within's. */
-void point_terms_exact(PointTerms* t, __global const uint* exps, __global const REAL* coefs, uint count) {
+static void point_terms_exact(PointTerms* t, __global const uint* exps, __global const REAL* coefs, uint count) {
   t->value = terms_sum(exps, coefs, count, t->x, t->y, t->z) * (REAL)(1 + 1.0 / 1024);
   t->exact = 1;
 }
@@ -267,8 +267,8 @@ void point_terms_exact(PointTerms* t, __global const uint* exps, __global const 
  * beyond the noise, as the search would (its first interval's coefficients all clear of its noise and of one sign;
  * P at the far end beyond the noise for any scale, noise_bound; P at the start counts with the sign it has).
  * The others are left to the search (*open), which doubts what it cannot settle. */
-LMASK segment_roots_settled_clear(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced,
-                                  LMASK* open, __constant const REAL* binomials, LREAL scale, LREAL terms) {
+static LMASK segment_roots_settled_clear(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced,
+                                         LMASK* open, __constant const REAL* binomials, LREAL scale, LREAL terms) {
   const LREAL noise = DOUBT_NOISE(scale, terms) * (REAL)(1 + 8 * REAL_EPS);
   const LREAL end_noise = DOUBT_NOISE(terms, terms);
   LMASK none = one_strict_sign(c);
@@ -285,15 +285,14 @@ LMASK segment_roots_settled_clear(const LREAL* c, const LREAL* power, LREAL t_in
   return root || crossed;
 }
 
-
 /* Which of the traced lanes' segments a cheap test shows to hold a root, from the scaled Bernstein coefficients c
  * on [t_in, t_out] (power basis power, the same polynomial); *open gets the lanes only the search can settle. The
  * signs of c settle most (bernstein_root_by_signs' answers), and a sign change at seven points of the segment
  * most of the rest. Adaptive builds ask the same of values beyond their noise (segment_roots_settled_clear), first
  * on the terms' upper bound, then, where a lane is left open, on the terms summed (*terms made exact). */
-LMASK segment_roots_settled(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced, LMASK* open,
-                            __constant const REAL* binomials, PointTerms* terms, __global const uint* exps,
-                            __global const REAL* coefs, uint count) {
+static LMASK segment_roots_settled(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced,
+                                   LMASK* open, __constant const REAL* binomials, PointTerms* terms,
+                                   __global const uint* exps, __global const REAL* coefs, uint count) {
   if (ALGRAY_ESCALATE) {
     const LREAL scale = search_scale_bound(c);
     const LMASK root =
@@ -357,8 +356,8 @@ ALGRAY_INLINE LaneTerms queued_terms(const SearchQueue* queue, __global const ui
 
 /* The samples whose queued segments hold a root, by the Bernstein search over the queue's lanes; in adaptive
  * builds, *doubted gets those it doubted. The queue is emptied. */
-ulong search_queued(SearchQueue* queue, ulong* doubted, __global const uint* exps, __global const REAL* coefs,
-                    uint count) {
+static ulong search_queued(SearchQueue* queue, ulong* doubted, __global const uint* exps, __global const REAL* coefs,
+                           uint count) {
   ulong found = 0;
   LREAL cur[NCOEF];
   const LMASK running = lanes_of_bits((1u << queue->count) - 1);
@@ -378,9 +377,9 @@ ulong search_queued(SearchQueue* queue, ulong* doubted, __global const uint* exp
 
 /* Queues the open lanes of the block of samples s0 ..; searches whenever the queue fills. Returns the samples
  * found hidden; *doubted gets those the search doubted. */
-ulong queue_for_search(SearchQueue* queue, const LREAL* c, LREAL t_in, LREAL t_out, uint open_bits, uint s0,
-                       __constant const REAL* binomials, ulong* doubted, const PointTerms* terms,
-                       __global const uint* exps, __global const REAL* coefs, uint count) {
+static ulong queue_for_search(SearchQueue* queue, const LREAL* c, LREAL t_in, LREAL t_out, uint open_bits, uint s0,
+                              __constant const REAL* binomials, ulong* doubted, const PointTerms* terms,
+                              __global const uint* exps, __global const REAL* coefs, uint count) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   LREAL b[NCOEF];
   ALGRAY_UNROLL
@@ -412,12 +411,12 @@ ulong queue_for_search(SearchQueue* queue, const LREAL* c, LREAL t_in, LREAL t_o
  * traced added to *traced, and in adaptive builds the samples whose answers the float search doubted in
  * *undecided. LANES light samples at a time, so the one-lane build (shadow_serial, GPUs) takes the same decisions
  * ray by ray. P is expanded about the origin once, when the first ray is traced. */
-ulong shadow_mask_point_form(__global const REAL4* points, __global const float4* normals, uint i,
-                             __global const REAL4* light_points, uint light_count, REAL offset, REAL4 extent_centre,
-                             REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
-                             __global const REAL4* clip_planes, uint clip_count, __global const uint* mono_exps,
-                             __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
-                             ulong mask, uint* traced, ulong* undecided) {
+static ulong shadow_mask_point_form(__global const REAL4* points, __global const float4* normals, uint i,
+                                    __global const REAL4* light_points, uint light_count, REAL offset,
+                                    REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
+                                    __global const REAL4* clip_planes, uint clip_count, __global const uint* mono_exps,
+                                    __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
+                                    ulong mask, uint* traced, ulong* undecided) {
   REAL3 p, n, o, o_unit;
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
   PolyVec q[POINT_FORM_COLUMNS];
@@ -473,12 +472,12 @@ ulong shadow_mask_point_form(__global const REAL4* points, __global const float4
 
 /* The point form's work-item of the shadow kernels, whose arguments these are (shadow.cl): surface point i's mask,
  * its traced rays counted, and in adaptive builds its doubted samples. */
-void shadow_point_form_item(__global const REAL4* points, __global const float4* normals, uint point_count,
-                            __global const REAL4* light_points, uint light_count, REAL offset, REAL4 extent_centre,
-                            REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
-                            __global const REAL4* clip_planes, uint clip_count, __global const uint* mono_exps,
-                            __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
-                            __global ulong* occluded, __global uint* rays_traced, __global ulong* undecided) {
+static void shadow_point_form_item(__global const REAL4* points, __global const float4* normals, uint point_count,
+                                   __global const REAL4* light_points, uint light_count, REAL offset,
+                                   REAL4 extent_centre, REAL extent_inv_scale, REAL4 extent_box_half, int extent_kind,
+                                   __global const REAL4* clip_planes, uint clip_count, __global const uint* mono_exps,
+                                   __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
+                                   __global ulong* occluded, __global uint* rays_traced, __global ulong* undecided) {
   const uint i = get_global_id(0);
   if (i >= point_count) return;
   uint traced = 0;

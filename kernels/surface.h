@@ -49,7 +49,7 @@ ALGRAY_INLINE __global const REAL* screen_row(__global const REAL* rows, uint py
  * summed from, as RayTerms' sum does for the extent construction; the noise is measured alike (isolation.h,
  * DOUBT_NOISE), with ALGRAY_SCREEN_TERMS_WEIGHT for the screen form's two Horner chains where the extent
  * construction has one, and 2^-10 more for this sum's own rounding. */
-LREAL screen_terms(__global const REAL* row, LREAL xi, LREAL tau_in, LREAL tau_out) {
+static LREAL screen_terms(__global const REAL* row, LREAL xi, LREAL tau_in, LREAL tau_out) {
   const LREAL ax = fabs(xi), reach = fmax(fabs(tau_in), fabs(tau_out));
   LREAL total = 0;
   for (int k = DEGREE; k >= 0; --k) {
@@ -62,8 +62,8 @@ LREAL screen_terms(__global const REAL* row, LREAL xi, LREAL tau_in, LREAL tau_o
 
 /* Adaptive builds: a camera ray's terms in the screen form (screen_terms, exact from the start) with what the search
  * evaluates P from in float-float: the ray in unit coordinates, its segment, and the monomials. */
-RayTerms screen_ray_terms(REAL value, REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
-                          __global const REAL* coefs, uint count) {
+static RayTerms screen_ray_terms(REAL value, REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
+                                 __global const REAL* coefs, uint count) {
   RayTerms t = known_terms(value);
   t.exps = exps;
   t.coefs = coefs;
@@ -77,8 +77,8 @@ RayTerms screen_ray_terms(REAL value, REAL3 o, REAL3 d, REAL t_in, REAL t_out, _
 }
 
 /* Pixel (px, py)'s Taylor coefficients; returns the t they are expanded about. */
-REAL screen_ray_taylor(uint px, uint py, __global const REAL* rows, uint row0, REAL t0, REAL xi_scale, REAL xi_offset,
-                       REAL* taylor) {
+static REAL screen_ray_taylor(uint px, uint py, __global const REAL* rows, uint row0, REAL t0, REAL xi_scale,
+                              REAL xi_offset, REAL* taylor) {
   screen_taylor(screen_row(rows, py, row0), screen_column(px, xi_scale, xi_offset), taylor);
   return t0;
 }
@@ -118,7 +118,7 @@ ALGRAY_INLINE HitRecord missed_record(void) {
 }
 
 /* The size of the isolating interval's coefficients, for the refinement's value stop; over lanes, each lane's. */
-LREAL coefficient_scale(const LREAL* c) {
+static LREAL coefficient_scale(const LREAL* c) {
   LREAL scale = 0;
   for (int k = 0; k <= DEGREE; ++k) scale = fmax(scale, fabs(c[k]));
   return scale;
@@ -140,8 +140,8 @@ LREAL coefficient_scale(const LREAL* c) {
  * that lies where P is so flat that the coefficients' noise could move it by more than ALGRAY_DOUBT_POSITION of
  * its t, read off P's slope there: the secant of the isolating interval can be many times steeper than P at the
  * root (a Kummer shell ray: 60 times, with the root 1e-3 off). */
-void refine_rays(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in, LREAL t_out,
-                 __constant const REAL* binomials, LaneRoots* roots, ProbeLog* probe_log) {
+static void refine_rays(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in, LREAL t_out,
+                        __constant const REAL* binomials, LaneRoots* roots, ProbeLog* probe_log) {
   if (LANE_ANY(entered))
     PROBE(ALGRAY_EVENT_ISOLATED, iso->budget, (uint)iso->status, 0u, iso->lo, iso->hi, iso->f_lo, iso->f_hi);
   /* the isolation's flags */
@@ -187,8 +187,8 @@ void refine_rays(LMASK entered, const LaneIsolation* iso, LREAL* c, LREAL t_in, 
 
 /* The coordinates' factors of the ray o + t*d restricted to [t_in, t_out] as s in [0, 1], in the isolation's
  * basis: entry and exit points for the Bernstein form, entry point and chord for the power basis. */
-void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, AxisFactor* fx, AxisFactor* fy,
-                     AxisFactor* fz) {
+static void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, AxisFactor* fx, AxisFactor* fy,
+                            AxisFactor* fz) {
   const REAL3 pa = o + t_in * d, pb = o + t_out * d;
   const REAL3 l1 = ISOLATION_POWER_BASIS ? pb - pa : pb;
   *fx = axis_factor(pa.x, l1.x, even_axes & 1);
@@ -197,7 +197,8 @@ void segment_factors(REAL3 o, REAL3 d, REAL t_in, REAL t_out, uint even_axes, Ax
 }
 
 /* The restriction's result (scaled Bernstein coefficients, or a power basis) as the isolation method takes it. */
-void restricted_to_isolation_basis(REAL* root, REAL* root_lo, __constant const REAL* binomials, ProbeLog* probe_log) {
+static void restricted_to_isolation_basis(REAL* root, REAL* root_lo, __constant const REAL* binomials,
+                                          ProbeLog* probe_log) {
   if (!ISOLATION_POWER_BASIS) bernstein_from_scaled(root, root_lo, binomials);
   probe_coefficients(root, root_lo,
                      !ISOLATION_POWER_BASIS              ? ALGRAY_BASIS_BERNSTEIN
@@ -239,9 +240,10 @@ ALGRAY_INLINE void segment_coefficients(REAL3 o, REAL3 d, REAL t_in, REAL t_out,
 /* Isolates the smallest root of P*(t) on [t_in, t_out] for the ray o + t*d in unit coordinates; iso_c gets
  * the polynomial on the isolating interval. The primary and shadow kernels share this: one refines what it
  * returns, the other only asks whether there is anything to refine. */
-Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
-                             __global const REAL* coefs, uint count, __constant const REAL* binomials, uint even_axes,
-                             REAL* iso_c, const REAL* taylor, REAL taylor_t, ProbeLog* probe_log) {
+static Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global const uint* exps,
+                                    __global const REAL* coefs, uint count, __constant const REAL* binomials,
+                                    uint even_axes, REAL* iso_c, const REAL* taylor, REAL taylor_t,
+                                    ProbeLog* probe_log) {
   REAL root[NCOEF], root_lo[NCOEF];
   RayTerms terms;
   segment_coefficients(o, d, t_in, t_out, exps, coefs, count, binomials, even_axes, root,
@@ -252,8 +254,8 @@ Isolation isolate_on_segment(REAL3 o, REAL3 d, REAL t_in, REAL t_out, __global c
 /* Isolates the smallest root on [t_in, t_out] from the coefficients restrict_to_rays made of segment_factors'
  * factors (root, root_lo are consumed), as isolate_on_segment would; iso_c gets the polynomial on the isolating
  * interval. */
-Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
-                             REAL* iso_c, RayTerms* terms, ProbeLog* probe_log) {
+static Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, __constant const REAL* binomials,
+                                    REAL* iso_c, RayTerms* terms, ProbeLog* probe_log) {
   restricted_to_isolation_basis(root, root_lo, binomials, probe_log);
   return isolate_method(root, root_lo, t_in, t_out, iso_c, terms, probe_log);
 }
@@ -263,9 +265,9 @@ Isolation isolate_restricted(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, _
  * *lane_t_out get each lane's segment (0 and 1 where it misses). Returns the lanes that enter the extent (none from
  * `count` on). Unit coordinates keep every point of the extent within |u| <= 1: the conditioning step that makes
  * float usable. */
-LMASK enter_extent(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
-                   __global const REAL4* clip_planes, uint clip_count, LaneRays* unit, LREAL* lane_t_in,
-                   LREAL* lane_t_out, ProbeLog* probe_log) {
+static LMASK enter_extent(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half,
+                          int extent_kind, __global const REAL4* clip_planes, uint clip_count, LaneRays* unit,
+                          LREAL* lane_t_in, LREAL* lane_t_out, ProbeLog* probe_log) {
   unit->ox = (rays->ox - centre.x) * inv_scale;
   unit->oy = (rays->oy - centre.y) * inv_scale;
   unit->oz = (rays->oz - centre.z) * inv_scale;
@@ -295,9 +297,9 @@ ALGRAY_INLINE REAL3 lane_direction(const LaneRays* rays, uint j) {
  * lane's polynomial on its isolating interval, for refine_rays. Lanes from `count` on, and those whose ray missed the
  * extent (in_extent[j] == 0), are left alone. rays: the lanes' rays in unit coordinates, where adaptive builds'
  * search evaluates P in float-float (bracket_ends_in_float_float). */
-void isolate_rays(uint count, const int* in_extent, const LaneRays* rays, REAL (*root)[NCOEF], REAL (*root_lo)[NCOEF],
-                  const REAL* t_in, const REAL* t_out, LaneIsolation* iso, LREAL* c, RayTerms* terms,
-                  ProbeLog* probe_log) {
+static void isolate_rays(uint count, const int* in_extent, const LaneRays* rays, REAL (*root)[NCOEF],
+                         REAL (*root_lo)[NCOEF], const REAL* t_in, const REAL* t_out, LaneIsolation* iso, LREAL* c,
+                         RayTerms* terms, ProbeLog* probe_log) {
 #if LANES > 1
   isolate_rays_together(count, in_extent, rays, root, root_lo, t_in, t_out, iso, c, terms, probe_log);
 #else
@@ -327,7 +329,7 @@ void isolate_rays(uint count, const int* in_extent, const LaneRays* rays, REAL (
 /* P at q from the monomials (the power tables of axis_powers, restrict.h), and a bound on its rounding: the
  * products, the sum, and the rounding of q's coordinates and of the coefficients, each of at most REAL_EPS / 2
  * per operation to first order, with room. */
-REAL direct_value(REAL3 q, __global const uint* exps, __global const REAL* coefs, uint count, REAL* rounding) {
+static REAL direct_value(REAL3 q, __global const uint* exps, __global const REAL* coefs, uint count, REAL* rounding) {
   REAL px[NCOEF], py[NCOEF], pz[NCOEF];
   axis_powers(q, px, py, pz);
   REAL value = 0, size = 0;
@@ -349,9 +351,9 @@ REAL direct_value(REAL3 q, __global const uint* exps, __global const REAL* coefs
 /* The float-float check of confirm_flat_roots for the lanes in `doubted` (roots at t, rays r from their starts),
  * at t -+ delta with delta shrunk by 2^-10, so that their own rounding keeps the points within
  * ALGRAY_DOUBT_POSITION |t| of t; the lanes it confirms. *v0 ... *rounding1: the values and their bounds. */
-LMASK confirmed_in_float_float(LMASK doubted, const LaneRays* r, LREAL t, __global const uint* exps,
-                               __global const REAL* coefs, uint count, LREAL* v0, LREAL* rounding0, LREAL* v1,
-                               LREAL* rounding1) {
+static LMASK confirmed_in_float_float(LMASK doubted, const LaneRays* r, LREAL t, __global const uint* exps,
+                                      __global const REAL* coefs, uint count, LREAL* v0, LREAL* rounding0, LREAL* v1,
+                                      LREAL* rounding1) {
   const LREAL inner = (REAL)ALGRAY_DOUBT_POSITION * (REAL)(1 - 1.0 / 1024) * fabs(t);
   *v0 = direct_value_ff(r, ff_of(t - inner), exps, coefs, count, rounding0);
   *v1 = direct_value_ff(r, ff_of(t + inner), exps, coefs, count, rounding1);
@@ -362,8 +364,9 @@ LMASK confirmed_in_float_float(LMASK doubted, const LaneRays* r, LREAL t, __glob
  * coordinates) that P's values confirm, in float lane by lane, and then in float-float for the lanes still in
  * doubt, together (unit: the rays from their starts). The probe sees which arithmetic confirmed it (decision 0 or
  * 1). */
-void confirm_flat_roots(uint count, LaneRoots* roots, const LaneRays* at, const LaneRays* unit,
-                        __global const uint* exps, __global const REAL* coefs, uint mono_count, ProbeLog* probe_log) {
+static void confirm_flat_roots(uint count, LaneRoots* roots, const LaneRays* at, const LaneRays* unit,
+                               __global const uint* exps, __global const REAL* coefs, uint mono_count,
+                               ProbeLog* probe_log) {
   const LMASK found = (roots->flags & (LANE_INT_VEC)ALGRAY_HIT_FOUND) != 0;
   const uint doubted_bits = lane_mask_bits(found && (roots->flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0);
   for (uint j = 0; j < min(count, (uint)LANES); ++j) {
@@ -387,8 +390,8 @@ void confirm_flat_roots(uint count, LaneRoots* roots, const LaneRays* at, const 
 }
 
 /* grad P at (x, y, z), from the monomials, with a table of powers per axis; over lanes, each lane's point. */
-void surface_gradient(LREAL x, LREAL y, LREAL z, __global const uint* exps, __global const REAL* coefs,
-                      uint count, LREAL* gx, LREAL* gy, LREAL* gz) {
+static void surface_gradient(LREAL x, LREAL y, LREAL z, __global const uint* exps, __global const REAL* coefs,
+                             uint count, LREAL* gx, LREAL* gy, LREAL* gz) {
   LREAL px[NCOEF], py[NCOEF], pz[NCOEF];
   px[0] = py[0] = pz[0] = 1;
   for (int n = 1; n <= DEGREE; ++n) {
@@ -413,8 +416,8 @@ void surface_gradient(LREAL x, LREAL y, LREAL z, __global const uint* exps, __gl
 /* The hit records of the first `count` (<= LANES) of the lanes' rays: lane j of roots holds ray j's root, `at` the
  * rays in unit coordinates with each found root's point as the origin, `rays` the rays as traced. Depth, the normal
  * from grad P (taken together in lanes) facing the ray, and the side. */
-void hit_records(uint count, const LaneRays* rays, const LaneRays* at, const LaneRoots* roots,
-                 __global const uint* exps, __global const REAL* coefs, uint mono_count, HitRecord* out) {
+static void hit_records(uint count, const LaneRays* rays, const LaneRays* at, const LaneRoots* roots,
+                        __global const uint* exps, __global const REAL* coefs, uint mono_count, HitRecord* out) {
   const LMASK found = (roots->flags & (LANE_INT_VEC)ALGRAY_HIT_FOUND) != 0;
   const uint found_bits = lane_mask_bits(found);
   REAL depth_of[LANES], nx_of[LANES], ny_of[LANES], nz_of[LANES];
@@ -532,11 +535,11 @@ ALGRAY_INLINE void screen_coefficients(__global const REAL* row, LREAL xi, LREAL
  * where LANES > 1, with the one-ray build's records bit for bit (tests/test_lanes). Camera and secondary rays, and
  * the probe, share it. px0, py: the first ray's pixel, and screen_rows .. xi_offset the image rows' polynomials, for
  * the screen form (other builds never read them). */
-int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
-               __global const REAL4* clip_planes, uint clip_count, __global const uint* exps,
-               __global const REAL* coefs, uint mono_count, __constant const REAL* binomials, uint even_axes,
-               HitRecord* records, uint px0, uint py, __global const REAL* screen_rows, uint screen_row0,
-               REAL screen_t, REAL xi_scale, REAL xi_offset, ProbeLog* probe_log) {
+static int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_scale, REAL3 box_half, int extent_kind,
+                      __global const REAL4* clip_planes, uint clip_count, __global const uint* exps,
+                      __global const REAL* coefs, uint mono_count, __constant const REAL* binomials, uint even_axes,
+                      HitRecord* records, uint px0, uint py, __global const REAL* screen_rows, uint screen_row0,
+                      REAL screen_t, REAL xi_scale, REAL xi_offset, ProbeLog* probe_log) {
   LaneIsolation iso;
   LaneRoots roots;
   LREAL iso_c[NCOEF], lane_t_in, lane_t_out;

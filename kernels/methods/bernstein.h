@@ -291,7 +291,7 @@ typedef struct {
   ProvenEnds proven;
 } LaneNoise;
 
-LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
+static LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
   LaneNoise n;
   no_proven_ends(&n.proven);
   n.one = search_noise(root, terms);
@@ -317,7 +317,7 @@ typedef struct {
   ProvenEnds proven;
 } LaneNoise;
 
-LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
+static LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
   LaneNoise n;
   no_proven_ends(&n.proven);
   LREAL magnitude[NCOEF];
@@ -598,8 +598,9 @@ ALGRAY_INLINE void settle_brackets(BernsteinSearch* s, LaneTerms* terms, LREAL t
  * coefficients on [iso.lo, iso.hi] (rounded to float in mixed precision, where they are accurate relative to their
  * own size). Over lanes, a halving, a recomputation from `root` and a copy of the cached sibling each cost every
  * lane, so this pays where neighbouring rays take similar searches (bench/history/2026-12.md, "Lock-step lanes"). */
-void isolate_bernstein_search(LMASK running, const LREAL* root, const LREAL* root_lo, LREAL t_in, LREAL t_out,
-                              LaneIsolation* iso, LREAL* cur_out, LaneTerms* terms, ProbeLog* probe_log) {
+static ALGRAY_NOINLINE void isolate_bernstein_search(LMASK running, const LREAL* root, const LREAL* root_lo, LREAL t_in,
+                                                     LREAL t_out, LaneIsolation* iso, LREAL* cur_out, LaneTerms* terms,
+                                                     ProbeLog* probe_log) {
   BernsteinSearch s;
   coefs_copy(s.cur, s.cur_lo, root, root_lo);
   coefs_copy(s.sib, s.sib_lo, root, root_lo);
@@ -648,8 +649,8 @@ void isolate_bernstein_search(LMASK running, const LREAL* root, const LREAL* roo
 }
 
 /* The search for one ray (the method's entry, isolate.h; shadow rays): its coefficients in lane 0. */
-Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out, REAL* cur,
-                            RayTerms* terms, ProbeLog* probe_log) {
+static Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, REAL t_out, REAL* cur,
+                                   RayTerms* terms, ProbeLog* probe_log) {
   LREAL r[NCOEF], r_lo[NCOEF], c[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) {
@@ -667,16 +668,16 @@ Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t_in, RE
 }
 
 /* The method's entry (isolate.h). */
-Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
-                         ProbeLog* probe_log) {
+static Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
+                                ProbeLog* probe_log) {
   return isolate_bernstein(root, root_lo, t_in, t_out, iso_c, terms, probe_log);
 }
 #if LANES > 1
 /* isolate_rays (surface.h) for lanes: the rays' segment coefficients root[j], root_lo[j] (consumed) and segments
  * gathered into lanes, with adaptive builds' terms summed together, then searched together. */
-void isolate_rays_together(uint count, const int* in_extent, const LaneRays* rays, REAL (*root)[NCOEF],
-                           REAL (*root_lo)[NCOEF], const REAL* t_in, const REAL* t_out, LaneIsolation* iso, LREAL* c,
-                           RayTerms* terms, ProbeLog* probe_log) {
+static void isolate_rays_together(uint count, const int* in_extent, const LaneRays* rays, REAL (*root)[NCOEF],
+                                  REAL (*root_lo)[NCOEF], const REAL* t_in, const REAL* t_out, LaneIsolation* iso,
+                                  LREAL* c, RayTerms* terms, ProbeLog* probe_log) {
   for (int k = 0; k <= DEGREE; ++k) c[k] = 0;
   LREAL lane_root[NCOEF], lane_root_lo[NCOEF], lane_t_in = 0, lane_t_out = 1, lane_terms = 0;
   for (int k = 0; k <= DEGREE; ++k) lane_root[k] = lane_root_lo[k] = 0;
@@ -737,7 +738,7 @@ void isolate_rays_together(uint count, const int* in_extent, const LaneRays* ray
  *    last one it reaches holds the sign change (or the zero) that it reports;
  *  - -1 otherwise, NaN included: only the search can tell.
  * A shadow ray asks for nothing more, so most of its rays skip the division and the search. */
-int bernstein_root_by_signs(const REAL* c) {
+static int bernstein_root_by_signs(const REAL* c) {
   int positive = 1, negative = 1;
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) {
@@ -756,7 +757,7 @@ int bernstein_root_by_signs(const REAL* c) {
  * rule holds, as from any start (near a double root the formula loses digits, and the search then finds them). A
  * start moves where in the stopping width a root lands, so other degrees keep the paper's start (bench/RESULTS.md:
  * the control polygon's crossing as a start, measured and not kept). Over lanes, each lane's. */
-LREAL isolated_start(const LREAL* c) {
+static LREAL isolated_start(const LREAL* c) {
   if (DEGREE != 2) return -1;
   /* c0 (1 - y)^2 + 2 c1 y (1 - y) + c2 y^2 = a y^2 + b y + c0 */
   const LREAL a = (c[0] - (REAL)2 * c[1]) + c[DEGREE], b = (REAL)2 * (c[1] - c[0]);
@@ -766,14 +767,14 @@ LREAL isolated_start(const LREAL* c) {
 }
 
 /* Turns Bernstein coefficients into the form isolated_value() expects: c_k * C(n,k); over lanes, each lane's. */
-void prepare_isolated(LREAL* c, __constant const REAL* binomials) {
+static void prepare_isolated(LREAL* c, __constant const REAL* binomials) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) c[k] *= row[k];
 }
 
 /* x^DEGREE by repeated multiplication: pown() goes through exp and log on some devices. */
-LREAL power_of(LREAL x) {
+static LREAL power_of(LREAL x) {
   LREAL p = 1;
   ALGRAY_UNROLL
   for (int k = 0; k < DEGREE; ++k) p *= x;
@@ -783,7 +784,7 @@ LREAL power_of(LREAL x) {
 /* Value at y in [0,1] of a prepared polynomial in O(n): Horner in y/(1-y), mirrored past 1/2 so the ratio
  * stays at most 1. Over lanes (lanes.h), each lane picks its side by selection; the ratio is then one
  * division of the selected numerator by the selected denominator, the same operations as either side alone. */
-LREAL isolated_value(const LREAL* c, LREAL y) {
+static LREAL isolated_value(const LREAL* c, LREAL y) {
   const LMASK mirrored = !(y <= (REAL)0.5);
   const LREAL u = LANE_SEL((REAL)1 - y, y, mirrored); /* the factor raised to the power n */
   const LREAL r = LANE_SEL(y, (REAL)1 - y, mirrored) / u;
@@ -795,7 +796,7 @@ LREAL isolated_value(const LREAL* c, LREAL y) {
 
 /* The size of the terms isolated_value(c, y) sums, sum |c_k| r^k times the same power: its rounding error is
  * a small multiple of REAL_EPS times this, so a value below REAL_EPS times it has no reliable sign. */
-LREAL isolated_magnitude(const LREAL* c, LREAL y) {
+static LREAL isolated_magnitude(const LREAL* c, LREAL y) {
   const LMASK mirrored = y > (REAL)0.5;
   const LREAL u = LANE_SEL((REAL)1 - y, y, mirrored);
   const LREAL r = LANE_SEL(y, (REAL)1 - y, mirrored) / u;
@@ -808,7 +809,7 @@ LREAL isolated_magnitude(const LREAL* c, LREAL y) {
 /* Value and slope at y in [0,1] of a prepared polynomial, for Newton's method and adaptive builds' flat check. With
  * r = y/(1-y) and H(r) = sum c_k r^k, P = (1-y)^n H and P' = (1-y)^(n-2) (H' - n (1-y) H); mirrored past 1/2 like
  * the value; over lanes, each lane's. */
-LREAL isolated_value_slope(const LREAL* c, LREAL y, LREAL* slope) {
+static LREAL isolated_value_slope(const LREAL* c, LREAL y, LREAL* slope) {
   if (DEGREE == 1) {
     *slope = c[1] - c[0];
     return c[0] * ((REAL)1 - y) + c[1] * y;

@@ -8,7 +8,7 @@
  * starting at chain_offset(m); level DEGREE is A itself, kept apart. All levels at once is ~DEGREE^2/2 values:
  * kept, as the inner solves evaluate each level many times. */
 #define CHAIN_STORAGE ((DEGREE - 1) * (DEGREE + 2) / 2 + 1)
-int chain_offset(int m) { return (m - 1) * (m + 2) / 2; }
+static int chain_offset(int m) { return (m - 1) * (m + 2) / 2; }
 
 /* The cap on one inner solve: from [0, 1], bisection alone is down to adjacent numbers after REAL_MAX_HALVINGS
  * steps, and the Newton steps allowed in between rarely double that. Reaching it sets iso.budget. */
@@ -17,7 +17,7 @@ int chain_offset(int m) { return (m - 1) * (m + 2) / 2; }
 /* d = c' for c of degree m + 1, scaled by a power of two to a largest coefficient in [1/2, 1): exact, and
  * without it the factors k would reach DEGREE! ~ 1e35 down the chain and overflow float. The exponent is
  * clamped so the scale itself stays a normal number. */
-void chain_derivative(const REAL* c, int m, REAL* d) {
+static void chain_derivative(const REAL* c, int m, REAL* d) {
   REAL big = 0;
   for (int k = 0; k <= m; ++k) {
     d[k] = (REAL)(k + 1) * c[k + 1];
@@ -32,13 +32,13 @@ void chain_derivative(const REAL* c, int m, REAL* d) {
 
 /* Horner on one level. The degree varies at run time, so these loops stay rolled: a fully unrolled loop over
  * DEGREE with the terms above m masked off measured no faster. */
-REAL chain_value(const REAL* c, int m, REAL y) {
+static REAL chain_value(const REAL* c, int m, REAL y) {
   REAL h = c[m];
   for (int k = m - 1; k >= 0; --k) h = h * y + c[k];
   return h;
 }
 
-REAL chain_value_slope(const REAL* c, int m, REAL y, REAL* slope) {
+static REAL chain_value_slope(const REAL* c, int m, REAL y, REAL* slope) {
   REAL h = c[m], d = 0;
   for (int k = m - 1; k >= 0; --k) {
     d = d * y + h;
@@ -51,7 +51,7 @@ REAL chain_value_slope(const REAL* c, int m, REAL y, REAL* slope) {
 /* A(1) is the sum of the coefficients; summed with its rounding errors carried (Neumaier), so that a root at
  * the far end, where the ray leaves the extent, is seen on its true side: plain summation flips its sign about
  * half the time, and a simple root just inside would be missed. */
-REAL chain_value_at_one(const REAL* a) {
+static REAL chain_value_at_one(const REAL* a) {
   REAL s = a[0], e = 0;
   ALGRAY_UNROLL
   for (int k = 1; k <= DEGREE; ++k) {
@@ -70,8 +70,8 @@ REAL chain_value_at_one(const REAL* a) {
  * stopping width tol lets pass as located (no sign change, as in settle_cluster). Below A', such a missed pair
  * leaves a wiggle of order d^3 in the level above that: a near triple root of A, found within ~2d either way.
  * The last Newton step usually lands far closer than tol anyway. */
-REAL chain_root(const REAL* c, int m, REAL lo, REAL hi, REAL f_lo, REAL f_hi, REAL tol, Isolation* iso,
-                ProbeLog* probe_log) {
+static REAL chain_root(const REAL* c, int m, REAL lo, REAL hi, REAL f_lo, REAL f_hi, REAL tol, Isolation* iso,
+                       ProbeLog* probe_log) {
   const int rising = f_lo < 0;
   REAL x = lo - f_lo * ((hi - lo) / (f_hi - f_lo));
   if (!(x > lo && x < hi)) x = (REAL)0.5 * (lo + hi);
@@ -114,7 +114,7 @@ REAL chain_root(const REAL* c, int m, REAL lo, REAL hi, REAL f_lo, REAL f_hi, RE
  * evaluations). Its roots in (0, 1), in increasing order, in r; returns how many. A double root is kept: one
  * boundary too many is harmless. */
 #define CHAIN_BOTTOM (DEGREE >= 3 ? 2 : 1)
-int chain_bottom_roots(const REAL* c, REAL* r) {
+static int chain_bottom_roots(const REAL* c, REAL* r) {
   const REAL c0 = c[0], c1 = c[1];
   const REAL c2 = CHAIN_BOTTOM == 2 ? c[2] : (REAL)0;
   REAL x0 = -1, x1 = -1;
@@ -151,7 +151,7 @@ typedef struct {
  * on a boundary is a root only if A has the other sign after it (a double root only touches, and is invisible
  * as in settle_cluster), or if it is the far end, where nothing follows to tell. A NaN is neither a sign nor a
  * zero, so a degenerate polynomial finds nothing. Returns 1 when it settled iso->status. */
-int chain_visit(ChainWalk* w, Isolation* iso, const REAL* a, REAL x, ProbeLog* probe_log) {
+static int chain_visit(ChainWalk* w, Isolation* iso, const REAL* a, REAL x, ProbeLog* probe_log) {
   ++iso->steps;
   const REAL f = x == (REAL)1 ? chain_value_at_one(a) : power_value(a, x);
   const int s = (f > 0) - (f < 0);
@@ -269,8 +269,8 @@ ALGRAY_INLINE void walk_chain_pieces(const REAL* a, REAL t_in, REAL t_out, Chain
  * multiplicity, as in the other methods: the ray starts on the surface. iso.steps counts polynomial
  * evaluations: piece ends at every level, inner solver iterations, the closed-form bottom as one. On return
  * `a1` is A1 on [lo, hi] when the status is a bracket. */
-Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out,
-                                   REAL* a1, ProbeLog* probe_log) {
+static Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1,
+                                          ProbeLog* probe_log) {
   Isolation iso = isolation_none();
   REAL a[NCOEF];
   power_on_interval(p, s0, len_s, a);
@@ -294,8 +294,8 @@ Isolation isolate_derivative_chain(const REAL* p, REAL s0, REAL len_s, REAL t_in
 }
 
 /* The method's entry (isolate.h): P*(s) in the power basis as power_s0 and power_len_s place it. */
-Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
-                         ProbeLog* probe_log) {
+static Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
+                                ProbeLog* probe_log) {
   (void)root_lo;
   (void)terms;
   return isolate_derivative_chain(root, power_s0(t_in), power_len_s(t_in, t_out), t_in, t_out, iso_c, probe_log);

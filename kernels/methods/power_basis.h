@@ -5,14 +5,14 @@
 #include "isolation.h"
 
 /* c(x) -> c(x + a), by repeated synthetic division. */
-void taylor_shift(REAL* c, REAL a) {
+static void taylor_shift(REAL* c, REAL a) {
   ALGRAY_UNROLL
   for (int i = 0; i < DEGREE; ++i) ALGRAY_UNROLL
   for (int k = DEGREE - 1; k >= i; --k) c[k] += a * c[k + 1];
 }
 
 /* A1(y) = p(alpha + beta*y): the polynomial on one subinterval, mapped to [0,1]. */
-void power_on_interval(const REAL* p, REAL alpha, REAL beta, REAL* a1) {
+static void power_on_interval(const REAL* p, REAL alpha, REAL beta, REAL* a1) {
   poly_copy(a1, p);
   if (alpha != 0) taylor_shift(a1, alpha);
   REAL s = 1;
@@ -23,7 +23,7 @@ void power_on_interval(const REAL* p, REAL alpha, REAL beta, REAL* a1) {
   }
 }
 
-REAL power_value(const REAL* c, REAL y) {
+static REAL power_value(const REAL* c, REAL y) {
   REAL h = c[DEGREE];
   ALGRAY_UNROLL
   for (int k = DEGREE - 1; k >= 0; --k) h = h * y + c[k];
@@ -31,7 +31,7 @@ REAL power_value(const REAL* c, REAL y) {
 }
 
 /* Value and slope at y of a polynomial in the power basis, by Horner's scheme with its derivative. */
-REAL power_value_slope(const REAL* c, REAL y, REAL* slope) {
+static REAL power_value_slope(const REAL* c, REAL y, REAL* slope) {
   REAL h = c[DEGREE], d = 0;
   ALGRAY_UNROLL
   for (int k = DEGREE - 1; k >= 0; --k) {
@@ -51,22 +51,22 @@ ALGRAY_INLINE REAL power_len_s(REAL t_in, REAL t_out) {
 
 /* isolate.h's interface for the refinement: on the isolating interval the polynomial is A1(y), y in [0, 1], in the
  * power basis, ready as it is; no start for the refinement, which begins as the paper has it. */
-REAL isolated_start(const REAL* c) {
+static REAL isolated_start(const REAL* c) {
   (void)c;
   return -1;
 }
 
-void prepare_isolated(REAL* c, __constant const REAL* binomials) {
+static void prepare_isolated(REAL* c, __constant const REAL* binomials) {
   (void)c;
   (void)binomials;
 }
 
-REAL isolated_value(const REAL* c, REAL y) { return power_value(c, y); }
+static REAL isolated_value(const REAL* c, REAL y) { return power_value(c, y); }
 
-REAL isolated_value_slope(const REAL* c, REAL y, REAL* slope) { return power_value_slope(c, y, slope); }
+static REAL isolated_value_slope(const REAL* c, REAL y, REAL* slope) { return power_value_slope(c, y, slope); }
 
 /* sum |c_k| y^k: Horner's rounding error at y is a small multiple of REAL_EPS times this. */
-REAL isolated_magnitude(const REAL* c, REAL y) {
+static REAL isolated_magnitude(const REAL* c, REAL y) {
   REAL h = fabs(c[DEGREE]);
   ALGRAY_UNROLL
   for (int k = DEGREE - 1; k >= 0; --k) h = h * y + fabs(c[k]);

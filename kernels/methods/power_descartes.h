@@ -6,7 +6,7 @@
 
 /* Sign variations of A2(x) = (x+1)^n A1(1/(x+1)), whose positive roots are those of A1 in (0, 1]...
  * except a root at 1, which maps to x = 0 and is not counted. */
-int descartes_unit_interval(const REAL* a1) {
+static int descartes_unit_interval(const REAL* a1) {
   REAL a2[NCOEF];
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) a2[k] = a1[DEGREE - k];
@@ -16,7 +16,8 @@ int descartes_unit_interval(const REAL* a1) {
 
 /* p is P*(s) in the power basis, the extent interval being s in [s0, s0 + len_s]. Subintervals are the dyadic
  * (level, idx) pieces of that interval, visited depth first, left first. On return `a1` is A1 on [lo, hi]. */
-Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1, ProbeLog* probe_log) {
+static Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1,
+                               ProbeLog* probe_log) {
   Isolation iso = isolation_none();
   int level = 0;
   ulong idx = 0;
@@ -57,8 +58,8 @@ Isolation isolate_power(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
 }
 
 /* The method's entry (isolate.h): P*(s) in the power basis as power_s0 and power_len_s place it. */
-Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
-                         ProbeLog* probe_log) {
+static Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
+                                ProbeLog* probe_log) {
   (void)root_lo;
   (void)terms;
   return isolate_power(root, power_s0(t_in), power_len_s(t_in, t_out), t_in, t_out, iso_c, probe_log);

@@ -20,7 +20,7 @@
 /* 2^-e for a positive x in [2^e, 2^(e+1)), from the exponent bits: ldexp and ilogb are library calls on
  * PoCL, which measured 11% of the whole Barth decic kernel. Clamped to a normal number at the ends of the
  * range, where any power of two will do. */
-REAL inverse_power_of_two(REAL x) {
+static REAL inverse_power_of_two(REAL x) {
 #if ALGRAY_DOUBLE
   const long e = (as_long(x) >> 52) & 0x7ff;
   return as_double(clamp(2046L - e, 1L, 2046L) << 52);
@@ -32,7 +32,7 @@ REAL inverse_power_of_two(REAL x) {
 
 /* Scales c[0..d] by the power of two that brings its largest |coefficient| into [1, 2): exact, so the signs of
  * the values, and for S0 the values themselves up to that factor, are the unscaled polynomial's. */
-void sturm_normalise(REAL* c, int d, REAL sign) {
+static void sturm_normalise(REAL* c, int d, REAL sign) {
   REAL largest = 0;
   for (int j = 0; j <= d; ++j) largest = fmax(largest, fabs(c[j]));
   const REAL scale = sign * inverse_power_of_two(largest);
@@ -42,7 +42,7 @@ void sturm_normalise(REAL* c, int d, REAL sign) {
 /* What a remainder coefficient that is zero in exact arithmetic may come out as, when the largest quotient
  * term was q_largest. Members are below 2 in every coefficient, so the terms subtracted are below
  * 2 max(1, |q|). */
-REAL sturm_remainder_noise(REAL q_largest) {
+static REAL sturm_remainder_noise(REAL q_largest) {
   return (REAL)(STURM_ZERO_ULPS * DEGREE) * REAL_EPS * (REAL)2 * fmax((REAL)1, q_largest);
 }
 
@@ -52,7 +52,7 @@ REAL sturm_remainder_noise(REAL q_largest) {
  * last member is their gcd, and the counts below are of distinct roots, a multiple root counting once. Degrees
  * are data, so neither this nor the generic path below is unrolled: O(DEGREE^2) of straight-line code at
  * degree 32 would buy nothing for loops that run once per ray. */
-void sturm_sequence(const REAL* a1, REAL* seq) {
+static void sturm_sequence(const REAL* a1, REAL* seq) {
   for (int j = 0; j < STURM_STORE; ++j) seq[j] = 0;
   int a = DEGREE; /* degree of S(k-1) */
   while (a > 0 && a1[a] == 0) --a;
@@ -96,7 +96,7 @@ void sturm_sequence(const REAL* a1, REAL* seq) {
  * every ray: each division is two quotient terms, and every loop's trip count depends on the member only, so
  * all work-items run them in step. Returns 0, leaving seq half written, at the first remainder that loses a
  * degree (or vanishes), for sturm_sequence to redo in general. */
-int sturm_sequence_generic(const REAL* a1, REAL* seq) {
+static int sturm_sequence_generic(const REAL* a1, REAL* seq) {
   if (a1[DEGREE] == 0) return 0;
   for (int j = 0; j <= DEGREE; ++j) seq[j] = a1[j];
   sturm_normalise(seq, DEGREE, (REAL)1);
@@ -124,7 +124,7 @@ int sturm_sequence_generic(const REAL* a1, REAL* seq) {
  * Every slot is evaluated over its full length with a fixed trip count: the zeros past a member's degree, and
  * the members past the end, cost a few multiplications, which a generic sequence (degrees DEGREE, DEGREE - 1,
  * ..., 0) does not even have. The bound is Horner's: at most 2n roundings of eps/2 of sum |c_k| x^k, doubled. */
-int sturm_variations(const REAL* seq, REAL x, REAL* f0, REAL* noise) {
+static int sturm_variations(const REAL* seq, REAL x, REAL* f0, REAL* noise) {
   int v = 0;
   int prev = 0; /* sign of the last nonzero member, 0 before the first */
   ALGRAY_UNROLL
@@ -155,7 +155,7 @@ int sturm_variations(const REAL* seq, REAL x, REAL* f0, REAL* noise) {
  * entry). The sequence saw a sign change between the ends; recomputed on the subinterval, an end value within
  * rounding of zero may come out with the other sign, and the refinement needs two opposite signs: then the
  * root is at that end, as far as this precision can tell, and is reported there. */
-void sturm_bracket(Isolation* iso, REAL* a1) {
+static void sturm_bracket(Isolation* iso, REAL* a1) {
   power_on_interval(a1, iso->lo, iso->hi - iso->lo, a1);
   const REAL f0 = a1[0], f1 = power_value(a1, (REAL)1);
   iso->f_lo = f0;
@@ -175,7 +175,8 @@ void sturm_bracket(Isolation* iso, REAL* a1) {
  * on A1 over the whole interval; then the dyadic (level, idx) pieces of [0, 1] are visited depth first, left
  * first, each needing the sequence at its right end only: its left end is its parent's, or the right end of
  * the interval examined before it. On return `a1` is A1 on [lo, hi]. */
-Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1, ProbeLog* probe_log) {
+static Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_out, REAL* a1,
+                               ProbeLog* probe_log) {
   Isolation iso = isolation_none();
   const REAL len = t_out - t_in;
   power_on_interval(p, s0, len_s, a1);
@@ -249,8 +250,8 @@ Isolation isolate_sturm(const REAL* p, REAL s0, REAL len_s, REAL t_in, REAL t_ou
 }
 
 /* The method's entry (isolate.h): P*(s) in the power basis as power_s0 and power_len_s place it. */
-Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
-                         ProbeLog* probe_log) {
+static Isolation isolate_method(REAL* root, REAL* root_lo, REAL t_in, REAL t_out, REAL* iso_c, RayTerms* terms,
+                                ProbeLog* probe_log) {
   (void)root_lo;
   (void)terms;
   return isolate_sturm(root, power_s0(t_in), power_len_s(t_in, t_out), t_in, t_out, iso_c, probe_log);
