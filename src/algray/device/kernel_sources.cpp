@@ -7,19 +7,22 @@
 #include <regex>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
 #include <vector>
 
 namespace algray {
 namespace {
 
-std::string read_kernel_file(const std::string& name) {
+// A kernel file's text: the embedded file itself (no copy), or, with ALGRAY_KERNEL_DIR, the file read into storage.
+std::string_view kernel_file_text(const std::string& name, std::string& storage) {
   if (const char* dir = std::getenv("ALGRAY_KERNEL_DIR"); dir && *dir) {
     std::ifstream in(std::string(dir) + "/" + name, std::ios::binary);
     if (!in)
       throw std::runtime_error("ALGRAY_KERNEL_DIR is set but " + std::string(dir) + "/" + name + " cannot be read");
     std::ostringstream text;
     text << in.rdbuf();
-    return text.str();
+    storage = text.str();
+    return storage;
   }
   for (const EmbeddedFile& f : embedded_kernel_files())
     if (name == f.name) return f.text;
@@ -27,22 +30,27 @@ std::string read_kernel_file(const std::string& name) {
 }
 
 // Every #include is expanded where it stands, even when the file came in before: an earlier copy may sit in a
-// branch of #if that the preprocessor drops, so only the headers' own include guards may skip it.
+// branch of #if that the preprocessor drops, so only the headers' own include guards may skip it. The assembled
+// text is thus megabytes (primary.cl's 2.2 MB), assembled once per process and entry file: lines are scanned in
+// place rather than copied through a stream.
 void append_with_includes(const std::string& name, std::vector<std::string>& stack, std::string& out) {
   if (std::find(stack.begin(), stack.end(), name) != stack.end())
     throw std::runtime_error("kernel file '" + name + "' includes itself");
   stack.push_back(name);
-  std::istringstream lines(read_kernel_file(name));
-  std::string line;
+  std::string storage;
+  const std::string_view text = kernel_file_text(name, storage);
   int number = 0;
   out += "#line 1 \"" + name + "\"\n";
-  while (std::getline(lines, line)) {
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::string_view line = text.substr(at, end - at);
+    at = end + 1;
     ++number;
     const auto first = line.find_first_not_of(" \t");
-    if (first != std::string::npos && line.compare(first, 9, "#include ") == 0) {
+    if (first != std::string_view::npos && line.compare(first, 9, "#include ") == 0) {
       const auto open = line.find('"', first), close = line.rfind('"');
-      if (open != std::string::npos && close > open) {
-        append_with_includes(line.substr(open + 1, close - open - 1), stack, out);
+      if (open != std::string_view::npos && close > open) {
+        append_with_includes(std::string(line.substr(open + 1, close - open - 1)), stack, out);
         out += "#line " + std::to_string(number + 1) + " \"" + name + "\"\n";
         continue;
       }
