@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
-#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -85,12 +84,6 @@ Answer exact_root(const ZPoly& p, const mpq_class& t, const mpq_class& t_in, con
   return a;
 }
 
-Answer miss() {
-  Answer a;
-  a.t_nearest = std::numeric_limits<double>::infinity();
-  return a;
-}
-
 // The square-free part, which has the same distinct roots, and the factorisation that gives multiplicities.
 struct SquareFree {
   ZPoly part;
@@ -145,30 +138,13 @@ struct Segment {
   }
 };
 
-// The leftmost root of r in the open unit interval, in the interval's own coordinate s. `local` is r moved
-// to the isolating interval (num / 2^depth, (num + 1) / 2^depth), where it has exactly one root, simple.
+// A root of r in the open unit interval, isolated: `local` is r moved to the interval (num / 2^depth,
+// (num + 1) / 2^depth), where it has exactly one root, simple.
 struct Isolated {
-  bool exact = false;  // the root is s = num / 2^depth itself
   mpz_class num;
   unsigned long depth = 0;
   ZPoly local;
 };
-
-// r square-free, r(0) != 0. Depth first, left half first, so the first interval with one sign variation
-// holds the smallest root; a root exactly at a midpoint shows as a zero constant term and is caught between
-// the two halves.
-std::optional<Isolated> leftmost(const ZPoly& r, const mpz_class& num, unsigned long depth) {
-  const int v = detail::descartes_bound_unit(r, 2);
-  if (v == 0) return std::nullopt;
-  if (v == 1) return Isolated{false, num, depth, r};
-  ZPoly left = detail::left_half(r);
-  detail::remove_power_of_two(left);
-  if (auto found = leftmost(left, 2 * num, depth + 1)) return found;
-  ZPoly right = detail::taylor_shift_one(left);
-  if (sgn(right[0]) == 0) return Isolated{true, 2 * num + 1, depth + 1, {}};
-  detail::remove_power_of_two(right);
-  return leftmost(right, 2 * num + 1, depth + 1);
-}
 
 // Whether square-free r has a root in the open unit interval. An odd Descartes bound already proves one.
 bool any_root(const ZPoly& r) {
@@ -293,26 +269,10 @@ Answer refine(const ZPoly& p, const SquareFree& sf, const Segment& seg, const Is
   return a;
 }
 
-Answer solve(const ZPoly& p, const mpq_class& t_in, const mpq_class& t_out, const mpq_class& width) {
-  check_arguments(t_in, t_out, width);
-  if (p.empty()) return identically_zero(t_in, t_out);
-  if (detail::degree(p) == 0) return miss();
-  if (detail::sign_at(p, t_in) == 0) return exact_root(p, t_in, t_in, t_out);
-  if (t_in == t_out) return miss();
-
-  const SquareFree sf = square_free(p);
-  const Segment seg(t_in, t_out);
-  ZPoly r = detail::to_unit_interval(sf.part, seg.A, seg.H, seg.M);
-  detail::make_primitive(r);
-  const std::optional<Isolated> found = leftmost(r, 0, 0);
-  if (!found) return detail::sign_at(sf.part, t_out) == 0 ? exact_root(p, t_out, t_in, t_out) : miss();
-  if (found->exact) return exact_root(p, seg.t_of(found->num, found->depth), t_in, t_out);
-  return refine(p, sf, seg, *found, t_in, t_out, width);
-}
-
-// Every root of p in the open unit interval of `seg`, in increasing order, to `visit`: leftmost's descent, left
-// half first, carried on past each root instead of stopping at the first, so that the polynomial is made square-free
-// and moved to the unit interval once for all its roots.
+// Every root of p in the open unit interval of `seg`, in increasing order, to `visit`: a descent by halves, left
+// half first, so that the first interval with one sign variation holds the smallest root; it carries on past each
+// root until visit says stop, so the polynomial is made square-free and moved to the unit interval once for all of
+// them. A root exactly at a midpoint shows as a zero constant term between the two halves.
 struct RootWalk {
   const ZPoly& p;
   const SquareFree& sf;
@@ -325,7 +285,7 @@ struct RootWalk {
   bool descend(const ZPoly& r, const mpz_class& num, unsigned long depth) const {
     const int v = detail::descartes_bound_unit(r, 2);
     if (v == 0) return true;
-    if (v == 1) return visit(refine(p, sf, seg, Isolated{false, num, depth, r}, t_in, t_out, width));
+    if (v == 1) return visit(refine(p, sf, seg, Isolated{num, depth, r}, t_in, t_out, width));
     ZPoly left = detail::left_half(r);
     detail::remove_power_of_two(left);
     if (!descend(left, 2 * num, depth + 1)) return false;
@@ -339,12 +299,10 @@ struct RootWalk {
   }
 };
 
-}  // namespace
-
-bool for_each_root(const std::vector<mpq_class>& poly, const mpq_class& t_in, const mpq_class& t_out,
-                   const mpq_class& width, const std::function<bool(const Answer&)>& visit) {
+// for_each_root on p's integer coefficients; smallest_root is its first visit.
+bool walk_roots(const ZPoly& p, const mpq_class& t_in, const mpq_class& t_out, const mpq_class& width,
+                const std::function<bool(const Answer&)>& visit) {
   check_arguments(t_in, t_out, width);
-  const ZPoly p = detail::primitive_from_rational(poly);
   if (p.empty()) return visit(identically_zero(t_in, t_out));
   if (detail::degree(p) == 0) return true;
   if (detail::sign_at(p, t_in) == 0 && !visit(exact_root(p, t_in, t_in, t_out))) return false;
@@ -356,6 +314,22 @@ bool for_each_root(const std::vector<mpq_class>& poly, const mpq_class& t_in, co
   if (sgn(r[0]) == 0) r.erase(r.begin());  // the root at t_in, visited above
   if (!RootWalk{p, sf, seg, t_in, t_out, width, visit}.descend(r, 0, 0)) return false;
   return detail::sign_at(sf.part, t_out) != 0 || visit(exact_root(p, t_out, t_in, t_out));
+}
+
+Answer solve(const ZPoly& p, const mpq_class& t_in, const mpq_class& t_out, const mpq_class& width) {
+  Answer smallest;  // a Miss unless a root is visited
+  walk_roots(p, t_in, t_out, width, [&](const Answer& a) {
+    smallest = a;
+    return false;
+  });
+  return smallest;
+}
+
+}  // namespace
+
+bool for_each_root(const std::vector<mpq_class>& poly, const mpq_class& t_in, const mpq_class& t_out,
+                   const mpq_class& width, const std::function<bool(const Answer&)>& visit) {
+  return walk_roots(detail::primitive_from_rational(poly), t_in, t_out, width, visit);
 }
 
 Answer smallest_root(const std::vector<mpq_class>& poly, const mpq_class& t_in, const mpq_class& t_out,

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "algray/math/polynomial.h"
@@ -33,7 +34,7 @@ struct Answer {
   mpq_class lo, hi;
   // The double nearest to (lo + hi) / 2; it lies in [lo, hi] whenever any double does (a requested width
   // below the spacing of doubles leaves none). +infinity for a Miss.
-  double t_nearest = 0;
+  double t_nearest = std::numeric_limits<double>::infinity();
   int multiplicity = 0;                              // of the smallest root; 0 for Miss and IdenticallyZero
   bool root_at_t_in = false, root_at_t_out = false;  // the root is exactly that end point
 };

@@ -44,7 +44,11 @@ void PrecisionRace::record(const std::string& key, Precision precision, double k
     if (precision != *e.chosen) return;
     const double other = fastest(*e.chosen == Precision::Double ? e.adaptive_ms : e.double_ms);
     e.slow_in_a_row = kernel_ms > kReopen * other ? e.slow_in_a_row + 1 : 0;
-    if (e.slow_in_a_row >= kRounds) e = Entry{{}, {}, std::nullopt, 0, e.last_used};  // race again
+    if (e.slow_in_a_row >= kRounds) {  // race again
+      const std::size_t used = e.last_used;
+      e = Entry{};
+      e.last_used = used;
+    }
     return;
   }
   (precision == Precision::Double ? e.double_ms : e.adaptive_ms).push_back(kernel_ms);

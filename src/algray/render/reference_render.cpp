@@ -213,7 +213,6 @@ RayCertificate certify_ray(const Polynomial& polynomial, const std::vector<Monom
     found = true;
     return root.kind == ref::Classification::SimpleRoot;
   });
-  if (!found) c.answer.t_nearest = std::numeric_limits<double>::infinity();  // a Miss, as smallest_root answers it
   c.cls = classify(c.answer.kind);
   if (c.answer.kind == ref::Classification::Miss) {
     if (flips_under_ray_rounding(c.restricted, monomials, ray, c.lo, c.hi, eps)) c.cls = PixelClass::RayRounding;
