@@ -262,13 +262,12 @@ static void point_terms_exact(PointTerms* t, __global const uint* exps, __global
   t->exact = 1;
 }
 
-/* segment_roots_settled for adaptive builds, with the noise of coefficients of largest Bernstein magnitude
- * `scale` summed from terms of size `terms`: each shortcut answers a lane only where the values it reads stand
+/* The signs of segment_roots_settled for adaptive builds, with the noise of coefficients of largest Bernstein
+ * magnitude `scale` summed from terms of size `terms`: each answers a lane only where the values it reads stand
  * beyond the noise, as the search would (its first interval's coefficients all clear of its noise and of one sign;
  * P at the far end beyond the noise for any scale, noise_bound; P at the start counts with the sign it has).
- * The others are left to the search (*open), which doubts what it cannot settle. */
-static LMASK segment_roots_settled_clear(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced,
-                                         LMASK* open, __constant const REAL* binomials, LREAL scale, LREAL terms) {
+ * Returns the lanes with a root; *open gets the traced lanes these signs leave open. */
+static LMASK segment_roots_settled_by_signs(const LREAL* c, LMASK traced, LMASK* open, LREAL scale, LREAL terms) {
   const LREAL noise = DOUBT_NOISE(scale, terms) * (REAL)(1 + 8 * REAL_EPS);
   const LREAL end_noise = DOUBT_NOISE(terms, terms);
   LMASK none = one_strict_sign(c);
@@ -278,8 +277,19 @@ static LMASK segment_roots_settled_clear(const LREAL* c, const LREAL* power, LRE
   const LMASK root =
       traced && start != 0 && ((start < 0 && end > 0) || (start > 0 && end < 0)) && fabs(end) > end_noise;
   *open = traced && !none && !root;
+  return root;
+}
+
+/* segment_roots_settled_by_signs, then, for the lanes they leave open, a sign change at seven points and the
+ * pieces' signs, each value beyond the same noise. The others are left to the search (*open), which doubts what
+ * it cannot settle. */
+static LMASK segment_roots_settled_clear(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced,
+                                         LMASK* open, __constant const REAL* binomials, LREAL scale, LREAL terms) {
+  const LREAL noise = DOUBT_NOISE(scale, terms) * (REAL)(1 + 8 * REAL_EPS);
+  const LREAL end_noise = DOUBT_NOISE(terms, terms);
+  const LMASK root = segment_roots_settled_by_signs(c, traced, open, scale, terms);
   if (!LANE_ANY(*open)) return root;
-  const LMASK crossed = sign_change_sampled(power, t_in, t_out, start, *open, end_noise);
+  const LMASK crossed = sign_change_sampled(power, t_in, t_out, c[0], *open, end_noise);
   *open = *open && !crossed;
   if (LANE_ANY(*open)) *open = *open && !no_root_in_pieces(c, binomials, noise);
   return root || crossed;
@@ -288,18 +298,22 @@ static LMASK segment_roots_settled_clear(const LREAL* c, const LREAL* power, LRE
 /* Which of the traced lanes' segments a cheap test shows to hold a root, from the scaled Bernstein coefficients c
  * on [t_in, t_out] (power basis power, the same polynomial); *open gets the lanes only the search can settle. The
  * signs of c settle most (bernstein_root_by_signs' answers), and a sign change at seven points of the segment
- * most of the rest. Adaptive builds ask the same of values beyond their noise (segment_roots_settled_clear), first
- * on the terms' upper bound, then, where a lane is left open, on the terms summed (*terms made exact). */
+ * most of the rest. Adaptive builds ask the same of values beyond their noise: the signs on the terms' upper bound
+ * first, and where they leave a lane open, every test on the terms summed (*terms made exact, kept no larger than
+ * the bound: both bound the terms). The sampled tests ran on the bound first until 2026-12-07 and again on the sum
+ * for what the bound left open; once on the sum settles every lane they did (each value is beyond a noise no larger)
+ * and took the Barth decic's float shadow pass (first pass) from 1,758 to 1,464 ms (bench/history/2026-12.md,
+ * "Shadow shortcuts on the summed terms"). */
 static LMASK segment_roots_settled(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced,
                                    LMASK* open, __constant const REAL* binomials, PointTerms* terms,
                                    __global const uint* exps, __global const REAL* coefs, uint count) {
   if (ALGRAY_ESCALATE) {
     const LREAL scale = search_scale_bound(c);
-    const LMASK root =
-        segment_roots_settled_clear(c, power, t_in, t_out, traced, open, binomials, scale, terms->value);
+    const LMASK root = segment_roots_settled_by_signs(c, traced, open, scale, terms->value);
     if (!LANE_ANY(*open)) return root;
-    /* what the bound settled, the sum settles alike: each of its values is beyond a smaller noise */
+    const LREAL bound = terms->value;
     point_terms_exact(terms, exps, coefs, count);
+    terms->value = fmin(terms->value, bound);
     return segment_roots_settled_clear(c, power, t_in, t_out, traced, open, binomials, scale, terms->value);
   }
   const LREAL start = c[0], end = c[DEGREE];
