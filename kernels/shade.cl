@@ -243,19 +243,30 @@ ALGRAY_INLINE void load_records(__global const HitRecord* hits, uint tile_w, uin
 }
 
 /* The lanes' first `count` pixels into the film from index `at`: the samples' sums times `weight`, and where the
- * film has them the nearest sample's depth and normal. */
+ * film has them the nearest sample's depth and normal. Each vector goes to private storage in one store and the
+ * pixels read it from there: read lane by lane (lane_get), the vectors were stored again for every pixel, a fifth
+ * of the shading kernel's time in a preview (bench/history/2026-12.md, "Shading stores"). */
 ALGRAY_INLINE void store_pixels(size_t at, uint count, REAL weight, LREAL r, LREAL g, LREAL b, LREAL a, LREAL depth,
                                 LREAL nx, LREAL ny, LREAL nz, __global float4* film_rgba, __global float* film_depth,
                                 __global float* film_normal, uint film_depth_and_normal) {
+  REAL red[LANES], green[LANES], blue[LANES], alpha[LANES];
+  LANES_STORE(r * weight, red);
+  LANES_STORE(g * weight, green);
+  LANES_STORE(b * weight, blue);
+  LANES_STORE(a * weight, alpha);
+  for (uint j = 0; j < count; ++j)
+    film_rgba[at + j] = (float4)((float)red[j], (float)green[j], (float)blue[j], (float)alpha[j]);
+  if (!film_depth_and_normal) return;
+  REAL d[LANES], x[LANES], y[LANES], z[LANES];
+  LANES_STORE(depth, d);
+  LANES_STORE(nx, x);
+  LANES_STORE(ny, y);
+  LANES_STORE(nz, z);
   for (uint j = 0; j < count; ++j) {
-    film_rgba[at + j] = (float4)((float)(lane_get(r, j) * weight), (float)(lane_get(g, j) * weight),
-                                 (float)(lane_get(b, j) * weight), (float)(lane_get(a, j) * weight));
-    if (film_depth_and_normal) {
-      film_depth[at + j] = (float)lane_get(depth, j);
-      film_normal[3 * (at + j)] = (float)lane_get(nx, j);
-      film_normal[3 * (at + j) + 1] = (float)lane_get(ny, j);
-      film_normal[3 * (at + j) + 2] = (float)lane_get(nz, j);
-    }
+    film_depth[at + j] = (float)d[j];
+    film_normal[3 * (at + j)] = (float)x[j];
+    film_normal[3 * (at + j) + 1] = (float)y[j];
+    film_normal[3 * (at + j) + 2] = (float)z[j];
   }
 }
 
