@@ -326,10 +326,24 @@ TEST_CASE("kernel sources resolve their includes from the embedded files", "[con
   CHECK(source.find("typedef struct {") != std::string::npos);  // algray_shared.h's HitRecord came in
   CHECK(source.find("#include \"") == std::string::npos);       // every include was resolved
   CHECK_THROWS(assemble_kernel_source("no_such_kernel.cl"));
-  // A header included in one #if branch must come again in the next: the preprocessor drops the first copy.
-  const auto power_branch = source.find("#elif ISOLATION == ALGRAY_ISOLATION_POWER");
-  REQUIRE(power_branch != std::string::npos);
-  CHECK(source.find("int sign_variations(", power_branch) != std::string::npos);
+  // A header included in one #if branch must come again in the next: the preprocessor drops the first copy
+  // (methods/power_basis.h, under both the Descartes and the Sturm method).
+  const auto sturm_branch = source.find("#elif ISOLATION == ALGRAY_ISOLATION_STURM");
+  REQUIRE(sturm_branch != std::string::npos);
+  const auto power_basis_at = source.find("static void taylor_shift(");
+  REQUIRE(power_basis_at != std::string::npos);
+  CHECK(power_basis_at < sturm_branch);
+  CHECK(source.find("static void taylor_shift(", sturm_branch) != std::string::npos);
+  // A header once outside every #if is not written again: its guard is set (each include of it was written out
+  // where it stood, megabytes, until 2026-12-07).
+  const auto copies = [&source](const std::string& text) {
+    std::size_t n = 0;
+    for (auto at = source.find(text); at != std::string::npos; at = source.find(text, at + 1)) ++n;
+    return n;
+  };
+  CHECK(copies("#define ALGRAY_REAL_H") == 1);
+  CHECK(copies("#define ALGRAY_SHARED_H") == 1);
+  CHECK(source.size() < 400000);
 }
 
 // The -D switches: declared once, in kernels/build_switches.h, and the host writes exactly those of its host part.

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
@@ -29,45 +30,101 @@ std::string_view kernel_file_text(const std::string& name, std::string& storage)
   throw std::runtime_error("kernel file '" + name + "' is not embedded in this build");
 }
 
-// Every #include is expanded where it stands, even when the file came in before: an earlier copy may sit in a
-// branch of #if that the preprocessor drops, so only the headers' own include guards may skip it. The assembled
-// text is thus megabytes (primary.cl's 2.2 MB), assembled once per process and entry file: lines are scanned in
-// place rather than copied through a stream.
-void append_with_includes(const std::string& name, std::vector<std::string>& stack, std::string& out) {
-  if (std::find(stack.begin(), stack.end(), name) != stack.end())
+// Where the assembly stands in the program text it writes: which files it has written and which of them the
+// preprocessor is sure to have read, whatever the build's switches.
+struct Assembly {
+  std::vector<std::string> stack;          // the files being written, outermost first (an include cycle is an error)
+  std::set<std::string> written;           // files written at least once
+  std::set<std::string> surely_read;       // files written outside every #if: their include guards are set after
+  std::vector<bool> condition_counts;      // the open #if directives: whether each may drop what it holds
+  int conditions = 0;                      // how many of them may
+  std::string out;
+};
+
+std::string_view directive_of(std::string_view line) {
+  const auto hash = line.find_first_not_of(" \t");
+  if (hash == std::string_view::npos || line[hash] != '#') return {};
+  const auto word = line.find_first_not_of(" \t", hash + 1);
+  if (word == std::string_view::npos) return {};
+  const auto end = line.find_first_of(" \t(", word);
+  return line.substr(word, (end == std::string_view::npos ? line.size() : end) - word);
+}
+
+// The name after `#ifndef` or `#define` on a line, or empty.
+std::string_view directive_name(std::string_view line) {
+  const auto word = line.find_first_not_of(" \t", line.find_first_of(" \t", line.find('#')));
+  if (word == std::string_view::npos) return {};
+  const auto end = line.find_first_of(" \t(", word);
+  return line.substr(word, (end == std::string_view::npos ? line.size() : end) - word);
+}
+
+// Writes `name` with its #include "..." lines resolved. A file is written again where it is included again,
+// unless an earlier copy stands outside every #if: an earlier copy in a branch the preprocessor drops (isolate.h
+// includes one isolation method per branch) must not hide the file from a later include. A file's own include
+// guard, the first time it is written, drops nothing and does not count as an #if; a later copy's guard does (the
+// preprocessor may have read the file already). So each header is written about once instead of at every include
+// (primary.cl's program was 2.2 MB, shadow.cl's 3.4 MB: assembled by every process, and lexed by every compile).
+void append_with_includes(const std::string& name, Assembly& a) {
+  if (std::find(a.stack.begin(), a.stack.end(), name) != a.stack.end())
     throw std::runtime_error("kernel file '" + name + "' includes itself");
-  stack.push_back(name);
+  a.stack.push_back(name);
+  const bool first_copy = a.written.insert(name).second;
   std::string storage;
   const std::string_view text = kernel_file_text(name, storage);
-  int number = 0;
-  out += "#line 1 \"" + name + "\"\n";
+  int number = 0, directives = 0;
+  std::string_view guard;  // the first copy's include guard, while it is still to be seen
+  a.out += "#line 1 \"" + name + "\"\n";
   for (std::size_t at = 0; at < text.size();) {
     const std::size_t end = std::min(text.find('\n', at), text.size());
     const std::string_view line = text.substr(at, end - at);
     at = end + 1;
     ++number;
-    const auto first = line.find_first_not_of(" \t");
-    if (first != std::string_view::npos && line.compare(first, 9, "#include ") == 0) {
-      const auto open = line.find('"', first), close = line.rfind('"');
+    const std::string_view directive = directive_of(line);
+    if (directive.empty()) {
+      a.out += line;
+      a.out += '\n';
+      continue;
+    }
+    ++directives;
+    if (directives == 2 && !guard.empty() && !(directive == "define" && directive_name(line) == guard)) {
+      a.condition_counts.back() = true;  // not an include guard after all: the #ifndef may drop what it holds
+      ++a.conditions;
+    }
+    if (directive == "if" || directive == "ifdef" || directive == "ifndef") {
+      // `#ifndef X` then `#define X` as a first copy's first directives: its include guard
+      const bool is_guard = first_copy && directives == 1 && directive == "ifndef";
+      if (is_guard) guard = directive_name(line);
+      a.condition_counts.push_back(!is_guard);
+      a.conditions += is_guard ? 0 : 1;
+    } else if (directive == "endif" && !a.condition_counts.empty()) {
+      a.conditions -= a.condition_counts.back() ? 1 : 0;
+      a.condition_counts.pop_back();
+    } else if (directive == "include") {
+      const auto open = line.find('"'), close = line.rfind('"');
       if (open != std::string_view::npos && close > open) {
-        append_with_includes(std::string(line.substr(open + 1, close - open - 1)), stack, out);
-        out += "#line " + std::to_string(number + 1) + " \"" + name + "\"\n";
+        const std::string included(line.substr(open + 1, close - open - 1));
+        if (a.surely_read.count(included)) {
+          a.out += '\n';  // its guard is set: the line stays, empty, so that the lines after keep their numbers
+          continue;
+        }
+        if (a.conditions == 0) a.surely_read.insert(included);
+        append_with_includes(included, a);
+        a.out += "#line " + std::to_string(number + 1) + " \"" + name + "\"\n";
         continue;
       }
     }
-    out += line;
-    out += '\n';
+    a.out += line;
+    a.out += '\n';
   }
-  stack.pop_back();
+  a.stack.pop_back();
 }
 
 }  // namespace
 
 std::string assemble_kernel_source(const std::string& main_file) {
-  std::vector<std::string> stack;
-  std::string out;
-  append_with_includes(main_file, stack, out);
-  return out;
+  Assembly a;
+  append_with_includes(main_file, a);
+  return std::move(a.out);
 }
 
 namespace {

@@ -7,7 +7,8 @@
 
 namespace algray {
 
-// The text of `main_file` with its #include "..." lines replaced by the embedded files, each included once.
+// The text of `main_file` with its #include "..." lines replaced by the embedded files: a file again where it is
+// included again, unless a copy before stands outside every #if (then its include guard is set).
 // With the environment variable ALGRAY_KERNEL_DIR set, files are read from that directory instead, so kernels
 // can be edited without rebuilding the host.
 std::string assemble_kernel_source(const std::string& main_file);
