@@ -261,6 +261,44 @@ TEST_CASE("the float shadow kernel takes as many lanes as a vector register hold
         default_lanes("CPU"));
 }
 
+TEST_CASE("the point form's doubted shadow rays go through float's extent form before float-float", "[config]") {
+  // Full mode with a shadow-casting light: adaptive's shadow pass is the float point form (degree 2).
+  Scene scene = load_scene_text(std::string(kSphereScene) + "[[light]]\nposition = [3, 3, 3]\n", "t.toml",
+                                {{"render.preview", "false"}});
+  DeviceInfo cpu;
+  cpu.type = "CPU";
+  const auto shadow_pass = [&](Precision escalation) {
+    const RenderPlan plan = make_render_plan(scene, Precision::Adaptive, std::vector<PlanDevice>{{cpu, escalation}});
+    return *plan.find(PassKind::Shadow);
+  };
+  // A float-float second pass: a float tier in the extent construction first, which settles what it can (its
+  // doubts go on); the point form settles none itself.
+  const PlannedPass mixed = shadow_pass(Precision::Mixed);
+  REQUIRE(mixed.kernels.at(0).ray_origin == RayOrigin::Point);
+  CHECK_FALSE(mixed.kernels.at(0).settle_doubts);
+  REQUIRE(mixed.float_escalation.size() == 1);
+  REQUIRE(mixed.float_escalation[0].has_value());
+  CHECK(mixed.float_escalation[0]->ray_origin == RayOrigin::Extent);
+  CHECK(mixed.float_escalation[0]->precision == Precision::Adaptive);
+  CHECK(mixed.float_escalation[0]->settle_doubts);
+  CHECK(mixed.escalation.at(0).precision == Precision::Mixed);
+  CHECK(make_render_plan(scene, Precision::Adaptive, std::vector<PlanDevice>{{cpu, Precision::Mixed}})
+            .json()["passes"][1]["float_escalation"][0] == mixed.float_escalation[0]->key());
+  // A double second pass costs about what float's extent form does: no tier between.
+  const PlannedPass in_double = shadow_pass(Precision::Double);
+  CHECK(in_double.float_escalation.empty());
+  CHECK(in_double.escalation.at(0).precision == Precision::Double);
+  // Plain float's doubted rays go to float's extent form already.
+  const RenderPlan plain = make_render_plan(scene, Precision::Float, std::vector<PlanDevice>{{cpu}});
+  CHECK(plain.find(PassKind::Shadow)->float_escalation.empty());
+  // Where the first pass is the extent form already (a scene that asks for it), there is nothing to add.
+  scene.render.ray_origin = RayOrigin::Extent;
+  const RenderPlan extent = make_render_plan(scene, Precision::Adaptive, std::vector<PlanDevice>{{cpu}});
+  const PlannedPass& extent_shadow = *extent.find(PassKind::Shadow);
+  CHECK(std::none_of(extent_shadow.float_escalation.begin(), extent_shadow.float_escalation.end(),
+                     [](const std::optional<KernelConfig>& c) { return c.has_value(); }));
+}
+
 TEST_CASE("the surface in unit coordinates vanishes where the world surface does", "[config]") {
   const Scene scene = load_scene_text(kSphereScene, "t.toml");
   const SurfaceData data = prepare_surface(scene);

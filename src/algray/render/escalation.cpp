@@ -49,8 +49,10 @@ ShadowEscalation::ShadowEscalation(ClSession& session, ProgramCache& cache, cons
 
 EscalationCount ShadowEscalation::redo(const std::vector<glm::dvec3>& points, const std::vector<glm::vec3>& normals,
                                        const std::vector<glm::dvec3>& light_points,
-                                       const std::vector<std::uint64_t>& undecided, std::vector<std::uint64_t>& masks) {
+                                       const std::vector<std::uint64_t>& undecided, std::vector<std::uint64_t>& masks,
+                                       std::vector<std::uint64_t>* still_undecided) {
   EscalationCount done;
+  if (still_undecided) still_undecided->assign(undecided.size(), 0);
   std::vector<std::size_t> doubted;
   std::vector<glm::dvec3> again_points;
   std::vector<glm::vec3> again_normals;
@@ -70,6 +72,7 @@ EscalationCount ShadowEscalation::redo(const std::vector<glm::dvec3>& points, co
     const std::uint64_t bits = undecided[doubted[k]];
     std::uint64_t& m = masks[doubted[k]];
     m = (m & ~bits) | (answer.masks[k] & bits);
+    if (still_undecided && !answer.undecided.empty()) (*still_undecided)[doubted[k]] = answer.undecided[k] & bits;
   }
   return done;
 }

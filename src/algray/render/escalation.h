@@ -55,17 +55,20 @@ class RayEscalation {
   RayTracer tracer_;
 };
 
-// One surface's shadow kernel in mixed precision or double, for the shadow rays a float kernel doubted.
+// One surface's shadow kernel in mixed precision or double, for the shadow rays a float kernel doubted; or in float
+// (the extent construction's, for the point form's doubted rays before float-float: PlannedPass::float_escalation).
 class ShadowEscalation {
  public:
   ShadowEscalation(ClSession& session, ProgramCache& cache, const KernelConfig& config, const Scene& scene,
                    std::size_t surface, double offset);
   const ProgramRecord& program() const { return tracer_.program(); }
   // For each surface point i (points[i], normals[i]) whose undecided[i] has bits set, the shadow rays to those
-  // light points are traced again and masks[i]'s bits there replaced by the answers.
+  // light points are traced again and masks[i]'s bits there replaced by the answers. Where the kernel doubts
+  // some of them in turn (a float kernel: PlannedPass::float_escalation), still_undecided, if given, gets them
+  // (one mask per point, as undecided).
   EscalationCount redo(const std::vector<glm::dvec3>& points, const std::vector<glm::vec3>& normals,
                        const std::vector<glm::dvec3>& light_points, const std::vector<std::uint64_t>& undecided,
-                       std::vector<std::uint64_t>& masks);
+                       std::vector<std::uint64_t>& masks, std::vector<std::uint64_t>* still_undecided = nullptr);
 
  private:
   DeviceSurface surface_;

@@ -64,6 +64,31 @@ void escalate_in(RenderPlan& plan, Precision precision) {
     }
 }
 
+namespace {
+
+// Adaptive precision with a float-float second pass: the point form's doubted shadow rays through float's extent
+// construction first (PlannedPass::float_escalation). Its first pass then settles no doubts itself: the float
+// extent pass settles more of them for less (Barth decic, 1024x768, no fp64: bench/history/2026-12.md, "Doubted
+// shadow rays in float first").
+void escalate_point_form_in_float(RenderPlan& plan) {
+  for (PlannedPass& pass : plan.passes) {
+    if (pass.kind != PassKind::Shadow || pass.escalation.empty()) continue;
+    pass.float_escalation.assign(pass.kernels.size(), std::nullopt);
+    for (std::size_t i = 0; i < pass.kernels.size(); ++i) {
+      KernelConfig& first = pass.kernels[i];
+      if (first.ray_origin != RayOrigin::Point || pass.escalation[i].precision != Precision::Mixed) continue;
+      KernelConfig in_float = first;
+      in_float.ray_origin = RayOrigin::Extent;
+      if (!lanes_apply(in_float)) in_float.lanes = 1;
+      in_float.settle_doubts = true;  // what it leaves goes to float-float
+      pass.float_escalation[i] = in_float;
+      first.settle_doubts = false;
+    }
+  }
+}
+
+}  // namespace
+
 double shadow_offset_unit(Precision precision) { return precision == Precision::Double ? 1e-6 : 1e-3; }
 
 std::string to_string(PassKind kind) {
@@ -136,6 +161,7 @@ void plan_shadows(RenderPlan& plan, const Scene& scene, const std::vector<Kernel
                          std::to_string(plan.shadow_lights.size()) + " shadow-casting light(s), " +
                              std::to_string(points) + " sample point(s) per lit surface point",
                          shadow,
+                         {},
                          {}});
   // A batch of surface points at a time, asked about each light in turn.
   const std::size_t batch = std::min(rays, kBatchRays);
@@ -173,6 +199,7 @@ void plan_bounces(RenderPlan& plan, const Scene& scene, const std::vector<Kernel
       plan.passes.push_back({effect.kind,
                              std::string(effect.why) + ", up to depth " + std::to_string(scene.render.max_depth),
                              trace,
+                             {},
                              {}});
       // Each bounce can double a tile's rays; they are traced in batches of at most kBatchRays.
       const std::size_t batch = rays << std::min(scene.render.max_depth - 1, 8) < kBatchRays
@@ -192,6 +219,7 @@ void plan_antialias(RenderPlan& plan, const Scene& scene, const std::vector<Kern
     plan.passes.push_back({PassKind::Antialias,
                            n + "x" + n + " camera rays in pixels whose colour differs from a neighbour's",
                            trace,
+                           {},
                            {}});
     const std::size_t batch =
         std::min(rays * static_cast<std::size_t>(plan.refine_samples * plan.refine_samples), kBatchRays);
@@ -299,6 +327,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, int tile_si
                                                 std::to_string(plan.samples) + " per pixel"
                                           : "camera rays, one per pixel",
                          primary,
+                         {},
                          {}});
   plan.buffers.push_back({"primary hits", rays * sizeof(HitRecord)});
   plan_shadows(plan, scene, primary, rays, real_size, float_shadow_lanes);
@@ -380,6 +409,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::
     const bool all_fast = std::all_of(devices.begin(), devices.end(),
                                       [](const PlanDevice& d) { return d.escalation == Precision::Double; });
     escalate_in(plan, all_fast ? Precision::Double : Precision::Mixed);
+    if (!all_fast) escalate_point_form_in_float(plan);
   }
   plan_shading(plan, scene, devices);
   return plan;
@@ -402,6 +432,8 @@ nlohmann::json RenderPlan::json() const {
       pass["escalation"] = nlohmann::json::array();
       for (const KernelConfig& k : p.escalation) pass["escalation"].push_back(k.key());
     }
+    for (const std::optional<KernelConfig>& k : p.float_escalation)
+      if (k) pass["float_escalation"].push_back(k->key());
     j["passes"].push_back(pass);
   }
   for (const PlannedBuffer& b : buffers) j["buffers"].push_back({{"name", b.name}, {"bytes", b.bytes}});

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,12 @@ struct PlannedPass {
   // the rays `kernels` doubted (the trace kernel for ray passes, the shadow kernel for the shadow pass); in plain
   // float, float's own (float_measures_noise). Empty elsewhere.
   std::vector<KernelConfig> escalation;
+  // Adaptive precision whose second pass is float-float: per surface, where the shadow pass's float kernel is the
+  // point form, the float kernel of the extent construction that traces its doubted rays first. The point form's
+  // noise grows with the segment's reach from its origin (kernels/shadow.h, PointTerms), the extent
+  // construction's does not, so it settles most of them at a fraction of float-float's cost; what it doubts goes
+  // on to `escalation`. Empty elsewhere (no entry for a surface without one).
+  std::vector<std::optional<KernelConfig>> float_escalation;
 };
 
 struct PlannedBuffer {

@@ -184,6 +184,8 @@ struct Renderer::DeviceKernels {
   // its shadow kernel for doubted shadow rays (when the plan has a shadow pass); plain float: float's own.
   std::vector<std::unique_ptr<RayEscalation>> escalate_rays;
   std::vector<std::unique_ptr<ShadowEscalation>> escalate_shadows;
+  // per surface, null where the plan has none: PlannedPass::float_escalation, before escalate_shadows
+  std::vector<std::unique_ptr<ShadowEscalation>> escalate_shadows_in_float;
   std::unique_ptr<DeviceShader> shading;  // the camera rays' pixels into the film
   bool host_reads_records = true;         // the host reads a tile's camera-ray records (prepare_passes)
 };
@@ -320,9 +322,22 @@ inline ShadowData trace_shadows(Passes& p, const HitRecord* hits, std::size_t co
         ++stats.launches;
         if (s == 0) stats.rays += answer.rays_traced;
         if (!p.kernels.escalate_shadows.empty()) {
-          count_escalation(
-              stats, p.kernels.shadows.size() + s,
-              p.kernels.escalate_shadows[s]->redo(points, normals, group.points, answer.undecided, answer.masks));
+          const std::size_t n = p.kernels.shadows.size();
+          if (const auto& in_float = p.kernels.escalate_shadows_in_float.at(s)) {
+            // The first pass's doubts in float's extent construction, then what that doubts in float-float: the
+            // escalated rays are the first pass's, the time both passes'.
+            std::vector<std::uint64_t> still;
+            count_escalation(stats, 2 * n + s,
+                             in_float->redo(points, normals, group.points, answer.undecided, answer.masks, &still));
+            EscalationCount last =
+                p.kernels.escalate_shadows[s]->redo(points, normals, group.points, still, answer.masks);
+            last.rays = 0;
+            count_escalation(stats, n + s, last);
+          } else {
+            count_escalation(
+                stats, n + s,
+                p.kernels.escalate_shadows[s]->redo(points, normals, group.points, answer.undecided, answer.masks));
+          }
         }
         hidden = std::move(answer.masks);
       }
