@@ -33,29 +33,27 @@ std::string_view kernel_file_text(const std::string& name, std::string& storage)
 // Where the assembly stands in the program text it writes: which files it has written and which of them the
 // preprocessor is sure to have read, whatever the build's switches.
 struct Assembly {
-  std::vector<std::string> stack;          // the files being written, outermost first (an include cycle is an error)
-  std::set<std::string> written;           // files written at least once
-  std::set<std::string> surely_read;       // files written outside every #if: their include guards are set after
-  std::vector<bool> condition_counts;      // the open #if directives: whether each may drop what it holds
-  int conditions = 0;                      // how many of them may
+  std::vector<std::string> stack;      // the files being written, outermost first (an include cycle is an error)
+  std::set<std::string> written;       // files written at least once
+  std::set<std::string> surely_read;   // files written outside every #if: their include guards are set after
+  std::vector<bool> condition_counts;  // the open #if directives: whether each may drop what it holds
+  int conditions = 0;                  // how many of them may
   std::string out;
 };
 
-std::string_view directive_of(std::string_view line) {
+// The words of a preprocessor line: `# ifndef X` gives "ifndef" (word 0) and "X" (word 1); empty past its end or
+// for a line that is no directive.
+std::string_view directive_word(std::string_view line, int index) {
   const auto hash = line.find_first_not_of(" \t");
   if (hash == std::string_view::npos || line[hash] != '#') return {};
-  const auto word = line.find_first_not_of(" \t", hash + 1);
-  if (word == std::string_view::npos) return {};
-  const auto end = line.find_first_of(" \t(", word);
-  return line.substr(word, (end == std::string_view::npos ? line.size() : end) - word);
-}
-
-// The name after `#ifndef` or `#define` on a line, or empty.
-std::string_view directive_name(std::string_view line) {
-  const auto word = line.find_first_not_of(" \t", line.find_first_of(" \t", line.find('#')));
-  if (word == std::string_view::npos) return {};
-  const auto end = line.find_first_of(" \t(", word);
-  return line.substr(word, (end == std::string_view::npos ? line.size() : end) - word);
+  std::size_t at = hash + 1;
+  for (int i = 0;; ++i) {
+    const auto word = line.find_first_not_of(" \t", at);
+    if (word == std::string_view::npos) return {};
+    const auto end = std::min(line.find_first_of(" \t(", word), line.size());
+    if (i == index) return line.substr(word, end - word);
+    at = end;
+  }
 }
 
 // Writes `name` with its #include "..." lines resolved. A file is written again where it is included again,
@@ -79,21 +77,21 @@ void append_with_includes(const std::string& name, Assembly& a) {
     const std::string_view line = text.substr(at, end - at);
     at = end + 1;
     ++number;
-    const std::string_view directive = directive_of(line);
+    const std::string_view directive = directive_word(line, 0);
     if (directive.empty()) {
       a.out += line;
       a.out += '\n';
       continue;
     }
     ++directives;
-    if (directives == 2 && !guard.empty() && !(directive == "define" && directive_name(line) == guard)) {
+    if (directives == 2 && !guard.empty() && !(directive == "define" && directive_word(line, 1) == guard)) {
       a.condition_counts.back() = true;  // not an include guard after all: the #ifndef may drop what it holds
       ++a.conditions;
     }
     if (directive == "if" || directive == "ifdef" || directive == "ifndef") {
       // `#ifndef X` then `#define X` as a first copy's first directives: its include guard
       const bool is_guard = first_copy && directives == 1 && directive == "ifndef";
-      if (is_guard) guard = directive_name(line);
+      if (is_guard) guard = directive_word(line, 1);
       a.condition_counts.push_back(!is_guard);
       a.conditions += is_guard ? 0 : 1;
     } else if (directive == "endif" && !a.condition_counts.empty()) {
