@@ -262,20 +262,30 @@ static void point_terms_exact(PointTerms* t, __global const uint* exps, __global
   t->exact = 1;
 }
 
-/* The signs of segment_roots_settled for adaptive builds, with the noise of coefficients of largest Bernstein
- * magnitude `scale` summed from terms of size `terms`: each answers a lane only where the values it reads stand
+/* The noise adaptive builds' shortcuts measure against, for coefficients of largest Bernstein magnitude `scale`
+ * summed from terms of size `terms`: the search's for coefficients, and noise_bound's for P's values (any scale). */
+typedef struct {
+  LREAL coefficient, value;
+} SettleNoise;
+
+ALGRAY_INLINE SettleNoise settle_noise(LREAL scale, LREAL terms) {
+  SettleNoise n;
+  n.coefficient = DOUBT_NOISE(scale, terms) * (REAL)(1 + 8 * REAL_EPS);
+  n.value = DOUBT_NOISE(terms, terms);
+  return n;
+}
+
+/* The signs of segment_roots_settled for adaptive builds: each answers a lane only where the values it reads stand
  * beyond the noise, as the search would (its first interval's coefficients all clear of its noise and of one sign;
- * P at the far end beyond the noise for any scale, noise_bound; P at the start counts with the sign it has).
- * Returns the lanes with a root; *open gets the traced lanes these signs leave open. */
-static LMASK segment_roots_settled_by_signs(const LREAL* c, LMASK traced, LMASK* open, LREAL scale, LREAL terms) {
-  const LREAL noise = DOUBT_NOISE(scale, terms) * (REAL)(1 + 8 * REAL_EPS);
-  const LREAL end_noise = DOUBT_NOISE(terms, terms);
+ * P at the far end beyond the noise for any scale; P at the start counts with the sign it has). Returns the lanes
+ * with a root; *open gets the traced lanes these signs leave open. */
+static LMASK segment_roots_settled_by_signs(const LREAL* c, LMASK traced, LMASK* open, SettleNoise noise) {
   LMASK none = one_strict_sign(c);
   ALGRAY_UNROLL
-  for (int k = 1; k <= DEGREE; ++k) none = none && fabs(c[k]) > noise * degree_binomial(k);
+  for (int k = 1; k <= DEGREE; ++k) none = none && fabs(c[k]) > noise.coefficient * degree_binomial(k);
   const LREAL start = c[0], end = c[DEGREE];
   const LMASK root =
-      traced && start != 0 && ((start < 0 && end > 0) || (start > 0 && end < 0)) && fabs(end) > end_noise;
+      traced && start != 0 && ((start < 0 && end > 0) || (start > 0 && end < 0)) && fabs(end) > noise.value;
   *open = traced && !none && !root;
   return root;
 }
@@ -284,14 +294,12 @@ static LMASK segment_roots_settled_by_signs(const LREAL* c, LMASK traced, LMASK*
  * pieces' signs, each value beyond the same noise. The others are left to the search (*open), which doubts what
  * it cannot settle. */
 static LMASK segment_roots_settled_clear(const LREAL* c, const LREAL* power, LREAL t_in, LREAL t_out, LMASK traced,
-                                         LMASK* open, __constant const REAL* binomials, LREAL scale, LREAL terms) {
-  const LREAL noise = DOUBT_NOISE(scale, terms) * (REAL)(1 + 8 * REAL_EPS);
-  const LREAL end_noise = DOUBT_NOISE(terms, terms);
-  const LMASK root = segment_roots_settled_by_signs(c, traced, open, scale, terms);
+                                         LMASK* open, __constant const REAL* binomials, SettleNoise noise) {
+  const LMASK root = segment_roots_settled_by_signs(c, traced, open, noise);
   if (!LANE_ANY(*open)) return root;
-  const LMASK crossed = sign_change_sampled(power, t_in, t_out, c[0], *open, end_noise);
+  const LMASK crossed = sign_change_sampled(power, t_in, t_out, c[0], *open, noise.value);
   *open = *open && !crossed;
-  if (LANE_ANY(*open)) *open = *open && !no_root_in_pieces(c, binomials, noise);
+  if (LANE_ANY(*open)) *open = *open && !no_root_in_pieces(c, binomials, noise.coefficient);
   return root || crossed;
 }
 
@@ -309,12 +317,13 @@ static LMASK segment_roots_settled(const LREAL* c, const LREAL* power, LREAL t_i
                                    __global const uint* exps, __global const REAL* coefs, uint count) {
   if (ALGRAY_ESCALATE) {
     const LREAL scale = search_scale_bound(c);
-    const LMASK root = segment_roots_settled_by_signs(c, traced, open, scale, terms->value);
+    const LMASK root = segment_roots_settled_by_signs(c, traced, open, settle_noise(scale, terms->value));
     if (!LANE_ANY(*open)) return root;
     const LREAL bound = terms->value;
     point_terms_exact(terms, exps, coefs, count);
     terms->value = fmin(terms->value, bound);
-    return segment_roots_settled_clear(c, power, t_in, t_out, traced, open, binomials, scale, terms->value);
+    return segment_roots_settled_clear(c, power, t_in, t_out, traced, open, binomials,
+                                       settle_noise(scale, terms->value));
   }
   const LREAL start = c[0], end = c[DEGREE];
   const LMASK none = one_strict_sign(c);

@@ -171,7 +171,6 @@ nlohmann::json program_json(const ProgramRecord& p, const std::vector<PassStats>
 nlohmann::json pass_json(const PassStats& p, const std::vector<ProgramRecord>& programs) {
   nlohmann::json kernels = nlohmann::json::array();
   for (const std::string& key : p.program_keys) {
-    if (key.empty()) continue;  // a surface's place where it has no such kernel (float_escalation)
     std::string origin;
     for (const ProgramRecord& program : programs)
       if (program.key == key) origin = program.origin;

@@ -37,7 +37,6 @@ struct Assembly {
   std::set<std::string> written;       // files written at least once
   std::set<std::string> surely_read;   // files written outside every #if: their include guards are set after
   std::vector<bool> condition_counts;  // the open #if directives: whether each may drop what it holds
-  int conditions = 0;                  // how many of them may
   std::string out;
 };
 
@@ -86,16 +85,13 @@ void append_with_includes(const std::string& name, Assembly& a) {
     ++directives;
     if (directives == 2 && !guard.empty() && !(directive == "define" && directive_word(line, 1) == guard)) {
       a.condition_counts.back() = true;  // not an include guard after all: the #ifndef may drop what it holds
-      ++a.conditions;
     }
     if (directive == "if" || directive == "ifdef" || directive == "ifndef") {
       // `#ifndef X` then `#define X` as a first copy's first directives: its include guard
       const bool is_guard = first_copy && directives == 1 && directive == "ifndef";
       if (is_guard) guard = directive_word(line, 1);
       a.condition_counts.push_back(!is_guard);
-      a.conditions += is_guard ? 0 : 1;
     } else if (directive == "endif" && !a.condition_counts.empty()) {
-      a.conditions -= a.condition_counts.back() ? 1 : 0;
       a.condition_counts.pop_back();
     } else if (directive == "include") {
       const auto open = line.find('"'), close = line.rfind('"');
@@ -105,7 +101,9 @@ void append_with_includes(const std::string& name, Assembly& a) {
           a.out += '\n';  // its guard is set: the line stays, empty, so that the lines after keep their numbers
           continue;
         }
-        if (a.conditions == 0) a.surely_read.insert(included);
+        const bool outside_every_if =
+            std::find(a.condition_counts.begin(), a.condition_counts.end(), true) == a.condition_counts.end();
+        if (outside_every_if) a.surely_read.insert(included);
         append_with_includes(included, a);
         a.out += "#line " + std::to_string(number + 1) + " \"" + name + "\"\n";
         continue;

@@ -94,8 +94,6 @@ void Renderer::prepare_escalation(Passes& passes) {
         kernels.escalate_shadows.push_back(
             std::make_unique<ShadowEscalation>(passes.session, cache_, shadow_pass->escalation[i], scene, i, offset));
         passes.tally.programs.push_back(kernels.escalate_shadows.back()->program());
-      }
-      for (std::size_t i = 0; i < scene.surfaces.size(); ++i) {
         const bool in_float = i < shadow_pass->float_escalation.size() && shadow_pass->float_escalation[i];
         kernels.escalate_shadows_in_float.push_back(
             in_float ? std::make_unique<ShadowEscalation>(passes.session, cache_, *shadow_pass->float_escalation[i],
@@ -149,14 +147,12 @@ void Renderer::prepare_passes(Passes& passes, bool first_device) {
       passes.tally.stats[i].program_keys.push_back(config.key());
       passes.tally.stats[i].program_ms.push_back(0);
     }
-    // then the float escalation kernels, each surface's place kept (an empty key where it has none)
-    if (std::none_of(plan.passes[i].float_escalation.begin(), plan.passes[i].float_escalation.end(),
-                     [](const std::optional<KernelConfig>& c) { return c.has_value(); }))
-      continue;
-    for (const std::optional<KernelConfig>& config : plan.passes[i].float_escalation) {
-      passes.tally.stats[i].program_keys.push_back(config ? config->key() : std::string());
-      passes.tally.stats[i].program_ms.push_back(0);
-    }
+    // then the float escalation kernels of the surfaces that have one (trace_shadows finds each one's place)
+    for (const std::optional<KernelConfig>& config : plan.passes[i].float_escalation)
+      if (config) {
+        passes.tally.stats[i].program_keys.push_back(config->key());
+        passes.tally.stats[i].program_ms.push_back(0);
+      }
   }
 }
 

@@ -326,8 +326,12 @@ inline ShadowData trace_shadows(Passes& p, const HitRecord* hits, std::size_t co
           if (const auto& in_float = p.kernels.escalate_shadows_in_float.at(s)) {
             // The first pass's doubts in float's extent construction, then what that doubts in float-float: the
             // escalated rays are the first pass's, the time both passes'.
+            // Its program follows the pass's own and the last tier's, among the surfaces that have one.
+            const auto& tiers = p.kernels.escalate_shadows_in_float;
+            const auto earlier = std::count_if(tiers.begin(), tiers.begin() + static_cast<std::ptrdiff_t>(s),
+                                               [](const auto& tier) { return tier != nullptr; });
             std::vector<std::uint64_t> still;
-            count_escalation(stats, 2 * n + s,
+            count_escalation(stats, 2 * n + static_cast<std::size_t>(earlier),
                              in_float->redo(points, normals, group.points, answer.undecided, answer.masks, &still));
             EscalationCount last =
                 p.kernels.escalate_shadows[s]->redo(points, normals, group.points, still, answer.masks);
