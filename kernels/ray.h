@@ -186,4 +186,9 @@ static LaneRays camera_rays(uint px0, uint py, REAL4 o00, REAL4 ou, REAL4 ov, RE
   return camera_rays_through(lane_pixel_centres(px0), (REAL)py + (REAL)0.5, o00, ou, ov, d00, du, dv);
 }
 
+/* The index of this work-item in a launch of ray_launch's shape (render/device_surface.cpp): rows of work-items,
+ * each get_global_size(0) wide, numbered row after row. Rows keep every dimension of a launch under 65,536
+ * work-items, where PoCL compiles one variant of a kernel (it compiles another, for seconds, past that). */
+ALGRAY_INLINE uint launch_item_index(void) { return (uint)(get_global_id(1) * get_global_size(0) + get_global_id(0)); }
+
 #endif /* ALGRAY_RAY_H */

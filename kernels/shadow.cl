@@ -126,7 +126,7 @@ __kernel void shadow(__global const REAL4* points, __global const float4* normal
                          extent_inv_scale, extent_box_half, extent_kind, clip_planes, clip_count, mono_exps, mono_coefs,
                          mono_count, binomials, occluded, rays_traced, undecided);
 #else
-  const uint i = get_global_id(0);
+  const uint i = launch_item_index();
   if (i >= point_count) return;
   REAL3 p, n, o, o_unit;
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);

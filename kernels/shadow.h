@@ -501,7 +501,7 @@ static void shadow_point_form_item(__global const REAL4* points, __global const 
                                    __global const REAL4* clip_planes, uint clip_count, __global const uint* mono_exps,
                                    __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials,
                                    __global ulong* occluded, __global uint* rays_traced, __global ulong* undecided) {
-  const uint i = get_global_id(0);
+  const uint i = launch_item_index();
   if (i >= point_count) return;
   uint traced = 0;
   ulong unsure = 0;

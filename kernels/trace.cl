@@ -19,7 +19,7 @@ __kernel void trace(__global const REAL4* origins, __global const REAL4* directi
                     uint clip_count, __global const uint* mono_exps,
                     __global const REAL* mono_coefs, uint mono_count, __constant const REAL* binomials, uint even_axes,
                     __global HitRecord* out) {
-  const uint first = get_global_id(0) * LANES;
+  const uint first = launch_item_index() * LANES;
   if (first >= count) return;
   const uint group = min((uint)LANES, count - first);
   /* lanes from `group` on repeat the last ray; trace_rays leaves them alone */

@@ -275,3 +275,57 @@ TEST_CASE("adaptive shadow rays that start exactly on the surface are doubted al
   INFO("seed " << kSeed + 2 << ": " << undecided << " of " << points.size() * lights.size() << " samples undecided");
   CHECK(undecided > 0);
 }
+
+TEST_CASE("a launch of many rows of work-items answers each ray as launches of one row do", "[shadows]") {
+  // ray_launch's shape: fixed groups, rows under PoCL's 65,536 work-items a dimension, every ray covered.
+  for (std::size_t largest : {std::size_t{256}, std::size_t{32}, std::size_t{1}})
+    for (std::size_t count : {std::size_t{1}, std::size_t{63}, std::size_t{64}, std::size_t{65}, std::size_t{16383},
+                              std::size_t{16384}, std::size_t{16385}, std::size_t{40000}, std::size_t{1} << 24}) {
+      const RayLaunch launch = ray_launch(count, largest);
+      INFO("count " << count << ", largest group " << largest << ": global " << launch.global[0] << " x "
+                    << launch.global[1] << ", local " << launch.local[0] << " x " << launch.local[1]);
+      REQUIRE(launch.global.dimensions() == 2);
+      CHECK(launch.local[0] == std::min<std::size_t>(largest, 64));
+      CHECK(launch.local[1] == 1);
+      CHECK(launch.global[0] % launch.local[0] == 0);
+      CHECK(launch.global[0] < 65536);
+      CHECK(launch.global[1] < 65536);
+      CHECK(launch.global[0] * launch.global[1] >= count);
+      CHECK(launch.global[0] * launch.global[1] - count < launch.global[0]);  // at most the last row part empty
+    }
+
+  // On the device: 40,000 points in one launch (three rows of 16,384) and in launches of 5,000 (one row each).
+  // A ball of radius 0.5 under lights above it: the points beneath or inside it are hidden, the others not.
+  const unsigned seed = kSeed + 7;
+  std::mt19937 rng(seed);
+  const Scene scene = load_scene_text(
+      "[surface]\nequation = \"x^2 + y^2 + z^2 - 0.25\"\n[extent]\nradius = 1\n"
+      "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n[render]\nprecision = \"double\"\n",
+      "ball.toml");
+  TracerPair tracers(scene, Precision::Double, Isolation::Bernstein);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<glm::dvec3> points, lights;
+  std::vector<glm::vec3> normals;
+  for (int i = 0; i < 40000; ++i) {
+    points.emplace_back(u(rng), u(rng), u(rng));
+    normals.emplace_back(glm::normalize(glm::vec3(u(rng), u(rng), u(rng)) + glm::vec3(0, 0, 2)));
+  }
+  for (int s = 0; s < 8; ++s) lights.emplace_back(0.2 * u(rng), 0.2 * u(rng), 3.0);
+  const ShadowAnswer whole = tracers.batched.trace(points, normals, lights, {});
+  std::vector<std::uint64_t> masks;
+  std::uint64_t traced = 0;
+  for (std::size_t first = 0; first < points.size(); first += 5000) {
+    const auto part = [&](const auto& v) { return std::vector(v.begin() + first, v.begin() + first + 5000); };
+    const ShadowAnswer a = tracers.batched.trace(part(points), part(normals), lights, {});
+    masks.insert(masks.end(), a.masks.begin(), a.masks.end());
+    traced += a.rays_traced;
+  }
+  long hidden = 0;
+  for (std::uint64_t m : whole.masks) hidden += std::popcount(m);
+  INFO("seed " << seed << ": " << whole.rays_traced << " rays traced, " << hidden << " of "
+               << points.size() * lights.size() << " samples hidden");
+  CHECK(whole.masks == masks);
+  CHECK(whole.rays_traced == traced);
+  CHECK(hidden > 1000);
+  CHECK(hidden < static_cast<long>(points.size() * lights.size()) - 1000);
+}

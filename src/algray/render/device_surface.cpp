@@ -32,7 +32,14 @@ RayLaunch ray_launch(std::size_t count, std::size_t largest_group) {
   // too large for it on some device gets the largest power of two that device allows.
   std::size_t group = 64;
   while (group > 1 && group > largest_group) group /= 2;
-  return {cl::NDRange((count + group - 1) / group * group), cl::NDRange(group)};
+  // Rows of 16,384 work-items (kernels/ray.h launch_item_index), fewer than 65,536 of them up to 2^30 rays, far
+  // past any batch the memory bound lets through: PoCL specialises a kernel for launches whose every dimension is
+  // under 65,536 work-items and compiles it again, uninterruptibly, for the first one past that, so a 1024^2 frame
+  // after small ones stalled for a second.
+  constexpr std::size_t row = 16384;  // a multiple of every group size here
+  const std::size_t whole = (count + group - 1) / group * group;
+  if (whole <= row) return {cl::NDRange(std::max(whole, group), 1), cl::NDRange(group, 1)};
+  return {cl::NDRange(row, (whole + row - 1) / row), cl::NDRange(group, 1)};
 }
 
 RayLaunch primary_launch(int lanes, int width, int height, std::size_t largest_group) {

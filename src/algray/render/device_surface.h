@@ -23,10 +23,11 @@ SurfaceData prepare_surface(const Scene& scene, std::size_t surface = 0);
 // Device time of a finished command, in milliseconds (the queue has profiling on).
 double ms_between(const cl::Event& e);
 
-// A launch of one work-item per ray for `count` rays, in work-groups of a fixed size; the kernels skip the items
-// past `count`. The driver's own choice would follow each count, and PoCL compiles a work-group function for
-// every group size it meets: a render's batches come in many sizes, and each new one cost a second or more.
-// `largest_group` is the kernel's CL_KERNEL_WORK_GROUP_SIZE on the device.
+// A launch of one work-item per ray for `count` rays, in work-groups of a fixed size and rows of a fixed width
+// (kernels/ray.h launch_item_index numbers them); the kernels skip the items past `count`. The driver's own choice
+// would follow each count, and PoCL compiles a work-group function for every group size it meets: a render's batches
+// come in many sizes, and each new one cost a second or more. `largest_group` is the kernel's CL_KERNEL_WORK_GROUP_SIZE
+// on the device.
 struct RayLaunch {
   cl::NDRange global, local;
 };
