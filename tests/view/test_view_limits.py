@@ -163,10 +163,17 @@ try:
     if len(slow_answers) != 10 or not all(b" 408 " in a and b"--header-timeout" in a for a in slow_answers):
         fail(f"slow clients: expected 10 answers 408 naming --header-timeout, got {[a[:60] for a in slow_answers]}")
 
-    # Past --max-connections: 429 naming it at once, and served again once they close.
+    # Past --max-connections: 429 naming it at once, and served again once they close. The server counts a
+    # connection when a thread takes it up, which on two busy cores (a cold cache's compiles) can take longer than
+    # the 0.3 s allowed: a 200 before all 24 are counted is asked again, for up to 5 s.
     idle = [socket.create_connection((host, port)) for _ in range(24)]
     time.sleep(0.3)
-    status, _, body = request(host, port, "/scene.json")
+    counted_by = time.monotonic() + 5
+    while True:
+        status, _, body = request(host, port, "/scene.json")
+        if status != 200 or time.monotonic() > counted_by:
+            break
+        time.sleep(0.2)
     problem = error_of(status, body, 429, "--max-connections", "--max-connections")
     for s in idle:
         s.close()
