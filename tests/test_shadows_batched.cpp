@@ -302,7 +302,12 @@ TEST_CASE("a launch of many rows of work-items answers each ray as launches of o
       "[surface]\nequation = \"x^2 + y^2 + z^2 - 0.25\"\n[extent]\nradius = 1\n"
       "[camera]\neye = [0, 0, 3]\nlook_at = [0, 0, 0]\nup = [0, 1, 0]\n[render]\nprecision = \"double\"\n",
       "ball.toml");
-  TracerPair tracers(scene, Precision::Double, Isolation::Bernstein);
+  // The batched kernel alone: the serial one is not needed here (each program is seconds to compile on PoCL).
+  const DeviceSurface surface(testing::device_session().context, scene, Precision::Double);
+  ShadowTracer batched(
+      testing::device_session(), testing::program_cache(),
+      shadow_config(scene, Precision::Double, Isolation::Bernstein, "shadow", RayOrigin::Extent, false), surface,
+      shadow_offset_unit(Precision::Double) * scene.extent.unit_scale());
   std::uniform_real_distribution<double> u(-1, 1);
   std::vector<glm::dvec3> points, lights;
   std::vector<glm::vec3> normals;
@@ -311,12 +316,12 @@ TEST_CASE("a launch of many rows of work-items answers each ray as launches of o
     normals.emplace_back(glm::normalize(glm::vec3(u(rng), u(rng), u(rng)) + glm::vec3(0, 0, 2)));
   }
   for (int s = 0; s < 8; ++s) lights.emplace_back(0.2 * u(rng), 0.2 * u(rng), 3.0);
-  const ShadowAnswer whole = tracers.batched.trace(points, normals, lights, {});
+  const ShadowAnswer whole = batched.trace(points, normals, lights, {});
   std::vector<std::uint64_t> masks;
   std::uint64_t traced = 0;
   for (std::size_t first = 0; first < points.size(); first += 5000) {
     const auto part = [&](const auto& v) { return std::vector(v.begin() + first, v.begin() + first + 5000); };
-    const ShadowAnswer a = tracers.batched.trace(part(points), part(normals), lights, {});
+    const ShadowAnswer a = batched.trace(part(points), part(normals), lights, {});
     masks.insert(masks.end(), a.masks.begin(), a.masks.end());
     traced += a.rays_traced;
   }

@@ -224,9 +224,10 @@ try:
         time.sleep(1.0)
     # Then the preview's programs (the parser cases' frames), and a stream's at the size of the stream not read
     # (7): its previews race double against adaptive precision (render/precision_race.h), so its second frame
-    # builds adaptive's programs, and PoCL compiles each kernel again at its first launch (the escalation's only
-    # once a frame has doubted rays, as 512^2 ones do), seconds that would otherwise land in that case's quiet
-    # second. Each until four frames in a row, both precisions twice in the stream, take no more than 1 s.
+    # builds adaptive's programs, and PoCL by default compiles each kernel again at its first launch (the
+    # escalation's only once a frame has doubted rays, as 512^2 ones do), seconds that would otherwise land in
+    # that case's quiet second. Each until four frames in a row, both precisions twice in the stream, take no
+    # more than 1 s.
     quiet = 0
     while quiet < 4:
         status, fields, body = request(host, port, "/frame.png?width=64&height=64", timeout=30.0)
