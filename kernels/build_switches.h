@@ -86,8 +86,9 @@
 #endif
 
 /* Adaptive builds only, 0/1: the float pass settles more of what it would doubt, where the second pass runs in
- * float-float (KernelConfig::settle_doubts): shadow kernels by within_noise_at (isolation.h) and
- * sampled_sign_change (shadow.h), the others by discards_settled (methods/bernstein.h). */
+ * float-float or float (KernelConfig::settle_doubts): the extent form's shadow kernels by within_noise_at
+ * (isolation.h) and sampled_sign_change (shadow.h), the point form's by searching its doubted rays again
+ * (shadow.h, point_part_polys), the others by discards_settled (methods/bernstein.h). */
 #ifndef ALGRAY_SETTLE_DOUBTS
 #define ALGRAY_SETTLE_DOUBTS 0
 #endif

@@ -56,13 +56,16 @@ ALGRAY_INLINE void shift_columns(PolyVec* q, REAL s, int along_x) {
 #undef SHIFTED_COLUMN
 }
 
-/* q: P(o + v) by columns, from P's monomials (exponents packed i | j<<8 | k<<16) in unit coordinates. The shift
+/* q: P(o + v) by columns, from P's monomials (exponents packed i | j<<8 | k<<16) in unit coordinates, or with
+ * `absolute` Pabs(o + v), Pabs = sum_m |a_m| x^i y^j z^k (adaptive builds, o >= 0: every operation then adds and
+ * multiplies nonnegative numbers, so the result is within a relative few REAL_EPS per monomial of the exact). The shift
  * is separable: along z while each monomial is added to its column (one vector operation per monomial), then
  * along y and along x, each a sum of vector products with independent accumulators (the nested Taylor shift
  * of one coefficient at a time was a chain of dependent operations, 3x slower). Every loop runs to DEGREE and
  * tests its bound inside: with bounds that depend on the outer indices LLVM unrolled the inner loops only partly
  * and kept the sums in memory (measured in PoCL's compiled kernel). */
-static void taylor_at_point(__global const uint* exps, __global const REAL* coefs, uint count, REAL3 o, PolyVec* q) {
+ALGRAY_INLINE void taylor_at_point(__global const uint* exps, __global const REAL* coefs, uint count, REAL3 o,
+                                   PolyVec* q, int absolute) {
   PolyVec rows[NCOEF];
   shift_rows(o.z, rows);
   ALGRAY_UNROLL
@@ -70,7 +73,7 @@ static void taylor_at_point(__global const uint* exps, __global const REAL* coef
   for (uint m = 0; m < count; ++m) {
     const uint e = exps[m];
     const int i = (int)(e & 0xffu), j = (int)((e >> 8) & 0xffu), k = (int)((e >> 16) & 0xffu);
-    q[POINT_FORM_COLUMN(i, j)] += coefs[m] * rows[k];
+    q[POINT_FORM_COLUMN(i, j)] += (absolute ? fabs(coefs[m]) : coefs[m]) * rows[k];
   }
   shift_columns(q, o.y, 0);
   shift_columns(q, o.x, 1);
@@ -78,7 +81,7 @@ static void taylor_at_point(__global const uint* exps, __global const REAL* coef
 
 /* P(o + t d) = sum_k c[k] t^k for LANES directions d (unit coordinates), from taylor_at_point's q; its loops are
  * bounded as taylor_at_point's (left partly unrolled, the sums went through memory: four loads and stores a term). */
-static void point_form_restrict(const PolyVec* columns, LREAL dx, LREAL dy, LREAL dz, LREAL* c) {
+ALGRAY_INLINE void point_form_restrict(const PolyVec* columns, LREAL dx, LREAL dy, LREAL dz, LREAL* c) {
   const REAL* q = (const REAL*)columns;
   LREAL pz[NCOEF], sum[NCOEF];
   pz[0] = 1;

@@ -73,6 +73,10 @@ typedef struct {
   uint count;
   REAL x, y, z;
   REAL x0, x1, y0, y1, z0, z1; /* |x|, |y|, |z| at the segment's ends, for ray_terms_local */
+  /* a point form's shadow ray searched again (shadow.h, PointPartNoise): its local noise's two polynomials in t
+   * over [t_in, t_out]; null elsewhere */
+  const REAL* part_terms;
+  const REAL* part_scale;
   /* camera and secondary rays: the ray o + t d in unit coordinates and its segment, where P is evaluated again
    * in float-float (float_float.h; has_ray 0 elsewhere) */
   int has_ray;
@@ -90,6 +94,7 @@ static RayTerms known_terms(REAL value) {
   t.count = 0;
   t.x = t.y = t.z = 0;
   t.x0 = t.x1 = t.y0 = t.y1 = t.z0 = t.z1 = 0;
+  t.part_terms = t.part_scale = 0;
   t.has_ray = 0;
   return t;
 }
@@ -135,6 +140,7 @@ static RayTerms ray_terms(__global const uint* exps, __global const REAL* coefs,
   t.z0 = fabs(fz.l0);
   t.z1 = fabs(fz.l1);
   t.value = one_ray_terms_within(coefs, count, fmax(t.x, fmax(t.y, t.z)));
+  t.part_terms = t.part_scale = 0;
   t.has_ray = 0;
   return t;
 }

@@ -236,18 +236,14 @@ static LMASK no_root_in_pieces(const LREAL* c, __constant const REAL* binomials,
  * Pabs(|o| + t_out |d|), Pabs = sum_m |a_m| x^i y^j z^k, axis by axis: the point form's terms. They exceed the extent
  * construction's, Pabs at |o + t d|, as a segment from o reaches further than o + t d does from the centre. */
 typedef struct {
-  LREAL x, y, z;    /* |o| + t_out |d| per axis, where Pabs is summed */
-  LREAL x0, y0, z0; /* |o| + t_in |d|: with x, y, z the line |o| + t |d|, for the search's local noise */
-  LREAL value;      /* an upper bound (terms_within at each lane's largest coordinate) until `exact` */
+  LREAL x, y, z; /* |o| + t_out |d| per axis, where Pabs is summed */
+  LREAL value;   /* an upper bound (terms_within at each lane's largest coordinate) until `exact` */
   int exact;
 } PointTerms;
 
-static PointTerms point_terms(REAL3 o, LREAL dx, LREAL dy, LREAL dz, LREAL t_in, LREAL t_out,
-                              __global const REAL* coefs, uint count) {
+static PointTerms point_terms(REAL3 o, LREAL dx, LREAL dy, LREAL dz, LREAL t_out, __global const REAL* coefs,
+                              uint count) {
   PointTerms t;
-  t.x0 = fabs(o.x) + t_in * fabs(dx);
-  t.y0 = fabs(o.y) + t_in * fabs(dy);
-  t.z0 = fabs(o.z) + t_in * fabs(dz);
   t.x = fabs(o.x) + t_out * fabs(dx);
   t.y = fabs(o.y) + t_out * fabs(dy);
   t.z = fabs(o.z) + t_out * fabs(dz);
@@ -336,71 +332,168 @@ static LMASK segment_roots_settled(const LREAL* c, const LREAL* power, LREAL t_i
   return root || crossed;
 }
 
+/* P expanded about a surface point's shadow origin o (taylor_at_point) when its first ray is traced, and in
+ * adaptive builds Pabs = sum_m |a_m| x^i y^j z^k expanded about |o| when the search first doubts one of its rays
+ * (point_part_polys). */
+typedef struct {
+  PolyVec q[POINT_FORM_COLUMNS];
+  PolyVec terms[POINT_FORM_COLUMNS];
+  int made, terms_made;
+  REAL3 o;
+} PointExpansion;
+
+/* Adaptive builds search a point form's doubted segments again, with the noise local to each part of the segment
+ * (isolation.h, point_part_noise). The segment's noise is its largest coefficients' and the terms at its far end on
+ * the extent's sphere, and a shadow ray starts on the surface, where both are orders of magnitude smaller: the
+ * search doubts P near the start for the far end's noise. The part's noise comes from two polynomials in t with
+ * nonnegative coefficients per lane: the terms Pabs(|o| + t |d|) (Pabs expanded about |o|, restricted to |d|), and
+ * sum_k |c_k| t^k of the power basis c about o (the restriction again, bit for bit). Searching again only the doubted
+ * rays decides each as one search with the part's noise throughout would (a ray with no value within the segment's
+ * noise never asks for the part's), and costs nothing where nothing is doubted. Barth decic at 1024x768, full mode:
+ * its doubted shadow rays 4.08 M of 25.4 M -> 1.35 M, all passes 0.93x in float and 0.90x without fp64; Endrass
+ * octic 0.95x and 0.89x; the Chebyshev nonic, which doubts one ray in ninety, 1.00x-1.09x: Pabs's expansion for a
+ * point costs about what its few rays save (bench/history/2026-12.md, "Point-form shadow rays searched again"). */
+static ALGRAY_NOINLINE void point_part_polys(PointExpansion* e, __global const uint* exps, __global const REAL* coefs,
+                                             uint count, LREAL dx, LREAL dy, LREAL dz, LREAL* part_terms,
+                                             LREAL* part_scale) {
+  if (!e->terms_made) {
+    taylor_at_point(exps, coefs, count, fabs(e->o), e->terms, 1);
+    e->terms_made = 1;
+  }
+  point_form_restrict(e->terms, fabs(dx), fabs(dy), fabs(dz), part_terms);
+  point_form_restrict(e->q, dx, dy, dz, part_scale);
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) part_scale[k] = fabs(part_scale[k]);
+}
+
 /* Segments waiting for the search, gathered from the blocks of lanes of one surface point until they fill a block:
  * the search in lanes costs every lane while any runs, and a block holds two open segments on average. Adaptive
- * builds keep each segment's terms (summed) and, for the search's noise local to a part of the segment
- * (isolation.h, within_noise_at), |o| + t |d| per axis at its ends. */
+ * builds keep each segment's terms (summed) and its direction, and a second queue the segments searched again with
+ * their two polynomials (point_part_polys). */
 typedef struct {
   LREAL b[NCOEF]; /* Bernstein coefficients (bernstein_from_scaled's) */
   LREAL t_in, t_out;
   uint sample[LANES];
   uint count;
-  LREAL terms; /* adaptive builds' */
-  LREAL x0, y0, z0, x1, y1, z1;
+  LREAL terms;                                /* adaptive builds' */
+  LREAL dx, dy, dz;                           /* adaptive builds' first queue */
+  LREAL part_terms[NCOEF], part_scale[NCOEF]; /* adaptive builds' second queue */
 } SearchQueue;
 
+/* An empty queue. Lanes a search leaves empty are never decided on, but keep them defined: copies of a harmless
+ * segment at first, then of earlier ones. */
+ALGRAY_INLINE void empty_queue(SearchQueue* queue) {
+  queue->count = 0;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) queue->b[k] = queue->part_terms[k] = queue->part_scale[k] = 1;
+  queue->t_in = 0;
+  queue->t_out = 1;
+  queue->terms = 1;
+  queue->dx = queue->dy = queue->dz = 0;
+}
+
+/* Appends lane j of a segment (b: Bernstein coefficients) as sample `sample`; returns whether the queue is full. */
+ALGRAY_INLINE int queue_lane(SearchQueue* queue, const LREAL* b, LREAL t_in, LREAL t_out, LREAL terms, uint j,
+                             uint sample) {
+  const uint at = queue->count;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) lane_set(&queue->b[k], at, lane_get(b[k], j));
+  lane_set(&queue->t_in, at, lane_get(t_in, j));
+  lane_set(&queue->t_out, at, lane_get(t_out, j));
+  if (ALGRAY_ESCALATE) lane_set(&queue->terms, at, lane_get(terms, j));
+  queue->sample[at] = sample;
+  return ++queue->count == LANES;
+}
+
 /* What the search of the queue's lanes measures its noise by (adaptive builds; methods/bernstein.h, LaneTerms):
- * one ray's RayTerms, or the lanes' own. |o| + t |d| is linear in t: the ends' values interpolate it exactly, as
- * the noise local to a part reads them (within_noise_at, within_lanes_noise). */
-ALGRAY_INLINE LaneTerms queued_terms(const SearchQueue* queue, __global const uint* exps, __global const REAL* coefs,
-                                     uint count) {
+ * one ray's RayTerms, or the lanes' own; by their parts' noise in the second queue (`again`). */
+ALGRAY_INLINE LaneTerms queued_terms(const SearchQueue* queue, int again, __global const uint* exps,
+                                     __global const REAL* coefs, uint count) {
 #if LANES == 1
   LaneTerms t = known_terms(queue->terms);
-  t.x = queue->x1;
-  t.y = queue->y1;
-  t.z = queue->z1;
+  t.part_terms = again ? queue->part_terms : (const REAL*)0;
+  t.part_scale = queue->part_scale;
+  t.t_in = queue->t_in;
+  t.t_out = queue->t_out;
 #else
   LaneTerms t;
   t.value = queue->terms;
   t.rays = (const LaneRays*)0; /* shadow rays' searches evaluate nothing in float-float */
-  t.by_part = ALGRAY_SETTLE_DOUBTS; /* as one ray's search (isolation.h, within_noise_at) */
+  t.by_part = again;
+  t.part_terms = queue->part_terms;
+  t.part_scale = queue->part_scale;
+  t.seg_in = queue->t_in;
+  t.seg_out = queue->t_out;
 #endif
   t.exps = exps;
   t.coefs = coefs;
   t.count = count;
-  t.x0 = queue->x0;
-  t.x1 = queue->x1;
-  t.y0 = queue->y0;
-  t.y1 = queue->y1;
-  t.z0 = queue->z0;
-  t.z1 = queue->z1;
   return t;
 }
 
-/* The samples whose queued segments hold a root, by the Bernstein search over the queue's lanes; in adaptive
- * builds, *doubted gets those it doubted. The queue is emptied. */
-static ulong search_queued(SearchQueue* queue, ulong* doubted, __global const uint* exps, __global const REAL* coefs,
-                           uint count) {
-  ulong found = 0;
+/* The Bernstein search over the queue's lanes: the lanes it finds a root in (*found) and, in adaptive builds, those
+ * it doubts (*doubted), as bits of the queue's entries. */
+static void queue_search(const SearchQueue* queue, int again, __global const uint* exps, __global const REAL* coefs,
+                         uint count, uint* found, uint* doubted) {
   LREAL cur[NCOEF];
   const LMASK running = lanes_of_bits((1u << queue->count) - 1);
   LaneIsolation iso;
-  LaneTerms terms = queued_terms(queue, exps, coefs, count);
+  LaneTerms terms = queued_terms(queue, again, exps, coefs, count);
   isolate_bernstein_search(running, queue->b, queue->b, queue->t_in, queue->t_out, &iso, cur,
                            ALGRAY_ESCALATE ? &terms : (LaneTerms*)0, NO_PROBE);
-  const uint found_bits = lane_mask_bits(running && iso.status != (REAL)ISOLATION_NONE);
-  const uint doubt_bits = ALGRAY_ESCALATE ? lane_mask_bits(running && iso.doubt != (REAL)0) : 0u;
+  *found = lane_mask_bits(running && iso.status != (REAL)ISOLATION_NONE);
+  *doubted = ALGRAY_ESCALATE ? lane_mask_bits(running && iso.doubt != (REAL)0) : 0u;
+}
+
+/* The samples whose segments in the second queue hold a root; *doubted gets those it doubts still. Emptied. */
+static ulong search_again(SearchQueue* again, ulong* doubted, __global const uint* exps, __global const REAL* coefs,
+                          uint count) {
+  uint found_bits, doubt_bits;
+  queue_search(again, 1, exps, coefs, count, &found_bits, &doubt_bits);
+  ulong found = 0;
+  for (uint j = 0; j < again->count; ++j) {
+    if ((found_bits >> j) & 1u) found |= (ulong)1 << again->sample[j];
+    if ((doubt_bits >> j) & 1u) *doubted |= (ulong)1 << again->sample[j];
+  }
+  again->count = 0;
+  return found;
+}
+
+/* The samples whose queued segments hold a root, by the Bernstein search over the queue's lanes; in adaptive builds
+ * *doubted gets those it doubts, or, where the build settles doubts, those that doubts still after the second queue
+ * (point_part_polys) searched them again. The queue is emptied. */
+static ulong search_queued(SearchQueue* queue, SearchQueue* again, PointExpansion* e, ulong* doubted,
+                           __global const uint* exps, __global const REAL* coefs, uint count) {
+  uint found_bits, doubt_bits;
+  queue_search(queue, 0, exps, coefs, count, &found_bits, &doubt_bits);
+  ulong found = 0;
   for (uint j = 0; j < queue->count; ++j) {
     if ((found_bits >> j) & 1u) found |= (ulong)1 << queue->sample[j];
-    if ((doubt_bits >> j) & 1u) *doubted |= (ulong)1 << queue->sample[j];
+    if (!ALGRAY_SETTLE_DOUBTS && ((doubt_bits >> j) & 1u)) *doubted |= (ulong)1 << queue->sample[j];
+  }
+  if (ALGRAY_ESCALATE && ALGRAY_SETTLE_DOUBTS && doubt_bits) {
+    LREAL part_terms[NCOEF], part_scale[NCOEF];
+    point_part_polys(e, exps, coefs, count, queue->dx, queue->dy, queue->dz, part_terms, part_scale);
+    for (uint j = 0; j < queue->count; ++j) {
+      if (!((doubt_bits >> j) & 1u)) continue;
+      const uint at = again->count;
+      ALGRAY_UNROLL
+      for (int k = 0; k <= DEGREE; ++k) {
+        lane_set(&again->part_terms[k], at, lane_get(part_terms[k], j));
+        lane_set(&again->part_scale[k], at, lane_get(part_scale[k], j));
+      }
+      if (queue_lane(again, queue->b, queue->t_in, queue->t_out, queue->terms, j, queue->sample[j]))
+        found |= search_again(again, doubted, exps, coefs, count);
+    }
   }
   queue->count = 0;
   return found;
 }
 
-/* Queues the open lanes of the block of samples s0 ..; searches whenever the queue fills. Returns the samples
- * found hidden; *doubted gets those the search doubted. */
-static ulong queue_for_search(SearchQueue* queue, const LREAL* c, LREAL t_in, LREAL t_out, uint open_bits, uint s0,
+/* Queues the open lanes of the block of samples s0 .. (directions dx, dy, dz); searches whenever the queue fills.
+ * Returns the samples found hidden; *doubted gets those the searches doubt. */
+static ulong queue_for_search(SearchQueue* queue, SearchQueue* again, PointExpansion* e, const LREAL* c, LREAL t_in,
+                              LREAL t_out, LREAL dx, LREAL dy, LREAL dz, uint open_bits, uint s0,
                               __constant const REAL* binomials, ulong* doubted, const PointTerms* terms,
                               __global const uint* exps, __global const REAL* coefs, uint count) {
   __constant const REAL* row = binomials + DEGREE * NCOEF;
@@ -410,22 +503,14 @@ static ulong queue_for_search(SearchQueue* queue, const LREAL* c, LREAL t_in, LR
   ulong found = 0;
   for (uint j = 0; j < LANES; ++j) {
     if (!((open_bits >> j) & 1)) continue;
-    const uint at = queue->count;
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE; ++k) lane_set(&queue->b[k], at, lane_get(b[k], j));
-    lane_set(&queue->t_in, at, lane_get(t_in, j));
-    lane_set(&queue->t_out, at, lane_get(t_out, j));
     if (ALGRAY_ESCALATE) {
-      lane_set(&queue->terms, at, lane_get(terms->value, j));
-      lane_set(&queue->x0, at, lane_get(terms->x0, j));
-      lane_set(&queue->y0, at, lane_get(terms->y0, j));
-      lane_set(&queue->z0, at, lane_get(terms->z0, j));
-      lane_set(&queue->x1, at, lane_get(terms->x, j));
-      lane_set(&queue->y1, at, lane_get(terms->y, j));
-      lane_set(&queue->z1, at, lane_get(terms->z, j));
+      const uint at = queue->count;
+      lane_set(&queue->dx, at, lane_get(dx, j));
+      lane_set(&queue->dy, at, lane_get(dy, j));
+      lane_set(&queue->dz, at, lane_get(dz, j));
     }
-    queue->sample[at] = s0 + j;
-    if (++queue->count == LANES) found |= search_queued(queue, doubted, exps, coefs, count);
+    if (queue_lane(queue, b, t_in, t_out, terms->value, j, s0 + j))
+      found |= search_queued(queue, again, e, doubted, exps, coefs, count);
   }
   return found;
 }
@@ -442,17 +527,12 @@ static ulong shadow_mask_point_form(__global const REAL4* points, __global const
                                     ulong mask, uint* traced, ulong* undecided) {
   REAL3 p, n, o, o_unit;
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
-  PolyVec q[POINT_FORM_COLUMNS];
-  int expanded = 0;
-  SearchQueue queue;
-  queue.count = 0;
-  /* Lanes the queue leaves empty are never read, but keep them defined: copies of a harmless segment. */
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) queue.b[k] = 1;
-  queue.t_in = 0;
-  queue.t_out = 1;
-  queue.terms = 1;
-  queue.x0 = queue.y0 = queue.z0 = queue.x1 = queue.y1 = queue.z1 = 1;
+  PointExpansion e;
+  e.made = e.terms_made = 0;
+  e.o = o_unit;
+  SearchQueue queue, again;
+  empty_queue(&queue);
+  empty_queue(&again);
   for (uint s0 = 0; s0 < light_count; s0 += LANES) {
     /* The host pads the light points to a multiple of 16, so a block may read past light_count. */
 #define LIGHT_X(j) light_points[s0 + (j)].x
@@ -472,24 +552,25 @@ static ulong shadow_mask_point_form(__global const REAL4* points, __global const
     trace = trace && wanted;
     if (!LANE_ANY(trace)) continue;
     *traced += popcount(lane_mask_bits(trace));
-    if (!expanded) {
-      taylor_at_point(mono_exps, mono_coefs, mono_count, o_unit, q);
-      expanded = 1;
+    if (!e.made) {
+      taylor_at_point(mono_exps, mono_coefs, mono_count, o_unit, e.q, 0);
+      e.made = 1;
     }
     LREAL power[NCOEF], c[NCOEF];
-    point_form_restrict(q, dx, dy, dz, power);
+    point_form_restrict(e.q, dx, dy, dz, power);
     point_form_segment(power, t_in, t_out, binomials, c);
     PointTerms terms;
-    if (ALGRAY_ESCALATE) terms = point_terms(o_unit, dx, dy, dz, t_in, t_out, mono_coefs, mono_count);
+    if (ALGRAY_ESCALATE) terms = point_terms(o_unit, dx, dy, dz, t_out, mono_coefs, mono_count);
     LMASK open;
     mask |= (ulong)lane_mask_bits(segment_roots_settled(c, power, t_in, t_out, trace, &open, binomials, &terms,
                                                         mono_exps, mono_coefs, mono_count))
             << s0;
     if (LANE_ANY(open))
-      mask |= queue_for_search(&queue, c, t_in, t_out, lane_mask_bits(open), s0, binomials, undecided, &terms,
-                               mono_exps, mono_coefs, mono_count);
+      mask |= queue_for_search(&queue, &again, &e, c, t_in, t_out, dx, dy, dz, lane_mask_bits(open), s0, binomials,
+                               undecided, &terms, mono_exps, mono_coefs, mono_count);
   }
-  if (queue.count) mask |= search_queued(&queue, undecided, mono_exps, mono_coefs, mono_count);
+  if (queue.count) mask |= search_queued(&queue, &again, &e, undecided, mono_exps, mono_coefs, mono_count);
+  if (again.count) mask |= search_again(&again, undecided, mono_exps, mono_coefs, mono_count);
   return mask;
 }
 

@@ -272,10 +272,10 @@ TEST_CASE("the point form's doubted shadow rays go through float's extent form b
     return *plan.find(PassKind::Shadow);
   };
   // A float-float second pass: a float tier in the extent construction first, which settles what it can (its
-  // doubts go on); the point form settles none itself.
+  // doubts go on); the point form settles doubts only by searching its doubted rays again (kernels/shadow.h).
   const PlannedPass mixed = shadow_pass(Precision::Mixed);
   REQUIRE(mixed.kernels.at(0).ray_origin == RayOrigin::Point);
-  CHECK_FALSE(mixed.kernels.at(0).settle_doubts);
+  CHECK(mixed.kernels.at(0).settle_doubts);
   REQUIRE(mixed.float_escalation.size() == 1);
   REQUIRE(mixed.float_escalation[0].has_value());
   CHECK(mixed.float_escalation[0]->ray_origin == RayOrigin::Extent);
@@ -284,13 +284,17 @@ TEST_CASE("the point form's doubted shadow rays go through float's extent form b
   CHECK(mixed.escalation.at(0).precision == Precision::Mixed);
   CHECK(make_render_plan(scene, Precision::Adaptive, std::vector<PlanDevice>{{cpu, Precision::Mixed}})
             .json()["passes"][1]["float_escalation"][0] == mixed.float_escalation[0]->key());
-  // A double second pass costs about what float's extent form does: no tier between.
+  // A double second pass costs about what float's extent form does: no tier between, and the point form's search
+  // again saves less than it costs.
   const PlannedPass in_double = shadow_pass(Precision::Double);
   CHECK(in_double.float_escalation.empty());
   CHECK(in_double.escalation.at(0).precision == Precision::Double);
-  // Plain float's doubted rays go to float's extent form already.
+  CHECK_FALSE(in_double.kernels.at(0).settle_doubts);
+  // Plain float's doubted rays go to float's extent form already, after the point form's search again.
   const RenderPlan plain = make_render_plan(scene, Precision::Float, std::vector<PlanDevice>{{cpu}});
   CHECK(plain.find(PassKind::Shadow)->float_escalation.empty());
+  CHECK(plain.find(PassKind::Shadow)->kernels.at(0).settle_doubts);
+  CHECK_FALSE(plain.find(PassKind::Primary)->kernels.at(0).settle_doubts);
   // Where the first pass is the extent form already (a scene that asks for it), there is nothing to add.
   scene.render.ray_origin = RayOrigin::Extent;
   const RenderPlan extent = make_render_plan(scene, Precision::Adaptive, std::vector<PlanDevice>{{cpu}});

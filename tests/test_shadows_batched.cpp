@@ -215,9 +215,9 @@ TEST_CASE("the point form's shadow rays in lanes answer as one at a time, bit fo
   std::mt19937 rng(kSeed + 3);
   check_same_masks(barth, Precision::Double, Isolation::Bernstein, rng,
                    "point form (seed " + std::to_string(kSeed + 3) + "), Barth sextic", RayOrigin::Point);
-  // Adaptive's point form: its noise checks, doubts and (where it settles doubts) the noise local to each part
-  // decide alike in 16 lanes and in one, undecided samples included (check_same_masks compares them), on two
-  // surfaces whose shadow rays it doubts often.
+  // Adaptive's point form: its noise checks, doubts and (where it settles doubts) its doubted rays searched again by
+  // the noise of each part (kernels/shadow.h, point_part_polys) decide alike in 16 lanes and in one, undecided
+  // samples included (check_same_masks compares them), on two surfaces whose shadow rays it doubts often.
   for (const auto& [file, settle_doubts] :
        {std::pair{"barth_decic.toml", false}, std::pair{"endrass_octic.toml", true}}) {
     const unsigned seed = kSeed + 5;

@@ -251,11 +251,13 @@ typedef struct {
   __global const uint* exps;
   __global const REAL* coefs;
   uint count;
-  /* The point form's shadow rays in builds that settle doubts (shadow.h, PointTerms): each lane's noise local to a
-   * part of its segment, as one ray's (isolation.h, within_noise_at), from its terms' coordinates at the segment's
-   * ends; 0 elsewhere. */
+  /* The point form's shadow rays searched again (shadow.h, PointPartNoise): each lane's noise local to a part of
+   * its segment [seg_in, seg_out], as one ray's (isolation.h, within_noise_at), from its two polynomials; 0
+   * elsewhere. */
   int by_part;
-  LREAL x0, y0, z0, x1, y1, z1;
+  const LREAL* part_terms;
+  const LREAL* part_scale;
+  LREAL seg_in, seg_out;
 } LaneTerms;
 ALGRAY_INLINE LaneRays terms_rays(const LaneTerms* t) { return *t->rays; }
 ALGRAY_INLINE LMASK terms_have_rays(const LaneTerms* t) {
@@ -336,20 +338,11 @@ ALGRAY_INLINE LMASK within_lanes_noise(LaneNoise* n, LREAL value, LREAL lo, LREA
   LMASK within = fabs(value) <= n->noise;
   const LaneTerms* t = n->terms;
   if (!t->by_part || !LANE_ANY(within)) return within;
-  /* within_noise_at's local checks: the per-degree sums at the part's largest coordinate, then the terms summed */
-  const LREAL x = fmax(mix(t->x0, t->x1, lo), mix(t->x0, t->x1, hi));
-  const LREAL y = fmax(mix(t->y0, t->y1, lo), mix(t->y0, t->y1, hi));
-  const LREAL z = fmax(mix(t->z0, t->z1, lo), mix(t->z0, t->z1, hi));
-  const LREAL above = terms_within(t->coefs, t->count, fmax(x, fmax(y, z)));
-  within = within && !(fabs(value) > (REAL)ALGRAY_LOCAL_FACTOR * DOUBT_NOISE(fmin(n->scale, above), above));
-  if (!LANE_ANY(within)) return within;
   /* the part's own noise, computed once per part as one ray's (a search step asks about one part several times) */
   if (LANE_ANY(lo != n->part_lo || hi != n->part_hi)) {
     n->part_lo = lo;
     n->part_hi = hi;
-    const LREAL part_terms = terms_sum(t->exps, t->coefs, t->count, x, y, z) * (REAL)(1 + 1.0 / 1024);
-    n->part_noise =
-        (REAL)ALGRAY_LOCAL_FACTOR * DOUBT_NOISE(fmin(n->scale, local_scale(n->root, lo, hi)), part_terms);
+    n->part_noise = point_part_noise(n->scale, t->part_terms, t->part_scale, t->seg_in + hi * (t->seg_out - t->seg_in));
   }
   return within && fabs(value) <= n->part_noise;
 }

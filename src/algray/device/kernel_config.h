@@ -44,13 +44,14 @@ struct KernelConfig {
   // trace kernels with Bernstein isolation and Brent refinement, and the shadow kernel's point form
   // (lanes_apply), where the plan asks for it.
   int lanes = 1;
-  // Adaptive kernels only: the float pass settles more of what it would doubt. In shadow kernels a value within the
-  // segment's noise is held to the noise of its own interval too (isolation.h, within_noise_at), and before a
-  // doubted ray goes to the second pass, two values of P* of opposite signs beyond the noise at 16 points settle it
-  // as hidden (shadow.h, sampled_sign_change). In camera and secondary ray kernels an interval doubted for an end
-  // value within the noise is settled by P's signs there in float-float (discards_settled). These pay
-  // where the second pass runs in float-float, not where it runs in double (bench/RESULTS.md), so the plan sets it
-  // for the former only.
+  // Adaptive kernels only: the float pass settles more of what it would doubt. In the extent form's shadow kernels a
+  // value within the segment's noise is held to the noise of its own interval too (isolation.h, within_noise_at),
+  // and before a doubted ray goes to the second pass, two values of P* of opposite signs beyond the noise at 16
+  // points settle it as hidden (shadow.h, sampled_sign_change); the point form searches its doubted rays again by
+  // the noise of each part (shadow.h, point_part_polys). In camera and secondary ray kernels an interval doubted for
+  // an end value within the noise is settled by P's signs there in float-float (discards_settled). These pay where
+  // the second pass runs in float-float or float, not where it runs in double (bench/RESULTS.md), so the plan sets
+  // it for the former only (escalate_in).
   bool settle_doubts = false;
 
   // "-D DEGREE=6 -D ALGRAY_DOUBLE=1 ..." with the tolerance as an exact hexadecimal literal.

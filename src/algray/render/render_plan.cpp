@@ -59,17 +59,23 @@ void escalate_in(RenderPlan& plan, Precision precision) {
       // sampling 1.28x -> 1.30x float's time, 1.69x -> 1.55x where the second pass is float-float; each interval's
       // own noise 1.24x either way, 1.45x -> 1.32x where it is float-float; Kummer shell, discard doubts settled
       // in float-float: 2.2x -> 2.7x, 4.1x -> 3.9x).
-      // A float second pass (plain float's, make_render_plan) costs less still.
-      if (precision != Precision::Mixed) pass.kernels.at(i).settle_doubts = false;
+      // A float second pass (plain float's, make_render_plan) costs less still, but for the point form's doubted
+      // shadow rays, which its own search again by each part's noise (kernels/shadow.h, point_part_polys) settles
+      // for less than float's extent construction (Barth decic, 1024x768 full: 2.76 -> 2.61 s; with a double
+      // second pass it saved nothing: 2.58 -> 2.60 s).
+      const bool point_form_again = precision == Precision::Float && pass.kind == PassKind::Shadow &&
+                                    pass.kernels.at(i).ray_origin == RayOrigin::Point;
+      if (precision != Precision::Mixed && !point_form_again) pass.kernels.at(i).settle_doubts = false;
     }
 }
 
 namespace {
 
 // Adaptive precision with a float-float second pass: the point form's doubted shadow rays through float's extent
-// construction first (PlannedPass::float_escalation). Its first pass then settles no doubts itself: the float
-// extent pass settles more of them for less (Barth decic, 1024x768, no fp64: bench/history/2026-12.md, "Doubted
-// shadow rays in float first").
+// construction first (PlannedPass::float_escalation). Its first pass settles doubts only by searching its doubted
+// rays again by each part's noise (kernels/shadow.h, point_part_polys; Barth decic, 1024x768, no fp64: 3.30 ->
+// 2.94 s): the float extent pass settles the rest for less than the first pass's other checks (bench/history/
+// 2026-12.md, "Doubted shadow rays in float first").
 void escalate_point_form_in_float(RenderPlan& plan) {
   for (PlannedPass& pass : plan.passes) {
     if (pass.kind != PassKind::Shadow || pass.escalation.empty()) continue;
@@ -81,8 +87,7 @@ void escalate_point_form_in_float(RenderPlan& plan) {
       in_float.ray_origin = RayOrigin::Extent;
       if (!lanes_apply(in_float)) in_float.lanes = 1;
       in_float.settle_doubts = true;  // what it leaves goes to float-float
-      pass.float_escalation[i] = in_float;
-      first.settle_doubts = false;
+      pass.float_escalation[i] = in_float;  // the first pass keeps settle_doubts: its own search again
     }
   }
 }
