@@ -339,8 +339,15 @@ typedef struct {
   PolyVec q[POINT_FORM_COLUMNS];
   PolyVec terms[POINT_FORM_COLUMNS];
   int made, terms_made;
+  uint doubts; /* the point's rays doubted so far */
   REAL3 o;
 } PointExpansion;
+
+/* A point's doubted rays are searched again from its third on; the first two go to the second pass as they are,
+ * so that a point that doubts few pays for no expansion of Pabs. Float, 1024x768 full mode, 3 rounds against
+ * searching every one again: Chebyshev nonic (a doubted ray in ninety) 1,481 -> 1,450 ms, Barth decic 2,598 ->
+ * 2,534 ms, though 1.70 M of its rays go to the second pass where 1.35 M did. */
+#define POINT_SEARCH_AGAIN_FROM 3
 
 /* Adaptive builds search a point form's doubted segments again, with the noise local to each part of the segment
  * (isolation.h, point_part_noise). The segment's noise is its largest coefficients' and the terms at its far end on
@@ -350,9 +357,10 @@ typedef struct {
  * sum_k |c_k| t^k of the power basis c about o (the restriction again, bit for bit). Searching again only the doubted
  * rays decides each as one search with the part's noise throughout would (a ray with no value within the segment's
  * noise never asks for the part's), and costs nothing where nothing is doubted. Barth decic at 1024x768, full mode:
- * its doubted shadow rays 4.08 M of 25.4 M -> 1.35 M, all passes 0.93x in float and 0.90x without fp64; Endrass
- * octic 0.95x and 0.89x; the Chebyshev nonic, which doubts one ray in ninety, 1.00x-1.09x: Pabs's expansion for a
- * point costs about what its few rays save (bench/history/2026-12.md, "Point-form shadow rays searched again"). */
+ * its doubted shadow rays 4.08 M of 25.4 M -> 1.70 M, all passes 0.94x in float and 0.89x without fp64; Endrass
+ * octic 0.90x and 0.89x; the Chebyshev nonic, which doubts one ray in ninety, 0.99x and 1.05x: Pabs's expansion
+ * for a point costs about what its few rays save (bench/history/2026-12.md, "Point-form shadow rays searched
+ * again"). */
 static ALGRAY_NOINLINE void point_part_polys(PointExpansion* e, __global const uint* exps, __global const REAL* coefs,
                                              uint count, LREAL dx, LREAL dy, LREAL dz, LREAL* part_terms,
                                              LREAL* part_scale) {
@@ -393,14 +401,19 @@ ALGRAY_INLINE void empty_queue(SearchQueue* queue) {
 }
 
 /* Appends lane j of a segment (b: Bernstein coefficients) as sample `sample`; returns whether the queue is full. */
-ALGRAY_INLINE int queue_lane(SearchQueue* queue, const LREAL* b, LREAL t_in, LREAL t_out, LREAL terms, uint j,
-                             uint sample) {
+ALGRAY_INLINE int queue_lane(SearchQueue* queue, const LREAL* b, LREAL t_in, LREAL t_out, LREAL terms, LREAL dx,
+                             LREAL dy, LREAL dz, uint j, uint sample) {
   const uint at = queue->count;
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) lane_set(&queue->b[k], at, lane_get(b[k], j));
   lane_set(&queue->t_in, at, lane_get(t_in, j));
   lane_set(&queue->t_out, at, lane_get(t_out, j));
-  if (ALGRAY_ESCALATE) lane_set(&queue->terms, at, lane_get(terms, j));
+  if (ALGRAY_ESCALATE) {
+    lane_set(&queue->terms, at, lane_get(terms, j));
+    lane_set(&queue->dx, at, lane_get(dx, j));
+    lane_set(&queue->dy, at, lane_get(dy, j));
+    lane_set(&queue->dz, at, lane_get(dz, j));
+  }
   queue->sample[at] = sample;
   return ++queue->count == LANES;
 }
@@ -446,8 +459,9 @@ static void queue_search(const SearchQueue* queue, int again, __global const uin
 }
 
 /* The samples whose segments in the second queue hold a root; *doubted gets those it doubts still. Emptied. */
-static ulong search_again(SearchQueue* again, ulong* doubted, __global const uint* exps, __global const REAL* coefs,
-                          uint count) {
+static ulong search_again(SearchQueue* again, PointExpansion* e, ulong* doubted, __global const uint* exps,
+                          __global const REAL* coefs, uint count) {
+  point_part_polys(e, exps, coefs, count, again->dx, again->dy, again->dz, again->part_terms, again->part_scale);
   uint found_bits, doubt_bits;
   queue_search(again, 1, exps, coefs, count, &found_bits, &doubt_bits);
   ulong found = 0;
@@ -471,21 +485,18 @@ static ulong search_queued(SearchQueue* queue, SearchQueue* again, PointExpansio
     if ((found_bits >> j) & 1u) found |= (ulong)1 << queue->sample[j];
     if (!ALGRAY_SETTLE_DOUBTS && ((doubt_bits >> j) & 1u)) *doubted |= (ulong)1 << queue->sample[j];
   }
-  if (ALGRAY_ESCALATE && ALGRAY_SETTLE_DOUBTS && doubt_bits) {
-    LREAL part_terms[NCOEF], part_scale[NCOEF];
-    point_part_polys(e, exps, coefs, count, queue->dx, queue->dy, queue->dz, part_terms, part_scale);
+  if (ALGRAY_ESCALATE && ALGRAY_SETTLE_DOUBTS && doubt_bits)
     for (uint j = 0; j < queue->count; ++j) {
       if (!((doubt_bits >> j) & 1u)) continue;
-      const uint at = again->count;
-      ALGRAY_UNROLL
-      for (int k = 0; k <= DEGREE; ++k) {
-        lane_set(&again->part_terms[k], at, lane_get(part_terms[k], j));
-        lane_set(&again->part_scale[k], at, lane_get(part_scale[k], j));
+      /* a point's first doubted rays go to the second pass as they are (POINT_SEARCH_AGAIN_FROM) */
+      if (++e->doubts < POINT_SEARCH_AGAIN_FROM) {
+        *doubted |= (ulong)1 << queue->sample[j];
+        continue;
       }
-      if (queue_lane(again, queue->b, queue->t_in, queue->t_out, queue->terms, j, queue->sample[j]))
-        found |= search_again(again, doubted, exps, coefs, count);
+      if (queue_lane(again, queue->b, queue->t_in, queue->t_out, queue->terms, queue->dx, queue->dy, queue->dz, j,
+                     queue->sample[j]))
+        found |= search_again(again, e, doubted, exps, coefs, count);
     }
-  }
   queue->count = 0;
   return found;
 }
@@ -503,13 +514,7 @@ static ulong queue_for_search(SearchQueue* queue, SearchQueue* again, PointExpan
   ulong found = 0;
   for (uint j = 0; j < LANES; ++j) {
     if (!((open_bits >> j) & 1)) continue;
-    if (ALGRAY_ESCALATE) {
-      const uint at = queue->count;
-      lane_set(&queue->dx, at, lane_get(dx, j));
-      lane_set(&queue->dy, at, lane_get(dy, j));
-      lane_set(&queue->dz, at, lane_get(dz, j));
-    }
-    if (queue_lane(queue, b, t_in, t_out, terms->value, j, s0 + j))
+    if (queue_lane(queue, b, t_in, t_out, terms->value, dx, dy, dz, j, s0 + j))
       found |= search_queued(queue, again, e, doubted, exps, coefs, count);
   }
   return found;
@@ -529,6 +534,7 @@ static ulong shadow_mask_point_form(__global const REAL4* points, __global const
   shadow_origin(points, normals, i, offset, extent_centre, extent_inv_scale, &p, &n, &o, &o_unit);
   PointExpansion e;
   e.made = e.terms_made = 0;
+  e.doubts = 0;
   e.o = o_unit;
   SearchQueue queue, again;
   empty_queue(&queue);
@@ -570,7 +576,7 @@ static ulong shadow_mask_point_form(__global const REAL4* points, __global const
                                undecided, &terms, mono_exps, mono_coefs, mono_count);
   }
   if (queue.count) mask |= search_queued(&queue, &again, &e, undecided, mono_exps, mono_coefs, mono_count);
-  if (again.count) mask |= search_again(&again, undecided, mono_exps, mono_coefs, mono_count);
+  if (again.count) mask |= search_again(&again, &e, undecided, mono_exps, mono_coefs, mono_count);
   return mask;
 }
 

@@ -390,8 +390,9 @@ TEST_CASE("adaptive shadow rays that settle_doubts settles are only doubted ones
       std::printf("%s, %s form: %d doubted shadow rays, %d of them settled (%d hidden), %d of those certified\n", file,
                   to_string(origin).c_str(), doubted, settled, hidden, certified);
       INFO(file << ", " << to_string(origin) << " form");
-      // The noise of each interval settles most of them; the point form's searches again, from segments that reach
-      // further from their start, more than a third (Endrass octic: 46% of these, 69% in a 1024x768 render).
+      // The noise of each interval settles most of them; the point form's search again, on segments that reach
+      // further from their start and from a point's third doubted ray on, more than a third (Endrass octic: 39% of
+      // these, 61% in a 1024x768 render).
       CHECK(settled * (origin == RayOrigin::Extent ? 2 : 3) > doubted);
       CHECK(hidden > 0);
       CHECK(hidden < settled);
