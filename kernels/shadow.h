@@ -384,8 +384,10 @@ typedef struct {
   uint sample[LANES];
   uint count;
   LREAL terms;                                /* adaptive builds' */
-  LREAL dx, dy, dz;                           /* adaptive builds' first queue */
-  LREAL part_terms[NCOEF], part_scale[NCOEF]; /* adaptive builds' second queue */
+  LREAL dx, dy, dz;                           /* adaptive builds' */
+  /* the second queue's: the two polynomials, and where the first search stopped (SearchStart) */
+  LREAL part_terms[NCOEF], part_scale[NCOEF];
+  LREAL stop[NCOEF], stop_at, stop_width;
 } SearchQueue;
 
 /* An empty queue. Lanes a search leaves empty are never decided on, but keep them defined: copies of a harmless
@@ -393,7 +395,9 @@ typedef struct {
 ALGRAY_INLINE void empty_queue(SearchQueue* queue) {
   queue->count = 0;
   ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) queue->b[k] = queue->part_terms[k] = queue->part_scale[k] = 1;
+  for (int k = 0; k <= DEGREE; ++k) queue->b[k] = queue->part_terms[k] = queue->part_scale[k] = queue->stop[k] = 1;
+  queue->stop_at = 0;
+  queue->stop_width = 1;
   queue->t_in = 0;
   queue->t_out = 1;
   queue->terms = 1;
@@ -445,15 +449,22 @@ ALGRAY_INLINE LaneTerms queued_terms(const SearchQueue* queue, int again, __glob
 }
 
 /* The Bernstein search over the queue's lanes: the lanes it finds a root in (*found) and, in adaptive builds, those
- * it doubts (*doubted), as bits of the queue's entries. */
+ * it doubts (*doubted), as bits of the queue's entries. The first queue's search from the start of each segment,
+ * leaving in *stopped where it stopped; the second queue's from there. */
 static void queue_search(const SearchQueue* queue, int again, __global const uint* exps, __global const REAL* coefs,
-                         uint count, uint* found, uint* doubted) {
-  LREAL cur[NCOEF];
+                         uint count, uint* found, uint* doubted, SearchQueue* stopped) {
   const LMASK running = lanes_of_bits((1u << queue->count) - 1);
   LaneIsolation iso;
   LaneTerms terms = queued_terms(queue, again, exps, coefs, count);
-  isolate_bernstein_search(running, queue->b, queue->b, queue->t_in, queue->t_out, &iso, cur,
+  SearchStart start;
+  start.cur = queue->stop;
+  start.at = queue->stop_at;
+  start.width = queue->stop_width;
+  isolate_bernstein_search(running, queue->b, queue->b, queue->t_in, queue->t_out,
+                           again ? &start : (const SearchStart*)0, &iso, stopped->stop,
                            ALGRAY_ESCALATE ? &terms : (LaneTerms*)0, NO_PROBE);
+  stopped->stop_at = iso.lo;
+  stopped->stop_width = iso.hi - iso.lo;
   *found = lane_mask_bits(running && iso.status != (REAL)ISOLATION_NONE);
   *doubted = ALGRAY_ESCALATE ? lane_mask_bits(running && iso.doubt != (REAL)0) : 0u;
 }
@@ -463,7 +474,7 @@ static ulong search_again(SearchQueue* again, PointExpansion* e, ulong* doubted,
                           __global const REAL* coefs, uint count) {
   point_part_polys(e, exps, coefs, count, again->dx, again->dy, again->dz, again->part_terms, again->part_scale);
   uint found_bits, doubt_bits;
-  queue_search(again, 1, exps, coefs, count, &found_bits, &doubt_bits);
+  queue_search(again, 1, exps, coefs, count, &found_bits, &doubt_bits, again); /* its own stops: not read again */
   ulong found = 0;
   for (uint j = 0; j < again->count; ++j) {
     if ((found_bits >> j) & 1u) found |= (ulong)1 << again->sample[j];
@@ -479,7 +490,7 @@ static ulong search_again(SearchQueue* again, PointExpansion* e, ulong* doubted,
 static ulong search_queued(SearchQueue* queue, SearchQueue* again, PointExpansion* e, ulong* doubted,
                            __global const uint* exps, __global const REAL* coefs, uint count) {
   uint found_bits, doubt_bits;
-  queue_search(queue, 0, exps, coefs, count, &found_bits, &doubt_bits);
+  queue_search(queue, 0, exps, coefs, count, &found_bits, &doubt_bits, queue);
   ulong found = 0;
   for (uint j = 0; j < queue->count; ++j) {
     if ((found_bits >> j) & 1u) found |= (ulong)1 << queue->sample[j];
@@ -493,6 +504,11 @@ static ulong search_queued(SearchQueue* queue, SearchQueue* again, PointExpansio
         *doubted |= (ulong)1 << queue->sample[j];
         continue;
       }
+      const uint at = again->count;
+      ALGRAY_UNROLL
+      for (int k = 0; k <= DEGREE; ++k) lane_set(&again->stop[k], at, lane_get(queue->stop[k], j));
+      lane_set(&again->stop_at, at, lane_get(queue->stop_at, j));
+      lane_set(&again->stop_width, at, lane_get(queue->stop_width, j));
       if (queue_lane(again, queue->b, queue->t_in, queue->t_out, queue->terms, queue->dx, queue->dy, queue->dz, j,
                      queue->sample[j]))
         found |= search_again(again, e, doubted, exps, coefs, count);

@@ -310,7 +310,8 @@ static void isolate_rays(uint count, const int* in_extent, const LaneRays* rays,
 #if ISOLATION == ALGRAY_ISOLATION_BERNSTEIN
   /* straight into the lanes' isolation: isolate_method's round trip through an Isolation measured 2% of the
    * lemniscate's one-ray kernel */
-  isolate_bernstein_search(1, root[0], root_lo[0], t_in[0], t_out[0], iso, c, &terms[0], probe_log);
+  isolate_bernstein_search(1, root[0], root_lo[0], t_in[0], t_out[0], (const SearchStart*)0, iso, c, &terms[0],
+                           probe_log);
 #else
   set_lane_isolation(iso, 0, isolate_method(root[0], root_lo[0], t_in[0], t_out[0], c, &terms[0], probe_log));
 #endif
@@ -570,7 +571,7 @@ static int trace_rays(uint count, const LaneRays* rays, REAL3 centre, REAL inv_s
     screen_lanes.coefs = coefs;
     screen_lanes.count = mono_count;
   }
-  isolate_bernstein_search(running, lane_root, lane_root, lane_t_in, lane_t_out, &iso, iso_c,
+  isolate_bernstein_search(running, lane_root, lane_root, lane_t_in, lane_t_out, (const SearchStart*)0, &iso, iso_c,
                            ALGRAY_ESCALATE ? &screen_lanes : (LaneTerms*)0, probe_log);
 #else
   /* one ray at a time: each lane's segment and whether it entered. The loops over lanes run to min(count, LANES),

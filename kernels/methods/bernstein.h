@@ -582,8 +582,18 @@ ALGRAY_INLINE void settle_brackets(BernsteinSearch* s, LaneTerms* terms, LREAL t
   s->doubt = LANE_SEL(s->doubt, (LREAL)0, settled);
 }
 
+/* Where a search starts, lane by lane: the interval [at, at + width] of a dyadic depth-first search of [0, 1] and
+ * its coefficients cur, as an earlier search of the same root stopped there (its iso lo and hi, and cur_out). The
+ * intervals before it are root-free, as that search showed; the first interval's cached sibling is not known, so
+ * the next one is made from the root. Not in mixed precision, whose coefficients have low parts. */
+typedef struct {
+  const LREAL* cur;
+  LREAL at, width;
+} SearchStart;
+
 /* Finds the leftmost subinterval of [0,1] that isolates the smallest root of the polynomial with Bernstein
- * coefficients `root` (+ `root_lo` in mixed precision), for the lanes in `running` (the others are left alone).
+ * coefficients `root` (+ `root_lo` in mixed precision), for the lanes in `running` (the others are left alone),
+ * from the start of [0, 1] or from `start` (null: [0, 1]).
  * Depth-first, left half first. The right half of the latest split is cached, as the left half is usually rejected
  * at once. The position is kept as the interval's left end and width, REALs that are exact for these dyadic
  * numbers, so that all the state is in registers: the path (level, idx) of a depth-first search is (-log2 width,
@@ -592,13 +602,14 @@ ALGRAY_INLINE void settle_brackets(BernsteinSearch* s, LaneTerms* terms, LREAL t
  * own size). Over lanes, a halving, a recomputation from `root` and a copy of the cached sibling each cost every
  * lane, so this pays where neighbouring rays take similar searches (bench/history/2026-12.md, "Lock-step lanes"). */
 static ALGRAY_NOINLINE void isolate_bernstein_search(LMASK running, const LREAL* root, const LREAL* root_lo, LREAL t_in,
-                                                     LREAL t_out, LaneIsolation* iso, LREAL* cur_out, LaneTerms* terms,
-                                                     ProbeLog* probe_log) {
+                                                     LREAL t_out, const SearchStart* start, LaneIsolation* iso,
+                                                     LREAL* cur_out, LaneTerms* terms, ProbeLog* probe_log) {
   BernsteinSearch s;
-  coefs_copy(s.cur, s.cur_lo, root, root_lo);
+  coefs_copy(s.cur, s.cur_lo, start ? start->cur : root, root_lo);
   coefs_copy(s.sib, s.sib_lo, root, root_lo);
-  s.at = s.sib_at = s.sib_width = 0;
-  s.width = 1;
+  s.at = start ? start->at : (LREAL)0;
+  s.width = start ? start->width : (LREAL)1;
+  s.sib_at = s.sib_width = 0;
   s.status = ISOLATION_NONE;
   s.steps = s.doubt = 0;
   s.start_sign = LANE_SEL((LREAL)0, (LREAL)1, root[0] > 0) - LANE_SEL((LREAL)0, (LREAL)1, root[0] < 0);
@@ -654,7 +665,8 @@ static Isolation isolate_bernstein(const REAL* root, const REAL* root_lo, REAL t
   LaneRays rays;
   LaneTerms ray_lanes;
   LaneTerms* lane_terms = one_ray_terms(terms, &ray_lanes, &rays);
-  isolate_bernstein_search(lanes_of_bits(1u), r, r_lo, t_in, t_out, &iso, c, lane_terms, probe_log);
+  isolate_bernstein_search(lanes_of_bits(1u), r, r_lo, t_in, t_out, (const SearchStart*)0, &iso, c, lane_terms,
+                           probe_log);
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) cur[k] = lane_get(c[k], 0);
   return lane_isolation(&iso, 0);
@@ -715,8 +727,8 @@ static void isolate_rays_together(uint count, const int* in_extent, const LaneRa
       search_terms.coefs = terms[first].coefs;
       search_terms.count = terms[first].count;
     }
-    isolate_bernstein_search(running, lane_root, lane_root_lo, lane_t_in, lane_t_out, iso, c, &search_terms,
-                             probe_log);
+    isolate_bernstein_search(running, lane_root, lane_root_lo, lane_t_in, lane_t_out, (const SearchStart*)0, iso, c,
+                             &search_terms, probe_log);
   }
 }
 #endif
