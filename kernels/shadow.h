@@ -333,11 +333,15 @@ static LMASK segment_roots_settled(const LREAL* c, const LREAL* power, LREAL t_i
 }
 
 /* P expanded about a surface point's shadow origin o (taylor_at_point) when its first ray is traced, and in
- * adaptive builds Pabs = sum_m |a_m| x^i y^j z^k expanded about |o| when the search first doubts one of its rays
- * (point_part_polys). */
+ * adaptive builds that settle doubts Pabs = sum_m |a_m| x^i y^j z^k expanded about |o| when the point first searches
+ * a ray again (point_part_polys). Only those builds hold the second expansion: a GPU keeps a work-item's arrays in
+ * its registers or spills them. */
+#define POINT_SEARCHES_AGAIN (ALGRAY_ESCALATE && ALGRAY_SETTLE_DOUBTS)
 typedef struct {
   PolyVec q[POINT_FORM_COLUMNS];
+#if POINT_SEARCHES_AGAIN
   PolyVec terms[POINT_FORM_COLUMNS];
+#endif
   int made, terms_made;
   uint doubts; /* the point's rays doubted so far */
   REAL3 o;
@@ -364,11 +368,13 @@ typedef struct {
 static ALGRAY_NOINLINE void point_part_polys(PointExpansion* e, __global const uint* exps, __global const REAL* coefs,
                                              uint count, LREAL dx, LREAL dy, LREAL dz, LREAL* part_terms,
                                              LREAL* part_scale) {
+#if POINT_SEARCHES_AGAIN
   if (!e->terms_made) {
     taylor_at_point(exps, coefs, count, fabs(e->o), e->terms, 1);
     e->terms_made = 1;
   }
   point_form_restrict(e->terms, fabs(dx), fabs(dy), fabs(dz), part_terms);
+#endif
   point_form_restrict(e->q, dx, dy, dz, part_scale);
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) part_scale[k] = fabs(part_scale[k]);
@@ -494,9 +500,9 @@ static ulong search_queued(SearchQueue* queue, SearchQueue* again, PointExpansio
   ulong found = 0;
   for (uint j = 0; j < queue->count; ++j) {
     if ((found_bits >> j) & 1u) found |= (ulong)1 << queue->sample[j];
-    if (!ALGRAY_SETTLE_DOUBTS && ((doubt_bits >> j) & 1u)) *doubted |= (ulong)1 << queue->sample[j];
+    if (!POINT_SEARCHES_AGAIN && ((doubt_bits >> j) & 1u)) *doubted |= (ulong)1 << queue->sample[j];
   }
-  if (ALGRAY_ESCALATE && ALGRAY_SETTLE_DOUBTS && doubt_bits)
+  if (POINT_SEARCHES_AGAIN && doubt_bits)
     for (uint j = 0; j < queue->count; ++j) {
       if (!((doubt_bits >> j) & 1u)) continue;
       /* a point's first doubted rays go to the second pass as they are (POINT_SEARCH_AGAIN_FROM) */
