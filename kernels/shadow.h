@@ -353,14 +353,16 @@ typedef struct {
  * 2,534 ms, though 1.70 M of its rays go to the second pass where 1.35 M did. */
 #define POINT_SEARCH_AGAIN_FROM 3
 
-/* Adaptive builds search a point form's doubted segments again, with the noise local to each part of the segment
- * (isolation.h, point_part_noise). The segment's noise is its largest coefficients' and the terms at its far end on
+/* Adaptive builds that settle doubts (POINT_SEARCHES_AGAIN) search a point form's doubted segments again, with the
+ * noise local to each part of the segment (isolation.h, point_part_noise), from where the first search stopped
+ * (methods/bernstein.h, SearchStart). The segment's noise is its largest coefficients' and the terms at its far end on
  * the extent's sphere, and a shadow ray starts on the surface, where both are orders of magnitude smaller: the
  * search doubts P near the start for the far end's noise. The part's noise comes from two polynomials in t with
  * nonnegative coefficients per lane: the terms Pabs(|o| + t |d|) (Pabs expanded about |o|, restricted to |d|), and
  * sum_k |c_k| t^k of the power basis c about o (the restriction again, bit for bit). Searching again only the doubted
  * rays decides each as one search with the part's noise throughout would (a ray with no value within the segment's
- * noise never asks for the part's), and costs nothing where nothing is doubted. Barth decic at 1024x768, full mode:
+ * noise never asks for the part's; only the interval after the one it stopped at is made from the segment's
+ * coefficients rather than from a cached half), and costs little where little is doubted. Barth decic at 1024x768, full mode:
  * its doubted shadow rays 4.08 M of 25.4 M -> 1.70 M, all passes 0.94x in float and 0.89x without fp64; Endrass
  * octic 0.90x and 0.89x; the Chebyshev nonic, which doubts one ray in ninety, 0.99x and 1.05x: Pabs's expansion
  * for a point costs about what its few rays save (bench/history/2026-12.md, "Point-form shadow rays searched
@@ -391,8 +393,8 @@ typedef struct {
   uint count;
   LREAL terms;                                /* adaptive builds' */
   LREAL dx, dy, dz;                           /* adaptive builds' */
-  /* the second queue's: the two polynomials, and where the first search stopped (SearchStart) */
-  LREAL part_terms[NCOEF], part_scale[NCOEF];
+  LREAL part_terms[NCOEF], part_scale[NCOEF]; /* the second queue's: the two polynomials */
+  /* where each lane's last search stopped, and in the second queue where its first one did (SearchStart) */
   LREAL stop[NCOEF], stop_at, stop_width;
 } SearchQueue;
 
