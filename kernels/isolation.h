@@ -192,7 +192,7 @@ static REAL local_noise(const REAL* c, REAL scale, RayTerms* terms, REAL lo, REA
 
 /* The noise local to a part of a point-form shadow segment that ends at t (t >= 0, measured from the rays' shared
  * origin o), lane by lane: local_noise's, from two polynomials in t with nonnegative coefficients, whose values at
- * the part's far end bound those of the whole part (shadow.h, PointPartNoise). part_terms: the terms, sum_m |a_m|
+ * the part's far end bound those of the whole part (shadow.h, point_part_polys). part_terms: the terms, sum_m |a_m|
  * (|o| + t |d|)^m per axis, ray_terms_local's value there. part_scale: sum_k |c_k| t^k, c the power basis of P*
  * about o, which bounds local_scale: each Bernstein coefficient of P* on [t_a, t_b], 0 <= t_a, is a sum of c_k times
  * the nonnegative ones of t^k. Two Horner schemes in place of local_scale's de Casteljau and a sum over the

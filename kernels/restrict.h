@@ -73,7 +73,7 @@ typedef struct {
   uint count;
   REAL x, y, z;
   REAL x0, x1, y0, y1, z0, z1; /* |x|, |y|, |z| at the segment's ends, for ray_terms_local */
-  /* a point form's shadow ray searched again (shadow.h, PointPartNoise): its local noise's two polynomials in t
+  /* a point form's shadow ray searched again (shadow.h, point_part_polys): its local noise's two polynomials in t
    * over [t_in, t_out]; null elsewhere */
   const REAL* part_terms;
   const REAL* part_scale;

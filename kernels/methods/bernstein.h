@@ -251,7 +251,7 @@ typedef struct {
   __global const uint* exps;
   __global const REAL* coefs;
   uint count;
-  /* The point form's shadow rays searched again (shadow.h, PointPartNoise): each lane's noise local to a part of
+  /* The point form's shadow rays searched again (shadow.h, point_part_polys): each lane's noise local to a part of
    * its segment [seg_in, seg_out], as one ray's (isolation.h, within_noise_at), from its two polynomials; 0
    * elsewhere. */
   int by_part;
@@ -313,7 +313,6 @@ ALGRAY_INLINE LREAL found_noise(LaneNoise* n, LMASK found) { return found ? exac
 typedef struct {
   LREAL noise;
   LREAL scale; /* max |b_k| of the coefficients the search starts from */
-  const LREAL* root;
   const LaneTerms* terms;
   LREAL part_lo, part_hi, part_noise; /* the last local noise computed, and its part */
   ProvenEnds proven;
@@ -327,7 +326,6 @@ static LaneNoise lanes_noise(const LREAL* root, LaneTerms* terms) {
   for (int k = 0; k <= DEGREE; ++k) magnitude[k] = fabs(root[k]);
   MAGNITUDE_TREE(magnitude, LANE_LARGER);
   n.scale = magnitude[0];
-  n.root = root;
   n.terms = terms;
   n.part_lo = n.part_hi = -1;
   n.part_noise = 0;
