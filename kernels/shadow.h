@@ -392,7 +392,7 @@ typedef struct {
   uint sample[LANES];
   uint count;
   LREAL terms;                                /* adaptive builds' */
-  LREAL dx, dy, dz;                           /* adaptive builds' */
+  LREAL dx, dy, dz;                           /* builds that search again */
   LREAL part_terms[NCOEF], part_scale[NCOEF]; /* the second queue's: the two polynomials */
   /* where each lane's last search stopped, and in the second queue where its first one did (SearchStart) */
   LREAL stop[NCOEF], stop_at, stop_width;
@@ -420,8 +420,8 @@ ALGRAY_INLINE int queue_lane(SearchQueue* queue, const LREAL* b, LREAL t_in, LRE
   for (int k = 0; k <= DEGREE; ++k) lane_set(&queue->b[k], at, lane_get(b[k], j));
   lane_set(&queue->t_in, at, lane_get(t_in, j));
   lane_set(&queue->t_out, at, lane_get(t_out, j));
-  if (ALGRAY_ESCALATE) {
-    lane_set(&queue->terms, at, lane_get(terms, j));
+  if (ALGRAY_ESCALATE) lane_set(&queue->terms, at, lane_get(terms, j));
+  if (POINT_SEARCHES_AGAIN) {
     lane_set(&queue->dx, at, lane_get(dx, j));
     lane_set(&queue->dy, at, lane_get(dy, j));
     lane_set(&queue->dz, at, lane_get(dz, j));
@@ -457,10 +457,10 @@ ALGRAY_INLINE LaneTerms queued_terms(const SearchQueue* queue, int again, __glob
 }
 
 /* The Bernstein search over the queue's lanes: the lanes it finds a root in (*found) and, in adaptive builds, those
- * it doubts (*doubted), as bits of the queue's entries. The first queue's search from the start of each segment,
- * leaving in *stopped where it stopped; the second queue's from there. */
-static void queue_search(const SearchQueue* queue, int again, __global const uint* exps, __global const REAL* coefs,
-                         uint count, uint* found, uint* doubted, SearchQueue* stopped) {
+ * it doubts (*doubted), as bits of the queue's entries. The first queue's search runs from the start of each
+ * segment, the second queue's from where the first stopped; each leaves in the queue where it stopped. */
+static void queue_search(SearchQueue* queue, int again, __global const uint* exps, __global const REAL* coefs,
+                         uint count, uint* found, uint* doubted) {
   const LMASK running = lanes_of_bits((1u << queue->count) - 1);
   LaneIsolation iso;
   LaneTerms terms = queued_terms(queue, again, exps, coefs, count);
@@ -469,12 +469,20 @@ static void queue_search(const SearchQueue* queue, int again, __global const uin
   start.at = queue->stop_at;
   start.width = queue->stop_width;
   isolate_bernstein_search(running, queue->b, queue->b, queue->t_in, queue->t_out,
-                           again ? &start : (const SearchStart*)0, &iso, stopped->stop,
+                           again ? &start : (const SearchStart*)0, &iso, queue->stop,
                            ALGRAY_ESCALATE ? &terms : (LaneTerms*)0, NO_PROBE);
-  stopped->stop_at = iso.lo;
-  stopped->stop_width = iso.hi - iso.lo;
+  queue->stop_at = iso.lo;
+  queue->stop_width = iso.hi - iso.lo;
   *found = lane_mask_bits(running && iso.status != (REAL)ISOLATION_NONE);
   *doubted = ALGRAY_ESCALATE ? lane_mask_bits(running && iso.doubt != (REAL)0) : 0u;
+}
+
+/* The samples of the queue's entries in `bits`. */
+ALGRAY_INLINE ulong queued_samples(const SearchQueue* queue, uint bits) {
+  ulong samples = 0;
+  for (uint j = 0; j < queue->count; ++j)
+    if ((bits >> j) & 1u) samples |= (ulong)1 << queue->sample[j];
+  return samples;
 }
 
 /* The samples whose segments in the second queue hold a root; *doubted gets those it doubts still. Emptied. */
@@ -482,12 +490,9 @@ static ulong search_again(SearchQueue* again, PointExpansion* e, ulong* doubted,
                           __global const REAL* coefs, uint count) {
   point_part_polys(e, exps, coefs, count, again->dx, again->dy, again->dz, again->part_terms, again->part_scale);
   uint found_bits, doubt_bits;
-  queue_search(again, 1, exps, coefs, count, &found_bits, &doubt_bits, again); /* its own stops: not read again */
-  ulong found = 0;
-  for (uint j = 0; j < again->count; ++j) {
-    if ((found_bits >> j) & 1u) found |= (ulong)1 << again->sample[j];
-    if ((doubt_bits >> j) & 1u) *doubted |= (ulong)1 << again->sample[j];
-  }
+  queue_search(again, 1, exps, coefs, count, &found_bits, &doubt_bits);
+  const ulong found = queued_samples(again, found_bits);
+  *doubted |= queued_samples(again, doubt_bits);
   again->count = 0;
   return found;
 }
@@ -498,12 +503,9 @@ static ulong search_again(SearchQueue* again, PointExpansion* e, ulong* doubted,
 static ulong search_queued(SearchQueue* queue, SearchQueue* again, PointExpansion* e, ulong* doubted,
                            __global const uint* exps, __global const REAL* coefs, uint count) {
   uint found_bits, doubt_bits;
-  queue_search(queue, 0, exps, coefs, count, &found_bits, &doubt_bits, queue);
-  ulong found = 0;
-  for (uint j = 0; j < queue->count; ++j) {
-    if ((found_bits >> j) & 1u) found |= (ulong)1 << queue->sample[j];
-    if (!POINT_SEARCHES_AGAIN && ((doubt_bits >> j) & 1u)) *doubted |= (ulong)1 << queue->sample[j];
-  }
+  queue_search(queue, 0, exps, coefs, count, &found_bits, &doubt_bits);
+  ulong found = queued_samples(queue, found_bits);
+  if (!POINT_SEARCHES_AGAIN) *doubted |= queued_samples(queue, doubt_bits);
   if (POINT_SEARCHES_AGAIN && doubt_bits)
     for (uint j = 0; j < queue->count; ++j) {
       if (!((doubt_bits >> j) & 1u)) continue;
