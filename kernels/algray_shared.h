@@ -143,13 +143,13 @@ typedef struct {
 #define ALGRAY_EVENT_DOUBT 7        /* adaptive precision: a decision within the coefficients' rounding noise, which
                                        ends the float search. decision: ALGRAY_DOUBT_*; level: halving level;
                                        values: the interval's lo, hi, the value in question, the noise bound */
-#define ALGRAY_EVENT_CONFIRMED 8    /* adaptive precision: a flat-doubted root kept after all (confirm_flat_roots).
-                                       decision: 0 evaluated in float, 1 in float-float; values: P and its
-                                       rounding bound at t - delta, then at t + delta. Decision 2: an
-                                       accept-doubted bracket kept (methods/bernstein.h, settle_brackets), values P
-                                       in float-float and its bound at the bracket's ends. Decision 3: a
-                                       discard-doubted interval settled (methods/bernstein.h, discards_settled), values
-                                       P and its bound at the interval's ends */
+/* ALGRAY_EVENT_CONFIRMED, adaptive precision: a doubt settled after all. Decision 0: a flat-doubted root kept
+ * (confirm_flat_roots), P from the monomials in float, values P and its rounding bound at t - delta, then at
+ * t + delta; decision 1: the same in float-float. Decision 2: an accept-doubted bracket kept (methods/bernstein.h,
+ * settle_brackets), values P and its bound at the bracket's ends, level 1 where float-float evaluated them, 0 where
+ * float did. Decision 3: a discard-doubted interval settled (methods/bernstein.h, discards_settled), values P and its
+ * bound at the interval's ends. */
+#define ALGRAY_EVENT_CONFIRMED 8
 
 /* What an isolation found (kernels/isolation.h's Isolation.status) */
 #define ALGRAY_ISOLATED_NONE 0    /* certified: no root in [t_in, t_out] (up to the tolerance) */

@@ -103,18 +103,6 @@ static LREAL direct_value_ff(const LaneRays* r, FloatFloat t, __global const uin
  * same point): float's sign there proven. Of one ray or of lanes. */
 #define SIGN_PROVEN(v, rounding, c) ((c) != 0 && fabs(v) > (rounding) && ((v) > 0) == ((c) > 0))
 
-/* Lanes in `doubted` whose isolating interval [lo, hi] (fractions of [t_in, t_out]) has P, in float-float at both
- * ends, of the signs float gave there (f_lo, f_hi, which differ), each value beyond its rounding: then P changes
- * sign inside, as surely as where float's own end values stand clear of its noise. *v_lo ... *rounding_hi: the
- * values and their bounds. */
-static LMASK bracket_ends_in_float_float(LMASK doubted, const LaneRays* r, LREAL t_in, LREAL t_out, LREAL lo, LREAL hi,
-                                         LREAL f_lo, LREAL f_hi, __global const uint* exps, __global const REAL* coefs,
-                                         uint count, LREAL* v_lo, LREAL* rounding_lo, LREAL* v_hi, LREAL* rounding_hi) {
-  *v_lo = direct_value_ff(r, ff_segment_point(t_in, t_out, lo), exps, coefs, count, rounding_lo);
-  *v_hi = direct_value_ff(r, ff_segment_point(t_in, t_out, hi), exps, coefs, count, rounding_hi);
-  return doubted && SIGN_PROVEN(*v_lo, *rounding_lo, f_lo) && SIGN_PROVEN(*v_hi, *rounding_hi, f_hi);
-}
-
 /* P in float-float at the search's last interval ends evaluated (fractions of [t_in, t_out]; -1 where none yet),
  * with its rounding bounds, of one ray or of lanes: an interval doubted for an end value within the noise reads
  * the sign there from these (proven_sign_of), and its halves and its neighbour, which share that end, read it

@@ -6,6 +6,7 @@
 #include "algray_shared.h"
 #include "float_float.h"
 #include "lanes.h"
+#include "point_values.h"
 #include "ray.h"
 #include "real.h"
 #include "restrict.h"
@@ -296,7 +297,7 @@ ALGRAY_INLINE REAL3 lane_direction(const LaneRays* rays, uint j) {
  * (isolate_method); lanes together, in the Bernstein search, the one method built for lanes (refine.h). c gets each
  * lane's polynomial on its isolating interval, for refine_rays. Lanes from `count` on, and those whose ray missed the
  * extent (in_extent[j] == 0), are left alone. rays: the lanes' rays in unit coordinates, where adaptive builds'
- * search evaluates P in float-float (bracket_ends_in_float_float). */
+ * search evaluates P from the monomials (point_values.h, bracket_ends_proven). */
 static void isolate_rays(uint count, const int* in_extent, const LaneRays* rays, REAL (*root)[NCOEF],
                          REAL (*root_lo)[NCOEF], const REAL* t_in, const REAL* t_out, LaneIsolation* iso, LREAL* c,
                          RayTerms* terms, ProbeLog* probe_log) {
@@ -319,36 +320,14 @@ static void isolate_rays(uint count, const int* in_extent, const LaneRays* rays,
 }
 
 /* Adaptive builds: a root doubted as flat (refine_rays) is kept after all where P, evaluated from the
- * monomials at t -+ ALGRAY_DOUBT_POSITION |t| on the ray, has opposite signs beyond that evaluation's rounding:
- * then a root lies within what the flat check allows. The check held the root to the coefficients' noise, which
- * sums the terms over the whole segment, out to the extent's sphere; at a root inside, the terms are far smaller
- * (the Barth decic's flat-doubted roots: 1e-4 to 2e-3 of the segment's), and so is P's rounding there.
- * Measured on the decic at 1024x768: 61% fewer camera rays traced again (bench/RESULTS.md). Where float's
+ * monomials (point_values.h, direct_value) at t -+ ALGRAY_DOUBT_POSITION |t| on the ray, has opposite signs beyond that
+ * evaluation's rounding: then a root lies within what the flat check allows. The check held the root to the
+ * coefficients' noise, which sums the terms over the whole segment, out to the extent's sphere; at a root inside, the
+ * terms are far smaller (the Barth decic's flat-doubted roots: 1e-4 to 2e-3 of the segment's), and so is P's rounding
+ * there. Measured on the decic at 1024x768: 61% fewer camera rays traced again (bench/RESULTS.md). Where float's
  * rounding is still too large (surfaces whose monomials cancel by orders of magnitude, such as Chebyshev sums),
  * P is evaluated again in float-float, whose rounding is float's squared: over the lanes together, that costs less
  * than the second pass even in double (bench/history/2026-12.md, "Flat roots confirmed in float-float"). */
-/* P at q from the monomials (the power tables of axis_powers, restrict.h), and a bound on its rounding: the
- * products, the sum, and the rounding of q's coordinates and of the coefficients, each of at most REAL_EPS / 2
- * per operation to first order, with room. */
-static REAL direct_value(REAL3 q, __global const uint* exps, __global const REAL* coefs, uint count, REAL* rounding) {
-  REAL px[NCOEF], py[NCOEF], pz[NCOEF];
-  axis_powers(q, px, py, pz);
-  REAL value = 0, size = 0;
-  for (uint m = 0; m < count; ++m) {
-    const uint e = exps[m];
-    const REAL term = coefs[m] * px[e & 0xffu] * py[(e >> 8) & 0xffu] * pz[(e >> 16) & 0xffu];
-    value += term;
-    size += fabs(term);
-  }
-  *rounding = size * (REAL)(2 * DEGREE + 4 + (int)count) * REAL_EPS;
-  return value;
-}
-
-/* Whether values v0 and v1 stand beyond their roundings with opposite signs (of one ray or of lanes): then P
- * changes sign between them. */
-#define CERTAIN_SIGN_CHANGE(v0, rounding0, v1, rounding1) \
-  (fabs(v0) > (rounding0) && fabs(v1) > (rounding1) && ((v0) > 0) != ((v1) > 0))
-
 /* The float-float check of confirm_flat_roots for the lanes in `doubted` (roots at t, rays r from their starts),
  * at t -+ delta with delta shrunk by 2^-10, so that their own rounding keeps the points within
  * ALGRAY_DOUBT_POSITION |t| of t; the lanes it confirms. *v0 ... *rounding1: the values and their bounds. */

@@ -93,9 +93,10 @@ TEST_CASE("lanes give the one-ray kernel's hit records bit for bit", "[lanes]") 
   CHECK(hits > cases.size() * 100);  // the surfaces are in view: the comparison covers refined roots
 }
 
-// Adaptive precision's float-float checks (kernels/float_float.h): flat-doubted roots confirmed lane by lane in
-// float, then the lanes still in doubt together (surface.h, confirmed_in_float_float); brackets doubted for their
-// end values settled together after the search (bernstein method). The one-ray kernel does both one ray at a time. On
+// Adaptive precision's checks of P from the monomials (kernels/point_values.h, float_float.h): flat-doubted roots
+// confirmed lane by lane in float, then the lanes still in doubt together in float-float (surface.h,
+// confirmed_in_float_float); brackets doubted for their end values settled after the search likewise (bernstein
+// method, bracket_ends_proven). The one-ray kernel does both one ray at a time. On
 // the first two hard surfaces most doubted roots go through float-float (tests/test_probe); the torus shell's
 // doubts are mostly brackets.
 TEST_CASE("lanes settle doubts in float-float as the one-ray kernel does, bit for bit", "[lanes]") {

@@ -505,11 +505,45 @@ TEST_CASE("a flat-doubted root that P's values confirm is kept: one trace, the r
   CHECK(check_confirmed_roots("tests/data/hard_surfaces/tooth_cubed.toml", false, context) > 0);
 }
 
-TEST_CASE("a bracket doubted for its end values that float-float settles is kept: one trace, the render's record",
+TEST_CASE("a bracket doubted for its end values that P's values settle is kept: one trace, the render's record",
           "[probe]") {
   RenderContext context("", true);
-  // The Kummer shell's two sheets lie within float's noise of each other: its brackets' end values often do too.
+  // The Kummer shell's two sheets lie within float's noise of each other: its brackets' end values often do too,
+  // and float's rounding of P from the monomials is too large there: float-float settles them. The Barth decic's
+  // brackets are settled in float.
   CHECK(check_confirmed_roots("tests/data/hard_surfaces/kummer_shell.toml", true, context) == 4);
+}
+
+TEST_CASE("a bracket float's own evaluation of P settles needs no float-float: one trace, the render's record",
+          "[probe]") {
+  // One of the three brackets of the Barth decic at 160x120 that P from the monomials settles in float
+  // (kernels/point_values.h, bracket_ends_proven: found by rendering with those brackets left unsettled).
+  RenderContext context("", true);
+  const Scene scene = load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_decic.toml",
+                                      {{"image.width", "160"},
+                                       {"image.height", "120"},
+                                       {"render.precision", "\"adaptive\""},
+                                       {"render.preview", "true"}});
+  Renderer renderer(context.session(), context.cache());
+  const RenderResult render = renderer.render_with_records(scene);
+  const HitRecord& rendered = render.hits.at(68, 81);
+  ProbeTarget target{false, 68, 81, {}, {}};
+  const std::vector<SurfaceProbe> probes = probe_scene(scene, target, false, context);
+  const SolverTrace& trace = probes.at(0).traces.at(0);
+  REQUIRE(trace.confirmed.has_value());
+  CHECK(trace.confirmed->bracket);
+  CHECK_FALSE(trace.confirmed->float_float);
+  REQUIRE(trace.doubt.has_value());
+  CHECK(doubt_reason(static_cast<unsigned>(trace.doubt->reason))->id == ALGRAY_DOUBT_ACCEPT);
+  CHECK(probes[0].traces.size() == 1);
+  CHECK((trace.hit.flags & ALGRAY_HIT_DOUBT) == 0);
+  CHECK(std::fabs(trace.confirmed->before) > trace.confirmed->before_rounding);
+  CHECK(std::fabs(trace.confirmed->after) > trace.confirmed->after_rounding);
+  CHECK((trace.confirmed->before > 0) != (trace.confirmed->after > 0));
+  CHECK(std::memcmp(&trace.hit, &rendered, offsetof(HitRecord, flags)) == 0);
+  REQUIRE(probes[0].reference.certificate.cls == PixelClass::SimpleRoot);
+  const double t_ref = probes[0].reference.roots.at(0).t;
+  CHECK(std::fabs(trace.t - t_ref) <= ALGRAY_DOUBT_POSITION * std::fabs(t_ref) * 1.01);
 }
 
 TEST_CASE(

@@ -5,6 +5,7 @@
 #include "float_float.h"
 #include "isolation.h"
 #include "lanes.h"
+#include "point_values.h"
 
 /* Mixed precision isolates in float-float: every Bernstein coefficient is an unevaluated sum hi + lo, and the
  * *_lo arrays below hold the low parts (other builds never touch them). Rounding the coefficients to float
@@ -231,7 +232,7 @@ ALGRAY_INLINE LREAL lanes_smaller_end(const LREAL* c, LREAL lo) {
 }
 
 /* What the search of an adaptive build needs of its rays: their terms, which it measures its noise by, and the
- * rays in unit coordinates with the monomials, where it evaluates P in float-float (float_float.h). One ray takes
+ * rays in unit coordinates with the monomials, where it evaluates P (point_values.h, float_float.h). One ray takes
  * RayTerms (restrict.h) and sums its terms only when a value falls within their upper bound's noise; lanes take
  * every lane's terms summed. Other builds never read it. */
 #if LANES == 1
@@ -561,10 +562,10 @@ ALGRAY_INLINE void move_on(BernsteinSearch* s, LMASK move, const LREAL* root, co
 }
 
 /* Adaptive camera and secondary rays: the brackets doubted for an end value within the noise (brackets_doubted) are
- * settled after all where P's values at their ends in float-float have float's signs beyond their rounding
- * (bracket_ends_in_float_float). A stopped lane keeps its interval and coefficients, so they are checked here
- * together, in one evaluation for the lanes rather than one per step that doubted some. The probe sees what
- * settled it (ALGRAY_EVENT_CONFIRMED, decision 2). */
+ * settled after all where P's values at their ends from the monomials, in float or else in float-float, have float's
+ * signs beyond their rounding (point_values.h, bracket_ends_proven). A stopped lane keeps its interval and
+ * coefficients, so they are checked here together, rather than in each step that doubted some. The probe sees what
+ * settled it (ALGRAY_EVENT_CONFIRMED, decision 2; level 1 where float-float did). */
 ALGRAY_INLINE void settle_brackets(BernsteinSearch* s, LaneTerms* terms, LREAL t_in, LREAL t_out,
                                    ProbeLog* probe_log) {
   if (!ALGRAY_ESCALATE || ALGRAY_SHADOW_RAYS) return;
@@ -572,10 +573,12 @@ ALGRAY_INLINE void settle_brackets(BernsteinSearch* s, LaneTerms* terms, LREAL t
   if (!LANE_ANY(doubted)) return;
   const LaneRays rays = terms_rays(terms);
   LREAL v_lo, rounding_lo, v_hi, rounding_hi;
+  LMASK in_float_float;
   const LMASK settled =
-      bracket_ends_in_float_float(doubted, &rays, t_in, t_out, s->at, s->at + s->width, s->cur[0], s->cur[DEGREE],
-                                  terms->exps, terms->coefs, terms->count, &v_lo, &rounding_lo, &v_hi, &rounding_hi);
-  if (LANE_ANY(settled)) PROBE(ALGRAY_EVENT_CONFIRMED, 0, 2u, 0u, v_lo, rounding_lo, v_hi, rounding_hi);
+      bracket_ends_proven(doubted, &rays, t_in, t_out, s->at, s->at + s->width, s->cur[0], s->cur[DEGREE], terms->exps,
+                          terms->coefs, terms->count, &v_lo, &rounding_lo, &v_hi, &rounding_hi, &in_float_float);
+  if (LANE_ANY(settled))
+    PROBE(ALGRAY_EVENT_CONFIRMED, 0, 2u, LANE_ANY(in_float_float) ? 1u : 0u, v_lo, rounding_lo, v_hi, rounding_hi);
   s->status = LANE_SEL(s->status, (LREAL)ISOLATION_BRACKET, settled);
   s->doubt = LANE_SEL(s->doubt, (LREAL)0, settled);
 }

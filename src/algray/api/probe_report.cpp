@@ -190,13 +190,13 @@ void print_settled_discards(std::ostream& out, const SolverTrace& tr) {
   }
 }
 
-// How the doubt ended: settled in float-float or confirmed (the render keeps the answer), else the next trace.
+// How the doubt ended: settled or confirmed by P from the monomials (the render keeps the answer), else the next trace.
 void print_doubt_outcome(std::ostream& out, const std::optional<ProbeConfirmed>& confirmed) {
   if (confirmed && confirmed->bracket)
-    out << "; settled: P from the monomials in float-float is " << num(confirmed->before, 4) << " (rounding "
-        << num(confirmed->before_rounding, 3) << ") at the interval's start and " << num(confirmed->after, 4)
-        << " (rounding " << num(confirmed->after_rounding, 3)
-        << ") at its end, the signs float gave: the render keeps this bracket\n";
+    out << "; settled: P from the monomials" << (confirmed->float_float ? " in float-float" : "") << " is "
+        << num(confirmed->before, 4) << " (rounding " << num(confirmed->before_rounding, 3)
+        << ") at the interval's start and " << num(confirmed->after, 4) << " (rounding "
+        << num(confirmed->after_rounding, 3) << ") at its end, the signs float gave: the render keeps this bracket\n";
   else if (confirmed && confirmed->discard)
     out << "; settled: P at the interval's ends is " << num(confirmed->before, 4) << " (bound "
         << num(confirmed->before_rounding, 3) << ") and " << num(confirmed->after, 4) << " (bound "

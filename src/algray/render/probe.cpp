@@ -63,8 +63,13 @@ void decode_events(const std::vector<ProbeEvent>& events, const std::vector<doub
         trace.confirmed.reset();  // a settled bracket's root may be doubted again, as flat
         break;
       case ALGRAY_EVENT_CONFIRMED:
-        trace.confirmed =
-            ProbeConfirmed{v[0], v[1], v[2], v[3], e.decision >= 1, e.decision == 2, e.decision == 3};
+        trace.confirmed = ProbeConfirmed{v[0],
+                                         v[1],
+                                         v[2],
+                                         v[3],
+                                         e.decision == 1 || e.decision == 3 || (e.decision == 2 && e.level != 0),
+                                         e.decision == 2,
+                                         e.decision == 3};
         if (trace.confirmed->discard && trace.doubt) trace.settled_discards.emplace_back(*trace.doubt, *trace.confirmed);
         break;
       default:

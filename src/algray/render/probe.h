@@ -59,7 +59,7 @@ struct ProbeDoubt {
 struct ProbeConfirmed {
   double before = 0, before_rounding = 0;
   double after = 0, after_rounding = 0;
-  bool float_float = false;  // evaluated in float-float, float's rounding having been too large
+  bool float_float = false;  // evaluated in float-float, float's rounding having been too large (discards: always)
   bool bracket = false;      // the bracket's ends, with the signs float gave there
   bool discard = false;      // a root-free interval's ends, of its coefficients' sign (at an end that stood clear of
                              // the noise, float's value and that noise)
