@@ -8,31 +8,43 @@
 #include "real.h"
 #include "restrict.h"
 
-/* P at q from the monomials (the power tables of axis_powers, restrict.h), and a bound on its rounding. Each term's
- * roundings (the powers, the coefficient, the products and q's coordinates) are at most 2 DEGREE + 4 of REAL_EPS / 2
- * relative to |term|; each addition's at most REAL_EPS / 2 of the partial sum it leaves, and the bound adds up those
- * partial sums as they run (a running error bound, Higham, "Accuracy and Stability of Numerical Algorithms", 3.1).
- * Near a root the terms cancel and the partial sums stay far below count times the terms' sum, which bounded the
- * additions until 2026-12-07. Four partial sums, each a chain of additions waiting on the one before, paired at the
- * end. REAL_EPS per rounding, twice what each can be, is the room for second-order terms and for the bound's own
- * sums. Measured on the Barth decic (1024x768 preview, float): of its 42,400 flat-doubted roots, the float
- * evaluations left 6,068 to float-float with the terms' sum times count, 1,603 with this bound. */
-static REAL direct_value(REAL3 q, __global const uint* exps, __global const REAL* coefs, uint count, REAL* rounding) {
-  REAL px[NCOEF], py[NCOEF], pz[NCOEF];
-  axis_powers(q, px, py, pz);
-  REAL value[4] = {0, 0, 0, 0}, size[4] = {0, 0, 0, 0}, partial[4] = {0, 0, 0, 0};
+/* P at two points q0 and q1 from the monomials, side by side in the two lanes of a vector (one chain of operations
+ * for both: two scalar evaluations were a tenth of the Barth decic's float camera pass), and a bound on each one's
+ * rounding. Each term's roundings (the powers, the coefficient, the products and the point's coordinates) are at
+ * most 2 DEGREE + 4 of REAL_EPS / 2 relative to |term|; each addition's at most REAL_EPS / 2 of the partial sum it
+ * leaves, and the bound adds up those partial sums as they run (a running error bound, Higham, "Accuracy and
+ * Stability of Numerical Algorithms", 3.1). Near a root the terms cancel and the partial sums stay far below count
+ * times the terms' sum, which bounded the additions until 2026-12-07. Four partial sums, each a chain of additions
+ * waiting on the one before, paired at the end. REAL_EPS per rounding, twice what each can be, is the room for
+ * second-order terms and for the bound's own sums. Measured on the Barth decic (1024x768 preview, float): of its
+ * 42,400 flat-doubted roots, the float evaluations left 6,068 to float-float with the terms' sum times count, 1,603
+ * with this bound. */
+static REAL2 direct_values(REAL3 q0, REAL3 q1, __global const uint* exps, __global const REAL* coefs, uint count,
+                           REAL2* rounding) {
+  const REAL2 x = (REAL2)(q0.x, q1.x), y = (REAL2)(q0.y, q1.y), z = (REAL2)(q0.z, q1.z);
+  REAL2 px[NCOEF], py[NCOEF], pz[NCOEF];
+  px[0] = py[0] = pz[0] = (REAL2)(1);
+  ALGRAY_UNROLL
+  for (int n = 1; n <= DEGREE; ++n) {
+    px[n] = px[n - 1] * x;
+    py[n] = py[n - 1] * y;
+    pz[n] = pz[n - 1] * z;
+  }
+  REAL2 value[4], size[4], partial[4];
+  ALGRAY_UNROLL
+  for (int a = 0; a < 4; ++a) value[a] = size[a] = partial[a] = (REAL2)(0);
   for (uint m = 0; m < count; m += 4) ALGRAY_UNROLL
   for (uint a = 0; a < 4; ++a) {
     if (m + a >= count) break;
     const uint e = exps[m + a];
-    const REAL term = coefs[m + a] * px[e & 0xffu] * py[(e >> 8) & 0xffu] * pz[(e >> 16) & 0xffu];
+    const REAL2 term = coefs[m + a] * px[e & 0xffu] * py[(e >> 8) & 0xffu] * pz[(e >> 16) & 0xffu];
     value[a] += term;
     size[a] += fabs(term);
     partial[a] += fabs(value[a]);
   }
-  const REAL low = value[0] + value[1], high = value[2] + value[3], sum = low + high;
-  const REAL sizes = (size[0] + size[1]) + (size[2] + size[3]);
-  const REAL partials =
+  const REAL2 low = value[0] + value[1], high = value[2] + value[3], sum = low + high;
+  const REAL2 sizes = (size[0] + size[1]) + (size[2] + size[3]);
+  const REAL2 partials =
       ((partial[0] + partial[1]) + (partial[2] + partial[3])) + ((fabs(low) + fabs(high)) + fabs(sum));
   *rounding = (sizes * (REAL)(2 * DEGREE + 4) + partials) * REAL_EPS;
   return sum;
@@ -46,7 +58,7 @@ static REAL direct_value(REAL3 q, __global const uint* exps, __global const REAL
 /* Lanes in `doubted` whose isolating interval [lo, hi] (fractions of [t_in, t_out] of the rays r) has P from the
  * monomials at both ends of the signs float gave there (f_lo, f_hi, which differ), each value beyond its rounding:
  * then P changes sign inside, as surely as where float's own end values stand clear of its noise. Lane by lane in
- * float first (direct_value at the ends as float places them, a sign change between points within float's rounding
+ * float first (direct_values at the ends as float places them, a sign change between points within float's rounding
  * of the ends), then, for the lanes float's rounding left open, together in float-float (direct_value_ff at the ends
  * to float's digits squared). Measured on the Barth decic (1024x768 preview, float): float settled 7,016 of the 7,654
  * brackets float-float settled alone, and the first pass took 40.6 -> 37.6 ms. *v_lo ... *rounding_hi: the values
@@ -64,10 +76,15 @@ static LMASK bracket_ends_proven(LMASK doubted, const LaneRays* r, LREAL t_in, L
     const REAL3 o = (REAL3)(lane_get(r->ox, j), lane_get(r->oy, j), lane_get(r->oz, j));
     const REAL3 d = (REAL3)(lane_get(r->dx, j), lane_get(r->dy, j), lane_get(r->dz, j));
     const REAL start = lane_get(t_in, j), length = lane_get(t_out, j) - start;
-    value_lo[j] = direct_value(o + (start + lane_get(lo, j) * length) * d, exps, coefs, count, &bound_lo[j]);
-    if (!SIGN_PROVEN(value_lo[j], bound_lo[j], lane_get(f_lo, j))) continue;
-    value_hi[j] = direct_value(o + (start + lane_get(hi, j) * length) * d, exps, coefs, count, &bound_hi[j]);
-    if (SIGN_PROVEN(value_hi[j], bound_hi[j], lane_get(f_hi, j))) proven_bits |= 1u << j;
+    REAL2 bound;
+    const REAL2 value = direct_values(o + (start + lane_get(lo, j) * length) * d,
+                                      o + (start + lane_get(hi, j) * length) * d, exps, coefs, count, &bound);
+    value_lo[j] = value.s0;
+    value_hi[j] = value.s1;
+    bound_lo[j] = bound.s0;
+    bound_hi[j] = bound.s1;
+    if (SIGN_PROVEN(value.s0, bound.s0, lane_get(f_lo, j)) && SIGN_PROVEN(value.s1, bound.s1, lane_get(f_hi, j)))
+      proven_bits |= 1u << j;
   }
   *v_lo = LANES_LOAD(value_lo);
   *rounding_lo = LANES_LOAD(bound_lo);

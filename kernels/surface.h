@@ -320,8 +320,8 @@ static void isolate_rays(uint count, const int* in_extent, const LaneRays* rays,
 }
 
 /* Adaptive builds: a root doubted as flat (refine_rays) is kept after all where P, evaluated from the
- * monomials (point_values.h, direct_value) at t -+ ALGRAY_DOUBT_POSITION |t| on the ray, has opposite signs beyond that
- * evaluation's rounding: then a root lies within what the flat check allows. The check held the root to the
+ * monomials (point_values.h, direct_values) at t -+ ALGRAY_DOUBT_POSITION |t| on the ray, has opposite signs beyond
+ * that evaluation's rounding: then a root lies within what the flat check allows. The check held the root to the
  * coefficients' noise, which sums the terms over the whole segment, out to the extent's sphere; at a root inside, the
  * terms are far smaller (the Barth decic's flat-doubted roots: 1e-4 to 2e-3 of the segment's), and so is P's rounding
  * there. Measured on the decic at 1024x768: 61% fewer camera rays traced again (bench/RESULTS.md). Where float's
@@ -353,11 +353,10 @@ static void confirm_flat_roots(uint count, LaneRoots* roots, const LaneRays* at,
     if (!((doubted_bits >> j) & 1u)) continue;
     const REAL delta = (REAL)ALGRAY_DOUBT_POSITION * fabs(lane_get(roots->t, j));
     const REAL3 u = lane_origin(at, j), d = lane_direction(at, j);
-    REAL rounding0, rounding1;
-    const REAL v0 = direct_value(u - delta * d, exps, coefs, mono_count, &rounding0);
-    const REAL v1 = direct_value(u + delta * d, exps, coefs, mono_count, &rounding1);
-    if (!CERTAIN_SIGN_CHANGE(v0, rounding0, v1, rounding1)) continue;
-    PROBE(ALGRAY_EVENT_CONFIRMED, 0, 0u, 0u, v0, rounding0, v1, rounding1);
+    REAL2 rounding;
+    const REAL2 v = direct_values(u - delta * d, u + delta * d, exps, coefs, mono_count, &rounding);
+    if (!CERTAIN_SIGN_CHANGE(v.s0, rounding.s0, v.s1, rounding.s1)) continue;
+    PROBE(ALGRAY_EVENT_CONFIRMED, 0, 0u, 0u, v.s0, rounding.s0, v.s1, rounding.s1);
     ((LANE_INT*)&roots->flags)[j] &= ~ALGRAY_HIT_DOUBT;
   }
   const LMASK still = found && (roots->flags & (LANE_INT_VEC)ALGRAY_HIT_DOUBT) != 0;

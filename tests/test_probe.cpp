@@ -499,8 +499,8 @@ int check_confirmed_roots(const char* file, bool brackets, RenderContext& contex
 
 TEST_CASE("a flat-doubted root that P's values confirm is kept: one trace, the render's record", "[probe]") {
   RenderContext context("", true);
-  // The Barth decic's doubted roots are confirmed in float; the cubed tooth's, every root nearly triple and its
-  // monomials cancelling, need float-float.
+  // The Barth decic's doubted roots are confirmed (most in float at 1024x768; the first four of this scan in
+  // float-float); the cubed tooth's, every root nearly triple and its monomials cancelling, need float-float.
   check_confirmed_roots("scenes/barth_decic.toml", false, context);
   CHECK(check_confirmed_roots("tests/data/hard_surfaces/tooth_cubed.toml", false, context) > 0);
 }
