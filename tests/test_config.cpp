@@ -261,6 +261,33 @@ TEST_CASE("the float shadow kernel takes as many lanes as a vector register hold
         default_lanes("CPU"));
 }
 
+TEST_CASE("the rays traced again take as many lanes as a vector register holds in their precision", "[config]") {
+  const Scene scene = load_scene_text(kSphereScene, "t.toml");
+  const auto trace_lanes = [&](Precision precision, Precision escalation,
+                               std::vector<std::pair<unsigned, unsigned>> widths) {
+    std::vector<PlanDevice> devices;
+    for (const auto& [floats, doubles] : widths) {
+      DeviceInfo cpu;
+      cpu.type = "CPU";
+      cpu.native_float_width = floats;
+      cpu.native_double_width = doubles;
+      devices.push_back({cpu, escalation});
+    }
+    const RenderPlan plan = make_render_plan(scene, precision, devices);
+    const PlannedPass& primary = *plan.find(PassKind::Primary);
+    REQUIRE(primary.escalation.size() == 1);
+    CHECK(primary.escalation[0].entry == "trace");
+    CHECK(primary.kernels.at(0).lanes == default_lanes("CPU"));  // the first pass keeps its lanes
+    return primary.escalation[0].lanes;
+  };
+  CHECK(trace_lanes(Precision::Adaptive, Precision::Double, {{8, 4}}) == 4);           // AVX2: four doubles
+  CHECK(trace_lanes(Precision::Adaptive, Precision::Mixed, {{8, 4}}) == 8);            // float-float in floats
+  CHECK(trace_lanes(Precision::Float, Precision::Double, {{8, 4}}) == 8);              // plain float's second pass
+  CHECK(trace_lanes(Precision::Adaptive, Precision::Double, {{16, 8}}) == 8);          // AVX-512
+  CHECK(trace_lanes(Precision::Adaptive, Precision::Double, {{16, 8}, {8, 4}}) == 4);  // what every device holds
+  CHECK(trace_lanes(Precision::Adaptive, Precision::Double, {{0, 0}}) == default_lanes("CPU"));  // not known
+}
+
 TEST_CASE("the point form's doubted shadow rays go through float's extent form before float-float", "[config]") {
   // Full mode with a shadow-casting light: adaptive's shadow pass is the float point form (degree 2).
   Scene scene = load_scene_text(std::string(kSphereScene) + "[[light]]\nposition = [3, 3, 3]\n", "t.toml",

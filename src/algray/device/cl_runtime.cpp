@@ -62,6 +62,7 @@ std::vector<DeviceInfo> enumerate_devices() {
       info.type = type_name(d.getInfo<CL_DEVICE_TYPE>());
       info.compute_units = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
       info.native_float_width = d.getInfo<CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT>();
+      info.native_double_width = d.getInfo<CL_DEVICE_NATIVE_VECTOR_WIDTH_DOUBLE>();
       const bool fp64 = d.getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>() != 0;
       info.fp64_hidden = fp64 && fp64_hidden_by_environment();
       info.fp64 = fp64 && !info.fp64_hidden;

@@ -86,6 +86,9 @@ int float_shadow_lanes(unsigned native_float_width) {
 int shadow_lanes(int lanes, Precision precision, int float_lanes) {
   return std::min(lanes, precision == Precision::Double ? kMaxShadowLanes : float_lanes);
 }
+int escalation_lanes(int lanes, unsigned native_width) {
+  return native_width == 0 ? lanes : std::min(lanes, static_cast<int>(native_width));
+}
 bool lanes_apply(const KernelConfig& c) {
   if (c.entry == "shadow") return c.ray_origin == RayOrigin::Point;  // the extent form batches its own way
   return (c.entry == "primary" || c.entry == "trace") && lanes_supported(c.isolation, c.refinement);

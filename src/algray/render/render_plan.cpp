@@ -71,6 +71,18 @@ void escalate_in(RenderPlan& plan, Precision precision) {
 
 namespace {
 
+// The trace kernel's second pass (doubted camera rays, antialiasing samples and bounces) in as many lanes as one of
+// every device's vector registers holds in its precision (escalation_lanes).
+void narrow_escalation_lanes(RenderPlan& plan, const std::vector<PlanDevice>& devices) {
+  for (PlannedPass& pass : plan.passes)
+    for (KernelConfig& c : pass.escalation) {
+      if (c.entry != "trace" || c.lanes == 1) continue;
+      for (const PlanDevice& device : devices)
+        c.lanes = escalation_lanes(c.lanes, c.precision == Precision::Double ? device.info.native_double_width
+                                                                             : device.info.native_float_width);
+    }
+}
+
 // Adaptive precision with a float-float second pass: the point form's doubted shadow rays through float's extent
 // construction first (PlannedPass::float_escalation). Its first pass settles doubts only by searching its doubted
 // rays again by each part's noise (kernels/shadow.h, point_part_polys; Barth decic, 1024x768, no fp64: 3.30 ->
@@ -416,6 +428,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::
     escalate_in(plan, all_fast ? Precision::Double : Precision::Mixed);
     if (!all_fast) escalate_point_form_in_float(plan);
   }
+  narrow_escalation_lanes(plan, devices);
   plan_shading(plan, scene, devices);
   return plan;
 }
