@@ -78,7 +78,7 @@ typedef struct {
   const REAL* part_terms;
   const REAL* part_scale;
   /* camera and secondary rays: the ray o + t d in unit coordinates and its segment, where P is evaluated again
-   * in float-float (float_float.h; has_ray 0 elsewhere) */
+   * from the monomials (point_values.h, float_float.h; has_ray 0 elsewhere) */
   int has_ray;
   REAL3 o, d;
   REAL t_in, t_out;
