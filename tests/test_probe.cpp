@@ -450,15 +450,44 @@ TEST_CASE("a ray adaptive precision doubts: the probe says why, and the second p
 
 namespace {
 
-// Scans a preview of `file` (in the source tree) in adaptive precision for the first four roots the float kernel
-// doubted and kept after all: flat roots P's values confirmed, or with `brackets` isolating intervals P's values at
-// their ends settled. Returns how many of them were decided in float-float.
+// An adaptive preview of `file` (in the source tree), width x height.
+Scene adaptive_preview(const char* file, int width, int height) {
+  return load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/" + file, {{"image.width", std::to_string(width)},
+                                                                       {"image.height", std::to_string(height)},
+                                                                       {"render.precision", "\"adaptive\""},
+                                                                       {"render.preview", "true"}});
+}
+
+// A root the float kernel doubted and kept after all, as the probe traces it (probe: the pixel's surface probe, whose
+// first trace settled the doubt; rendered: the render's record of that pixel): a flat root P's values confirmed, or
+// with `brackets` an isolating interval P's values at its ends settled.
+void check_kept_doubt(const SurfaceProbe& probe, const HitRecord& rendered, bool brackets) {
+  const SolverTrace& trace = probe.traces.at(0);
+  REQUIRE(trace.confirmed.has_value());
+  CHECK(trace.confirmed->bracket == brackets);
+  REQUIRE(trace.doubt.has_value());
+  CHECK(doubt_reason(static_cast<unsigned>(trace.doubt->reason))->id ==
+        (brackets ? ALGRAY_DOUBT_ACCEPT : ALGRAY_DOUBT_FLAT));
+  CHECK(probe.traces.size() == 1);
+  CHECK((trace.hit.flags & ALGRAY_HIT_DOUBT) == 0);
+  // P changes sign across the root (or the bracket), each value beyond its rounding.
+  CHECK(std::fabs(trace.confirmed->before) > trace.confirmed->before_rounding);
+  CHECK(std::fabs(trace.confirmed->after) > trace.confirmed->after_rounding);
+  CHECK((trace.confirmed->before > 0) != (trace.confirmed->after > 0));
+  // The render kept this very root,
+  CHECK(std::memcmp(&trace.hit, &rendered, offsetof(HitRecord, flags)) == 0);
+  // which lies within ALGRAY_DOUBT_POSITION of its t from the certified smallest root, where there is one.
+  const PixelClass cls = probe.reference.certificate.cls;
+  if (cls == PixelClass::SimpleRoot || cls == PixelClass::OddMultipleRoot) {
+    const double t_ref = probe.reference.roots.at(0).t;
+    CHECK(std::fabs(trace.t - t_ref) <= ALGRAY_DOUBT_POSITION * std::fabs(t_ref) * 1.01);
+  }
+}
+
+// Scans a 96x72 adaptive preview of `file` for the first four roots the float kernel doubted and kept after all
+// (check_kept_doubt). Returns how many of them were decided in float-float.
 int check_confirmed_roots(const char* file, bool brackets, RenderContext& context) {
-  const Scene scene =
-      load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/" + file, {{"image.width", "96"},
-                                                                    {"image.height", "72"},
-                                                                    {"render.precision", "\"adaptive\""},
-                                                                    {"render.preview", "true"}});
+  const Scene scene = adaptive_preview(file, 96, 72);
   Renderer renderer(context.session(), context.cache());
   const RenderResult render = renderer.render_with_records(scene);
   int confirmed = 0, in_float_float = 0;
@@ -473,23 +502,7 @@ int check_confirmed_roots(const char* file, bool brackets, RenderContext& contex
       ++confirmed;
       in_float_float += trace.confirmed->float_float;
       INFO(file << ", pixel (" << px << ", " << py << ")");
-      REQUIRE(trace.doubt.has_value());
-      CHECK(doubt_reason(static_cast<unsigned>(trace.doubt->reason))->id ==
-            (brackets ? ALGRAY_DOUBT_ACCEPT : ALGRAY_DOUBT_FLAT));
-      CHECK(probes[0].traces.size() == 1);
-      CHECK((trace.hit.flags & ALGRAY_HIT_DOUBT) == 0);
-      // P changes sign across the root (or the bracket), each value beyond its rounding.
-      CHECK(std::fabs(trace.confirmed->before) > trace.confirmed->before_rounding);
-      CHECK(std::fabs(trace.confirmed->after) > trace.confirmed->after_rounding);
-      CHECK((trace.confirmed->before > 0) != (trace.confirmed->after > 0));
-      // The render kept this very root,
-      CHECK(std::memcmp(&trace.hit, &rendered, offsetof(HitRecord, flags)) == 0);
-      // which lies within ALGRAY_DOUBT_POSITION of its t from the certified smallest root, where there is one.
-      const PixelClass cls = probes[0].reference.certificate.cls;
-      if (cls == PixelClass::SimpleRoot || cls == PixelClass::OddMultipleRoot) {
-        const double t_ref = probes[0].reference.roots.at(0).t;
-        CHECK(std::fabs(trace.t - t_ref) <= ALGRAY_DOUBT_POSITION * std::fabs(t_ref) * 1.01);
-      }
+      check_kept_doubt(probes.at(0), rendered, brackets);
     }
   CHECK(confirmed == 4);
   return in_float_float;
@@ -519,31 +532,14 @@ TEST_CASE("a bracket float's own evaluation of P settles needs no float-float: o
   // One of the three brackets of the Barth decic at 160x120 that P from the monomials settles in float
   // (kernels/point_values.h, bracket_ends_proven: found by rendering with those brackets left unsettled).
   RenderContext context("", true);
-  const Scene scene = load_scene_file(std::string(ALGRAY_SOURCE_DIR) + "/scenes/barth_decic.toml",
-                                      {{"image.width", "160"},
-                                       {"image.height", "120"},
-                                       {"render.precision", "\"adaptive\""},
-                                       {"render.preview", "true"}});
+  const Scene scene = adaptive_preview("scenes/barth_decic.toml", 160, 120);
   Renderer renderer(context.session(), context.cache());
   const RenderResult render = renderer.render_with_records(scene);
-  const HitRecord& rendered = render.hits.at(68, 81);
   ProbeTarget target{false, 68, 81, {}, {}};
   const std::vector<SurfaceProbe> probes = probe_scene(scene, target, false, context);
-  const SolverTrace& trace = probes.at(0).traces.at(0);
-  REQUIRE(trace.confirmed.has_value());
-  CHECK(trace.confirmed->bracket);
-  CHECK_FALSE(trace.confirmed->float_float);
-  REQUIRE(trace.doubt.has_value());
-  CHECK(doubt_reason(static_cast<unsigned>(trace.doubt->reason))->id == ALGRAY_DOUBT_ACCEPT);
-  CHECK(probes[0].traces.size() == 1);
-  CHECK((trace.hit.flags & ALGRAY_HIT_DOUBT) == 0);
-  CHECK(std::fabs(trace.confirmed->before) > trace.confirmed->before_rounding);
-  CHECK(std::fabs(trace.confirmed->after) > trace.confirmed->after_rounding);
-  CHECK((trace.confirmed->before > 0) != (trace.confirmed->after > 0));
-  CHECK(std::memcmp(&trace.hit, &rendered, offsetof(HitRecord, flags)) == 0);
-  REQUIRE(probes[0].reference.certificate.cls == PixelClass::SimpleRoot);
-  const double t_ref = probes[0].reference.roots.at(0).t;
-  CHECK(std::fabs(trace.t - t_ref) <= ALGRAY_DOUBT_POSITION * std::fabs(t_ref) * 1.01);
+  check_kept_doubt(probes.at(0), render.hits.at(68, 81), true);
+  CHECK_FALSE(probes.at(0).traces.at(0).confirmed->float_float);
+  CHECK(probes.at(0).reference.certificate.cls == PixelClass::SimpleRoot);
 }
 
 TEST_CASE(
