@@ -32,7 +32,7 @@ int shadow_lanes(int lanes, Precision precision, int float_lanes = kMaxFloatShad
 // and float-float; 0, not known, leaves `lanes`). The doubted rays are scattered over the image and search for very
 // different lengths, and lanes wait on their slowest: with AVX2 at 1024x768 (Barth decic, Endrass octic) 4 lanes of
 // double took 0.80x and 0.84x the time of 16, 8 of float 0.97x and 0.91x, 8 of float-float 0.86x and 0.81x, and 2
-// or 1 lanes more than 4 (bench/history/2026-12.md, "Lanes for the rays traced again").
+// or 1 lanes more than 4 (bench/history/2026-12.md, "Camera rays' doubts settled in float first").
 int escalation_lanes(int lanes, unsigned native_width);
 
 // The -D switches build_options() writes, in its order; kernels/build_switches.h declares each one.
