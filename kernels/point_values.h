@@ -73,8 +73,7 @@ static LMASK bracket_ends_proven(LMASK doubted, const LaneRays* r, LREAL t_in, L
   for (uint j = 0; j < (uint)LANES; ++j) {
     value_lo[j] = value_hi[j] = bound_lo[j] = bound_hi[j] = 0; /* no sign proven */
     if (!((doubted_bits >> j) & 1u)) continue;
-    const REAL3 o = (REAL3)(lane_get(r->ox, j), lane_get(r->oy, j), lane_get(r->oz, j));
-    const REAL3 d = (REAL3)(lane_get(r->dx, j), lane_get(r->dy, j), lane_get(r->dz, j));
+    const REAL3 o = lane_origin(r, j), d = lane_direction(r, j);
     const REAL start = lane_get(t_in, j), length = lane_get(t_out, j) - start;
     REAL2 bound;
     const REAL2 value = direct_values(o + (start + lane_get(lo, j) * length) * d,

@@ -148,6 +148,14 @@ ALGRAY_INLINE LaneRays one_lane_rays(REAL3 o, REAL3 d) {
   return r;
 }
 
+/* Lane j of rays as one ray (REAL3 origin and direction). */
+ALGRAY_INLINE REAL3 lane_origin(const LaneRays* rays, uint j) {
+  return (REAL3)(lane_get(rays->ox, j), lane_get(rays->oy, j), lane_get(rays->oz, j));
+}
+ALGRAY_INLINE REAL3 lane_direction(const LaneRays* rays, uint j) {
+  return (REAL3)(lane_get(rays->dx, j), lane_get(rays->dy, j), lane_get(rays->dz, j));
+}
+
 /* One ray's clip_lanes_to_extent: the ray in every lane, lane 0 read (in one-ray builds, the only lane). */
 static int clip_to_extent(REAL3 o, REAL3 d, int kind, REAL3 box_half, __global const REAL4* clip_planes,
                           uint clip_count, REAL* t_in, REAL* t_out) {

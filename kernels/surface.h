@@ -285,14 +285,6 @@ static LMASK enter_extent(uint count, const LaneRays* rays, REAL3 centre, REAL i
   return inside;
 }
 
-/* Lane j of rays as one ray (REAL3 origin and direction). */
-ALGRAY_INLINE REAL3 lane_origin(const LaneRays* rays, uint j) {
-  return (REAL3)(lane_get(rays->ox, j), lane_get(rays->oy, j), lane_get(rays->oz, j));
-}
-ALGRAY_INLINE REAL3 lane_direction(const LaneRays* rays, uint j) {
-  return (REAL3)(lane_get(rays->dx, j), lane_get(rays->dy, j), lane_get(rays->dz, j));
-}
-
 /* The isolations of the rays from their segment_coefficients (root, root_lo are consumed): one ray by its method
  * (isolate_method); lanes together, in the Bernstein search, the one method built for lanes (refine.h). c gets each
  * lane's polynomial on its isolating interval, for refine_rays. Lanes from `count` on, and those whose ray missed the
