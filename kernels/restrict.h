@@ -396,16 +396,105 @@ ALGRAY_INLINE void acc_store(REAL* out, REAL* out_lo, const Acc* c) {
 #if ALGRAY_COMPENSATED
 #error "mixed precision supports degrees up to 15"
 #endif
-#define ACC_SLOTS NCOEF
+/* Above degree 15 a polynomial takes ACC_FULL 16-wide vectors and a tail of the narrowest vector type that holds
+ * the rest, coefficient k in lane k % 16 of vector k / 16, and a step is the vector step below degree 16 on each of
+ * them, a shift carrying the top lane of one vector into the bottom of the next: the same operations per coefficient,
+ * the shifted-in zero added as there. In scalar arrays (until 2026-12-07) LLVM left the restriction unvectorised,
+ * 94% of a degree-24 shadow pass, and float ran at 1.1x to 1.3x double's rate (bench/history/2026-12.md,
+ * "Restriction above degree 15 in vectors"); a whole 16-wide tail made degree 16's double pass 12% slower than the
+ * scalars. Lanes above the degree hold garbage (the binomial rows read on into the next row and the padding), which
+ * shifts only move higher. */
+#define ACC_FULL ((NCOEF - 1) / 16)
+#define ACC_TAIL (NCOEF - 16 * ACC_FULL) /* 1 to 16 coefficients */
+#if ACC_TAIL <= 2
+typedef REAL2 AccTail;
+#define TAIL_WIDTH 2
+#define TAIL_SHIFT(c, below) ((AccTail)((below), (c).s0))
+#define TAIL_LOAD(p) vload2(0, p)
+#define TAIL_STORE(v, p) vstore2(v, 0, p)
+#elif ACC_TAIL <= 4
+typedef REAL4 AccTail;
+#define TAIL_WIDTH 4
+#define TAIL_SHIFT(c, below) ((AccTail)((below), (c).s0, (c).s1, (c).s2))
+#define TAIL_LOAD(p) vload4(0, p)
+#define TAIL_STORE(v, p) vstore4(v, 0, p)
+#elif ACC_TAIL <= 8
+typedef REAL8 AccTail;
+#define TAIL_WIDTH 8
+#define TAIL_SHIFT(c, below) ((AccTail)((below), (c).s0, (c).s1, (c).s2, (c).s3, (c).s4, (c).s5, (c).s6))
+#define TAIL_LOAD(p) vload8(0, p)
+#define TAIL_STORE(v, p) vstore8(v, 0, p)
+#else
+typedef REAL16 AccTail;
+#define TAIL_WIDTH 16
+#define TAIL_SHIFT(c, below) shift_in(c, below)
+#define TAIL_LOAD(p) vload16(0, p)
+#define TAIL_STORE(v, p) vstore16(v, 0, p)
+#endif
+#define ACC_SLOTS 1
 #define ACC_SQUARES 1
-typedef REAL Acc;
-#define acc_mul_linear poly_mul_linear
-#define acc_mul_quadratic poly_mul_quadratic
-#define acc_add_constant(c, n, a, a_lo, binomials) ((void)(a_lo), poly_add_constant(c, n, a, binomials))
-#define acc_add poly_add
-#define acc_copy poly_copy
-#define acc_set_constant(c, a, a_lo) ((void)(a_lo), poly_set_constant(c, a))
-#define acc_store(out, out_lo, c) ((void)(out_lo), poly_copy(out, c))
+typedef struct {
+  REAL16 v[ACC_FULL];
+  AccTail tail;
+} Acc;
+ALGRAY_INLINE REAL16 shift_in(REAL16 c, REAL below) {
+  return (REAL16)(below, c.s0, c.s1, c.s2, c.s3, c.s4, c.s5, c.s6, c.s7, c.s8, c.s9, c.sa, c.sb, c.sc, c.sd, c.se);
+}
+/* c shifted up one coefficient, a zero below */
+ALGRAY_INLINE Acc acc_shifted(const Acc* c) {
+  Acc r;
+  r.v[0] = shift_in(c->v[0], (REAL)0);
+  ALGRAY_UNROLL
+  for (int i = 1; i < ACC_FULL; ++i) r.v[i] = shift_in(c->v[i], c->v[i - 1].sf);
+  r.tail = TAIL_SHIFT(c->tail, c->v[ACC_FULL - 1].sf);
+  return r;
+}
+ALGRAY_INLINE void acc_mul_linear(Acc* c, REAL l0, REAL l1) {
+  const Acc s = acc_shifted(c);
+  ALGRAY_UNROLL
+  for (int i = 0; i < ACC_FULL; ++i) c->v[i] = l0 * c->v[i] + l1 * s.v[i];
+  c->tail = l0 * c->tail + l1 * s.tail;
+}
+ALGRAY_INLINE void acc_mul_quadratic(Acc* c, REAL q0, REAL q1, REAL q2) {
+  const Acc s1 = acc_shifted(c);
+  const Acc s2 = acc_shifted(&s1);
+  ALGRAY_UNROLL
+  for (int i = 0; i < ACC_FULL; ++i) c->v[i] = q0 * c->v[i] + q1 * s1.v[i] + q2 * s2.v[i];
+  c->tail = q0 * c->tail + q1 * s1.tail + q2 * s2.tail;
+}
+ALGRAY_INLINE void acc_add_constant(Acc* c, int n, REAL a, REAL a_lo, __constant const REAL* binomials) {
+  (void)a_lo;
+  if (RESTRICT_BERNSTEIN) {
+    __constant const REAL* row = binomials + n * NCOEF;
+    ALGRAY_UNROLL
+    for (int i = 0; i < ACC_FULL; ++i) c->v[i] += a * vload16(i, row);
+    c->tail += a * TAIL_LOAD(row + 16 * ACC_FULL);
+  } else {
+    c->v[0].s0 += a;
+  }
+}
+ALGRAY_INLINE void acc_add(Acc* c, const Acc* other) {
+  ALGRAY_UNROLL
+  for (int i = 0; i < ACC_FULL; ++i) c->v[i] += other->v[i];
+  c->tail += other->tail;
+}
+ALGRAY_INLINE void acc_copy(Acc* dst, const Acc* src) { *dst = *src; }
+ALGRAY_INLINE void acc_set_constant(Acc* c, REAL a, REAL a_lo) {
+  (void)a_lo;
+  ALGRAY_UNROLL
+  for (int i = 0; i < ACC_FULL; ++i) c->v[i] = (REAL16)((REAL)0);
+  c->tail = (AccTail)((REAL)0);
+  c->v[0].s0 = a;
+}
+ALGRAY_INLINE void acc_store(REAL* out, REAL* out_lo, const Acc* c) {
+  (void)out_lo;
+  REAL t[16 * ACC_FULL + TAIL_WIDTH];
+  ALGRAY_UNROLL
+  for (int i = 0; i < ACC_FULL; ++i) vstore16(c->v[i], i, t);
+  TAIL_STORE(c->tail, t + 16 * ACC_FULL);
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) out[k] = t[k];
+}
 #endif
 
 /* How many rays restrict_to_rays expands side by side: RESTRICT_RAYS (build_switches.h; the entry file sets it).

@@ -483,8 +483,8 @@ ALGRAY_INLINE void screen_coefficients(__global const REAL* row, LREAL xi, LREAL
     /* acc_mul_linear: l0 c + l1 (c shifted up one, a zero below) */
     ALGRAY_UNROLL
     for (int k = DEGREE; k > 0; --k) c[k] = l0 * c[k] + l1 * c[k - 1];
-    /* the vector step adds the shifted-in zero (a -0 becomes +0); poly_mul_linear, above degree 15, does not */
-    c[0] = DEGREE <= 15 ? l0 * c[0] + l1 * (LREAL)0 : l0 * c[0];
+    /* the vector step adds the shifted-in zero (a -0 becomes +0) */
+    c[0] = l0 * c[0] + l1 * (LREAL)0;
     /* acc_add_constant */
     if (RESTRICT_BERNSTEIN) {
       ALGRAY_UNROLL
