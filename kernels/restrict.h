@@ -18,24 +18,6 @@
  * Homogenising with w = one makes every partial sum of a Horner level the same degree, so sums never need
  * degree elevation, and in the Bernstein basis all arithmetic stays a sum of products of nearby values. */
 
-/* All operations run over the full NCOEF coefficients, with zeros above the current degree: fixed trip counts
- * let the compiler unroll them and keep the arrays in registers, which beats skipping the zeros. */
-
-/* c (degree < DEGREE) times (l0 + l1 s), or times (l0 (1-s) + l1 s) in the scaled Bernstein form: same recurrence. */
-ALGRAY_INLINE void poly_mul_linear(REAL* c, REAL l0, REAL l1) {
-  ALGRAY_UNROLL
-  for (int k = DEGREE; k > 0; --k) c[k] = l0 * c[k] + l1 * c[k - 1];
-  c[0] = l0 * c[0];
-}
-
-/* c (degree < DEGREE - 1) times (q0 + q1 s + q2 s^2), or the same in the scaled Bernstein form. */
-ALGRAY_INLINE void poly_mul_quadratic(REAL* c, REAL q0, REAL q1, REAL q2) {
-  ALGRAY_UNROLL
-  for (int k = DEGREE; k > 1; --k) c[k] = q0 * c[k] + q1 * c[k - 1] + q2 * c[k - 2];
-  c[1] = q0 * c[1] + q1 * c[0];
-  c[0] = q0 * c[0];
-}
-
 /* One coordinate along the segment: the linear factor l0 + l1 s (or l0 (1-s) + l1 s) and its square. */
 typedef struct {
   REAL l0, l1;
@@ -231,31 +213,9 @@ static REAL ray_terms_within_part(const RayTerms* t, REAL lo, REAL hi) {
   return one_ray_terms_within(t->coefs, t->count, fmax(q.x, fmax(q.y, q.z)));
 }
 
-/* c (degree n) plus a * one^n. binomials[n * NCOEF + k] = C(n, k), zero for k > n. */
-ALGRAY_INLINE void poly_add_constant(REAL* c, int n, REAL a, __constant const REAL* binomials) {
-  if (RESTRICT_BERNSTEIN) {
-    /* one^n = sum C(n,k) (1-s)^(n-k) s^k in the scaled basis. */
-    __constant const REAL* row = binomials + n * NCOEF;
-    ALGRAY_UNROLL
-    for (int k = 0; k <= DEGREE; ++k) c[k] += a * row[k];
-  } else {
-    c[0] += a;
-  }
-}
-
-ALGRAY_INLINE void poly_add(REAL* c, const REAL* other) {
-  ALGRAY_UNROLL
-  for (int k = 0; k <= DEGREE; ++k) c[k] += other[k];
-}
-
 ALGRAY_INLINE void poly_copy(REAL* dst, const REAL* src) {
   ALGRAY_UNROLL
   for (int k = 0; k <= DEGREE; ++k) dst[k] = src[k];
-}
-
-ALGRAY_INLINE void poly_set_constant(REAL* c, REAL a) {
-  c[0] = a;
-  for (int k = 1; k <= DEGREE; ++k) c[k] = 0;
 }
 
 /* The Horner accumulators of the restriction, in one of three representations, each providing acc_mul_linear,
@@ -265,7 +225,10 @@ ALGRAY_INLINE void poly_set_constant(REAL* c, REAL a) {
  *    moves to higher lanes, never into the coefficients; the host pads the binomial table so that any row
  *    loads as one vector;
  *  - mixed precision: the same vectors as unevaluated float sums hi + lo;
- *  - above degree 15, the unrolled arrays above. */
+ *  - above degree 15, several vectors (below).
+ * A linear step takes c (degree < DEGREE) times (l0 + l1 s), or times (l0 (1-s) + l1 s) in the scaled Bernstein
+ * form, by the same recurrence c_k = l0 c_k + l1 c_(k-1); a quadratic step times (q0 + q1 s + q2 s^2). Every step
+ * runs over all the coefficients, zeros above the current degree included: fixed widths beat skipping the zeros. */
 #if DEGREE <= 15
 #if DEGREE <= 7
 #define ACC_WIDTH 8

@@ -460,7 +460,7 @@ static void hit_records(uint count, const LaneRays* rays, const LaneRays* at, co
 #define SCREEN_LANES 1
 /* The screen form's coefficients for a group of lanes at once: screen_ray_taylor, restrict_from_taylor and
  * bernstein_from_scaled over lanes, each lane with the operations that those run one ray at a time (restrict.h:
- * vector Horner steps up to degree 15, the unrolled arrays above), so every lane's coefficients are the one-ray
+ * the vector Horner steps), so every lane's coefficients are the one-ray
  * build's bit for bit (tests/test_lanes). One ray's steps are chains of dependent operations; over lanes the D + 1
  * coefficients' chains run side by side (above degree 15 too, where a camera ray restricted one at a time made
  * float 0.63-0.70x double's rate; bench/RESULTS.md, "Float against double, per degree"). row: the image row's
