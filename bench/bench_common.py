@@ -1,4 +1,4 @@
-"""What the render benchmarks share: running `algray render` with --stats, naming the machine and the commit, the
+"""What the render benchmarks share: running `algray render` with --stats (or `algray batch` for several frames), naming the machine and the commit, the
 command line as run, and replacing one section of bench/RESULTS.md (a page of current figures, a table per area
 with its date, machine, commit and command; the history is in bench/history/)."""
 import datetime
@@ -26,6 +26,22 @@ def run_render(binary, scene, args, env, workdir):
     subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     wall = (time.perf_counter() - start) * 1000
     return wall, json.loads(stats.read_text())
+
+
+def run_frames(binary, scene, args, env, workdir, frames):
+    """Renders SCENE `frames` + 1 times in one `algray batch` process (an orbit of 0 degrees: the same camera each
+    frame), with ARGS on its command line; returns the --stats of every frame but the first. Frames in one process
+    share its device, programs and buffers, so a frame's kernel time is free of one process's start-up and of a
+    single frame's stall: on a shared VM one-frame processes of the same kernels read up to 2x apart."""
+    jobs, log = workdir / "frames.toml", workdir / "frames.log.jsonl"
+    log.unlink(missing_ok=True)
+    jobs.write_text(f'[[job]]\nscene = {json.dumps(str(Path(scene).resolve()))}\n'
+                    f'output = {json.dumps(str(workdir / "frame_{frame}.exr"))}\n'
+                    f'orbit = {{ frames = {frames + 1}, degrees = 0 }}\n')
+    cmd = [str(binary), "batch", str(jobs), "--log", str(log)] + list(args)
+    subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    lines = [json.loads(line) for line in log.read_text().splitlines() if line.strip()]
+    return [line["stats"] for line in sorted(lines, key=lambda line: line["frame"])[1:]]
 
 
 def parse_degrees(text):

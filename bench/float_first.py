@@ -3,6 +3,9 @@
 surfaces and the Endrass octic, the Kummer surface, Goursat's dodecic and the Chebyshev nonic, in preview (camera
 rays, one per pixel) and in full mode (the scene as it is: its lights, shadows and antialiasing).
 
+Each mode's figure in a round is the median kernel time of --frames frames rendered in one process (algray batch,
+after a first frame not counted).
+
 Modes: double, float, adaptive (its second pass in double: this CPU's fp64 is fast) and adaptive with
 ALGRAY_NO_FP64=1 (its second pass in float-float, as on a GPU without fast fp64). Each round runs every mode once,
 the order rotating from round to round; the table gives each mode's median kernel time (device time of every pass,
@@ -30,9 +33,9 @@ MODES = [("double", "double", {}), ("float", "float", {}), ("adaptive", "adaptiv
 TARGETS = {"float": 0.6, "adaptive": 0.7, "adaptive, no fp64": 0.7}
 
 
-def measure(binary, scene, preview, runs, work):
+def measure(binary, scene, preview, runs, frames, work):
     args = ["--width", "1024", "--height", "768"] + (["--preview", "--set", "antialias.samples=1"] if preview else [])
-    medians, _ = speed(binary, scene, runs, work, modes=MODES, args=args, warm_up=True)
+    medians, _ = speed(binary, scene, runs, work, modes=MODES, args=args, warm_up=True, frames=frames)
     return medians
 
 
@@ -42,13 +45,16 @@ def cell(ms, double_ms, target):
     return f"**{text}**" if target is not None and ratio > target else text
 
 
-def section(rows, runs, preview_runs, binary, note):
+def section(rows, runs, preview_runs, frames, binary, note):
     lines = [HEADING, "", f"- Date: {datetime.date.today().isoformat()}", f"- Machine: {machine()}",
              f"- Commit: {commit(binary)}", f"- Command: `{command_line()}` (after `cmake --build build`)"]
     lines += [f"- Conditions: {note}", ""] if note else [""]
     lines += [
              "Kernel ms at 1024x768 (median of " + str(runs) + " interleaved rounds in full mode, " + str(preview_runs)
-             + " in preview, after a warm-up round; device "
+             + " in preview, after a warm-up round; "
+             + (f"each round's figure the median of {frames} frames in one `algray batch` process, after a first "
+                "frame not counted; " if frames > 1 else "")
+             + "device "
              "time of every pass, adaptive's second pass included) and the ratio to double's. **Bold**: over the "
              "target (float 0.6x, adaptive 0.7x). Preview: camera rays, one per pixel; full: the scene's lights, "
              "shadows and antialiasing.", "",
@@ -68,6 +74,10 @@ def main():
     ap.add_argument("--preview-runs", type=int,
                     help="rounds in preview (default: 3x --runs): kernels of 10-60 ms swing by a third between runs "
                          "on a shared 2-core VM, where full mode's seconds hold within a few per cent")
+    ap.add_argument("--frames", type=int, default=3,
+                    help="frames per mode and round, in one process (their median is the round's figure); 1: one "
+                         "`algray render` process per figure, as before 2026-12-07, whose single frames read up to "
+                         "2x apart for the same kernels")
     ap.add_argument("--scenes", nargs="*", default=SCENES)
     ap.add_argument("--modes", nargs="*", default=["preview", "full"], choices=["preview", "full"])
     ap.add_argument("--output", default=ROOT / "bench/RESULTS.md")
@@ -79,10 +89,11 @@ def main():
         for name in args.scenes:
             for mode in args.modes:
                 runs = preview_runs if mode == "preview" else args.runs
-                ms = measure(args.binary, ROOT / "scenes" / f"{name}.toml", mode == "preview", runs, Path(tmp))
+                ms = measure(args.binary, ROOT / "scenes" / f"{name}.toml", mode == "preview", runs, args.frames,
+                             Path(tmp))
                 rows.append({"scene": name, "mode": mode, "ms": ms})
                 print(name, mode, {m: round(v, 1) for m, v in ms.items()}, flush=True)
-    replace_section(args.output, HEADING, section(rows, args.runs, preview_runs, args.binary, args.note), under=AREA)
+    replace_section(args.output, HEADING, section(rows, args.runs, preview_runs, args.frames, args.binary, args.note), under=AREA)
 
 
 if __name__ == "__main__":

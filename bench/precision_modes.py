@@ -24,7 +24,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-from bench_common import ROOT, command_line, commit, heading_level, machine, replace_section, run_render
+from bench_common import (ROOT, command_line, commit, heading_level, machine, replace_section, run_frames,
+                          run_render)
 
 AREA = "## Precision modes: time and accuracy"
 HEADING = "### Float, adaptive, mixed and double"
@@ -56,10 +57,11 @@ def pass_sum(stats, key, name=None):
     return sum(p[key] for p in stats["passes"] if name is None or p["name"] == name)
 
 
-def speed(binary, scene, runs, work, modes=SPEED_MODES, args=None, warm_up=False):
+def speed(binary, scene, runs, work, modes=SPEED_MODES, args=None, warm_up=False, frames=1):
     """Each mode's median kernel time over `runs` rounds, the modes' order rotating from round to round (a first
     round not counted with warm_up), and each mode's escalated share per pass. modes: (name, --precision, extra
-    environment); args: the render's other arguments (default 1024x768, one ray per pixel)."""
+    environment); args: the render's other arguments (default 1024x768, one ray per pixel). frames > 1: each
+    round's figure for a mode is the median of that many frames in one process (run_frames), not one render's."""
     if args is None:
         args = ["--width", "1024", "--height", "768", "--set", "antialias.samples=1"]
     times = {m[0]: [] for m in modes}
@@ -69,10 +71,16 @@ def speed(binary, scene, runs, work, modes=SPEED_MODES, args=None, warm_up=False
         order = modes[r % len(modes):] + modes[:r % len(modes)]
         for name, precision, extra in order:
             env = dict(os.environ, **extra)
-            _, stats = run_render(binary, scene, args + ["--precision", precision], env, work)
+            if frames > 1:
+                every = run_frames(binary, scene, args + ["--precision", precision], env, work, frames)
+                stats = every[-1]
+                kernel_ms = statistics.median(pass_sum(s, "kernel_ms") for s in every)
+            else:
+                _, stats = run_render(binary, scene, args + ["--precision", precision], env, work)
+                kernel_ms = pass_sum(stats, "kernel_ms")
             if r < 0:
                 continue
-            times[name].append(pass_sum(stats, "kernel_ms"))
+            times[name].append(kernel_ms)
             shares[name] = {p["name"]: p["escalated"] / max(p["rays"], 1) for p in stats["passes"]}
     return {m: statistics.median(t) for m, t in times.items()}, shares
 
