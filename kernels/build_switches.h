@@ -93,6 +93,13 @@
 #define ALGRAY_SETTLE_DOUBTS 0
 #endif
 
+/* The extent form's shadow kernels: 0, or how many rays one vector register holds in the kernel's precision, which
+ * it then restricts side by side in the lanes of one vector per coefficient (restrict.h; KernelConfig's
+ * shadow_batch, which the plan sets for devices that fuse multiply-adds). */
+#ifndef ALGRAY_SHADOW_BATCH
+#define ALGRAY_SHADOW_BATCH 0
+#endif
+
 /* ALGRAY_DEVICE_COPY=n (ProgramCache, for the n-th device of one name and driver in a process) is read by no
  * kernel: it only makes that device's program differ from the first one's (cl_runtime.h says why). */
 

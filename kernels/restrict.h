@@ -463,37 +463,168 @@ ALGRAY_INLINE void acc_store(REAL* out, REAL* out_lo, const Acc* c) {
 /* How many rays restrict_to_rays expands side by side: RESTRICT_RAYS (build_switches.h; the entry file sets it).
  * One ray's Horner scheme is a chain of dependent vector operations, so a core waits on their latency; the
  * rays of a batch share the walk over the monomials and interleave their chains. Every ray gets exactly the
- * operations it would get alone. */
-
-/* One accumulator per ray of the batch. */
-typedef Acc RayAccs[RESTRICT_RAYS][ACC_SLOTS];
-
-/* Every c[r] times its ray's L^times. With only even exponents (the same for every ray: they are the surface's)
- * every gap is even, and one quadratic pass replaces two linear ones: fewer flops and half the sweeps over c. */
-ALGRAY_INLINE void acc_mul_axis(RayAccs c, const AxisFactor* f, int times) {
-#if ACC_SQUARES
-  if (f[0].even) {
-    for (int q = 0; q < times; q += 2) ALGRAY_UNROLL
-    for (int r = 0; r < RESTRICT_RAYS; ++r) acc_mul_quadratic(c[r], f[r].q0, f[r].q1, f[r].q2);
-    return;
-  }
-#endif
-  for (int q = 0; q < times; ++q) ALGRAY_UNROLL
-  for (int r = 0; r < RESTRICT_RAYS; ++r) acc_mul_linear(c[r], f[r].l0, f[r].l1);
-}
-
-/* Every c[r] times one^times: degree elevation in the Bernstein form; nothing to do in the power basis. */
-ALGRAY_INLINE void acc_mul_one(RayAccs c, int times) {
-  if (!RESTRICT_BERNSTEIN) return;
-  for (int q = 0; q < times; ++q) ALGRAY_UNROLL
-  for (int r = 0; r < RESTRICT_RAYS; ++r) acc_mul_linear(c[r], (REAL)1, (REAL)1);
-}
-
-/* The other accumulator operations, ray by ray. The batch loops are unrolled so that the accumulators stay in
- * registers (measured: left as loops, they went through the stack and the batch gained nothing). */
+ * operations it would get alone. The walk (restrict_to_rays) takes its batch through the batch_* operations below,
+ * in one of two layouts:
+ *  - one accumulator per ray (Acc above), each step the ray's vector step;
+ *  - with ALGRAY_SHADOW_BATCH (the host's choice for the extent form's shadow rays on devices whose vector
+ *    registers hold several rays and that fuse multiply-adds): coefficient k of every ray in the lanes of one
+ *    vector, so a step is one operation per coefficient for the whole batch, with no shifts across lanes and no
+ *    chain between the coefficients. Degree 16 and 24 shadow passes 0.65x in float, 0.55-0.8x in double with AVX2
+ *    (bench/history/2026-12.md, "Shadow rays restricted side by side in lanes"). Each step is written with fma()
+ *    in the vector step's order: as plain expressions the compiler fused them otherwise than the vector step's,
+ *    and most coefficients differed in their last bits; so written, on a device that fuses (the host's
+ *    condition), not one differed. */
 #define FOR_EACH_RAY(statement) \
   ALGRAY_UNROLL                 \
   for (int r = 0; r < RESTRICT_RAYS; ++r) statement
+
+#if ALGRAY_SHADOW_BATCH > 1 && !ALGRAY_COMPENSATED
+#if RESTRICT_RAYS != ALGRAY_SHADOW_BATCH
+#error "the lanes' batch is RESTRICT_RAYS rays"
+#endif
+#if RESTRICT_RAYS == 2
+typedef REAL2 BatchLanes;
+#define BATCH_LOAD(p) vload2(0, p)
+#define BATCH_STORE(v, p) vstore2(v, 0, p)
+#elif RESTRICT_RAYS == 4
+typedef REAL4 BatchLanes;
+#define BATCH_LOAD(p) vload4(0, p)
+#define BATCH_STORE(v, p) vstore4(v, 0, p)
+#elif RESTRICT_RAYS == 8
+typedef REAL8 BatchLanes;
+#define BATCH_LOAD(p) vload8(0, p)
+#define BATCH_STORE(v, p) vstore8(v, 0, p)
+#elif RESTRICT_RAYS == 16
+typedef REAL16 BatchLanes;
+#define BATCH_LOAD(p) vload16(0, p)
+#define BATCH_STORE(v, p) vstore16(v, 0, p)
+#else
+#error "ALGRAY_SHADOW_BATCH is 2, 4, 8 or 16"
+#endif
+typedef BatchLanes RayBatch[NCOEF];
+/* One coordinate's factors, ray r's in lane r. */
+typedef struct {
+  BatchLanes l0, l1, q0, q1, q2;
+  int even;
+} BatchFactor;
+ALGRAY_INLINE BatchFactor batch_factor(const AxisFactor* f) {
+  REAL t[5][RESTRICT_RAYS];
+  ALGRAY_UNROLL
+  for (int r = 0; r < RESTRICT_RAYS; ++r) {
+    t[0][r] = f[r].l0;
+    t[1][r] = f[r].l1;
+    t[2][r] = f[r].q0;
+    t[3][r] = f[r].q1;
+    t[4][r] = f[r].q2;
+  }
+  BatchFactor b;
+  b.l0 = BATCH_LOAD(t[0]);
+  b.l1 = BATCH_LOAD(t[1]);
+  b.q0 = BATCH_LOAD(t[2]);
+  b.q1 = BATCH_LOAD(t[3]);
+  b.q2 = BATCH_LOAD(t[4]);
+  b.even = f[0].even;
+  return b;
+}
+/* acc_mul_linear lane by lane: c_k = l0 c_k + l1 c_(k-1), the zero below added as the vector step adds it */
+ALGRAY_INLINE void batch_mul_linear(BatchLanes* c, BatchLanes l0, BatchLanes l1) {
+  const BatchLanes zero = (BatchLanes)((REAL)0);
+  ALGRAY_UNROLL
+  for (int k = DEGREE; k > 0; --k) c[k] = fma(l0, c[k], l1 * c[k - 1]);
+  c[0] = fma(l0, c[0], l1 * zero);
+}
+/* acc_mul_quadratic lane by lane */
+ALGRAY_INLINE void batch_mul_quadratic(BatchLanes* c, BatchLanes q0, BatchLanes q1, BatchLanes q2) {
+  const BatchLanes zero = (BatchLanes)((REAL)0);
+  ALGRAY_UNROLL
+  for (int k = DEGREE; k > 1; --k) c[k] = fma(q2, c[k - 2], fma(q0, c[k], q1 * c[k - 1]));
+  c[1] = fma(q2, zero, fma(q0, c[1], q1 * c[0]));
+  c[0] = fma(q2, zero, fma(q0, c[0], q1 * zero));
+}
+ALGRAY_INLINE void batch_mul_axis(RayBatch c, const BatchFactor* f, int times) {
+  if (f->even) {
+    for (int q = 0; q < times; q += 2) batch_mul_quadratic(c, f->q0, f->q1, f->q2);
+    return;
+  }
+  for (int q = 0; q < times; ++q) batch_mul_linear(c, f->l0, f->l1);
+}
+/* times one: the vector step's c + (c shifted), the products by one exact */
+ALGRAY_INLINE void batch_mul_one(RayBatch c, int times) {
+  if (!RESTRICT_BERNSTEIN) return;
+  for (int q = 0; q < times; ++q) {
+    ALGRAY_UNROLL
+    for (int k = DEGREE; k > 0; --k) c[k] = c[k] + c[k - 1];
+    c[0] = c[0] + (BatchLanes)((REAL)0);
+  }
+}
+ALGRAY_INLINE void batch_copy(RayBatch dst, const RayBatch src) {
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) dst[k] = src[k];
+}
+ALGRAY_INLINE void batch_add(RayBatch dst, const RayBatch src) {
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) dst[k] += src[k];
+}
+ALGRAY_INLINE void batch_set_constant(RayBatch c, REAL a, REAL a_lo) {
+  (void)a_lo;
+  ALGRAY_UNROLL
+  for (int k = 1; k <= DEGREE; ++k) c[k] = (BatchLanes)((REAL)0);
+  c[0] = (BatchLanes)(a);
+}
+ALGRAY_INLINE void batch_add_constant(RayBatch c, int n, REAL a, REAL a_lo, __constant const REAL* binomials) {
+  (void)a_lo;
+  if (RESTRICT_BERNSTEIN) {
+    ALGRAY_UNROLL
+    for (int k = 0; k <= DEGREE; ++k) c[k] = fma((BatchLanes)(a), (BatchLanes)(binomials[n * NCOEF + k]), c[k]);
+  } else {
+    c[0] += a;
+  }
+}
+ALGRAY_INLINE void batch_store(REAL (*out)[NCOEF], REAL (*out_lo)[NCOEF], const RayBatch c) {
+  (void)out_lo;
+  ALGRAY_UNROLL
+  for (int k = 0; k <= DEGREE; ++k) {
+    REAL t[RESTRICT_RAYS];
+    BATCH_STORE(c[k], t);
+    ALGRAY_UNROLL
+    for (int r = 0; r < RESTRICT_RAYS; ++r) out[r][k] = t[r];
+  }
+}
+#else
+/* One accumulator per ray of the batch. The batch loops are unrolled so that the accumulators stay in registers
+ * (measured: left as loops, they went through the stack and the batch gained nothing). */
+typedef Acc RayBatch[RESTRICT_RAYS][ACC_SLOTS];
+typedef const AxisFactor* BatchFactor; /* ray r's at [r] */
+ALGRAY_INLINE BatchFactor batch_factor(const AxisFactor* f) { return f; }
+
+/* Every c[r] times its ray's L^times. With only even exponents (the same for every ray: they are the surface's)
+ * every gap is even, and one quadratic pass replaces two linear ones: fewer flops and half the sweeps over c. */
+ALGRAY_INLINE void batch_mul_axis(RayBatch c, const BatchFactor* factor, int times) {
+  const AxisFactor* f = *factor;
+#if ACC_SQUARES
+  if (f[0].even) {
+    for (int q = 0; q < times; q += 2) FOR_EACH_RAY(acc_mul_quadratic(c[r], f[r].q0, f[r].q1, f[r].q2));
+    return;
+  }
+#endif
+  for (int q = 0; q < times; ++q) FOR_EACH_RAY(acc_mul_linear(c[r], f[r].l0, f[r].l1));
+}
+
+/* Every c[r] times one^times: degree elevation in the Bernstein form; nothing to do in the power basis. */
+ALGRAY_INLINE void batch_mul_one(RayBatch c, int times) {
+  if (!RESTRICT_BERNSTEIN) return;
+  for (int q = 0; q < times; ++q) FOR_EACH_RAY(acc_mul_linear(c[r], (REAL)1, (REAL)1));
+}
+ALGRAY_INLINE void batch_copy(RayBatch dst, RayBatch src) { FOR_EACH_RAY(acc_copy(dst[r], src[r])); }
+ALGRAY_INLINE void batch_add(RayBatch dst, RayBatch src) { FOR_EACH_RAY(acc_add(dst[r], src[r])); }
+ALGRAY_INLINE void batch_set_constant(RayBatch c, REAL a, REAL a_lo) { FOR_EACH_RAY(acc_set_constant(c[r], a, a_lo)); }
+ALGRAY_INLINE void batch_add_constant(RayBatch c, int n, REAL a, REAL a_lo, __constant const REAL* binomials) {
+  FOR_EACH_RAY(acc_add_constant(c[r], n, a, a_lo, binomials));
+}
+ALGRAY_INLINE void batch_store(REAL (*out)[NCOEF], REAL (*out_lo)[NCOEF], RayBatch c) {
+  FOR_EACH_RAY(acc_store(out[r], out_lo[r], c[r]));
+}
+#endif
 
 /* Monomials arrive sorted by i, then j, then k, all descending, exponents packed as i | j<<8 | k<<16.
  * P = sum_i x^i sum_j y^j sum_k a_ijk z^k w^(D-i-j-k), evaluated as three nested Horner levels, each
@@ -504,7 +635,8 @@ static ALGRAY_NOINLINE void restrict_to_rays(__global const uint* exps, __global
                                              __constant const REAL* binomials, const AxisFactor* fx,
                                              const AxisFactor* fy, const AxisFactor* fz, REAL (*out)[NCOEF],
                                              REAL (*out_lo)[NCOEF]) {
-  RayAccs acc_z, acc_y, acc_x;
+  RayBatch acc_z, acc_y, acc_x;
+  const BatchFactor bx = batch_factor(fx), by = batch_factor(fy), bz = batch_factor(fz);
   int deg_z = -1;             /* degree of acc_z; -1 while the (i, j) group is empty */
   int have_y = 0, have_x = 0; /* acc_y, out hold a partial sum */
   int cur_i = -1, cur_j = -1, cur_k = -1;
@@ -523,27 +655,27 @@ static ALGRAY_NOINLINE void restrict_to_rays(__global const uint* exps, __global
     }
     /* Close the z-level group (cur_i, cur_j) when (i, j) changes or the list ends. */
     if (deg_z >= 0 && (i != cur_i || j != cur_j)) {
-      acc_mul_axis(acc_z, fz, cur_k);
-      acc_mul_one(acc_z, DEGREE - cur_i - cur_j - (deg_z + cur_k)); /* B_ij has degree D - i - j */
+      batch_mul_axis(acc_z, &bz, cur_k);
+      batch_mul_one(acc_z, DEGREE - cur_i - cur_j - (deg_z + cur_k)); /* B_ij has degree D - i - j */
       if (!have_y) {
-        FOR_EACH_RAY(acc_copy(acc_y[r], acc_z[r]));
+        batch_copy(acc_y, acc_z);
         have_y = 1;
       } else {
-        acc_mul_axis(acc_y, fy, prev_j - cur_j);
-        FOR_EACH_RAY(acc_add(acc_y[r], acc_z[r]));
+        batch_mul_axis(acc_y, &by, prev_j - cur_j);
+        batch_add(acc_y, acc_z);
       }
       prev_j = cur_j;
       deg_z = -1;
     }
     /* Close the y-level group cur_i when i changes or the list ends. */
     if (have_y && i != cur_i) {
-      acc_mul_axis(acc_y, fy, prev_j);
+      batch_mul_axis(acc_y, &by, prev_j);
       if (!have_x) {
-        FOR_EACH_RAY(acc_copy(acc_x[r], acc_y[r]));
+        batch_copy(acc_x, acc_y);
         have_x = 1;
       } else {
-        acc_mul_axis(acc_x, fx, prev_i - cur_i);
-        FOR_EACH_RAY(acc_add(acc_x[r], acc_y[r]));
+        batch_mul_axis(acc_x, &bx, prev_i - cur_i);
+        batch_add(acc_x, acc_y);
       }
       prev_i = cur_i;
       have_y = 0;
@@ -551,21 +683,21 @@ static ALGRAY_NOINLINE void restrict_to_rays(__global const uint* exps, __global
     if (m == count) break;
     /* Add a_ijk to the z-level Horner sum of group (i, j). */
     if (deg_z < 0) {
-      FOR_EACH_RAY(acc_set_constant(acc_z[r], a, a_lo));
+      batch_set_constant(acc_z, a, a_lo);
       deg_z = 0;
     } else {
-      acc_mul_axis(acc_z, fz, cur_k - k);
+      batch_mul_axis(acc_z, &bz, cur_k - k);
       deg_z += cur_k - k;
-      FOR_EACH_RAY(acc_add_constant(acc_z[r], deg_z, a, a_lo, binomials));
+      batch_add_constant(acc_z, deg_z, a, a_lo, binomials);
     }
     cur_i = i;
     cur_j = j;
     cur_k = k;
   }
   /* No monomials: the host never sends this, but stay defined. */
-  if (!have_x) FOR_EACH_RAY(acc_set_constant(acc_x[r], 0, 0));
-  acc_mul_axis(acc_x, fx, prev_i);
-  FOR_EACH_RAY(acc_store(out[r], out_lo[r], acc_x[r]));
+  if (!have_x) batch_set_constant(acc_x, 0, 0);
+  batch_mul_axis(acc_x, &bx, prev_i);
+  batch_store(out, out_lo, acc_x);
 }
 
 /* One ray: restrict_to_rays with every ray of the batch the same (a build with RESTRICT_RAYS = 1, as every

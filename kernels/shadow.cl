@@ -3,9 +3,14 @@
 /* Shadow rays start off the surface and ask only whether there is a root: what adaptive builds doubt (isolation.h). */
 #define ALGRAY_SHADOW_RAYS 1
 
-/* Shadow rays restrict P in batches (see RESTRICT_RAYS in restrict.h); the width that measured fastest for the
- * vector width the degree takes. */
+/* Shadow rays restrict P in batches (see RESTRICT_RAYS in restrict.h): the host's ALGRAY_SHADOW_BATCH where it
+ * gives one (a vector register's rays, in its lanes), else the width that measured fastest for the vector width
+ * the degree takes. */
+#if ALGRAY_SHADOW_BATCH > 1 && !ALGRAY_COMPENSATED
+#define RESTRICT_RAYS ALGRAY_SHADOW_BATCH
+#else
 #define RESTRICT_RAYS (DEGREE <= 7 ? 4 : 2)
+#endif
 
 #include "isolate.h"
 #include "ray.h"

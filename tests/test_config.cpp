@@ -288,6 +288,49 @@ TEST_CASE("the rays traced again take as many lanes as a vector register holds i
   CHECK(trace_lanes(Precision::Adaptive, Precision::Double, {{0, 0}}) == default_lanes("CPU"));  // not known
 }
 
+TEST_CASE("the extent form's shadow rays are restricted a vector register's rays at a time where it fuses",
+          "[config]") {
+  CHECK(shadow_batch_width(8, true) == 8);    // AVX2 floats
+  CHECK(shadow_batch_width(4, true) == 4);    // AVX2 doubles
+  CHECK(shadow_batch_width(16, true) == 16);  // AVX-512 floats
+  CHECK(shadow_batch_width(1, true) == 0);    // a GPU's one lane
+  CHECK(shadow_batch_width(0, true) == 0);    // not known
+  CHECK(shadow_batch_width(3, true) == 0);    // no such vector type
+  CHECK(shadow_batch_width(8, false) == 0);   // fma() would not match the vector steps' unfused multiply-adds
+  KernelConfig c;
+  c.entry = "shadow";
+  c.shadow_batch = 8;
+  CHECK(c.key().find(" batch=8") != std::string::npos);
+  CHECK(c.build_options().find("-D ALGRAY_SHADOW_BATCH=8") != std::string::npos);
+  c.shadow_batch = 0;
+  CHECK(c.key().find("batch") == std::string::npos);
+
+  // Degree 16 (the point form stops at 15): every shadow kernel is the extent form's.
+  const Scene scene = load_scene_text(std::string(kSphereScene) + "[[light]]\nposition = [3, 3, 3]\n", "t.toml",
+                                      {{"render.preview", "false"}, {"surface.equation", "\"x^16 + y^2 + z^2 - 1\""}});
+  const auto batches = [&](Precision precision, std::vector<std::pair<unsigned, bool>> float_widths) {
+    std::vector<PlanDevice> devices;
+    for (const auto& [width, fma] : float_widths) {
+      DeviceInfo cpu;
+      cpu.type = "CPU";
+      cpu.native_float_width = width;
+      cpu.native_double_width = width / 2;
+      cpu.float_fma = cpu.double_fma = fma;
+      devices.push_back({cpu, Precision::Double});
+    }
+    const PlannedPass shadow = *make_render_plan(scene, precision, devices).find(PassKind::Shadow);
+    REQUIRE(shadow.kernels.at(0).ray_origin == RayOrigin::Extent);
+    std::vector<int> out{shadow.kernels.at(0).shadow_batch};
+    for (const KernelConfig& e : shadow.escalation) out.push_back(e.shadow_batch);
+    return out;
+  };
+  CHECK(batches(Precision::Double, {{8, true}}) == std::vector<int>{4});
+  CHECK(batches(Precision::Float, {{8, true}}) == std::vector<int>{8, 8});              // the first pass and its second
+  CHECK(batches(Precision::Float, {{16, true}, {8, true}}) == std::vector<int>{8, 8});  // what every device holds
+  CHECK(batches(Precision::Float, {{8, true}, {8, false}}) == std::vector<int>{0, 0});  // one device without fma
+  CHECK(batches(Precision::Double, {{1, true}}) == std::vector<int>{0});                // GPUs: one accumulator per ray
+}
+
 TEST_CASE("the point form's doubted shadow rays go through float's extent form before float-float", "[config]") {
   // Full mode with a shadow-casting light: adaptive's shadow pass is the float point form (degree 2).
   Scene scene = load_scene_text(std::string(kSphereScene) + "[[light]]\nposition = [3, 3, 3]\n", "t.toml",

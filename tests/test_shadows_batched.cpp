@@ -50,7 +50,9 @@ struct Counts {
 };
 
 // The config both kernels are built with; entry names the kernel. The point form's shadow kernel runs the lanes
-// the plan gives it on this device (testing::plan_shadow_lanes), and shadow_serial the same code in one.
+// the plan gives it on this device (testing::plan_shadow_lanes), and shadow_serial the same code in one; the extent
+// form's restricts the batch the plan gives it (testing::plan_shadow_batch: a vector register's rays in its lanes
+// here), shadow_serial one ray at a time.
 KernelConfig shadow_config(const Scene& scene, Precision precision, Isolation isolation, const std::string& entry,
                            RayOrigin origin, bool settle_doubts) {
   KernelConfig config = primary_config(scene, precision);
@@ -61,6 +63,7 @@ KernelConfig shadow_config(const Scene& scene, Precision precision, Isolation is
   config.max_iterations = default_max_iterations(Refinement::Brent);
   config.entry = entry;
   config.settle_doubts = settle_doubts;
+  config.shadow_batch = origin == RayOrigin::Extent && entry == "shadow" ? testing::plan_shadow_batch(precision) : 0;
   return config;
 }
 

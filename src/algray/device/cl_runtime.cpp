@@ -63,7 +63,10 @@ std::vector<DeviceInfo> enumerate_devices() {
       info.compute_units = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
       info.native_float_width = d.getInfo<CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT>();
       info.native_double_width = d.getInfo<CL_DEVICE_NATIVE_VECTOR_WIDTH_DOUBLE>();
-      const bool fp64 = d.getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>() != 0;
+      const cl_device_fp_config double_config = d.getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>();
+      const bool fp64 = double_config != 0;
+      info.float_fma = (d.getInfo<CL_DEVICE_SINGLE_FP_CONFIG>() & CL_FP_FMA) != 0;
+      info.double_fma = (double_config & CL_FP_FMA) != 0;
       info.fp64_hidden = fp64 && fp64_hidden_by_environment();
       info.fp64 = fp64 && !info.fp64_hidden;
       info.global_mem_bytes = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();

@@ -23,6 +23,8 @@ struct DeviceInfo {
   unsigned compute_units = 0;
   unsigned native_float_width = 0;     // CL_DEVICE_NATIVE_VECTOR_WIDTH_FLOAT: floats a vector register holds
   unsigned native_double_width = 0;    // CL_DEVICE_NATIVE_VECTOR_WIDTH_DOUBLE: doubles it holds (0 without fp64)
+  bool float_fma = false;              // CL_FP_FMA in CL_DEVICE_SINGLE_FP_CONFIG: fused multiply-add in hardware
+  bool double_fma = false;             // the same for double
   bool fp64 = false;                   // double precision usable: the device has cl_khr_fp64 and fp64_hidden is false
   bool fp64_hidden = false;            // the device has it, but ALGRAY_NO_FP64 (--no-fp64) makes algray act as if not
   std::uint64_t global_mem_bytes = 0;  // CL_DEVICE_GLOBAL_MEM_SIZE

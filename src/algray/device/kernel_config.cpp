@@ -74,6 +74,7 @@ const BuildSwitch kBuildSwitches[] = {
     {"MAX_ITERATIONS", [](const KernelConfig& c) { return std::to_string(c.max_iterations); }},
     {"LANES", [](const KernelConfig& c) { return std::to_string(c.lanes); }},
     {"ALGRAY_SETTLE_DOUBTS", [](const KernelConfig& c) { return flag(c.settle_doubts); }},
+    {"ALGRAY_SHADOW_BATCH", [](const KernelConfig& c) { return std::to_string(c.shadow_batch); }},
 };
 
 }  // namespace
@@ -88,6 +89,10 @@ int shadow_lanes(int lanes, Precision precision, int float_lanes) {
 }
 int escalation_lanes(int lanes, unsigned native_width) {
   return native_width == 0 ? lanes : std::min(lanes, static_cast<int>(native_width));
+}
+int shadow_batch_width(unsigned native_width, bool fused_multiply_add) {
+  const bool vector_type = native_width == 2 || native_width == 4 || native_width == 8 || native_width == 16;
+  return fused_multiply_add && vector_type ? static_cast<int>(native_width) : 0;
 }
 bool lanes_apply(const KernelConfig& c) {
   if (c.entry == "shadow") return c.ray_origin == RayOrigin::Point;  // the extent form batches its own way
@@ -113,7 +118,7 @@ std::string KernelConfig::key() const {
          " isolation=" + to_string(isolation) + " refinement=" + to_string(refinement) +
          " origin=" + to_string(ray_origin) + " tolerance=" + hex_double(tolerance) +
          " max_iterations=" + std::to_string(max_iterations) + (lanes != 1 ? " lanes=" + std::to_string(lanes) : "") +
-         (settle_doubts ? " settle_doubts" : "");
+         (settle_doubts ? " settle_doubts" : "") + (shadow_batch != 0 ? " batch=" + std::to_string(shadow_batch) : "");
 }
 
 }  // namespace algray

@@ -34,6 +34,12 @@ int shadow_lanes(int lanes, Precision precision, int float_lanes = kMaxFloatShad
 // double took 0.80x and 0.84x the time of 16, 8 of float 0.97x and 0.91x, 8 of float-float 0.86x and 0.81x, and 2
 // or 1 lanes more than 4 (bench/history/2026-12.md, "Camera rays' doubts settled in float first").
 int escalation_lanes(int lanes, unsigned native_width);
+// The extent form's shadow batch (KernelConfig::shadow_batch) on a device whose vector registers hold native_width
+// numbers of the kernel's precision: that many where it is 2, 4, 8 or 16 and the device fuses multiply-adds in that
+// precision (the batch's steps are written with fma(), which matches the one-ray vector steps bit for bit where
+// the compiler fuses those too); else 0, one accumulator per ray. Degree 16 and 24 shadow passes 0.5-0.6x in
+// float, 0.55-0.8x in double with AVX2 (bench/history/2026-12.md, "Shadow rays restricted side by side in lanes").
+int shadow_batch_width(unsigned native_width, bool fused_multiply_add);
 
 // The -D switches build_options() writes, in its order; kernels/build_switches.h declares each one.
 std::vector<std::string> build_switch_names();
@@ -60,6 +66,9 @@ struct KernelConfig {
   // the second pass runs in float-float or float, not where it runs in double (bench/RESULTS.md), so the plan sets
   // it for the former only (escalate_in).
   bool settle_doubts = false;
+  // The extent form's shadow kernels: 0, or how many rays they restrict side by side in the lanes of one vector per
+  // coefficient (kernels/restrict.h; shadow_batch_width).
+  int shadow_batch = 0;
 
   // "-D DEGREE=6 -D ALGRAY_DOUBLE=1 ..." with the tolerance as an exact hexadecimal literal.
   std::string build_options() const;

@@ -83,6 +83,30 @@ void narrow_escalation_lanes(RenderPlan& plan, const std::vector<PlanDevice>& de
     }
 }
 
+// The extent form's shadow kernels (first passes where the point form does not apply, and the float second passes
+// of the point form's doubted rays) restrict a vector register's rays side by side where every device's registers
+// and fused multiply-adds allow it (shadow_batch_width); mixed precision's float-float accumulators keep theirs.
+void batch_extent_shadows(RenderPlan& plan, const std::vector<PlanDevice>& devices) {
+  auto batch = [&devices](KernelConfig& c) {
+    if (c.entry != "shadow" || c.ray_origin != RayOrigin::Extent || c.precision == Precision::Mixed) return;
+    const bool in_double = c.precision == Precision::Double;
+    // Several devices: the narrowest batch (0 where any device takes none), which every device's compiler builds
+    int width = devices.empty() ? 0 : 16;
+    for (const PlanDevice& device : devices)
+      width = std::min(width,
+                       shadow_batch_width(in_double ? device.info.native_double_width : device.info.native_float_width,
+                                          in_double ? device.info.double_fma : device.info.float_fma));
+    c.shadow_batch = width;
+  };
+  for (PlannedPass& pass : plan.passes) {
+    if (pass.kind != PassKind::Shadow) continue;
+    for (KernelConfig& c : pass.kernels) batch(c);
+    for (KernelConfig& c : pass.escalation) batch(c);
+    for (std::optional<KernelConfig>& c : pass.float_escalation)
+      if (c) batch(*c);
+  }
+}
+
 // Adaptive precision with a float-float second pass: the point form's doubted shadow rays through float's extent
 // construction first (PlannedPass::float_escalation). Its first pass settles doubts only by searching its doubted
 // rays again by each part's noise (kernels/shadow.h, point_part_polys; Barth decic, 1024x768, no fp64: 3.30 ->
@@ -429,6 +453,7 @@ RenderPlan make_render_plan(const Scene& scene, Precision precision, const std::
     if (!all_fast) escalate_point_form_in_float(plan);
   }
   narrow_escalation_lanes(plan, devices);
+  batch_extent_shadows(plan, devices);
   plan_shading(plan, scene, devices);
   return plan;
 }
