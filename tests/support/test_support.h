@@ -2,8 +2,8 @@
 #pragma once
 
 #include <algorithm>
-#include <cstdlib>
 #include <catch2/catch.hpp>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -12,6 +12,7 @@
 #include "algray/device/cl_runtime.h"
 #include "algray/device/kernel_config.h"
 #include "algray/device/program_cache.h"
+#include "algray/render/render_plan.h"
 
 namespace algray::testing {
 
@@ -37,12 +38,7 @@ inline int plan_shadow_lanes(Precision precision) {
   return shadow_lanes(default_lanes(device.type), precision, float_shadow_lanes(device.native_float_width));
 }
 // The extent form's shadow batch the plan gives a kernel of this precision on the test device (shadow_batch_width).
-inline int plan_shadow_batch(Precision precision) {
-  const DeviceInfo& device = device_session().info;
-  if (precision == Precision::Mixed) return 0;
-  return precision == Precision::Double ? shadow_batch_width(device.native_double_width, device.double_fma)
-                                        : shadow_batch_width(device.native_float_width, device.float_fma);
-}
+inline int plan_shadow_batch(Precision precision) { return shadow_batch_on(device_session().info, precision); }
 
 // One program cache for the whole test executable, in memory only. Every test that builds kernels through it
 // compiles each configuration once per process: a cache per test case, or `--no-cache`'s ProgramCache(false),

@@ -37,7 +37,7 @@ int escalation_lanes(int lanes, unsigned native_width);
 // The extent form's shadow batch (KernelConfig::shadow_batch) on a device whose vector registers hold native_width
 // numbers of the kernel's precision: that many where it is 2, 4, 8 or 16 and the device fuses multiply-adds in that
 // precision (the batch's steps are written with fma(), which matches the one-ray vector steps bit for bit where
-// the compiler fuses those too); else 0, one accumulator per ray. Degree 16 and 24 shadow passes 0.5-0.6x in
+// the compiler fuses those too); else 0, one accumulator per ray. Degree 16 and 24 shadow passes about 0.65x in
 // float, 0.55-0.8x in double with AVX2 (bench/history/2026-12.md, "Shadow rays restricted side by side in lanes").
 int shadow_batch_width(unsigned native_width, bool fused_multiply_add);
 

@@ -83,19 +83,26 @@ void narrow_escalation_lanes(RenderPlan& plan, const std::vector<PlanDevice>& de
     }
 }
 
+}  // namespace
+
+int shadow_batch_on(const DeviceInfo& device, Precision precision) {
+  if (precision == Precision::Mixed) return 0;
+  const bool in_double = precision == Precision::Double;
+  return shadow_batch_width(in_double ? device.native_double_width : device.native_float_width,
+                            in_double ? device.double_fma : device.float_fma);
+}
+
+namespace {
+
 // The extent form's shadow kernels (first passes where the point form does not apply, and the float second passes
 // of the point form's doubted rays) restrict a vector register's rays side by side where every device's registers
 // and fused multiply-adds allow it (shadow_batch_width); mixed precision's float-float accumulators keep theirs.
 void batch_extent_shadows(RenderPlan& plan, const std::vector<PlanDevice>& devices) {
   auto batch = [&devices](KernelConfig& c) {
-    if (c.entry != "shadow" || c.ray_origin != RayOrigin::Extent || c.precision == Precision::Mixed) return;
-    const bool in_double = c.precision == Precision::Double;
+    if (c.entry != "shadow" || c.ray_origin != RayOrigin::Extent) return;
     // Several devices: the narrowest batch (0 where any device takes none), which every device's compiler builds
     int width = devices.empty() ? 0 : 16;
-    for (const PlanDevice& device : devices)
-      width = std::min(width,
-                       shadow_batch_width(in_double ? device.info.native_double_width : device.info.native_float_width,
-                                          in_double ? device.info.double_fma : device.info.float_fma));
+    for (const PlanDevice& device : devices) width = std::min(width, shadow_batch_on(device.info, c.precision));
     c.shadow_batch = width;
   };
   for (PlannedPass& pass : plan.passes) {

@@ -171,6 +171,10 @@ struct PlanDevice {
 inline constexpr int kGpuTileSize = 2048;
 inline constexpr int kCpuTileSize = 1024;
 int default_tile_size(const DeviceInfo& device);
+// The extent form's shadow batch (KernelConfig::shadow_batch) a kernel of this precision gets on this device:
+// shadow_batch_width of its native vector width and fused multiply-add in that precision; 0 for mixed precision,
+// whose float-float accumulators keep one per ray.
+int shadow_batch_on(const DeviceInfo& device, Precision precision);
 
 // The render's plan, settled once for the devices that carry it out (at least one): its passes and their kernels,
 // the lanes (the first device's kind's), the tile size (the scene's; else the devices' smallest default, halved
