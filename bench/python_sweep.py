@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """What Python adds per frame: a parameter sweep rendered from Python (render, then save as PNG) against the same
 sweep through `algray batch`, which writes the same PNGs; rounds alternate between the two, per-frame medians.
-Run with the package on the path: PYTHONPATH=build/python python3 bench/python_sweep.py
+Run from the build tree: python3 bench/python_sweep.py (it imports build/python's package first)
 
 With --results the table replaces its section of bench/RESULTS.md (under "Python per frame": "Python rendering what
 a PNG holds", or with --depth "Python keeping depth and normals"), with the date, machine, commit and command."""
@@ -11,12 +11,16 @@ import json
 import statistics
 import subprocess
 import tempfile
+import sys
 import time
 from pathlib import Path
 
-import algray
-
 from bench_common import RESULTS_MD, ROOT, command_line, commit, machine, replace_section
+
+# The build tree's package first: `python3` alone imports the one scripts/install-python.sh put in the system
+# Python, which is the build of the last test.sh and can be older than the binary this sweep compares it with.
+sys.path.insert(0, str(ROOT / "build/python"))
+import algray  # noqa: E402
 
 AREA = "## Python per frame"
 HEADINGS = {False: "### Python rendering what a PNG holds", True: "### Python keeping depth and normals"}
