@@ -478,7 +478,10 @@ ALGRAY_INLINE void acc_store(REAL* out, REAL* out_lo, const Acc* c) {
   ALGRAY_UNROLL                 \
   for (int r = 0; r < RESTRICT_RAYS; ++r) statement
 
-#if ALGRAY_SHADOW_BATCH > 1 && !ALGRAY_COMPENSATED
+#if ALGRAY_SHADOW_BATCH > 1
+#if ALGRAY_COMPENSATED
+#error "mixed precision keeps one float-float accumulator per ray: the host sets no batch for it"
+#endif
 #if RESTRICT_RAYS != ALGRAY_SHADOW_BATCH
 #error "the lanes' batch is RESTRICT_RAYS rays"
 #endif

@@ -6,7 +6,7 @@
 /* Shadow rays restrict P in batches (see RESTRICT_RAYS in restrict.h): the host's ALGRAY_SHADOW_BATCH where it
  * gives one (a vector register's rays, in its lanes), else the width that measured fastest for the vector width
  * the degree takes. */
-#if ALGRAY_SHADOW_BATCH > 1 && !ALGRAY_COMPENSATED
+#if ALGRAY_SHADOW_BATCH > 1
 #define RESTRICT_RAYS ALGRAY_SHADOW_BATCH
 #else
 #define RESTRICT_RAYS (DEGREE <= 7 ? 4 : 2)
