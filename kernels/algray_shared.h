@@ -75,6 +75,8 @@ typedef cl_int algray_i32;
   ALGRAY_CAMERA_ARG_NAMES(X) X(px) X(py) X(use_given_ray) X(given_o) X(given_d) ALGRAY_EXTENT_ARG_NAMES(X)            \
   ALGRAY_SURFACE_ARG_NAMES(X) ALGRAY_SCREEN_ARG_NAMES(X) X(out) X(ray_out) X(events) X(values) X(capacity) X(event_count)
 #define ALGRAY_UNIVARIATE_ARG_NAMES(X) X(polys) X(count) X(binomials) X(out)
+#define ALGRAY_RESTRICT_CHECK_ARG_NAMES(X) \
+  X(segments) X(count) X(mono_exps) X(mono_coefs) X(mono_count) X(binomials) X(even_axes) X(out)
 #define ALGRAY_SHADE_ARG_NAMES(X)                                                                                  \
   ALGRAY_CAMERA_ARG_NAMES(X) X(rays_in_float) X(samples) X(tile_x0) X(tile_y0) X(tile_w) X(tile_h) X(hits)         \
   X(hit_surface) X(several_surfaces) X(materials) X(light_colours) X(light_first) X(light_occlusion) X(light_count)  \

@@ -61,6 +61,7 @@ TEST_CASE("every kernel declares the arguments the host sets by name, in every k
       config_of("shadow_serial", Precision::Float, RayOrigin::Extent, 1),
       config_of("probe", Precision::Double, RayOrigin::Screen, 1),
       config_of("univariate", Precision::Float, RayOrigin::Extent, 1),
+      config_of("restrict_check", Precision::Double, RayOrigin::Extent, 1),
       config_of("shade", Precision::Float, RayOrigin::Extent, 16),
       config_of("shade", Precision::Double, RayOrigin::Extent, 1),
   };

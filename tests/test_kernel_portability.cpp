@@ -136,6 +136,17 @@ std::vector<Compile> every_configuration() {
       c.lanes = lanes;
       jobs.push_back({"shade " + to_string(precision), c.key(), c.source_file(), device_options(c)});
     }
+  // The test-only restriction kernel, one ray at a time and in a vector's lanes, on each side of degree 15.
+  for (Precision precision : {Precision::Float, Precision::Double})
+    for (int degree : {7, kMaxDegree})
+      for (int batch : {0, 8}) {
+        KernelConfig c;
+        c.entry = "restrict_check";
+        c.precision = precision;
+        c.degree = degree;
+        c.shadow_batch = batch;
+        jobs.push_back({"restrict_check " + to_string(precision), c.key(), c.source_file(), device_options(c)});
+      }
   for (bool in_double : {false, true})
     jobs.push_back(
         {std::string("fp_speed ") + (in_double ? "double" : "float"), "fp_speed", "fp_speed.cl",

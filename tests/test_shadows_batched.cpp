@@ -1,12 +1,15 @@
 // The shadow kernel against shadow_serial, the plain one-segment-at-a-time construction: whatever shortcuts
 // shadow.cl takes, the occlusion masks must be identical on seeded random surfaces, points and lights.
+#include <algorithm>
 #include <bit>
 #include <catch2/catch.hpp>
+#include <cstdio>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "algray/device/kernel_binder.h"
 #include "algray/device/program_cache.h"
 #include "algray/render/device_surface.h"
 #include "algray/render/render_plan.h"
@@ -190,6 +193,104 @@ TEST_CASE("batched shadow rays answer as the serial ones, bit for bit, at every 
         check_same_masks(scene, precision, Isolation::Bernstein, own,
                          what.str() + ", settled by signs (seed " + std::to_string(kSeed + 10 + c) + ")",
                          RayOrigin::Extent, true);
+      }
+    }
+  }
+}
+
+namespace {
+
+// The coefficients restrict_check (kernels/restrict_check.cl) gives `segments` (two 4-vectors a segment: o and t_in,
+// d and t_out), restricted `batch` at a time (0: one ray at a time), as the bits of each: doubles, or floats widened.
+std::vector<std::uint64_t> restricted_bits(const Scene& scene, Precision precision, int batch,
+                                           const std::vector<double>& segments) {
+  const DeviceSurface surface(testing::device_session().context, scene, precision);
+  KernelConfig config = primary_config(scene, precision);
+  config.entry = "restrict_check";
+  config.ray_origin = RayOrigin::Extent;
+  config.lanes = 1;
+  config.shadow_batch = batch;
+  ClSession& session = testing::device_session();
+  cl::Kernel kernel = testing::program_cache().kernel(session, config);
+  const std::size_t count = segments.size() / 8, ncoef = static_cast<std::size_t>(config.degree) + 1;
+  const bool is_double = precision == Precision::Double;
+  const std::vector<float> as_float(segments.begin(), segments.end());
+  const std::size_t real_bytes = is_double ? sizeof(double) : sizeof(float);
+  // CL_MEM_COPY_HOST_PTR only reads the host memory, which CLHPP still takes as void*.
+  void* host = is_double ? static_cast<void*>(const_cast<double*>(segments.data()))
+                         : static_cast<void*>(const_cast<float*>(as_float.data()));
+  cl::Buffer in(session.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, segments.size() * real_bytes, host);
+  cl::Buffer out(session.context, CL_MEM_WRITE_ONLY, count * ncoef * real_bytes);
+  KernelBinder args(kernel, "restrict_check", precision);
+  args.plain("segments", in);
+  args.plain("count", static_cast<cl_uint>(count));
+  surface.set_surface_args(args);
+  args.plain("out", out);
+  const std::size_t per_item = static_cast<std::size_t>(std::max(batch, 1));
+  session.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(count / per_item));
+  std::vector<std::uint64_t> bits(count * ncoef);
+  if (is_double) {
+    session.queue.enqueueReadBuffer(out, CL_TRUE, 0, bits.size() * sizeof(double), bits.data());
+  } else {
+    std::vector<std::uint32_t> words(bits.size());
+    session.queue.enqueueReadBuffer(out, CL_TRUE, 0, words.size() * sizeof(float), words.data());
+    std::copy(words.begin(), words.end(), bits.begin());
+  }
+  return bits;
+}
+
+}  // namespace
+
+TEST_CASE("the extent form's shadow batch restricts every segment as one ray at a time, coefficient for coefficient",
+          "[shadows]") {
+  // Occlusion masks (above) hide a difference in the last bits of a few coefficients: a batch whose steps the
+  // compiler fused otherwise than the one-ray vector step's passed them (bench/history/2026-12.md, "Shadow rays
+  // restricted side by side in lanes"). Degrees on each side of the accumulators' layouts: one vector (up to 15),
+  // 16-wide vectors and a tail (16 to 32); even exponents step by squares.
+  for (Precision precision : {Precision::Float, Precision::Double}) {
+    const int batch = testing::plan_shadow_batch(precision);
+    if (batch == 0) {
+      // The plan batches only where the device fuses multiply-adds in vector registers of several rays; elsewhere
+      // every kernel restricts one ray at a time, and there is no second layout to hold to it.
+      std::printf("test_shadows_batched: no %s shadow batch on this device\n", to_string(precision).c_str());
+      continue;
+    }
+    for (int degree : testing::sampled("test_shadows_batched restriction degrees " + to_string(precision),
+                                       {1, 2, 3, 5, 6, 7, 8, 10, 12, 15, 16, 17, 20, 24, 31, 32}, {7, 16, 24}, 1)) {
+      // Every exponent even (the steps by squares) where the degree is, and any exponents (the linear steps).
+      for (const bool even : {false, true}) {
+        if (even && degree % 2 != 0) continue;
+        const unsigned seed = kSeed + 20 + 1000 * static_cast<unsigned>(degree) + 10 * static_cast<unsigned>(even) +
+                              static_cast<unsigned>(precision);
+        std::mt19937 rng(seed);
+        const Scene scene = random_scene(rng, degree, even, precision, Isolation::Bernstein);
+        // 2048 segments from points in the unit ball (some outside it), of lengths 0.3 to 2.5 units.
+        std::uniform_real_distribution<double> u(-1, 1), length(0.3, 2.5), start(0, 0.3), end(0.6, 1);
+        std::vector<double> segments;
+        for (int s = 0; s < 2048; ++s) {
+          const glm::dvec3 o(1.1 * u(rng), 1.1 * u(rng), 1.1 * u(rng));
+          const glm::dvec3 d = length(rng) * glm::normalize(glm::dvec3(u(rng), u(rng), u(rng)) + glm::dvec3(1e-3));
+          segments.insert(segments.end(), {o.x, o.y, o.z, start(rng), d.x, d.y, d.z, end(rng)});
+        }
+        const std::vector<std::uint64_t> lanes = restricted_bits(scene, precision, batch, segments);
+        const std::vector<std::uint64_t> one = restricted_bits(scene, precision, 0, segments);
+        REQUIRE(lanes.size() == one.size());
+        const std::size_t ncoef = static_cast<std::size_t>(degree) + 1;
+        const std::uint64_t sign_bit = precision == Precision::Double ? std::uint64_t{1} << 63 : std::uint64_t{1} << 31;
+        std::size_t differing = 0, nonzero = 0;
+        for (std::size_t i = 0; i < one.size(); ++i) {
+          if ((one[i] & ~sign_bit) != 0) ++nonzero;
+          if (lanes[i] == one[i]) continue;
+          if (differing++ == 0)
+            UNSCOPED_INFO(to_string(precision)
+                          << " degree " << degree << (even ? " (even)" : "") << ", seed " << seed << ": segment "
+                          << i / ncoef << ", coefficient " << i % ncoef << ": batch bits " << std::hex << lanes[i]
+                          << ", one ray " << one[i] << std::dec);
+        }
+        INFO(to_string(precision) << " degree " << degree << ", batch " << batch << ", seed " << seed << ": "
+                                  << differing << " of " << one.size() << " coefficients differ");
+        CHECK(differing == 0);
+        CHECK(nonzero > one.size() / 2);  // coefficients, not a buffer left empty
       }
     }
   }

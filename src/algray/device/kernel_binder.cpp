@@ -17,6 +17,7 @@ const std::vector<std::string>& kernel_arg_names(const std::string& entry) {
       {"shadow_serial", {ALGRAY_SHADOW_ARG_NAMES(ALGRAY_ARG_NAME)}},
       {"probe", {ALGRAY_PROBE_ARG_NAMES(ALGRAY_ARG_NAME)}},
       {"univariate", {ALGRAY_UNIVARIATE_ARG_NAMES(ALGRAY_ARG_NAME)}},
+      {"restrict_check", {ALGRAY_RESTRICT_CHECK_ARG_NAMES(ALGRAY_ARG_NAME)}},
       {"shade", {ALGRAY_SHADE_ARG_NAMES(ALGRAY_ARG_NAME)}},
   };
 #undef ALGRAY_ARG_NAME
