@@ -1,5 +1,6 @@
 // The shadow kernel against shadow_serial, the plain one-segment-at-a-time construction: whatever shortcuts
-// shadow.cl takes, the occlusion masks must be identical on seeded random surfaces, points and lights.
+// shadow.cl takes, the occlusion masks must be identical on seeded random surfaces, points and lights; and its
+// batch of restrictions in a vector's lanes against one ray at a time, coefficient for coefficient.
 #include <algorithm>
 #include <bit>
 #include <catch2/catch.hpp>
