@@ -140,7 +140,7 @@
 #endif
 /* The noise local to an interval of a shadow ray, this many times (local_noise). */
 #ifndef ALGRAY_LOCAL_FACTOR
-#define ALGRAY_LOCAL_FACTOR 16
+#define ALGRAY_LOCAL_FACTOR 4
 #endif
 
 #endif
