@@ -181,7 +181,7 @@ static LREAL local_scale(const LREAL* c, LREAL lo, LREAL hi) {
  * Only shadow rays take it (camera rays run from sphere to sphere: the local noise settled few of their doubts).
  * The factor, measured on shadow rays against the certified reference (tests/test_shadows, the settled doubts of the
  * Barth decic and the Endrass octic in the extent and point forms, 9,000-15,000 certified rays): at 0 (no doubt
- * near the start) 337 answered wrongly, at 0.25 17, at 0.5 4, at 1, 4 and 16 none; 4 keeps 4 times the smallest
+ * near the start) 337 of its checks failed, at 0.25 17, at 0.5 4, at 1, 4 and 16 none; 4 keeps 4 times the smallest
  * safe factor (it was 16, four times a camera-ray trial's 4, until 2026-12-08: the Barth decic's float shadow pass
  * then sent 292 k rays to its second pass instead of 425 k, 0.92x the time, 0.90x without fp64; bench/history). */
 static REAL local_noise(const REAL* c, REAL scale, RayTerms* terms, REAL lo, REAL hi) {
