@@ -215,12 +215,8 @@ std::vector<std::uint64_t> restricted_bits(const Scene& scene, Precision precisi
   cl::Kernel kernel = testing::program_cache().kernel(session, config);
   const std::size_t count = segments.size() / 8, ncoef = static_cast<std::size_t>(config.degree) + 1;
   const bool is_double = precision == Precision::Double;
-  const std::vector<float> as_float(segments.begin(), segments.end());
   const std::size_t real_bytes = is_double ? sizeof(double) : sizeof(float);
-  // CL_MEM_COPY_HOST_PTR only reads the host memory, which CLHPP still takes as void*.
-  void* host = is_double ? static_cast<void*>(const_cast<double*>(segments.data()))
-                         : static_cast<void*>(const_cast<float*>(as_float.data()));
-  cl::Buffer in(session.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, segments.size() * real_bytes, host);
+  const cl::Buffer in = real_buffer(session.context, segments, precision);
   cl::Buffer out(session.context, CL_MEM_WRITE_ONLY, count * ncoef * real_bytes);
   KernelBinder args(kernel, "restrict_check", precision);
   args.plain("segments", in);
