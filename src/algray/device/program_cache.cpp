@@ -46,10 +46,15 @@ double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The device and driver a cache entry was made on: any change to them must miss.
+// The device and driver a cache entry was made on, and the driver's own build flags from the environment (PoCL
+// appends POCL_EXTRA_BUILD_FLAGS to every build: the tests' unoptimised programs, docs/testing.md): any change to
+// them must miss. Unset, the flags add nothing, so entries made without them keep their names.
 std::string device_identity(const DeviceInfo& d) {
-  return "device=" + d.name + "\ndriver=" + d.driver_version + "\nplatform=" + d.platform_name + " " +
-         d.platform_version + "\n";
+  std::string identity = "device=" + d.name + "\ndriver=" + d.driver_version + "\nplatform=" + d.platform_name + " " +
+                         d.platform_version + "\n";
+  if (const char* flags = std::getenv("POCL_EXTRA_BUILD_FLAGS"); flags && *flags)
+    identity += "driver-build-flags=" + std::string(flags) + "\n";
+  return identity;
 }
 
 std::string build_log(const cl::Program& program, const cl::Device& device) {
